@@ -1,0 +1,1 @@
+"""The ``videocal`` command line: one module per subcommand, dispatched by ``main``."""

@@ -1,0 +1,74 @@
+"""Entry point of the ``videocal`` console script.
+
+Each subcommand lives in its own module of ``app.cli`` exposing ``add_arguments(parser)``
+and ``run(args) -> int``; modules are imported only when their command runs, so
+``videocal --help`` is fast and headless commands never load Qt or VTK.
+
+Exit codes shared by every command: 0 success, 2 bad input (one ``error: ...`` line on
+stderr, no traceback); commands document their own further codes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from calib_core import __version__
+from calib_core.errors import VideocalError
+
+# name -> (module, one-line help). Add a line here when a command lands.
+COMMANDS: dict[str, tuple[str, str]] = {}
+
+
+def _register(name: str, module: str, help_text: str) -> None:
+    COMMANDS[name] = (module, help_text)
+
+
+_register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
+_register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2, as for every bad input
+        self.print_usage(sys.stderr)
+        print(f"error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="videocal", description="Remote video calibration of a robot workcell.")
+    parser.add_argument("--version", action="version", version=f"videocal {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name, (module, help_text) in COMMANDS.items():
+        sp = sub.add_parser(name, help=help_text, description=help_text)
+        sp.set_defaults(_module=module)
+        # Arguments are declared by the module itself, imported lazily only for this parser.
+        sp.set_defaults(_add_arguments=None)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    # Let the chosen command's module declare its arguments before the full parse.
+    first = next((a for a in argv if not a.startswith("-")), None)
+    if first in COMMANDS:
+        module = importlib.import_module(COMMANDS[first][0])
+        module.add_arguments(parser._subparsers._group_actions[0].choices[first])  # type: ignore[union-attr]
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    module = importlib.import_module(args._module)
+    try:
+        return int(module.run(args) or 0)
+    except (VideocalError, ValueError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

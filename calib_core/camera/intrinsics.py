@@ -1,0 +1,130 @@
+"""Camera intrinsics: focal lengths, principal point, image size, lens distortion."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+DISTORTION_NAMES = ("k1", "k2", "p1", "p2", "k3")
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """A pinhole camera with OpenCV's 5-parameter lens distortion.
+
+    ``fu``, ``fv``: focal lengths, px. ``cx``, ``cy``: principal point, px, with the
+    centre of the top-left pixel at (0, 0) as in OpenCV. ``width``, ``height``: image
+    size, px. ``distortion``: ``(k1, k2, p1, p2, k3)``, dimensionless, OpenCV's model.
+    """
+
+    fu: float
+    fv: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+    distortion: tuple[float, float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0, 0.0))
+
+    def __post_init__(self) -> None:
+        for name in ("fu", "fv", "cx", "cy"):
+            v = float(getattr(self, name))
+            if not np.isfinite(v):
+                raise ValueError(f"intrinsics: {name} must be finite, got {v}")
+            object.__setattr__(self, name, v)
+        if self.fu <= 0 or self.fv <= 0:
+            raise ValueError(f"intrinsics: focal lengths must be positive, got fu={self.fu}, fv={self.fv}")
+        for name in ("width", "height"):
+            v = getattr(self, name)
+            if int(v) != v or int(v) <= 0:
+                raise ValueError(f"intrinsics: {name} must be a positive whole number of pixels, got {v}")
+            object.__setattr__(self, name, int(v))
+        d = tuple(float(x) for x in np.asarray(self.distortion, dtype=float).ravel())
+        if len(d) != 5:
+            raise ValueError(f"intrinsics: distortion needs 5 values (k1, k2, p1, p2, k3), got {len(d)}")
+        if not all(np.isfinite(d)):
+            raise ValueError("intrinsics: distortion contains NaN or infinite values")
+        object.__setattr__(self, "distortion", d)
+
+    @property
+    def K(self) -> np.ndarray:
+        """Camera matrix (3, 3), px."""
+        return np.array([[self.fu, 0.0, self.cx], [0.0, self.fv, self.cy], [0.0, 0.0, 1.0]])
+
+    @property
+    def dist_coeffs(self) -> np.ndarray:
+        """Distortion as OpenCV wants it: array (5,) ``k1 k2 p1 p2 k3``."""
+        return np.asarray(self.distortion, dtype=float)
+
+    @property
+    def has_distortion(self) -> bool:
+        return any(d != 0.0 for d in self.distortion)
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """``(width, height)`` in px."""
+        return (self.width, self.height)
+
+    def without_distortion(self) -> Intrinsics:
+        return replace(self, distortion=(0.0, 0.0, 0.0, 0.0, 0.0))
+
+    def with_focal(self, fu: float, fv: float) -> Intrinsics:
+        return replace(self, fu=fu, fv=fv)
+
+    def scaled(self, factor: float) -> Intrinsics:
+        """The same camera at another resolution (``factor`` times width and height)."""
+        return replace(
+            self,
+            fu=self.fu * factor,
+            fv=self.fv * factor,
+            cx=(self.cx + 0.5) * factor - 0.5,
+            cy=(self.cy + 0.5) * factor - 0.5,
+            width=int(round(self.width * factor)),
+            height=int(round(self.height * factor)),
+        )
+
+    def contains(self, pixels: np.ndarray, margin_px: float = 0.0) -> np.ndarray:
+        """Boolean mask (n,): which pixels (n, 2) lie inside the image, ``margin_px`` in from the edge."""
+        p = np.asarray(pixels, dtype=float).reshape(-1, 2)
+        lo = -0.5 + margin_px
+        return (
+            (p[:, 0] >= lo)
+            & (p[:, 1] >= lo)
+            & (p[:, 0] <= self.width - 0.5 - margin_px)
+            & (p[:, 1] <= self.height - 0.5 - margin_px)
+        )
+
+    def to_dict(self) -> dict:
+        return {
+            "fu": self.fu,
+            "fv": self.fv,
+            "cx": self.cx,
+            "cy": self.cy,
+            "width": self.width,
+            "height": self.height,
+            "distortion": list(self.distortion),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Intrinsics:
+        """From ``{"fu", "fv", "cx", "cy", "width", "height", optional "distortion"}``.
+
+        Raises ``ValueError`` naming the missing or bad field.
+        """
+        if not isinstance(data, dict):
+            raise ValueError("intrinsics: expected an object with fu, fv, cx, cy, width, height")
+        missing = [k for k in ("fu", "fv", "cx", "cy", "width", "height") if k not in data]
+        if missing:
+            raise ValueError(f"intrinsics: missing field(s) {', '.join(missing)}")
+        unknown = set(data) - {"fu", "fv", "cx", "cy", "width", "height", "distortion"}
+        if unknown:
+            raise ValueError(f"intrinsics: unknown field(s) {', '.join(sorted(unknown))}")
+        kwargs = {}
+        for k in ("fu", "fv", "cx", "cy", "width", "height"):
+            v = data[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise ValueError(f"intrinsics: field '{k}' must be a number, got {v!r}")
+            kwargs[k] = v
+        if "distortion" in data:
+            kwargs["distortion"] = tuple(data["distortion"])
+        return cls(**kwargs)
