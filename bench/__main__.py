@@ -1,0 +1,31 @@
+"""Run every ``bench/*_bench.py`` (or the ones named on the command line).
+
+Each bench module has ``main() -> str``: it measures, writes its Markdown report to
+``docs/benchmarks/<name>.md`` and returns the report's path. Timings never go in tests.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def main(argv: list[str]) -> int:
+    names = argv or sorted(p.stem for p in HERE.glob("*_bench.py"))
+    failed = []
+    for name in names:
+        mod = importlib.import_module(f"bench.{name.removesuffix('.py')}")
+        print(f"== {name}", flush=True)
+        try:
+            print(f"   wrote {mod.main()}", flush=True)
+        except Exception as exc:  # one bench failing must not hide the others' figures
+            print(f"   FAILED: {exc!r}", flush=True)
+            failed.append(name)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
