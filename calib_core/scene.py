@@ -1,0 +1,33 @@
+"""What the renderer draws: a flat list of meshes with their poses.
+
+The workcell and robot models produce scene items; the renderer consumes them. Neither
+knows the other, which keeps VTK out of everything but ``calib_core/render``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import trimesh
+
+
+@dataclass
+class SceneItem:
+    """One rigid mesh in the world (the robot base frame).
+
+    ``name``: unique in a scene, e.g. ``"rack_a"`` or ``"robot/link3"``.
+    ``mesh``: vertices in mm in the item's own frame.
+    ``item2world``: (4, 4) pose, mm.
+    ``color``: RGB in [0, 1].
+    ``kind``: ``"component"`` (a workcell object that can be a calibration target),
+    ``"robot"`` (a robot link, gripper or camera bracket) or ``"fixture"`` (floor, walls).
+    ``features``: named feature points, (3,) mm each, in the item's own frame.
+    """
+
+    name: str
+    mesh: trimesh.Trimesh
+    item2world: np.ndarray
+    color: tuple[float, float, float] = (0.7, 0.7, 0.7)
+    kind: str = "component"
+    features: dict[str, np.ndarray] = field(default_factory=dict)
