@@ -1,0 +1,170 @@
+"""Intrinsics files: OpenCV FileStorage YAML and ROS ``camera_info`` YAML.
+
+``load_intrinsics(path)`` tells the two apart by their keys; ``save_intrinsics(path,
+intrinsics, fmt=...)`` writes either, atomically. Every problem is a
+:class:`~calib_core.errors.FileFormatError` naming the file and the field.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import yaml
+
+from calib_core.atomic_file import atomic_path, atomic_write_text
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.errors import FileFormatError
+
+FORMATS = ("opencv", "ros")
+
+
+def load_intrinsics(path: str | Path) -> Intrinsics:
+    """Read intrinsics from an OpenCV FileStorage YAML or a ROS camera_info YAML file."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileFormatError(path, "no such file" if not path.exists() else "not a regular file")
+    text = path.read_text(encoding="utf-8", errors="replace")
+    if text.lstrip().startswith("%YAML") or "!!opencv-matrix" in text:
+        return _load_opencv(path)
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise FileFormatError(path, f"not valid YAML ({_first_line(exc)})") from None
+    if isinstance(data, dict) and "camera_matrix" in data and isinstance(data["camera_matrix"], dict):
+        return _load_ros(path, data)
+    raise FileFormatError(path, "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
+                          "!!opencv-matrix) or ROS camera_info YAML (camera_matrix: {rows, cols, data})")
+
+
+def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv", camera_name: str = "videocal_camera") -> None:
+    """Write ``intrinsics`` as ``fmt`` ("opencv" or "ros") to ``path``, atomically."""
+    if fmt not in FORMATS:
+        raise ValueError(f"unknown intrinsics format {fmt!r}; expected one of {', '.join(FORMATS)}")
+    path = Path(path)
+    if fmt == "opencv":
+        with atomic_path(path) as tmp:
+            fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_FORMAT_YAML)
+            fs.write("image_width", intrinsics.width)
+            fs.write("image_height", intrinsics.height)
+            fs.write("camera_matrix", intrinsics.K)
+            fs.write("distortion_coefficients", intrinsics.dist_coeffs.reshape(1, 5))
+            fs.release()
+    else:
+        atomic_write_text(path, yaml.safe_dump(_ros_dict(intrinsics, camera_name), sort_keys=False))
+
+
+def _load_opencv(path: Path) -> Intrinsics:
+    try:
+        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
+    except (cv2.error, SystemError) as exc:  # the binding wraps parse errors in SystemError
+        cause = exc.__cause__ or exc
+        raise FileFormatError(path, f"OpenCV cannot parse it ({_first_line(cause)})") from None
+    try:
+        if not fs.isOpened():
+            raise FileFormatError(path, "OpenCV cannot open it as FileStorage")
+        K = _fs_matrix(fs, path, "camera_matrix", (3, 3))
+        dist_node = fs.getNode("distortion_coefficients")
+        if dist_node.empty() or dist_node.isNone():
+            dist = np.zeros(5)
+        else:
+            dist = _fs_matrix(fs, path, "distortion_coefficients", None).ravel()
+        width = _fs_int(fs, path, "image_width")
+        height = _fs_int(fs, path, "image_height")
+    finally:
+        fs.release()
+    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")
+
+
+def _fs_matrix(fs: cv2.FileStorage, path: Path, key: str, shape: tuple[int, int] | None) -> np.ndarray:
+    node = fs.getNode(key)
+    if node.empty() or node.isNone():
+        raise FileFormatError(path, "missing", key)
+    m = node.mat()
+    if m is None:
+        raise FileFormatError(path, "expected an !!opencv-matrix", key)
+    m = np.asarray(m, dtype=float)
+    if shape is not None and m.shape != shape:
+        raise FileFormatError(path, f"expected a {shape[0]}x{shape[1]} matrix, got {m.shape}", key)
+    return m
+
+
+def _fs_int(fs: cv2.FileStorage, path: Path, key: str) -> int:
+    node = fs.getNode(key)
+    if node.empty() or node.isNone():
+        raise FileFormatError(path, "missing", key)
+    if not node.isInt():
+        raise FileFormatError(path, "expected a whole number of pixels", key)
+    return int(node.real())
+
+
+def _load_ros(path: Path, data: dict) -> Intrinsics:
+    known = {"image_width", "image_height", "camera_name", "camera_matrix", "distortion_model",
+             "distortion_coefficients", "rectification_matrix", "projection_matrix"}
+    unknown = sorted(set(data) - known)
+    if unknown:
+        raise FileFormatError(path, f"unknown key(s) for a ROS camera_info file: {', '.join(unknown)}")
+    for key in ("image_width", "image_height"):
+        if key not in data:
+            raise FileFormatError(path, "missing", key)
+        if isinstance(data[key], bool) or not isinstance(data[key], int):
+            raise FileFormatError(path, f"expected a whole number of pixels, got {data[key]!r}", key)
+    model = data.get("distortion_model", "plumb_bob")
+    if model not in ("plumb_bob", "rational_polynomial"):
+        raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
+    K = _ros_matrix(path, data, "camera_matrix", 9).reshape(3, 3)
+    dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(5)
+    return _build(path, K, dist, data["image_width"], data["image_height"], "camera_matrix", "distortion_coefficients")
+
+
+def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarray:
+    node = data.get(key)
+    if not isinstance(node, dict) or "data" not in node:
+        raise FileFormatError(path, "expected {rows, cols, data}", key)
+    values = node["data"]
+    if not isinstance(values, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise FileFormatError(path, "data must be a list of numbers", f"{key}.data")
+    if size is not None and len(values) != size:
+        raise FileFormatError(path, f"expected {size} numbers, got {len(values)}", f"{key}.data")
+    rows, cols = node.get("rows"), node.get("cols")
+    if rows is not None and cols is not None and rows * cols != len(values):
+        raise FileFormatError(path, f"rows x cols = {rows} x {cols} does not match {len(values)} numbers", key)
+    return np.asarray(values, dtype=float)
+
+
+def _build(path: Path, K: np.ndarray, dist: np.ndarray, width: int, height: int, k_field: str, d_field: str) -> Intrinsics:
+    if not np.all(np.isfinite(K)):
+        raise FileFormatError(path, "contains NaN or infinite values", k_field)
+    if abs(K[0, 1]) > 1e-9 or np.any(np.abs(K[2] - [0, 0, 1]) > 1e-9) or abs(K[1, 0]) > 1e-9:
+        raise FileFormatError(path, "not a pinhole camera matrix [[fu,0,cx],[0,fv,cy],[0,0,1]] (skew is not supported)", k_field)
+    dist = np.asarray(dist, dtype=float).ravel()
+    if dist.size not in (4, 5, 8) or not np.all(np.isfinite(dist)):
+        raise FileFormatError(path, f"expected 4 or 5 finite coefficients k1 k2 p1 p2 [k3], got {dist.size}", d_field)
+    if dist.size == 8 and np.any(dist[5:] != 0):
+        raise FileFormatError(path, "rational distortion (k4..k6) is not supported", d_field)
+    dist5 = np.zeros(5)
+    dist5[: min(5, dist.size)] = dist[:5]
+    try:
+        return Intrinsics(K[0, 0], K[1, 1], K[0, 2], K[1, 2], width, height, tuple(dist5))
+    except ValueError as exc:
+        raise FileFormatError(path, str(exc).removeprefix("intrinsics: "), k_field) from None
+
+
+def _ros_dict(intr: Intrinsics, camera_name: str) -> dict:
+    P = np.zeros((3, 4))
+    P[:, :3] = intr.K
+    return {
+        "image_width": intr.width,
+        "image_height": intr.height,
+        "camera_name": camera_name,
+        "camera_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in intr.K.ravel()]},
+        "distortion_model": "plumb_bob",
+        "distortion_coefficients": {"rows": 1, "cols": 5, "data": [float(v) for v in intr.distortion]},
+        "rectification_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in np.eye(3).ravel()]},
+        "projection_matrix": {"rows": 3, "cols": 4, "data": [float(v) for v in P.ravel()]},
+    }
+
+
+def _first_line(exc: Exception) -> str:
+    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
