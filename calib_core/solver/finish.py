@@ -1,0 +1,79 @@
+"""Turning the chosen refined pose into a :class:`PoseSolution`: outliers, uncertainty,
+leave-one-out residuals, status and the warnings an operator should read."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calib_core.solver.candidates import RefinedPose, refine_seed
+from calib_core.solver.errors import point_label, points_label
+from calib_core.solver.paper_model import paper_to_metric_jacobian
+from calib_core.solver.problem import PoseProblem, make_problem
+from calib_core.solver.refine import residuals_and_jacobian
+from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
+from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, choose_sigma_px, pose_uncertainty
+
+# Beyond this condition number (of the column-scaled Jacobian) the pose is poorly determined.
+_POOR_CONDITION = 1e4
+
+def noise_px(sigma_px: float | None) -> float:
+    """The pick noise assumed for thresholds: the caller's, or the default 0.5 px."""
+    return DEFAULT_SIGMA_PX if sigma_px is None else float(sigma_px)
+
+def _flag_outliers(residuals: np.ndarray, noise: float) -> np.ndarray:
+    e = np.linalg.norm(residuals, axis=1)
+    spread = 1.4826 * float(np.median(e))
+    return e > max(4.0 * noise, 3.0 * spread)
+
+def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple[PoseCandidate, ...], *, sigma_px: float | None, limit_px: float, huber_px: float | None) -> PoseSolution:
+    """Build the solution for ``chosen``; ``candidates`` all poses that fit about as well."""
+    warnings: list[str] = []
+    noise = noise_px(sigma_px)
+    iterations = chosen.newton.iterations
+    outliers = np.zeros(problem.n_points, dtype=bool)
+    if huber_px is not None:
+        outliers = _flag_outliers(chosen.newton.residuals, noise)
+        inliers = np.flatnonzero(~outliers)
+        if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3):
+            # Least squares on the inliers alone: the Huber fit still leans slightly on the outliers.
+            sub = make_problem(problem.points_3d[inliers], problem.points_2d[inliers], problem.intrinsics, estimate_focal=problem.estimate_focal, model=problem.model)
+            again = refine_seed(sub, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], chosen.fu, chosen.fv, None)
+            if again is not None and again.converged:
+                iterations += again.newton.iterations
+                chosen = again
+            warnings.append(f"{points_label(np.flatnonzero(outliers))} rejected as outliers (robust fit); check those picks")
+    residuals, jacobian = chosen.newton.residuals, chosen.newton.jacobian
+    if outliers.any():
+        # The inlier re-fit's own arrays lack the outliers: evaluate every point at the final pose.
+        residuals, jacobian, _ = residuals_and_jacobian(problem, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv)
+    weights = (~outliers).astype(float)
+    sigma, source = choose_sigma_px(residuals, weights, problem.n_params, sigma_px)
+    to_metric = paper_to_metric_jacobian(chosen.newton.t, problem.intrinsics, chosen.fu, chosen.fv, problem.n_params) if problem.model == "paper" else None
+    loo, uncertainty = pose_uncertainty(jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma, source, to_metric)
+
+    e = np.linalg.norm(residuals, axis=1)
+    rms = float(np.sqrt(np.mean(e[~outliers] ** 2)))
+    status, reason = SolveStatus.OK, None
+    if not chosen.converged:
+        status, reason = SolveStatus.FAILED, f"Newton iterations stopped: {chosen.newton.reason}"
+    elif rms > limit_px:
+        worst = int(np.nanargmax(np.where(np.isfinite(loo), loo, e)))
+        status = SolveStatus.FAILED
+        reason = f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; {point_label(worst)} fits worst (check that pick, or use robust)"
+    elif len(candidates) > 1:
+        status = SolveStatus.AMBIGUOUS
+        reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
+    if problem.n_points * 2 <= problem.n_params:
+        warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
+    if uncertainty.condition_number > _POOR_CONDITION:
+        warnings.append(f"the pose is poorly determined (condition number {uncertainty.condition_number:.3g}): spread the points over more of the object and the image")
+    off_image = np.flatnonzero(~problem.intrinsics.contains(problem.points_2d))
+    if len(off_image):
+        warnings.append(f"{points_label(off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image")
+    if problem.model == "paper" and problem.intrinsics.has_distortion:
+        warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
+    return PoseSolution(
+        status=status, obj2cam=chosen.obj2cam, fu=chosen.fu, fv=chosen.fv, model=problem.model,
+        iterations=iterations, residuals_px=residuals, uncertainty=uncertainty, leave_one_out_px=loo,
+        outliers=outliers, candidates=candidates, reason=reason, warnings=tuple(warnings),
+    )

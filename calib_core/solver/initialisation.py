@@ -1,0 +1,99 @@
+"""Starting poses without a guess: every root of P3P, SQPnP, IPPE for planar points.
+
+OpenCV supplies the closed-form seeds; each is refined afterwards by the Newton solver.
+Seeds are object-to-camera poses ``(R (3, 3), t (3,) mm)``.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import cv2
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.solver.problem import PoseProblem
+
+# P3P over subsets is run for small problems (where other local minima are likely and must be
+# reported) and as a fallback when the all-points seeds fit badly (a mis-click spoils SQPnP).
+SMALL_PROBLEM_POINTS = 5
+MAX_SUBSETS = 6
+
+
+def _camera(intrinsics: Intrinsics, fu: float, fv: float) -> tuple[np.ndarray, np.ndarray]:
+    K = np.array([[fu, 0.0, intrinsics.cx], [0.0, fv, intrinsics.cy], [0.0, 0.0, 1.0]])
+    return K, intrinsics.dist_coeffs
+
+
+def _as_seeds(rvecs, tvecs) -> list[tuple[np.ndarray, np.ndarray]]:
+    seeds = []
+    for rvec, tvec in zip(rvecs, tvecs):
+        rvec = np.asarray(rvec, dtype=float).reshape(3)
+        tvec = np.asarray(tvec, dtype=float).reshape(3)
+        if np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec)):
+            seeds.append((cv2.Rodrigues(rvec)[0], tvec))
+    return seeds
+
+
+def p3p_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Every real root of P3P on exactly three pairs (up to four poses)."""
+    K, dist = _camera(intrinsics, fu, fv)
+    try:
+        n, rvecs, tvecs = cv2.solveP3P(points_3d.reshape(3, 1, 3), points_2d.reshape(3, 1, 2), K, dist, flags=cv2.SOLVEPNP_P3P)
+    except cv2.error:
+        return []
+    return _as_seeds(rvecs[:n], tvecs[:n]) if n else []
+
+
+def sqpnp_seed(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The global minimum of SQPnP's algebraic cost (one pose), for four or more pairs."""
+    K, dist = _camera(intrinsics, fu, fv)
+    try:
+        ok, rvec, tvec = cv2.solvePnP(points_3d, points_2d, K, dist, flags=cv2.SOLVEPNP_SQPNP)
+    except cv2.error:
+        return []
+    return _as_seeds([rvec], [tvec]) if ok else []
+
+
+def ippe_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Both poses IPPE finds for four or more coplanar pairs (the planar two-fold ambiguity)."""
+    K, dist = _camera(intrinsics, fu, fv)
+    try:
+        n, rvecs, tvecs, _ = cv2.solvePnPGeneric(points_3d, points_2d, K, dist, flags=cv2.SOLVEPNP_IPPE)
+    except cv2.error:
+        return []
+    return _as_seeds(rvecs[:n], tvecs[:n]) if n else []
+
+
+def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tuple[int, int, int]]:
+    """Up to ``limit`` triplets of point indices, the largest triangles first (best conditioned P3P)."""
+    triplets = list(combinations(range(len(points_3d)), 3))
+    if len(triplets) <= limit:
+        return triplets
+    P = points_3d
+    area = [np.linalg.norm(np.cross(P[j] - P[i], P[k] - P[i])) for i, j, k in triplets]
+    order = np.argsort(area)[::-1]
+    return [triplets[i] for i in order[:limit]]
+
+
+def subset_p3p_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """P3P roots over several triplets of the pairs."""
+    seeds = []
+    for tri in spread_triplets(problem.points_3d):
+        idx = list(tri)
+        seeds += p3p_seeds(problem.points_3d[idx], problem.points_2d[idx], problem.intrinsics, fu, fv)
+    return seeds
+
+
+def initial_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Seeds for a problem without a guess: P3P roots for 3 pairs; SQPnP (+ IPPE when planar,
+    + P3P over triplets when there are few pairs) for more."""
+    P, uv, intr = problem.points_3d, problem.points_2d, problem.intrinsics
+    if problem.n_points == 3:
+        return p3p_seeds(P, uv, intr, fu, fv)
+    seeds = sqpnp_seed(P, uv, intr, fu, fv)
+    if problem.coplanar:
+        seeds += ippe_seeds(P, uv, intr, fu, fv)
+    if problem.n_points <= SMALL_PROBLEM_POINTS:
+        seeds += subset_p3p_seeds(problem, fu, fv)
+    return seeds

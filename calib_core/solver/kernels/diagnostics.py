@@ -1,0 +1,82 @@
+"""Compiled covariance, conditioning and leave-one-out residuals at a solved pose."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
+    """Fill ``cov_unit`` (p, p) with ``(J^T W J)^-1`` (the covariance for unit pixel noise),
+    ``cov_centre_unit`` (3, 3) with the covariance of the camera centre ``c = -R^T t`` in the
+    object frame, and ``loo`` (n,) with first-order leave-one-out residual lengths, px;
+    return the condition number of the column-scaled Jacobian (inf when singular).
+
+    ``J`` (n, 2, p) Jacobian of the predicted pixels, ``r`` (n, 2) residuals, ``w`` (n,)
+    point weights (0 drops a point). Leave-one-out uses the 2x2 blocks of the hat matrix,
+    ``(I - H_ii)^-1 r_i``: no re-solve; NaN where dropping the point leaves no redundancy.
+    """
+    n, _, p = J.shape
+    A = np.zeros((p, p))
+    for i in range(n):
+        for row in range(2):
+            for a in range(p):
+                ja = w[i] * J[i, row, a]
+                for b in range(p):
+                    A[a, b] += ja * J[i, row, b]
+    s = np.empty(p)
+    for a in range(p):
+        s[a] = np.sqrt(A[a, a]) if A[a, a] > 0.0 else 1.0
+    As = np.empty((p, p))
+    for a in range(p):
+        for b in range(p):
+            As[a, b] = A[a, b] / (s[a] * s[b])
+    eig = np.linalg.eigvalsh(As)
+    if not eig[0] > 1e-14 * eig[-1]:
+        cov_unit[:, :] = np.inf
+        cov_centre_unit[:, :] = np.inf
+        loo[:] = np.nan
+        return np.inf
+    inv_s = np.linalg.inv(As)
+    for a in range(p):
+        for b in range(p):
+            cov_unit[a, b] = inv_s[a, b] / (s[a] * s[b])
+    # dc/dt = -R^T, dc/dphi = -R^T [t]x (rotations pre-multiplied about the camera axes).
+    tx = np.zeros((3, 3))
+    tx[0, 1], tx[0, 2], tx[1, 2] = -t[2], t[1], -t[0]
+    tx[1, 0], tx[2, 0], tx[2, 1] = t[2], -t[1], t[0]
+    Ac = np.zeros((3, 6))
+    for a in range(3):
+        for b in range(3):
+            Ac[a, b] = -R[b, a]
+            for k in range(3):
+                Ac[a, 3 + b] -= R[k, a] * tx[k, b]
+    for a in range(3):
+        for b in range(3):
+            acc = 0.0
+            for k in range(6):
+                for m in range(6):
+                    acc += Ac[a, k] * cov_unit[k, m] * Ac[b, m]
+            cov_centre_unit[a, b] = acc
+    for i in range(n):
+        h00 = 0.0
+        h01 = 0.0
+        h11 = 0.0
+        for a in range(p):
+            for b in range(p):
+                c = cov_unit[a, b]
+                h00 += J[i, 0, a] * c * J[i, 0, b]
+                h01 += J[i, 0, a] * c * J[i, 1, b]
+                h11 += J[i, 1, a] * c * J[i, 1, b]
+        m00 = 1.0 - w[i] * h00
+        m01 = -w[i] * h01
+        m11 = 1.0 - w[i] * h11
+        det = m00 * m11 - m01 * m01
+        if abs(det) <= 1e-9:
+            loo[i] = np.nan
+        else:
+            d0 = (m11 * r[i, 0] - m01 * r[i, 1]) / det
+            d1 = (-m01 * r[i, 0] + m00 * r[i, 1]) / det
+            loo[i] = np.sqrt(d0 * d0 + d1 * d1)
+    return np.sqrt(eig[-1] / eig[0])

@@ -1,0 +1,112 @@
+"""A validated pose problem: matched 3D and 2D points, intrinsics and options.
+
+Validation happens once here, so the numerical code can trust its input.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.solver.kernels.geometry_checks import COLLINEAR, DUPLICATE_2D, DUPLICATE_3D, NON_FINITE_2D, NON_FINITE_3D, check_pairs
+from calib_core.solver.errors import (
+    DegenerateGeometryError,
+    DuplicatePointsError,
+    InvalidIntrinsicsError,
+    MismatchedPointsError,
+    NonFiniteInputError,
+    PointsBehindCameraError,
+    TooFewPointsError,
+    point_label,
+    points_label,
+)
+
+MODELS = ("pinhole", "paper")
+
+# Relative spread along the second principal axis of the 3D points below which they count as collinear.
+_COLLINEAR_RATIO = 1e-6
+# Relative spread along the third principal axis below which the points count as coplanar (IPPE applies).
+COPLANAR_RATIO = 1e-6
+# Two 3D points closer than this fraction of the point spread, or two pixels closer than this, are duplicates.
+_DUPLICATE_REL_3D = 1e-9
+_DUPLICATE_PX = 1e-6
+
+
+@dataclass(frozen=True)
+class PoseProblem:
+    """Point pairs ready for the solver.
+
+    ``points_3d``: (n, 3), mm, object frame. ``points_2d``: (n, 2), px, as observed
+    (with lens distortion). ``intrinsics``: the camera. ``coplanar``: whether the 3D
+    points lie in one plane.
+    """
+
+    points_3d: np.ndarray
+    points_2d: np.ndarray
+    intrinsics: Intrinsics
+    estimate_focal: bool
+    model: str
+    coplanar: bool
+
+    @property
+    def n_points(self) -> int:
+        return len(self.points_3d)
+
+    @property
+    def n_params(self) -> int:
+        """Unknowns: 6 for the pose, 8 with the two focal lengths."""
+        return 8 if self.estimate_focal else 6
+
+
+def _as_points(values: ArrayLike, dim: int, name: str) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise MismatchedPointsError(f"{name}: not a list of numbers ({exc})") from None
+    if arr.ndim != 2 or arr.shape[1] != dim:
+        raise MismatchedPointsError(f"{name}: expected a list of [{'x, y, z' if dim == 3 else 'u, v'}] rows, got shape {arr.shape}")
+    return np.ascontiguousarray(arr)
+
+
+def check_intrinsics(intrinsics: Intrinsics) -> None:
+    """Raise :class:`InvalidIntrinsicsError` unless both focal lengths are positive and finite."""
+    for name in ("fu", "fv"):
+        v = getattr(intrinsics, name)
+        if not np.isfinite(v) or v <= 0:
+            raise InvalidIntrinsicsError(f"intrinsics: {name} must be a positive focal length in px, got {v}")
+
+
+def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, estimate_focal: bool = False, model: str = "pinhole") -> PoseProblem:
+    """Validate the input of a solve; raise a :class:`SolverInputError` subclass naming the points at fault."""
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    check_intrinsics(intrinsics)
+    p3 = _as_points(points_3d, 3, "points_3d")
+    p2 = _as_points(points_2d, 2, "points_2d")
+    if len(p3) != len(p2):
+        raise MismatchedPointsError(f"{len(p3)} 3D points but {len(p2)} 2D points: every pair needs both")
+    needed = 4 if estimate_focal else 3
+    if len(p3) < needed:
+        why = " (the focal lengths are estimated too)" if estimate_focal else ""
+        raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
+    code, i, j, coplanar = check_pairs(p3, p2, _DUPLICATE_REL_3D, _DUPLICATE_PX, _COLLINEAR_RATIO, COPLANAR_RATIO)
+    if code == NON_FINITE_3D or code == NON_FINITE_2D:
+        bad = np.flatnonzero(~np.all(np.isfinite(p3), axis=1) | ~np.all(np.isfinite(p2), axis=1))
+        raise NonFiniteInputError(f"{points_label(bad)}: coordinates are NaN or infinite", bad)
+    if code == DUPLICATE_3D or code == DUPLICATE_2D:
+        what = "3D point" if code == DUPLICATE_3D else "pixel"
+        raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same {what}", (i, j))
+    if code == COLLINEAR:
+        raise DegenerateGeometryError(f"{points_label(range(len(p3)))}: the 3D points are collinear; pick points that span a plane or a volume", range(len(p3)))
+    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar))
+
+
+def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:
+    """Raise :class:`PointsBehindCameraError` if ``obj2cam`` puts any point at z <= 0 (camera frame)."""
+    z = points_3d @ obj2cam[2, :3] + obj2cam[2, 3]
+    behind = np.flatnonzero(z <= 0)
+    if len(behind):
+        raise PointsBehindCameraError(f"the {what} puts {points_label(behind)} at or behind the camera (z <= 0)", behind)

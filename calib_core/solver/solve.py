@@ -1,0 +1,122 @@
+"""``solve_pose``: the camera pose from point pairs, with no starting pose needed.
+
+Every seed (P3P roots, SQPnP, IPPE, the prior) is refined by the damped Newton solver;
+the refined poses that fit about as well as the best are all returned, ranked by
+closeness to the prior (the modelled camera pose) when there is one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.frames import check_transform, rotation_angle_deg
+from calib_core.solver.candidates import RefinedPose, distinct_poses, refine_seed
+from calib_core.solver.initialisation import initial_seeds, subset_p3p_seeds
+from calib_core.solver.problem import PoseProblem, check_in_front, make_problem
+from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
+from calib_core.solver.finish import finish_solution, noise_px
+from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
+
+# Candidates whose cost exceeds the best by less than this many sigma^2 fit "about equally well"
+# (a 3-sigma difference in chi-square).
+_AMBIGUITY_CHI2 = 9.0
+
+
+def _check_sigma(sigma_px: float | None) -> None:
+    if sigma_px is not None and not (np.isfinite(sigma_px) and sigma_px > 0):
+        raise ValueError(f"sigma_px must be a positive number of pixels, got {sigma_px}")
+
+
+def _distance_to_prior_mm(obj2cam: np.ndarray, prior: np.ndarray) -> float:
+    """Translation difference plus rotation difference as arc length at the prior's object distance, mm."""
+    dt = float(np.linalg.norm(obj2cam[:3, 3] - prior[:3, 3]))
+    angle_rad = np.radians(rotation_angle_deg(obj2cam[:3, :3] @ prior[:3, :3].T))
+    return dt + angle_rad * float(np.linalg.norm(prior[:3, 3]))
+
+
+def _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px) -> tuple[PoseProblem, np.ndarray | None]:
+    problem = make_problem(points_3d, points_2d, intrinsics, estimate_focal=estimate_focal, model=model)
+    _check_sigma(sigma_px)
+    prior2 = None
+    if prior is not None:
+        prior2 = check_transform(prior, name="prior (obj2cam)")
+        check_in_front(problem.points_3d, prior2, "prior pose")
+    return problem, prior2
+
+
+def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, prior: ArrayLike | None = None, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None) -> PoseSolution:
+    """Solve the object-to-camera pose from point pairs.
+
+    ``points_3d`` (n, 3) mm in the object frame; ``points_2d`` (n, 2) px as observed (lens
+    distortion is modelled through ``intrinsics``); ``prior`` (4, 4) the modelled
+    ``obj2cam``, used to rank ambiguous solutions (never needed to converge);
+    ``estimate_focal`` solves fu and fv too (4 pairs or more); ``model`` ``"pinhole"``
+    or ``"paper"`` (the paper's biased model, to reproduce it); ``sigma_px`` the pick
+    noise (estimated from the residuals when omitted and there is redundancy);
+    ``robust`` uses Huber's loss and flags outliers; ``max_rms_px`` the largest RMS
+    accepted as a fit (default five times the noise).
+
+    Raises a :class:`~calib_core.solver.errors.SolverInputError` subclass for bad input.
+    Non-convergence and poor fits are a ``failed`` status with a reason.
+    """
+    problem, prior2 = _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px)
+    noise = noise_px(sigma_px)
+    limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
+    huber = 2.0 * noise if robust else None
+    fu0, fv0 = intrinsics.fu, intrinsics.fv
+
+    seeds = initial_seeds(problem, fu0, fv0)
+    if prior2 is not None:
+        seeds.append((prior2[:3, :3], prior2[:3, 3]))
+    refined = [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in seeds) if r is not None]
+    best_rms = min((r.rms_px for r in refined), default=np.inf)
+    if problem.n_points > 5 and (best_rms > limit or robust):
+        # A mis-click spoils the all-points seeds; triplets that avoid it still find the pose.
+        refined += [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in subset_p3p_seeds(problem, fu0, fv0)) if r is not None]
+    if not refined:
+        return _no_pose(problem, "no starting pose could be found for these picks (P3P/SQPnP found no pose in front of the camera)")
+
+    poses = distinct_poses(refined)
+    best = poses[0]
+    close = [p for p in poses if p.converged and p.cost - best.cost <= _AMBIGUITY_CHI2 * noise**2]
+    if not close:
+        close = [best]
+    distances = [None if prior2 is None else _distance_to_prior_mm(p.obj2cam, prior2) for p in close]
+    order = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
+    ranked = [close[i] for i in order]
+    candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, order))
+    return finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+
+
+def refine_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, start_obj2cam: ArrayLike, *, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None, damped: bool = True, max_iterations: int = 100) -> PoseSolution:
+    """Newton iterations from ``start_obj2cam`` (4, 4) only, as in the paper: no global seeds.
+
+    Finds the pose nearest the start, silently ignoring any other pose that fits; use
+    :func:`solve_pose` unless reproducing the paper or measuring convergence.
+    ``damped=False`` takes full Newton steps like the paper's program.
+    """
+    problem, start = _prepare(points_3d, points_2d, intrinsics, start_obj2cam, estimate_focal, model, sigma_px)
+    if start is None:
+        raise ValueError("refine_pose needs a starting pose (start_obj2cam)")
+    noise = noise_px(sigma_px)
+    limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
+    huber = 2.0 * noise if robust else None
+    r = refine_seed(problem, start[:3, :3], start[:3, 3], intrinsics.fu, intrinsics.fv, huber, damped=damped, max_iterations=max_iterations)
+    if r is None:
+        return _no_pose(problem, "the starting pose puts points behind the camera")
+    candidate = PoseCandidate(r.obj2cam, r.fu, r.fv, r.rms_px)
+    return finish_solution(problem, r, (candidate,), sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+
+
+def _no_pose(problem: PoseProblem, reason: str) -> PoseSolution:
+    n = problem.n_points
+    return PoseSolution(
+        status=SolveStatus.FAILED, obj2cam=np.full((4, 4), np.nan), fu=problem.intrinsics.fu, fv=problem.intrinsics.fv,
+        model=problem.model, iterations=0, residuals_px=np.full((n, 2), np.nan), uncertainty=None,
+        leave_one_out_px=np.full(n, np.nan), outliers=np.zeros(n, dtype=bool), candidates=(), reason=reason,
+    )
+
+
+__all__ = ["solve_pose", "refine_pose", "DEFAULT_SIGMA_PX", "pose_matrix"]
