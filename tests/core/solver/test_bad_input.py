@@ -1,0 +1,110 @@
+"""Every bad input gives a specific ValueError subclass that names the points involved."""
+
+import numpy as np
+import pytest
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.frames import make_transform
+from calib_core.solver import (
+    DegenerateGeometryError,
+    DuplicatePointsError,
+    InvalidIntrinsicsError,
+    MismatchedPointsError,
+    NonFiniteInputError,
+    PointsBehindCameraError,
+    SolveStatus,
+    TooFewPointsError,
+    solve_pose,
+    solve_pose_batch,
+)
+
+from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, random_pose
+
+RNG = np.random.default_rng(0)
+TRUTH = random_pose(RNG)
+P = random_points(RNG, 5)
+UV = pixels(P, TRUTH)
+
+
+def test_too_few_points():
+    with pytest.raises(TooFewPointsError, match="2 point pairs given, at least 3"):
+        solve_pose(P[:2], UV[:2], GRIPPER_CAMERA)
+    with pytest.raises(TooFewPointsError, match="at least 4 needed .the focal lengths"):
+        solve_pose(P[:3], UV[:3], GRIPPER_CAMERA, estimate_focal=True)
+
+
+def test_mismatched_lengths_and_shapes():
+    with pytest.raises(MismatchedPointsError, match="5 3D points but 4 2D points"):
+        solve_pose(P, UV[:4], GRIPPER_CAMERA)
+    with pytest.raises(MismatchedPointsError, match="points_2d"):
+        solve_pose(P, UV[:, :1], GRIPPER_CAMERA)
+    with pytest.raises(MismatchedPointsError, match="points_3d"):
+        solve_pose([[1, 2, 3], [4, 5]], UV[:2], GRIPPER_CAMERA)
+
+
+def test_non_finite_values_name_the_point():
+    uv = UV.copy()
+    uv[3, 1] = np.nan
+    with pytest.raises(NonFiniteInputError, match="point 4") as info:
+        solve_pose(P, uv, GRIPPER_CAMERA)
+    assert info.value.points == (3,)
+    p = P.copy()
+    p[0, 0] = np.inf
+    with pytest.raises(NonFiniteInputError, match="point 1"):
+        solve_pose(p, UV, GRIPPER_CAMERA)
+
+
+def test_duplicates_name_both_points():
+    p = P.copy()
+    p[4] = p[1]
+    with pytest.raises(DuplicatePointsError, match="point 2 and point 5 have the same 3D point"):
+        solve_pose(p, UV, GRIPPER_CAMERA)
+    uv = UV.copy()
+    uv[2] = uv[0]
+    with pytest.raises(DuplicatePointsError, match="point 1 and point 3 have the same pixel"):
+        solve_pose(P, uv, GRIPPER_CAMERA)
+
+
+def test_collinear_points():
+    line = np.outer(np.arange(5.0), [10.0, 5.0, 2.0])
+    with pytest.raises(DegenerateGeometryError, match="collinear"):
+        solve_pose(line, UV, GRIPPER_CAMERA)
+
+
+def test_prior_with_points_behind_the_camera():
+    behind = make_transform(np.eye(3), [0.0, 0.0, -500.0])
+    with pytest.raises(PointsBehindCameraError, match="prior pose puts points 1, 2, 3, 4, 5 at or behind"):
+        solve_pose(P, UV, GRIPPER_CAMERA, prior=behind)
+
+
+def test_non_positive_focal_length():
+    bad = Intrinsics.__new__(Intrinsics)
+    object.__setattr__(bad, "fu", -5.0)
+    object.__setattr__(bad, "fv", 1000.0)
+    with pytest.raises(InvalidIntrinsicsError, match="fu must be a positive focal length"):
+        solve_pose(P, UV, bad)
+    with pytest.raises(ValueError, match="focal lengths must be positive"):
+        Intrinsics(0.0, 1000.0, 320, 240, 640, 480)
+
+
+def test_unknown_model_and_bad_sigma():
+    with pytest.raises(ValueError, match="model must be one of"):
+        solve_pose(P, UV, GRIPPER_CAMERA, model="fisheye")
+    with pytest.raises(ValueError, match="sigma_px"):
+        solve_pose(P, UV, GRIPPER_CAMERA, sigma_px=-1.0)
+
+
+def test_batch_shapes_and_values_are_checked():
+    with pytest.raises(MismatchedPointsError):
+        solve_pose_batch(P, UV, GRIPPER_CAMERA)
+    bad = np.stack([UV, UV])
+    bad[1, 0, 0] = np.nan
+    with pytest.raises(NonFiniteInputError, match="problems 1"):
+        solve_pose_batch(np.stack([P, P]), bad, GRIPPER_CAMERA)
+
+
+def test_nonsense_pixels_fail_as_a_status_not_an_exception():
+    uv = RNG.uniform(0, 1000, (5, 2))
+    sol = solve_pose(P, uv, GRIPPER_CAMERA)
+    assert sol.status is SolveStatus.FAILED
+    assert sol.reason
