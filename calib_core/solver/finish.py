@@ -11,19 +11,30 @@ from calib_core.solver.paper_model import paper_to_metric_jacobian
 from calib_core.solver.problem import PoseProblem, make_problem
 from calib_core.solver.refine import residuals_and_jacobian
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
-from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, choose_sigma_px, pose_uncertainty
+from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, fit_uncertainty
 
 # Beyond this condition number (of the column-scaled Jacobian) the pose is poorly determined.
 _POOR_CONDITION = 1e4
+
 
 def noise_px(sigma_px: float | None) -> float:
     """The pick noise assumed for thresholds: the caller's, or the default 0.5 px."""
     return DEFAULT_SIGMA_PX if sigma_px is None else float(sigma_px)
 
+
 def _flag_outliers(residuals: np.ndarray, noise: float) -> np.ndarray:
     e = np.linalg.norm(residuals, axis=1)
     spread = 1.4826 * float(np.median(e))
     return e > max(4.0 * noise, 3.0 * spread)
+
+
+def _off_image(points_2d: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Indices of pixels outside the image (cheap when, as usual, there are none)."""
+    if points_2d.min() >= -0.5 and points_2d[:, 0].max() <= width - 0.5 and points_2d[:, 1].max() <= height - 0.5:
+        return np.empty(0, dtype=int)
+    u, v = points_2d[:, 0], points_2d[:, 1]
+    return np.flatnonzero((u < -0.5) | (v < -0.5) | (u > width - 0.5) | (v > height - 0.5))
+
 
 def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple[PoseCandidate, ...], *, sigma_px: float | None, limit_px: float, huber_px: float | None) -> PoseSolution:
     """Build the solution for ``chosen``; ``candidates`` all poses that fit about as well."""
@@ -47,12 +58,8 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
         # The inlier re-fit's own arrays lack the outliers: evaluate every point at the final pose.
         residuals, jacobian, _ = residuals_and_jacobian(problem, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv)
     weights = (~outliers).astype(float)
-    sigma, source = choose_sigma_px(residuals, weights, problem.n_params, sigma_px)
     to_metric = paper_to_metric_jacobian(chosen.newton.t, problem.intrinsics, chosen.fu, chosen.fv, problem.n_params) if problem.model == "paper" else None
-    loo, uncertainty = pose_uncertainty(jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma, source, to_metric)
-
-    e = np.linalg.norm(residuals, axis=1)
-    rms = float(np.sqrt(np.mean(e[~outliers] ** 2)))
+    rms, e, loo, uncertainty = fit_uncertainty(jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma_px, to_metric)
     status, reason = SolveStatus.OK, None
     if not chosen.converged:
         status, reason = SolveStatus.FAILED, f"Newton iterations stopped: {chosen.newton.reason}"
@@ -67,7 +74,7 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
         warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
     if uncertainty.condition_number > _POOR_CONDITION:
         warnings.append(f"the pose is poorly determined (condition number {uncertainty.condition_number:.3g}): spread the points over more of the object and the image")
-    off_image = np.flatnonzero(~problem.intrinsics.contains(problem.points_2d))
+    off_image = _off_image(problem.points_2d, problem.intrinsics.width, problem.intrinsics.height)
     if len(off_image):
         warnings.append(f"{points_label(off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image")
     if problem.model == "paper" and problem.intrinsics.has_distortion:

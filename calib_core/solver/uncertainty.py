@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from calib_core.solver.kernels.diagnostics import information_diagnostics
+from calib_core.solver.kernels.diagnostics import fit_summary
 
 DEFAULT_SIGMA_PX = 0.5
 
@@ -37,49 +37,44 @@ class PoseUncertainty:
     condition_number: float
 
 
-def choose_sigma_px(residuals: np.ndarray, weights: np.ndarray, n_params: int, sigma_px: float | None) -> tuple[float, str]:
-    """The image noise (px) to scale the covariance with, and its source."""
-    if sigma_px is not None:
-        return float(sigma_px), "given"
-    redundancy = 2 * int(np.count_nonzero(weights > 0)) - n_params
-    if redundancy > 0:
-        cost = float(np.sum(weights[:, None] * residuals**2))
-        return float(np.sqrt(cost / redundancy)), "estimated"
-    return DEFAULT_SIGMA_PX, "default"
+_SOURCES = ("given", "estimated", "default")
 
 
-def pose_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.ndarray, R_obj2cam: np.ndarray, t_obj2cam_mm: np.ndarray, sigma_px: float, sigma_source: str, to_metric: np.ndarray | None = None) -> tuple[np.ndarray, PoseUncertainty]:
-    """Covariance ``sigma^2 (J^T W J)^-1`` and the 1-sigma figures derived from it.
+def fit_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.ndarray, R_obj2cam: np.ndarray, t_obj2cam_mm: np.ndarray, sigma_px: float | None, to_metric: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray, PoseUncertainty]:
+    """Covariance ``sigma^2 (J^T W J)^-1`` and the figures derived from it.
 
-    ``jacobian`` (n, 2, p) of the predicted pixels, ``residuals`` (n, 2) px; ``weights``
-    (n,) per point (0 drops it). Also returns the leave-one-out residuals (n,) px: how far
-    each point would land from its pick if the pose were solved without it (first order,
-    from the hat matrix; NaN where dropping the point leaves no redundancy).
-    ``to_metric`` (p, p): the derivative of the solver's parameters in the order above
-    with respect to the model's own (the paper's model solves image shifts, not mm).
+    ``jacobian`` (n, 2, p) of the predicted pixels, ``residuals`` (n, 2) px, ``weights``
+    (n,) per point (0 drops it); ``sigma_px`` the pick noise, estimated from the residuals
+    when ``None`` and there is redundancy, else :data:`DEFAULT_SIGMA_PX`. ``to_metric``
+    (p, p): the derivative of the metric parameters with respect to the model's own (the
+    paper's model solves image shifts, not mm).
+
+    Returns ``(rms_px, residual lengths (n,) px, leave-one-out residuals (n,) px,
+    uncertainty)``. Leave-one-out: how far each point would land from its pick if the pose
+    were solved without it (first order, from the hat matrix; NaN where dropping the point
+    leaves no redundancy).
     """
     n, _, p = jacobian.shape
     cov = np.empty((p, p))
     cov_c = np.empty((3, 3))
     loo = np.empty(n)
-    condition = float(information_diagnostics(jacobian, residuals, weights, R_obj2cam, t_obj2cam_mm, cov, cov_c, loo))
+    lengths = np.empty(n)
+    rms, sigma, source, condition = fit_summary(jacobian, residuals, weights, R_obj2cam, t_obj2cam_mm, -1.0 if sigma_px is None else float(sigma_px), DEFAULT_SIGMA_PX, cov, cov_c, loo, lengths)
     if to_metric is not None:
         # The paper's model solves image shifts: carry its covariance over to the metric pose.
         cov = to_metric @ cov @ to_metric.T
         cov_c = _centre_covariance(cov, R_obj2cam, t_obj2cam_mm)
-    cov *= sigma_px**2
-    cov_c *= sigma_px**2
-    var = np.diag(cov)
-    return loo, PoseUncertainty(
+    var = cov.diagonal()
+    return float(rms), lengths, loo, PoseUncertainty(
         covariance=cov,
         std_t_obj2cam_mm=np.sqrt(var[:3]),
         std_rotation_deg=np.degrees(np.sqrt(var[3:6])),
-        std_camera_position_mm=np.sqrt(np.diag(cov_c)),
+        std_camera_position_mm=np.sqrt(cov_c.diagonal()),
         std_fu_px=float(np.sqrt(var[6])) if p == 8 else None,
         std_fv_px=float(np.sqrt(var[7])) if p == 8 else None,
-        sigma_px=float(sigma_px),
-        sigma_source=sigma_source,
-        condition_number=condition,
+        sigma_px=float(sigma),
+        sigma_source=_SOURCES[source],
+        condition_number=float(condition),
     )
 
 

@@ -80,3 +80,40 @@ def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
             d1 = (-m01 * r[i, 0] + m00 * r[i, 1]) / det
             loo[i] = np.sqrt(d0 * d0 + d1 * d1)
     return np.sqrt(eig[-1] / eig[0])
+
+
+@njit(cache=True)
+def fit_summary(J, r, w, R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths):
+    """Everything a solution reports about its fit, in one pass.
+
+    Fills ``lengths`` (n,) with the residual lengths, px, and ``cov``/``cov_centre``/``loo``
+    as :func:`information_diagnostics`, scaled by the noise used: ``sigma_given`` when it
+    is positive, else estimated from the weighted residuals when there is redundancy, else
+    ``default_sigma``. Returns ``(rms over weighted points px, sigma px, source, condition)``
+    with source 0 given, 1 estimated, 2 default.
+    """
+    n, _, p = J.shape
+    cost = 0.0
+    used = 0
+    for i in range(n):
+        lengths[i] = np.sqrt(r[i, 0] ** 2 + r[i, 1] ** 2)
+        if w[i] > 0.0:
+            cost += lengths[i] ** 2
+            used += 1
+    rms = np.sqrt(cost / used) if used else np.nan
+    redundancy = 2 * used - p
+    if sigma_given > 0.0:
+        sigma, source = sigma_given, 0
+    elif redundancy > 0:
+        sigma, source = np.sqrt(cost / redundancy), 1
+    else:
+        sigma, source = default_sigma, 2
+    condition = information_diagnostics(J, r, w, R, t, cov, cov_centre, loo)
+    s2 = sigma * sigma
+    for a in range(p):
+        for b in range(p):
+            cov[a, b] *= s2
+    for a in range(3):
+        for b in range(3):
+            cov_centre[a, b] *= s2
+    return rms, sigma, source, condition

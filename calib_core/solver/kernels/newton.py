@@ -21,7 +21,7 @@ OUTCOMES = (
     "exact fit",
     "did not converge within the iteration limit",
     "found no step that reduces the reprojection error (a saddle or a bad start)",
-    "diverged: a Newton step threw points behind the camera",
+    "diverged: a Newton step threw points behind the camera or the focal lengths out of range",
     "the starting pose puts points behind the camera",
     "the normal equations are singular (degenerate geometry)",
 )
@@ -34,6 +34,8 @@ _COST_RTOL = 1e-15
 TRANSLATION_RTOL = 1e-10
 ROTATION_TOL_RAD = 1e-11
 FOCAL_RTOL = 1e-10
+# Estimated focal lengths must stay within this factor range of their starting values.
+FOCAL_RANGE = (0.2, 5.0)
 
 
 @njit(cache=True)
@@ -148,6 +150,12 @@ def _small(delta, p, scale, f):
 
 
 @njit(cache=True)
+def _focal_sane(f, f0):
+    # A focal length running off to zero or infinity is the orthographic or degenerate limit, never a camera.
+    return FOCAL_RANGE[0] * f0[0] < f[0] < FOCAL_RANGE[1] * f0[0] and FOCAL_RANGE[0] * f0[1] < f[1] < FOCAL_RANGE[1] * f0[1]
+
+
+@njit(cache=True)
 def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_iterations, damped, r, J):
     """Minimise the reprojection cost from the state ``(R, t, f)``, updated in place.
 
@@ -174,6 +182,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
     Aa = np.empty((p, p))
     g = np.empty(p)
     delta = np.zeros(p)
+    f0 = f.copy()
     lam = _LAMBDA_START
     for iteration in range(1, max_iterations + 1):
         if cost <= 1e-28 * n:
@@ -186,7 +195,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
             zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r, J)
             R[:, :], t[:], f[:] = R_new, t_new, f_new
             cost = robust_cost(r, huber)
-            if not (zmin > 0.0 and np.isfinite(cost)):
+            if not (zmin > 0.0 and np.isfinite(cost) and _focal_sane(f, f0)):
                 return iteration, DIVERGED
             if _small(delta, p, scale, f):
                 return iteration, CONVERGED
@@ -201,7 +210,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
             if cholesky_solve(Aa, g, delta, p):
                 _step(R, t, f, delta, p, R_new, t_new, f_new)
                 zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r_new, J_new)
-                if zmin > 0.0:
+                if zmin > 0.0 and _focal_sane(f_new, f0):
                     cost_new = robust_cost(r_new, huber)
                 if cost_new <= cost:
                     break
