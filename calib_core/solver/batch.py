@@ -15,9 +15,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.camera.projection import undistort_normalized
 from calib_core.solver.errors import MismatchedPointsError, NonFiniteInputError, TooFewPointsError
-from calib_core.solver.initialisation import sqpnp_seed
+from calib_core.solver.initialisation import normalized_coordinates, sqpnp_seed
+from calib_core.solver.kernels.dlt import dlt_pose_batch
 from calib_core.solver.kernels.camera_models import PINHOLE
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, newton_batch
 from calib_core.solver.problem import check_intrinsics
@@ -52,29 +52,12 @@ class BatchPoseSolution:
 
 def _dlt_seeds(P: np.ndarray, uv: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Batched DLT: rotations (b, 3, 3), translations (b, 3) mm, and which seeds are usable (b,)."""
-    b, n, _ = P.shape
-    xy = np.stack([(uv[..., 0] - intrinsics.cx) / intrinsics.fu, (uv[..., 1] - intrinsics.cy) / intrinsics.fv], axis=-1)
-    if intrinsics.has_distortion:
-        xy = undistort_normalized(xy.reshape(-1, 2), intrinsics.distortion).reshape(b, n, 2)
-    centre = P.mean(axis=1, keepdims=True)
-    scale = np.sqrt(np.mean(np.sum((P - centre) ** 2, axis=2), axis=1))[:, None, None]
-    Q = np.concatenate([(P - centre) / scale, np.ones((b, n, 1))], axis=2)  # (b, n, 4)
-    A = np.zeros((b, 2 * n, 12))
-    A[:, 0::2, 0:4] = Q
-    A[:, 0::2, 8:12] = -xy[..., 0:1] * Q
-    A[:, 1::2, 4:8] = Q
-    A[:, 1::2, 8:12] = -xy[..., 1:2] * Q
-    _, s, Vt = np.linalg.svd(A, full_matrices=False)
-    M = Vt[:, -1, :].reshape(b, 3, 4)
-    # M is [R | (R centre + t) / scale] up to a signed factor: the centroid must lie in front.
-    M[M[:, 2, 3] < 0] *= -1.0
-    U, S, Wt = np.linalg.svd(M[:, :, :3])
-    fix = np.ones((b, 3))
-    fix[:, 2] = np.sign(np.linalg.det(U @ Wt))
-    R = (U * fix[:, None, :]) @ Wt
-    t = M[:, :, 3] / S.mean(axis=1)[:, None] * scale[:, 0] - np.einsum("bij,bj->bi", R, centre[:, 0, :])
-    usable = np.isfinite(t).all(axis=1) & (s[:, -2] > 1e-9 * s[:, 0]) & (S[:, 2] > 1e-6 * S[:, 0])
-    return R, t, usable
+    b = len(P)
+    R = np.zeros((b, 3, 3))
+    t = np.zeros((b, 3))
+    ok = np.zeros(b, dtype=np.bool_)
+    dlt_pose_batch(P, normalized_coordinates(uv, intrinsics, intrinsics.fu, intrinsics.fv), R, t, ok)
+    return R, t, ok
 
 
 def _check_batch(points_3d, points_2d, estimate_focal) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +89,7 @@ def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Int
             raise MismatchedPointsError(f"batch: starts must be ({b}, 4, 4), got {S.shape}")
         R, t = S[:, :3, :3].copy(), S[:, :3, 3].copy()
     else:
-        R, t, usable = _dlt_seeds(P, uv, intrinsics) if n >= 6 else (np.zeros((b, 3, 3)), np.zeros((b, 3)), np.zeros(b, bool))
+        R, t, usable = _dlt_seeds(np.ascontiguousarray(P), uv, intrinsics) if n >= 6 else (np.zeros((b, 3, 3)), np.zeros((b, 3)), np.zeros(b, bool))
         for i in np.flatnonzero(~usable):
             seed = sqpnp_seed(P[i], uv[i], intrinsics, intrinsics.fu, intrinsics.fv)
             if seed:

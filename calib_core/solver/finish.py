@@ -28,12 +28,18 @@ def _flag_outliers(residuals: np.ndarray, noise: float) -> np.ndarray:
     return e > max(4.0 * noise, 3.0 * spread)
 
 
-def _off_image(points_2d: np.ndarray, width: int, height: int) -> np.ndarray:
-    """Indices of pixels outside the image (cheap when, as usual, there are none)."""
-    if points_2d.min() >= -0.5 and points_2d[:, 0].max() <= width - 0.5 and points_2d[:, 1].max() <= height - 0.5:
-        return np.empty(0, dtype=int)
-    u, v = points_2d[:, 0], points_2d[:, 1]
-    return np.flatnonzero((u < -0.5) | (v < -0.5) | (u > width - 0.5) | (v > height - 0.5))
+def operator_warnings(problem: PoseProblem, condition_number: float) -> list[str]:
+    """What an operator should know about a solve that is not an error."""
+    warnings = []
+    if problem.n_points * 2 <= problem.n_params:
+        warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
+    if condition_number > _POOR_CONDITION:
+        warnings.append(f"the pose is poorly determined (condition number {condition_number:.3g}): spread the points over more of the object and the image")
+    if problem.off_image:
+        warnings.append(f"{points_label(problem.off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image")
+    if problem.model == "paper" and problem.intrinsics.has_distortion:
+        warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
+    return warnings
 
 
 def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple[PoseCandidate, ...], *, sigma_px: float | None, limit_px: float, huber_px: float | None) -> PoseSolution:
@@ -70,15 +76,7 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     elif len(candidates) > 1:
         status = SolveStatus.AMBIGUOUS
         reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
-    if problem.n_points * 2 <= problem.n_params:
-        warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
-    if uncertainty.condition_number > _POOR_CONDITION:
-        warnings.append(f"the pose is poorly determined (condition number {uncertainty.condition_number:.3g}): spread the points over more of the object and the image")
-    off_image = _off_image(problem.points_2d, problem.intrinsics.width, problem.intrinsics.height)
-    if len(off_image):
-        warnings.append(f"{points_label(off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image")
-    if problem.model == "paper" and problem.intrinsics.has_distortion:
-        warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
+    warnings += operator_warnings(problem, uncertainty.condition_number)
     return PoseSolution(
         status=status, obj2cam=chosen.obj2cam, fu=chosen.fu, fv=chosen.fv, model=problem.model,
         iterations=iterations, residuals_px=residuals, uncertainty=uncertainty, leave_one_out_px=loo,

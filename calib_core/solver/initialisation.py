@@ -1,7 +1,9 @@
-"""Starting poses without a guess: every root of P3P, SQPnP, IPPE for planar points.
+"""Starting poses without a guess: a DLT for many points, every root of P3P, SQPnP, IPPE
+for planar points.
 
-OpenCV supplies the closed-form seeds; each is refined afterwards by the Newton solver.
-Seeds are object-to-camera poses ``(R (3, 3), t (3,) mm)``.
+OpenCV supplies the closed-form seeds except the DLT (compiled here, because it is cheap);
+each is refined afterwards by the Newton solver. Seeds are object-to-camera poses
+``(R (3, 3), t (3,) mm)``.
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ import cv2
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import undistort_normalized
+from calib_core.solver.kernels.dlt import dlt_pose
 from calib_core.solver.problem import PoseProblem
 
 # P3P over subsets is run for small problems (where other local minima are likely and must be
@@ -33,6 +37,27 @@ def _as_seeds(rvecs, tvecs) -> list[tuple[np.ndarray, np.ndarray]]:
         if np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec)):
             seeds.append((cv2.Rodrigues(rvec)[0], tvec))
     return seeds
+
+
+def normalized_coordinates(points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> np.ndarray:
+    """Undistorted normalized image coordinates (..., 2) of pixels (..., 2)."""
+    xy = np.empty(points_2d.shape)
+    xy[..., 0] = (points_2d[..., 0] - intrinsics.cx) / fu
+    xy[..., 1] = (points_2d[..., 1] - intrinsics.cy) / fv
+    if intrinsics.has_distortion:
+        xy = undistort_normalized(xy.reshape(-1, 2), intrinsics.distortion).reshape(points_2d.shape)
+    return xy
+
+
+def dlt_seed(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The DLT pose for six or more non-coplanar pairs (empty list when it does not apply)."""
+    if problem.n_points < 6 or problem.coplanar:
+        return []
+    R = np.empty((3, 3))
+    t = np.empty(3)
+    if dlt_pose(problem.points_3d, normalized_coordinates(problem.points_2d, problem.intrinsics, fu, fv), R, t):
+        return [(R, t)]
+    return []
 
 
 def p3p_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -86,12 +111,12 @@ def subset_p3p_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[n
 
 
 def initial_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Seeds for a problem without a guess: P3P roots for 3 pairs; SQPnP (+ IPPE when planar,
-    + P3P over triplets when there are few pairs) for more."""
+    """Seeds for a problem without a guess: P3P roots for 3 pairs; DLT (6 or more pairs off a
+    plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs."""
     P, uv, intr = problem.points_3d, problem.points_2d, problem.intrinsics
     if problem.n_points == 3:
         return p3p_seeds(P, uv, intr, fu, fv)
-    seeds = sqpnp_seed(P, uv, intr, fu, fv)
+    seeds = dlt_seed(problem, fu, fv) + sqpnp_seed(P, uv, intr, fu, fv)
     if problem.coplanar:
         seeds += ippe_seeds(P, uv, intr, fu, fv)
     if problem.n_points <= SMALL_PROBLEM_POINTS:

@@ -5,6 +5,7 @@ Validation happens once here, so the numerical code can trust its input.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +51,8 @@ class PoseProblem:
     estimate_focal: bool
     model: str
     coplanar: bool
+    distortion: np.ndarray
+    off_image: tuple[int, ...] = ()
 
     @property
     def n_points(self) -> int:
@@ -73,9 +76,8 @@ def _as_points(values: ArrayLike, dim: int, name: str) -> np.ndarray:
 
 def check_intrinsics(intrinsics: Intrinsics) -> None:
     """Raise :class:`InvalidIntrinsicsError` unless both focal lengths are positive and finite."""
-    for name in ("fu", "fv"):
-        v = getattr(intrinsics, name)
-        if not np.isfinite(v) or v <= 0:
+    for name, v in (("fu", intrinsics.fu), ("fv", intrinsics.fv)):
+        if not (math.isfinite(v) and v > 0):
             raise InvalidIntrinsicsError(f"intrinsics: {name} must be a positive focal length in px, got {v}")
 
 
@@ -92,7 +94,7 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
     if len(p3) < needed:
         why = " (the focal lengths are estimated too)" if estimate_focal else ""
         raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
-    code, i, j, coplanar = check_pairs(p3, p2, _DUPLICATE_REL_3D, _DUPLICATE_PX, _COLLINEAR_RATIO, COPLANAR_RATIO)
+    code, i, j, coplanar, n_off_image = check_pairs(p3, p2, _DUPLICATE_REL_3D, _DUPLICATE_PX, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height)
     if code == NON_FINITE_3D or code == NON_FINITE_2D:
         bad = np.flatnonzero(~np.all(np.isfinite(p3), axis=1) | ~np.all(np.isfinite(p2), axis=1))
         raise NonFiniteInputError(f"{points_label(bad)}: coordinates are NaN or infinite", bad)
@@ -101,7 +103,11 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
         raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same {what}", (i, j))
     if code == COLLINEAR:
         raise DegenerateGeometryError(f"{points_label(range(len(p3)))}: the 3D points are collinear; pick points that span a plane or a volume", range(len(p3)))
-    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar))
+    off_image = ()
+    if n_off_image:
+        u, v = p2[:, 0], p2[:, 1]
+        off_image = tuple(int(k) for k in np.flatnonzero((u < -0.5) | (v < -0.5) | (u > intrinsics.width - 0.5) | (v > intrinsics.height - 0.5)))
+    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image)
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:

@@ -52,7 +52,7 @@ def ideal_pixels(problem: PoseProblem) -> np.ndarray:
 def _model_inputs(problem: PoseProblem, model: str) -> tuple[int, np.ndarray, np.ndarray]:
     if model == "paper":
         return PAPER, ideal_pixels(problem), _NO_DISTORTION
-    return PINHOLE, problem.points_2d, problem.intrinsics.dist_coeffs
+    return PINHOLE, problem.points_2d, problem.distortion
 
 
 def run_newton(problem: PoseProblem, R, t, fu: float, fv: float, *, huber_px: float | None = None, max_iterations: int = 100, damped: bool = True, as_printed: bool = False) -> NewtonResult:

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import RefinedPose, distinct_poses, refine_seed
+from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import initial_seeds, subset_p3p_seeds
 from calib_core.solver.problem import PoseProblem, check_in_front, make_problem
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
@@ -29,11 +30,15 @@ def _check_sigma(sigma_px: float | None) -> None:
         raise ValueError(f"sigma_px must be a positive number of pixels, got {sigma_px}")
 
 
-def _distance_to_prior_mm(obj2cam: np.ndarray, prior: np.ndarray) -> float:
-    """Translation difference plus rotation difference as arc length at the prior's object distance, mm."""
-    dt = float(np.linalg.norm(obj2cam[:3, 3] - prior[:3, 3]))
-    angle_rad = np.radians(rotation_angle_deg(obj2cam[:3, :3] @ prior[:3, :3].T))
-    return dt + angle_rad * float(np.linalg.norm(prior[:3, 3]))
+def _distance_to_prior_mm(pose, prior: np.ndarray, intrinsics: Intrinsics) -> float:
+    """How far a refined pose is from the prior, mm: translation difference, plus the rotation
+    difference as arc length at the prior's object distance, plus (when the focal lengths were
+    estimated) their relative change times that distance, which is what it trades against."""
+    distance = float(np.linalg.norm(prior[:3, 3]))
+    dt = float(np.linalg.norm(pose.obj2cam[:3, 3] - prior[:3, 3]))
+    angle_rad = np.radians(rotation_angle_deg(pose.obj2cam[:3, :3] @ prior[:3, :3].T))
+    focal = abs(pose.fu / intrinsics.fu - 1.0) + abs(pose.fv / intrinsics.fv - 1.0)
+    return dt + (angle_rad + focal) * distance
 
 
 def _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px) -> tuple[PoseProblem, np.ndarray | None]:
@@ -67,6 +72,11 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     huber = 2.0 * noise if robust else None
     fu0, fv0 = intrinsics.fu, intrinsics.fv
 
+    if fast_path_applies(problem, robust):
+        # Many points: a DLT seed refined to a good fit is the answer; the other seeds cost more than the whole solve.
+        solution = fast_solve(problem, sigma_px, limit)
+        if solution is not None:
+            return solution
     seeds = initial_seeds(problem, fu0, fv0)
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
@@ -83,7 +93,7 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     close = [p for p in poses if p.converged and p.cost - best.cost <= _AMBIGUITY_CHI2 * noise**2]
     if not close:
         close = [best]
-    distances = [None if prior2 is None else _distance_to_prior_mm(p.obj2cam, prior2) for p in close]
+    distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
     order = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
     ranked = [close[i] for i in order]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, order))

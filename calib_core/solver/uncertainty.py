@@ -64,15 +64,22 @@ def fit_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.nda
         # The paper's model solves image shifts: carry its covariance over to the metric pose.
         cov = to_metric @ cov @ to_metric.T
         cov_c = _centre_covariance(cov, R_obj2cam, t_obj2cam_mm)
+    return float(rms), lengths, loo, uncertainty_from(cov, cov_c, sigma, int(source), condition)
+
+
+def uncertainty_from(cov: np.ndarray, cov_centre: np.ndarray, sigma_px: float, source: int, condition: float) -> PoseUncertainty:
+    """Package a covariance (p, p) and the camera centre's (3, 3) as 1-sigma figures."""
     var = cov.diagonal()
-    return float(rms), lengths, loo, PoseUncertainty(
+    std = np.sqrt(var)
+    focal = len(var) == 8
+    return PoseUncertainty(
         covariance=cov,
-        std_t_obj2cam_mm=np.sqrt(var[:3]),
-        std_rotation_deg=np.degrees(np.sqrt(var[3:6])),
-        std_camera_position_mm=np.sqrt(cov_c.diagonal()),
-        std_fu_px=float(np.sqrt(var[6])) if p == 8 else None,
-        std_fv_px=float(np.sqrt(var[7])) if p == 8 else None,
-        sigma_px=float(sigma),
+        std_t_obj2cam_mm=std[:3],
+        std_rotation_deg=np.degrees(std[3:6]),
+        std_camera_position_mm=np.sqrt(cov_centre.diagonal()),
+        std_fu_px=float(std[6]) if focal else None,
+        std_fv_px=float(std[7]) if focal else None,
+        sigma_px=float(sigma_px),
         sigma_source=_SOURCES[source],
         condition_number=float(condition),
     )

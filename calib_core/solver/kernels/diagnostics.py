@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from calib_core.solver.kernels.small_linalg import spd_inverse, symmetric_eigenvalues
+
 
 @njit(cache=True)
 def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
@@ -32,13 +34,13 @@ def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
     for a in range(p):
         for b in range(p):
             As[a, b] = A[a, b] / (s[a] * s[b])
-    eig = np.linalg.eigvalsh(As)
-    if not eig[0] > 1e-14 * eig[-1]:
+    eig = symmetric_eigenvalues(As)
+    inv_s = np.empty((p, p))
+    if not eig[0] > 1e-14 * eig[-1] or not spd_inverse(As, inv_s):
         cov_unit[:, :] = np.inf
         cov_centre_unit[:, :] = np.inf
         loo[:] = np.nan
         return np.inf
-    inv_s = np.linalg.inv(As)
     for a in range(p):
         for b in range(p):
             cov_unit[a, b] = inv_s[a, b] / (s[a] * s[b])

@@ -13,6 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from calib_core.solver.kernels.camera_models import PINHOLE, evaluate
+from calib_core.solver.kernels.small_linalg import cholesky_solve
 
 # Outcome codes (see ``OUTCOMES``).
 CONVERGED, EXACT_FIT, MAX_ITERATIONS, NO_DESCENT, DIVERGED, START_BEHIND, SINGULAR = range(7)
@@ -60,34 +61,6 @@ def rotate_by(phi, R, out):
     for i in range(3):
         for j in range(3):
             out[i, j] = M[i, 0] * R[0, j] + M[i, 1] * R[1, j] + M[i, 2] * R[2, j]
-
-
-@njit(cache=True)
-def cholesky_solve(A, g, x, p):
-    """Solve ``A x = g`` for symmetric positive definite ``A`` (p, p); False if not positive definite."""
-    L = np.zeros((p, p))
-    for i in range(p):
-        for j in range(i + 1):
-            s = A[i, j]
-            for k in range(j):
-                s -= L[i, k] * L[j, k]
-            if i == j:
-                if not s > 0.0:
-                    return False
-                L[i, i] = np.sqrt(s)
-            else:
-                L[i, j] = s / L[j, j]
-    for i in range(p):
-        s = g[i]
-        for k in range(i):
-            s -= L[i, k] * x[k]
-        x[i] = s / L[i, i]
-    for i in range(p - 1, -1, -1):
-        s = x[i]
-        for k in range(i + 1, p):
-            s -= L[k, i] * x[k]
-        x[i] = s / L[i, i]
-    return True
 
 
 @njit(cache=True)
@@ -189,7 +162,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
             return iteration - 1, EXACT_FIT
         normal_equations(J, r, huber, p, A, g)
         if not damped:
-            if not cholesky_solve(A, g, delta, p):
+            if not cholesky_solve(A, g, delta):
                 return iteration, SINGULAR
             _step(R, t, f, delta, p, R_new, t_new, f_new)
             zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r, J)
@@ -207,7 +180,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
                     Aa[a, b] = A[a, b]
                 Aa[a, a] += lam * max(A[a, a], 1e-300)
             cost_new = np.inf
-            if cholesky_solve(Aa, g, delta, p):
+            if cholesky_solve(Aa, g, delta):
                 _step(R, t, f, delta, p, R_new, t_new, f_new)
                 zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r_new, J_new)
                 if zmin > 0.0 and _focal_sane(f_new, f0):
