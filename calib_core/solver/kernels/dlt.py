@@ -13,6 +13,11 @@ from numba import njit, prange
 from calib_core.solver.kernels.small_linalg import cholesky_factor, cholesky_substitute, inverse3
 
 
+# The second-smallest eigenvalue of the (normalised) DLT system must exceed this fraction of its
+# trace: below it the null space is not one-dimensional (coplanar points, too few distinct rays).
+_GAP = 1e-9
+
+
 @njit(cache=True)
 def _smallest_eigenvector(M):
     """Unit eigenvector (12,) of the smallest eigenvalue of the PSD matrix ``M`` by inverse
@@ -34,8 +39,21 @@ def _smallest_eigenvector(M):
         cholesky_substitute(L, x, y)
         x[:] = y / np.sqrt(np.sum(y * y))
     rayleigh = x @ (M @ x)
-    # The second eigenvalue is at least the Rayleigh quotient of the rest; require a clear gap.
     if not rayleigh < 1e-2 * trace / p:
+        return None
+    # The next eigenvalue, by the same iteration on M with x shifted out of the way: coplanar or
+    # otherwise degenerate points leave it near zero too, and then the pose is not determined.
+    for i in range(p):
+        for k in range(p):
+            A[i, k] = M[i, k] + trace * x[i] * x[k]
+        A[i, i] += 1e-13 * trace
+    if not cholesky_factor(A, L):
+        return None
+    z = np.ones(p) / np.sqrt(p)
+    for _ in range(8):
+        cholesky_substitute(L, z, y)
+        z[:] = y / np.sqrt(np.sum(y * y))
+    if not z @ (M @ z) > _GAP * trace:
         return None
     return x
 
