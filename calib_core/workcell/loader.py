@@ -1,0 +1,165 @@
+"""Reading a workcell YAML file (``safe_load``: data only) with strict validation.
+
+Every error is a :class:`~calib_core.errors.FileFormatError` naming the file and the field
+(``components[2].placement.rpy``): unknown keys, missing meshes, wrong units, duplicate
+names, malformed numbers. The schema is in ``docs/workcell.md``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import trimesh
+import yaml
+
+from calib_core.errors import FileFormatError
+from calib_core.frames import transform_from_xyz_rpy
+from calib_core.scene import SceneItem
+from calib_core.workcell.model import TaskLocation, Workcell
+
+DEFAULT_WORKCELL = Path(__file__).resolve().parents[2] / "resources" / "workcell" / "workcell.yaml"
+SCHEMA_VERSION = 1
+_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations"}
+_COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
+_TASK_KEYS = {"name", "component", "tcp2base", "approach_mm"}
+_KINDS = {"component", "fixture"}
+_MESH_SCALE = {"mm": 1.0, "m": 1000.0}
+_MESH_SUFFIXES = {".stl", ".obj", ".glb", ".gltf", ".ply"}
+
+
+class _Reader:
+    """Validation helpers that know the file, so every error names it."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, field: str | None, message: str) -> FileFormatError:
+        return FileFormatError(self.path, message, field)
+
+    def mapping(self, value, field: str, allowed: set[str], required: set[str]) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(field, f"must be a mapping, got {type(value).__name__}")
+        unknown = set(value) - allowed
+        if unknown:
+            raise self.fail(field, f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; allowed: {', '.join(sorted(allowed))}")
+        missing = required - set(value)
+        if missing:
+            raise self.fail(field, f"missing key(s) {', '.join(sorted(missing))}")
+        return value
+
+    def number(self, value, field: str) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise self.fail(field, f"must be a finite number, got {value!r}")
+        return float(value)
+
+    def vector(self, value, n: int, field: str) -> np.ndarray:
+        if not isinstance(value, (list, tuple)) or len(value) != n:
+            raise self.fail(field, f"must be a list of {n} numbers, got {value!r}")
+        return np.array([self.number(v, f"{field}[{i}]") for i, v in enumerate(value)])
+
+    def text(self, value, field: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(field, f"must be a non-empty string, got {value!r}")
+        return value
+
+    def placement(self, value, field: str) -> np.ndarray:
+        value = self.mapping(value, field, {"xyz", "rpy"}, {"xyz", "rpy"})
+        return transform_from_xyz_rpy(self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy"))
+
+    def file(self, value, field: str) -> Path:
+        path = (self.path.parent / self.text(value, field)).resolve()
+        if not path.is_file():
+            raise self.fail(field, f"file not found: {path}")
+        return path
+
+
+def _component(reader: _Reader, raw, i: int) -> SceneItem:
+    f = f"components[{i}]"
+    raw = reader.mapping(raw, f, _COMPONENT_KEYS, {"name", "mesh", "mesh_units", "placement"})
+    name = reader.text(raw["name"], f"{f}.name")
+    kind = raw.get("kind", "component")
+    if kind not in _KINDS:
+        raise reader.fail(f"{f}.kind", f"must be one of {', '.join(sorted(_KINDS))}, got {kind!r}")
+    units = raw["mesh_units"]
+    if units not in _MESH_SCALE:
+        raise reader.fail(f"{f}.mesh_units", f"must be 'mm' or 'm', got {units!r}")
+    mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
+    if mesh_path.suffix.lower() not in _MESH_SUFFIXES:
+        raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, glTF/GLB or PLY")
+    try:
+        mesh = trimesh.load(mesh_path, force="mesh")
+    except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
+        raise reader.fail(f"{f}.mesh", f"cannot read mesh {mesh_path.name}: {exc}") from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise reader.fail(f"{f}.mesh", f"mesh {mesh_path.name} has no triangles")
+    if _MESH_SCALE[units] != 1.0:
+        mesh.apply_scale(_MESH_SCALE[units])
+    color = tuple(reader.vector(raw.get("color", [0.7, 0.7, 0.7]), 3, f"{f}.color"))
+    if not all(0.0 <= c <= 1.0 for c in color):
+        raise reader.fail(f"{f}.color", f"RGB values must lie in [0, 1], got {list(color)}")
+    features_raw = raw.get("features", {}) or {}
+    if not isinstance(features_raw, dict):
+        raise reader.fail(f"{f}.features", "must be a mapping of name: [x, y, z] (mm)")
+    features = {str(k): reader.vector(v, 3, f"{f}.features.{k}") for k, v in features_raw.items()}
+    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features)
+
+
+def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:
+    f = f"task_locations[{i}]"
+    raw = reader.mapping(raw, f, _TASK_KEYS, {"name", "tcp2base"})
+    component = raw.get("component")
+    if component is not None and component not in components:
+        raise reader.fail(f"{f}.component", f"no component called {component!r}")
+    approach = reader.number(raw.get("approach_mm", 0.0), f"{f}.approach_mm")
+    if approach < 0:
+        raise reader.fail(f"{f}.approach_mm", f"must be >= 0, got {approach}")
+    return TaskLocation(reader.text(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component)
+
+
+def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
+    """Read and validate a workcell file; raise :class:`FileFormatError` naming the field at fault."""
+    path = Path(path)
+    reader = _Reader(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise reader.fail(None, "no such workcell file") from None
+    except (IsADirectoryError, UnicodeDecodeError, PermissionError) as exc:
+        raise reader.fail(None, f"cannot read: {exc}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise reader.fail(None, f"not valid YAML: {exc}") from None
+    data = reader.mapping(data, "(top level)", _TOP_KEYS, {"schema_version", "units", "robot", "components"})
+    if data["schema_version"] != SCHEMA_VERSION:
+        raise reader.fail("schema_version", f"this videocal reads version {SCHEMA_VERSION}, the file is version {data['schema_version']!r}")
+    units = reader.mapping(data["units"], "units", {"length", "angle"}, {"length", "angle"})
+    if units["length"] != "mm" or units["angle"] != "deg":
+        raise reader.fail("units", f"placements must be in mm and deg, got {units['length']!r} and {units['angle']!r}")
+    robot = reader.mapping(data["robot"], "robot", {"urdf", "home_joints_deg"}, {"urdf"})
+    urdf = reader.file(robot["urdf"], "robot.urdf")
+    home = reader.vector(robot.get("home_joints_deg", [0.0] * 6), 6, "robot.home_joints_deg")
+    intrinsics_path = None
+    if data.get("camera") is not None:
+        camera = reader.mapping(data["camera"], "camera", {"intrinsics"}, {"intrinsics"})
+        intrinsics_path = reader.file(camera["intrinsics"], "camera.intrinsics")
+    if not isinstance(data["components"], list) or not data["components"]:
+        raise reader.fail("components", "must be a non-empty list")
+    components: list[SceneItem] = []
+    for i, raw in enumerate(data["components"]):
+        item = _component(reader, raw, i)
+        if any(c.name == item.name for c in components):
+            raise reader.fail(f"components[{i}].name", f"duplicate component name {item.name!r}")
+        components.append(item)
+    names = {c.name for c in components}
+    tasks: dict[str, TaskLocation] = {}
+    raw_tasks = data.get("task_locations", []) or []
+    if not isinstance(raw_tasks, list):
+        raise reader.fail("task_locations", "must be a list")
+    for i, raw in enumerate(raw_tasks):
+        task = _task(reader, raw, i, names)
+        if task.name in tasks:
+            raise reader.fail(f"task_locations[{i}].name", f"duplicate task location name {task.name!r}")
+        tasks[task.name] = task
+    return Workcell(str(data.get("name", path.stem)), path, components, tasks, urdf, intrinsics_path, home)

@@ -1,0 +1,67 @@
+"""A loaded workcell: what the renderer, the window and the calibration use."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from calib_core.frames import apply, make_transform
+from calib_core.scene import SceneItem
+
+
+@dataclass(frozen=True)
+class TaskLocation:
+    """A named task location. ``tcp2base`` (4, 4) mm: where the tool centre point must be;
+    ``approach_mm``: how far back along the tool's approach axis (its z) the robot stops
+    first, where the camera sees the component; ``component``: the object it works on."""
+
+    name: str
+    tcp2base: np.ndarray
+    approach_mm: float = 0.0
+    component: str | None = None
+
+    @property
+    def approach2base(self) -> np.ndarray:
+        """The TCP pose (4, 4) mm at the approach: ``approach_mm`` back along the tool z axis."""
+        return self.tcp2base @ make_transform(np.eye(3), [0.0, 0.0, -self.approach_mm])
+
+
+@dataclass
+class Workcell:
+    """Components (as :class:`SceneItem`, placed in the robot base frame), task locations,
+    and the files of the robot and camera the cell uses."""
+
+    name: str
+    path: Path
+    components: list[SceneItem]
+    task_locations: dict[str, TaskLocation]
+    robot_urdf: Path
+    intrinsics_path: Path | None
+    home_joints_deg: np.ndarray
+    meta: dict = field(default_factory=dict)
+
+    def component(self, name: str) -> SceneItem:
+        """The component called ``name``; ``KeyError`` names the known ones."""
+        for item in self.components:
+            if item.name == name:
+                return item
+        raise KeyError(f"the workcell has no component '{name}'; components: {', '.join(c.name for c in self.components)}")
+
+    def task(self, name: str) -> TaskLocation:
+        """The task location called ``name``; ``KeyError`` names the known ones."""
+        if name not in self.task_locations:
+            raise KeyError(f"the workcell has no task location '{name}'; task locations: {', '.join(self.task_locations)}")
+        return self.task_locations[name]
+
+    def feature_in_base(self, component: str, feature: str) -> np.ndarray:
+        """A named feature point of a component in the robot base frame (3,), mm."""
+        item = self.component(component)
+        if feature not in item.features:
+            raise KeyError(f"component '{component}' has no feature '{feature}'; features: {', '.join(item.features)}")
+        return apply(item.item2world, item.features[feature])
+
+    @property
+    def triangle_count(self) -> int:
+        return sum(len(c.mesh.faces) for c in self.components)

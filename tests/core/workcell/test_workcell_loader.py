@@ -1,0 +1,83 @@
+"""The bundled workcell loads; every kind of bad file gives an error naming the file and field."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from calib_core.errors import FileFormatError
+from calib_core.robot import load_robot, solve_ik
+from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+
+def test_bundled_workcell():
+    cell = load_workcell()
+    names = [c.name for c in cell.components]
+    assert {"rack_1", "rack_2", "oru_1", "drawer", "gripper_station", "screwdriver_station"} <= set(names)
+    assert cell.triangle_count < 50_000
+    grasp = cell.task("oru_1_grasp")
+    assert np.allclose(grasp.tcp2base[:3, 3], [1146.24, -428.85, 1367.70])
+    # The task location grasps the fixture pin: 25 mm in front of the plate, on its axis.
+    pin_axis_point = cell.feature_in_base("oru_1", "pin_tip")
+    assert np.linalg.norm(pin_axis_point - grasp.tcp2base[:3, 3]) == pytest.approx(20.0, abs=0.1)
+    # Both the grasp and its approach are reachable.
+    robot = load_robot(cell.robot_urdf)
+    q = solve_ik(robot, grasp.tcp2base, cell.home_joints_deg).q_deg
+    solve_ik(robot, grasp.approach2base, q)
+    assert np.allclose(grasp.approach2base[:3, 3], grasp.tcp2base[:3, 3] - 350 * grasp.tcp2base[:3, 2])
+
+
+@pytest.fixture
+def cell_copy(tmp_path):
+    """A copy of the bundled workcell (file, meshes, robot, camera) to break."""
+    root = DEFAULT_WORKCELL.parents[1]
+    for sub in ("workcell", "robot", "camera"):
+        shutil.copytree(root / sub, tmp_path / sub)
+    path = tmp_path / "workcell" / "workcell.yaml"
+    return path, yaml.safe_load(path.read_text())
+
+
+def _write(path: Path, data) -> Path:
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+@pytest.mark.parametrize(
+    "mutate, field, message",
+    [
+        (lambda d: d["components"][1].update(colour=[1, 0, 0]), "components[1]", "unknown key(s) colour"),
+        (lambda d: d["components"][1].update(mesh="meshes/nothing.stl"), "components[1].mesh", "file not found"),
+        (lambda d: d["components"][1].update(mesh_units="inch"), "components[1].mesh_units", "must be 'mm' or 'm'"),
+        (lambda d: d["components"][2].update(name="rack_1"), "components[2].name", "duplicate component name"),
+        (lambda d: d["components"][1]["placement"].update(rpy=[0, "ten", 0]), "components[1].placement.rpy[1]", "finite number"),
+        (lambda d: d["components"][1]["placement"].update(xyz=[0, 0]), "components[1].placement.xyz", "list of 3 numbers"),
+        (lambda d: d.update(units={"length": "m", "angle": "deg"}), "units", "mm and deg"),
+        (lambda d: d.update(schema_version=7), "schema_version", "version 1"),
+        (lambda d: d["task_locations"][0].update(component="oru_9"), "task_locations[0].component", "no component called 'oru_9'"),
+        (lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]), "components[2].features.pin_tip", "list of 3 numbers"),
+    ],
+)
+def test_bad_files_name_file_and_field(cell_copy, mutate, field, message):
+    path, data = cell_copy
+    mutate(data)
+    with pytest.raises(FileFormatError) as info:
+        load_workcell(_write(path, data))
+    assert info.value.field == field
+    assert message in str(info.value)
+    assert str(path) in str(info.value)
+
+
+def test_unreadable_files(tmp_path, cell_copy):
+    path, _ = cell_copy
+    path.write_text("components: [unclosed")
+    with pytest.raises(FileFormatError, match="not valid YAML"):
+        load_workcell(path)
+    with pytest.raises(FileFormatError, match="no such workcell file"):
+        load_workcell(tmp_path / "none.yaml")
+    broken = path.parent / "meshes" / "rack.stl"
+    broken.write_bytes(b"solid nonsense\nthis is not an stl\n")
+    path.write_text((DEFAULT_WORKCELL).read_text())
+    with pytest.raises(FileFormatError, match=r"components\[1\].mesh"):
+        load_workcell(path)
