@@ -50,7 +50,7 @@ def orbital_unit():
     """An orbital replacement unit with a grappling fixture on its front face.
 
     Frame: origin at the centre of the front face's fixture plate surface; x out of the face
-    (toward the robot), y left, z up. The box body lies behind (x < 0), 300 wide, 220 high,
+    (toward the robot), y to the right as seen from the robot, z up. The box body lies behind (x < 0), 300 wide, 220 high,
     280 deep, its bottom at z = -110."""
     body = box((280, 300, 220), (-140 - 6, 0, 0))
     plate = box((6, 160, 120), (-3, 0, 0))
@@ -62,7 +62,7 @@ def orbital_unit():
 
 
 def drawer():
-    """A drawer unit: frame at the front face centre, x out of the face, y left, z up."""
+    """A drawer unit: frame at the front face centre, x out of the face, y to the right as seen from the robot, z up."""
     cabinet = box((400, 500, 300), (-200, 0, 0))
     front = box((10, 460, 240), (5, 0, 0))
     handle = box((20, 200, 20), (25, 0, 60))

@@ -1,0 +1,60 @@
+"""Scene items as VTK actors: built once per mesh, moved by their poses, restyled per render."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+import vtk
+
+from calib_core.scene import SceneItem
+
+
+def vtk_matrix(T: np.ndarray) -> vtk.vtkMatrix4x4:
+    m = vtk.vtkMatrix4x4()
+    for i in range(4):
+        for j in range(4):
+            m.SetElement(i, j, float(T[i, j]))
+    return m
+
+
+class ItemActor:
+    """One scene item: a surface actor, and lazily its feature-edge actor for overlays."""
+
+    def __init__(self, item: SceneItem):
+        self.item = item
+        self.polydata = pv.wrap(item.mesh)
+        mapper = vtk.vtkPolyDataMapper()
+        mapper.SetInputData(self.polydata)
+        mapper.ScalarVisibilityOff()
+        self.surface = vtk.vtkActor()
+        self.surface.SetMapper(mapper)
+        self._edges: vtk.vtkActor | None = None
+        self.set_pose(item.item2world)
+
+    def set_pose(self, item2world: np.ndarray) -> None:
+        self.item.item2world = np.asarray(item2world, dtype=float)
+        m = vtk_matrix(self.item.item2world)
+        self.surface.SetUserMatrix(m)
+        if self._edges is not None:
+            self._edges.SetUserMatrix(m)
+
+    @property
+    def edges(self) -> vtk.vtkActor:
+        """Outline and crease edges (dihedral angle over 30 deg), the lines a CAD overlay shows."""
+        if self._edges is None:
+            fe = vtk.vtkFeatureEdges()
+            fe.SetInputData(self.polydata)
+            fe.BoundaryEdgesOn()
+            fe.FeatureEdgesOn()
+            fe.SetFeatureAngle(30.0)
+            fe.ManifoldEdgesOff()
+            fe.NonManifoldEdgesOff()
+            fe.ColoringOff()
+            fe.Update()
+            mapper = vtk.vtkPolyDataMapper()
+            mapper.SetInputData(fe.GetOutput())
+            mapper.ScalarVisibilityOff()
+            self._edges = vtk.vtkActor()
+            self._edges.SetMapper(mapper)
+            self._edges.SetUserMatrix(vtk_matrix(self.item.item2world))
+        return self._edges
