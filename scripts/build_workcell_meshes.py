@@ -47,18 +47,22 @@ def rack():
 
 
 def orbital_unit():
-    """An orbital replacement unit with a grappling fixture on its front face.
+    """An orbital replacement unit's body (its grappling fixture is a separate component).
 
     Frame: origin at the centre of the front face's fixture plate surface; x out of the face
-    (toward the robot), y to the right as seen from the robot, z up. The box body lies behind (x < 0), 300 wide, 220 high,
-    280 deep, its bottom at z = -110."""
-    body = box((280, 300, 220), (-140 - 6, 0, 0))
+    (toward the robot), y to the right as seen from the robot, z up. The body lies behind
+    (x < -6, under the 6 mm plate), 300 wide, 220 high, 280 deep, its bottom at z = -110."""
+    return box((280, 300, 220), (-140 - 6, 0, 0))
+
+
+def grappling_fixture():
+    """The grappling fixture on an ORU's front face, in the ORU's frame: a 160 x 120 x 6 mm plate,
+    a pin (radius 12, 40 long) with a knob, and four target bosses (radius 10, 4 high)."""
     plate = box((6, 160, 120), (-3, 0, 0))
     pin = cylinder(12, 40, (20, 0, 0), axis="x", sections=24)
     knob = cylinder(20, 10, (40, 0, 0), axis="x", sections=24)
-    # Target marks: two raised bosses with holes drawn as darker insets.
     bosses = [cylinder(10, 4, (2, y, z), axis="x", sections=20) for y, z in ((-55, 40), (55, 40), (-55, -40), (55, -40))]
-    return trimesh.util.concatenate([body, plate, pin, knob, *bosses])
+    return trimesh.util.concatenate([plate, pin, knob, *bosses])
 
 
 def drawer():
@@ -95,6 +99,7 @@ def floor():
 MESHES = {
     "rack.stl": rack,
     "orbital_unit.stl": orbital_unit,
+    "grappling_fixture.stl": grappling_fixture,
     "drawer.stl": drawer,
     "tool_station.stl": tool_station,
     "gripper_tool.stl": gripper_tool,

@@ -249,22 +249,24 @@ class SceneRenderer:
         return depth_from_zbuffer(zbuf)
 
     # --- picking -----------------------------------------------------------------------
-    def pick(self, u: float, v: float, *, snap_radius_px: float = 12.0, components_only: bool = True) -> PickResult | None:
-        """What pixel ``(u, v)`` of the last virtual-camera render shows, snapped to the nearest
-        visible named feature within ``snap_radius_px`` (of the component hit, or of any
-        component when the click fell just off one, e.g. beside a corner); ``None`` when
-        nothing pickable is there."""
+    def pick(self, u: float, v: float, *, snap_radius_px: float = 12.0, components: set[str] | None = None) -> PickResult | None:
+        """What pixel ``(u, v)`` of the last virtual-camera render shows.
+
+        The nearest visible named feature within ``snap_radius_px`` wins (so a click just
+        beside a corner still takes the corner); otherwise the surface point hit. Only items of
+        kind ``component`` are picked, and only those in ``components`` when given (the
+        calibration's target object). ``None`` when nothing pickable is there."""
         if self._last is None:
             raise RuntimeError("pick works on the last render_view")
+        allowed = [a.item for a in self._actors.values() if a.item.kind == "component" and (components is None or a.item.name in components)]
+        snapped = self._snap(u, v, snap_radius_px, allowed)
+        if snapped is not None:
+            return snapped
         name, world = self._ray_hit(u, v)
-        hit = self._actors[name].item if name is not None else None
-        if hit is not None and (hit.kind == "component" or not components_only):
-            snapped = self._snap(u, v, snap_radius_px, [hit])
-            if snapped is not None:
-                return snapped
-            return PickResult(hit.name, apply(invert(hit.item2world), world), world, None, 0.0)
-        candidates = [a.item for a in self._actors.values() if a.item.kind == "component" and a.item.features]
-        return self._snap(u, v, snap_radius_px, candidates)
+        if name is None or all(item.name != name for item in allowed):
+            return None
+        hit = self._actors[name].item
+        return PickResult(hit.name, apply(invert(hit.item2world), world), world, None, 0.0)
 
     def _ray_hit(self, u: float, v: float) -> tuple[str | None, np.ndarray | None]:
         _, h = self.window.GetSize()

@@ -27,7 +27,7 @@ def scene():
     renderer = SceneRenderer()
     renderer.set_items(cell.components + RobotVisuals.from_robot(robot).scene_items(q))
     cam2world = robot.fk(q, "camera")
-    image = renderer.render_view(intr, cam2world, RenderOptions(highlight="oru_1", show_features=True, feature_names=True))
+    image = renderer.render_view(intr, cam2world, RenderOptions(highlight="oru_1_fixture", show_features=True, feature_names=True))
     OUTPUT.mkdir(exist_ok=True)
     cv2.imwrite(str(OUTPUT / "render_virtual_oru_1.png"), image[:, :, ::-1])
     overview = renderer.render_overview(options=RenderOptions(highlight="oru_1"))
@@ -39,7 +39,7 @@ def scene():
 
 def test_the_target_fills_the_middle_of_the_view(scene):
     cell, intr, cam2world, _, image = scene
-    oru = cell.component("oru_1")
+    oru = cell.component("oru_1_fixture")
     px = project(apply(invert(cam2world), apply(oru.item2world, np.array(list(oru.features.values())))), intr, distort=False)
     assert intr.contains(px, margin_px=10).all()
     u, v = np.round(px[list(oru.features).index("pin_tip")]).astype(int)
@@ -48,23 +48,23 @@ def test_the_target_fills_the_middle_of_the_view(scene):
 
 def test_picking_a_feature_pixel_returns_that_feature(scene):
     cell, intr, cam2world, renderer, _ = scene
-    oru = cell.component("oru_1")
-    for name in ("plate_top_left", "boss_bottom_right", "pin_tip", "box_top_right"):
-        p_world = apply(oru.item2world, oru.features[name])
+    for component, name in (("oru_1_fixture", "plate_top_left"), ("oru_1_fixture", "boss_bottom_right"), ("oru_1_fixture", "pin_tip"), ("oru_1", "box_top_right")):
+        item = cell.component(component)
+        p_world = apply(item.item2world, item.features[name])
         u, v = project(apply(invert(cam2world), p_world[None]), intr, distort=False)[0]
         hit = renderer.pick(u + 2.0, v - 1.5, snap_radius_px=8)
-        assert hit is not None and hit.component == "oru_1" and hit.feature == name
-        assert np.allclose(hit.point_component_mm, oru.features[name])
+        assert hit is not None and hit.component == component and hit.feature == name
+        assert np.allclose(hit.point_component_mm, item.features[name])
 
 
 def test_picking_a_plain_surface_point_round_trips_within_half_a_mm(scene):
     cell, intr, cam2world, renderer, _ = scene
-    oru = cell.component("oru_1")
+    oru = cell.component("oru_1_fixture")
     point = np.array([0.0, 30.0, -20.0])  # on the fixture plate, away from every feature
     p_world = apply(oru.item2world, point)
     u, v = project(apply(invert(cam2world), p_world[None]), intr, distort=False)[0]
     hit = renderer.pick(u, v, snap_radius_px=0)
-    assert hit.component == "oru_1" and hit.feature is None
+    assert hit.component == "oru_1_fixture" and hit.feature is None
     assert np.linalg.norm(hit.point_component_mm - point) < 0.5
     # The depth buffer agrees with the pick.
     depth = renderer.depth_mm()[int(round(v)), int(round(u))]

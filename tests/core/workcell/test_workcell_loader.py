@@ -20,7 +20,7 @@ def test_bundled_workcell():
     grasp = cell.task("oru_1_grasp")
     assert np.allclose(grasp.tcp2base[:3, 3], [1146.24, -428.85, 1367.70])
     # The task location grasps the fixture pin: 25 mm in front of the plate, on its axis.
-    pin_axis_point = cell.feature_in_base("oru_1", "pin_tip")
+    pin_axis_point = cell.feature_in_base("oru_1_fixture", "pin_tip")
     assert np.linalg.norm(pin_axis_point - grasp.tcp2base[:3, 3]) == pytest.approx(20.0, abs=0.1)
     # Both the grasp and its approach are reachable.
     robot = load_robot(cell.robot_urdf)

@@ -1,0 +1,46 @@
+"""Lens distortion applied to an ideal render: where each pixel of the distorted image samples
+the ideal one. The ideal render is made larger than the image (same focal lengths, shifted
+principal point) so that barrel distortion's corners still find something to sample."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project, unproject
+
+
+@dataclass(frozen=True)
+class DistortionMap:
+    """``ideal``: the intrinsics to render (no distortion, larger canvas); ``map_x``/``map_y``
+    (h, w) float32: for each pixel of the real (distorted) image, its position in the ideal render."""
+
+    ideal: Intrinsics
+    map_x: np.ndarray
+    map_y: np.ndarray
+
+    def apply(self, ideal_image: np.ndarray) -> np.ndarray:
+        """The distorted image (h, w, c) from an ideal render of ``self.ideal``."""
+        return cv2.remap(ideal_image, self.map_x, self.map_y, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
+def distortion_map(intrinsics: Intrinsics) -> DistortionMap:
+    """The map for a camera with lens distortion (identity-sized canvas when there is none)."""
+    w, h = intrinsics.width, intrinsics.height
+    u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
+    pixels = np.column_stack([u.ravel(), v.ravel()])
+    if not intrinsics.has_distortion:
+        return DistortionMap(intrinsics, u.astype(np.float32), v.astype(np.float32))
+    ideal_px = project(unproject(pixels, intrinsics, undistort=True), intrinsics, distort=False)
+    lo = np.floor(ideal_px.min(axis=0)) - 2
+    hi = np.ceil(ideal_px.max(axis=0)) + 2
+    left, top = max(0.0, -lo[0]), max(0.0, -lo[1])
+    width = int(max(hi[0], w - 1) + left + 1)
+    height = int(max(hi[1], h - 1) + top + 1)
+    ideal = Intrinsics(intrinsics.fu, intrinsics.fv, intrinsics.cx + left, intrinsics.cy + top, width, height)
+    map_x = (ideal_px[:, 0] + left).reshape(h, w).astype(np.float32)
+    map_y = (ideal_px[:, 1] + top).reshape(h, w).astype(np.float32)
+    return DistortionMap(ideal, map_x, map_y)

@@ -1,0 +1,108 @@
+"""The simulated gripper camera: what a real camera on the *true* robot would see.
+
+Renders the workcell and robot from the true camera pose with lighting unlike the CAD
+views, applies the lens distortion, vignetting, sensor noise and optional blur;
+deterministic for a seed. It is a :class:`FrameSource` like any camera, and it reports its
+ground truth for tests.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.render import RenderOptions, SceneRenderer
+from calib_core.scene import SceneItem
+from calib_core.testbed.lens import distortion_map
+from calib_core.video.frame import Frame, FrameSource
+
+
+@dataclass(frozen=True)
+class CameraLook:
+    """Image formation beyond geometry: ``noise_sigma`` (grey levels), ``blur_sigma_px`` (0: none),
+    ``vignetting`` (relative darkening at the corners), ``gain`` and ``light_direction`` (of
+    the key light, world frame) so the image does not look like the CAD render."""
+
+    noise_sigma: float = 2.5
+    blur_sigma_px: float = 0.0
+    vignetting: float = 0.25
+    gain: float = 0.92
+    light_direction: tuple[float, float, float] = (-0.5, 0.4, 0.8)
+    light_intensity: float = 0.8
+    background: tuple[float, float, float] = (0.30, 0.31, 0.33)
+
+
+@dataclass(frozen=True)
+class CameraTruth:
+    """Ground truth of one simulated frame: the true ``cam2world`` (4, 4) mm, the commanded
+    joints (deg) and the true intrinsics."""
+
+    cam2world: np.ndarray
+    q_commanded_deg: np.ndarray
+    intrinsics: Intrinsics
+
+
+class SimulatedCamera(FrameSource):
+    """Frames of the test bed's camera. ``scene_at(q)`` gives the scene items at commanded
+    joints (workcell plus true robot), ``cam2world_at(q)`` the true camera pose, ``joints()``
+    the current commanded joints (deg)."""
+
+    description = "simulated camera"
+
+    def __init__(self, intrinsics: Intrinsics, scene_at: Callable[[np.ndarray], list[SceneItem]], cam2world_at: Callable[[np.ndarray], np.ndarray], joints: Callable[[], np.ndarray], *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0):
+        self.intrinsics = intrinsics
+        self._scene_at = scene_at
+        self._cam2world_at = cam2world_at
+        self._joints = joints
+        self._fps = float(fps)
+        self.look = look or CameraLook()
+        self._rng = np.random.default_rng(seed)
+        self._map = distortion_map(intrinsics)
+        self._renderer: SceneRenderer | None = None
+        self._index = 0
+        self._vignette = self._vignette_mask()
+        self.last_truth: CameraTruth | None = None
+
+    @property
+    def fps(self) -> float:
+        return self._fps
+
+    def _vignette_mask(self) -> np.ndarray:
+        h, w = self.intrinsics.height, self.intrinsics.width
+        y, x = np.mgrid[0:h, 0:w]
+        r2 = ((x - self.intrinsics.cx) / (w / 2)) ** 2 + ((y - self.intrinsics.cy) / (h / 2)) ** 2
+        return (self.look.gain * (1.0 - self.look.vignetting * np.clip(r2 / 2.0, 0, 1)))[..., None].astype(np.float32)
+
+    def render(self, q_commanded_deg: np.ndarray) -> tuple[np.ndarray, CameraTruth]:
+        """One image (h, w, 3) uint8 RGB at the given commanded joints, with its truth."""
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self._map.ideal.width, self._map.ideal.height)
+            self._renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
+        q = np.asarray(q_commanded_deg, dtype=float)
+        self._renderer.set_items(self._scene_at(q))
+        cam2world = self._cam2world_at(q)
+        ideal = self._renderer.render_view(self._map.ideal, cam2world, RenderOptions(background=self.look.background, show_edges=False))
+        image = self._map.apply(ideal).astype(np.float32) * self._vignette
+        if self.look.blur_sigma_px > 0:
+            image = cv2.GaussianBlur(image, (0, 0), self.look.blur_sigma_px)
+        if self.look.noise_sigma > 0:
+            image += self._rng.normal(0.0, self.look.noise_sigma, image.shape).astype(np.float32)
+        image = np.clip(image, 0, 255).astype(np.uint8)
+        return image, CameraTruth(cam2world, q, self.intrinsics)
+
+    def read(self) -> Frame | None:
+        image, truth = self.render(self._joints())
+        self.last_truth = truth
+        frame = Frame(image, self._index, time.monotonic(), self._index / self._fps if self._fps else None)
+        self._index += 1
+        return frame
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None

@@ -1,0 +1,63 @@
+"""The simulated test bed: the workcell, the model robot, the true robot and its camera.
+
+Everything the real site would provide, with its truth known: tests and the demo drive the
+whole calibration loop against it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.robot.model import RobotModel, load_robot
+from calib_core.robot.visuals import RobotVisuals
+from calib_core.scene import SceneItem
+from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
+from calib_core.testbed.true_robot import RobotErrors, TrueRobot
+from calib_core.workcell import Workcell, load_workcell
+
+
+@dataclass
+class TestBed:
+    """A simulated site. ``joints_deg`` holds the commanded joints (what the controller reports)."""
+
+    workcell: Workcell
+    model_robot: RobotModel
+    true_robot: TrueRobot
+    intrinsics: Intrinsics
+    visuals: RobotVisuals
+    joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+    __test__ = False  # not a pytest test class despite its name
+
+    @classmethod
+    def create(cls, workcell: Workcell | None = None, errors: RobotErrors | None = None, intrinsics: Intrinsics | None = None) -> TestBed:
+        """The bundled workcell with typical robot errors (seed 0) unless told otherwise."""
+        cell = workcell or load_workcell()
+        model = load_robot(cell.robot_urdf)
+        true = TrueRobot(model, RobotErrors.typical(0) if errors is None else errors)
+        intr = intrinsics or load_intrinsics(cell.intrinsics_path)
+        return cls(cell, model, true, intr, RobotVisuals.from_robot(true.robot), np.array(cell.home_joints_deg, dtype=float))
+
+    def true_scene(self, q_commanded_deg: ArrayLike) -> list[SceneItem]:
+        """Workcell plus the true robot's links where they really are at commanded joints."""
+        q_true = self.true_robot.true_joints(q_commanded_deg)
+        base = self.true_robot.base_true2base_model
+        links = self.visuals.scene_items(q_true)
+        for item in links:
+            item.item2world = base @ item.item2world
+        return list(self.workcell.components) + links
+
+    def true_cam2world(self, q_commanded_deg: ArrayLike) -> np.ndarray:
+        return self.true_robot.fk(q_commanded_deg, "camera")
+
+    def model_cam2world(self, q_commanded_deg: ArrayLike) -> np.ndarray:
+        return self.model_robot.fk(q_commanded_deg, "camera")
+
+    def camera(self, *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0, intrinsics: Intrinsics | None = None) -> SimulatedCamera:
+        """The test bed's camera, following ``joints_deg``."""
+        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, lambda: self.joints_deg.copy(), fps=fps, look=look, seed=seed)

@@ -1,0 +1,88 @@
+"""The simulated test bed: the true robot differs from the model as real robots do, and the
+simulated camera sees the true pose through the real lens."""
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import trimesh
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert, make_transform, pose_difference
+from calib_core.robot import solve_ik
+from calib_core.scene import SceneItem
+from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
+from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.true_robot import RobotErrors
+
+OUTPUT = Path(__file__).resolve().parents[2] / "output"
+SMALL_LENS = Intrinsics(280.0, 279.0, 161.3, 119.2, 320, 240, (-0.18, 0.07, 0.0006, -0.0004, -0.01))
+
+
+@pytest.fixture(scope="module")
+def bed():
+    return TestBed.create()
+
+
+def test_commanding_model_joints_leaves_the_true_tool_a_few_mm_off(bed):
+    q = solve_ik(bed.model_robot, bed.workcell.task("oru_1_grasp").tcp2base, bed.workcell.home_joints_deg).q_deg
+    d, rv = pose_difference(bed.true_robot.fk(q), bed.model_robot.fk(q))
+    assert 1.0 < np.linalg.norm(d) < 15.0
+    assert 0.05 < np.linalg.norm(rv) < 1.5
+    exact = TestBed.create(errors=RobotErrors.none())
+    assert np.allclose(exact.true_robot.fk(q), exact.model_robot.fk(q), atol=1e-9)
+    assert np.allclose(exact.true_cam2world(q), exact.model_cam2world(q), atol=1e-9)
+
+
+def test_hand_eye_error_moves_only_the_camera(bed):
+    errors = RobotErrors(hand_eye_xyz_mm=np.array([1.0, -2.0, 0.5]))
+    other = TestBed.create(errors=errors)
+    q = np.array([-20.0, 10.0, 5.0, 0.0, -15.0, 0.0])
+    assert np.allclose(other.true_robot.fk(q, "tcp"), other.model_robot.fk(q, "tcp"), atol=1e-9)
+    cam_true_in_model_cam = invert(other.model_cam2world(q)) @ other.true_cam2world(q)
+    assert np.allclose(cam_true_in_model_cam[:3, 3], [1.0, -2.0, 0.5], atol=1e-9)
+
+
+def _bright_dot_camera(points_world, look):
+    dots = [SceneItem(f"dot{i}", trimesh.creation.icosphere(radius=1.2, subdivisions=2), make_transform(np.eye(3), p), color=(1, 1, 1)) for i, p in enumerate(points_world)]
+    cam2world = np.eye(4)
+    return SimulatedCamera(SMALL_LENS, lambda q: dots, lambda q: cam2world, lambda: np.zeros(6), look=look)
+
+
+def test_features_land_where_the_distorted_projection_puts_them():
+    rng = np.random.default_rng(3)
+    targets = np.column_stack([rng.uniform(25, 295, 8), rng.uniform(20, 220, 8)])
+    from calib_core.camera.projection import unproject
+
+    points = unproject(targets, SMALL_LENS, undistort=True, depth_mm=400.0)
+    look = CameraLook(noise_sigma=0.0, vignetting=0.0, gain=1.0, background=(0, 0, 0))
+    for p, target in zip(points, targets):
+        cam = _bright_dot_camera([p], look)
+        image = cam.read().image
+        grey = image.astype(float).sum(axis=2)
+        ys, xs = np.nonzero(grey > 60)
+        centroid = np.array([np.average(xs, weights=grey[ys, xs]), np.average(ys, weights=grey[ys, xs])])
+        assert np.linalg.norm(centroid - project(p[None], SMALL_LENS)[0]) < 0.5
+        cam.close()
+
+
+def test_frames_are_deterministic_for_a_seed_and_report_truth(bed):
+    bed.joints_deg = solve_ik(bed.model_robot, bed.workcell.task("oru_1_grasp").approach2base, bed.workcell.home_joints_deg).q_deg
+    small = bed.intrinsics.scaled(0.25)
+    a = bed.camera(seed=7, intrinsics=small)
+    b = bed.camera(seed=7, intrinsics=small)
+    c = bed.camera(seed=8, intrinsics=small)
+    fa, fb, fc = a.read(), b.read(), c.read()
+    assert fa.image.shape == (240, 320, 3) and fa.index == 0 and a.read().index == 1
+    assert np.array_equal(fa.image, fb.image)
+    assert not np.array_equal(fa.image, fc.image)
+    assert np.allclose(a.last_truth.cam2world, bed.true_cam2world(bed.joints_deg))
+    # The truth is not the model: the camera really is somewhere else.
+    d, _ = pose_difference(a.last_truth.cam2world, bed.model_cam2world(bed.joints_deg))
+    assert np.linalg.norm(d) > 0.5
+    OUTPUT.mkdir(exist_ok=True)
+    cv2.imwrite(str(OUTPUT / "sim_camera_oru_1_approach.png"), fa.image[:, :, ::-1])
+    for cam in (a, b, c):
+        cam.close()
