@@ -27,6 +27,7 @@ def _register(name: str, module: str, help_text: str) -> None:
 
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
+_register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 
 class _Parser(argparse.ArgumentParser):

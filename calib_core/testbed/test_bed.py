@@ -31,6 +31,7 @@ class TestBed:
     intrinsics: Intrinsics
     visuals: RobotVisuals
     joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    _model_visuals: RobotVisuals | None = field(default=None, repr=False)
 
     __test__ = False  # not a pytest test class despite its name
 
@@ -51,6 +52,12 @@ class TestBed:
         for item in links:
             item.item2world = base @ item.item2world
         return list(self.workcell.components) + links
+
+    def visuals_for_model(self) -> RobotVisuals:
+        """The modelled robot's visuals (the CAD view draws the model, not the truth)."""
+        if self._model_visuals is None:
+            self._model_visuals = RobotVisuals.from_robot(self.model_robot)
+        return self._model_visuals
 
     def true_cam2world(self, q_commanded_deg: ArrayLike) -> np.ndarray:
         return self.true_robot.fk(q_commanded_deg, "camera")

@@ -1,0 +1,95 @@
+"""``videocal render``: write a PNG of the workcell from the modelled camera, the overview
+camera, or the simulated true camera.
+
+``--location NAME`` drives the robot (by IK) to the task location's approach pose, from which
+the camera sees its component; ``--joints`` sets the joints directly; neither renders the
+home pose.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from calib_core.atomic_file import atomic_write_bytes
+from calib_core.errors import VideocalError
+from calib_core.workcell import DEFAULT_WORKCELL
+
+VIEWS = ("virtual", "overview", "true")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--joints", help="six joint values in degrees, comma separated")
+    where.add_argument("--location", help="a task location: the robot goes to its approach pose")
+    parser.add_argument("--view", choices=VIEWS, default="virtual", help="virtual (modelled camera), overview, or true (the simulated camera on the true robot)")
+    parser.add_argument("--out", type=Path, required=True, help="PNG file to write")
+    parser.add_argument("--highlight", help="component to highlight (default: the location's component)")
+    parser.add_argument("--features", action="store_true", help="show feature points and their names")
+    parser.add_argument("--style", choices=("surface", "wireframe", "edges"), default="surface")
+    parser.add_argument("--scale", type=float, default=1.0, help="image size relative to the camera's (virtual and true views)")
+
+
+def _joints(text: str) -> np.ndarray:
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise VideocalError(f"--joints: expected six numbers in degrees separated by commas, got {text!r}") from None
+    if len(values) != 6 or not np.all(np.isfinite(values)):
+        raise VideocalError(f"--joints: expected six finite numbers in degrees, got {len(values)}: {text!r}")
+    return np.array(values)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.out.suffix.lower() != ".png":
+        raise VideocalError(f"--out: the image is written as PNG; name it *.png, got {args.out}")
+    if not (0.05 <= args.scale <= 4.0):
+        raise VideocalError(f"--scale must lie between 0.05 and 4, got {args.scale}")
+    from calib_core.render import RenderOptions, SceneRenderer
+    from calib_core.robot import solve_ik
+    from calib_core.testbed.test_bed import TestBed
+    from calib_core.workcell import load_workcell
+
+    cell = load_workcell(args.workcell)
+    bed = TestBed.create(cell)
+    highlight = args.highlight
+    q = np.array(cell.home_joints_deg, dtype=float)
+    if args.joints:
+        q = bed.model_robot.check_joints(_joints(args.joints))
+    elif args.location:
+        try:
+            task = cell.task(args.location)
+        except KeyError as exc:
+            raise VideocalError(str(exc.args[0])) from None
+        q = solve_ik(bed.model_robot, task.approach2base, q).q_deg
+        highlight = highlight or task.component
+    if highlight is not None:
+        try:
+            cell.component(highlight)
+        except KeyError as exc:
+            raise VideocalError(str(exc.args[0])) from None
+    intr = bed.intrinsics.scaled(args.scale)
+    options = RenderOptions(highlight=highlight, show_features=args.features, feature_names=args.features, style=args.style)
+    if args.view == "true":
+        bed.joints_deg = q
+        camera = bed.camera(intrinsics=intr)
+        image = camera.read().image
+        camera.close()
+    else:
+        renderer = SceneRenderer()
+        renderer.set_items(cell.components + bed.visuals_for_model().scene_items(q))
+        if args.view == "virtual":
+            image = renderer.render_view(intr.without_distortion(), bed.model_cam2world(q), options)
+        else:
+            image = renderer.render_overview(options=options)
+        renderer.close()
+    ok, png = cv2.imencode(".png", np.ascontiguousarray(image[:, :, ::-1]))
+    if not ok:
+        raise VideocalError("could not encode the image as PNG")
+    atomic_write_bytes(args.out, png.tobytes())
+    print(f"wrote {args.out} ({image.shape[1]} x {image.shape[0]}, {args.view} view, joints {', '.join(f'{v:.2f}' for v in q)} deg)")
+    return 0
