@@ -1,0 +1,74 @@
+"""``videocal sim-controller``: a simulated robot controller speaking the wire protocol on a
+pty (its path is printed) or a loopback TCP port, with fault injection for tests and demos."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from calib_core.errors import VideocalError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    where = parser.add_mutually_exclusive_group(required=True)
+    where.add_argument("--pty", action="store_true", help="serve on a new pseudo-terminal and print its path")
+    where.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT (0 picks a free port)")
+    parser.add_argument("--link", type=Path, help="with --pty: keep a symlink at this path to the current pty (stable across --reboot-after)")
+    parser.add_argument("--robot", choices=("bundled", "plain"), default="bundled", help="joint limits and speeds of the bundled arm, or a plain joint-space model")
+    parser.add_argument("--joints", help="initial joints, six values in degrees separated by commas (default: home)")
+    parser.add_argument("--noise-rate", type=float, default=0.0, help="probability of random garbage bytes before a sentence")
+    parser.add_argument("--corrupt-rate", type=float, default=0.0, help="probability of a flipped byte in a sentence")
+    parser.add_argument("--drop-rate", type=float, default=0.0, help="probability that a sentence is not sent")
+    parser.add_argument("--disconnect-after", type=float, metavar="SECONDS", help="vanish after this many seconds (the process ends)")
+    parser.add_argument("--reboot-after", type=float, metavar="SECONDS", help="reboot after this many seconds: gone for --reboot-downtime, then back")
+    parser.add_argument("--reboot-downtime", type=float, default=1.0, metavar="SECONDS")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the fault injection")
+
+
+def run(args: argparse.Namespace) -> int:
+    from calib_core.link.controller_sim import ControllerLogic
+    from calib_core.link.faults import FaultInjector
+    from calib_core.link.joint_motion import PlainJointModel
+    from calib_core.link.sim_transport import SimOptions, serve
+
+    if args.link is not None and not args.pty:
+        raise VideocalError("--link applies to --pty")
+    if args.tcp is not None and not (0 <= args.tcp <= 65535):
+        raise VideocalError(f"--tcp: not a port number: {args.tcp}")
+    faults = FaultInjector(args.noise_rate, args.corrupt_rate, args.drop_rate, args.seed)
+    if args.robot == "bundled":
+        from calib_core.robot import load_robot
+
+        model = load_robot()
+    else:
+        model = PlainJointModel()
+    initial = np.zeros(6)
+    if args.joints:
+        try:
+            initial = np.array([float(v) for v in args.joints.split(",")])
+        except ValueError:
+            raise VideocalError(f"--joints: expected six numbers in degrees, got {args.joints!r}") from None
+        if initial.shape != (6,):
+            raise VideocalError(f"--joints: expected six numbers in degrees, got {len(initial)}")
+    stop = {"flag": False}
+
+    def on_signal(signum, frame):
+        stop["flag"] = True
+
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
+
+    def announce(path: str) -> None:
+        print(path, flush=True)
+
+    options = SimOptions(pty=args.pty, tcp_port=args.tcp, link_path=args.link, disconnect_after_s=args.disconnect_after, reboot_after_s=args.reboot_after, reboot_downtime_s=args.reboot_downtime)
+    try:
+        serve(ControllerLogic(model, initial), options, faults, announce, lambda: stop["flag"])
+    except OSError as exc:
+        raise VideocalError(f"cannot serve: {exc}") from None
+    print(f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} dropped", file=sys.stderr)
+    return 0

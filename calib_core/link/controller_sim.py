@@ -1,0 +1,126 @@
+"""The simulated robot controller's logic: it answers the wire protocol like the PDL2 program
+of the original system, moves with trapezoidal profiles and streams joint samples.
+
+Transport-free: :meth:`ControllerLogic.handle` turns incoming sentence bodies into replies
+and :meth:`ControllerLogic.tick` produces the due stream samples and move completions; the
+transports in :mod:`calib_core.link.sim_transport` carry the bytes.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from calib_core.link.joint_motion import JointModel, PlainJointModel, TrapezoidMove
+from calib_core.link.protocol import (
+    SEQ_MODULUS,
+    Ack,
+    Done,
+    ErrorReply,
+    JointSample,
+    MoveJoints,
+    ProtocolError,
+    RequestJoints,
+    RequestState,
+    StateReport,
+    Stream,
+    parse_body,
+)
+
+MAX_STREAM_HZ = 250.0
+
+
+class ControllerLogic:
+    """State of the controller: joints (deg), the current move, the stream rate.
+
+    ``clock`` returns seconds (monotonic); ``t_ms`` in samples counts from start-up.
+    ``report_joints`` maps the true joint state to what the encoders report (identity by
+    default; the test bed reports commanded joints, which is what a real controller does).
+    """
+
+    def __init__(self, joint_model: JointModel | None = None, initial_deg=None, clock: Callable[[], float] = time.monotonic, seq_start: int = 0):
+        self.model = joint_model or PlainJointModel()
+        self.clock = clock
+        self.t_start = clock()
+        self.joints_deg = np.zeros(6) if initial_deg is None else np.asarray(initial_deg, dtype=float).copy()
+        self.move: TrapezoidMove | None = None
+        self.move_id: str | None = None
+        self.stream_hz = 0.0
+        self._next_stream_t = 0.0
+        self.seq = seq_start % SEQ_MODULUS
+
+    def _sample(self) -> JointSample:
+        sample = JointSample(self.seq, int(round((self.clock() - self.t_start) * 1000.0)), tuple(float(q) for q in self.joints_deg))
+        self.seq = (self.seq + 1) % SEQ_MODULUS
+        return sample
+
+    def _update_motion(self, now: float) -> list:
+        out = []
+        if self.move is not None:
+            self.joints_deg = self.move.position(now)
+            if self.move.finished(now):
+                self.joints_deg = self.move.goal_deg.copy()
+                out.append(Done(self.move_id))
+                self.move, self.move_id = None, None
+        return out
+
+    def handle(self, body: str) -> list:
+        """Replies (messages) to one incoming sentence body."""
+        now = self.clock()
+        out = self._update_motion(now)
+        try:
+            msg = parse_body(body)
+        except ProtocolError as exc:
+            code = "UNKNOWN" if exc.kind == "unknown" else "SYNTAX"
+            return out + [ErrorReply(code, str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80])]
+        if isinstance(msg, RequestJoints):
+            out.append(self._sample())
+        elif isinstance(msg, Stream):
+            if msg.hz > MAX_STREAM_HZ:
+                out.append(ErrorReply("RANGE", f"stream rate {msg.hz:g} Hz above {MAX_STREAM_HZ:g} Hz"))
+            else:
+                self.stream_hz = msg.hz
+                self._next_stream_t = now
+                out.append(Ack("STR", "-"))
+        elif isinstance(msg, MoveJoints):
+            goal = np.asarray(msg.joints_deg, dtype=float)
+            lo, hi = np.asarray(self.model.lower_limits_deg), np.asarray(self.model.upper_limits_deg)
+            bad = np.flatnonzero((goal < lo) | (goal > hi))
+            if len(bad):
+                j = int(bad[0])
+                out.append(ErrorReply("LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} deg outside [{lo[j]:.1f}; {hi[j]:.1f}]"))
+            elif self.move is not None:
+                out.append(ErrorReply("BUSY", f"move {msg.id}: still executing move {self.move_id}"))
+            else:
+                self.move = TrapezoidMove.plan(self.joints_deg, goal, np.asarray(self.model.max_speed_deg_s), now)
+                self.move_id = msg.id
+                out.append(Ack("MVJ", msg.id))
+        elif isinstance(msg, RequestState):
+            state = "MOVING" if self.move is not None else "IDLE"
+            out.append(StateReport(state, f"stream {self.stream_hz:g} Hz"))
+        else:
+            out.append(ErrorReply("UNEXPECTED", f"{type(msg).__name__} is sent by a controller; not accepted"))
+        return out
+
+    def tick(self) -> list:
+        """Messages due now: a finished move's DON and the stream samples."""
+        now = self.clock()
+        out = self._update_motion(now)
+        if self.stream_hz > 0 and now >= self._next_stream_t:
+            out.append(self._sample())
+            period = 1.0 / self.stream_hz
+            self._next_stream_t += period
+            if self._next_stream_t < now - period:  # fell behind (a stall): do not burst to catch up
+                self._next_stream_t = now + period
+        return out
+
+    def next_deadline(self) -> float:
+        """When :meth:`tick` next has something to do (monotonic seconds)."""
+        deadlines = [self.clock() + 0.05]
+        if self.stream_hz > 0:
+            deadlines.append(self._next_stream_t)
+        if self.move is not None:
+            deadlines.append(self.move.t0_s + self.move.duration_s)
+        return min(deadlines)

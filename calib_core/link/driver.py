@@ -1,0 +1,361 @@
+"""The serial driver of the controller link: a reader thread over anything pyserial's
+``serial_for_url`` opens (a port, a pty, ``socket://``, ``rfc2217://``, ``loop://``).
+
+It polls (``$RQJ`` at a rate: the paper's cyclic request) or asks for a stream (``$STR``);
+assembles sentences from a dirty line; delivers each joint sample once, in order; watches
+for staleness; when the device disappears it reports it and reconnects with backoff,
+keeping the caller's state (callbacks, statistics, pending moves); tracks moves (MVJ with
+ACK/DON, ERR and timeouts). Nothing blocks the caller's thread and no exception escapes
+the reader thread except as a reported error. :meth:`ControllerLink.close` returns within 1 s.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+
+import serial
+
+from calib_core.link.assembler import SentenceAssembler
+from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
+from calib_core.link.protocol import (
+    N_JOINTS,
+    SEQ_MODULUS,
+    Ack,
+    Done,
+    ErrorReply,
+    JointSample,
+    MoveJoints,
+    ProtocolError,
+    RequestJoints,
+    RequestState,
+    StateReport,
+    Stream,
+    encode,
+    parse_body,
+)
+
+_READ_TIMEOUT_S = 0.01
+_BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
+MODES = ("poll", "stream")
+
+
+class ControllerLink:
+    """A link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
+    ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
+    at least 0.25 s). Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
+
+    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, **serial_settings):
+        if mode not in MODES:
+            raise ValueError(f"mode must be 'poll' or 'stream', got {mode!r}")
+        if not (0 < rate_hz <= 250):
+            raise ValueError(f"rate must lie in (0, 250] Hz, got {rate_hz}")
+        self.url = url
+        self.mode = mode
+        self.rate_hz = float(rate_hz)
+        self.stale_after_s = stale_after_s if stale_after_s is not None else max(5.0 / rate_hz, 0.25)
+        self.reconnect = reconnect
+        self._serial_settings = {"baudrate": 115200, **serial_settings}
+        try:
+            serial.serial_for_url(url, do_not_open=True, **self._serial_settings)
+        except (ValueError, serial.SerialException) as exc:
+            raise LinkError(f"unusable link URL {url!r}: {exc}") from None
+        self.stats = LinkStats()
+        self._state = LinkState.CLOSED
+        self._lock = threading.Lock()
+        self._write_lock = threading.Lock()
+        self._queue: deque[TimedSample] = deque(maxlen=queue_size)
+        self._latest: TimedSample | None = None
+        self._last_seq: int | None = None
+        self._sample_callbacks: list[Callable[[TimedSample], None]] = []
+        self._state_callbacks: list[Callable[[LinkState, str], None]] = []
+        self._moves: dict[str, MoveHandle] = {}
+        self._awaiting_ack: deque[MoveHandle] = deque()
+        self._state_reports: deque[StateReport] = deque(maxlen=16)
+        self._state_event = threading.Condition(self._lock)
+        self._ids = itertools.count(1)
+        self._port: serial.SerialBase | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._assembler = SentenceAssembler()
+        self.last_error: str | None = None
+
+    # --- life cycle ------------------------------------------------------------------------
+    def start(self, *, wait_open: bool = False) -> ControllerLink:
+        """Start the reader thread. With ``wait_open``, open the device here first and raise
+        :class:`LinkError` if that fails (a command line wants to know at once)."""
+        if self._thread is not None:
+            return self
+        if wait_open:
+            self._port = self._open()
+            self._on_open()
+        else:
+            self._set_state(LinkState.CONNECTING, "opening")
+        self._thread = threading.Thread(target=self._run, name=f"controller-link {self.url}", daemon=True)
+        self._thread.start()
+        return self
+
+    def close(self) -> None:
+        """Stop the thread and close the device (within about 1 s)."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=1.0)
+        self._close_port()
+        self._set_state(LinkState.CLOSED, "closed by the caller")
+        for move in list(self._moves.values()):
+            move._finish(MoveError(f"move {move.id}: the link was closed"))
+
+    def __enter__(self) -> ControllerLink:
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # --- what callers read ---------------------------------------------------------------
+    @property
+    def state(self) -> LinkState:
+        return self._state
+
+    @property
+    def latest(self) -> TimedSample | None:
+        return self._latest
+
+    def drain(self) -> list[TimedSample]:
+        """Every sample queued since the last drain, oldest first."""
+        with self._lock:
+            out = list(self._queue)
+            self._queue.clear()
+        return out
+
+    def stats_snapshot(self) -> dict[str, int]:
+        with self._lock:
+            return self.stats.as_dict()
+
+    def on_sample(self, callback: Callable[[TimedSample], None]) -> None:
+        """``callback(sample)`` on the reader thread for every sample (keep it short)."""
+        self._sample_callbacks.append(callback)
+
+    def on_state(self, callback: Callable[[LinkState, str], None]) -> None:
+        """``callback(state, reason)`` on the reader thread when the state changes."""
+        self._state_callbacks.append(callback)
+
+    # --- commands --------------------------------------------------------------------------
+    def move_joints(self, joints_deg, *, timeout_s: float = 60.0) -> MoveHandle:
+        """Send ``$MVJ`` and return its handle at once."""
+        q = tuple(float(v) for v in joints_deg)
+        if len(q) != N_JOINTS:
+            raise ValueError(f"a move needs {N_JOINTS} joint values, got {len(q)}")
+        handle = MoveHandle(f"m{next(self._ids)}", q, time.monotonic() + timeout_s)
+        with self._lock:
+            self._moves[handle.id] = handle
+            self._awaiting_ack.append(handle)
+        if not self._send(MoveJoints(handle.id, q).body()):
+            with self._lock:
+                self._moves.pop(handle.id, None)
+                if handle in self._awaiting_ack:
+                    self._awaiting_ack.remove(handle)
+            handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
+        return handle
+
+    def request_state(self, timeout_s: float = 1.0) -> StateReport | None:
+        """Ask ``$STA`` and wait for the report (``None`` on timeout)."""
+        with self._lock:
+            self._state_reports.clear()
+        self._send(RequestState().body())
+        with self._state_event:
+            self._state_event.wait_for(lambda: bool(self._state_reports), timeout_s)
+            return self._state_reports.popleft() if self._state_reports else None
+
+    def wait_for_samples(self, count: int, timeout_s: float) -> bool:
+        """Block until ``count`` samples have been delivered in all (``stats.samples``)."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.stats.samples >= count:
+                return True
+            time.sleep(0.005)
+        return self.stats.samples >= count
+
+    # --- internals -------------------------------------------------------------------------
+    def _open(self) -> serial.SerialBase:
+        try:
+            port = serial.serial_for_url(self.url, timeout=_READ_TIMEOUT_S, write_timeout=0.5, **self._serial_settings)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise LinkError(f"cannot open {self.url}: {exc}") from None
+        return port
+
+    def _on_open(self) -> None:
+        """A fresh connection: forget stale bytes and partial sentences, set the controller's stream."""
+        try:
+            self._port.reset_input_buffer()
+        except (serial.SerialException, OSError, AttributeError):
+            pass
+        self._assembler.reset()
+        self._set_state(LinkState.CONNECTING, "open, waiting for samples")
+        # Polling stops any stream a previous session left running; streaming (re)starts it.
+        self._send(Stream(self.rate_hz if self.mode == "stream" else 0).body())
+
+    def _close_port(self) -> None:
+        port, self._port = self._port, None
+        if port is not None:
+            try:
+                port.close()
+            except Exception:  # closing a vanished device may fail in many ways; it is gone either way
+                pass
+
+    def _send(self, body: str) -> bool:
+        port = self._port
+        if port is None:
+            return False
+        try:
+            with self._write_lock:
+                port.write(encode(body))
+            return True
+        except (serial.SerialException, OSError, ValueError) as exc:
+            self.last_error = f"write failed: {exc}"
+            return False
+
+    def _set_state(self, state: LinkState, reason: str) -> None:
+        if state is self._state:
+            return
+        self._state = state
+        for cb in list(self._state_callbacks):
+            try:
+                cb(state, reason)
+            except Exception as exc:  # a caller's bug must not kill the link
+                self.stats.errors += 1
+                self.last_error = f"state callback failed: {exc!r}"
+
+    def _run(self) -> None:
+        backoff = iter(_BACKOFF_S)
+        next_poll = 0.0
+        last_sample_t = time.monotonic()
+        while not self._stop.is_set():
+            if self._port is None:
+                try:
+                    self._port = self._open()
+                except LinkError as exc:
+                    self.last_error = str(exc)
+                    self._set_state(LinkState.DOWN, str(exc))
+                    if not self.reconnect:
+                        return
+                    self._stop.wait(next(backoff, _BACKOFF_S[-1]))
+                    continue
+                backoff = iter(_BACKOFF_S)
+                self._on_open()
+                last_sample_t = time.monotonic()
+            try:
+                port = self._port
+                data = port.read(max(1, port.in_waiting))
+            except (serial.SerialException, OSError, TypeError, AttributeError) as exc:
+                # The device vanished (USB unplugged, controller rebooted, server gone).
+                self._close_port()
+                with self._lock:
+                    self.stats.reconnects += 1
+                self.last_error = f"device lost: {exc}"
+                self._set_state(LinkState.DOWN, f"device lost: {exc}")
+                continue
+            now = time.monotonic()
+            if data:
+                for body in self._assembler.feed(data):
+                    if self._dispatch(body, now):
+                        last_sample_t = now
+                self._sync_counts()
+            if self.mode == "poll" and now >= next_poll:
+                self._send(RequestJoints().body())
+                next_poll = max(next_poll + 1.0 / self.rate_hz, now)
+            if self._state in (LinkState.UP, LinkState.CONNECTING) and now - last_sample_t > self.stale_after_s:
+                self._set_state(LinkState.STALE, f"no joint sample for {now - last_sample_t:.2f} s")
+                if self.mode == "stream":
+                    self._send(Stream(self.rate_hz).body())  # a controller that forgot the stream gets asked again
+                    last_sample_t = now
+            self._expire_moves(now)
+
+    def _sync_counts(self) -> None:
+        c = self._assembler.counts
+        with self._lock:
+            s = self.stats
+            s.garbage_bytes, s.bad_checksum, s.too_long = c.garbage_bytes, c.bad_checksum, c.too_long
+            s.sentences = c.sentences
+            s.malformed = c.malformed + self._field_errors
+
+    _field_errors = 0
+
+    def _dispatch(self, body: str, t_host: float) -> bool:
+        try:
+            msg = parse_body(body)
+        except ProtocolError as exc:
+            with self._lock:
+                if exc.kind == "non_finite":
+                    self.stats.non_finite += 1
+                elif exc.kind == "unknown":
+                    self.stats.unknown += 1
+                else:
+                    self._field_errors += 1
+            return False
+        if isinstance(msg, JointSample):
+            self._deliver(TimedSample(msg, t_host))
+            return True
+        if isinstance(msg, Ack) and msg.cmd == "MVJ":
+            with self._lock:
+                handle = self._moves.get(msg.id)
+                if handle is not None:
+                    handle.acked = True
+                    if handle in self._awaiting_ack:
+                        self._awaiting_ack.remove(handle)
+        elif isinstance(msg, Done):
+            with self._lock:
+                handle = self._moves.pop(msg.id, None)
+            if handle is not None:
+                handle._finish()
+        elif isinstance(msg, ErrorReply):
+            with self._lock:
+                self.stats.errors += 1
+                handle = self._awaiting_ack.popleft() if self._awaiting_ack else None
+                if handle is not None:
+                    self._moves.pop(handle.id, None)
+            self.last_error = f"controller error {msg.code}: {msg.text}"
+            if handle is not None:
+                handle._finish(MoveError(f"move {handle.id} refused by the controller: {msg.code}: {msg.text}"))
+        elif isinstance(msg, StateReport):
+            with self._state_event:
+                self._state_reports.append(msg)
+                self._state_event.notify_all()
+        return False
+
+    def _deliver(self, sample: TimedSample) -> None:
+        seq = sample.sample.seq
+        with self._lock:
+            if self._last_seq is not None:
+                expected = (self._last_seq + 1) % SEQ_MODULUS
+                if seq != expected:
+                    self.stats.seq_gaps += 1
+                    skipped = (seq - expected) % SEQ_MODULUS
+                    if skipped < SEQ_MODULUS // 2:  # otherwise the controller restarted its count
+                        self.stats.missing_samples += skipped
+            self._last_seq = seq
+            self._latest = sample
+            self._queue.append(sample)
+            self.stats.samples += 1
+        if self._state is not LinkState.UP:
+            self._set_state(LinkState.UP, "samples arriving")
+        for cb in list(self._sample_callbacks):
+            try:
+                cb(sample)
+            except Exception as exc:  # a caller's bug must not kill the link
+                self.stats.errors += 1
+                self.last_error = f"sample callback failed: {exc!r}"
+
+    def _expire_moves(self, now: float) -> None:
+        expired = []
+        with self._lock:
+            for move_id, handle in list(self._moves.items()):
+                if now > handle.deadline_s:
+                    expired.append(self._moves.pop(move_id))
+                    if handle in self._awaiting_ack:
+                        self._awaiting_ack.remove(handle)
+        for handle in expired:
+            what = "no DON" if handle.acked else "no ACK"
+            handle._finish(MoveTimeout(f"move {handle.id}: {what} before its timeout"))

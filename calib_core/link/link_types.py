@@ -1,0 +1,100 @@
+"""What the controller link reports: its state, timestamped samples, statistics, move outcomes."""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from enum import Enum
+
+from calib_core.errors import VideocalError
+from calib_core.link.protocol import JointSample
+
+
+class LinkState(str, Enum):
+    """``connecting``: opening or waiting for the first sample; ``up``: samples arrive;
+    ``stale``: open but no sample within the watchdog time; ``down``: the device is gone
+    (reconnecting with backoff); ``closed``: closed by the caller."""
+
+    CONNECTING = "connecting"
+    UP = "up"
+    STALE = "stale"
+    DOWN = "down"
+    CLOSED = "closed"
+
+
+@dataclass(frozen=True)
+class TimedSample:
+    """A joint sample with ``t_host_s``: the host's monotonic clock when its last byte arrived."""
+
+    sample: JointSample
+    t_host_s: float
+
+    @property
+    def joints_deg(self) -> tuple[float, ...]:
+        return self.sample.joints_deg
+
+
+@dataclass
+class LinkStats:
+    """Counters since the link started. Sentences: ``sentences`` verified, ``garbage_bytes``,
+    ``bad_checksum``, ``too_long``, ``malformed`` (framing or fields), ``non_finite``,
+    ``unknown`` types. Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
+    jumped) and ``missing_samples`` (how many it skipped). Link: ``reconnects``, ``errors``
+    (ERR replies and callback failures)."""
+
+    sentences: int = 0
+    garbage_bytes: int = 0
+    bad_checksum: int = 0
+    too_long: int = 0
+    malformed: int = 0
+    non_finite: int = 0
+    unknown: int = 0
+    samples: int = 0
+    seq_gaps: int = 0
+    missing_samples: int = 0
+    reconnects: int = 0
+    errors: int = 0
+
+    def as_dict(self) -> dict[str, int]:
+        return dict(self.__dict__)
+
+
+class LinkError(VideocalError, RuntimeError):
+    """The link could not be opened (an unusable URL or a missing device)."""
+
+
+class MoveError(VideocalError, RuntimeError):
+    """The controller refused or aborted a move; the message carries its ERR code and text."""
+
+
+class MoveTimeout(MoveError):
+    """No DON arrived for a move within its timeout."""
+
+
+class MoveHandle:
+    """Tracks one MVJ: ``acked`` once the controller accepted it; :meth:`wait` returns when it
+    is done, or raises :class:`MoveError` / :class:`MoveTimeout`."""
+
+    def __init__(self, move_id: str, joints_deg: tuple[float, ...], deadline_s: float):
+        self.id = move_id
+        self.joints_deg = joints_deg
+        self.deadline_s = deadline_s
+        self.acked = False
+        self._event = threading.Event()
+        self._error: MoveError | None = None
+
+    @property
+    def finished(self) -> bool:
+        return self._event.is_set()
+
+    def _finish(self, error: MoveError | None = None) -> None:
+        if not self._event.is_set():
+            self._error = error
+            self._event.set()
+
+    def wait(self, timeout: float | None = None) -> None:
+        """Block until the move is done (at most ``timeout`` s, then :class:`MoveTimeout`)."""
+        if not self._event.wait(timeout):
+            raise MoveTimeout(f"move {self.id}: still running after {timeout:g} s of waiting")
+        if self._error is not None:
+            raise self._error

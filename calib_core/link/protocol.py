@@ -1,0 +1,204 @@
+"""The wire protocol: NMEA-0183-style ASCII sentences and their typed messages.
+
+A sentence is ``$`` + body + ``*`` + two upper-case hex digits (the XOR of every body byte)
++ CR LF, at most 128 bytes. Fields are separated by commas; angles are degrees with up to
+4 decimals. The full description is in ``docs/controller-protocol.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+MAX_SENTENCE_BYTES = 128
+SEQ_MODULUS = 2**32
+N_JOINTS = 6
+
+
+class ProtocolError(ValueError):
+    """A sentence body that is not a valid message. ``kind``: ``malformed``, ``non_finite`` or ``unknown``."""
+
+    def __init__(self, kind: str, message: str):
+        self.kind = kind
+        super().__init__(message)
+
+
+def checksum(body: bytes) -> int:
+    """XOR of every byte of the body (between ``$`` and ``*``)."""
+    c = 0
+    for b in body:
+        c ^= b
+    return c
+
+
+def encode(body: str) -> bytes:
+    """The full sentence for ``body``; ``ValueError`` if it cannot be sent as one."""
+    raw = body.encode("ascii")
+    if any(ch in raw for ch in b"$*\r\n"):
+        raise ValueError(f"a sentence body may not contain $, *, CR or LF: {body!r}")
+    sentence = b"$" + raw + b"*" + f"{checksum(raw):02X}".encode() + b"\r\n"
+    if len(sentence) > MAX_SENTENCE_BYTES:
+        raise ValueError(f"sentence of {len(sentence)} bytes exceeds {MAX_SENTENCE_BYTES}: {body!r}")
+    return sentence
+
+
+def format_angle(deg: float) -> str:
+    return f"{deg:.4f}"
+
+
+# --- messages from the controller ------------------------------------------------------------
+@dataclass(frozen=True)
+class JointSample:
+    """``$JNT,<seq>,<t_ms>,<q1>,...,<q6>``: a joint sample. ``seq`` counts up and wraps at 2^32;
+    ``t_ms`` is the controller's clock; ``joints_deg`` (6,) degrees."""
+
+    seq: int
+    t_ms: int
+    joints_deg: tuple[float, ...]
+
+    def body(self) -> str:
+        return ",".join(["JNT", str(self.seq % SEQ_MODULUS), str(self.t_ms)] + [format_angle(q) for q in self.joints_deg])
+
+
+@dataclass(frozen=True)
+class Ack:
+    """``$ACK,<cmd>,<id>``: a command was accepted (``id`` is the move id, ``-`` for others)."""
+
+    cmd: str
+    id: str
+
+    def body(self) -> str:
+        return f"ACK,{self.cmd},{self.id}"
+
+
+@dataclass(frozen=True)
+class Done:
+    """``$DON,<id>``: the move ``id`` finished."""
+
+    id: str
+
+    def body(self) -> str:
+        return f"DON,{self.id}"
+
+
+@dataclass(frozen=True)
+class StateReport:
+    """``$STA,<state>,<text>``: the controller's state (``IDLE``, ``MOVING``, ``FAULT``) and a remark."""
+
+    state: str
+    text: str
+
+    def body(self) -> str:
+        return f"STA,{self.state},{self.text}"
+
+
+@dataclass(frozen=True)
+class ErrorReply:
+    """``$ERR,<code>,<text>``: a command was refused or failed."""
+
+    code: str
+    text: str
+
+    def body(self) -> str:
+        return f"ERR,{self.code},{self.text}"
+
+
+# --- commands to the controller --------------------------------------------------------------
+@dataclass(frozen=True)
+class RequestJoints:
+    """``$RQJ``: send one joint sample now (the paper's cyclic request)."""
+
+    def body(self) -> str:
+        return "RQJ"
+
+
+@dataclass(frozen=True)
+class Stream:
+    """``$STR,<hz>``: stream joint samples at ``hz`` (0 stops)."""
+
+    hz: float
+
+    def body(self) -> str:
+        return f"STR,{self.hz:g}"
+
+
+@dataclass(frozen=True)
+class MoveJoints:
+    """``$MVJ,<id>,<q1>,...,<q6>``: move to these joints (degrees)."""
+
+    id: str
+    joints_deg: tuple[float, ...]
+
+    def body(self) -> str:
+        return ",".join(["MVJ", self.id] + [format_angle(q) for q in self.joints_deg])
+
+
+@dataclass(frozen=True)
+class RequestState:
+    """``$STA``: report the controller state."""
+
+    def body(self) -> str:
+        return "STA"
+
+
+Message = JointSample | Ack | Done | StateReport | ErrorReply | RequestJoints | Stream | MoveJoints | RequestState
+
+
+def _number(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise ProtocolError("malformed", f"{what}: not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise ProtocolError("non_finite", f"{what}: not finite: {text!r}")
+    return value
+
+
+def _integer(text: str, what: str) -> int:
+    if not text.isdigit():
+        raise ProtocolError("malformed", f"{what}: not a non-negative integer: {text!r}")
+    return int(text)
+
+
+def _token(text: str, what: str) -> str:
+    if not text or not all(c.isalnum() or c in "_-." for c in text):
+        raise ProtocolError("malformed", f"{what}: not a valid identifier: {text!r}")
+    return text
+
+
+def parse_body(body: str) -> Message:
+    """The message of a sentence body (checksum already verified); :class:`ProtocolError` if invalid."""
+    fields = body.split(",")
+    kind = fields[0]
+    n = len(fields)
+    if kind == "JNT":
+        if n != 3 + N_JOINTS:
+            raise ProtocolError("malformed", f"JNT needs {3 + N_JOINTS} fields, got {n}")
+        seq = _integer(fields[1], "JNT seq")
+        if seq >= SEQ_MODULUS:
+            raise ProtocolError("malformed", f"JNT seq {seq} exceeds 2^32 - 1")
+        return JointSample(seq, _integer(fields[2], "JNT t_ms"), tuple(_number(f, f"JNT q{i + 1}") for i, f in enumerate(fields[3:])))
+    if kind == "ACK" and n == 3:
+        return Ack(_token(fields[1], "ACK cmd"), _token(fields[2], "ACK id"))
+    if kind == "DON" and n == 2:
+        return Done(_token(fields[1], "DON id"))
+    if kind == "STA" and n == 1:
+        return RequestState()
+    if kind == "STA" and n == 3:
+        return StateReport(_token(fields[1], "STA state"), fields[2])
+    if kind == "ERR" and n == 3:
+        return ErrorReply(_token(fields[1], "ERR code"), fields[2])
+    if kind == "RQJ" and n == 1:
+        return RequestJoints()
+    if kind == "STR" and n == 2:
+        hz = _number(fields[1], "STR hz")
+        if hz < 0:
+            raise ProtocolError("malformed", f"STR hz must be >= 0, got {hz}")
+        return Stream(hz)
+    if kind == "MVJ":
+        if n != 2 + N_JOINTS:
+            raise ProtocolError("malformed", f"MVJ needs {2 + N_JOINTS} fields, got {n}")
+        return MoveJoints(_token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:])))
+    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ"):
+        raise ProtocolError("malformed", f"{kind} with {n - 1} fields")
+    raise ProtocolError("unknown", f"unknown sentence type {kind!r}")
