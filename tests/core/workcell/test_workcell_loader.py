@@ -26,7 +26,7 @@ def test_bundled_workcell():
     robot = load_robot(cell.robot_urdf)
     q = solve_ik(robot, grasp.tcp2base, cell.home_joints_deg).q_deg
     solve_ik(robot, grasp.approach2base, q)
-    assert np.allclose(grasp.approach2base[:3, 3], grasp.tcp2base[:3, 3] - 350 * grasp.tcp2base[:3, 2])
+    assert np.allclose(grasp.approach2base[:3, 3], grasp.tcp2base[:3, 3] - 200 * grasp.tcp2base[:3, 2])
 
 
 @pytest.fixture

@@ -1,0 +1,78 @@
+"""The correction table: for each task location, the measured displacement of the real end
+effector from the model, with its history, and the corrected target to command."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from calib_core.frames import invert
+
+
+@dataclass(frozen=True)
+class Correction:
+    """One stored calibration of a task location.
+
+    ``tcp2base_model``/``tcp2base_measured`` (4, 4) mm at ``joints_deg``; ``displacement_mm``,
+    ``rotation_deg`` (3,) with 1-sigma; ``rms_px`` and ``pairs`` of the solve; ``time_s``
+    (Unix time); ``source``: where it came from (e.g. a recording and pick numbers)."""
+
+    task: str
+    tcp2base_model: np.ndarray
+    tcp2base_measured: np.ndarray
+    displacement_mm: np.ndarray
+    rotation_deg: np.ndarray
+    std_displacement_mm: np.ndarray
+    std_rotation_deg: np.ndarray
+    joints_deg: np.ndarray
+    rms_px: float
+    pairs: int
+    time_s: float = field(default_factory=time.time)
+    source: str = ""
+
+    @property
+    def delta_base(self) -> np.ndarray:
+        """``Δ`` with ``tcp_real = Δ @ tcp_model`` (base frame) near this location."""
+        return self.tcp2base_measured @ invert(self.tcp2base_model)
+
+
+class CorrectionTable:
+    """Corrections per task location, oldest first; listeners hear every change."""
+
+    def __init__(self) -> None:
+        self._table: dict[str, list[Correction]] = {}
+        self._listeners = []
+
+    def subscribe(self, listener) -> None:
+        self._listeners.append(listener)
+
+    def add(self, correction: Correction) -> None:
+        self._table.setdefault(correction.task, []).append(correction)
+        for listener in list(self._listeners):
+            listener(correction.task)
+
+    def remove_last(self, task: str) -> Correction:
+        c = self._table[task].pop()
+        if not self._table[task]:
+            del self._table[task]
+        for listener in list(self._listeners):
+            listener(task)
+        return c
+
+    def history(self, task: str) -> list[Correction]:
+        return list(self._table.get(task, []))
+
+    def latest(self, task: str) -> Correction | None:
+        h = self._table.get(task)
+        return h[-1] if h else None
+
+    def tasks(self) -> list[str]:
+        return list(self._table)
+
+    def corrected_target(self, task: str, target2base: np.ndarray) -> np.ndarray:
+        """The pose (4, 4) mm to command through the model so the real TCP reaches ``target2base``:
+        ``Δ^-1 @ target``, with ``Δ`` the latest correction (the target itself when there is none)."""
+        c = self.latest(task)
+        return target2base.copy() if c is None else invert(c.delta_base) @ target2base

@@ -1,0 +1,120 @@
+"""The one correspondence model every pane shares: point pairs picked by the operator.
+
+A pair joins a 3D point on a workcell component (mm, world = robot base frame, with the
+component and feature it came from) and the same point on the camera image (px). A pair
+may be half made (3D picked, 2D not yet), and may be disabled without being deleted.
+Listeners are told of every change; panes subscribe and never reach into each other.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Correspondence:
+    """One pair. ``number``: shown to the operator, from 1, never reused in a session.
+    ``point_world_mm`` (3,): the picked 3D point in the robot base frame; ``component`` and
+    ``feature`` where it was picked (feature ``None`` for a plain surface point);
+    ``pixel`` (2,) px or ``None`` until the 2D point is picked; ``enabled``: used by the solve."""
+
+    number: int
+    component: str
+    feature: str | None
+    point_world_mm: tuple[float, float, float]
+    pixel: tuple[float, float] | None = None
+    enabled: bool = True
+
+    @property
+    def complete(self) -> bool:
+        return self.pixel is not None
+
+    @property
+    def label(self) -> str:
+        return f"{self.number} ({self.feature})" if self.feature else str(self.number)
+
+
+class CorrespondenceSet:
+    """The ordered pairs of a calibration. Edits go through the commands in
+    :mod:`calib_core.calibration.commands` so they can be undone."""
+
+    def __init__(self) -> None:
+        self._pairs: list[Correspondence] = []
+        self._listeners: list[Callable[[str, int | None], None]] = []
+        self._next_number = 1
+
+    def subscribe(self, listener: Callable[[str, int | None], None]) -> None:
+        """``listener(event, number)``: event ``added``, ``removed``, ``changed`` or ``reset``."""
+        self._listeners.append(listener)
+
+    def _emit(self, event: str, number: int | None) -> None:
+        for listener in list(self._listeners):
+            listener(event, number)
+
+    def __len__(self) -> int:
+        return len(self._pairs)
+
+    def __iter__(self):
+        return iter(list(self._pairs))
+
+    def pairs(self) -> list[Correspondence]:
+        return list(self._pairs)
+
+    def get(self, number: int) -> Correspondence:
+        for p in self._pairs:
+            if p.number == number:
+                return p
+        raise KeyError(f"no pair number {number}")
+
+    def index_of(self, number: int) -> int:
+        for i, p in enumerate(self._pairs):
+            if p.number == number:
+                return i
+        raise KeyError(f"no pair number {number}")
+
+    def new_number(self) -> int:
+        n = self._next_number
+        self._next_number += 1
+        return n
+
+    def usable(self) -> list[Correspondence]:
+        """Complete, enabled pairs: what the solve uses."""
+        return [p for p in self._pairs if p.complete and p.enabled]
+
+    def pending(self) -> Correspondence | None:
+        """The pair waiting for its 2D point, if any."""
+        return next((p for p in self._pairs if not p.complete), None)
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
+        """Usable pairs as ``points_world_mm`` (n, 3), ``pixels`` (n, 2) and their numbers."""
+        use = self.usable()
+        return (np.array([p.point_world_mm for p in use], dtype=float).reshape(-1, 3), np.array([p.pixel for p in use], dtype=float).reshape(-1, 2), [p.number for p in use])
+
+    # Low-level edits used by the commands only.
+    def _insert(self, index: int, pair: Correspondence) -> None:
+        self._pairs.insert(index, pair)
+        self._emit("added", pair.number)
+
+    def _remove(self, number: int) -> tuple[int, Correspondence]:
+        i = self.index_of(number)
+        pair = self._pairs.pop(i)
+        self._emit("removed", number)
+        return i, pair
+
+    def _replace(self, pair: Correspondence) -> Correspondence:
+        i = self.index_of(pair.number)
+        old, self._pairs[i] = self._pairs[i], pair
+        self._emit("changed", pair.number)
+        return old
+
+    def _reset(self, pairs: list[Correspondence]) -> list[Correspondence]:
+        old, self._pairs = self._pairs, list(pairs)
+        self._emit("reset", None)
+        return old
+
+
+def with_pixel(pair: Correspondence, pixel: tuple[float, float] | None) -> Correspondence:
+    return replace(pair, pixel=None if pixel is None else (float(pixel[0]), float(pixel[1])))

@@ -1,0 +1,82 @@
+"""Undoable commands on one stack: every operator edit is a command with do and undo."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+
+class Command:
+    """An edit. ``label`` names it in the Edit menu (``"Add pair 3"``)."""
+
+    label = "edit"
+
+    def do(self) -> None:
+        raise NotImplementedError
+
+    def undo(self) -> None:
+        raise NotImplementedError
+
+
+class UndoStack:
+    """Executes commands and keeps them for undo and redo; listeners hear every change."""
+
+    def __init__(self, limit: int = 500):
+        self._done: list[Command] = []
+        self._undone: list[Command] = []
+        self._limit = limit
+        self._listeners: list[Callable[[], None]] = []
+
+    def subscribe(self, listener: Callable[[], None]) -> None:
+        self._listeners.append(listener)
+
+    def _changed(self) -> None:
+        for listener in list(self._listeners):
+            listener()
+
+    def push(self, command: Command) -> None:
+        """Do ``command`` and record it (clears the redo history)."""
+        command.do()
+        self._done.append(command)
+        del self._done[: -self._limit]
+        self._undone.clear()
+        self._changed()
+
+    def undo(self) -> str | None:
+        """Undo the last command; its label, or None when there is nothing to undo."""
+        if not self._done:
+            return None
+        command = self._done.pop()
+        command.undo()
+        self._undone.append(command)
+        self._changed()
+        return command.label
+
+    def redo(self) -> str | None:
+        if not self._undone:
+            return None
+        command = self._undone.pop()
+        command.do()
+        self._done.append(command)
+        self._changed()
+        return command.label
+
+    @property
+    def can_undo(self) -> bool:
+        return bool(self._done)
+
+    @property
+    def can_redo(self) -> bool:
+        return bool(self._undone)
+
+    @property
+    def undo_label(self) -> str | None:
+        return self._done[-1].label if self._done else None
+
+    @property
+    def redo_label(self) -> str | None:
+        return self._undone[-1].label if self._undone else None
+
+    def clear(self) -> None:
+        self._done.clear()
+        self._undone.clear()
+        self._changed()

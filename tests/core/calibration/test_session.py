@@ -1,0 +1,117 @@
+"""The calibration workflow without a window, against the simulated test bed: picks, undo and
+redo, the solve, the end-effector displacement against the truth, the stored correction."""
+
+import numpy as np
+import pytest
+
+from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert, pose_difference
+from calib_core.robot import solve_ik
+from calib_core.solver import SolveStatus
+from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.true_robot import RobotErrors
+
+FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left", "boss_top_right", "boss_bottom_left", "boss_bottom_right"]
+
+
+@pytest.fixture(scope="module")
+def bed():
+    errors = RobotErrors.typical(0)
+    # No hand-eye error here: with the modelled mounting the camera tells the TCP exactly (issue #7 calibrates it).
+    errors = RobotErrors(errors.joint_offsets_deg, errors.link_errors_mm, errors.base_xyz_mm, errors.base_rpy_deg)
+    return TestBed.create(errors=errors)
+
+
+def _pick_all(session, bed, q, names=FEATURES, noise_px=0.2, seed=0):
+    rng = np.random.default_rng(seed)
+    fx = bed.workcell.component("oru_1_fixture")
+    cam_true = bed.true_cam2world(q)
+    for name in names:
+        p_world = apply(fx.item2world, fx.features[name])
+        session.pick_3d("oru_1_fixture", name, p_world)
+        pixel = project(apply(invert(cam_true), p_world[None]), bed.intrinsics)[0] + rng.normal(0, noise_px, 2)
+        session.pick_2d(pixel)
+
+
+def _calibrate(session, bed, q):
+    fx = bed.workcell.component("oru_1_fixture")
+    return session.calibrate(bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q, "tcp"), q)
+
+
+def test_estimated_displacement_matches_the_truth(bed):
+    q = solve_ik(bed.model_robot, bed.workcell.task("oru_1_grasp").approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q)
+    est = _calibrate(s, bed, q)
+    assert est.solution.status is SolveStatus.OK
+    d_true, r_true = pose_difference(bed.true_robot.fk(q), bed.model_robot.fk(q))
+    assert np.linalg.norm(d_true) > 3.0  # the model really is off
+    # Within the reported uncertainty (a 0.2 px pick noise on a 160 x 120 mm plate: tenths of a mm).
+    assert np.all(np.abs(est.displacement_mm - d_true) < 4 * est.std_displacement_mm + 0.05)
+    assert np.all(np.abs(est.rotation_deg - r_true) < 4 * est.std_rotation_deg + 0.005)
+    assert np.all(est.std_displacement_mm > 0) and np.all(est.std_displacement_mm < 1.0)
+
+
+def test_stored_correction_brings_the_real_tool_to_the_target(bed):
+    task = bed.workcell.task("oru_1_grasp")
+    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q_app, noise_px=0.0)
+    _calibrate(s, bed, q_app)
+    s.store_correction(task.name)
+    # Uncorrected: the real tool misses the grasp by millimetres; corrected: by far less.
+    q_plain = solve_ik(bed.model_robot, task.tcp2base, q_app).q_deg
+    miss_plain = np.linalg.norm(pose_difference(bed.true_robot.fk(q_plain), task.tcp2base)[0])
+    target = s.corrections.corrected_target(task.name, task.tcp2base)
+    q_corr = solve_ik(bed.model_robot, target, q_plain).q_deg
+    miss_corr = np.linalg.norm(pose_difference(bed.true_robot.fk(q_corr), task.tcp2base)[0])
+    assert miss_plain > 3.0
+    # The correction is measured at the approach pose (200 mm back), where the camera sees the fixture; the joints
+    # change on the way to the grasp, and with them the model error: about 1 mm is left of 8.
+    assert miss_corr < 1.5 and miss_corr < miss_plain / 5
+
+
+def test_undo_redo_and_workflow_errors(bed):
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    with pytest.raises(CalibrationError, match="pick the point on the model"):
+        s.pick_2d((10, 10))
+    n = s.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    with pytest.raises(CalibrationError, match=f"pair {n} still needs its 2D point"):
+        s.pick_3d("oru_1_fixture", "plate_top_left", (0, 0, 0))
+    s.pick_2d((5.0, 6.0))
+    with pytest.raises(CalibrationError, match="pick on the target object 'oru_1_fixture'"):
+        s.pick_3d("rack_1", None, (0, 0, 0))
+    assert s.pairs.get(n).pixel == (5.0, 6.0)
+    s.set_enabled(n, False)
+    assert s.pairs.usable() == []
+    assert s.undo.undo() == f"Disable pair {n}"
+    assert s.pairs.get(n).enabled
+    s.delete(n)
+    assert len(s.pairs) == 0
+    s.undo.undo()
+    assert len(s.pairs) == 1 and s.pairs.get(n).pixel == (5.0, 6.0)
+    s.undo.undo()  # the 2D pick
+    assert s.pairs.get(n).pixel is None
+    s.undo.redo()
+    assert s.pairs.get(n).pixel == (5.0, 6.0)
+    s.clear()
+    assert len(s.pairs) == 0
+    s.undo.undo()
+    assert len(s.pairs) == 1
+    with pytest.raises(CalibrationError, match="1 complete pairs; calibrating needs 3"):
+        s.calibrate(bed.intrinsics, np.eye(4), np.eye(4), np.eye(4))
+
+
+def test_listeners_hear_every_change():
+    s = CalibrationSession()
+    events = []
+    s.pairs.subscribe(lambda event, number: events.append((event, number)))
+    s.pick_3d("a", None, (0, 0, 1))
+    s.pick_2d((1, 2))
+    s.undo.undo()
+    s.undo.undo()
+    assert events == [("added", 1), ("changed", 1), ("changed", 1), ("removed", 1)]
