@@ -45,6 +45,7 @@ class RenderOptions:
     edge_color: tuple[float, float, float] = (0.2, 1.0, 0.4)
     show_edges: bool = True
     label_color: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    lines: list[tuple[np.ndarray, tuple[float, float, float]]] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -155,6 +156,7 @@ class SceneRenderer:
                 e.GetProperty().LightingOff()
                 self.renderer.AddActor(e)
         self._add_points(options)
+        self._add_lines(options)
         if options.transparent_background:
             self.renderer.SetBackground(0, 0, 0)
             self.renderer.SetBackgroundAlpha(0.0)
@@ -202,6 +204,28 @@ class SceneRenderer:
                 label.GetTextProperty().SetColor(*options.label_color)
                 label.GetTextProperty().ShadowOn()
                 self.renderer.AddActor(label)
+
+    def _add_lines(self, options: RenderOptions) -> None:
+        """Polylines ((k, 3) mm, world frame) such as camera frustums."""
+        for points, color in options.lines:
+            pts = np.ascontiguousarray(np.asarray(points, dtype=float).reshape(-1, 3))
+            poly = vtk.vtkPolyData()
+            vpts = vtk.vtkPoints()
+            vpts.SetData(numpy_support.numpy_to_vtk(pts, deep=True))
+            poly.SetPoints(vpts)
+            cells = vtk.vtkCellArray()
+            cells.InsertNextCell(len(pts))
+            for i in range(len(pts)):
+                cells.InsertCellPoint(i)
+            poly.SetLines(cells)
+            mapper = vtk.vtkPolyDataMapper()
+            mapper.SetInputData(poly)
+            actor = vtk.vtkActor()
+            actor.SetMapper(mapper)
+            actor.GetProperty().SetColor(*color)
+            actor.GetProperty().SetLineWidth(2.0)
+            actor.GetProperty().LightingOff()
+            self.renderer.AddActor(actor)
 
     def _read_back(self, transparent: bool) -> np.ndarray:
         w, h = self.window.GetSize()

@@ -1,0 +1,53 @@
+"""``videocal gui``: the operator's window with the bundled workcell, the controller simulator
+(a child process on a pty) and the simulated camera, ready to calibrate; or a real port and camera."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from calib_core.workcell import DEFAULT_WORKCELL
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
+    parser.add_argument("--port", help="a real controller link URL (serial port, socket://host:port, ...) instead of the simulator")
+    parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file or a stream URL, instead of the simulated camera")
+    parser.add_argument("--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
+
+    from app.gui.main_window import MainWindow
+    from app.gui.workbench import Workbench
+    from calib_core.testbed.test_bed import TestBed
+    from calib_core.workcell import load_workcell
+
+    bed = TestBed.create(load_workcell(args.workcell))
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    app.setApplicationName("videocal")
+    workbench = Workbench(bed)
+    if args.port:
+        workbench.connect_link(args.port)
+    else:
+        workbench.start_simulated_controller()
+    window = MainWindow(workbench)
+    if args.camera:
+        from calib_core.video.opencv_source import OpenCVSource
+
+        spec = args.camera
+        window.start_camera(lambda: OpenCVSource(int(spec) if spec.isdigit() else spec))
+    else:
+        window.start_camera(lambda: bed.camera(intrinsics=bed.intrinsics, fps=15.0))
+    window.show()
+    if args.screenshot is not None:
+        def shoot():
+            window.grab().save(str(args.screenshot))
+            window.close()
+            app.quit()
+
+        QTimer.singleShot(4000, shoot)
+    return int(app.exec())

@@ -1,0 +1,121 @@
+"""The command panel with the original's four modes: programming, simulation, calibration, execution."""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QGroupBox,
+    QLabel,
+    QListWidget,
+    QPushButton,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.gui.workbench import Workbench
+
+
+def _button(text: str, name: str, tip: str = "") -> QPushButton:
+    b = QPushButton(text)
+    b.setObjectName(name)
+    if tip:
+        b.setToolTip(tip)
+    return b
+
+
+class CommandPanel(QTabWidget):
+    """Buttons only: the main window connects them to actions."""
+
+    def __init__(self, workbench: Workbench, parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        self.setMinimumWidth(250)
+
+        # Programming
+        prog = QWidget()
+        pl = QVBoxLayout(prog)
+        pl.addWidget(QLabel("Task locations"))
+        self.tasks = QListWidget()
+        self.tasks.setObjectName("tasks")
+        for name in workbench.workcell.task_locations:
+            self.tasks.addItem(name)
+        pl.addWidget(self.tasks, 1)
+        self.go_approach = _button("Go to approach", "go_approach", "IK to the approach pose, then move the robot (MVJ)")
+        self.go_task = _button("Go to task", "go_task", "IK to the task pose itself, without correction")
+        self.add_location = _button("Add location from current pose", "add_location")
+        for b in (self.go_approach, self.go_task, self.add_location):
+            pl.addWidget(b)
+        self.addTab(prog, "Programming")
+
+        # Simulation
+        sim = QWidget()
+        sl = QVBoxLayout(sim)
+        sl.addWidget(QLabel("Animate the planned motion in CAD (the robot does not move)."))
+        self.animate = _button("Animate to selected task", "animate")
+        sl.addWidget(self.animate)
+        self.sim_status = QLabel("")
+        self.sim_status.setWordWrap(True)
+        sl.addWidget(self.sim_status)
+        sl.addStretch(1)
+        self.addTab(sim, "Simulation")
+
+        # Calibration
+        cal = QWidget()
+        cl = QVBoxLayout(cal)
+        form = QFormLayout()
+        self.target = QComboBox()
+        self.target.setObjectName("target")
+        for c in workbench.workcell.components:
+            if c.kind == "component":
+                self.target.addItem(c.name)
+        if workbench.session.target:
+            self.target.setCurrentText(workbench.session.target)
+        form.addRow("Target object", self.target)
+        cl.addLayout(form)
+        steps = QGroupBox("Point pairs")
+        sl2 = QVBoxLayout(steps)
+        self.hint = QLabel("Point: click a feature in the virtual camera, then the same point on the camera image.")
+        self.hint.setWordWrap(True)
+        sl2.addWidget(self.hint)
+        self.accept = _button("Accept pair", "accept", "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then")
+        self.delete = _button("Delete pair", "delete")
+        self.clear = _button("Clear all", "clear")
+        self.undo = _button("Undo", "undo")
+        self.redo = _button("Redo", "redo")
+        for b in (self.accept, self.delete, self.clear, self.undo, self.redo):
+            sl2.addWidget(b)
+        cl.addWidget(steps)
+        self.estimate_focal = QCheckBox("Estimate focal lengths (4+ pairs)")
+        self.robust = QCheckBox("Robust (flag mis-clicks)")
+        cl.addWidget(self.estimate_focal)
+        cl.addWidget(self.robust)
+        self.calibrate = _button("Calibrate", "calibrate", "Solve the camera pose (F5)")
+        self.calibrate.setStyleSheet("font-weight: bold; padding: 6px;")
+        self.store = _button("Store correction", "store", "Store the displacement for the current task location")
+        cl.addWidget(self.calibrate)
+        cl.addWidget(self.store)
+        cl.addStretch(1)
+        self.addTab(cal, "Calibration")
+
+        # Execution
+        ex = QWidget()
+        el = QVBoxLayout(ex)
+        self.monitoring = QCheckBox("Monitoring (CAD follows the robot)")
+        self.monitoring.setChecked(True)
+        self.live = QCheckBox("Live (camera video)")
+        self.live.setChecked(True)
+        el.addWidget(self.monitoring)
+        el.addWidget(self.live)
+        self.go_corrected = _button("Go to task, corrected", "go_corrected", "Move to the task location with its stored correction")
+        self.go_uncorrected = _button("Go to task, uncorrected", "go_uncorrected")
+        el.addWidget(self.go_corrected)
+        el.addWidget(self.go_uncorrected)
+        self.corrections = QLabel("No corrections stored.")
+        self.corrections.setWordWrap(True)
+        el.addWidget(self.corrections)
+        el.addStretch(1)
+        self.addTab(ex, "Execution")
+        self.setCurrentIndex(2)

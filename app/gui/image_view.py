@@ -1,0 +1,212 @@
+"""A widget that shows an image with zoom, pan, a cross-hair cursor and vector overlays.
+
+Image coordinates follow OpenCV: the centre of the top-left pixel is (0, 0). Clicks are
+reported in image pixels (floats). The wheel zooms about the cursor, the right or middle
+button drags to pan, a left click picks. Overlays are drawn in image coordinates on top.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QImage, QMouseEvent, QPainter, QPen, QWheelEvent
+from PySide6.QtWidgets import QSizePolicy, QWidget
+
+
+@dataclass
+class Overlay:
+    """Things drawn over the image, in image pixels. ``points``: (u, v, label, color);
+    ``segments``: (u0, v0, u1, v1, color); ``text``: a caption at the top left."""
+
+    points: list[tuple[float, float, str, QColor]] = field(default_factory=list)
+    segments: list[tuple[float, float, float, float, QColor]] = field(default_factory=list)
+    text: str = ""
+    image: np.ndarray | None = None  # RGBA overlay (same size as the image), e.g. CAD edges
+    image_opacity: float = 0.7
+
+
+def qimage_from_array(array: np.ndarray) -> QImage:
+    """A QImage sharing nothing with ``array`` (h, w, 3 RGB or 4 RGBA, uint8)."""
+    a = np.ascontiguousarray(array)
+    h, w = a.shape[:2]
+    fmt = QImage.Format.Format_RGBA8888 if a.shape[2] == 4 else QImage.Format.Format_RGB888
+    return QImage(a.data, w, h, a.strides[0], fmt).copy()
+
+
+class ImageView(QWidget):
+    """Shows one image; emits ``clicked(u, v)`` in image pixels and ``hovered(u, v)``."""
+
+    clicked = Signal(float, float)
+    hovered = Signal(float, float)
+
+    def __init__(self, parent=None, *, placeholder: str = "no image"):
+        super().__init__(parent)
+        self.setMouseTracking(True)
+        self.setCursor(Qt.CursorShape.CrossCursor)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setMinimumSize(160, 120)
+        self._image: QImage | None = None
+        self._array: np.ndarray | None = None
+        self._overlay_image: QImage | None = None
+        self.overlay = Overlay()
+        self.placeholder = placeholder
+        self._zoom = 1.0  # relative to fit-to-window
+        self._centre: QPointF | None = None  # image point shown at the widget centre
+        self._drag_from: QPointF | None = None
+        self._mouse: QPointF | None = None
+
+    # --- content -------------------------------------------------------------------------
+    def set_image(self, array: np.ndarray | None) -> None:
+        if array is None:
+            self._image, self._array = None, None
+        else:
+            new_size = (array.shape[1], array.shape[0])
+            if self._array is None or (self._array.shape[1], self._array.shape[0]) != new_size:
+                self._centre = None
+            self._array = array
+            self._image = qimage_from_array(array)
+        self.update()
+
+    @property
+    def image_array(self) -> np.ndarray | None:
+        return self._array
+
+    def set_overlay(self, overlay: Overlay) -> None:
+        self.overlay = overlay
+        self._overlay_image = None if overlay.image is None else qimage_from_array(overlay.image)
+        self.update()
+
+    def reset_view(self) -> None:
+        self._zoom, self._centre = 1.0, None
+        self.update()
+
+    def set_zoom(self, zoom: float, about_image_point: QPointF | None = None) -> None:
+        self._zoom = float(np.clip(zoom, 0.5, 40.0))
+        if about_image_point is not None:
+            self._centre = about_image_point
+        self.update()
+
+    @property
+    def zoom(self) -> float:
+        return self._zoom
+
+    # --- geometry ----------------------------------------------------------------------------
+    def _scale(self) -> float:
+        if self._image is None:
+            return 1.0
+        fit = min(self.width() / self._image.width(), self.height() / self._image.height())
+        return fit * self._zoom
+
+    def _centre_point(self) -> QPointF:
+        if self._centre is None and self._image is not None:
+            return QPointF((self._image.width() - 1) / 2.0, (self._image.height() - 1) / 2.0)
+        return self._centre or QPointF(0, 0)
+
+    def widget_to_image(self, x: float, y: float) -> tuple[float, float]:
+        """Image pixel (OpenCV convention) under widget point (x, y)."""
+        s = self._scale()
+        c = self._centre_point()
+        # Pixel centre k sits at widget coordinate (k + 0.5 - (c + 0.5)) * s + W/2.
+        return (x - self.width() / 2.0) / s + c.x(), (y - self.height() / 2.0) / s + c.y()
+
+    def image_to_widget(self, u: float, v: float) -> tuple[float, float]:
+        s = self._scale()
+        c = self._centre_point()
+        return (u - c.x()) * s + self.width() / 2.0, (v - c.y()) * s + self.height() / 2.0
+
+    # --- painting --------------------------------------------------------------------------
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.fillRect(self.rect(), QColor(24, 25, 28))
+        if self._image is None:
+            p.setPen(QColor(150, 150, 150))
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, self.placeholder)
+            return
+        s = self._scale()
+        x0, y0 = self.image_to_widget(-0.5, -0.5)
+        target = QRectF(x0, y0, self._image.width() * s, self._image.height() * s)
+        p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, s < 2.0)
+        p.drawImage(target, self._image)
+        if self._overlay_image is not None:
+            p.setOpacity(self.overlay.image_opacity)
+            p.drawImage(target, self._overlay_image)
+            p.setOpacity(1.0)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        for u0, v0, u1, v1, color in self.overlay.segments:
+            p.setPen(QPen(color, 1.6))
+            a, b = self.image_to_widget(u0, v0), self.image_to_widget(u1, v1)
+            p.drawLine(QPointF(*a), QPointF(*b))
+        font = QFont(self.font())
+        font.setPointSizeF(9.0)
+        font.setBold(True)
+        p.setFont(font)
+        for u, v, label, color in self.overlay.points:
+            x, y = self.image_to_widget(u, v)
+            p.setPen(QPen(QColor(0, 0, 0, 160), 3.0))
+            p.drawEllipse(QPointF(x, y), 5.0, 5.0)
+            p.setPen(QPen(color, 1.8))
+            p.drawEllipse(QPointF(x, y), 5.0, 5.0)
+            p.drawLine(QPointF(x - 8, y), QPointF(x - 3, y))
+            p.drawLine(QPointF(x + 3, y), QPointF(x + 8, y))
+            if label:
+                p.setPen(QColor(0, 0, 0))
+                p.drawText(QPointF(x + 8, y - 7), label)
+                p.setPen(color)
+                p.drawText(QPointF(x + 7, y - 8), label)
+        if self._mouse is not None and self.underMouse():
+            self._paint_crosshair(p)
+        if self.overlay.text:
+            p.setPen(QColor(230, 230, 230))
+            p.drawText(QRectF(8, 6, self.width() - 16, 40), Qt.AlignmentFlag.AlignLeft, self.overlay.text)
+
+    def _paint_crosshair(self, p: QPainter) -> None:
+        u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())
+        x, y = self.image_to_widget(round(u), round(v))  # snaps to the pixel a click would pick
+        p.setPen(QPen(QColor(255, 255, 0, 200), 1.0))
+        p.drawLine(QPointF(0, y), QPointF(x - 6, y))
+        p.drawLine(QPointF(x + 6, y), QPointF(self.width(), y))
+        p.drawLine(QPointF(x, 0), QPointF(x, y - 6))
+        p.drawLine(QPointF(x, y + 6), QPointF(x, self.height()))
+
+    # --- interaction ------------------------------------------------------------------------
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        if self._image is None:
+            return
+        pos = event.position()
+        u, v = self.widget_to_image(pos.x(), pos.y())
+        factor = 1.25 if event.angleDelta().y() > 0 else 0.8
+        old_zoom = self._zoom
+        self._zoom = float(np.clip(self._zoom * factor, 0.5, 40.0))
+        # Keep the image point under the cursor where it is.
+        s = self._scale()
+        self._centre = QPointF(u - (pos.x() - self.width() / 2.0) / s, v - (pos.y() - self.height() / 2.0) / s)
+        if old_zoom != self._zoom:
+            self.update()
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() in (Qt.MouseButton.RightButton, Qt.MouseButton.MiddleButton):
+            self._drag_from = event.position()
+        elif event.button() == Qt.MouseButton.LeftButton and self._image is not None:
+            u, v = self.widget_to_image(event.position().x(), event.position().y())
+            self.clicked.emit(u, v)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        self._mouse = event.position()
+        if self._drag_from is not None and self._image is not None:
+            delta = event.position() - self._drag_from
+            s = self._scale()
+            c = self._centre_point()
+            self._centre = QPointF(c.x() - delta.x() / s, c.y() - delta.y() / s)
+            self._drag_from = event.position()
+        if self._image is not None:
+            self.hovered.emit(*self.widget_to_image(self._mouse.x(), self._mouse.y()))
+        self.update()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        self._drag_from = None
+
+    def leaveEvent(self, event) -> None:
+        self._mouse = None
+        self.update()

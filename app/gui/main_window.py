@@ -1,0 +1,320 @@
+"""The main window: it only assembles the panes and connects them to the workbench."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QSplitter, QVBoxLayout, QWidget
+
+from app.gui.camera_pane import CameraPane
+from app.gui.command_panel import CommandPanel
+from app.gui.error_boundary import guarded
+from app.gui.frame_worker import FrameWorker
+from app.gui.overview_pane import OverviewPane
+from app.gui.pairs_table import PairsTable
+from app.gui.results_panel import ResultsPanel
+from app.gui.virtual_pane import VirtualPane
+from app.gui.workbench import Workbench
+from calib_core.render import RenderOptions
+from calib_core.robot import solve_ik
+from calib_core.testbed.lens import distortion_map
+
+
+class MainWindow(QMainWindow):
+    def __init__(self, workbench: Workbench, *, settings: QSettings | None = None):
+        super().__init__()
+        self.workbench = workbench
+        self.settings = settings or QSettings("videocal", "videocal")
+        self.setWindowTitle(f"videocal - {workbench.workcell.name}")
+        self.camera = CameraPane(workbench)
+        self.virtual = VirtualPane(workbench)
+        self.overview = OverviewPane(workbench)
+        self.table = PairsTable(workbench)
+        self.results = ResultsPanel(workbench)
+        self.commands = CommandPanel(workbench)
+        self._current_pair: int | None = None
+        self._distortion = distortion_map(workbench.intrinsics)
+        self.worker: FrameWorker | None = None
+        self._build_layout()
+        self._build_menus()
+        self._build_status()
+        self._connect()
+        self._restore()
+        self._redraw = QTimer(self)
+        self._redraw.setInterval(66)  # overview and virtual camera at up to 15 fps, only when something changed
+        self._redraw.timeout.connect(self._redraw_views)
+        self._redraw.start()
+        self.virtual.refresh()
+        self.overview.refresh()
+
+    # --- layout ----------------------------------------------------------------------------
+    def _build_layout(self) -> None:
+        top = QSplitter(Qt.Orientation.Horizontal)
+        top.addWidget(self.camera)
+        top.addWidget(self.virtual)
+        top.setSizes([1, 1])
+        right_bottom = QWidget()
+        rb = QVBoxLayout(right_bottom)
+        rb.setContentsMargins(0, 0, 0, 0)
+        rb.addWidget(QLabel("<b>Point pairs</b>"))
+        rb.addWidget(self.table, 1)
+        rb.addWidget(QLabel("<b>Results</b>"))
+        rb.addWidget(self.results, 1)
+        bottom = QSplitter(Qt.Orientation.Horizontal)
+        bottom.addWidget(self.overview)
+        bottom.addWidget(right_bottom)
+        bottom.setSizes([1, 1])
+        self.splitter = QSplitter(Qt.Orientation.Vertical)
+        self.splitter.addWidget(top)
+        self.splitter.addWidget(bottom)
+        self.splitter.setStretchFactor(0, 3)
+        self.splitter.setStretchFactor(1, 2)
+        self.setCentralWidget(self.splitter)
+        dock = QDockWidget("Commands", self)
+        dock.setObjectName("commands_dock")
+        dock.setWidget(self.commands)
+        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable)
+        self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, dock)
+        self.resize(1600, 1000)
+
+    def _build_menus(self) -> None:
+        file_menu = self.menuBar().addMenu("&File")
+        quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self.close)
+        file_menu.addAction(quit_action)
+        edit = self.menuBar().addMenu("&Edit")
+        self.undo_action = QAction("&Undo", self, shortcut=QKeySequence.StandardKey.Undo, triggered=self._undo)
+        self.redo_action = QAction("&Redo", self, shortcut=QKeySequence.StandardKey.Redo, triggered=self._redo)
+        self.delete_action = QAction("&Delete pair", self, shortcut=QKeySequence.StandardKey.Delete, triggered=self._delete)
+        self.accept_action = QAction("&Accept pair", self, shortcut=QKeySequence("Ctrl+Return"), triggered=self._accept)
+        for a in (self.undo_action, self.redo_action, self.delete_action, self.accept_action):
+            edit.addAction(a)
+        cal = self.menuBar().addMenu("&Calibration")
+        self.calibrate_action = QAction("&Calibrate", self, shortcut=QKeySequence("F5"), triggered=self._calibrate)
+        cal.addAction(self.calibrate_action)
+        cal.addAction(QAction("&Store correction", self, triggered=self._store))
+        view = self.menuBar().addMenu("&View")
+        view.addAction(QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view))
+        robot = self.menuBar().addMenu("&Robot")
+        robot.addAction(QAction("Go to &approach", self, triggered=lambda: self._go(approach=True)))
+        robot.addAction(QAction("Go to task, &corrected", self, triggered=lambda: self._go(approach=False, corrected=True)))
+
+    def _build_status(self) -> None:
+        self.link_label = QLabel("link: not connected")
+        self.fps_label = QLabel("camera: -")
+        self.pairs_label = QLabel("pairs: 0")
+        for w in (self.link_label, self.fps_label, self.pairs_label):
+            self.statusBar().addPermanentWidget(w)
+        self._fps_timer = QTimer(self)
+        self._fps_timer.setInterval(1000)
+        self._fps_timer.timeout.connect(self._update_status)
+        self._fps_timer.start()
+
+    def _connect(self) -> None:
+        wb = self.workbench
+        c = self.commands
+        self.report = guarded(self.show_error)
+        self.virtual.picked.connect(self.report(self._on_pick_3d))
+        self.camera.picked.connect(self.report(self._on_pick_2d))
+        c.accept.clicked.connect(self._accept)
+        c.delete.clicked.connect(self._delete)
+        c.clear.clicked.connect(self.report(lambda: wb.session.clear()))
+        c.undo.clicked.connect(self._undo)
+        c.redo.clicked.connect(self._redo)
+        c.calibrate.clicked.connect(self._calibrate)
+        c.store.clicked.connect(self._store)
+        c.target.currentTextChanged.connect(self.report(lambda name: wb.session.set_target(name)))
+        c.estimate_focal.toggled.connect(lambda on: setattr(wb.session, "estimate_focal", on))
+        c.robust.toggled.connect(lambda on: setattr(wb.session, "robust", on))
+        c.tasks.currentTextChanged.connect(self.report(lambda name: name and wb.set_task(name)))
+        c.go_approach.clicked.connect(lambda: self._go(approach=True))
+        c.go_task.clicked.connect(lambda: self._go(approach=False))
+        c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
+        c.go_uncorrected.clicked.connect(lambda: self._go(approach=False, corrected=False))
+        c.animate.clicked.connect(self.report(self._animate))
+        c.add_location.clicked.connect(self.report(self._add_location))
+        c.live.toggled.connect(lambda on: self.worker is not None and setattr(self.worker, "paused", not on))
+        self.results.candidate_chosen.connect(self.report(lambda k: wb.session.choose_candidate(k)))
+        wb.joints_changed.connect(self._on_joints)
+        wb.link_state.connect(lambda text: self.link_label.setText(f"link: {text}"))
+        wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
+        wb.session.undo.subscribe(self._update_actions)
+        wb.session.corrections.subscribe(lambda task: self._update_corrections())
+        wb.session.subscribe(self._after_solve)
+        self._update_actions()
+
+    # --- camera ----------------------------------------------------------------------------
+    def start_camera(self, make_source) -> None:
+        self.worker = FrameWorker(make_source, self)
+        self.worker.frame.connect(self.camera.show_frame)
+        self.worker.failed.connect(self.show_error)
+        self.worker.start()
+
+    # --- actions ---------------------------------------------------------------------------
+    def show_error(self, text: str) -> None:
+        self.results.show_error(text)
+        self.statusBar().showMessage(text, 15000)
+
+    def _on_pick_3d(self, hit) -> None:
+        if self.workbench.session.pairs.pending() is not None:
+            # A new model pick replaces a pair still waiting for its image point.
+            self.workbench.session.delete(self.workbench.session.pairs.pending().number)
+        self._current_pair = self.workbench.session.pick_3d(hit.component, hit.feature, hit.point_world_mm)
+        self.statusBar().showMessage(f"pair {self._current_pair}: now pick {hit.feature or 'the point'} on the camera image", 8000)
+
+    def _on_pick_2d(self, u: float, v: float) -> None:
+        session = self.workbench.session
+        if session.pairs.pending() is not None:
+            self._current_pair = session.pick_2d((u, v))
+        elif self._current_pair is not None and self._current_pair in [p.number for p in session.pairs]:
+            session.move_2d(self._current_pair, (u, v))  # not yet accepted: the click moves its image point
+        else:
+            session.pick_2d((u, v))  # raises with a clear message
+
+    def _accept(self) -> None:
+        if self._current_pair is not None:
+            self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
+        self._current_pair = None
+
+    def _delete(self) -> None:
+        self.report(self._delete_impl)()
+
+    def _delete_impl(self) -> None:
+        number = self.table.selected_number() or self._current_pair
+        if number is None:
+            raise ValueError("select a pair in the table to delete it")
+        self.workbench.session.delete(number)
+        if number == self._current_pair:
+            self._current_pair = None
+
+    def _undo(self) -> None:
+        label = self.workbench.session.undo.undo()
+        self._current_pair = None
+        self.statusBar().showMessage(f"undone: {label}" if label else "nothing to undo", 5000)
+
+    def _redo(self) -> None:
+        label = self.workbench.session.undo.redo()
+        self.statusBar().showMessage(f"redone: {label}" if label else "nothing to redo", 5000)
+
+    def _calibrate(self) -> None:
+        self.report(self._calibrate_impl)()
+
+    def _calibrate_impl(self) -> None:
+        self._current_pair = None
+        result = self.workbench.calibrate()
+        s = result.solution
+        self.statusBar().showMessage(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)
+
+    def _store(self) -> None:
+        self.report(self.workbench.store_correction)()
+
+    def _go(self, *, approach: bool, corrected: bool = False) -> None:
+        self.report(lambda: self.workbench.go_to_task(approach=approach, corrected=corrected))()
+
+    def _animate(self) -> None:
+        wb = self.workbench
+        if wb.task is None:
+            raise ValueError("choose a task location")
+        goal = solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg).q_deg
+        start = wb.joints_deg.copy()
+        margin = np.minimum(goal - wb.robot.lower_limits_deg, wb.robot.upper_limits_deg - goal)
+        warn = [f"joint {i + 1} within {m:.1f} deg of its limit" for i, m in enumerate(margin) if m < 10.0]
+        self.commands.sim_status.setText("; ".join(warn) if warn else f"path to {wb.task.name}: joints within limits")
+        steps = 30
+        self._anim = [start + (goal - start) * (k / steps) for k in range(steps + 1)]
+        self._anim_timer = QTimer(self)
+        self._anim_timer.setInterval(40)
+
+        def step():
+            if not self._anim:
+                self._anim_timer.stop()
+                self._on_joints(wb.joints_deg)  # back to the real robot
+                return
+            q = self._anim.pop(0)
+            self.overview.mark_dirty()
+            saved = wb.joints_deg
+            wb.joints_deg = q
+            self.overview.refresh()
+            wb.joints_deg = saved
+
+        self._anim_timer.timeout.connect(step)
+        self._anim_timer.start()
+
+    def _add_location(self, name: str | None = None) -> None:
+        from calib_core.workcell.model import TaskLocation
+
+        wb = self.workbench
+        name = name or f"location_{len(wb.workcell.task_locations) + 1}"
+        wb.workcell.task_locations[name] = TaskLocation(name, wb.model_tcp2base(), 0.0, wb.session.target)
+        self.commands.tasks.addItem(name)
+        self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
+
+    # --- updates ---------------------------------------------------------------------------
+    def _on_joints(self, q) -> None:
+        if self.commands.monitoring.isChecked():
+            self.overview.mark_dirty()
+            self._joints_dirty = True
+
+    def _redraw_views(self) -> None:
+        if getattr(self, "_joints_dirty", False):
+            self._joints_dirty = False
+            self.virtual.refresh_if_moved()
+        self.overview.refresh()
+
+    def _after_solve(self) -> None:
+        r = self.workbench.session.result
+        if r is None:
+            self.camera.set_edges_image(None)
+            return
+        # The CAD edges seen from the measured camera, through the lens, over the video.
+        ideal = self._distortion.ideal
+        rgba = self.virtual.renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target, hidden=frozenset(i.name for i in self.workbench.bed.visuals_for_model().scene_items(self.workbench.joints_deg))))
+        self.camera.set_edges_image(self._distortion.apply(rgba))
+        self.virtual.refresh()
+
+    def _update_actions(self) -> None:
+        undo = self.workbench.session.undo
+        self.undo_action.setEnabled(undo.can_undo)
+        self.redo_action.setEnabled(undo.can_redo)
+        self.undo_action.setText(f"&Undo {undo.undo_label}" if undo.undo_label else "&Undo")
+        self.redo_action.setText(f"&Redo {undo.redo_label}" if undo.redo_label else "&Redo")
+        self.commands.undo.setEnabled(undo.can_undo)
+        self.commands.redo.setEnabled(undo.can_redo)
+        self.commands.calibrate.setEnabled(self.workbench.session.can_calibrate)
+        self.pairs_label.setText(f"pairs: {len(self.workbench.session.pairs.usable())}/{self.workbench.session.required_pairs} needed")
+
+    def _update_corrections(self) -> None:
+        table = self.workbench.session.corrections
+        lines = []
+        for task in table.tasks():
+            c = table.latest(task)
+            lines.append(f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored)")
+        self.commands.corrections.setText("\n".join(lines) or "No corrections stored.")
+
+    def _update_status(self) -> None:
+        if self.worker is not None:
+            self.fps_label.setText(f"camera: {self.worker.fps_measured:.1f} fps")
+        link = self.workbench.link
+        if link is not None:
+            s = link.stats_snapshot()
+            self.link_label.setText(f"link: {link.state.value}, {s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected")
+
+    # --- life cycle ------------------------------------------------------------------------
+    def _restore(self) -> None:
+        geometry = self.settings.value("window/geometry")
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        state = self.settings.value("window/state")
+        if state is not None:
+            self.restoreState(state)
+
+    def closeEvent(self, event) -> None:
+        self.settings.setValue("window/geometry", self.saveGeometry())
+        self.settings.setValue("window/state", self.saveState())
+        self._redraw.stop()
+        if self.worker is not None:
+            self.worker.stop()
+        self.virtual.close_renderer()
+        self.overview.renderer.close()
+        self.workbench.close()
+        super().closeEvent(event)

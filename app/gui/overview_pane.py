@@ -1,0 +1,105 @@
+"""The workcell overview: the whole cell, the robot following the joints, the modelled camera
+frustum and, after a solve, the measured one; orbit (left drag), zoom (wheel)."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+
+from app.gui.image_view import ImageView
+from app.gui.workbench import Workbench
+from calib_core.render import RenderOptions, SceneRenderer
+from calib_core.render.frustum import frustum_polyline
+
+MODEL_FRUSTUM = (0.35, 0.6, 1.0)
+MEASURED_FRUSTUM = (0.2, 1.0, 0.4)
+
+
+class _OrbitView(ImageView):
+    """An image view whose left drag orbits and wheel zooms the camera instead of the image."""
+
+    def __init__(self, pane):
+        super().__init__(placeholder="rendering...")
+        self.pane = pane
+        self._orbit_from: QPointF | None = None
+
+    def mousePressEvent(self, event):
+        if event.button() == Qt.MouseButton.LeftButton:
+            self._orbit_from = event.position()
+        else:
+            super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event):
+        if self._orbit_from is not None:
+            d = event.position() - self._orbit_from
+            self._orbit_from = event.position()
+            self.pane.orbit(-0.4 * d.x(), 0.3 * d.y())
+        else:
+            super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event):
+        self._orbit_from = None
+        super().mouseReleaseEvent(event)
+
+    def wheelEvent(self, event):
+        self.pane.dolly(0.85 if event.angleDelta().y() > 0 else 1.18)
+
+
+class OverviewPane(QWidget):
+    def __init__(self, workbench: Workbench, parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        self.renderer = SceneRenderer()
+        self.view = _OrbitView(self)
+        self.view.setCursor(Qt.CursorShape.OpenHandCursor)
+        bar = QHBoxLayout()
+        bar.addWidget(QLabel("<b>Workcell overview</b>"))
+        bar.addStretch(1)
+        legend = QLabel("<span style='color:#5a9aff'>model camera</span>  <span style='color:#33ff66'>measured camera</span>")
+        bar.addWidget(legend)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(2, 2, 2, 2)
+        layout.addLayout(bar)
+        layout.addWidget(self.view, 1)
+        self.target = np.array([700.0, 0.0, 800.0])
+        self.azimuth_deg, self.elevation_deg, self.distance_mm = -130.0, 32.0, 4300.0
+        self.redraws = 0
+        self._dirty = True
+        workbench.session.subscribe(self.mark_dirty)
+        workbench.session.pairs.subscribe(lambda *_: self.mark_dirty())
+
+    def orbit(self, d_azimuth: float, d_elevation: float) -> None:
+        self.azimuth_deg += d_azimuth
+        self.elevation_deg = float(np.clip(self.elevation_deg + d_elevation, -5.0, 85.0))
+        self.mark_dirty()
+        self.refresh()
+
+    def dolly(self, factor: float) -> None:
+        self.distance_mm = float(np.clip(self.distance_mm * factor, 800.0, 15000.0))
+        self.mark_dirty()
+        self.refresh()
+
+    def mark_dirty(self) -> None:
+        self._dirty = True
+
+    def eye(self) -> np.ndarray:
+        a, e = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
+        return self.target + self.distance_mm * np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+
+    def refresh(self) -> None:
+        """Redraw only when something changed (joints, a solve, the view)."""
+        if not self._dirty:
+            return
+        wb = self.workbench
+        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg))
+        lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
+        if wb.session.result is not None:
+            lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))
+        markers = [(np.array(p.point_world_mm), (1.0, 0.84, 0.04)) for p in wb.session.pairs]
+        size = self.view.size()
+        w, h = max(size.width(), 320), max(size.height(), 240)
+        image = self.renderer.render_overview(self.eye(), self.target, width=w, height=h, options=RenderOptions(highlight=wb.session.target, lines=lines, markers=markers, feature_size_px=8))
+        self.view.set_image(image)
+        self.redraws += 1
+        self._dirty = False

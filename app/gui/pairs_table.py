@@ -1,0 +1,72 @@
+"""The correspondence table: number, feature, 3D point (mm), 2D point (px), residual (px), enabled."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
+
+from app.gui.workbench import Workbench
+
+COLUMNS = ("#", "feature", "X mm", "Y mm", "Z mm", "u px", "v px", "residual px", "use")
+
+
+class PairsTable(QTableWidget):
+    def __init__(self, workbench: Workbench, parent=None):
+        super().__init__(0, len(COLUMNS), parent)
+        self.workbench = workbench
+        self.setHorizontalHeaderLabels(COLUMNS)
+        self.verticalHeader().setVisible(False)
+        self.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.horizontalHeader().setStretchLastSection(True)
+        self._updating = False
+        self.itemChanged.connect(self._on_item_changed)
+        workbench.session.pairs.subscribe(lambda *_: self.refresh())
+        workbench.session.subscribe(self.refresh)
+
+    def selected_number(self) -> int | None:
+        rows = self.selectionModel().selectedRows()
+        if not rows:
+            return None
+        item = self.item(rows[0].row(), 0)
+        return int(item.text()) if item is not None else None
+
+    def _residuals(self) -> dict[int, float]:
+        result = self.workbench.session.result
+        if result is None:
+            return {}
+        numbers = self.workbench.session._context[4] if self.workbench.session._context else []
+        norms = result.solution.residual_norms_px
+        return {n: float(r) for n, r in zip(numbers, norms)}
+
+    def refresh(self) -> None:
+        self._updating = True
+        pairs = self.workbench.session.pairs.pairs()
+        residuals = self._residuals()
+        self.setRowCount(len(pairs))
+        for row, p in enumerate(pairs):
+            x, y, z = p.point_world_mm
+            u, v = p.pixel if p.pixel is not None else (np.nan, np.nan)
+            texts = [str(p.number), p.feature or "(surface)", f"{x:.1f}", f"{y:.1f}", f"{z:.1f}",
+                     "pending" if p.pixel is None else f"{u:.2f}", "" if p.pixel is None else f"{v:.2f}",
+                     f"{residuals[p.number]:.2f}" if p.number in residuals else ""]
+            for col, text in enumerate(texts):
+                item = QTableWidgetItem(text)
+                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter if col >= 2 else Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+                self.setItem(row, col, item)
+            check = QTableWidgetItem()
+            check.setFlags(Qt.ItemFlag.ItemIsUserCheckable | Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsSelectable)
+            check.setCheckState(Qt.CheckState.Checked if p.enabled else Qt.CheckState.Unchecked)
+            self.setItem(row, len(COLUMNS) - 1, check)
+        self._updating = False
+
+    def _on_item_changed(self, item: QTableWidgetItem) -> None:
+        if self._updating or item.column() != len(COLUMNS) - 1:
+            return
+        number = int(self.item(item.row(), 0).text())
+        enabled = item.checkState() == Qt.CheckState.Checked
+        if self.workbench.session.pairs.get(number).enabled != enabled:
+            self.workbench.session.set_enabled(number, enabled)

@@ -1,0 +1,119 @@
+"""Results of the last solve: status in words, camera pose, the end-effector displacement with
+1-sigma, RMS, a per-point residual chart, and the candidates when the solve is ambiguous."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QPainter
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
+
+from app.gui.workbench import Workbench
+from calib_core.solver import SolveStatus
+
+
+class ResidualChart(QWidget):
+    """Bars of the per-point residual lengths (px), with the leave-one-out value as a tick."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setMinimumHeight(70)
+        self.values: list[tuple[str, float, float]] = []
+
+    def set_values(self, values: list[tuple[str, float, float]]) -> None:
+        self.values = values
+        self.update()
+
+    def paintEvent(self, event) -> None:
+        p = QPainter(self)
+        p.fillRect(self.rect(), QColor(30, 31, 35))
+        if not self.values:
+            p.setPen(QColor(140, 140, 140))
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, "residuals per point appear after Calibrate")
+            return
+        top = max(max(max(r, l if np.isfinite(l) else 0) for _, r, l in self.values), 0.5)
+        n = len(self.values)
+        w = self.width() / n
+        h = self.height() - 16
+        for i, (label, r, loo) in enumerate(self.values):
+            bar = h * r / top
+            p.fillRect(QRectF(i * w + 3, h - bar, w - 6, bar), QColor(255, 200, 40))
+            if np.isfinite(loo):
+                y = h - h * loo / top
+                p.setPen(QColor(255, 80, 80))
+                p.drawLine(int(i * w + 2), int(y), int((i + 1) * w - 2), int(y))
+            p.setPen(QColor(200, 200, 200))
+            p.drawText(QRectF(i * w, h, w, 16), Qt.AlignmentFlag.AlignCenter, label)
+        p.setPen(QColor(160, 160, 160))
+        p.drawText(QRectF(4, 2, self.width() - 8, 14), Qt.AlignmentFlag.AlignRight, f"max {top:.2f} px  (red: if left out)")
+
+
+class ResultsPanel(QWidget):
+    """``candidate_chosen(index)`` when the operator picks one of several equally good solutions."""
+
+    candidate_chosen = Signal(int)
+
+    def __init__(self, workbench: Workbench, parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        self.status = QLabel("No solve yet.")
+        self.status.setWordWrap(True)
+        self.status.setTextFormat(Qt.TextFormat.RichText)
+        self.details = QLabel("")
+        self.details.setTextFormat(Qt.TextFormat.RichText)
+        self.details.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.chart = ResidualChart()
+        self.candidates = QHBoxLayout()
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
+        layout.addWidget(self.status)
+        layout.addWidget(self.details)
+        layout.addLayout(self.candidates)
+        layout.addWidget(self.chart, 1)
+        workbench.session.subscribe(self.refresh)
+
+    def show_error(self, text: str) -> None:
+        self.status.setText(f"<span style='color:#ff6b6b'><b>{text}</b></span>")
+
+    def refresh(self) -> None:
+        session = self.workbench.session
+        r = session.result
+        while self.candidates.count():
+            w = self.candidates.takeAt(0).widget()
+            if w is not None:
+                w.deleteLater()
+        if r is None:
+            self.status.setText("No solve yet. Pick at least %d pairs, then Calibrate." % session.required_pairs)
+            self.details.setText("")
+            self.chart.set_values([])
+            return
+        sol = r.solution
+        color = {SolveStatus.OK: "#5fd35f", SolveStatus.AMBIGUOUS: "#ffb347", SolveStatus.FAILED: "#ff6b6b"}[sol.status]
+        text = f"<span style='color:{color}'><b>{sol.status.value.upper()}</b></span>"
+        if sol.reason:
+            text += f" - {sol.reason}"
+        for w in sol.warnings:
+            text += f"<br><span style='color:#ccb'>note: {w}</span>"
+        self.status.setText(text)
+        d, rv, sd, sr = r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
+        cam = r.cam2world_measured[:3, 3]
+        self.details.setText(
+            "<table cellspacing=4>"
+            f"<tr><td>end-effector displacement</td><td>dx {d[0]:+.2f}</td><td>dy {d[1]:+.2f}</td><td>dz {d[2]:+.2f} mm</td><td>|d| {np.linalg.norm(d):.2f} mm</td></tr>"
+            f"<tr><td>1-sigma</td><td>{sd[0]:.2f}</td><td>{sd[1]:.2f}</td><td>{sd[2]:.2f} mm</td><td></td></tr>"
+            f"<tr><td>rotation (base axes)</td><td>rx {rv[0]:+.3f}</td><td>ry {rv[1]:+.3f}</td><td>rz {rv[2]:+.3f} deg</td><td>{np.linalg.norm(rv):.3f} deg</td></tr>"
+            f"<tr><td>1-sigma</td><td>{sr[0]:.3f}</td><td>{sr[1]:.3f}</td><td>{sr[2]:.3f} deg</td><td></td></tr>"
+            f"<tr><td>camera (base frame)</td><td>{cam[0]:.1f}</td><td>{cam[1]:.1f}</td><td>{cam[2]:.1f} mm</td><td></td></tr>"
+            f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} pairs</td><td>{sol.iterations} iterations</td><td></td></tr>"
+            "</table>"
+        )
+        numbers = session._context[4] if session._context else []
+        self.chart.set_values([(str(n), float(e), float(l)) for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px)])
+        if sol.status is SolveStatus.AMBIGUOUS:
+            for i, c in enumerate(sol.candidates):
+                button = QPushButton(f"Use solution {i + 1} ({c.rms_px:.2f} px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})")
+                button.setObjectName(f"candidate_{i}")
+                button.setCheckable(True)
+                button.setChecked(i == session.chosen_candidate)
+                button.clicked.connect(lambda _=False, k=i: self.candidate_chosen.emit(k))
+                self.candidates.addWidget(button)

@@ -1,0 +1,84 @@
+"""The virtual camera pane: the CAD workcell from the modelled camera pose (robot model at the
+current joints, hand-eye, intrinsics), the target highlighted; a click picks a 3D point."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+
+from app.gui.image_view import ImageView, Overlay
+from app.gui.workbench import Workbench
+from calib_core.render import PickResult, RenderOptions, SceneRenderer
+
+RENDER_SCALE = 0.5  # the pane shows a half-size render: plenty to pick features, half the cost
+
+
+class VirtualPane(QWidget):
+    """``picked(PickResult)`` when the operator picks on the target object."""
+
+    picked = Signal(object)
+
+    def __init__(self, workbench: Workbench, parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        self.renderer = SceneRenderer()
+        self.view = ImageView(placeholder="rendering...")
+        self.info = QLabel("")
+        self.info.setStyleSheet("color: #9aa;")
+        bar = QHBoxLayout()
+        bar.addWidget(QLabel("<b>Virtual camera</b> (CAD model)"))
+        bar.addStretch(1)
+        bar.addWidget(self.info)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(2, 2, 2, 2)
+        layout.addLayout(bar)
+        layout.addWidget(self.view, 1)
+        self.intrinsics = workbench.intrinsics.without_distortion().scaled(RENDER_SCALE)
+        self.view.clicked.connect(self._on_click)
+        workbench.session.pairs.subscribe(lambda *_: self.refresh())
+        workbench.session.subscribe(self.refresh)
+        self._last_joints = None
+
+    def refresh(self) -> None:
+        wb = self.workbench
+        items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg)
+        self.renderer.set_items(items)
+        markers = [(np.array(p.point_world_mm), (1.0, 0.2, 0.2) if not p.complete else (1.0, 0.84, 0.04)) for p in wb.session.pairs]
+        options = RenderOptions(highlight=wb.session.target, show_features=True, feature_names=False, markers=markers, feature_size_px=6)
+        image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), options)
+        self.view.set_image(image)
+        overlay = Overlay()
+        from calib_core.camera.projection import project
+        from calib_core.frames import apply, invert
+
+        world2cam = invert(wb.model_cam2world())
+        for p in wb.session.pairs:
+            uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
+            if np.all(np.isfinite(uv)):
+                overlay.points.append((uv[0], uv[1], str(p.number), _qcolor(p.complete)))
+        overlay.text = f"target: {wb.session.target or '(choose one)'}" + ("" if wb.session.pairs.pending() else " - click a feature to pick its 3D point")
+        self.view.set_overlay(overlay)
+        self._last_joints = wb.joints_deg.copy()
+
+    def refresh_if_moved(self, tolerance_deg: float = 1e-3) -> None:
+        if self._last_joints is None or np.max(np.abs(self.workbench.joints_deg - self._last_joints)) > tolerance_deg:
+            self.refresh()
+
+    def _on_click(self, u: float, v: float) -> None:
+        target = self.workbench.session.target
+        hit: PickResult | None = self.renderer.pick(u, v, snap_radius_px=10, components=None if target is None else {target})
+        if hit is None:
+            self.info.setText("nothing of the target object there")
+            return
+        self.info.setText(f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm")
+        self.picked.emit(hit)
+
+    def close_renderer(self) -> None:
+        self.renderer.close()
+
+
+def _qcolor(complete: bool):
+    from PySide6.QtGui import QColor
+
+    return QColor(255, 214, 10) if complete else QColor(255, 80, 60)

@@ -1,0 +1,153 @@
+"""The window's state and its connections to the world, without widgets: the workcell and
+robot, the calibration session, the controller link (with its simulator), the camera.
+
+Panes read from here and send the operator's actions here; nothing here draws.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal
+
+from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.link.driver import ControllerLink
+from calib_core.link.link_types import LinkState, MoveError
+from calib_core.robot import solve_ik
+from calib_core.testbed.test_bed import TestBed
+from calib_core.workcell import TaskLocation
+
+
+class Workbench(QObject):
+    """Signals: ``joints_changed(q)``, ``link_state(str)``, ``message(str)`` (status bar),
+    ``error(str)`` (shown to the operator), ``solved()``, ``task_changed(str)``."""
+
+    joints_changed = Signal(object)
+    link_state = Signal(str)
+    message = Signal(str)
+    error = Signal(str)
+    solved = Signal()
+    task_changed = Signal(str)
+    _sample_arrived = Signal(object)
+    _state_arrived = Signal(str, str)
+
+    def __init__(self, bed: TestBed | None = None, parent=None):
+        super().__init__(parent)
+        self.bed = bed or TestBed.create()
+        self.workcell = self.bed.workcell
+        self.robot = self.bed.model_robot
+        self.intrinsics: Intrinsics = self.bed.intrinsics
+        self.session = CalibrationSession()
+        self.joints_deg = np.array(self.workcell.home_joints_deg, dtype=float)
+        self.task: TaskLocation | None = next(iter(self.workcell.task_locations.values()), None)
+        if self.task is not None and self.task.component:
+            self.session.set_target(self.task.component)
+        self.link: ControllerLink | None = None
+        self._sim_process: subprocess.Popen | None = None
+        self._tmp = tempfile.TemporaryDirectory(prefix="videocal-")
+        self._sample_arrived.connect(self._on_sample)
+        self._state_arrived.connect(lambda state, why: self.link_state.emit(f"{state}: {why}"))
+
+    # --- robot and link ----------------------------------------------------------------------
+    def start_simulated_controller(self) -> str:
+        """Start ``videocal sim-controller`` on a pty as a child process and connect to it."""
+        link_path = Path(self._tmp.name) / "controller"
+        q = ",".join(f"{v:.4f}" for v in self.joints_deg)
+        self._sim_process = subprocess.Popen(
+            [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(link_path), "--joints", q],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=str(Path(__file__).resolve().parents[2]),
+        )
+        device = self._sim_process.stdout.readline().strip()
+        if not device:
+            raise RuntimeError("the controller simulator did not start")
+        self.connect_link(str(link_path))
+        return device
+
+    def connect_link(self, url: str, rate_hz: float = 50.0) -> None:
+        if self.link is not None:
+            self.link.close()
+        self.link = ControllerLink(url, mode="stream", rate_hz=rate_hz)
+        self.link.on_sample(self._sample_arrived.emit)  # queued into the GUI thread
+        self.link.on_state(lambda state, why: self._state_arrived.emit(state.value, why))
+        self.link.start()
+        self.message.emit(f"controller link: {url}")
+
+    def _on_sample(self, sample) -> None:
+        self.joints_deg = np.array(sample.joints_deg, dtype=float)
+        self.bed.joints_deg = self.joints_deg.copy()  # the simulated camera follows the commanded joints
+        self.joints_changed.emit(self.joints_deg)
+
+    @property
+    def link_up(self) -> bool:
+        return self.link is not None and self.link.state is LinkState.UP
+
+    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0):
+        """IK for the target from the current joints, then MVJ over the link."""
+        q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
+        if self.link is None:
+            raise CalibrationError("no controller link: connect one first")
+        handle = self.link.move_joints(q, timeout_s=timeout_s)
+        self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)} deg")
+        if wait:
+            handle.wait(timeout_s)
+        return handle
+
+    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False):
+        if self.task is None:
+            raise CalibrationError("choose a task location first")
+        target = self.task.approach2base if approach else self.task.tcp2base
+        if corrected:
+            if self.session.corrections.latest(self.task.name) is None:
+                raise CalibrationError(f"no stored correction for {self.task.name}: calibrate and store one first")
+            target = self.session.corrections.corrected_target(self.task.name, target)
+        what = f"{self.task.name} ({'approach' if approach else 'task'}{', corrected' if corrected else ''})"
+        return self.move_to(target, what, wait=wait)
+
+    def set_task(self, name: str) -> None:
+        self.task = self.workcell.task(name)
+        if self.task.component:
+            self.session.set_target(self.task.component)
+        self.task_changed.emit(name)
+
+    # --- frames of reference -------------------------------------------------------------------
+    def model_cam2world(self) -> np.ndarray:
+        return self.robot.fk(self.joints_deg, "camera")
+
+    def model_tcp2base(self) -> np.ndarray:
+        return self.robot.fk(self.joints_deg, "tcp")
+
+    # --- calibration -------------------------------------------------------------------------
+    def calibrate(self):
+        target = self.session.target
+        if target is None:
+            raise CalibrationError("choose the target object first")
+        obj2world = self.workcell.component(target).item2world
+        result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
+        self.solved.emit()
+        return result
+
+    def store_correction(self):
+        if self.task is None:
+            raise CalibrationError("choose the task location the correction is for")
+        c = self.session.store_correction(self.task.name)
+        self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
+        return c
+
+    def close(self) -> None:
+        if self.link is not None:
+            self.link.close()
+        if self._sim_process is not None and self._sim_process.poll() is None:
+            self._sim_process.terminate()
+            try:
+                self._sim_process.wait(timeout=3)
+            except subprocess.TimeoutExpired:
+                self._sim_process.kill()
+            self._sim_process.stdout.close()
+        self._tmp.cleanup()
