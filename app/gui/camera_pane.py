@@ -21,14 +21,15 @@ RESIDUAL_COLOR = QColor(255, 70, 70)
 RESIDUAL_SCALE = 10.0
 
 
-def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5) -> tuple[float, float]:
+def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
     """The corner nearest (u, v) to sub-pixel accuracy (``cv2.cornerSubPix``); the click itself
-    when the refinement wanders off (no corner there)."""
+    when the refinement wanders further than ``max_shift_px`` (no corner there: a circle centre,
+    a flat patch), since the operator's click is then the better estimate."""
     grey = cv2.cvtColor(image_rgb, cv2.COLOR_RGB2GRAY).astype(np.float32)
     corner = np.array([[[u, v]]], dtype=np.float32)
     criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 40, 0.01)
     refined = cv2.cornerSubPix(grey, corner, (half_window, half_window), (-1, -1), criteria)[0, 0]
-    if np.hypot(refined[0] - u, refined[1] - v) > half_window:
+    if np.hypot(refined[0] - u, refined[1] - v) > max_shift_px:
         return u, v
     return float(refined[0]), float(refined[1])
 

@@ -9,8 +9,13 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.gui.image_view import ImageView, Overlay
 from app.gui.workbench import Workbench
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert
 from calib_core.render import PickResult, RenderOptions, SceneRenderer
 
+from PySide6.QtGui import QColor
+
+FEATURE_COLOR = QColor(90, 190, 255)
 RENDER_SCALE = 0.5  # the pane shows a half-size render: plenty to pick features, half the cost
 
 
@@ -44,15 +49,19 @@ class VirtualPane(QWidget):
         wb = self.workbench
         items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg)
         self.renderer.set_items(items)
-        markers = [(np.array(p.point_world_mm), (1.0, 0.2, 0.2) if not p.complete else (1.0, 0.84, 0.04)) for p in wb.session.pairs]
-        options = RenderOptions(highlight=wb.session.target, show_features=True, feature_names=False, markers=markers, feature_size_px=6)
-        image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), options)
+        # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
+        # cover the very surface points the picker tests for visibility.
+        image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), RenderOptions(highlight=wb.session.target))
         self.view.set_image(image)
         overlay = Overlay()
-        from calib_core.camera.projection import project
-        from calib_core.frames import apply, invert
-
         world2cam = invert(wb.model_cam2world())
+        if wb.session.target is not None:
+            target = wb.workcell.component(wb.session.target)
+            if target.features:
+                pts = apply(world2cam, apply(target.item2world, np.array(list(target.features.values()))))
+                for uv in project(pts, self.intrinsics, distort=False):
+                    if np.all(np.isfinite(uv)):
+                        overlay.points.append((uv[0], uv[1], "", FEATURE_COLOR))
         for p in wb.session.pairs:
             uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
             if np.all(np.isfinite(uv)):

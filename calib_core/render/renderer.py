@@ -229,6 +229,7 @@ class SceneRenderer:
 
     def _read_back(self, transparent: bool) -> np.ndarray:
         w, h = self.window.GetSize()
+        self.window.MakeCurrent()
         arr = vtk.vtkUnsignedCharArray()
         self.window.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, arr)
         img = numpy_support.vtk_to_numpy(arr).reshape(h, w, 4)[::-1]
@@ -267,6 +268,7 @@ class SceneRenderer:
         if self._last is None:
             raise RuntimeError("depth is available after render_view only")
         w, h = self.window.GetSize()
+        self.window.MakeCurrent()  # several render windows share the thread: read this one's buffers
         z = vtk.vtkFloatArray()
         self.window.GetZbufferData(0, 0, w - 1, h - 1, z)
         zbuf = numpy_support.vtk_to_numpy(z).reshape(h, w)[::-1]
@@ -294,6 +296,7 @@ class SceneRenderer:
 
     def _ray_hit(self, u: float, v: float) -> tuple[str | None, np.ndarray | None]:
         _, h = self.window.GetSize()
+        self.window.MakeCurrent()
         picker = vtk.vtkCellPicker()
         picker.SetTolerance(0.0)
         for actor in self._actors.values():
@@ -329,9 +332,9 @@ class SceneRenderer:
                 col, row = int(round(px[k, 0])), int(round(px[k, 1]))
                 if not (0 <= row < depth.shape[0] and 0 <= col < depth.shape[1]):
                     continue
-                # Visible if nothing nearer than the feature covers its pixel (a few mm of slack for edges).
+                # Visible if nothing nearer than the feature covers its pixel (slack for edges and markers).
                 window = depth[max(row - 1, 0) : row + 2, max(col - 1, 0) : col + 2]
-                if pts_cam[k, 2] <= window.max() + 3.0:
+                if pts_cam[k, 2] <= window.max() + max(3.0, 0.02 * pts_cam[k, 2]):
                     best = (float(d[k]), item, names[k])
         if best is None:
             return None

@@ -83,3 +83,18 @@ def test_render_options(renderer):
     OUTPUT.mkdir(exist_ok=True)
     with pytest.raises(ValueError, match="style must be one of"):
         renderer.render_view(intr, np.eye(4), RenderOptions(style="toon"))
+
+
+def test_depth_read_back_survives_another_window_rendering_in_between():
+    intr = Intrinsics(300.0, 300.0, 160.0, 120.0, 320, 240)
+    near = SceneItem("near", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 805.0]), kind="fixture")
+    far = SceneItem("far", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 3005.0]), kind="fixture")
+    a, b = SceneRenderer(), SceneRenderer()
+    a.set_items([near])
+    b.set_items([far])
+    a.render_view(intr, np.eye(4))
+    b.render_view(intr, np.eye(4))
+    assert np.allclose(a.depth_mm(), 800.0, atol=0.5)
+    assert np.allclose(b.depth_mm(), 3000.0, atol=2.0)
+    a.close()
+    b.close()

@@ -1,0 +1,128 @@
+"""The whole calibration through the real window: the controller simulator as a child process,
+the simulated camera on its worker thread, and mouse clicks on the panes' widgets."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, QPointF, QSettings, Qt
+
+from app.gui.main_window import MainWindow
+from app.gui.workbench import Workbench
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert, pose_difference
+from calib_core.solver import SolveStatus
+from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.true_robot import RobotErrors
+
+OUTPUT = Path(__file__).resolve().parents[1] / "output"
+FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
+
+
+@pytest.fixture
+def window(qtbot, tmp_path):
+    typical = RobotErrors.typical(0)
+    errors = RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
+    bed = TestBed.create(errors=errors)
+    bed.intrinsics = bed.intrinsics.scaled(0.5)  # 640 x 480: the same workflow at a quarter of the rendering cost
+    wb = Workbench(bed)
+    wb.start_simulated_controller()
+    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+    qtbot.addWidget(win)
+    win.resize(1500, 950)
+    win.start_camera(lambda: bed.camera(fps=10.0))
+    win.show()
+    qtbot.waitUntil(lambda: wb.link_up, timeout=10_000)
+    yield win
+    win.close()
+
+
+def _click_image(qtbot, view, u, v, zoom=None):
+    if zoom is not None:
+        # The operator zooms in (mouse wheel) around the point before clicking it.
+        view.set_zoom(zoom, QPointF(u, v))
+    x, y = view.image_to_widget(u, v)
+    qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+
+
+def _go_to_approach(qtbot, win):
+    wb = win.workbench
+    task = wb.task
+    qtbot.mouseClick(win.commands.go_approach, Qt.MouseButton.LeftButton)
+    target = wb.robot.fk
+    qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.approach2base)[0]) < 0.01, timeout=20_000)
+    # A frame rendered at the final joints, and the virtual camera redrawn there.
+    frames = []
+    win.worker.frame.connect(frames.append)
+    qtbot.waitUntil(lambda: len(frames) >= 2, timeout=10_000)
+    qtbot.waitUntil(lambda: win.virtual._last_joints is not None and np.allclose(win.virtual._last_joints, wb.joints_deg), timeout=5_000)
+
+
+def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window):
+    win = window
+    wb = win.workbench
+    bed = wb.bed
+    _go_to_approach(qtbot, win)
+    fixture = wb.workcell.component("oru_1_fixture")
+    model_cam = wb.model_cam2world()
+    true_cam = bed.true_cam2world(wb.joints_deg)
+    for k, name in enumerate(FEATURES, start=1):
+        p_world = apply(fixture.item2world, fixture.features[name])
+        uv_model = project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0]
+        _click_image(qtbot, win.virtual.view, *uv_model)
+        pair = wb.session.pairs.pending()
+        assert pair is not None and pair.feature == name, f"pick {k}: {win.virtual.info.text()}"
+        # The operator looks at the camera image and clicks the same corner: here the truth tells where it is.
+        uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
+        # Sub-pixel refinement finds corners; the operator turns it off for the centre of a round boss.
+        win.camera.subpixel.setChecked(name.startswith("plate"))
+        _click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
+        picked = wb.session.pairs.get(pair.number).pixel
+        assert picked is not None
+        assert np.linalg.norm(np.array(picked) - uv_true) < 1.0
+        qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)
+    assert len(wb.session.pairs.usable()) == len(FEATURES)
+    assert win.table.rowCount() == len(FEATURES)
+    assert win.commands.calibrate.isEnabled()
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    result = wb.session.result
+    assert result is not None and result.solution.status is SolveStatus.OK, win.results.status.text()
+    assert result.solution.rms_px < 1.0
+    d_true, r_true = pose_difference(bed.true_robot.fk(wb.joints_deg), bed.model_robot.fk(wb.joints_deg))
+    assert np.linalg.norm(result.displacement_mm - d_true) < 1.0
+    assert "OK" in win.results.status.text()
+    OUTPUT.mkdir(exist_ok=True)
+    win.grab().save(str(OUTPUT / "window_after_calibration.png"))
+
+    # Store the correction, undo it, redo it.
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    assert wb.session.corrections.latest(wb.task.name) is not None
+    qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert wb.session.corrections.latest(wb.task.name) is None
+    qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
+    assert wb.session.corrections.latest(wb.task.name) is not None
+
+    # Execute the task with its correction: the real tool ends close to the planned location.
+    qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
+    corrected = wb.session.corrections.corrected_target(wb.task.name, wb.task.tcp2base)
+    qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), corrected)[0]) < 0.01, timeout=20_000)
+    miss = np.linalg.norm(pose_difference(bed.true_robot.fk(wb.joints_deg), wb.task.tcp2base)[0])
+    miss_uncorrected = np.linalg.norm(d_true)
+    assert miss < 2.0 and miss < miss_uncorrected / 3
+
+
+def test_mistakes_become_messages_not_crashes(qtbot, window):
+    win = window
+    wb = win.workbench
+    # An image click before any model pick.
+    win.camera.show_frame(type("F", (), {"image": np.zeros((480, 640, 3), np.uint8)})())
+    _click_image(qtbot, win.camera.view, 100, 100)
+    assert "pick the point on the model" in win.results.status.text()
+    # Calibrate with no pairs: the button is disabled, the shortcut explains.
+    assert not win.commands.calibrate.isEnabled()
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    assert "complete pairs; calibrating needs 3" in win.results.status.text()
+    # Going to a corrected location that has no correction.
+    qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
+    assert "no stored correction" in win.results.status.text()
+    assert win.isVisible()
