@@ -19,8 +19,12 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
+# With a display: the window. Without one: the window driven through a whole calibration offscreen,
+# its screenshots and report.json in out/demo (open them with any image viewer).
 run: $(STAMP)
-	$(BIN)/videocal table1
+	@if [ -n "$$DISPLAY$$WAYLAND_DISPLAY" ]; then $(BIN)/videocal gui; \
+	else echo "no display: running the calibration demo offscreen; screenshots and report.json go to out/demo"; \
+	$(BIN)/videocal demo --offscreen --out out/demo; fi
 
 test: $(STAMP)
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest

@@ -6,10 +6,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _imports(path: Path) -> set[str]:
+def _imports(path: Path, *, module_level_only: bool = False) -> set[str]:
     tree = ast.parse(path.read_text(), filename=str(path))
     names: set[str] = set()
-    for node in ast.walk(tree):
+    for node in tree.body if module_level_only else ast.walk(tree):
         if isinstance(node, ast.Import):
             names.update(a.name.split(".")[0] for a in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
@@ -36,10 +36,27 @@ def test_only_render_imports_vtk():
     assert offenders == []
 
 
-def test_cli_package_does_not_import_qt():
+def test_cli_package_does_not_import_qt_at_load():
+    # Headless commands must never load Qt: command modules may import it only inside the
+    # function that runs the window (``videocal gui``, ``videocal demo``).
     offenders = [
         str(p.relative_to(ROOT))
         for p in (ROOT / "app" / "cli").rglob("*.py")
-        if _imports(p) & {"PySide6", "shiboken6"}
+        if _imports(p, module_level_only=True) & {"PySide6", "shiboken6", "app.gui"}
+        or any(m.startswith("app.gui") for m in _from_imports(p))
     ]
     assert offenders == []
+
+
+def _from_imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    return {n.module for n in tree.body if isinstance(n, ast.ImportFrom) and n.module}
+
+
+def test_headless_commands_do_not_load_qt():
+    import subprocess
+    import sys
+
+    code = "import sys, app.cli.main as m; m.main(['table1', '--json']); print('PySide6' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert out.stdout.strip().endswith("False")

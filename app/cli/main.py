@@ -27,6 +27,7 @@ def _register(name: str, module: str, help_text: str) -> None:
 
 
 _register("gui", "app.cli.cmd_gui", "open the operator's window (the bundled workcell with simulated robot and camera by default)")
+_register("demo", "app.cli.cmd_demo", "drive the window through a whole calibration, writing screenshots and report.json")
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
 _register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot controller on a pty or a TCP port")

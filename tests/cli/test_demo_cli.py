@@ -1,0 +1,22 @@
+"""``videocal demo --offscreen``: the whole calibration through the window, as `make run` runs it headless."""
+
+import json
+import subprocess
+import sys
+
+import cv2
+
+
+def test_demo_writes_screenshots_and_a_report(tmp_path):
+    out = tmp_path / "demo"
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--out", str(out), "--scale", "0.5"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads((out / "report.json").read_text())
+    assert report["status"] == "ok" and report["pairs"] >= 6
+    for key in ("estimated_displacement", "std", "true_displacement", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "rms_px"):
+        assert key in report
+    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 2
+    assert len(report["screenshots"]) == 6
+    for name in report["screenshots"]:
+        image = cv2.imread(str(out / name))
+        assert image is not None and image.shape[1] >= 1000 and image.std() > 10
