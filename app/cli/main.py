@@ -32,6 +32,8 @@ _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
 _register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot controller on a pty or a TCP port")
 _register("monitor", "app.cli.cmd_monitor", "print the joint samples of a controller link")
+_register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results")
+_register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 

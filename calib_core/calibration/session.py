@@ -17,6 +17,7 @@ from calib_core.calibration.end_effector import EndEffectorEstimate, end_effecto
 from calib_core.calibration.undo import Command, UndoStack
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import apply, invert
+from calib_core.recording.replay import solve_inputs
 from calib_core.solver import SolveStatus, solve_pose
 
 
@@ -53,6 +54,7 @@ class CalibrationSession:
     result: EndEffectorEstimate | None = None
     chosen_candidate: int = 0
     _context: tuple | None = None
+    last_solve_inputs: dict | None = None
     _listeners: list = field(default_factory=list)
 
     def subscribe(self, listener) -> None:
@@ -119,6 +121,7 @@ class CalibrationSession:
         points_obj = apply(invert(obj2world), points_world)
         prior = invert(cam2world_model) @ obj2world
         solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
+        self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self._context = (obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), numbers)
         self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model)
         self.chosen_candidate = 0

@@ -1,0 +1,102 @@
+"""Reading a recording, tolerating a file cut off by a crash, and recovering such a file."""
+
+from __future__ import annotations
+
+import base64
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+from mcap.exceptions import McapError
+from mcap.records import Channel, Footer, Message
+from mcap.stream_reader import StreamReader
+
+from calib_core.errors import FileFormatError
+from calib_core.recording.recorder import SessionRecorder
+from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC
+
+
+@dataclass(frozen=True)
+class RecordedMessage:
+    """One message: ``topic``, ``log_time_ns`` (Unix ns), ``payload`` (decoded JSON)."""
+
+    topic: str
+    log_time_ns: int
+    payload: dict
+
+
+@dataclass
+class RecordingContents:
+    """What a pass over a file found: the messages, whether it ended cleanly, and why not."""
+
+    messages: list[RecordedMessage]
+    complete: bool
+    problem: str | None = None
+
+    def topic(self, name: str) -> list[RecordedMessage]:
+        return [m for m in self.messages if m.topic == name]
+
+
+def read_recording(path: str | Path) -> RecordingContents:
+    """Every readable message of a recording; a file cut short gives ``complete=False`` with the
+    messages before the cut. A file that is not a videocal MCAP recording raises ``FileFormatError``."""
+    path = Path(path)
+    try:
+        handle = open(path, "rb")
+    except FileNotFoundError:
+        raise FileFormatError(path, "no such recording") from None
+    channels: dict[int, str] = {}
+    messages: list[RecordedMessage] = []
+    complete, problem = False, None
+    with handle:
+        try:
+            for record in StreamReader(handle, skip_magic=False).records:
+                if isinstance(record, Channel):
+                    channels[record.id] = record.topic
+                elif isinstance(record, Message):
+                    topic = channels.get(record.channel_id)
+                    if topic is None:
+                        continue
+                    try:
+                        payload = json.loads(record.data)
+                    except (ValueError, UnicodeDecodeError):
+                        problem = f"message {len(messages) + 1} on {topic} is not JSON"
+                        break
+                    messages.append(RecordedMessage(topic, record.log_time, payload))
+                elif isinstance(record, Footer):
+                    complete = True
+        except (McapError, ValueError, EOFError, OSError) as exc:
+            if not messages and not channels:
+                raise FileFormatError(path, f"not an MCAP recording ({exc})") from None
+            problem = f"the file ends abruptly after {len(messages)} messages ({type(exc).__name__})"
+        except Exception as exc:  # the mcap stream reader raises assorted errors on a truncated record
+            if not messages and not channels:
+                raise FileFormatError(path, f"not an MCAP recording ({exc})") from None
+            problem = f"the file ends abruptly after {len(messages)} messages ({type(exc).__name__})"
+    if not complete and problem is None:
+        problem = f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)"
+    return RecordingContents(messages, complete, problem)
+
+
+def decode_frame(payload: dict) -> np.ndarray:
+    """The RGB image (h, w, 3) of a ``foxglove.CompressedImage`` payload."""
+    data = np.frombuffer(base64.b64decode(payload["data"]), dtype=np.uint8)
+    bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    if bgr is None:
+        raise ValueError("frame data could not be decoded")
+    return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+
+
+def recover(path: str | Path, out: str | Path) -> RecordingContents:
+    """Rewrite a cut-off recording as a complete one with every message before the cut."""
+    contents = read_recording(path)
+    writer = SessionRecorder(out)
+    topics = {FRAME_TOPIC, JOINTS_TOPIC, EVENT_TOPIC, SOLVE_TOPIC, CORRECTION_TOPIC, SETUP_TOPIC}
+    for m in contents.messages:
+        if m.topic in topics:
+            writer._write(m.topic, m.payload, log_time_ns=m.log_time_ns)
+    writer.close()
+    return contents

@@ -1,0 +1,80 @@
+"""Re-solving every calibration of a recording and comparing with what was recorded.
+
+With the same version of videocal the results agree exactly (the solver is deterministic and
+JSON round-trips doubles exactly); a newer solver shows here how its answers differ.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.frames import make_transform
+from calib_core.recording.reader import read_recording
+from calib_core.recording.schemas import SOLVE_TOPIC
+from calib_core.solver import solve_pose
+
+
+def solve_inputs(points_3d, points_2d, intrinsics: Intrinsics, *, prior=None, estimate_focal=False, model="pinhole", sigma_px=None, robust=False) -> dict:
+    """The JSON form of a solve's inputs (the fields of ``videocal solve``)."""
+    inputs = {
+        "intrinsics": intrinsics.to_dict(),
+        "points_3d": np.asarray(points_3d, dtype=float).tolist(),
+        "points_2d": np.asarray(points_2d, dtype=float).tolist(),
+        "estimate_focal": bool(estimate_focal),
+        "model": model,
+        "sigma_px": sigma_px,
+        "robust": bool(robust),
+    }
+    if prior is not None:
+        inputs["prior"] = {"R_obj2cam": np.asarray(prior)[:3, :3].tolist(), "t_obj2cam_mm": np.asarray(prior)[:3, 3].tolist()}
+    return inputs
+
+
+def solve_from_inputs(inputs: dict):
+    prior = None
+    if inputs.get("prior"):
+        prior = make_transform(inputs["prior"]["R_obj2cam"], inputs["prior"]["t_obj2cam_mm"])
+    return solve_pose(
+        inputs["points_3d"], inputs["points_2d"], Intrinsics.from_dict(inputs["intrinsics"]), prior=prior,
+        estimate_focal=inputs.get("estimate_focal", False), model=inputs.get("model", "pinhole"),
+        sigma_px=inputs.get("sigma_px"), robust=inputs.get("robust", False),
+    )
+
+
+@dataclass(frozen=True)
+class ReplayedSolve:
+    """One recorded solve re-computed: ``agree`` when status and pose match exactly;
+    ``translation_diff_mm`` and ``rms_diff_px`` the largest differences."""
+
+    id: int
+    recorded: dict
+    recomputed: dict
+    agree: bool
+    translation_diff_mm: float
+    rotation_diff: float
+    rms_diff_px: float
+
+
+def _diff(a, b) -> float:
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.shape != b.shape:
+        return float("inf")
+    return float(np.max(np.abs(a - b))) if a.size else 0.0
+
+
+def replay(path: str | Path) -> list[ReplayedSolve]:
+    contents = read_recording(path)
+    out = []
+    for message in contents.topic(SOLVE_TOPIC):
+        recorded = message.payload["result"]
+        recomputed = solve_from_inputs(message.payload["inputs"]).to_dict()
+        dt = _diff(recorded["t_obj2cam_mm"], recomputed["t_obj2cam_mm"])
+        dr = _diff(recorded["R_obj2cam"], recomputed["R_obj2cam"])
+        drms = abs(float(recorded["rms_px"]) - float(recomputed["rms_px"]))
+        agree = recorded["status"] == recomputed["status"] and dt == 0.0 and dr == 0.0 and drms == 0.0
+        out.append(ReplayedSolve(int(message.payload["id"]), recorded, recomputed, agree, dt, dr, drms))
+    return out

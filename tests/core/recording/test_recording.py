@@ -1,0 +1,105 @@
+"""Recordings: write and read back, survive a cut, recover, replay solves exactly; the sample
+recording in resources replays; a tampered result is found."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from calib_core.errors import FileFormatError
+from calib_core.recording.reader import decode_frame, read_recording, recover
+from calib_core.recording.recorder import SessionRecorder
+from calib_core.recording.replay import replay, solve_inputs
+from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SOLVE_TOPIC
+from calib_core.solver import solve_pose
+
+from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, random_pose
+
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "recordings" / "sample_session.mcap"
+
+
+def _record(path, n_frames=3, n_solves=2):
+    rng = np.random.default_rng(0)
+    with SessionRecorder(path) as rec:
+        rec.record_setup(intrinsics=GRIPPER_CAMERA.to_dict())
+        for i in range(n_frames):
+            image = (rng.uniform(0, 255, (48, 64, 3))).astype(np.uint8)
+            rec.record_frame(image, float(i))
+            rec.record_joints(i, 10 * i, float(i), [1.0, 2.0, 3.0, 4.0, 5.0, float(i)])
+            rec.record_event("pick", number=i)
+        for _ in range(n_solves):
+            truth = random_pose(rng)
+            P = random_points(rng, 6)
+            uv = pixels(P, truth, noise_px=0.4, rng=rng)
+            inputs = solve_inputs(P, uv, GRIPPER_CAMERA, prior=truth)
+            rec.record_solve(inputs, solve_pose(P, uv, GRIPPER_CAMERA, prior=truth).to_dict())
+    return path
+
+
+def test_round_trip(tmp_path):
+    path = _record(tmp_path / "s.mcap")
+    contents = read_recording(path)
+    assert contents.complete and contents.problem is None
+    assert len(contents.topic(FRAME_TOPIC)) == 3 and len(contents.topic(JOINTS_TOPIC)) == 3 and len(contents.topic(EVENT_TOPIC)) == 3
+    frame = contents.topic(FRAME_TOPIC)[0].payload
+    assert frame["format"] == "jpeg" and decode_frame(frame).shape == (48, 64, 3)
+    assert contents.topic(JOINTS_TOPIC)[2].payload["joints_deg"][-1] == 2.0
+
+
+def test_every_message_before_a_cut_survives_and_recovers(tmp_path):
+    path = _record(tmp_path / "s.mcap", n_frames=8, n_solves=1)
+    full = read_recording(path).messages
+    data = path.read_bytes()
+    for cut in (len(data) // 3, len(data) // 2, len(data) - 200):
+        cut_path = tmp_path / f"cut{cut}.mcap"
+        cut_path.write_bytes(data[:cut])
+        contents = read_recording(cut_path)
+        assert not contents.complete and "ends" in contents.problem
+        n = len(contents.messages)
+        assert 0 < n <= len(full)  # a cut inside the summary at the end loses no message
+        assert [m.payload for m in contents.messages] == [m.payload for m in full[:n]]
+        fixed = recover(cut_path, tmp_path / f"fixed{cut}.mcap")
+        again = read_recording(tmp_path / f"fixed{cut}.mcap")
+        assert again.complete and [m.payload for m in again.messages] == [m.payload for m in fixed.messages]
+
+
+def test_replay_agrees_exactly_and_finds_a_tampered_result(tmp_path):
+    path = _record(tmp_path / "s.mcap")
+    assert all(r.agree for r in replay(path))
+    # Tamper: the same messages with one recorded translation nudged by 1 um.
+    contents = read_recording(path)
+    tampered = tmp_path / "t.mcap"
+    with SessionRecorder(tampered) as rec:
+        for m in contents.messages:
+            payload = m.payload
+            if m.topic == SOLVE_TOPIC and payload["id"] == 2:
+                payload["result"]["t_obj2cam_mm"][0] += 0.001
+            rec._write(m.topic, payload, m.log_time_ns)
+    results = replay(tampered)
+    assert [r.agree for r in results] == [True, False]
+    assert results[1].translation_diff_mm == pytest.approx(0.001, rel=1e-6)
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(tampered), "--json"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 5
+    assert [s["agree"] for s in json.loads(run.stdout)["solves"]] == [True, False]
+
+
+def test_the_bundled_sample_recording_replays():
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(SAMPLE)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "2 solves" in run.stdout and "agrees" in run.stdout
+    contents = read_recording(SAMPLE)
+    assert contents.complete and len(contents.topic(FRAME_TOPIC)) >= 5
+
+
+def test_foreign_and_missing_files(tmp_path):
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"this is not mcap at all")
+    with pytest.raises(FileFormatError, match="not an MCAP recording"):
+        read_recording(junk)
+    with pytest.raises(FileFormatError, match="no such recording"):
+        read_recording(tmp_path / "none.mcap")
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(junk)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and run.stderr.startswith("error: ")
