@@ -13,6 +13,8 @@ Conventions (see docs/conventions.md):
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
@@ -108,7 +110,10 @@ def transform_from_xyz_rpy(xyz_mm: ArrayLike, rpy_deg: ArrayLike) -> np.ndarray:
 def xyz_rpy_from_transform(a2b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of :func:`transform_from_xyz_rpy`: ``(xyz_mm, rpy_deg)``."""
     m = np.asarray(a2b, dtype=float)
-    rpy = Rotation.from_matrix(m[:3, :3]).as_euler("xyz", degrees=True)
+    with warnings.catch_warnings():
+        # At +-90 deg pitch roll and yaw are not unique; scipy's choice still gives the same rotation.
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(m[:3, :3]).as_euler("xyz", degrees=True)
     return m[:3, 3].copy(), rpy
 
 

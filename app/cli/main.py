@@ -34,6 +34,7 @@ _register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot
 _register("monitor", "app.cli.cmd_monitor", "print the joint samples of a controller link")
 _register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results")
 _register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")
+_register("export", "app.cli.cmd_export", "export a workspace's corrections as JSON, CSV or a PDL2 listing")
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 

@@ -1,0 +1,1 @@
+"""The workspace file: what an operator's work is saved as, and the correction exports."""

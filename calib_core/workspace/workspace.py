@@ -1,0 +1,159 @@
+"""The workspace file (JSON, ``schema_version`` 1): the workcell in use, the intrinsics, the task
+locations, the point pairs and the correction table with its history.
+
+Saving is atomic (a crash mid-save leaves the old file intact). Loading is strict: a corrupt,
+truncated, unknown-version or foreign file gives a :class:`FileFormatError` naming the file and
+the field. Files are data only: nothing in them is executed.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from calib_core import __version__
+from calib_core.atomic_file import atomic_write_text
+from calib_core.calibration.corrections import Correction, CorrectionTable
+from calib_core.calibration.correspondences import Correspondence
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.errors import FileFormatError
+from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.workcell.model import TaskLocation
+
+SCHEMA_VERSION = 1
+KIND = "videocal-workspace"
+
+
+@dataclass
+class Workspace:
+    """Everything an operator's work needs to be resumed, reviewed or exported."""
+
+    workcell_path: str
+    intrinsics: Intrinsics
+    task_locations: dict[str, TaskLocation] = field(default_factory=dict)
+    target: str | None = None
+    pairs: list[Correspondence] = field(default_factory=list)
+    corrections: CorrectionTable = field(default_factory=CorrectionTable)
+    created_s: float = field(default_factory=time.time)
+
+
+def _pose(T: np.ndarray) -> dict:
+    xyz, rpy = xyz_rpy_from_transform(T)
+    return {"xyz": [float(v) for v in xyz], "rpy": [float(v) for v in rpy]}
+
+
+def _correction_dict(c: Correction) -> dict:
+    return {
+        "task": c.task, "time_s": c.time_s, "source": c.source, "joints_deg": c.joints_deg.tolist(),
+        "tcp2base_model": _pose(c.tcp2base_model), "tcp2base_measured": _pose(c.tcp2base_measured),
+        "displacement_mm": c.displacement_mm.tolist(), "rotation_deg": c.rotation_deg.tolist(),
+        "std_displacement_mm": c.std_displacement_mm.tolist(), "std_rotation_deg": c.std_rotation_deg.tolist(),
+        "rms_px": c.rms_px, "pairs": c.pairs,
+    }
+
+
+def workspace_to_dict(ws: Workspace) -> dict:
+    return {
+        "kind": KIND,
+        "schema_version": SCHEMA_VERSION,
+        "videocal_version": __version__,
+        "created_s": ws.created_s,
+        "saved_s": time.time(),
+        "workcell": ws.workcell_path,
+        "intrinsics": ws.intrinsics.to_dict(),
+        "target": ws.target,
+        "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
+        "pairs": [{"number": p.number, "component": p.component, "feature": p.feature, "point_world_mm": list(p.point_world_mm), "pixel": None if p.pixel is None else list(p.pixel), "enabled": p.enabled} for p in ws.pairs],
+        "corrections": [_correction_dict(c) for task in ws.corrections.tasks() for c in ws.corrections.history(task)],
+    }
+
+
+def save_workspace(path: str | Path, ws: Workspace) -> None:
+    """Write atomically: the old file stays whole until the new one is complete on disk."""
+    atomic_write_text(path, json.dumps(workspace_to_dict(ws), indent=1))
+
+
+class _Fields:
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, field: str | None, message: str) -> FileFormatError:
+        return FileFormatError(self.path, message, field)
+
+    def get(self, data: dict, key: str, where: str, kind=None):
+        if not isinstance(data, dict):
+            raise self.fail(where or None, "must be an object")
+        if key not in data:
+            raise self.fail(f"{where}.{key}" if where else key, "missing")
+        value = data[key]
+        if kind is not None and not isinstance(value, kind):
+            raise self.fail(f"{where}.{key}" if where else key, f"must be {getattr(kind, '__name__', kind)}, got {type(value).__name__}")
+        return value
+
+    def vector(self, value, n: int, where: str) -> np.ndarray:
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise self.fail(where, f"must be {n} finite numbers, got {value!r}") from None
+        if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+            raise self.fail(where, f"must be {n} finite numbers, got {value!r}")
+        return arr
+
+    def pose(self, value, where: str) -> np.ndarray:
+        return transform_from_xyz_rpy(self.vector(self.get(value, "xyz", where), 3, f"{where}.xyz"), self.vector(self.get(value, "rpy", where), 3, f"{where}.rpy"))
+
+
+def load_workspace(path: str | Path) -> Workspace:
+    path = Path(path)
+    f = _Fields(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise f.fail(None, "no such workspace file") from None
+    except (UnicodeDecodeError, IsADirectoryError, PermissionError) as exc:
+        raise f.fail(None, f"cannot read: {exc}") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise f.fail(None, f"not valid JSON (truncated or corrupt?): {exc}") from None
+    if not isinstance(data, dict) or data.get("kind") != KIND:
+        raise f.fail("kind", f"not a videocal workspace (kind must be {KIND!r})")
+    version = data.get("schema_version")
+    if version != SCHEMA_VERSION:
+        raise f.fail("schema_version", f"this videocal reads version {SCHEMA_VERSION}, the file is version {version!r}")
+    try:
+        intrinsics = Intrinsics.from_dict(f.get(data, "intrinsics", "", dict))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise f.fail("intrinsics", str(exc)) from None
+    tasks = {}
+    for i, t in enumerate(f.get(data, "task_locations", "", list)):
+        where = f"task_locations[{i}]"
+        name = f.get(t, "name", where, str)
+        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), float(f.get(t, "approach_mm", where, (int, float))), t.get("component"))
+    pairs = []
+    for i, p in enumerate(f.get(data, "pairs", "", list)):
+        where = f"pairs[{i}]"
+        pixel = p.get("pixel") if isinstance(p, dict) else None
+        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.get(p, "component", where, str), p.get("feature"), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True))))
+    table = CorrectionTable()
+    for i, c in enumerate(f.get(data, "corrections", "", list)):
+        where = f"corrections[{i}]"
+        table.add(Correction(
+            task=f.get(c, "task", where, str),
+            tcp2base_model=f.pose(f.get(c, "tcp2base_model", where, dict), f"{where}.tcp2base_model"),
+            tcp2base_measured=f.pose(f.get(c, "tcp2base_measured", where, dict), f"{where}.tcp2base_measured"),
+            displacement_mm=f.vector(f.get(c, "displacement_mm", where), 3, f"{where}.displacement_mm"),
+            rotation_deg=f.vector(f.get(c, "rotation_deg", where), 3, f"{where}.rotation_deg"),
+            std_displacement_mm=np.asarray(f.get(c, "std_displacement_mm", where), dtype=float),
+            std_rotation_deg=np.asarray(f.get(c, "std_rotation_deg", where), dtype=float),
+            joints_deg=f.vector(f.get(c, "joints_deg", where), 6, f"{where}.joints_deg"),
+            rms_px=float(f.get(c, "rms_px", where, (int, float))),
+            pairs=int(f.get(c, "pairs", where, int)),
+            time_s=float(c.get("time_s", 0.0)),
+            source=str(c.get("source", "")),
+        ))
+    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)))
