@@ -47,6 +47,15 @@ class MainWindow(QMainWindow):
         self._redraw.start()
         self.virtual.refresh()
         self.overview.refresh()
+        from pathlib import Path
+
+        import platformdirs
+
+        self.autosave_path = Path(self.settings.value("files/autosave_dir") or platformdirs.user_data_dir("videocal")) / "recovery" / "autosave.json"
+        self._autosave_timer = QTimer(self)
+        self._autosave_timer.setInterval(60_000)
+        self._autosave_timer.timeout.connect(self._autosave)
+        self._autosave_timer.start()
 
     # --- layout ----------------------------------------------------------------------------
     def _build_layout(self) -> None:
@@ -80,6 +89,12 @@ class MainWindow(QMainWindow):
 
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
+        file_menu.addAction(QAction("&Open workspace...", self, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
+        file_menu.addAction(QAction("&Save workspace as...", self, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
+        file_menu.addSeparator()
+        self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
+        file_menu.addAction(self.record_action)
+        file_menu.addSeparator()
         quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self.close)
         file_menu.addAction(quit_action)
         edit = self.menuBar().addMenu("&Edit")
@@ -103,7 +118,8 @@ class MainWindow(QMainWindow):
         self.link_label = QLabel("link: not connected")
         self.fps_label = QLabel("camera: -")
         self.pairs_label = QLabel("pairs: 0")
-        for w in (self.link_label, self.fps_label, self.pairs_label):
+        self.record_label = QLabel("")
+        for w in (self.record_label, self.link_label, self.fps_label, self.pairs_label):
             self.statusBar().addPermanentWidget(w)
         self._fps_timer = QTimer(self)
         self._fps_timer.setInterval(1000)
@@ -147,6 +163,7 @@ class MainWindow(QMainWindow):
     def start_camera(self, make_source) -> None:
         self.worker = FrameWorker(make_source, self)
         self.worker.frame.connect(self.camera.show_frame)
+        self.worker.frame.connect(self.workbench.record_frame)
         self.worker.failed.connect(self.show_error)
         self.worker.start()
 
@@ -249,6 +266,61 @@ class MainWindow(QMainWindow):
         self.commands.tasks.addItem(name)
         self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
 
+    # --- files -------------------------------------------------------------------------------
+    def save_workspace(self, path) -> None:
+        self.report(self.workbench.save_workspace)(path)
+        self._remember_recent(path)
+
+    def open_workspace(self, path) -> None:
+        self.report(self.workbench.open_workspace)(path)
+        self._remember_recent(path)
+
+    def _remember_recent(self, path) -> None:
+        recent = [str(path)] + [p for p in (self.settings.value("files/recent") or []) if p != str(path)]
+        self.settings.setValue("files/recent", recent[:8])
+
+    def _save_dialog(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getSaveFileName(self, "Save workspace", "workspace.json", "videocal workspace (*.json)")
+        if path:
+            self.save_workspace(path)
+
+    def _open_dialog(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Open workspace", "", "videocal workspace (*.json)")
+        if path:
+            self.open_workspace(path)
+
+    def start_recording(self, path) -> None:
+        self.report(self.workbench.start_recording)(path)
+        self.record_action.setChecked(self.workbench.recorder is not None)
+
+    def stop_recording(self) -> None:
+        self.workbench.stop_recording()
+        self.record_action.setChecked(False)
+
+    def _record_toggled(self, on: bool) -> None:
+        if not on:
+            self.stop_recording()
+            return
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getSaveFileName(self, "Record session", "session.mcap", "MCAP recording (*.mcap)")
+        if path:
+            self.start_recording(path)
+        else:
+            self.record_action.setChecked(False)
+
+    def _autosave(self) -> None:
+        """Every minute, the workspace to the recovery folder (offered again after a crash)."""
+        try:
+            self.autosave_path.parent.mkdir(parents=True, exist_ok=True)
+            self.workbench.save_workspace(self.autosave_path)
+        except OSError as exc:
+            self.statusBar().showMessage(f"autosave failed: {exc}", 8000)
+
     # --- updates ---------------------------------------------------------------------------
     def _on_joints(self, q) -> None:
         if self.commands.monitoring.isChecked():
@@ -298,6 +370,8 @@ class MainWindow(QMainWindow):
         if link is not None:
             s = link.stats_snapshot()
             self.link_label.setText(f"link: {link.state.value}, {s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected")
+        rec = self.workbench.recorder
+        self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
 
     # --- life cycle ------------------------------------------------------------------------
     def _restore(self) -> None:

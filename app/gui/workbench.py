@@ -52,6 +52,8 @@ class Workbench(QObject):
         self.link: ControllerLink | None = None
         self._sim_process: subprocess.Popen | None = None
         self._tmp = tempfile.TemporaryDirectory(prefix="videocal-")
+        self.recorder = None
+        self.session.pairs.subscribe(self._record_pairs_event)
         self._sample_arrived.connect(self._on_sample)
         self._state_arrived.connect(lambda state, why: self.link_state.emit(f"{state}: {why}"))
 
@@ -80,6 +82,8 @@ class Workbench(QObject):
         self.message.emit(f"controller link: {url}")
 
     def _on_sample(self, sample) -> None:
+        if self.recorder is not None:
+            self.recorder.record_joints(sample.sample.seq, sample.sample.t_ms, sample.t_host_s, sample.joints_deg)
         self.joints_deg = np.array(sample.joints_deg, dtype=float)
         self.bed.joints_deg = self.joints_deg.copy()  # the simulated camera follows the commanded joints
         self.joints_changed.emit(self.joints_deg)
@@ -130,6 +134,8 @@ class Workbench(QObject):
             raise CalibrationError("choose the target object first")
         obj2world = self.workcell.component(target).item2world
         result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
+        if self.recorder is not None:
+            self.recorder.record_solve(self.session.last_solve_inputs, result.solution.to_dict())
         self.solved.emit()
         return result
 
@@ -137,10 +143,74 @@ class Workbench(QObject):
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
         c = self.session.store_correction(self.task.name)
+        if self.recorder is not None:
+            self.recorder.record_correction({"task": c.task, "displacement_mm": c.displacement_mm, "rotation_deg": c.rotation_deg, "std_displacement_mm": c.std_displacement_mm, "std_rotation_deg": c.std_rotation_deg, "joints_deg": c.joints_deg, "rms_px": c.rms_px, "pairs": c.pairs})
         self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
         return c
 
+    # --- workspace and recording --------------------------------------------------------------
+    def workspace(self):
+        from calib_core.workspace.workspace import Workspace
+
+        return Workspace(str(self.workcell.path), self.intrinsics, dict(self.workcell.task_locations), self.session.target, self.session.pairs.pairs(), self.session.corrections)
+
+    def save_workspace(self, path) -> None:
+        from calib_core.workspace.workspace import save_workspace
+
+        save_workspace(path, self.workspace())
+        self.message.emit(f"workspace saved to {path}")
+
+    def open_workspace(self, path) -> None:
+        """Load pairs, corrections and task locations; the current ones stay if the file is bad."""
+        from calib_core.workspace.workspace import load_workspace
+
+        ws = load_workspace(path)  # raises before anything is changed
+        self.workcell.task_locations.update(ws.task_locations)
+        if ws.target:
+            self.session.set_target(ws.target)
+        self.session.pairs._reset(ws.pairs)
+        self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
+        for task in self.session.corrections.tasks():
+            while self.session.corrections.latest(task) is not None:
+                self.session.corrections.remove_last(task)
+        for task in ws.corrections.tasks():
+            for c in ws.corrections.history(task):
+                self.session.corrections.add(c)
+        self.session.undo.clear()
+        self.message.emit(f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations")
+
+    def start_recording(self, path) -> None:
+        from calib_core.recording.recorder import SessionRecorder
+
+        self.stop_recording()
+        self.recorder = SessionRecorder(path)
+        self.recorder.record_setup(workcell=str(self.workcell.path), intrinsics=self.intrinsics.to_dict(), target=self.session.target, task=None if self.task is None else self.task.name)
+        self.message.emit(f"recording to {path}")
+
+    def stop_recording(self) -> None:
+        rec = getattr(self, "recorder", None)
+        if rec is not None:
+            rec.close()
+            self.message.emit(f"recording {rec.path} closed ({rec.messages} messages)")
+        self.recorder = None
+
+    def record_frame(self, frame) -> None:
+        rec = getattr(self, "recorder", None)
+        if rec is not None:
+            rec.record_frame(frame.image, frame.t_host_s)
+
+    def _record_pairs_event(self, event: str, number) -> None:
+        rec = getattr(self, "recorder", None)
+        if rec is None:
+            return
+        detail = {"number": number}
+        if number is not None and event in ("added", "changed"):
+            p = self.session.pairs.get(number)
+            detail.update(component=p.component, feature=p.feature, point_world_mm=list(p.point_world_mm), pixel=None if p.pixel is None else list(p.pixel), enabled=p.enabled)
+        rec.record_event(f"pair_{event}", **detail)
+
     def close(self) -> None:
+        self.stop_recording()
         if self.link is not None:
             self.link.close()
         if self._sim_process is not None and self._sim_process.poll() is None:

@@ -126,3 +126,34 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
     assert "no stored correction" in win.results.status.text()
     assert win.isVisible()
+
+
+def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
+    from calib_core.recording.reader import read_recording
+    from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC
+
+    win = window
+    wb = win.workbench
+    win.start_recording(tmp_path / "session.mcap")
+    assert win.record_action.isChecked()
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.session.pick_2d((100.0, 120.0))
+    qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
+    qtbot.wait(1100)
+    win._update_status()
+    assert "REC" in win.record_label.text()
+    win.save_workspace(tmp_path / "w.json")
+    win.stop_recording()
+    contents = read_recording(tmp_path / "session.mcap")
+    assert contents.complete and contents.topic(FRAME_TOPIC) and contents.topic(JOINTS_TOPIC)
+    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC)] == ["pair_added", "pair_changed"]
+    # Clear, then open the saved workspace: the pair comes back.
+    wb.session.clear()
+    assert len(wb.session.pairs) == 0
+    win.open_workspace(tmp_path / "w.json")
+    assert [p.feature for p in wb.session.pairs] == ["pin_tip"] and win.table.rowCount() == 1
+    # A bad file is a message; nothing is lost.
+    (tmp_path / "bad.json").write_text("{broken")
+    win.open_workspace(tmp_path / "bad.json")
+    assert "not valid JSON" in win.results.status.text()
+    assert len(wb.session.pairs) == 1
