@@ -12,19 +12,21 @@ from calib_core.errors import VideocalError
 
 def guarded(report: Callable[[str], None]):
     """Decorate an action handler: user mistakes (``VideocalError``, ``ValueError``, ``KeyError``)
-    are reported in words; anything else as an internal error with its traceback on stderr."""
+    are reported in words; anything else as an internal error with its traceback on stderr.
+
+    The wrapper returns nothing: a Qt slot that returns a value for a signal without one (a bool
+    above all) corrupts PySide's reference counts and crashes the interpreter at exit."""
 
     def wrap(fn):
         @functools.wraps(fn)
         def run(*args, **kwargs):
             try:
-                return fn(*args, **kwargs)
+                fn(*args, **kwargs)
             except (VideocalError, ValueError, KeyError, RuntimeError) as exc:
                 report(str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc))
             except Exception as exc:  # the boundary: nothing escapes into Qt's event loop
                 traceback.print_exc(file=sys.stderr)
                 report(f"internal error ({type(exc).__name__}): {exc}")
-            return None
 
         return run
 

@@ -95,7 +95,7 @@ class MainWindow(QMainWindow):
         self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
         file_menu.addAction(self.record_action)
         file_menu.addSeparator()
-        quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self.close)
+        quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self._quit)
         file_menu.addAction(quit_action)
         edit = self.menuBar().addMenu("&Edit")
         self.undo_action = QAction("&Undo", self, shortcut=QKeySequence.StandardKey.Undo, triggered=self._undo)
@@ -142,14 +142,14 @@ class MainWindow(QMainWindow):
         c.target.currentTextChanged.connect(self.report(lambda name: wb.session.set_target(name)))
         c.estimate_focal.toggled.connect(lambda on: setattr(wb.session, "estimate_focal", on))
         c.robust.toggled.connect(lambda on: setattr(wb.session, "robust", on))
-        c.tasks.currentTextChanged.connect(self.report(lambda name: name and wb.set_task(name)))
+        c.tasks.currentTextChanged.connect(self.report(self._task_selected))
         c.go_approach.clicked.connect(lambda: self._go(approach=True))
         c.go_task.clicked.connect(lambda: self._go(approach=False))
         c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
         c.go_uncorrected.clicked.connect(lambda: self._go(approach=False, corrected=False))
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self._add_location))
-        c.live.toggled.connect(lambda on: self.worker is not None and setattr(self.worker, "paused", not on))
+        c.live.toggled.connect(self._live_toggled)
         self.results.candidate_chosen.connect(self.report(lambda k: wb.session.choose_candidate(k)))
         wb.joints_changed.connect(self._on_joints)
         wb.link_state.connect(lambda text: self.link_label.setText(f"link: {text}"))
@@ -158,6 +158,18 @@ class MainWindow(QMainWindow):
         wb.session.corrections.subscribe(lambda task: self._update_corrections())
         wb.session.subscribe(self._after_solve)
         self._update_actions()
+
+    # Slots return nothing: PySide must never receive a value (least of all a bool) from a slot.
+    def _quit(self) -> None:
+        self.close()
+
+    def _task_selected(self, name: str) -> None:
+        if name:
+            self.workbench.set_task(name)
+
+    def _live_toggled(self, on: bool) -> None:
+        if self.worker is not None:
+            self.worker.paused = not on
 
     # --- camera ----------------------------------------------------------------------------
     def start_camera(self, make_source) -> None:

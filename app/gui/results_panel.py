@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from PySide6.QtCore import QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QPainter
@@ -72,6 +74,9 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.chart, 1)
         workbench.session.subscribe(self.refresh)
 
+    def _choose(self, index: int, *_) -> None:
+        self.candidate_chosen.emit(index)
+
     def show_error(self, text: str) -> None:
         self.status.setText(f"<span style='color:#ff6b6b'><b>{text}</b></span>")
 
@@ -115,5 +120,5 @@ class ResultsPanel(QWidget):
                 button.setObjectName(f"candidate_{i}")
                 button.setCheckable(True)
                 button.setChecked(i == session.chosen_candidate)
-                button.clicked.connect(lambda _=False, k=i: self.candidate_chosen.emit(k))
+                button.clicked.connect(functools.partial(self._choose, i))
                 self.candidates.addWidget(button)

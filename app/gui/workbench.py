@@ -55,7 +55,7 @@ class Workbench(QObject):
         self.recorder = None
         self.session.pairs.subscribe(self._record_pairs_event)
         self._sample_arrived.connect(self._on_sample)
-        self._state_arrived.connect(lambda state, why: self.link_state.emit(f"{state}: {why}"))
+        self._state_arrived.connect(self._on_state_arrived)
 
     # --- robot and link ----------------------------------------------------------------------
     def start_simulated_controller(self) -> str:
@@ -80,6 +80,9 @@ class Workbench(QObject):
         self.link.on_state(lambda state, why: self._state_arrived.emit(state.value, why))
         self.link.start()
         self.message.emit(f"controller link: {url}")
+
+    def _on_state_arrived(self, state: str, why: str) -> None:
+        self.link_state.emit(f"{state}: {why}")
 
     def _on_sample(self, sample) -> None:
         if self.recorder is not None:
