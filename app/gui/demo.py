@@ -23,6 +23,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.true_robot import RobotErrors
 
 FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_top_right", "boss_bottom_right", "boss_bottom_left")
 
@@ -62,7 +63,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
 
     out_dir.mkdir(parents=True, exist_ok=True)
     app = QApplication.instance() or QApplication([])
-    bed = TestBed.create()
+    # One view cannot see an error in the camera's mounting: until the hand-eye calibration (issue #7) exists
+    # the demo's true robot keeps its joint, link and base errors but has the modelled camera mounting.
+    typical = RobotErrors.typical(0)
+    bed = TestBed.create(errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
     if scale != 1.0:
         bed.intrinsics = bed.intrinsics.scaled(scale)
     wb = Workbench(bed)
@@ -134,8 +138,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
             "uncorrected_tcp_error_deg": float(np.linalg.norm(plain_r)),
             "corrected_tcp_error_mm": float(np.linalg.norm(miss_d)),
             "corrected_tcp_error_deg": float(np.linalg.norm(miss_r)),
+            "hand_eye": "exact",
+            "estimate_within_3_sigma": bool(np.all(np.abs(r.displacement_mm - d_true) <= 3 * r.std_displacement_mm)),
             "screenshots": shots,
-            "note": "the true robot of the test bed has typical joint, link, base and hand-eye errors; the hand-eye error is not calibrated here (issue #7)",
+            "note": "the true robot has typical joint, link and base errors and the modelled camera mounting (hand_eye exact until issue #7); "
+                    "the correction is measured at the approach pose, 200 mm before the task, and the model error changes on the way",
         }
         atomic_write_text(out_dir / "report.json", json.dumps(report, indent=2))
         return report
