@@ -35,6 +35,7 @@ _register("monitor", "app.cli.cmd_monitor", "print the joint samples of a contro
 _register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results")
 _register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")
 _register("export", "app.cli.cmd_export", "export a workspace's corrections as JSON, CSV or a PDL2 listing")
+_register("calibrate-intrinsics", "app.cli.cmd_calibrate_intrinsics", "calibrate the camera's intrinsics from ChArUco board views (folder, video or 'sim')")
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 

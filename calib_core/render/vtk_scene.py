@@ -28,8 +28,30 @@ class ItemActor:
         mapper.ScalarVisibilityOff()
         self.surface = vtk.vtkActor()
         self.surface.SetMapper(mapper)
+        if item.texture is not None:
+            self._apply_texture(item)
         self._edges: vtk.vtkActor | None = None
         self.set_pose(item.item2world)
+
+    def _apply_texture(self, item: SceneItem) -> None:
+        from vtk.util import numpy_support
+
+        tcoords = numpy_support.numpy_to_vtk(np.ascontiguousarray(item.texture_coords, dtype=np.float32), deep=True)
+        tcoords.SetName("TCoords")
+        self.polydata.GetPointData().SetTCoords(tcoords)
+        image = item.texture if item.texture.ndim == 3 else np.repeat(item.texture[:, :, None], 3, axis=2)
+        h, w = image.shape[:2]
+        data = vtk.vtkImageData()
+        data.SetDimensions(w, h, 1)
+        # VTK images start at the bottom row.
+        pixels = numpy_support.numpy_to_vtk(np.ascontiguousarray(image[::-1].reshape(-1, 3)), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
+        pixels.SetNumberOfComponents(3)
+        data.GetPointData().SetScalars(pixels)
+        texture = vtk.vtkTexture()
+        texture.SetInputData(data)
+        texture.InterpolateOn()
+        texture.MipmapOn()
+        self.surface.SetTexture(texture)
 
     def set_pose(self, item2world: np.ndarray) -> None:
         self.item.item2world = np.asarray(item2world, dtype=float)

@@ -1,0 +1,76 @@
+"""``videocal calibrate-intrinsics SOURCE --out FILE``: the camera's intrinsics from ChArUco board views.
+
+SOURCE is a folder of images, a video file (every ``--every``-th frame), or ``sim`` (views of the
+board rendered by the simulated camera, whose truth is then printed beside the result).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from calib_core.errors import VideocalError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("source", help="a folder of images, a video file, or 'sim'")
+    parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100", help="charuco:<columns>x<rows>:<square mm>:<marker mm>:<dictionary>")
+    parser.add_argument("--out", type=Path, required=True, help="intrinsics file to write (YAML)")
+    parser.add_argument("--format", choices=("opencv", "ros"), default="opencv")
+    parser.add_argument("--no-distortion", action="store_true", help="fit the pinhole only (as the paper's tool did)")
+    parser.add_argument("--every", type=int, default=15, help="with a video: use every n-th frame")
+    parser.add_argument("--views", type=int, default=15, help="with 'sim': how many views to render")
+    parser.add_argument("--json", action="store_true", help="print the result as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from calib_core.camera.intrinsics_io import load_intrinsics, save_intrinsics
+    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.image_sources import folder_images, video_frames
+    from calib_core.vision.intrinsics_calibration import calibrate_intrinsics, detect_views
+
+    spec = BoardSpec.parse(args.board)
+    truth = None
+    if args.source == "sim":
+        from calib_core.vision.sim_views import simulated_board_images
+        from calib_core.workcell import load_workcell
+
+        truth = load_intrinsics(load_workcell().intrinsics_path)
+        print(f"rendering {args.views} simulated views of {spec}...", file=sys.stderr)
+        images = simulated_board_images(truth, spec, args.views)
+    else:
+        source = Path(args.source)
+        if source.is_dir():
+            images = folder_images(source)
+        elif source.is_file():
+            images = video_frames(source, args.every)
+        else:
+            raise VideocalError(f"{source}: no such folder or video file (or use 'sim')")
+    views, rejected = detect_views(images, spec)
+    for r in rejected:
+        print(f"rejected {r.name}: {r.reason}", file=sys.stderr)
+    result = calibrate_intrinsics(views, spec, distortion=not args.no_distortion, rejected=rejected)
+    save_intrinsics(args.out, result.intrinsics, args.format)
+    i = result.intrinsics
+    summary = {
+        "fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion), "rms_px": result.rms_px,
+        "std": result.std, "coverage": result.coverage, "views_used": len(result.used), "views_rejected": len(rejected),
+        "per_view_rms_px": result.per_view_rms_px, "advice": result.advice, "out": str(args.out),
+    }
+    if truth is not None:
+        summary["truth"] = {"fu": truth.fu, "fv": truth.fv, "cx": truth.cx, "cy": truth.cy, "distortion": list(truth.distortion)}
+    if args.json:
+        json.dump(summary, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        print(f"{len(result.used)} views used, {len(rejected)} rejected; RMS {result.rms_px:.3f} px; corners cover {100 * result.coverage:.0f} % of the image")
+        for name in ("fu", "fv", "cx", "cy"):
+            t = f"   (truth {getattr(truth, name):.2f})" if truth is not None else ""
+            print(f"  {name} = {getattr(i, name):9.2f} +- {result.std[name]:.2f} px{t}")
+        print("  distortion k1 k2 p1 p2 k3 = " + " ".join(f"{v:+.5f}" for v in i.distortion))
+        for line in result.advice:
+            print(f"advice: {line}")
+        print(f"wrote {args.out}")
+    return 0

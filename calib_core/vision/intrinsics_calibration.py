@@ -1,0 +1,139 @@
+"""Camera intrinsics (fu, fv, cx, cy and k1 k2 p1 p2 k3) from views of a ChArUco board, with
+OpenCV's ``CharucoDetector`` and ``calibrateCameraExtended``: per-view errors, the standard
+deviation of every parameter, coverage of the image, and advice on what views to add."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.vision.board import BoardSpec
+
+MIN_CORNERS = 8
+MIN_VIEWS = 3
+PARAMETERS = ("fu", "fv", "cx", "cy", "k1", "k2", "p1", "p2", "k3")
+
+
+class CalibrationInputError(ValueError):
+    """Views that cannot give a calibration (too few, all rejected); the message says why."""
+
+
+@dataclass(frozen=True)
+class BoardView:
+    """Corners of one view: ``corners_px`` (n, 2) and their ``ids`` (n,) on the board."""
+
+    name: str
+    corners_px: np.ndarray
+    ids: np.ndarray
+    image_size: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class RejectedView:
+    name: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class IntrinsicsCalibration:
+    """The result: ``intrinsics``; ``rms_px`` over all corners; ``per_view_rms_px`` per view;
+    ``std`` the 1-sigma of each parameter (px for fu, fv, cx, cy; unitless for distortion);
+    ``coverage`` the fraction of image cells holding a corner; ``used``/``rejected`` views."""
+
+    intrinsics: Intrinsics
+    rms_px: float
+    per_view_rms_px: dict[str, float]
+    std: dict[str, float]
+    coverage: float
+    used: list[str]
+    rejected: list[RejectedView] = field(default_factory=list)
+    advice: list[str] = field(default_factory=list)
+
+
+def detect_view(name: str, image: np.ndarray, spec: BoardSpec, detector=None) -> BoardView | RejectedView:
+    """Find the board's corners in one image (RGB or grey)."""
+    grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
+    detector = detector or cv2.aruco.CharucoDetector(spec.board())
+    corners, ids, marker_corners, _ = detector.detectBoard(grey)
+    size = (grey.shape[1], grey.shape[0])
+    if ids is None or len(ids) == 0:
+        seen = 0 if marker_corners is None else len(marker_corners)
+        return RejectedView(name, "no board found" if seen == 0 else f"{seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred")
+    if len(ids) < MIN_CORNERS:
+        return RejectedView(name, f"only {len(ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden")
+    return BoardView(name, corners.reshape(-1, 2).astype(np.float64), ids.ravel().astype(int), size)
+
+
+def detect_views(images: Iterable[tuple[str, np.ndarray]], spec: BoardSpec) -> tuple[list[BoardView], list[RejectedView]]:
+    detector = cv2.aruco.CharucoDetector(spec.board())
+    views, rejected = [], []
+    size = None
+    for name, image in images:
+        result = detect_view(name, image, spec, detector)
+        if isinstance(result, BoardView):
+            if size is None:
+                size = result.image_size
+            elif result.image_size != size:
+                rejected.append(RejectedView(name, f"image size {result.image_size[0]}x{result.image_size[1]} differs from the first view's {size[0]}x{size[1]}"))
+                continue
+            views.append(result)
+        else:
+            rejected.append(result)
+    return views, rejected
+
+
+def coverage(views: list[BoardView], image_size: tuple[int, int], grid: tuple[int, int] = (8, 6)) -> float:
+    """Fraction of a ``grid`` of image cells that hold at least one detected corner."""
+    w, h = image_size
+    hit = np.zeros(grid[::-1], dtype=bool)
+    for v in views:
+        cols = np.clip((v.corners_px[:, 0] / w * grid[0]).astype(int), 0, grid[0] - 1)
+        rows = np.clip((v.corners_px[:, 1] / h * grid[1]).astype(int), 0, grid[1] - 1)
+        hit[rows, cols] = True
+    return float(hit.mean())
+
+
+def calibrate_intrinsics(views: list[BoardView], spec: BoardSpec, *, distortion: bool = True, rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
+    """Calibrate from detected views; ``distortion=False`` fits the pinhole only (what the paper's tool had)."""
+    rejected = list(rejected or [])
+    if len(views) < MIN_VIEWS:
+        why = "; ".join(f"{r.name}: {r.reason}" for r in rejected[:5])
+        raise CalibrationInputError(f"{len(views)} usable board views, at least {MIN_VIEWS} needed" + (f" (rejected: {why})" if why else ""))
+    size = views[0].image_size
+    corners3d = spec.corners_mm()
+    object_points = [corners3d[v.ids].astype(np.float32) for v in views]
+    image_points = [v.corners_px.astype(np.float32).reshape(-1, 1, 2) for v in views]
+    flags = 0
+    if not distortion:
+        flags |= cv2.CALIB_FIX_K1 | cv2.CALIB_FIX_K2 | cv2.CALIB_FIX_K3 | cv2.CALIB_ZERO_TANGENT_DIST
+    rms, K, dist, _, _, std_intr, _, per_view = cv2.calibrateCameraExtended(object_points, image_points, size, None, None, flags=flags)
+    dist = np.asarray(dist, dtype=float).ravel()[:5]
+    intr = Intrinsics(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), size[0], size[1], tuple(np.pad(dist, (0, 5 - len(dist)))))
+    s = np.asarray(std_intr, dtype=float).ravel()
+    std = {"fu": s[0], "fv": s[1], "cx": s[2], "cy": s[3], "k1": s[4], "k2": s[5], "p1": s[6], "p2": s[7], "k3": s[8]}
+    result = IntrinsicsCalibration(intr, float(rms), {v.name: float(e) for v, e in zip(views, np.asarray(per_view).ravel())}, {k: float(v) for k, v in std.items()}, coverage(views, size), [v.name for v in views], rejected)
+    return IntrinsicsCalibration(**{**result.__dict__, "advice": advice(result)})
+
+
+def advice(result: IntrinsicsCalibration) -> list[str]:
+    """What the operator should do next, in words."""
+    out = []
+    if result.coverage < 0.7:
+        out.append(f"the corners cover {100 * result.coverage:.0f} % of the image: add views with the board near the image corners and edges, where distortion is strongest")
+    if len(result.used) < 10:
+        out.append(f"{len(result.used)} views: 10-20 views at different tilts give a stable calibration")
+    rel = result.std["fu"] / result.intrinsics.fu
+    if rel > 0.002:
+        out.append(f"fu is known to {100 * rel:.2f} % (1-sigma): add views tilted 20-40 deg about both axes")
+    if result.std["cx"] > 1.0 or result.std["cy"] > 1.0:
+        out.append(f"the principal point is known to {max(result.std['cx'], result.std['cy']):.1f} px: add tilted views")
+    worst = max(result.per_view_rms_px.items(), key=lambda kv: kv[1])
+    if worst[1] > 3 * max(result.rms_px, 0.05):
+        out.append(f"view {worst[0]} fits poorly ({worst[1]:.2f} px against {result.rms_px:.2f} px overall): blurred or mis-detected, consider removing it")
+    if not out:
+        out.append("good enough: every parameter is well determined and the image is covered")
+    return out
