@@ -1,0 +1,70 @@
+"""``videocal calibrate-hand-eye sim --out FILE``: the camera's mounting on the flange (``cam2flange``)
+from robot poses looking at a ChArUco board, here on the simulated test bed (its truth printed beside)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from calib_core.errors import VideocalError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("source", choices=("sim",), help="'sim': the simulated test bed (a real robot and camera need the window's capture mode, not built yet)")
+    parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100")
+    parser.add_argument("--poses", type=int, default=10)
+    parser.add_argument("--out", type=Path, required=True, help="YAML file for cam2flange (xyz mm, rpy deg) and its 1-sigma")
+    parser.add_argument("--robot-errors", action="store_true", help="give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
+
+
+def run(args: argparse.Namespace) -> int:
+    from calib_core.atomic_file import atomic_write_text
+    from calib_core.frames import pose_difference, xyz_rpy_from_transform
+    from calib_core.testbed.test_bed import TestBed
+    from calib_core.testbed.true_robot import RobotErrors
+    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.hand_eye import calibrate_hand_eye
+    from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
+    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+
+    spec = BoardSpec.parse(args.board)
+    typical = RobotErrors.typical(0)
+    errors = typical if args.robot_errors else RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
+    bed = TestBed.create(errors=errors)
+    board2base = board_facing_robot(spec)
+    joints = hand_eye_poses(bed, spec, board2base, args.poses)
+    if len(joints) < 3:
+        raise VideocalError(f"only {len(joints)} reachable poses see the board")
+    print(f"rendering {len(joints)} poses...", file=sys.stderr)
+    views, flanges = [], []
+    for name, image, q in simulated_hand_eye_images(bed, spec, joints, board2base):
+        v = detect_view(name, image, spec)
+        if isinstance(v, BoardView):
+            views.append(v)
+            flanges.append(bed.model_robot.fk(q, "flange"))
+        else:
+            print(f"rejected {name}: {v.reason}", file=sys.stderr)
+    result = calibrate_hand_eye(views, flanges, spec, bed.intrinsics)
+    xyz, rpy = xyz_rpy_from_transform(result.cam2flange)
+    doc = {
+        "cam2flange": {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
+        "std": {"xyz_mm": [round(float(v), 4) for v in result.std_xyz_mm], "rotation_deg": [round(float(v), 5) for v in result.std_rotation_deg]},
+        "units": {"length": "mm", "angle": "deg"},
+        "rms_px": round(result.rms_px, 4),
+        "poses": result.views,
+        "warnings": result.warnings,
+    }
+    atomic_write_text(args.out, yaml.safe_dump(doc, sort_keys=False))
+    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
+    d, r = pose_difference(result.cam2flange, true)
+    print(f"{result.views} poses, RMS {result.rms_px:.3f} px")
+    print(f"cam2flange xyz {', '.join(f'{v:.3f}' for v in xyz)} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})")
+    print(f"error against the test bed's truth: {np.linalg.norm(d):.3f} mm, {np.linalg.norm(r):.4f} deg")
+    for w in result.warnings:
+        print(f"warning: {w}")
+    print(f"wrote {args.out}")
+    return 0
