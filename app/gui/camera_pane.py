@@ -19,6 +19,7 @@ PENDING_COLOR = QColor(255, 140, 0)
 REPROJECTED_COLOR = QColor(0, 220, 255)
 RESIDUAL_COLOR = QColor(255, 70, 70)
 RESIDUAL_SCALE = 10.0
+GHOST_COLOR = QColor(255, 60, 220)
 
 
 def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
@@ -116,6 +117,18 @@ class CameraPane(QWidget):
                     end = np.array(pair.pixel) + RESIDUAL_SCALE * (np.array(pair.pixel) - uv)
                     overlay.segments.append((uv[0], uv[1], end[0], end[1], RESIDUAL_COLOR))
             overlay.text = f"cyan: model points from the solved pose; red: residuals x{RESIDUAL_SCALE:g}"
+            candidates = result.solution.candidates
+            if len(candidates) > 1:
+                # Ghosts of the other poses that fit as well, so the operator can tell them apart.
+                for k, candidate in enumerate(candidates):
+                    if k == session.chosen_candidate:
+                        continue
+                    for pair in session.pairs:
+                        p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
+                        uv = project_points(p_obj, candidate.obj2cam, self.workbench.intrinsics)[0]
+                        if np.all(np.isfinite(uv)):
+                            overlay.points.append((uv[0], uv[1], f"s{k + 1}", GHOST_COLOR))
+                overlay.text = f"{len(candidates)} poses fit: magenta ghosts show the others; choose one in Results"
             if self.edges.isChecked() and self._edges_image is not None:
                 overlay.image = self._edges_image
                 overlay.image_opacity = self.opacity.value() / 100.0

@@ -157,3 +157,29 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.open_workspace(tmp_path / "bad.json")
     assert "not valid JSON" in win.results.status.text()
     assert len(wb.session.pairs) == 1
+
+
+def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
+    win = window
+    wb = win.workbench
+    _go_to_approach(qtbot, win)
+    fixture = wb.workcell.component("oru_1_fixture")
+    true_cam = wb.bed.true_cam2world(wb.joints_deg)
+    for name in ("plate_top_left", "plate_top_right", "pin_tip"):  # three pairs: P3P has several exact poses
+        p = apply(fixture.item2world, fixture.features[name])
+        wb.session.pick_3d("oru_1_fixture", name, p)
+        wb.session.pick_2d(project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    solution = wb.session.result.solution
+    if solution.status is not SolveStatus.AMBIGUOUS:
+        pytest.skip("this configuration has a single P3P root")
+    ghosts = [p for p in win.camera.view.overlay.points if p[2].startswith("s")]
+    assert ghosts and "poses fit" in win.camera.view.overlay.text
+    button = win.results.findChild(type(win.commands.calibrate), "candidate_1")
+    assert button is not None
+    before = wb.session.result.cam2world_measured.copy()
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert wb.session.chosen_candidate == 1
+    assert not np.allclose(wb.session.result.cam2world_measured, before)
+    qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert wb.session.chosen_candidate == 0
