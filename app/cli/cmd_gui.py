@@ -15,7 +15,8 @@ from calib_core.workcell import DEFAULT_WORKCELL
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
     parser.add_argument("--port", help="a real controller link URL (serial port, socket://host:port, ...) instead of the simulator")
-    parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file or a stream URL, instead of the simulated camera")
+    parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file, a stream URL or a folder of images, instead of the simulated camera")
+    parser.add_argument("--hand-eye", type=Path, help="a cam2flange file from videocal calibrate-hand-eye: the measured camera mounting replaces the modelled one")
     parser.add_argument("--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)")
 
 
@@ -32,16 +33,22 @@ def run(args: argparse.Namespace) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("videocal")
     workbench = Workbench(bed)
+    if args.hand_eye is not None:
+        workbench.apply_hand_eye_file(args.hand_eye)
     if args.port:
         workbench.connect_link(args.port)
     else:
         workbench.start_simulated_controller()
     window = MainWindow(workbench)
     if args.camera:
+        from calib_core.video.folder_source import ImageFolderSource
         from calib_core.video.opencv_source import OpenCVSource
 
         spec = args.camera
-        window.start_camera(lambda: OpenCVSource(int(spec) if spec.isdigit() else spec))
+        if Path(spec).is_dir():
+            window.start_camera(lambda: ImageFolderSource(spec, loop=True))
+        else:
+            window.start_camera(lambda: OpenCVSource(int(spec) if spec.isdigit() else spec))
     else:
         window.start_camera(lambda: bed.camera(intrinsics=bed.intrinsics, fps=15.0))
     window.show()

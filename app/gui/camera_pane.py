@@ -43,7 +43,7 @@ class CameraPane(QWidget):
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
         self.workbench = workbench
-        self.view = ImageView(placeholder="waiting for the camera...")
+        self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
         self.freeze = QCheckBox("Freeze")
         self.freeze.setToolTip("Hold the current frame while picking")
         self.subpixel = QCheckBox("Sub-pixel")

@@ -41,8 +41,9 @@ class ImageView(QWidget):
     clicked = Signal(float, float)
     hovered = Signal(float, float)
 
-    def __init__(self, parent=None, *, placeholder: str = "no image"):
+    def __init__(self, parent=None, *, placeholder: str = "no image", loupe: bool = False):
         super().__init__(parent)
+        self.loupe = loupe
         self.setMouseTracking(True)
         self.setCursor(Qt.CursorShape.CrossCursor)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
@@ -157,6 +158,8 @@ class ImageView(QWidget):
                 p.drawText(QPointF(x + 7, y - 8), label)
         if self._mouse is not None and self.underMouse():
             self._paint_crosshair(p)
+            if self.loupe:
+                self._paint_loupe(p)
         if self.overlay.text:
             p.setPen(QColor(230, 230, 230))
             p.drawText(QRectF(8, 6, self.width() - 16, 40), Qt.AlignmentFlag.AlignLeft, self.overlay.text)
@@ -169,6 +172,24 @@ class ImageView(QWidget):
         p.drawLine(QPointF(x + 6, y), QPointF(self.width(), y))
         p.drawLine(QPointF(x, 0), QPointF(x, y - 6))
         p.drawLine(QPointF(x, y + 6), QPointF(x, self.height()))
+
+    def _paint_loupe(self, p: QPainter, radius_px: int = 10, size: int = 150) -> None:
+        """A magnified inset of the pixels around the cursor, in the corner away from it."""
+        u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())
+        cu, cv_ = int(round(u)), int(round(v))
+        src = QRectF(cu - radius_px, cv_ - radius_px, 2 * radius_px + 1, 2 * radius_px + 1)  # QImage pixel k spans [k, k + 1)
+        x = 8 if self._mouse.x() > self.width() / 2 else self.width() - size - 8
+        target = QRectF(x, self.height() - size - 8, size, size)
+        p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
+        p.fillRect(target, QColor(0, 0, 0))
+        p.drawImage(target, self._image, src)
+        p.setPen(QPen(QColor(255, 255, 0), 1.0))
+        cx, cy = target.center().x(), target.center().y()
+        cell = size / (2 * radius_px + 1)
+        p.drawRect(QRectF(cx - cell / 2, cy - cell / 2, cell, cell))
+        p.setPen(QPen(QColor(200, 200, 200), 1.0))
+        p.drawRect(target)
+        p.drawText(QRectF(target.x() + 4, target.y() + 2, size, 16), Qt.AlignmentFlag.AlignLeft, f"({cu}, {cv_}) x{cell:.0f}")
 
     # --- interaction ------------------------------------------------------------------------
     def wheelEvent(self, event: QWheelEvent) -> None:

@@ -151,6 +151,26 @@ class Workbench(QObject):
         self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
         return c
 
+    def apply_hand_eye_file(self, path) -> None:
+        """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""
+        import yaml
+
+        from calib_core.errors import FileFormatError
+        from calib_core.frames import transform_from_xyz_rpy
+
+        path = Path(path)
+        try:
+            doc = yaml.safe_load(path.read_text())
+            pose = doc["cam2flange"]
+            cam2flange = transform_from_xyz_rpy(pose["xyz"], pose["rpy"])
+        except FileNotFoundError:
+            raise FileFormatError(path, "no such hand-eye file") from None
+        except (yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
+            raise FileFormatError(path, f"not a cam2flange file: {exc}", "cam2flange") from None
+        flange = self.robot.frame_placement("flange")
+        self.robot.set_frame_placement("camera", flange @ cam2flange)
+        self.message.emit(f"camera mounting from {path}")
+
     # --- workspace and recording --------------------------------------------------------------
     def workspace(self):
         from calib_core.workspace.workspace import Workspace

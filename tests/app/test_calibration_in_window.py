@@ -183,3 +183,20 @@ def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
     assert not np.allclose(wb.session.result.cam2world_measured, before)
     qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
     assert wb.session.chosen_candidate == 0
+
+
+def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):
+    win = window
+    view = win.camera.view
+    image = np.zeros((480, 640, 3), np.uint8)
+    image[240, 320] = (255, 0, 0)  # one red pixel to find in the loupe
+    win.camera.freeze.setChecked(False)
+    view.set_image(image)
+    x, y = view.image_to_widget(320, 240)
+    qtbot.mouseMove(view, QPoint(int(round(x)), int(round(y))))
+    view._mouse = QPointF(x, y)
+    view.underMouse = lambda: True
+    shot = view.grab().toImage()
+    # The loupe sits in the bottom corner away from the cursor and shows the red pixel magnified.
+    reds = [(i, j) for i in range(shot.width()) for j in range(shot.height() - 160, shot.height()) if shot.pixelColor(i, j).red() > 200 and shot.pixelColor(i, j).green() < 60]
+    assert len(reds) > 20
