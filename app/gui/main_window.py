@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
@@ -34,7 +35,8 @@ class MainWindow(QMainWindow):
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
         self._current_pair: int | None = None
-        self._distortion = distortion_map(workbench.intrinsics)
+        self._half_distortion = distortion_map(workbench.intrinsics.scaled(0.5))
+        self._edges_renderer = None
         self.worker: FrameWorker | None = None
         self._build_layout()
         self._build_menus()
@@ -350,11 +352,18 @@ class MainWindow(QMainWindow):
         if r is None:
             self.camera.set_edges_image(None)
             return
-        # The CAD edges seen from the measured camera, through the lens, over the video.
-        ideal = self._distortion.ideal
-        rgba = self.virtual.renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target, hidden=frozenset(i.name for i in self.workbench.bed.visuals_for_model().scene_items(self.workbench.joints_deg))))
-        self.camera.set_edges_image(self._distortion.apply(rgba))
-        self.virtual.refresh()
+        # The CAD edges seen from the measured camera, through the lens, over the video: rendered at half
+        # size (a quarter of the cost) and enlarged, in a renderer of their own (the virtual camera's must keep
+        # its last frame for picking).
+        ideal = self._half_distortion.ideal
+        if self._edges_renderer is None:
+            from calib_core.render import SceneRenderer
+
+            self._edges_renderer = SceneRenderer()
+        self._edges_renderer.set_items(self.workbench.workcell.components)
+        rgba = self._edges_renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target))
+        edges = cv2.resize(self._half_distortion.apply(rgba), (self.workbench.intrinsics.width, self.workbench.intrinsics.height), interpolation=cv2.INTER_LINEAR)
+        self.camera.set_edges_image(edges)
 
     def _update_actions(self) -> None:
         undo = self.workbench.session.undo
@@ -402,5 +411,7 @@ class MainWindow(QMainWindow):
             self.worker.stop()
         self.virtual.close_renderer()
         self.overview.renderer.close()
+        if self._edges_renderer is not None:
+            self._edges_renderer.close()
         self.workbench.close()
         super().closeEvent(event)

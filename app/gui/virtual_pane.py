@@ -44,15 +44,22 @@ class VirtualPane(QWidget):
         workbench.session.pairs.subscribe(lambda *_: self.refresh())
         workbench.session.subscribe(self.refresh)
         self._last_joints = None
+        self._render_key = None
+        self.renders = 0
 
     def refresh(self) -> None:
+        """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
         wb = self.workbench
-        items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg)
-        self.renderer.set_items(items)
-        # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
-        # cover the very surface points the picker tests for visibility.
-        image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), RenderOptions(highlight=wb.session.target))
-        self.view.set_image(image)
+        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target)
+        if key != self._render_key:
+            items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg)
+            self.renderer.set_items(items)
+            # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
+            # cover the very surface points the picker tests for visibility.
+            image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), RenderOptions(highlight=wb.session.target))
+            self.view.set_image(image)
+            self._render_key = key
+            self.renders += 1
         overlay = Overlay()
         world2cam = invert(wb.model_cam2world())
         if wb.session.target is not None:
