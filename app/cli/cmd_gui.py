@@ -21,6 +21,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import subprocess
+    import tempfile
+
+    simulator = None
+    if not args.port:
+        # Start the controller simulator first: its start-up then overlaps the window's imports.
+        sim_dir = tempfile.TemporaryDirectory(prefix="videocal-sim-")
+        simulator = (subprocess.Popen(
+            [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(Path(sim_dir.name) / "controller")],
+            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=str(Path(__file__).resolve().parents[2]),
+        ), Path(sim_dir.name) / "controller")
     from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
@@ -38,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
     if args.port:
         workbench.connect_link(args.port)
     else:
-        workbench.start_simulated_controller()
+        workbench.start_simulated_controller(simulator)
     window = MainWindow(workbench)
     if args.camera:
         from calib_core.video.folder_source import ImageFolderSource

@@ -25,6 +25,17 @@ from calib_core.testbed.test_bed import TestBed
 from calib_core.workcell import TaskLocation
 
 
+def spawn_simulator(joints_deg, folder: Path) -> tuple[subprocess.Popen, Path]:
+    """Start the controller simulator on a pty behind a symlink in ``folder``; returns at once."""
+    link_path = Path(folder) / "controller"
+    q = ",".join(f"{v:.4f}" for v in joints_deg)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(link_path), "--joints", q],
+        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=str(Path(__file__).resolve().parents[2]),
+    )
+    return process, link_path
+
+
 class Workbench(QObject):
     """Signals: ``joints_changed(q)``, ``link_state(str)``, ``message(str)`` (status bar),
     ``error(str)`` (shown to the operator), ``solved()``, ``task_changed(str)``."""
@@ -58,15 +69,12 @@ class Workbench(QObject):
         self._state_arrived.connect(self._on_state_arrived)
 
     # --- robot and link ----------------------------------------------------------------------
-    def start_simulated_controller(self) -> str:
-        """Start ``videocal sim-controller`` on a pty as a child process and connect to it."""
-        link_path = Path(self._tmp.name) / "controller"
-        q = ",".join(f"{v:.4f}" for v in self.joints_deg)
-        self._sim_process = subprocess.Popen(
-            [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(link_path), "--joints", q],
-            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=str(Path(__file__).resolve().parents[2]),
-        )
-        device = self._sim_process.stdout.readline().strip()
+    def start_simulated_controller(self, started: tuple[subprocess.Popen, Path] | None = None) -> str:
+        """Start ``videocal sim-controller`` on a pty as a child process (or adopt one already started
+        with :func:`spawn_simulator`, so its start-up overlaps the window's) and connect to it."""
+        process, link_path = started or spawn_simulator(self.joints_deg, Path(self._tmp.name))
+        self._sim_process = process
+        device = process.stdout.readline().strip()
         if not device:
             raise RuntimeError("the controller simulator did not start")
         self.connect_link(str(link_path))
