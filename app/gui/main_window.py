@@ -64,7 +64,7 @@ class MainWindow(QMainWindow):
         top = QSplitter(Qt.Orientation.Horizontal)
         top.addWidget(self.camera)
         top.addWidget(self.virtual)
-        top.setSizes([1, 1])
+        top.setSizes([700, 620])
         right_bottom = QWidget()
         rb = QVBoxLayout(right_bottom)
         rb.setContentsMargins(0, 0, 0, 0)
@@ -75,7 +75,8 @@ class MainWindow(QMainWindow):
         bottom = QSplitter(Qt.Orientation.Horizontal)
         bottom.addWidget(self.overview)
         bottom.addWidget(right_bottom)
-        bottom.setSizes([1, 1])
+        bottom.setSizes([700, 620])
+        self.top_splitter, self.bottom_splitter = top, bottom
         self.splitter = QSplitter(Qt.Orientation.Vertical)
         self.splitter.addWidget(top)
         self.splitter.addWidget(bottom)
@@ -402,10 +403,17 @@ class MainWindow(QMainWindow):
         state = self.settings.value("window/state")
         if state is not None:
             self.restoreState(state)
+        for key, splitter in (("window/split_main", self.splitter), ("window/split_top", self.top_splitter), ("window/split_bottom", self.bottom_splitter)):
+            value = self.settings.value(key)
+            if value is not None:
+                splitter.restoreState(value)
 
     def closeEvent(self, event) -> None:
         self.settings.setValue("window/geometry", self.saveGeometry())
         self.settings.setValue("window/state", self.saveState())
+        self.settings.setValue("window/split_main", self.splitter.saveState())
+        self.settings.setValue("window/split_top", self.top_splitter.saveState())
+        self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
         self._redraw.stop()
         if self.worker is not None:
             self.worker.stop()
