@@ -92,7 +92,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
         frames = []
         win.worker.frame.connect(frames.append)
         _wait(app, lambda: len(frames) >= 2, 30, "a camera frame at the approach pose")
-        _wait(app, lambda: win.virtual._last_joints is not None and np.allclose(win.virtual._last_joints, wb.joints_deg), 10, "the virtual camera")
+        _wait(app, win.virtual.is_current, 10, "the virtual camera")
         win.camera.freeze.setChecked(True)
         shot("approach")
         fixture = wb.workcell.component(wb.session.target)

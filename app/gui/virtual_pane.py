@@ -77,8 +77,12 @@ class VirtualPane(QWidget):
         self.view.set_overlay(overlay)
         self._last_joints = wb.joints_deg.copy()
 
+    def is_current(self, tolerance_deg: float = 1e-3) -> bool:
+        """Whether the view shows the robot at the current joints (to ``tolerance_deg``)."""
+        return self._last_joints is not None and float(np.max(np.abs(self.workbench.joints_deg - self._last_joints))) <= tolerance_deg
+
     def refresh_if_moved(self, tolerance_deg: float = 1e-3) -> None:
-        if self._last_joints is None or np.max(np.abs(self.workbench.joints_deg - self._last_joints)) > tolerance_deg:
+        if not self.is_current(tolerance_deg):
             self.refresh()
 
     def _on_click(self, u: float, v: float) -> None:

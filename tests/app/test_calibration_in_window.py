@@ -55,7 +55,7 @@ def _go_to_approach(qtbot, win):
     frames = []
     win.worker.frame.connect(frames.append)
     qtbot.waitUntil(lambda: len(frames) >= 2, timeout=10_000)
-    qtbot.waitUntil(lambda: win.virtual._last_joints is not None and np.allclose(win.virtual._last_joints, wb.joints_deg), timeout=5_000)
+    qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
 
 
 def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window):
