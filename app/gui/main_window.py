@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import cv2
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
@@ -58,6 +60,7 @@ class MainWindow(QMainWindow):
         self._autosave_timer.setInterval(60_000)
         self._autosave_timer.timeout.connect(self._autosave)
         self._autosave_timer.start()
+        self._offer_recovery()
 
     # --- layout ----------------------------------------------------------------------------
     def _build_layout(self) -> None:
@@ -91,7 +94,7 @@ class MainWindow(QMainWindow):
         self.resize(1600, 1000)
 
     def _build_menus(self) -> None:
-        file_menu = self.menuBar().addMenu("&File")
+        file_menu = self.file_menu = self.menuBar().addMenu("&File")
         file_menu.addAction(QAction("&Open workspace...", self, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
         file_menu.addAction(QAction("&Save workspace as...", self, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
         file_menu.addSeparator()
@@ -285,6 +288,7 @@ class MainWindow(QMainWindow):
     def save_workspace(self, path) -> None:
         self.report(self.workbench.save_workspace)(path)
         self._remember_recent(path)
+        self.settings.setValue("files/last_saved_time", time.time())
 
     def open_workspace(self, path) -> None:
         self.report(self.workbench.open_workspace)(path)
@@ -327,6 +331,23 @@ class MainWindow(QMainWindow):
             self.start_recording(path)
         else:
             self.record_action.setChecked(False)
+
+    def _offer_recovery(self) -> None:
+        """An autosave newer than the last saved workspace means the last session ended without saving:
+        offer it (File > Restore autosave) rather than load it unasked."""
+        if not self.autosave_path.is_file():
+            return
+        last_saved = self.settings.value("files/last_saved_time")
+        autosaved = self.autosave_path.stat().st_mtime
+        if last_saved is not None and float(last_saved) >= autosaved:
+            return
+        stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(autosaved))
+        self.restore_action = QAction(f"Restore &autosave of {stamp}", self, triggered=self.restore_autosave)
+        self.file_menu.insertAction(self.file_menu.actions()[0], self.restore_action)
+        self.statusBar().showMessage(f"an unsaved session from {stamp} was autosaved: File > Restore autosave", 30000)
+
+    def restore_autosave(self) -> None:
+        self.open_workspace(self.autosave_path)
 
     def _autosave(self) -> None:
         """Every minute, the workspace to the recovery folder (offered again after a crash)."""

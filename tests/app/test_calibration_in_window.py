@@ -200,3 +200,23 @@ def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):
     # The loupe sits in the bottom corner away from the cursor and shows the red pixel magnified.
     reds = [(i, j) for i in range(shot.width()) for j in range(shot.height() - 160, shot.height()) if shot.pixelColor(i, j).red() > 200 and shot.pixelColor(i, j).green() < 60]
     assert len(reds) > 20
+
+
+def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
+    from calib_core.calibration.correspondences import Correspondence
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+    settings.setValue("files/autosave_dir", str(tmp_path))
+    bed = TestBed.create()
+    (tmp_path / "recovery").mkdir()
+    save_workspace(tmp_path / "recovery" / "autosave.json", Workspace("cell", bed.intrinsics, {}, "oru_1_fixture", [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))]))
+    wb = Workbench(bed)
+    win = MainWindow(wb, settings=settings)
+    qtbot.addWidget(win)
+    try:
+        assert "Restore" in win.restore_action.text()
+        win.restore_action.trigger()
+        assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
+    finally:
+        win.close()
