@@ -32,7 +32,7 @@ def main() -> None:
     camera = bed.camera(intrinsics=small, seed=1)
     OUT.parent.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(5)
-    with SessionRecorder(OUT, jpeg_quality=80) as rec:
+    with SessionRecorder(OUT, drop_when_busy=False) as rec:
         rec.record_setup(workcell="resources/workcell/workcell.yaml", intrinsics=bed.intrinsics.to_dict(), task=task.name, target="oru_1_fixture")
         for i in range(6):
             frame = camera.read()

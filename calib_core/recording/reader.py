@@ -16,16 +16,26 @@ from mcap.stream_reader import StreamReader
 
 from calib_core.errors import FileFormatError
 from calib_core.recording.recorder import SessionRecorder
-from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC
+from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
 
 
 @dataclass(frozen=True)
 class RecordedMessage:
-    """One message: ``topic``, ``log_time_ns`` (Unix ns), ``payload`` (decoded JSON)."""
+    """One message: ``topic``, ``log_time_ns`` (Unix ns), ``payload`` (decoded JSON, or for a
+    video frame ``{"timestamp", "frame_id", "format", "data": bytes}``) and ``raw`` (its bytes
+    in the file)."""
 
     topic: str
     log_time_ns: int
     payload: dict
+    raw: bytes = b""
+
+
+def _video_payload(data: bytes) -> dict:
+    from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
+
+    m = CompressedVideo.FromString(data)
+    return {"timestamp": {"sec": m.timestamp.seconds, "nsec": m.timestamp.nanos}, "frame_id": m.frame_id, "format": m.format, "data": m.data}
 
 
 @dataclass
@@ -49,6 +59,7 @@ def read_recording(path: str | Path) -> RecordingContents:
     except FileNotFoundError:
         raise FileFormatError(path, "no such recording") from None
     channels: dict[int, str] = {}
+    encodings: dict[int, str] = {}
     messages: list[RecordedMessage] = []
     complete, problem = False, None
     with handle:
@@ -56,16 +67,18 @@ def read_recording(path: str | Path) -> RecordingContents:
             for record in StreamReader(handle, skip_magic=False).records:
                 if isinstance(record, Channel):
                     channels[record.id] = record.topic
+                    encodings[record.id] = record.message_encoding
                 elif isinstance(record, Message):
                     topic = channels.get(record.channel_id)
                     if topic is None:
                         continue
+                    encoding = encodings.get(record.channel_id)
                     try:
-                        payload = json.loads(record.data)
-                    except (ValueError, UnicodeDecodeError):
-                        problem = f"message {len(messages) + 1} on {topic} is not JSON"
+                        payload = _video_payload(record.data) if topic == VIDEO_TOPIC and encoding == "protobuf" else json.loads(record.data)
+                    except Exception:  # json and protobuf raise different errors on bad bytes
+                        problem = f"message {len(messages) + 1} on {topic} is not valid {encoding}"
                         break
-                    messages.append(RecordedMessage(topic, record.log_time, payload))
+                    messages.append(RecordedMessage(topic, record.log_time, payload, bytes(record.data)))
                 elif isinstance(record, Footer):
                     complete = True
         except (McapError, ValueError, EOFError, OSError) as exc:
@@ -82,7 +95,8 @@ def read_recording(path: str | Path) -> RecordingContents:
 
 
 def decode_frame(payload: dict) -> np.ndarray:
-    """The RGB image (h, w, 3) of a ``foxglove.CompressedImage`` payload."""
+    """The RGB image (h, w, 3) of a ``foxglove.CompressedImage`` payload (JPEG or PNG); video
+    frames need their predecessors: see :class:`~calib_core.recording.frame_track.FrameTrack`."""
     data = np.frombuffer(base64.b64decode(payload["data"]), dtype=np.uint8)
     bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
     if bgr is None:
@@ -94,9 +108,9 @@ def recover(path: str | Path, out: str | Path) -> RecordingContents:
     """Rewrite a cut-off recording as a complete one with every message before the cut."""
     contents = read_recording(path)
     writer = SessionRecorder(out)
-    topics = {FRAME_TOPIC, JOINTS_TOPIC, EVENT_TOPIC, SOLVE_TOPIC, CORRECTION_TOPIC, SETUP_TOPIC}
+    topics = {FRAME_TOPIC, VIDEO_TOPIC, JOINTS_TOPIC, EVENT_TOPIC, SOLVE_TOPIC, CORRECTION_TOPIC, SETUP_TOPIC}
     for m in contents.messages:
         if m.topic in topics:
-            writer._write(m.topic, m.payload, log_time_ns=m.log_time_ns)
+            writer.write_raw(m.topic, m.raw, log_time_ns=m.log_time_ns)
     writer.close()
     return contents

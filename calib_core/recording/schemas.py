@@ -9,6 +9,9 @@ from __future__ import annotations
 import json
 
 FRAME_TOPIC = "/camera/image/compressed"
+VIDEO_TOPIC = "/camera/video"
+"""Frames as H.264 (``foxglove.CompressedVideo``, protobuf): the default. ``FRAME_TOPIC`` carries
+JPEG frames (``foxglove.CompressedImage``, JSON) when a recording is made with ``frames="jpeg"``."""
 JOINTS_TOPIC = "/robot/joints"
 EVENT_TOPIC = "/videocal/events"
 SOLVE_TOPIC = "/videocal/solves"
@@ -66,3 +69,12 @@ TOPICS = {
 
 def schema_bytes(topic: str) -> bytes:
     return json.dumps(TOPICS[topic]).encode()
+
+
+def video_schema() -> tuple[str, bytes]:
+    """Name and ``FileDescriptorSet`` bytes of Foxglove's own protobuf ``CompressedVideo`` (the
+    schema Foxglove Studio plays), from the ``foxglove-schemas-protobuf`` package."""
+    from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
+    from mcap_protobuf.schema import build_file_descriptor_set
+
+    return CompressedVideo.DESCRIPTOR.full_name, build_file_descriptor_set(CompressedVideo).SerializeToString()

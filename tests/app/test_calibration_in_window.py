@@ -130,7 +130,7 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
 
 def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     from calib_core.recording.reader import read_recording
-    from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC
+    from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, VIDEO_TOPIC
 
     win = window
     wb = win.workbench
@@ -145,7 +145,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.save_workspace(tmp_path / "w.json")
     win.stop_recording()
     contents = read_recording(tmp_path / "session.mcap")
-    assert contents.complete and contents.topic(FRAME_TOPIC) and contents.topic(JOINTS_TOPIC)
+    assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
     assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC)] == ["pair_added", "pair_changed"]
     # Clear, then open the saved workspace: the pair comes back.
     wb.session.clear()

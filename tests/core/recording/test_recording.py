@@ -13,7 +13,8 @@ from calib_core.errors import FileFormatError
 from calib_core.recording.reader import decode_frame, read_recording, recover
 from calib_core.recording.recorder import SessionRecorder
 from calib_core.recording.replay import replay, solve_inputs
-from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SOLVE_TOPIC
+from calib_core.recording.frame_track import FrameTrack
+from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
 from calib_core.solver import solve_pose
 
 from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, random_pose
@@ -21,12 +22,19 @@ from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, rand
 SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "recordings" / "sample_session.mcap"
 
 
-def _record(path, n_frames=3, n_solves=2):
+def _image(i, rng, noise=3.0):
+    """A gradient with a moving square and some noise: video-like, so inter-frame coding matters."""
+    image = np.zeros((48, 64, 3), np.uint8) + np.linspace(20, 220, 64).astype(np.uint8)[None, :, None]
+    image[10:20, 5 + i : 15 + i] = (250, 30, 30)
+    return image if noise == 0 else np.clip(image + rng.normal(0, noise, image.shape), 0, 255).astype(np.uint8)
+
+
+def _record(path, n_frames=3, n_solves=2, frames="jpeg"):
     rng = np.random.default_rng(0)
-    with SessionRecorder(path) as rec:
+    with SessionRecorder(path, frames=frames, drop_when_busy=False) as rec:
         rec.record_setup(intrinsics=GRIPPER_CAMERA.to_dict())
         for i in range(n_frames):
-            image = (rng.uniform(0, 255, (48, 64, 3))).astype(np.uint8)
+            image = _image(i, rng)
             rec.record_frame(image, float(i))
             rec.record_joints(i, 10 * i, float(i), [1.0, 2.0, 3.0, 4.0, 5.0, float(i)])
             rec.record_event("pick", number=i)
@@ -49,8 +57,60 @@ def test_round_trip(tmp_path):
     assert contents.topic(JOINTS_TOPIC)[2].payload["joints_deg"][-1] == 2.0
 
 
-def test_every_message_before_a_cut_survives_and_recovers(tmp_path):
-    path = _record(tmp_path / "s.mcap", n_frames=8, n_solves=1)
+def test_video_frames_decode_in_order_and_by_seeking(tmp_path):
+    path = _record(tmp_path / "v.mcap", n_frames=70, n_solves=0, frames="h264")
+    contents = read_recording(path)
+    assert not contents.topic(FRAME_TOPIC)
+    track = FrameTrack(contents)
+    assert track.is_video and len(track) == 70 and track.keyframes == [0, 30, 60]
+    truth = [_image(i, None, noise=0.0) for i in range(70)]
+    sequential = [track.image(k) for k in range(70)]
+    for k in (69, 31, 5, 45, 44, 0):  # jumps forwards, back across keyframes, to the start
+        assert np.array_equal(track.image(k), sequential[k])
+    errors = [np.abs(img.astype(int) - ref).mean() for img, ref in zip(sequential, truth)]
+    assert max(errors) < 5.0  # gray levels against the noise-free picture (4:2:0 blurs the red square)
+    # the moving square is where it was in each frame, not in its neighbour's place
+    assert sequential[40][15, 45:55, 0].mean() > 200 and sequential[40][15, 35:40, 0].mean() < 150
+    assert np.all(np.diff(track.times_s) >= 0) and track.index_at(track.times_s[12] + 1e-6) == 12
+
+
+def test_video_frames_use_foxglove_compressed_video(tmp_path):
+    from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
+    from google.protobuf.descriptor_pb2 import FileDescriptorSet
+    from mcap.reader import make_reader
+
+    from calib_core.recording.video_codec import nal_unit_types
+
+    path = _record(tmp_path / "v.mcap", n_frames=3, n_solves=0, frames="h264")
+    with open(path, "rb") as f:
+        summary = make_reader(f).get_summary()
+    channel = next(c for c in summary.channels.values() if c.topic == VIDEO_TOPIC)
+    schema = summary.schemas[channel.schema_id]
+    assert (schema.name, schema.encoding, channel.message_encoding) == ("foxglove.CompressedVideo", "protobuf", "protobuf")
+    files = FileDescriptorSet.FromString(schema.data)
+    assert any(m.name == "CompressedVideo" for fd in files.file for m in fd.message_type)
+    first = read_recording(path).topic(VIDEO_TOPIC)[0]
+    message = CompressedVideo.FromString(first.raw)
+    assert message.format == "h264" and message.timestamp.ToNanoseconds() == first.log_time_ns
+    # Annex B with SPS and PPS before the IDR slice, as Foxglove requires of a keyframe
+    types = nal_unit_types(message.data)
+    assert message.data.startswith(b"\x00\x00\x00\x01") and types.index(7) < types.index(5) and 8 in types
+    image = next(c for c in summary.channels.values() if c.topic == FRAME_TOPIC)
+    assert summary.schemas[image.schema_id].name == "foxglove.CompressedImage" and image.message_encoding == "json"
+
+
+def test_a_busy_encoder_drops_frames_and_counts_them(tmp_path):
+    frame = np.zeros((480, 640, 3), np.uint8)
+    with SessionRecorder(tmp_path / "busy.mcap", queue_frames=2) as rec:
+        for _ in range(40):
+            rec.record_frame(frame, 0.0)
+    assert rec.frames_dropped > 0 and rec.frames_written + rec.frames_dropped == 40
+    assert len(read_recording(tmp_path / "busy.mcap").topic(VIDEO_TOPIC)) == rec.frames_written
+
+
+@pytest.mark.parametrize("frames", ["jpeg", "h264"])
+def test_every_message_before_a_cut_survives_and_recovers(tmp_path, frames):
+    path = _record(tmp_path / "s.mcap", n_frames=8, n_solves=1, frames=frames)
     full = read_recording(path).messages
     data = path.read_bytes()
     for cut in (len(data) // 3, len(data) // 2, len(data) - 200):
@@ -64,6 +124,9 @@ def test_every_message_before_a_cut_survives_and_recovers(tmp_path):
         fixed = recover(cut_path, tmp_path / f"fixed{cut}.mcap")
         again = read_recording(tmp_path / f"fixed{cut}.mcap")
         assert again.complete and [m.payload for m in again.messages] == [m.payload for m in fixed.messages]
+        if frames == "h264" and again.topic(VIDEO_TOPIC):
+            track = FrameTrack(again)
+            assert track.image(len(track) - 1).shape == (48, 64, 3)
 
 
 def test_replay_agrees_exactly_and_finds_a_tampered_result(tmp_path):
@@ -91,7 +154,7 @@ def test_the_bundled_sample_recording_replays():
     assert run.returncode == 0, run.stdout + run.stderr
     assert "2 solves" in run.stdout and "agrees" in run.stdout
     contents = read_recording(SAMPLE)
-    assert contents.complete and len(contents.topic(FRAME_TOPIC)) >= 5
+    assert contents.complete and len(FrameTrack(contents)) >= 5
 
 
 def test_foreign_and_missing_files(tmp_path):
