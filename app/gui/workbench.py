@@ -146,7 +146,8 @@ class Workbench(QObject):
         obj2world = self.workcell.component(target).item2world
         result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
         if self.recorder is not None:
-            self.recorder.record_solve(self.session.last_solve_inputs, result.solution.to_dict())
+            context = {"obj2world": obj2world, "cam2world_model": result.cam2world_model, "tcp2base_model": result.tcp2base_model, "joints_deg": self.joints_deg, "target": target}
+            self.recorder.record_solve(self.session.last_solve_inputs, result.solution.to_dict(), context=context)
         self.solved.emit()
         return result
 
@@ -234,10 +235,13 @@ class Workbench(QObject):
         rec = getattr(self, "recorder", None)
         if rec is None:
             return
+        from calib_core.recording.playback import pair_to_dict
+
         detail = {"number": number}
         if number is not None and event in ("added", "changed"):
-            p = self.session.pairs.get(number)
-            detail.update(component=p.component, feature=p.feature, point_world_mm=list(p.point_world_mm), pixel=None if p.pixel is None else list(p.pixel), enabled=p.enabled)
+            detail.update(pair_to_dict(self.session.pairs.get(number)))
+        elif event == "reset":  # a whole new set (clear, undo of a clear, a workspace): keep it all
+            detail["pairs"] = [pair_to_dict(p) for p in self.session.pairs]
         rec.record_event(f"pair_{event}", **detail)
 
     def close(self) -> None:

@@ -148,9 +148,11 @@ class SessionRecorder:
     def record_event(self, kind: str, **detail) -> None:
         self._write(EVENT_TOPIC, {"kind": kind, "detail": detail})
 
-    def record_solve(self, inputs: dict, result: dict) -> int:
+    def record_solve(self, inputs: dict, result: dict, context: dict | None = None) -> int:
+        """A solve: ``inputs`` to re-solve it, its ``result``, and the ``context`` that turns it
+        into an end-effector estimate (obj2world, cam2world_model, tcp2base_model (4, 4) mm, joints)."""
         self._solve_id += 1
-        self._write(SOLVE_TOPIC, {"id": self._solve_id, "inputs": inputs, "result": result})
+        self._write(SOLVE_TOPIC, {"id": self._solve_id, "inputs": inputs, "result": result, **({"context": context} if context else {})})
         return self._solve_id
 
     def record_correction(self, correction: dict) -> None:

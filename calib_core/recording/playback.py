@@ -1,0 +1,90 @@
+"""A recording seen at any instant: the camera frame, the joints, the point pairs and the last
+solve as they were then. The window's replay timeline is a view of this; it has no Qt in it.
+
+Times are seconds since the recording's first message (``0 .. duration_s``).
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+
+import numpy as np
+
+from calib_core.calibration.correspondences import Correspondence
+from calib_core.recording.frame_track import FrameTrack
+from calib_core.recording.reader import RecordedMessage, RecordingContents
+from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC
+
+
+def pair_to_dict(pair: Correspondence) -> dict:
+    """The JSON form of a pair, as recorded in ``pair_*`` events."""
+    return {"number": pair.number, "component": pair.component, "feature": pair.feature, "point_world_mm": list(pair.point_world_mm), "pixel": None if pair.pixel is None else list(pair.pixel), "enabled": pair.enabled}
+
+
+def pair_from_dict(d: dict) -> Correspondence:
+    pixel = d.get("pixel")
+    return Correspondence(int(d["number"]), str(d["component"]), d.get("feature"), tuple(float(v) for v in d["point_world_mm"]), None if pixel is None else (float(pixel[0]), float(pixel[1])), bool(d.get("enabled", True)))
+
+
+@dataclass(frozen=True)
+class RecordedSolve:
+    """A solve as recorded: its ``inputs`` (re-solvable), ``result`` (``PoseSolution.to_dict``),
+    ``context`` (obj2world, cam2world_model, tcp2base_model, joints; empty in older recordings)
+    and ``t_s``."""
+
+    id: int
+    t_s: float
+    inputs: dict
+    result: dict
+    context: dict
+
+
+class RecordingPlayback:
+    """Everything in a recording, indexed by time."""
+
+    def __init__(self, contents: RecordingContents):
+        self.contents = contents
+        self._t0 = contents.messages[0].log_time_ns if contents.messages else 0
+        self.frames = FrameTrack(contents)
+        joints = contents.topic(JOINTS_TOPIC)
+        self.joint_times_s = np.array([self._t(m) for m in joints])
+        self.joints_deg = np.array([m.payload["joints_deg"] for m in joints], dtype=float).reshape(len(joints), -1)
+        self._events = [m for m in contents.topic(EVENT_TOPIC) if str(m.payload.get("kind", "")).startswith("pair_")]
+        self._event_times = [self._t(m) for m in self._events]
+        self.solves = [RecordedSolve(int(m.payload.get("id", k + 1)), self._t(m), m.payload["inputs"], m.payload["result"], m.payload.get("context") or {}) for k, m in enumerate(contents.topic(SOLVE_TOPIC))]
+        setups = contents.topic(SETUP_TOPIC)
+        self.setup: dict = setups[0].payload if setups else {}
+        self.duration_s = self._t(contents.messages[-1]) if contents.messages else 0.0
+
+    def _t(self, m: RecordedMessage) -> float:
+        return (m.log_time_ns - self._t0) / 1e9
+
+    def frame_index_at(self, t_s: float) -> int | None:
+        """The frame shown at ``t_s``: the last one at or before it (``None`` without frames)."""
+        if not len(self.frames):
+            return None
+        return self.frames.index_at(t_s)
+
+    def joints_at(self, t_s: float) -> np.ndarray | None:
+        """The last joint sample (deg) at or before ``t_s``; ``None`` before the first."""
+        i = bisect.bisect_right(self.joint_times_s, t_s) - 1
+        return None if i < 0 else self.joints_deg[i].copy()
+
+    def pairs_at(self, t_s: float) -> list[Correspondence]:
+        """The point pairs as they stood at ``t_s``, rebuilt from the recorded edits."""
+        pairs: dict[int, Correspondence] = {}
+        for m in self._events[: bisect.bisect_right(self._event_times, t_s)]:
+            kind, d = m.payload["kind"], m.payload.get("detail", {})
+            if kind in ("pair_added", "pair_changed") and "point_world_mm" in d:
+                pairs[int(d["number"])] = pair_from_dict(d)
+            elif kind == "pair_removed":
+                pairs.pop(int(d["number"]), None)
+            elif kind == "pair_reset":
+                pairs = {int(p["number"]): pair_from_dict(p) for p in d.get("pairs", [])}
+        return list(pairs.values())
+
+    def solve_at(self, t_s: float) -> RecordedSolve | None:
+        """The last solve at or before ``t_s``."""
+        i = bisect.bisect_right([s.t_s for s in self.solves], t_s) - 1
+        return None if i < 0 else self.solves[i]
