@@ -14,8 +14,7 @@ def guarded(report: Callable[[str], None]):
     """Decorate an action handler: user mistakes (``VideocalError``, ``ValueError``, ``KeyError``)
     are reported in words; anything else as an internal error with its traceback on stderr.
 
-    The wrapper returns nothing: a Qt slot that returns a value for a signal without one (a bool
-    above all) corrupts PySide's reference counts and crashes the interpreter at exit."""
+    The wrapper returns nothing, so a slot never hands Qt a value its signal does not expect."""
 
     def wrap(fn):
         @functools.wraps(fn)

@@ -16,6 +16,7 @@ from app.gui.error_boundary import guarded
 from app.gui.frame_worker import FrameWorker
 from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
+from app.gui.replay_bar import ReplayBar
 from app.gui.results_panel import ResultsPanel
 from app.gui.virtual_pane import VirtualPane
 from app.gui.workbench import Workbench
@@ -36,6 +37,7 @@ class MainWindow(QMainWindow):
         self.table = PairsTable(workbench)
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
+        self.replay = ReplayBar(workbench, self.camera.show_frame)
         self._current_pair: int | None = None
         self._half_distortion = distortion_map(workbench.intrinsics.scaled(0.5))
         self._edges_renderer = None
@@ -85,7 +87,13 @@ class MainWindow(QMainWindow):
         self.splitter.addWidget(bottom)
         self.splitter.setStretchFactor(0, 3)
         self.splitter.setStretchFactor(1, 2)
-        self.setCentralWidget(self.splitter)
+        central = QWidget()
+        column = QVBoxLayout(central)
+        column.setContentsMargins(0, 0, 0, 0)
+        column.setSpacing(0)
+        column.addWidget(self.replay)
+        column.addWidget(self.splitter, 1)
+        self.setCentralWidget(central)
         dock = QDockWidget("Commands", self)
         dock.setObjectName("commands_dock")
         dock.setWidget(self.commands)
@@ -100,6 +108,9 @@ class MainWindow(QMainWindow):
         file_menu.addSeparator()
         self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
         file_menu.addAction(self.record_action)
+        file_menu.addAction(QAction("Open r&ecording...", self, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
+        self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
+        self.addAction(self.play_action)
         file_menu.addSeparator()
         quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self._quit)
         file_menu.addAction(quit_action)
@@ -158,14 +169,15 @@ class MainWindow(QMainWindow):
         c.live.toggled.connect(self._live_toggled)
         self.results.candidate_chosen.connect(self.report(lambda k: wb.session.choose_candidate(k)))
         wb.joints_changed.connect(self._on_joints)
+        self.replay.closed.connect(self._replay_closed)
         wb.link_state.connect(lambda text: self.link_label.setText(f"link: {text}"))
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.subscribe(self._update_actions)
+        wb.session.pairs.subscribe(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
         wb.session.corrections.subscribe(lambda task: self._update_corrections())
         wb.session.subscribe(self._after_solve)
         self._update_actions()
 
-    # Slots return nothing: PySide must never receive a value (least of all a bool) from a slot.
     def _quit(self) -> None:
         self.close()
 
@@ -312,7 +324,31 @@ class MainWindow(QMainWindow):
         if path:
             self.open_workspace(path)
 
+    def _open_recording_dialog(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Open recording", "", "MCAP recording (*.mcap)")
+        if path:
+            self.open_recording(path)
+
+    def open_recording(self, path) -> None:
+        """Replay a recording: the live camera pauses, the views follow the recording (see ReplayBar)."""
+        self.report(self._open_recording)(path)
+
+    def _open_recording(self, path) -> None:
+        if self.workbench.recorder is not None:
+            raise RuntimeError("stop recording before replaying a recording")
+        self.replay.open(path)
+        self.commands.live.setChecked(False)
+        self._remember_recent(path)
+
+    def _replay_closed(self) -> None:
+        self.commands.live.setChecked(True)
+
     def start_recording(self, path) -> None:
+        if self.replay.playback is not None:
+            self.show_error("close the replay before recording: a recording records the live camera and robot")
+            return
         self.report(self.workbench.start_recording)(path)
         self.record_action.setChecked(self.workbench.recorder is not None)
 
@@ -386,6 +422,9 @@ class MainWindow(QMainWindow):
         rgba = self._edges_renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target))
         edges = cv2.resize(self._half_distortion.apply(rgba), (self.workbench.intrinsics.width, self.workbench.intrinsics.height), interpolation=cv2.INTER_LINEAR)
         self.camera.set_edges_image(edges)
+
+    def _pairs_changed(self, event: str, number) -> None:
+        self._update_actions()
 
     def _update_actions(self) -> None:
         undo = self.workbench.session.undo

@@ -64,6 +64,7 @@ class Workbench(QObject):
         self._sim_process: subprocess.Popen | None = None
         self._tmp = tempfile.TemporaryDirectory(prefix="videocal-")
         self.recorder = None
+        self.replaying = False
         self.session.pairs.subscribe(self._record_pairs_event)
         self._sample_arrived.connect(self._on_sample)
         self._state_arrived.connect(self._on_state_arrived)
@@ -95,8 +96,15 @@ class Workbench(QObject):
     def _on_sample(self, sample) -> None:
         if self.recorder is not None:
             self.recorder.record_joints(sample.sample.seq, sample.sample.t_ms, sample.t_host_s, sample.joints_deg)
+        if self.replaying:
+            return  # the recorded joints drive the views while a recording is replayed
         self.joints_deg = np.array(sample.joints_deg, dtype=float)
         self.bed.joints_deg = self.joints_deg.copy()  # the simulated camera follows the commanded joints
+        self.joints_changed.emit(self.joints_deg)
+
+    def show_replayed_joints(self, joints_deg) -> None:
+        """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
+        self.joints_deg = np.array(joints_deg, dtype=float)
         self.joints_changed.emit(self.joints_deg)
 
     @property

@@ -128,6 +128,19 @@ class CalibrationSession:
         self._changed()
         return self.result
 
+    def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int]) -> EndEffectorEstimate:
+        """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here."""
+        self._context = (obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), list(numbers))
+        self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model)
+        self.chosen_candidate = 0
+        self._changed()
+        return self.result
+
+    def clear_result(self) -> None:
+        self.result = None
+        self._context = None
+        self._changed()
+
     def _select(self, index: int) -> None:
         if self.result is None:
             return

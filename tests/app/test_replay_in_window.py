@@ -1,0 +1,143 @@
+"""Replaying a recording in the real window: the timeline shows the recorded frames, joints, pairs
+and results as they were; the first edit branches a new session; the file is never written."""
+
+import hashlib
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, QSettings, Qt
+
+from app.gui.main_window import MainWindow
+from app.gui.workbench import Workbench
+from calib_core.recording.playback import RecordingPlayback
+from calib_core.recording.reader import read_recording
+from calib_core.testbed.test_bed import TestBed
+
+SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "recordings" / "sample_session.mcap"
+OUTPUT = Path(__file__).resolve().parents[1] / "output"
+
+
+@pytest.fixture
+def window(qtbot, tmp_path):
+    wb = Workbench(TestBed.create())
+    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+    qtbot.addWidget(win)
+    win.resize(1500, 950)
+    win.show()
+    yield win
+    win.close()
+
+
+@pytest.fixture
+def recording(tmp_path):
+    path = tmp_path / "session.mcap"
+    shutil.copy(SAMPLE, path)
+    return path
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
+    win, wb = window, window.workbench
+    truth = RecordingPlayback(read_recording(recording))
+    live_pair = wb.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    before = _digest(recording)
+    win.open_recording(recording)
+    bar = win.replay
+    assert bar.isVisible() and wb.replaying and not win.commands.live.isChecked()
+    assert win.results.status.text() == "" or "error" not in win.results.status.text().lower()
+
+    # Scrub to the middle of the pick sequence: that frame, those joints, those pairs, no result yet.
+    first_solve = truth.solves[0].t_s
+    t_mid = (truth._event_times[2] + truth._event_times[3]) / 2
+    bar.slider.setValue(int(t_mid * 1000))
+    k = truth.frame_index_at(t_mid)
+    assert np.array_equal(win.camera.last_frame.image, truth.frames.image(k))
+    assert np.allclose(wb.joints_deg, truth.joints_at(t_mid))
+    assert [p.number for p in wb.session.pairs] == [p.number for p in truth.pairs_at(t_mid)] and len(wb.session.pairs) >= 1
+    assert wb.session.result is None and t_mid < first_solve
+
+    # After the solves: the last result appears, re-solved from its recorded inputs exactly.
+    bar.seek(truth.duration_s)
+    result = wb.session.result
+    assert result is not None and win.commands.calibrate.isEnabled()
+    assert np.array_equal(result.solution.to_dict()["t_obj2cam_mm"], truth.solves[-1].result["t_obj2cam_mm"])
+    assert "mm" in win.results.status.text() or win.results.isVisible()
+
+    # Back before the first pick: no pairs, no result.
+    bar.seek(0.0)
+    assert len(wb.session.pairs) == 0 and wb.session.result is None
+
+    # Play runs the clock forward.
+    bar.play()
+    qtbot.waitUntil(lambda: bar.position_s > 0.5, timeout=5_000)
+    bar.pause()
+    assert not bar.playing
+
+    # Closing without an edit gives the live session back, pair and all.
+    qtbot.mouseClick(bar.close_button, Qt.MouseButton.LeftButton)
+    assert not bar.isVisible() and not wb.replaying and win.commands.live.isChecked()
+    assert [p.number for p in wb.session.pairs] == [live_pair]
+    assert _digest(recording) == before
+
+
+def test_an_edit_branches_a_new_session_and_leaves_the_file_alone(qtbot, window, recording):
+    win, wb = window, window.workbench
+    truth = RecordingPlayback(read_recording(recording))
+    before = _digest(recording)
+    win.open_recording(recording)
+    bar = win.replay
+    bar.seek(truth.duration_s)
+    n = len(wb.session.pairs)
+    # The operator deletes a pair through the table and re-solves on the recorded frame.
+    win.table.selectRow(0)
+    qtbot.mouseClick(win.commands.delete, Qt.MouseButton.LeftButton)
+    assert len(wb.session.pairs) == n - 1
+    assert bar.branched_at_s == pytest.approx(truth.duration_s) and "branched" in bar.state_label.text()
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    assert wb.session.result is not None and wb.session.result.solution.rms_px < 2.0
+    # Scrubbing moves the frames but no longer the branched pairs.
+    bar.seek(0.0)
+    assert len(wb.session.pairs) == n - 1 and win.camera.last_frame.index == 0
+    qtbot.mouseClick(bar.close_button, Qt.MouseButton.LeftButton)
+    assert len(wb.session.pairs) == n - 1  # the branch stays open
+    assert _digest(recording) == before
+
+
+def test_bad_and_cut_off_recordings(qtbot, window, tmp_path, recording):
+    win, wb = window, window.workbench
+    junk = tmp_path / "junk.mcap"
+    junk.write_bytes(b"not a recording")
+    win.open_recording(junk)
+    assert "not an MCAP recording" in win.results.status.text() and "junk.mcap" in win.results.status.text()
+    assert not win.replay.isVisible() and not wb.replaying
+    # A recording cut off by a crash opens with what it holds and offers recovery.
+    data = recording.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) * 2 // 3])
+    win.open_recording(cut)
+    assert win.replay.isVisible() and not win.replay.recover_button.isHidden()
+    qtbot.mouseClick(win.replay.recover_button, Qt.MouseButton.LeftButton)
+    recovered = read_recording(tmp_path / "cut-recovered.mcap")
+    assert recovered.complete and len(recovered.messages) == len(read_recording(cut).messages)
+
+
+def test_replay_screenshot(qtbot, window, recording):
+    win = window
+    win.open_recording(recording)
+    win.replay.seek(win.replay.playback.duration_s)
+    qtbot.waitUntil(win.virtual.is_current, timeout=10_000)
+    qtbot.wait(200)
+    OUTPUT.mkdir(exist_ok=True)
+    image = win.grab()
+    image.save(str(OUTPUT / "window_replay.png"))
+    # The bar sits on top of the panes and the recorded frame fills the camera pane.
+    bar_pos = win.replay.mapTo(win, QPoint(0, 0))
+    cam_pos = win.camera.mapTo(win, QPoint(0, 0))
+    assert bar_pos.y() < cam_pos.y()
+    frame = win.camera.last_frame.image
+    assert frame.shape == (960, 1280, 3) and frame.std() > 10
