@@ -17,6 +17,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--port", help="a real controller link URL (serial port, socket://host:port, ...) instead of the simulator")
     parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file, a stream URL or a folder of images, instead of the simulated camera")
     parser.add_argument("--hand-eye", type=Path, help="a cam2flange file from videocal calibrate-hand-eye: the measured camera mounting replaces the modelled one")
+    parser.add_argument("--recording", type=Path, help="open this MCAP recording on the replay timeline at start")
     parser.add_argument("--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)")
 
 
@@ -78,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
         window.start_camera(lambda: bed.camera(intrinsics=bed.intrinsics, fps=15.0))
     window.setGeometry(shell.geometry())
     window.show()
+    if args.recording is not None:
+        window.open_recording(args.recording)
     shell.close()
     if report:
         ready = Path(report).with_suffix(".ready")
