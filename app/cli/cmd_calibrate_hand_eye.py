@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from calib_core.errors import VideocalError
 
@@ -22,12 +21,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.atomic_file import atomic_write_text
     from calib_core.frames import pose_difference, xyz_rpy_from_transform
     from calib_core.testbed.test_bed import TestBed
     from calib_core.testbed.true_robot import RobotErrors
     from calib_core.vision.board import BoardSpec
     from calib_core.vision.hand_eye import calibrate_hand_eye
+    from calib_core.vision.hand_eye_io import save_hand_eye
     from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
     from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 
@@ -49,16 +48,8 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(f"rejected {name}: {v.reason}", file=sys.stderr)
     result = calibrate_hand_eye(views, flanges, spec, bed.intrinsics)
-    xyz, rpy = xyz_rpy_from_transform(result.cam2flange)
-    doc = {
-        "cam2flange": {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
-        "std": {"xyz_mm": [round(float(v), 4) for v in result.std_xyz_mm], "rotation_deg": [round(float(v), 5) for v in result.std_rotation_deg]},
-        "units": {"length": "mm", "angle": "deg"},
-        "rms_px": round(result.rms_px, 4),
-        "poses": result.views,
-        "warnings": result.warnings,
-    }
-    atomic_write_text(args.out, yaml.safe_dump(doc, sort_keys=False))
+    save_hand_eye(args.out, result)
+    xyz, _ = xyz_rpy_from_transform(result.cam2flange)
     true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
     d, r = pose_difference(result.cam2flange, true)
     print(f"{result.views} poses, RMS {result.rms_px:.3f} px")

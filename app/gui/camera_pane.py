@@ -20,6 +20,7 @@ REPROJECTED_COLOR = QColor(0, 220, 255)
 RESIDUAL_COLOR = QColor(255, 70, 70)
 RESIDUAL_SCALE = 10.0
 GHOST_COLOR = QColor(255, 60, 220)
+BOARD_COLOR = QColor(60, 230, 90)
 
 
 def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
@@ -89,6 +90,12 @@ class CameraPane(QWidget):
             u, v = refine_subpixel(self.last_frame.image, u, v)
         self.picked.emit(u, v)
 
+    def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
+        """Show a board detection (n, 2) px over the image (``None`` hides it)."""
+        self._board_corners = None if corners_px is None else np.asarray(corners_px, dtype=float)
+        self._board_text = text
+        self.refresh_overlay()
+
     def set_edges_image(self, rgba: np.ndarray | None) -> None:
         self._edges_image = rgba
         self.refresh_overlay()
@@ -134,4 +141,9 @@ class CameraPane(QWidget):
                 overlay.image_opacity = self.opacity.value() / 100.0
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
+        corners = getattr(self, "_board_corners", None)
+        if corners is not None:
+            for u, v in corners:
+                overlay.points.append((u, v, "", BOARD_COLOR))
+            overlay.text = self._board_text
         self.view.set_overlay(overlay)

@@ -33,6 +33,8 @@ class CommandPanel(QTabWidget):
         super().__init__(parent)
         self.workbench = workbench
         self.setMinimumWidth(250)
+        # Short verbs for the paper's four modes (programming, simulation, calibration, execution) and Vision,
+        # so all five tabs fit the panel without scroll arrows.
 
         # Programming
         prog = QWidget()
@@ -48,7 +50,7 @@ class CommandPanel(QTabWidget):
         self.add_location = _button("Add location from current pose", "add_location")
         for b in (self.go_approach, self.go_task, self.add_location):
             pl.addWidget(b)
-        self.addTab(prog, "Programming")
+        self.addTab(prog, "Program")
 
         # Simulation
         sim = QWidget()
@@ -60,7 +62,7 @@ class CommandPanel(QTabWidget):
         self.sim_status.setWordWrap(True)
         sl.addWidget(self.sim_status)
         sl.addStretch(1)
-        self.addTab(sim, "Simulation")
+        self.addTab(sim, "Simulate")
 
         # Calibration
         cal = QWidget()
@@ -98,7 +100,7 @@ class CommandPanel(QTabWidget):
         cl.addWidget(self.calibrate)
         cl.addWidget(self.store)
         cl.addStretch(1)
-        self.addTab(cal, "Calibration")
+        self.addTab(cal, "Calibrate")
 
         # Execution
         ex = QWidget()
@@ -117,5 +119,5 @@ class CommandPanel(QTabWidget):
         self.corrections.setWordWrap(True)
         el.addWidget(self.corrections)
         el.addStretch(1)
-        self.addTab(ex, "Execution")
+        self.addTab(ex, "Execute")
         self.setCurrentIndex(2)

@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QSplitter, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
 
 from app.gui.camera_pane import CameraPane
 from app.gui.command_panel import CommandPanel
@@ -17,6 +17,7 @@ from app.gui.frame_worker import FrameWorker
 from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
 from app.gui.replay_bar import ReplayBar
+from app.gui.vision_panel import VisionPanel
 from app.gui.results_panel import ResultsPanel
 from app.gui.virtual_pane import VirtualPane
 from app.gui.workbench import Workbench
@@ -38,6 +39,11 @@ class MainWindow(QMainWindow):
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
         self.replay = ReplayBar(workbench, self.camera.show_frame)
+        self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error)
+        vision_scroll = QScrollArea()
+        vision_scroll.setWidgetResizable(True)
+        vision_scroll.setWidget(self.vision)
+        self.commands.addTab(vision_scroll, "Vision")
         self._current_pair: int | None = None
         self._half_distortion = distortion_map(workbench.intrinsics.scaled(0.5))
         self._edges_renderer = None
@@ -170,6 +176,7 @@ class MainWindow(QMainWindow):
         self.results.candidate_chosen.connect(self.report(lambda k: wb.session.choose_candidate(k)))
         wb.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
+        wb.camera_model_changed.connect(self._camera_model_changed)
         wb.link_state.connect(lambda text: self.link_label.setText(f"link: {text}"))
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.subscribe(self._update_actions)
@@ -422,6 +429,10 @@ class MainWindow(QMainWindow):
         rgba = self._edges_renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target))
         edges = cv2.resize(self._half_distortion.apply(rgba), (self.workbench.intrinsics.width, self.workbench.intrinsics.height), interpolation=cv2.INTER_LINEAR)
         self.camera.set_edges_image(edges)
+
+    def _camera_model_changed(self) -> None:
+        self._half_distortion = distortion_map(self.workbench.intrinsics.scaled(0.5))
+        self.overview.mark_dirty()
 
     def _pairs_changed(self, event: str, number) -> None:
         self._update_actions()

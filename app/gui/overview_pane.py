@@ -67,6 +67,7 @@ class OverviewPane(QWidget):
         self.redraws = 0
         self._dirty = True
         workbench.session.subscribe(self.mark_dirty)
+        workbench.scene_changed.connect(self.mark_dirty)
         workbench.session.pairs.subscribe(lambda *_: self.mark_dirty())
 
     def orbit(self, d_azimuth: float, d_elevation: float) -> None:
@@ -92,7 +93,8 @@ class OverviewPane(QWidget):
         if not self._dirty:
             return
         wb = self.workbench
-        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg))
+        # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
+        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg) + list(wb.bed.extra_items))
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if wb.session.result is not None:
             lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))

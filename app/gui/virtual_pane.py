@@ -43,16 +43,23 @@ class VirtualPane(QWidget):
         self.view.clicked.connect(self._on_click)
         workbench.session.pairs.subscribe(lambda *_: self.refresh())
         workbench.session.subscribe(self.refresh)
+        workbench.camera_model_changed.connect(self._camera_model_changed)
+        workbench.scene_changed.connect(self.refresh)
         self._last_joints = None
         self._render_key = None
         self.renders = 0
 
+    def _camera_model_changed(self) -> None:
+        self.intrinsics = self.workbench.intrinsics.without_distortion().scaled(RENDER_SCALE)
+        self._render_key = None
+        self.refresh()
+
     def refresh(self) -> None:
         """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
         wb = self.workbench
-        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target)
+        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, tuple(item.name for item in wb.bed.extra_items))
         if key != self._render_key:
-            items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg)
+            items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg) + list(wb.bed.extra_items)
             self.renderer.set_items(items)
             # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
             # cover the very surface points the picker tests for visibility.

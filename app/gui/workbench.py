@@ -46,6 +46,8 @@ class Workbench(QObject):
     error = Signal(str)
     solved = Signal()
     task_changed = Signal(str)
+    camera_model_changed = Signal()  # the intrinsics or the camera mounting were replaced
+    scene_changed = Signal()  # something was put up in the cell or taken down (the calibration board)
     _sample_arrived = Signal(object)
     _state_arrived = Signal(str, str)
 
@@ -114,6 +116,10 @@ class Workbench(QObject):
     def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0):
         """IK for the target from the current joints, then MVJ over the link."""
         q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
+        return self.move_joints(q, what, wait=wait, timeout_s=timeout_s)
+
+    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0):
+        """MVJ to joints ``q`` (deg) over the link."""
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
         handle = self.link.move_joints(q, timeout_s=timeout_s)
@@ -184,9 +190,40 @@ class Workbench(QObject):
             raise FileFormatError(path, "no such hand-eye file") from None
         except (yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
             raise FileFormatError(path, f"not a cam2flange file: {exc}", "cam2flange") from None
+        self.apply_cam2flange(cam2flange, f"camera mounting from {path}")
+
+    def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
+        """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
         flange = self.robot.frame_placement("flange")
-        self.robot.set_frame_placement("camera", flange @ cam2flange)
-        self.message.emit(f"camera mounting from {path}")
+        self.robot.set_frame_placement("camera", flange @ np.asarray(cam2flange, dtype=float))
+        self.camera_model_changed.emit()
+        self.message.emit(why)
+
+    def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
+        """Use calibrated intrinsics for picking, solving and the virtual camera (the size must match)."""
+        if (intrinsics.width, intrinsics.height) != (self.intrinsics.width, self.intrinsics.height):
+            raise CalibrationError(f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px")
+        self.intrinsics = intrinsics
+        self.camera_model_changed.emit()
+        self.message.emit(why)
+
+    # --- the calibration board (simulated cell) ---------------------------------------------------
+    def show_calibration_board(self, spec, on: bool = True) -> np.ndarray:
+        """Put a ChArUco board up in the simulated cell (upright, facing the robot), or take it down.
+        Returns its ``board2base`` (4, 4) mm."""
+        from calib_core.vision.board import board_item
+        from calib_core.vision.hand_eye_sim import board_facing_robot
+
+        board2base = board_facing_robot(spec)
+        self.bed.extra_items = [board_item(spec, board2base)] if on else []
+        self.scene_changed.emit()
+        return board2base
+
+    def board_view_plan(self, spec, n: int = 12) -> list[np.ndarray]:
+        """Joint vectors (deg) from which the modelled camera sees the board from different directions."""
+        from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses
+
+        return hand_eye_poses(self.bed, spec, board_facing_robot(spec), n)
 
     # --- workspace and recording --------------------------------------------------------------
     def workspace(self):

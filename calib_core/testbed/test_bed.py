@@ -31,6 +31,8 @@ class TestBed:
     intrinsics: Intrinsics
     visuals: RobotVisuals
     joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    extra_items: list[SceneItem] = field(default_factory=list)
+    """Things put into the real cell for a while (a calibration board): the camera sees them, the CAD does not."""
     _model_visuals: RobotVisuals | None = field(default=None, repr=False)
 
     __test__ = False  # not a pytest test class despite its name
@@ -51,7 +53,7 @@ class TestBed:
         links = self.visuals.scene_items(q_true)
         for item in links:
             item.item2world = base @ item.item2world
-        return list(self.workcell.components) + links
+        return list(self.workcell.components) + links + list(self.extra_items)
 
     def visuals_for_model(self) -> RobotVisuals:
         """The modelled robot's visuals (the CAD view draws the model, not the truth)."""

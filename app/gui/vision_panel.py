@@ -1,0 +1,263 @@
+"""The Vision mode: capture ChArUco board views (live or from a recording being replayed), see each
+detection and the image coverage so far, calibrate the intrinsics and the camera's mounting on the
+flange, and apply or save the results.
+
+In the simulated cell the board can be put up in front of the robot and the robot stepped through
+planned viewing poses; with a real camera the operator holds up or places a board and moves the robot.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QPushButton, QVBoxLayout, QWidget
+
+from app.gui.error_boundary import guarded
+from calib_core.camera.intrinsics_io import save_intrinsics
+from calib_core.frames import pose_difference
+from calib_core.vision.board import DEFAULT_SPEC, BoardSpec
+from calib_core.vision.capture import BoardCapture
+from calib_core.vision.hand_eye import HandEyeCalibration
+from calib_core.vision.hand_eye_io import save_hand_eye
+from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
+
+STILL_S = 0.3
+"""A view is only captured from a frame taken this long after the robot last moved (joints and image agree)."""
+
+
+def _button(text: str, name: str, tip: str) -> QPushButton:
+    b = QPushButton(text)
+    b.setObjectName(name)
+    b.setToolTip(tip)
+    return b
+
+
+class VisionPanel(QWidget):
+    """``current_frame()`` gives the camera pane's frame (a ``Frame`` or ``None``); ``show_corners``
+    draws a detection on the camera pane; ``show_error`` puts a failed step's reason in the window;
+    progress goes to the workbench's messages (the status bar)."""
+
+    def __init__(self, workbench, current_frame: Callable, show_corners: Callable, show_error: Callable[[str], None], parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        self._current_frame = current_frame
+        self._show_corners = show_corners
+        self._report = workbench.message.emit
+        guard = guarded(show_error)
+        self.capture: BoardCapture | None = None
+        self.intrinsics_result: IntrinsicsCalibration | None = None
+        self.hand_eye_result: HandEyeCalibration | None = None
+        self._plan: list[np.ndarray] = []
+        self._plan_index = 0
+        self._last_motion_s = 0.0
+        self._last_joints = workbench.joints_deg.copy()
+
+        board = QGroupBox("Board")
+        bl = QVBoxLayout(board)
+        self.spec = QLineEdit(DEFAULT_SPEC)
+        self.spec.setToolTip("charuco:<columns>x<rows>:<square mm>:<marker mm>:<ArUco dictionary>")
+        self.spec.editingFinished.connect(guard(self._spec_changed))
+        bl.addWidget(self.spec)
+        self.show_board = QCheckBox("Board in the simulated cell")
+        self.show_board.setToolTip("Put the board up in front of the robot in the simulated cell (the simulated camera sees it)")
+        self.show_board.toggled.connect(guard(self._show_board_toggled))
+        bl.addWidget(self.show_board)
+        self.next_pose = _button("Next board pose", "vision_next_pose", "Move the robot (MVJ) to the next planned pose that sees the board")
+        self.next_pose.clicked.connect(guard(self._next_pose))
+        self.capture_button = _button("Capture view", "vision_capture", "Detect the board in the camera's current frame and keep the view with the robot's joints")
+        self.capture_button.clicked.connect(guard(self.capture_view))
+        row = QHBoxLayout()
+        row.addWidget(self.next_pose)
+        row.addWidget(self.capture_button)
+        bl.addLayout(row)
+
+        views = QGroupBox("Views")
+        vl = QVBoxLayout(views)
+        self.views = QListWidget()
+        self.views.setMinimumHeight(90)
+        vl.addWidget(self.views)
+        self.remove_button = _button("Remove view", "vision_remove", "Drop the selected view (blurred or mis-detected)")
+        self.remove_button.clicked.connect(guard(self._remove_selected))
+        vl.addWidget(self.remove_button)
+        self.coverage = QLabel("No views yet.")
+        self.coverage.setWordWrap(True)
+        vl.addWidget(self.coverage)
+
+        cal = QGroupBox("Calibrate")
+        cl = QVBoxLayout(cal)
+        self.calibrate_intrinsics_button = _button("Calibrate intrinsics", "vision_intrinsics", "fu, fv, cx, cy and k1 k2 p1 p2 k3 from the views (3 or more)")
+        self.calibrate_intrinsics_button.clicked.connect(guard(self.calibrate_intrinsics))
+        self.calibrate_hand_eye_button = _button("Calibrate hand-eye", "vision_hand_eye", "The camera's mounting on the flange from the views and their robot poses (3 or more, 10 recommended)")
+        self.calibrate_hand_eye_button.clicked.connect(guard(self.calibrate_hand_eye))
+        row = QHBoxLayout()
+        row.addWidget(self.calibrate_intrinsics_button)
+        row.addWidget(self.calibrate_hand_eye_button)
+        cl.addLayout(row)
+        self.result = QLabel("")
+        self.result.setWordWrap(True)
+        self.result.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        cl.addWidget(self.result)
+        self.apply_intrinsics_button = _button("Apply intrinsics", "vision_apply_intrinsics", "Use the calibrated intrinsics for picking, solving and the virtual camera")
+        self.apply_intrinsics_button.clicked.connect(guard(self.apply_intrinsics))
+        self.save_intrinsics_button = _button("Save...", "vision_save_intrinsics", "Save the intrinsics as OpenCV YAML or ROS camera_info")
+        self.save_intrinsics_button.clicked.connect(guard(self._save_intrinsics_dialog))
+        self.apply_hand_eye_button = _button("Apply mounting", "vision_apply_hand_eye", "Use the measured camera mounting for the virtual camera, the solver's prior and the displacement")
+        self.apply_hand_eye_button.clicked.connect(guard(self.apply_hand_eye))
+        self.save_hand_eye_button = _button("Save...", "vision_save_hand_eye", "Save cam2flange (xyz mm, rpy deg) with its 1-sigma as YAML")
+        self.save_hand_eye_button.clicked.connect(guard(self._save_hand_eye_dialog))
+        for pair in ((self.apply_intrinsics_button, self.save_intrinsics_button), (self.apply_hand_eye_button, self.save_hand_eye_button)):
+            row = QHBoxLayout()
+            row.addWidget(pair[0], 2)
+            row.addWidget(pair[1], 1)
+            cl.addLayout(row)
+
+        layout = QVBoxLayout(self)
+        layout.addWidget(board)
+        layout.addWidget(views, 1)
+        layout.addWidget(cal)
+        workbench.joints_changed.connect(self._on_joints)
+        self._spec_changed()
+
+    # --- board ---------------------------------------------------------------------------------
+    def _spec_changed(self) -> None:
+        try:
+            spec = BoardSpec.parse(self.spec.text().strip())
+        except ValueError:
+            self.spec.setStyleSheet("color: #ff6060")
+            raise
+        self.spec.setStyleSheet("")
+        if self.capture is not None and str(spec) == str(self.capture.spec):
+            return
+        if self.capture is not None and self.capture.views:
+            self._report(f"board changed to {spec}: the {len(self.capture.views)} views of the old board were set aside")
+        self.capture = BoardCapture(spec)
+        self._plan, self._plan_index = [], 0
+        if self.show_board.isChecked():
+            self.workbench.show_calibration_board(spec, True)
+        self._refresh()
+
+    def _show_board_toggled(self, on: bool) -> None:
+        self.workbench.show_calibration_board(self.capture.spec, on)
+        self._report("calibration board put up in front of the robot" if on else "calibration board taken down")
+
+    def _next_pose(self) -> None:
+        if not self._plan:
+            self._plan = self.workbench.board_view_plan(self.capture.spec)
+            if not self._plan:
+                raise RuntimeError("no reachable robot pose sees the board")
+        q = self._plan[self._plan_index % len(self._plan)]
+        self._plan_index += 1
+        self.workbench.move_joints(q, f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}")
+
+    def _on_joints(self, q) -> None:
+        q = np.asarray(q, dtype=float)
+        if np.max(np.abs(q - self._last_joints)) > 1e-6:
+            self._last_motion_s = time.monotonic()
+        self._last_joints = q.copy()
+
+    # --- capturing -----------------------------------------------------------------------------
+    def robot_is_still(self, frame) -> bool:
+        return frame.t_host_s - self._last_motion_s >= STILL_S
+
+    def capture_view(self) -> None:
+        """Detect the board in the current frame; keep it (with the joints) or say why not."""
+        frame = self._current_frame()
+        if frame is None:
+            raise RuntimeError("no camera frame yet: start the camera (Execution > Live) or open a recording")
+        replaying = self.workbench.replaying
+        if not replaying and not self.robot_is_still(frame):
+            raise RuntimeError("the robot is moving: capture when it has stopped, so the image and the joints agree")
+        joints = None if (replaying or not self.workbench.link_up) else self.workbench.joints_deg.copy()
+        if replaying:
+            joints = self.workbench.joints_deg.copy()  # the recorded joints at this instant of the recording
+        view = self.capture.add(frame.image, joints)
+        if isinstance(view, RejectedView):
+            self._show_corners(None, "")
+            self._report(f"{view.name} rejected: {view.reason}")
+        else:
+            self._show_corners(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
+            self._report(f"{view.name}: {len(view.ids)} corners" + ("" if joints is not None else " (no robot pose: not usable for hand-eye)"))
+        self._refresh()
+
+    def _remove_selected(self) -> None:
+        item = self.views.currentItem()
+        if item is None or item.data(Qt.ItemDataRole.UserRole) is None:
+            raise RuntimeError("select an accepted view to remove")
+        self.capture.remove(item.data(Qt.ItemDataRole.UserRole))
+        self._refresh()
+
+    def _refresh(self) -> None:
+        c = self.capture
+        self.views.clear()
+        for v, q in zip(c.views, c.joints_deg):
+            self.views.addItem(f"{v.name}: {len(v.ids)} corners" + ("" if q is not None else ", no robot pose"))
+            self.views.item(self.views.count() - 1).setData(Qt.ItemDataRole.UserRole, v.name)
+        for r in c.rejected:
+            self.views.addItem(f"x {r.name}: {r.reason}")
+        n = len(c.views)
+        self.coverage.setText(f"{n} views, corners cover {100 * c.coverage():.0f} % of the image." + ("" if n >= 10 else f" Add views with the board in every part of the image, tilted 20-40 deg ({max(0, 10 - n)} more for a stable calibration)."))
+        self.calibrate_intrinsics_button.setEnabled(n >= 3)
+        self.calibrate_hand_eye_button.setEnabled(n >= 3 and all(q is not None for q in c.joints_deg))
+        self.apply_intrinsics_button.setEnabled(self.intrinsics_result is not None)
+        self.save_intrinsics_button.setEnabled(self.intrinsics_result is not None)
+        self.apply_hand_eye_button.setEnabled(self.hand_eye_result is not None)
+        self.save_hand_eye_button.setEnabled(self.hand_eye_result is not None)
+
+    # --- calibrating ---------------------------------------------------------------------------
+    def calibrate_intrinsics(self) -> None:
+        r = self.intrinsics_result = self.capture.calibrate_intrinsics()
+        i, s = r.intrinsics, r.std
+        lines = [
+            f"<b>Intrinsics</b> from {len(r.used)} views, RMS {r.rms_px:.3f} px",
+            f"fu {i.fu:.2f} &plusmn; {s['fu']:.2f}, fv {i.fv:.2f} &plusmn; {s['fv']:.2f} px",
+            f"cx {i.cx:.2f} &plusmn; {s['cx']:.2f}, cy {i.cy:.2f} &plusmn; {s['cy']:.2f} px",
+            "k1 k2 p1 p2 k3: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
+        ]
+        lines += [f"&bull; {a}" for a in r.advice]
+        self.result.setText("<br>".join(lines))
+        self._refresh()
+
+    def calibrate_hand_eye(self) -> None:
+        intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
+        r = self.hand_eye_result = self.capture.calibrate_hand_eye(self.workbench.robot, intrinsics)
+        modelled = np.linalg.inv(self.workbench.robot.frame_placement("flange")) @ self.workbench.robot.frame_placement("camera")
+        d, rot = pose_difference(r.cam2flange, modelled)
+        lines = [
+            f"<b>Camera mounting</b> from {r.views} poses, RMS {r.rms_px:.3f} px",
+            "position " + ", ".join(f"{v:.2f}" for v in r.cam2flange[:3, 3]) + " mm (1-sigma " + ", ".join(f"{v:.3f}" for v in r.std_xyz_mm) + ")",
+            f"differs from the model by {np.linalg.norm(d):.2f} mm and {np.linalg.norm(rot):.3f} deg",
+        ]
+        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in r.warnings]
+        self.result.setText("<br>".join(lines))
+        self._refresh()
+
+    def apply_intrinsics(self) -> None:
+        if self.intrinsics_result is None:
+            raise RuntimeError("calibrate the intrinsics first")
+        self.workbench.apply_intrinsics(self.intrinsics_result.intrinsics, f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)")
+
+    def apply_hand_eye(self) -> None:
+        if self.hand_eye_result is None:
+            raise RuntimeError("calibrate the hand-eye first")
+        self.workbench.apply_cam2flange(self.hand_eye_result.cam2flange, f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)")
+
+    def save_intrinsics(self, path, fmt: str = "opencv") -> None:
+        save_intrinsics(path, self.intrinsics_result.intrinsics, fmt)
+        self._report(f"intrinsics saved to {path}")
+
+    def save_hand_eye(self, path) -> None:
+        save_hand_eye(path, self.hand_eye_result)
+        self._report(f"camera mounting saved to {path}")
+
+    def _save_intrinsics_dialog(self) -> None:
+        path, chosen = QFileDialog.getSaveFileName(self, "Save intrinsics", "camera.yaml", "OpenCV YAML (*.yaml *.yml);;ROS camera_info (*.yaml *.yml)")
+        if path:
+            self.save_intrinsics(path, "ros" if chosen.startswith("ROS") else "opencv")
+
+    def _save_hand_eye_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save camera mounting", "hand_eye.yaml", "hand-eye YAML (*.yaml *.yml)")
+        if path:
+            self.save_hand_eye(path)

@@ -1,0 +1,66 @@
+"""Collecting board views for the vision-system calibration: each captured image with the robot's
+joints when it was taken, detected at once so the operator sees what each view adds.
+
+The window's Vision mode is a view of this; the same object calibrates the intrinsics and, from the
+joints, the camera's mounting on the flange.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.robot.model import RobotModel
+from calib_core.vision.board import BoardSpec
+from calib_core.vision.hand_eye import HandEyeCalibration, calibrate_hand_eye
+from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError, IntrinsicsCalibration, RejectedView, calibrate_intrinsics, coverage, detect_view
+
+
+class BoardCapture:
+    """Views of one board. ``views`` (accepted, in order) with ``joints_deg`` (the commanded joints
+    (6,) deg at each, or ``None`` for a view without a robot pose); ``rejected`` with their reasons."""
+
+    def __init__(self, spec: BoardSpec):
+        self.spec = spec
+        self.views: list[BoardView] = []
+        self.joints_deg: list[np.ndarray | None] = []
+        self.rejected: list[RejectedView] = []
+        self._detector = cv2.aruco.CharucoDetector(spec.board())
+        self._count = 0
+
+    def add(self, image_rgb: np.ndarray, joints_deg=None) -> BoardView | RejectedView:
+        """Detect the board in an image and keep the view when enough corners are seen."""
+        if self.views and (image_rgb.shape[1], image_rgb.shape[0]) != self.views[0].image_size:
+            w, h = self.views[0].image_size
+            raise CalibrationInputError(f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one calibration is for one camera mode")
+        self._count += 1
+        result = detect_view(f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
+        if isinstance(result, RejectedView):
+            self.rejected.append(result)
+        else:
+            self.views.append(result)
+            self.joints_deg.append(None if joints_deg is None else np.array(joints_deg, dtype=float))
+        return result
+
+    def remove(self, name: str) -> None:
+        """Drop an accepted view (a blurred or mis-detected one)."""
+        for k, v in enumerate(self.views):
+            if v.name == name:
+                del self.views[k], self.joints_deg[k]
+                return
+        raise KeyError(f"no view named {name}; views: {', '.join(v.name for v in self.views) or 'none'}")
+
+    def coverage(self) -> float:
+        """Fraction of the image's 8 x 6 cells holding a detected corner (0 without views)."""
+        return coverage(self.views, self.views[0].image_size) if self.views else 0.0
+
+    def calibrate_intrinsics(self) -> IntrinsicsCalibration:
+        return calibrate_intrinsics(self.views, self.spec, rejected=self.rejected)
+
+    def calibrate_hand_eye(self, robot: RobotModel, intrinsics: Intrinsics) -> HandEyeCalibration:
+        """``cam2flange`` from the views taken with a robot pose, the flange placed by ``robot``'s FK."""
+        posed = [(v, q) for v, q in zip(self.views, self.joints_deg) if q is not None]
+        if len(posed) < len(self.views):
+            raise CalibrationInputError(f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a controller link)")
+        return calibrate_hand_eye([v for v, _ in posed], [robot.fk(q, "flange") for _, q in posed], self.spec, intrinsics)

@@ -1,0 +1,130 @@
+"""The Vision mode through the real window: the board put up in the simulated cell, the robot stepped
+through viewing poses over the controller link, views captured from the live camera, the intrinsics
+and the camera's mounting calibrated against the test bed's truth, applied and saved."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from PySide6.QtCore import QSettings, Qt
+
+from app.gui.main_window import MainWindow
+from app.gui.vision_panel import STILL_S
+from app.gui.workbench import Workbench
+from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.frames import pose_difference
+from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.true_robot import RobotErrors
+
+OUTPUT = Path(__file__).resolve().parents[1] / "output"
+
+
+@pytest.fixture
+def window(qtbot, tmp_path):
+    typical = RobotErrors.typical(0)
+    # The robot's kinematics exact, the camera mounting not: what a hand-eye calibration can find.
+    bed = TestBed.create(errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
+    bed.intrinsics = bed.intrinsics.scaled(0.5)
+    wb = Workbench(bed)
+    wb.start_simulated_controller()
+    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+    qtbot.addWidget(win)
+    win.resize(1500, 950)
+    win.start_camera(lambda: bed.camera(fps=10.0))
+    win.show()
+    qtbot.waitUntil(lambda: wb.link_up and win.camera.last_frame is not None, timeout=15_000)
+    yield win
+    win.close()
+
+
+def _fresh_still_frame(qtbot, win):
+    """Wait until the camera shows a frame taken after the robot came to rest."""
+    qtbot.waitUntil(lambda: win.vision.robot_is_still(win.camera.last_frame), timeout=10_000)
+
+
+def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    vision = win.vision
+    win.commands.setCurrentIndex(win.commands.count() - 1)
+    assert win.commands.tabText(win.commands.currentIndex()) == "Vision"
+    assert not vision.calibrate_intrinsics_button.isEnabled()
+
+    # At home the camera does not see the board: the view is rejected and said why.
+    _fresh_still_frame(qtbot, win)
+    qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    assert len(vision.capture.rejected) == 1 and "no board found" in win.statusBar().currentMessage()
+
+    vision.show_board.setChecked(True)
+    for k in range(8):
+        qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
+        target = vision._plan[k]
+        qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - target)) < 1e-3, timeout=30_000)
+        qtbot.wait(int(STILL_S * 1000))
+        _fresh_still_frame(qtbot, win)
+        qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+        assert len(vision.capture.views) == k + 1, vision.views.item(vision.views.count() - 1).text()
+        if k == 0:
+            OUTPUT.mkdir(exist_ok=True)
+            win.grab().save(str(OUTPUT / "window_vision.png"))
+            # the detection is drawn over the camera image
+            assert len(win.camera.view.overlay.points) >= 20 and "board corners" in win.camera.view.overlay.text
+    assert vision.calibrate_intrinsics_button.isEnabled() and vision.calibrate_hand_eye_button.isEnabled()
+    assert vision.views.count() == 9 and vision.views.item(8).text().startswith("x view_01")
+
+    # Intrinsics against the test bed's lens.
+    qtbot.mouseClick(vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
+    got, truth = vision.intrinsics_result.intrinsics, wb.bed.intrinsics
+    assert abs(got.fu / truth.fu - 1) < 0.005 and abs(got.fv / truth.fv - 1) < 0.005
+    assert abs(got.cx - truth.cx) < 2.0 and abs(got.cy - truth.cy) < 2.0
+    assert vision.intrinsics_result.rms_px < 0.3 and "Intrinsics" in vision.result.text()
+
+    # The camera's mounting against the true one (the model's is off by ~1 mm and ~0.2 deg).
+    qtbot.mouseClick(vision.calibrate_hand_eye_button, Qt.MouseButton.LeftButton)
+    true_robot = wb.bed.true_robot.robot
+    true_cam2flange = np.linalg.inv(true_robot.frame_placement("flange")) @ true_robot.frame_placement("camera")
+    model_cam2flange = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
+    d_model, r_model = pose_difference(model_cam2flange, true_cam2flange)
+    d, r = pose_difference(vision.hand_eye_result.cam2flange, true_cam2flange)
+    # 8 views at 640 x 480 with the intrinsics calibrated from the same views: a few tenths of a mm remain
+    assert np.linalg.norm(d) < 0.5 * np.linalg.norm(d_model) and np.linalg.norm(r) < 0.5 * np.linalg.norm(r_model)
+    assert "Camera mounting" in vision.result.text()
+
+    # Apply both: the window's model now uses them, the virtual camera redraws.
+    renders = win.virtual.renders
+    qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
+    applied = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
+    assert np.allclose(applied, vision.hand_eye_result.cam2flange)
+    assert win.virtual.renders > renders
+    qtbot.mouseClick(vision.apply_intrinsics_button, Qt.MouseButton.LeftButton)
+    assert wb.intrinsics == got and win.virtual.intrinsics.fu == pytest.approx(got.fu * win.virtual.intrinsics.width / got.width)
+
+    # Saved files read back.
+    vision.save_intrinsics(tmp_path / "camera.yaml")
+    assert load_intrinsics(tmp_path / "camera.yaml").fu == pytest.approx(got.fu)
+    vision.save_hand_eye(tmp_path / "hand_eye.yaml")
+    doc = yaml.safe_load((tmp_path / "hand_eye.yaml").read_text())
+    assert doc["units"] == {"length": "mm", "angle": "deg"} and doc["poses"] == 8
+    wb.apply_hand_eye_file(tmp_path / "hand_eye.yaml")
+    again = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
+    assert np.linalg.norm(pose_difference(again, vision.hand_eye_result.cam2flange)[0]) < 1e-3
+
+
+def test_bad_vision_input_gives_messages(qtbot, window):
+    win, wb = window, window.workbench
+    vision = win.vision
+    vision.spec.setText("charuco:nonsense")
+    vision.spec.editingFinished.emit()
+    assert "board spec" in win.results.status.text() and vision.capture is not None
+    # Removing with nothing selected.
+    qtbot.mouseClick(vision.remove_button, Qt.MouseButton.LeftButton)
+    assert "select an accepted view" in win.results.status.text()
+    # Capturing while the robot moves: refused, nothing kept.
+    vision.show_board.setChecked(True)
+    qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
+    start = wb.joints_deg.copy()
+    qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 0.5, timeout=10_000)
+    qtbot.waitUntil(lambda: win.camera.last_frame.t_host_s > vision._last_motion_s - 0.05, timeout=5_000)
+    qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    assert "the robot is moving" in win.results.status.text()
+    assert not vision.capture.views and not vision.capture.rejected
