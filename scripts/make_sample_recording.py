@@ -1,7 +1,7 @@
 """Make ``resources/recordings/sample_session.mcap``: a short calibration on the simulated test bed,
 recorded in real time (about 9 s) the way the window records one.
 
-The robot drives from home to the approach pose of ``oru_1_grasp`` (joints at 50 Hz, 1280 x 960
+The robot drives from home to the task location ``oru_1_grasp`` (where the camera sees the fixture) (joints at 50 Hz, 1280 x 960
 H.264 frames at 15 fps), then the operator picks six pairs, solves twice (plain and robust) and
 stores a correction, with the camera running throughout. Run from the project root:
 ``.venv/bin/python scripts/make_sample_recording.py``.
@@ -32,7 +32,7 @@ def main() -> None:
     cell = bed.workcell
     task = cell.task("oru_1_grasp")
     q_home = np.array(cell.home_joints_deg, dtype=float)
-    q_approach = solve_ik(bed.model_robot, task.approach2base, q_home).q_deg
+    q_task = solve_ik(bed.model_robot, task.tcp2base, q_home).q_deg
     camera = bed.camera(seed=1)
     OUT.parent.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(5)
@@ -57,7 +57,7 @@ def main() -> None:
         while steps:
             now = time.monotonic()
             s = min(1.0, (now - start) / DRIVE_S)
-            bed.joints_deg = q_home + (q_approach - q_home) * (3 * s * s - 2 * s * s * s)  # smooth start and stop
+            bed.joints_deg = q_home + (q_task - q_home) * (3 * s * s - 2 * s * s * s)  # smooth start and stop
             if now >= next_joint:
                 rec.record_joints(seq, 1000 + 20 * seq, now, bed.joints_deg)
                 seq += 1

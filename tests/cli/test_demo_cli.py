@@ -15,8 +15,10 @@ def test_demo_writes_screenshots_and_a_report(tmp_path):
     assert report["status"] == "ok" and report["pairs"] >= 6
     for key in ("estimated_displacement", "std", "true_displacement", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "rms_px"):
         assert key in report
-    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 2
-    assert len(report["screenshots"]) == 6
+    # Half-size images: a coarser look than the full-size demo, which reaches 0.1 mm (docs/benchmarks/gui.md).
+    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
+    assert report["estimate_within_3_sigma"] and report["first_look"]["rms_px"] < 1.0
+    assert len(report["screenshots"]) == 7
     for name in report["screenshots"]:
         image = cv2.imread(str(out / name))
         assert image is not None and image.shape[1] >= 1000 and image.std() > 10

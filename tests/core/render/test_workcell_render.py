@@ -1,4 +1,4 @@
-"""The bundled workcell rendered from the modelled camera at the paper's task location; picking
+"""The bundled workcell rendered from the modelled camera at the paper's task location (where the calibration looks from); picking
 round trips; the renders are saved to tests/output/ to be looked at."""
 
 from pathlib import Path
@@ -22,7 +22,7 @@ OUTPUT = Path(__file__).resolve().parents[2] / "output"
 def scene():
     cell = load_workcell()
     robot = load_robot(cell.robot_urdf)
-    q = solve_ik(robot, cell.task("oru_1_grasp").approach2base, cell.home_joints_deg).q_deg
+    q = solve_ik(robot, cell.task("oru_1_grasp").tcp2base, cell.home_joints_deg).q_deg
     intr = load_intrinsics(cell.intrinsics_path).without_distortion().scaled(0.5)
     renderer = SceneRenderer()
     renderer.set_items(cell.components + RobotVisuals.from_robot(robot).scene_items(q))
@@ -48,7 +48,7 @@ def test_the_target_fills_the_middle_of_the_view(scene):
 
 def test_picking_a_feature_pixel_returns_that_feature(scene):
     cell, intr, cam2world, renderer, _ = scene
-    for component, name in (("oru_1_fixture", "plate_top_left"), ("oru_1_fixture", "boss_bottom_right"), ("oru_1_fixture", "pin_tip"), ("oru_1", "box_top_right")):
+    for component, name in (("oru_1_fixture", "plate_top_left"), ("oru_1_fixture", "boss_bottom_right"), ("oru_1_fixture", "pin_tip"), ("oru_1_fixture", "plate_bottom_right")):
         item = cell.component(component)
         p_world = apply(item.item2world, item.features[name])
         u, v = project(apply(invert(cam2world), p_world[None]), intr, distort=False)[0]
@@ -60,7 +60,7 @@ def test_picking_a_feature_pixel_returns_that_feature(scene):
 def test_picking_a_plain_surface_point_round_trips_within_half_a_mm(scene):
     cell, intr, cam2world, renderer, _ = scene
     oru = cell.component("oru_1_fixture")
-    point = np.array([0.0, 30.0, -20.0])  # on the fixture plate, away from every feature
+    point = np.array([0.0, -70.0, 0.0])  # on the fixture plate, away from every feature and clear of the fingers
     p_world = apply(oru.item2world, point)
     u, v = project(apply(invert(cam2world), p_world[None]), intr, distort=False)[0]
     hit = renderer.pick(u, v, snap_radius_px=0)

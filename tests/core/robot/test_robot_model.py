@@ -20,8 +20,8 @@ def test_zero_pose_matches_the_drawing(robot):
     assert np.allclose(tcp[:3, 3], [1190.0, 0.0, 1410.0], atol=1e-6)
     assert np.allclose(tcp[:3, 2], [1.0, 0.0, 0.0], atol=1e-9)  # approach axis along +x
     cam = robot.fk(np.zeros(6), "camera")
-    assert np.allclose(cam[:3, 3], [1090.0, 0.0, 1500.0], atol=1e-9)
-    assert np.allclose(cam[:3, 2], [np.cos(np.radians(10)), 0.0, -np.sin(np.radians(10))], atol=1e-7)  # 10 deg down
+    assert np.allclose(cam[:3, 3], [1070.0, 0.0, 1520.0], atol=1e-9)  # 60 mm out and 110 mm up from the flange
+    assert np.allclose(cam[:3, 2], [np.cos(np.radians(30)), 0.0, -np.sin(np.radians(30))], atol=1e-7)  # 30 deg down
 
 
 def test_joint_1_turns_the_arm_about_z(robot):
