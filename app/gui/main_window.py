@@ -48,6 +48,7 @@ class MainWindow(QMainWindow):
         self._half_distortion = distortion_map(workbench.intrinsics.scaled(0.5))
         self._edges_renderer = None
         self.worker: FrameWorker | None = None
+        self.edges_drawn = 0
         self._build_layout()
         self._build_menus()
         self._build_status()
@@ -417,6 +418,14 @@ class MainWindow(QMainWindow):
         if r is None:
             self.camera.set_edges_image(None)
             return
+        # The reprojected points and residuals are drawn at once (the camera pane hears the session); the CAD
+        # edges take a render, so they follow on the next turn of the event loop, after that repaint.
+        QTimer.singleShot(0, self._draw_solved_edges)
+
+    def _draw_solved_edges(self) -> None:
+        r = self.workbench.session.result
+        if r is None:
+            return
         # The CAD edges seen from the measured camera, through the lens, over the video: rendered at half
         # size (a quarter of the cost) and enlarged, in a renderer of their own (the virtual camera's must keep
         # its last frame for picking).
@@ -429,6 +438,7 @@ class MainWindow(QMainWindow):
         rgba = self._edges_renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target))
         edges = cv2.resize(self._half_distortion.apply(rgba), (self.workbench.intrinsics.width, self.workbench.intrinsics.height), interpolation=cv2.INTER_LINEAR)
         self.camera.set_edges_image(edges)
+        self.edges_drawn += 1
 
     def _camera_model_changed(self) -> None:
         self._half_distortion = distortion_map(self.workbench.intrinsics.scaled(0.5))

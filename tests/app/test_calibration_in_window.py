@@ -91,6 +91,17 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     d_true, r_true = pose_difference(bed.true_robot.fk(wb.joints_deg), bed.model_robot.fk(wb.joints_deg))
     assert np.linalg.norm(result.displacement_mm - d_true) < 1.0
     assert "OK" in win.results.status.text()
+    # The CAD edges from the solved pose follow the points (next turn of the event loop) and lie on the
+    # plate's outline: the overlay is opaque at the projected corners' neighbourhood.
+    qtbot.waitUntil(lambda: win.edges_drawn > 0, timeout=5_000)
+    edges = win.camera.view.overlay.image
+    assert edges is not None and edges.shape[:2] == (wb.intrinsics.height, wb.intrinsics.width)
+    for name in ("plate_top_left", "plate_bottom_right"):
+        u, v = np.round(project(apply(invert(true_cam), apply(fixture.item2world, fixture.features[name])[None]), wb.intrinsics)[0]).astype(int)
+        assert edges[v - 3 : v + 4, u - 3 : u + 4, 3].max() > 100, name
+    # nothing drawn inside the flat plate face, between the bosses and the pin
+    u, v = np.round(project(apply(invert(true_cam), apply(fixture.item2world, np.array([0.0, -25.0, 25.0]))[None]), wb.intrinsics)[0]).astype(int)
+    assert edges[v - 3 : v + 4, u - 3 : u + 4, 3].max() == 0
     OUTPUT.mkdir(exist_ok=True)
     win.grab().save(str(OUTPUT / "window_after_calibration.png"))
 

@@ -54,7 +54,8 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     # Scrub to the middle of the pick sequence: that frame, those joints, those pairs, no result yet.
     first_solve = truth.solves[0].t_s
     t_mid = (truth._event_times[2] + truth._event_times[3]) / 2
-    bar.slider.setValue(int(t_mid * 1000))
+    bar.slider.setValue(int(t_mid * 1000))  # the slider has millisecond steps
+    t_mid = bar.position_s
     k = truth.frame_index_at(t_mid)
     assert np.array_equal(win.camera.last_frame.image, truth.frames.image(k))
     assert np.allclose(wb.joints_deg, truth.joints_at(t_mid))
