@@ -3,6 +3,7 @@ Writes docs/benchmarks/gui.md. On a desktop with a GPU the rendering figures are
 
 from __future__ import annotations
 
+import json
 import os
 import platform
 import subprocess
@@ -91,7 +92,7 @@ def main() -> str:
     _spin(app, 3.0)  # the robot arrives at the approach pose
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = bed.true_cam2world(wb.joints_deg)
-    pick_ms = []
+    pick_ms, edges_ms = [], []
     for name in ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left"):
         p = apply(fixture.item2world, fixture.features[name])
         wb.session.pick_3d("oru_1_fixture", name, p)
@@ -99,10 +100,18 @@ def main() -> str:
         t0 = time.perf_counter()
         wb.session.pick_2d(uv)
         if len(wb.session.pairs.usable()) >= 3:
+            edges_before = win.edges_drawn
             win._calibrate()
-        win.camera.view.repaint()
-        pick_ms.append(1000 * (time.perf_counter() - t0))
+            win.camera.view.repaint()
+            pick_ms.append(1000 * (time.perf_counter() - t0))
+            while win.edges_drawn == edges_before and time.perf_counter() - t0 < 2.0:
+                app.processEvents()
+            win.camera.view.repaint()
+            edges_ms.append(1000 * (time.perf_counter() - t0))
     win.close()
+    # 5. Accuracy: the whole calibration through the window (videocal demo, full size) on the simulated test bed.
+    demo = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--out", str(tmp / "demo")], capture_output=True, text=True, timeout=600)
+    report = json.loads((tmp / "demo" / "report.json").read_text()) if demo.returncode == 0 else None
     renderer = "OSMesa (llvmpipe, CPU)" if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW") == "vtkOSOpenGLRenderWindow" else "the default VTK window class"
     lines = [
         "# Window benchmarks",
@@ -117,7 +126,22 @@ def main() -> str:
         f"| camera pane, 30 fps 1280 x 960 video file, while the robot moves | {camera_fps:.1f} fps | >= 25 fps |",
         f"| overview redraws while following the 50 Hz joint stream | {overview_fps:.1f} fps | >= 15 fps |",
         f"| joint sample to the overview redrawn, median of 10 | {1000 * float(np.median(lat)):.0f} ms | <= 100 ms |",
-        f"| last pick to the solved overlays drawn (solve, edges overlay, repaint), median | {float(np.median(pick_ms[2:])):.0f} ms | <= 100 ms |",
+        f"| last pick to the solved overlays drawn (solve, reprojected points and residuals, repaint), median | {float(np.median(pick_ms)):.0f} ms | <= 100 ms |",
+        f"| ... and to the CAD edges from the solved pose drawn over the video (a render of the cell), median | {float(np.median(edges_ms)):.0f} ms | |",
+    ]
+    if report is None:
+        lines += [f"| accuracy (videocal demo) | the demo failed: {demo.stderr[-300:]!r} | |"]
+    else:
+        lines += [
+            f"| TCP error after the stored correction (videocal demo: {report['pairs']} pairs, looked at twice), position | {report['corrected_tcp_error_mm']:.3f} mm (uncorrected {report['uncorrected_tcp_error_mm']:.2f} mm) | <= 0.1 mm |",
+            f"| ... rotation | {report['corrected_tcp_error_deg']:.3f} deg (uncorrected {report['uncorrected_tcp_error_deg']:.3f} deg) | <= 0.1 deg |",
+            f"| estimate within 3 sigma of the truth | {report['estimate_within_3_sigma']} (RMS {report['rms_px']:.2f} px; camera mounting: {report['hand_eye']}) | True |",
+        ]
+    lines += [
+        "",
+        "The paper reached 1.07 mm and 0.64 deg. The demo's true robot has typical joint-offset, link-length and base "
+        "errors; the camera looks at the fixture from the task location, then again from the corrected location "
+        "(docs/window.md, The correction).",
         "",
     ]
     OUT.parent.mkdir(parents=True, exist_ok=True)

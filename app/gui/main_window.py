@@ -55,7 +55,7 @@ class MainWindow(QMainWindow):
         self._connect()
         self._restore()
         self._redraw = QTimer(self)
-        self._redraw.setInterval(66)  # overview and virtual camera at up to 15 fps, only when something changed
+        self._redraw.setInterval(50)  # overview and virtual camera at up to 20 fps, only when something changed
         self._redraw.timeout.connect(self._redraw_views)
         self._redraw.start()
         self.virtual.refresh()
