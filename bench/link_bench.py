@@ -13,7 +13,6 @@ import platform
 import socket
 import subprocess
 import sys
-import threading
 import time
 import tty
 from pathlib import Path

@@ -30,7 +30,10 @@ def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int 
     grey = cv2.cvtColor(image_rgb, cv2.COLOR_RGB2GRAY).astype(np.float32)
     corner = np.array([[[u, v]]], dtype=np.float32)
     criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 40, 0.01)
-    refined = cv2.cornerSubPix(grey, corner, (half_window, half_window), (-1, -1), criteria)[0, 0]
+    try:
+        refined = cv2.cornerSubPix(grey, corner, (half_window, half_window), (-1, -1), criteria)[0, 0]
+    except cv2.error:  # a click too near the border for the search window
+        return u, v
     if np.hypot(refined[0] - u, refined[1] - v) > max_shift_px:
         return u, v
     return float(refined[0]), float(refined[1])
@@ -40,6 +43,7 @@ class CameraPane(QWidget):
     """Shows frames; ``picked(u, v)`` when the operator picks a pixel (refined if asked)."""
 
     picked = Signal(float, float)
+    pick_rejected = Signal(str)  # a click that picks nothing, and why
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
@@ -85,6 +89,11 @@ class CameraPane(QWidget):
 
     def _on_click(self, u: float, v: float) -> None:
         if self.last_frame is None:
+            self.pick_rejected.emit("no camera image yet: start the camera (Execute > Live) or open a recording")
+            return
+        h, w = self.last_frame.image.shape[:2]
+        if not (-0.5 <= u < w - 0.5 and -0.5 <= v < h - 0.5):
+            self.pick_rejected.emit(f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked")
             return
         if self.subpixel.isChecked():
             u, v = refine_subpixel(self.last_frame.image, u, v)

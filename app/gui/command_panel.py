@@ -5,6 +5,7 @@ from __future__ import annotations
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
+    QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
     QLabel,
@@ -45,6 +46,17 @@ class CommandPanel(QTabWidget):
         for name in workbench.workcell.task_locations:
             self.tasks.addItem(name)
         pl.addWidget(self.tasks, 1)
+        approach_row = QFormLayout()
+        self.approach = QDoubleSpinBox()
+        self.approach.setObjectName("approach_mm")
+        self.approach.setRange(0.0, 1000.0)
+        self.approach.setDecimals(1)
+        self.approach.setSingleStep(10.0)
+        self.approach.setSuffix(" mm")
+        self.approach.setKeyboardTracking(False)  # one undoable edit per value, not one per keystroke
+        self.approach.setToolTip("How far back along the tool's z axis the robot stops before the task pose")
+        approach_row.addRow("Approach", self.approach)
+        pl.addLayout(approach_row)
         self.go_approach = _button("Go to approach", "go_approach", "IK to the approach pose, then move the robot (MVJ)")
         self.go_task = _button("Go to task", "go_task", "IK to the task pose itself, without correction")
         self.add_location = _button("Add location from current pose", "add_location")

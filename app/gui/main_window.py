@@ -26,6 +26,12 @@ from calib_core.robot import solve_ik
 from calib_core.testbed.lens import distortion_map
 
 
+STALE_CAMERA_S = 2.0
+"""The camera is reported stale when no frame came for this long (while live)."""
+STALE_LINK_S = 1.0
+"""The link is reported stale when it is up but no joint sample came for this long."""
+
+
 class MainWindow(QMainWindow):
     def __init__(self, workbench: Workbench, *, settings: QSettings | None = None):
         super().__init__()
@@ -118,6 +124,8 @@ class MainWindow(QMainWindow):
         file_menu.addAction(QAction("Open r&ecording...", self, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
         self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
         self.addAction(self.play_action)
+        self.recent_menu = file_menu.addMenu("Recent &files")
+        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         file_menu.addSeparator()
         quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self._quit)
         file_menu.addAction(quit_action)
@@ -156,6 +164,7 @@ class MainWindow(QMainWindow):
         self.report = guarded(self.show_error)
         self.virtual.picked.connect(self.report(self._on_pick_3d))
         self.camera.picked.connect(self.report(self._on_pick_2d))
+        self.camera.pick_rejected.connect(self.show_error)
         c.accept.clicked.connect(self._accept)
         c.delete.clicked.connect(self._delete)
         c.clear.clicked.connect(self.report(lambda: wb.session.clear()))
@@ -167,6 +176,10 @@ class MainWindow(QMainWindow):
         c.estimate_focal.toggled.connect(lambda on: setattr(wb.session, "estimate_focal", on))
         c.robust.toggled.connect(lambda on: setattr(wb.session, "robust", on))
         c.tasks.currentTextChanged.connect(self.report(self._task_selected))
+        c.approach.valueChanged.connect(self.report(self._approach_edited))
+        wb.task_changed.connect(self._show_task)
+        if wb.task is not None:
+            self._show_task(wb.task.name)
         c.go_approach.clicked.connect(lambda: self._go(approach=True))
         c.go_task.clicked.connect(lambda: self._go(approach=False))
         c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
@@ -192,6 +205,19 @@ class MainWindow(QMainWindow):
     def _task_selected(self, name: str) -> None:
         if name:
             self.workbench.set_task(name)
+
+    def _approach_edited(self, value_mm: float) -> None:
+        task = self.workbench.task
+        if task is not None:
+            self.workbench.set_task_approach(task.name, value_mm)
+
+    def _show_task(self, name: str) -> None:
+        task = self.workbench.task
+        if task is None or task.name != name:
+            return
+        self.commands.approach.blockSignals(True)
+        self.commands.approach.setValue(task.approach_mm)
+        self.commands.approach.blockSignals(False)
 
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
@@ -227,8 +253,15 @@ class MainWindow(QMainWindow):
             session.pick_2d((u, v))  # raises with a clear message
 
     def _accept(self) -> None:
-        if self._current_pair is not None:
-            self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
+        self.report(self._accept_impl)()
+
+    def _accept_impl(self) -> None:
+        pending = self.workbench.session.pairs.pending()
+        if pending is not None:
+            raise ValueError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
+        if self._current_pair is None:
+            raise ValueError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
+        self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
         self._current_pair = None
 
     def _delete(self) -> None:
@@ -313,6 +346,21 @@ class MainWindow(QMainWindow):
     def open_workspace(self, path) -> None:
         self.report(self.workbench.open_workspace)(path)
         self._remember_recent(path)
+
+    def _fill_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        recent = [p for p in (self.settings.value("files/recent") or []) if p]
+        if not recent:
+            self.recent_menu.addAction(QAction("(none yet)", self, enabled=False))
+        for path in recent:
+            self.recent_menu.addAction(QAction(path, self, triggered=lambda checked=False, p=path: self.open_recent(p)))
+
+    def open_recent(self, path: str) -> None:
+        """A workspace (.json) or a recording (.mcap) from the recent list."""
+        if path.endswith(".mcap"):
+            self.open_recording(path)
+        else:
+            self.open_workspace(path)
 
     def _remember_recent(self, path) -> None:
         recent = [str(path)] + [p for p in (self.settings.value("files/recent") or []) if p != str(path)]
@@ -467,12 +515,24 @@ class MainWindow(QMainWindow):
         self.commands.corrections.setText("\n".join(lines) or "No corrections stored.")
 
     def _update_status(self) -> None:
-        if self.worker is not None:
-            self.fps_label.setText(f"camera: {self.worker.fps_measured:.1f} fps")
+        now = time.monotonic()
+        frame = self.camera.last_frame_received if hasattr(self.camera, "last_frame_received") else None
+        if self.replay.playback is not None:
+            self.fps_label.setText("camera: replaying a recording")
+        elif self.worker is not None and not self.worker.paused:
+            age = None if frame is None else now - frame.t_host_s
+            if age is not None and age > STALE_CAMERA_S:
+                self.fps_label.setText(f"<span style='color:#ff9a30'>camera: no frame for {age:.0f} s</span>")
+            else:
+                self.fps_label.setText(f"camera: {self.worker.fps_measured:.1f} fps")
         link = self.workbench.link
         if link is not None:
             s = link.stats_snapshot()
-            self.link_label.setText(f"link: {link.state.value}, {s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected")
+            text = f"link: {link.state.value}, {s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
+            last = self.workbench.last_sample_s
+            if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
+                text = f"<span style='color:#ff9a30'>link: up but no joint sample for {now - last:.1f} s</span>"
+            self.link_label.setText(text)
         rec = self.workbench.recorder
         self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
 

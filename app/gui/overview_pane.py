@@ -1,5 +1,5 @@
 """The workcell overview: the whole cell, the robot following the joints, the modelled camera
-frustum and, after a solve, the measured one; orbit (left drag), zoom (wheel)."""
+frustum and, after a solve, the measured one; orbit (left drag), pan (right or middle drag), zoom (wheel)."""
 
 from __future__ import annotations
 
@@ -27,6 +27,8 @@ class _OrbitView(ImageView):
     def mousePressEvent(self, event):
         if event.button() == Qt.MouseButton.LeftButton:
             self._orbit_from = event.position()
+        elif event.button() in (Qt.MouseButton.RightButton, Qt.MouseButton.MiddleButton):
+            self._pan_from = event.position()
         else:
             super().mousePressEvent(event)
 
@@ -35,11 +37,16 @@ class _OrbitView(ImageView):
             d = event.position() - self._orbit_from
             self._orbit_from = event.position()
             self.pane.orbit(-0.4 * d.x(), 0.3 * d.y())
+        elif getattr(self, "_pan_from", None) is not None:
+            d = event.position() - self._pan_from
+            self._pan_from = event.position()
+            self.pane.pan(d.x(), d.y())
         else:
             super().mouseMoveEvent(event)
 
     def mouseReleaseEvent(self, event):
         self._orbit_from = None
+        self._pan_from = None
         super().mouseReleaseEvent(event)
 
     def wheelEvent(self, event):
@@ -73,6 +80,18 @@ class OverviewPane(QWidget):
     def orbit(self, d_azimuth: float, d_elevation: float) -> None:
         self.azimuth_deg += d_azimuth
         self.elevation_deg = float(np.clip(self.elevation_deg + d_elevation, -5.0, 85.0))
+        self.mark_dirty()
+        self.refresh()
+
+    def pan(self, dx_px: float, dy_px: float) -> None:
+        """Slide the view with the mouse (right or middle drag): the point looked at moves in the image plane."""
+        a, e = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
+        forward = -np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+        right = np.cross(forward, [0.0, 0.0, 1.0])
+        right /= np.linalg.norm(right)
+        up = np.cross(right, forward)
+        mm_per_px = 2.0 * self.distance_mm * np.tan(np.radians(20.0)) / max(self.view.height(), 1)
+        self.target = self.target - right * dx_px * mm_per_px + up * dy_px * mm_per_px
         self.mark_dirty()
         self.refresh()
 

@@ -6,7 +6,6 @@ Panes read from here and send the operator's actions here; nothing here draws.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import tempfile
@@ -19,7 +18,7 @@ from PySide6.QtCore import QObject, Signal
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkState, MoveError
+from calib_core.link.link_types import LinkState
 from calib_core.robot import solve_ik
 from calib_core.testbed.test_bed import TestBed
 from calib_core.workcell import TaskLocation
@@ -67,6 +66,7 @@ class Workbench(QObject):
         self._tmp = tempfile.TemporaryDirectory(prefix="videocal-")
         self.recorder = None
         self.replaying = False
+        self.last_sample_s: float | None = None
         self.session.pairs.subscribe(self._record_pairs_event)
         self._sample_arrived.connect(self._on_sample)
         self._state_arrived.connect(self._on_state_arrived)
@@ -96,6 +96,7 @@ class Workbench(QObject):
         self.link_state.emit(f"{state}: {why}")
 
     def _on_sample(self, sample) -> None:
+        self.last_sample_s = time.monotonic()
         if self.recorder is not None:
             self.recorder.record_joints(sample.sample.seq, sample.sample.t_ms, sample.t_host_s, sample.joints_deg)
         if self.replaying:
@@ -138,6 +139,19 @@ class Workbench(QObject):
             target = self.session.corrections.corrected_target(self.task.name, target)
         what = f"{self.task.name} ({'approach' if approach else 'task'}{', corrected' if corrected else ''})"
         return self.move_to(target, what, wait=wait)
+
+    def set_task_approach(self, name: str, approach_mm: float) -> None:
+        """Edit a task location's approach distance (mm): an undoable edit."""
+        from calib_core.calibration.commands import SetTaskApproach
+
+        if abs(self.workcell.task(name).approach_mm - approach_mm) < 1e-9:
+            return
+        self.session.undo.push(SetTaskApproach(self.workcell.task_locations, name, approach_mm, self._task_edited))
+
+    def _task_edited(self, name: str) -> None:
+        if self.task is not None and self.task.name == name:
+            self.task = self.workcell.task(name)
+        self.task_changed.emit(name)
 
     def set_task(self, name: str) -> None:
         self.task = self.workcell.task(name)

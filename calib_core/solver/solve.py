@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
-from calib_core.solver.candidates import RefinedPose, distinct_poses, refine_seed
+from calib_core.solver.candidates import distinct_poses, refine_seed
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import initial_seeds, subset_p3p_seeds
 from calib_core.solver.problem import PoseProblem, check_in_front, make_problem

@@ -13,28 +13,9 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
 from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
-
-
-@pytest.fixture
-def window(qtbot, tmp_path):
-    typical = RobotErrors.typical(0)
-    errors = RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
-    bed = TestBed.create(errors=errors)
-    bed.intrinsics = bed.intrinsics.scaled(0.5)  # 640 x 480: the same workflow at a quarter of the rendering cost
-    wb = Workbench(bed)
-    wb.start_simulated_controller()
-    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
-    qtbot.addWidget(win)
-    win.resize(1500, 950)
-    win.start_camera(lambda: bed.camera(fps=10.0))
-    win.show()
-    qtbot.waitUntil(lambda: wb.link_up, timeout=10_000)
-    yield win
-    win.close()
 
 
 def _click_image(qtbot, view, u, v, zoom=None):
@@ -126,7 +107,12 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     win = window
     wb = win.workbench
     # An image click before any model pick.
-    win.camera.show_frame(type("F", (), {"image": np.zeros((480, 640, 3), np.uint8)})())
+    import time
+
+    from calib_core.video.frame import Frame
+
+    win.camera.freeze.setChecked(True)  # the operator froze this (black) frame to pick on
+    win.camera.show_frame(Frame(np.zeros((480, 640, 3), np.uint8), 0, time.monotonic()))
     _click_image(qtbot, win.camera.view, 100, 100)
     assert "pick the point on the model" in win.results.status.text()
     # Calibrate with no pairs: the button is disabled, the shortcut explains.
@@ -136,7 +122,90 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     # Going to a corrected location that has no correction.
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
     assert "no stored correction" in win.results.status.text()
+    # Accept with nothing picked, then with only the 3D point.
+    qtbot.mouseClick(win.commands.accept, Qt.MouseButton.LeftButton)
+    assert "nothing to accept" in win.results.status.text()
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    qtbot.mouseClick(win.commands.accept, Qt.MouseButton.LeftButton)
+    assert "has no point on the camera image yet" in win.results.status.text()
+    # A click outside the image (zoomed out, in the margin): nothing picked, the pair still waits.
+    win.camera.view.set_zoom(0.5)
+    qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(3, 3))
+    assert "outside the camera image" in win.results.status.text()
+    assert wb.session.pairs.pending() is not None and len(wb.session.pairs) == 1
+    win.camera.view.reset_view()
     assert win.isVisible()
+
+
+def test_a_degenerate_point_set_is_explained_and_loses_no_pair(qtbot, window):
+    win, wb = window, window.workbench
+    fixture = wb.workcell.component("oru_1_fixture")
+    # Four points on one straight line of the plate: no pose follows from them.
+    for k, y in enumerate((-60.0, -20.0, 20.0, 60.0)):
+        wb.session.pick_3d("oru_1_fixture", None, apply(fixture.item2world, np.array([0.0, y, 0.0])))
+        wb.session.pick_2d((100.0 + 50 * k, 200.0))
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    text = win.results.status.text().lower()
+    assert "line" in text or "degenerate" in text or "collinear" in text, text
+    assert len(wb.session.pairs.usable()) == 4
+
+
+def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, tmp_path):
+    import cv2
+
+    from calib_core.video.folder_source import ImageFolderSource
+
+    win, wb = window, window.workbench
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    wb.session.pick_2d((320.0, 240.0))
+    # The camera: a folder of two images, not looped, ends; the window says so and keeps the last frame.
+    for k in range(2):
+        cv2.imwrite(str(tmp_path / f"frame_{k}.png"), np.full((480, 640, 3), 60 + 40 * k, np.uint8))
+    win.worker.stop()
+    win.start_camera(lambda: ImageFolderSource(tmp_path, loop=False, fps=20.0))
+    qtbot.waitUntil(lambda: "end of stream" in win.results.status.text(), timeout=10_000)
+    assert win.camera.last_frame is not None
+    win._update_status()
+    qtbot.waitUntil(lambda: (win._update_status(), "no frame for" in win.fps_label.text())[1], timeout=10_000)
+    # The link: the controller process dies; the state shows it and no pair is lost.
+    wb._sim_process.kill()
+    qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
+    qtbot.waitUntil(lambda: "up" not in win.link_label.text().split(",")[0], timeout=5_000)
+    qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    assert win.results.status.text()  # a reason, not a crash
+    assert len(wb.session.pairs) == 1 and wb.session.pairs.pairs()[0].pixel == (320.0, 240.0)
+    assert win.isVisible()
+
+
+def test_the_approach_is_edited_undone_and_the_overview_pans(qtbot, window):
+    win, wb = window, window.workbench
+    task = wb.task
+    assert win.commands.approach.value() == pytest.approx(task.approach_mm)
+    win.commands.approach.setValue(150.0)
+    assert wb.workcell.task(task.name).approach_mm == 150.0 and wb.task.approach_mm == 150.0
+    np.testing.assert_allclose(wb.task.approach2base[:3, 3], (task.tcp2base @ np.array([0, 0, -150.0, 1]))[:3], atol=1e-9)
+    qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert wb.workcell.task(task.name).approach_mm == task.approach_mm
+    assert win.commands.approach.value() == pytest.approx(task.approach_mm)
+    # Right-drag pans the overview: the point looked at moves, the view is redrawn.
+    target, redraws = win.overview.target.copy(), win.overview.redraws
+    view = win.overview.view
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=QPoint(100, 100))
+    qtbot.mouseMove(view, QPoint(160, 130))
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=QPoint(160, 130))
+    assert np.linalg.norm(win.overview.target - target) > 10.0 and win.overview.redraws > redraws
+
+
+def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    win.save_workspace(tmp_path / "w.json")
+    wb.session.clear()
+    win._fill_recent_menu()
+    actions = [a for a in win.recent_menu.actions() if a.text() == str(tmp_path / "w.json")]
+    assert actions
+    actions[0].trigger()
+    assert len(wb.session.pairs) == 1
 
 
 def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):

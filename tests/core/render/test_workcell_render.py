@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from calib_core.camera.intrinsics_io import load_intrinsics
-from calib_core.camera.projection import project, unproject
+from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.robot import load_robot, solve_ik
