@@ -528,7 +528,10 @@ class MainWindow(QMainWindow):
         link = self.workbench.link
         if link is not None:
             s = link.stats_snapshot()
-            text = f"link: {link.state.value}, {s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
+            prev = getattr(self, "_samples_then", None)
+            self._samples_then = (now, s["samples"])
+            rate = "" if prev is None or now <= prev[0] else f"{(s['samples'] - prev[1]) / (now - prev[0]):.0f} Hz, "
+            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
             last = self.workbench.last_sample_s
             if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
                 text = f"<span style='color:#ff9a30'>link: up but no joint sample for {now - last:.1f} s</span>"
