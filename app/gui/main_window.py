@@ -187,7 +187,7 @@ class MainWindow(QMainWindow):
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self._add_location))
         c.live.toggled.connect(self._live_toggled)
-        self.results.candidate_chosen.connect(self.report(lambda k: wb.session.choose_candidate(k)))
+        self.results.candidate_chosen.connect(self.report(self._choose_candidate))
         wb.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
         wb.camera_model_changed.connect(self._camera_model_changed)
@@ -252,6 +252,10 @@ class MainWindow(QMainWindow):
         else:
             session.pick_2d((u, v))  # raises with a clear message
 
+    def _choose_candidate(self, index: int) -> None:
+        self.workbench.session.choose_candidate(index)
+        self.workbench.record_event("candidate_chosen", index=index, solution=index + 1)
+
     def _accept(self) -> None:
         self.report(self._accept_impl)()
 
@@ -262,6 +266,7 @@ class MainWindow(QMainWindow):
         if self._current_pair is None:
             raise ValueError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
         self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
+        self.workbench.record_event("pair_accepted", number=self._current_pair)
         self._current_pair = None
 
     def _delete(self) -> None:

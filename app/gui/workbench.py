@@ -93,7 +93,14 @@ class Workbench(QObject):
         self.message.emit(f"controller link: {url}")
 
     def _on_state_arrived(self, state: str, why: str) -> None:
+        self.record_event("link_state", state=state, why=why)
         self.link_state.emit(f"{state}: {why}")
+
+    def record_event(self, kind: str, **detail) -> None:
+        """An event for the recording, when one is running (link states, accepts, candidate choices)."""
+        rec = getattr(self, "recorder", None)
+        if rec is not None:
+            rec.record_event(kind, **detail)
 
     def _on_sample(self, sample) -> None:
         self.last_sample_s = time.monotonic()

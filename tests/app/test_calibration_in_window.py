@@ -216,8 +216,9 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     wb = win.workbench
     win.start_recording(tmp_path / "session.mcap")
     assert win.record_action.isChecked()
-    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
-    wb.session.pick_2d((100.0, 120.0))
+    win._on_pick_3d(type("Hit", (), {"component": "oru_1_fixture", "feature": "pin_tip", "point_world_mm": (1.0, 2.0, 3.0)})())
+    win._on_pick_2d(100.0, 120.0)
+    qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
     qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
     qtbot.wait(1100)
     win._update_status()
@@ -226,7 +227,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.stop_recording()
     contents = read_recording(tmp_path / "session.mcap")
     assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
-    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC)] == ["pair_added", "pair_changed"]
+    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC)] == ["pair_added", "pair_changed", "pair_accepted"]
     # Clear, then open the saved workspace: the pair comes back.
     wb.session.clear()
     assert len(wb.session.pairs) == 0
