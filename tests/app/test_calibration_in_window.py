@@ -227,7 +227,8 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.stop_recording()
     contents = read_recording(tmp_path / "session.mcap")
     assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
-    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC)] == ["pair_added", "pair_changed", "pair_accepted"]
+    # (link_state events may come and go with the controller; the operator's edits are these)
+    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC) if m.payload["kind"].startswith("pair_")] == ["pair_added", "pair_changed", "pair_accepted"]
     # Clear, then open the saved workspace: the pair comes back.
     wb.session.clear()
     assert len(wb.session.pairs) == 0
