@@ -17,6 +17,7 @@ from app.gui.frame_worker import FrameWorker
 from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
 from app.gui.replay_bar import ReplayBar
+from app.gui.status_line import StatusLine
 from app.gui.vision_panel import VisionPanel
 from app.gui.results_panel import ResultsPanel
 from app.gui.virtual_pane import VirtualPane
@@ -24,12 +25,6 @@ from app.gui.workbench import Workbench
 from calib_core.render import RenderOptions
 from calib_core.robot import solve_ik
 from calib_core.testbed.lens import distortion_map
-
-
-STALE_CAMERA_S = 2.0
-"""The camera is reported stale when no frame came for this long (while live)."""
-STALE_LINK_S = 1.0
-"""The link is reported stale when it is up but no joint sample came for this long."""
 
 
 class MainWindow(QMainWindow):
@@ -147,16 +142,10 @@ class MainWindow(QMainWindow):
         robot.addAction(QAction("Go to task, &corrected", self, triggered=lambda: self._go(approach=False, corrected=True)))
 
     def _build_status(self) -> None:
-        self.link_label = QLabel("link: not connected")
-        self.fps_label = QLabel("camera: -")
-        self.pairs_label = QLabel("pairs: 0")
-        self.record_label = QLabel("")
-        for w in (self.record_label, self.link_label, self.fps_label, self.pairs_label):
-            self.statusBar().addPermanentWidget(w)
-        self._fps_timer = QTimer(self)
-        self._fps_timer.setInterval(1000)
-        self._fps_timer.timeout.connect(self._update_status)
-        self._fps_timer.start()
+        self.status_line = StatusLine(self.statusBar(), self.workbench, self._camera_state, self)
+        # the fields, by their old names (tests and the bench read them)
+        self.link_label, self.fps_label = self.status_line.link_label, self.status_line.fps_label
+        self.pairs_label, self.record_label = self.status_line.pairs_label, self.status_line.record_label
 
     def _connect(self) -> None:
         wb = self.workbench
@@ -191,7 +180,7 @@ class MainWindow(QMainWindow):
         wb.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
         wb.camera_model_changed.connect(self._camera_model_changed)
-        wb.link_state.connect(lambda text: self.link_label.setText(f"link: {text}"))
+        wb.link_state.connect(self.status_line.show_link_state)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.subscribe(self._update_actions)
         wb.session.pairs.subscribe(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
@@ -509,7 +498,7 @@ class MainWindow(QMainWindow):
         self.commands.undo.setEnabled(undo.can_undo)
         self.commands.redo.setEnabled(undo.can_redo)
         self.commands.calibrate.setEnabled(self.workbench.session.can_calibrate)
-        self.pairs_label.setText(f"pairs: {len(self.workbench.session.pairs.usable())}/{self.workbench.session.required_pairs} needed")
+        self.status_line.show_pairs(len(self.workbench.session.pairs.usable()), self.workbench.session.required_pairs)
 
     def _update_corrections(self) -> None:
         table = self.workbench.session.corrections
@@ -520,29 +509,10 @@ class MainWindow(QMainWindow):
         self.commands.corrections.setText("\n".join(lines) or "No corrections stored.")
 
     def _update_status(self) -> None:
-        now = time.monotonic()
-        frame = self.camera.last_frame_received if hasattr(self.camera, "last_frame_received") else None
-        if self.replay.playback is not None:
-            self.fps_label.setText("camera: replaying a recording")
-        elif self.worker is not None and not self.worker.paused:
-            age = None if frame is None else now - frame.t_host_s
-            if age is not None and age > STALE_CAMERA_S:
-                self.fps_label.setText(f"<span style='color:#ff9a30'>camera: no frame for {age:.0f} s</span>")
-            else:
-                self.fps_label.setText(f"camera: {self.worker.fps_measured:.1f} fps")
-        link = self.workbench.link
-        if link is not None:
-            s = link.stats_snapshot()
-            prev = getattr(self, "_samples_then", None)
-            self._samples_then = (now, s["samples"])
-            rate = "" if prev is None or now <= prev[0] else f"{(s['samples'] - prev[1]) / (now - prev[0]):.0f} Hz, "
-            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
-            last = self.workbench.last_sample_s
-            if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
-                text = f"<span style='color:#ff9a30'>link: up but no joint sample for {now - last:.1f} s</span>"
-            self.link_label.setText(text)
-        rec = self.workbench.recorder
-        self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
+        self.status_line.update()
+
+    def _camera_state(self) -> tuple:
+        return getattr(self.camera, "last_frame_received", None), self.worker, self.replay.playback is not None
 
     # --- life cycle ------------------------------------------------------------------------
     def _restore(self) -> None:

@@ -1,0 +1,67 @@
+"""The status bar's permanent fields: recording, link, camera, pairs; refreshed once a second.
+
+The link shows its state, sample rate and rejected lines, and turns orange when it is up but no
+joint sample came for ``STALE_LINK_S``; the camera shows its frame rate, and turns orange when no
+frame came for ``STALE_CAMERA_S`` while live.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QLabel, QStatusBar
+
+STALE_CAMERA_S = 2.0
+STALE_LINK_S = 1.0
+WARN = "<span style='color:#ff9a30'>{}</span>"
+
+
+class StatusLine:
+    """``camera_state()`` gives ``(last frame received or None, worker or None, replaying)``."""
+
+    def __init__(self, bar: QStatusBar, workbench, camera_state: Callable[[], tuple], parent) -> None:
+        self.workbench = workbench
+        self._camera_state = camera_state
+        self.record_label = QLabel("")
+        self.link_label = QLabel("link: not connected")
+        self.fps_label = QLabel("camera: -")
+        self.pairs_label = QLabel("pairs: 0")
+        for w in (self.record_label, self.link_label, self.fps_label, self.pairs_label):
+            bar.addPermanentWidget(w)
+        self._samples_then: tuple[float, int] | None = None
+        self.timer = QTimer(parent)
+        self.timer.setInterval(1000)
+        self.timer.timeout.connect(self.update)
+        self.timer.start()
+
+    def update(self) -> None:
+        now = time.monotonic()
+        frame, worker, replaying = self._camera_state()
+        if replaying:
+            self.fps_label.setText("camera: replaying a recording")
+        elif worker is not None and not worker.paused:
+            age = None if frame is None else now - frame.t_host_s
+            if age is not None and age > STALE_CAMERA_S:
+                self.fps_label.setText(WARN.format(f"camera: no frame for {age:.0f} s"))
+            else:
+                self.fps_label.setText(f"camera: {worker.fps_measured:.1f} fps")
+        link = self.workbench.link
+        if link is not None:
+            s = link.stats_snapshot()
+            prev, self._samples_then = self._samples_then, (now, s["samples"])
+            rate = "" if prev is None or now <= prev[0] else f"{(s['samples'] - prev[1]) / (now - prev[0]):.0f} Hz, "
+            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
+            last = self.workbench.last_sample_s
+            if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
+                text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
+            self.link_label.setText(text)
+        rec = self.workbench.recorder
+        self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
+
+    def show_pairs(self, usable: int, required: int) -> None:
+        self.pairs_label.setText(f"pairs: {usable}/{required} needed")
+
+    def show_link_state(self, text: str) -> None:
+        self.link_label.setText(f"link: {text}")
