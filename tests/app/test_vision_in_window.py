@@ -128,3 +128,35 @@ def test_bad_vision_input_gives_messages(qtbot, window):
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert "the robot is moving" in win.results.status.text()
     assert not vision.capture.views and not vision.capture.rejected
+
+
+def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot, window, tmp_path):
+    """Record the board at a few poses, then capture the views from the replayed frames: each view takes
+    the joints recorded with its frame, so the hand-eye data comes out of a recording as well as live."""
+    from calib_core.recording.playback import RecordingPlayback
+    from calib_core.recording.reader import read_recording
+
+    win, wb = window, window.workbench
+    vision = win.vision
+    vision.show_board.setChecked(True)
+    win.start_recording(tmp_path / "board.mcap")
+    for k in range(4):
+        qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
+        target = vision._plan[k]
+        qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - target)) < 1e-3, timeout=30_000)
+        qtbot.wait(int(STILL_S * 1000))
+        _fresh_still_frame(qtbot, win)
+        qtbot.wait(300)  # a few frames at rest into the recording
+    win.stop_recording()
+    plan = vision._plan[:4]
+    playback = RecordingPlayback(read_recording(tmp_path / "board.mcap"))
+    win.open_recording(tmp_path / "board.mcap")
+    assert wb.replaying
+    for q in plan:
+        # the moment the recorded joints reached this pose, plus a little: frame and joints at rest
+        at = next(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
+        win.replay.seek(at + STILL_S + 0.15)
+        qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    assert len(vision.capture.views) == 4, [vision.views.item(i).text() for i in range(vision.views.count())]
+    for recorded, q in zip(vision.capture.joints_deg, plan):
+        assert np.max(np.abs(recorded - q)) < 1e-3
