@@ -5,6 +5,13 @@ import os
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
 
+import tempfile  # noqa: E402
+
+# Autosaves, window settings and other per-user files (platformdirs and QSettings follow the XDG folders) go to
+# throw-away folders, never into the home of whoever runs the tests.
+os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="videocal-test-data-")
+os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="videocal-test-config-")
+
 
 import sys
 

@@ -534,6 +534,9 @@ class MainWindow(QMainWindow):
         self.settings.setValue("window/split_top", self.top_splitter.saveState())
         self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
         self._redraw.stop()
+        self._autosave_timer.stop()  # a closed window writes nothing more
+        self.status_line.timer.stop()
+        self.replay.pause()
         if self.worker is not None:
             self.worker.stop()
         self.virtual.close_renderer()
