@@ -4,7 +4,8 @@ The camera pane shows the recorded frames, the CAD views follow the recorded joi
 pairs and the last solve appear as they stood at the timeline's position. The first edit the
 operator makes (a pick, a delete, a solve...) branches a new session from that instant: the pairs
 stop following the recording and the operator works on the recorded frames. The recording file is
-only ever read. Closing the replay gives the live session back as it was, unless it was branched.
+only ever read. While it plays, the window uses the intrinsics the recording was made with. Closing the
+replay gives the live camera's intrinsics back, and the live session as it was unless it was branched.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QSlider, QStyle, QToolButton, QWidget
 
+from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import FileFormatError
 from calib_core.recording.playback import RecordedSolve, RecordingPlayback
 from calib_core.recording.reader import read_recording, recover
@@ -96,9 +98,19 @@ class ReplayBar(QWidget):
         if not contents.messages:
             raise FileFormatError(path, "the recording holds no messages")
         playback = RecordingPlayback(contents)
+        recorded_intrinsics = None
+        if playback.setup.get("intrinsics"):
+            try:
+                recorded_intrinsics = Intrinsics.from_dict(playback.setup["intrinsics"])
+            except (KeyError, TypeError, ValueError) as exc:
+                raise FileFormatError(path, f"its intrinsics cannot be read ({exc})", "/videocal/setup") from None
         if self.playback is None:
             s = self.workbench.session
-            self._live_state = (s.pairs.pairs(), s.result, s._context)
+            self._live_state = (s.pairs.pairs(), s.result, s._context, self.workbench.intrinsics)
+        # Picks and solves on the recorded frames need the camera they were recorded with.
+        if recorded_intrinsics is not None and recorded_intrinsics != self.workbench.intrinsics:
+            self.workbench.intrinsics = recorded_intrinsics
+            self.workbench.camera_model_changed.emit()
         self.playback, self.path = playback, path
         self.workbench.replaying = True
         self.branched_at_s = None
@@ -123,8 +135,11 @@ class ReplayBar(QWidget):
             return
         self.pause()
         branched = self.branched_at_s is not None
+        if self._live_state is not None and self._live_state[3] != self.workbench.intrinsics:
+            self.workbench.intrinsics = self._live_state[3]  # the live camera's, whatever the recording used
+            self.workbench.camera_model_changed.emit()
         if not branched and self._live_state is not None:
-            pairs, result, context = self._live_state
+            pairs, result, context, _ = self._live_state
             s = self.workbench.session
             self._applying = True
             try:

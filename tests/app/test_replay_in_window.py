@@ -142,3 +142,28 @@ def test_replay_screenshot(qtbot, window, recording):
     assert bar_pos.y() < cam_pos.y()
     frame = win.camera.last_frame.image
     assert frame.shape == (960, 1280, 3) and frame.std() > 10
+
+
+def test_a_recording_from_another_camera_mode_replays_with_its_own_intrinsics(qtbot, window, tmp_path):
+    """A session recorded at 640 x 480 opens in a window whose camera gives 1280 x 960: picks and solves on
+    its frames use the recorded intrinsics, and closing the replay gives the live ones back."""
+    from calib_core.recording.recorder import SessionRecorder
+
+    win, wb = window, window.workbench
+    live = wb.intrinsics
+    half = live.scaled(0.5)
+    path = tmp_path / "half.mcap"
+    image = np.zeros((half.height, half.width, 3), np.uint8) + 90
+    with SessionRecorder(path, drop_when_busy=False) as rec:
+        rec.record_setup(intrinsics=half.to_dict())
+        for k in range(3):
+            rec.record_frame(image, k / 15)
+            rec.record_joints(k, 20 * k, k / 15, list(wb.joints_deg))
+    win.open_recording(path)
+    from app.gui.virtual_pane import RENDER_SCALE
+
+    assert wb.intrinsics == half
+    assert win.virtual.intrinsics == half.without_distortion().scaled(RENDER_SCALE)  # the virtual camera follows
+    assert win.camera.last_frame.image.shape[:2] == (half.height, half.width)
+    win.replay.close_replay()
+    assert wb.intrinsics == live and win.virtual.intrinsics == live.without_distortion().scaled(RENDER_SCALE)
