@@ -128,6 +128,8 @@ class Workbench(QObject):
 
     def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0):
         """MVJ to joints ``q`` (deg) over the link."""
+        if self.replaying:
+            raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
         handle = self.link.move_joints(q, timeout_s=timeout_s)

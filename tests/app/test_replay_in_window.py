@@ -73,6 +73,10 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     bar.seek(0.0)
     assert len(wb.session.pairs) == 0 and wb.session.result is None
 
+    # The robot is not moved while the views show a recording.
+    qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    assert "close the replay before moving the robot" in win.results.status.text()
+
     # Play runs the clock forward.
     bar.play()
     qtbot.waitUntil(lambda: bar.position_s > 0.5, timeout=5_000)
