@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time
 
-import cv2
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
@@ -17,14 +16,14 @@ from app.gui.frame_worker import FrameWorker
 from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
 from app.gui.replay_bar import ReplayBar
-from app.gui.status_line import StatusLine
-from app.gui.vision_panel import VisionPanel
 from app.gui.results_panel import ResultsPanel
+from app.gui.session_files import Autosave, RecentFiles
+from app.gui.solved_edges import SolvedEdges
+from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
+from app.gui.vision_panel import VisionPanel
 from app.gui.workbench import Workbench
-from calib_core.render import RenderOptions
 from calib_core.robot import solve_ik
-from calib_core.testbed.lens import distortion_map
 
 
 class MainWindow(QMainWindow):
@@ -46,8 +45,7 @@ class MainWindow(QMainWindow):
         vision_scroll.setWidget(self.vision)
         self.commands.addTab(vision_scroll, "Vision")
         self._current_pair: int | None = None
-        self._half_distortion = distortion_map(workbench.intrinsics.scaled(0.5))
-        self._edges_renderer = None
+        self.solved_edges = SolvedEdges(workbench.intrinsics)
         self.worker: FrameWorker | None = None
         self.edges_drawn = 0
         self._build_layout()
@@ -61,15 +59,7 @@ class MainWindow(QMainWindow):
         self._redraw.start()
         self.virtual.refresh()
         self.overview.refresh()
-        from pathlib import Path
-
-        import platformdirs
-
-        self.autosave_path = Path(self.settings.value("files/autosave_dir") or platformdirs.user_data_dir("videocal")) / "recovery" / "autosave.json"
-        self._autosave_timer = QTimer(self)
-        self._autosave_timer.setInterval(60_000)
-        self._autosave_timer.timeout.connect(self._autosave)
-        self._autosave_timer.start()
+        self.autosave = Autosave(self.settings, self.workbench.save_workspace, lambda text: self.statusBar().showMessage(text, 8000), self)
         self._offer_recovery()
 
     # --- layout ----------------------------------------------------------------------------
@@ -119,8 +109,7 @@ class MainWindow(QMainWindow):
         file_menu.addAction(QAction("Open r&ecording...", self, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
         self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
         self.addAction(self.play_action)
-        self.recent_menu = file_menu.addMenu("Recent &files")
-        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        self.recent = RecentFiles(self.settings, file_menu.addMenu("Recent &files"), self.open_recent)
         file_menu.addSeparator()
         quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self._quit)
         file_menu.addAction(quit_action)
@@ -302,25 +291,7 @@ class MainWindow(QMainWindow):
         margin = np.minimum(goal - wb.robot.lower_limits_deg, wb.robot.upper_limits_deg - goal)
         warn = [f"joint {i + 1} within {m:.1f} deg of its limit" for i, m in enumerate(margin) if m < 10.0]
         self.commands.sim_status.setText("; ".join(warn) if warn else f"path to {wb.task.name}: joints within limits")
-        steps = 30
-        self._anim = [start + (goal - start) * (k / steps) for k in range(steps + 1)]
-        self._anim_timer = QTimer(self)
-        self._anim_timer.setInterval(40)
-
-        def step():
-            if not self._anim:
-                self._anim_timer.stop()
-                self._on_joints(wb.joints_deg)  # back to the real robot
-                return
-            q = self._anim.pop(0)
-            self.overview.mark_dirty()
-            saved = wb.joints_deg
-            wb.joints_deg = q
-            self.overview.refresh()
-            wb.joints_deg = saved
-
-        self._anim_timer.timeout.connect(step)
-        self._anim_timer.start()
+        self.overview.play_path([start + (goal - start) * (k / 30) for k in range(31)])
 
     def _add_location(self, name: str | None = None) -> None:
         from calib_core.workcell.model import TaskLocation
@@ -334,20 +305,12 @@ class MainWindow(QMainWindow):
     # --- files -------------------------------------------------------------------------------
     def save_workspace(self, path) -> None:
         self.report(self.workbench.save_workspace)(path)
-        self._remember_recent(path)
-        self.settings.setValue("files/last_saved_time", time.time())
+        self.recent.remember(path)
+        self.autosave.mark_saved()
 
     def open_workspace(self, path) -> None:
         self.report(self.workbench.open_workspace)(path)
-        self._remember_recent(path)
-
-    def _fill_recent_menu(self) -> None:
-        self.recent_menu.clear()
-        recent = [p for p in (self.settings.value("files/recent") or []) if p]
-        if not recent:
-            self.recent_menu.addAction(QAction("(none yet)", self, enabled=False))
-        for path in recent:
-            self.recent_menu.addAction(QAction(path, self, triggered=lambda checked=False, p=path: self.open_recent(p)))
+        self.recent.remember(path)
 
     def open_recent(self, path: str) -> None:
         """A workspace (.json) or a recording (.mcap) from the recent list."""
@@ -355,10 +318,6 @@ class MainWindow(QMainWindow):
             self.open_recording(path)
         else:
             self.open_workspace(path)
-
-    def _remember_recent(self, path) -> None:
-        recent = [str(path)] + [p for p in (self.settings.value("files/recent") or []) if p != str(path)]
-        self.settings.setValue("files/recent", recent[:8])
 
     def _save_dialog(self) -> None:
         from PySide6.QtWidgets import QFileDialog
@@ -390,7 +349,7 @@ class MainWindow(QMainWindow):
             raise RuntimeError("stop recording before replaying a recording")
         self.replay.open(path)
         self.commands.live.setChecked(False)
-        self._remember_recent(path)
+        self.recent.remember(path)
 
     def _replay_closed(self) -> None:
         self.commands.live.setChecked(True)
@@ -421,11 +380,8 @@ class MainWindow(QMainWindow):
     def _offer_recovery(self) -> None:
         """An autosave newer than the last saved workspace means the last session ended without saving:
         offer it (File > Restore autosave) rather than load it unasked."""
-        if not self.autosave_path.is_file():
-            return
-        last_saved = self.settings.value("files/last_saved_time")
-        autosaved = self.autosave_path.stat().st_mtime
-        if last_saved is not None and float(last_saved) >= autosaved:
+        autosaved = self.autosave.unsaved_since()
+        if autosaved is None:
             return
         stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(autosaved))
         self.restore_action = QAction(f"Restore &autosave of {stamp}", self, triggered=self.restore_autosave)
@@ -433,15 +389,7 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"an unsaved session from {stamp} was autosaved: File > Restore autosave", 30000)
 
     def restore_autosave(self) -> None:
-        self.open_workspace(self.autosave_path)
-
-    def _autosave(self) -> None:
-        """Every minute, the workspace to the recovery folder (offered again after a crash)."""
-        try:
-            self.autosave_path.parent.mkdir(parents=True, exist_ok=True)
-            self.workbench.save_workspace(self.autosave_path)
-        except OSError as exc:
-            self.statusBar().showMessage(f"autosave failed: {exc}", 8000)
+        self.open_workspace(self.autosave.path)
 
     # --- updates ---------------------------------------------------------------------------
     def _on_joints(self, q) -> None:
@@ -468,22 +416,11 @@ class MainWindow(QMainWindow):
         r = self.workbench.session.result
         if r is None:
             return
-        # The CAD edges seen from the measured camera, through the lens, over the video: rendered at half
-        # size (a quarter of the cost) and enlarged, in a renderer of their own (the virtual camera's must keep
-        # its last frame for picking).
-        ideal = self._half_distortion.ideal
-        if self._edges_renderer is None:
-            from calib_core.render import SceneRenderer
-
-            self._edges_renderer = SceneRenderer()
-        self._edges_renderer.set_items(self.workbench.workcell.components)
-        rgba = self._edges_renderer.render_view(ideal, r.cam2world_measured, RenderOptions(style="edges", transparent_background=True, highlight=self.workbench.session.target))
-        edges = cv2.resize(self._half_distortion.apply(rgba), (self.workbench.intrinsics.width, self.workbench.intrinsics.height), interpolation=cv2.INTER_LINEAR)
-        self.camera.set_edges_image(edges)
+        self.camera.set_edges_image(self.solved_edges.render(self.workbench.workcell.components, r.cam2world_measured, self.workbench.session.target))
         self.edges_drawn += 1
 
     def _camera_model_changed(self) -> None:
-        self._half_distortion = distortion_map(self.workbench.intrinsics.scaled(0.5))
+        self.solved_edges.set_intrinsics(self.workbench.intrinsics)
         self.overview.mark_dirty()
 
     def _pairs_changed(self, event: str, number) -> None:
@@ -534,14 +471,13 @@ class MainWindow(QMainWindow):
         self.settings.setValue("window/split_top", self.top_splitter.saveState())
         self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
         self._redraw.stop()
-        self._autosave_timer.stop()  # a closed window writes nothing more
+        self.autosave.timer.stop()  # a closed window writes nothing more
         self.status_line.timer.stop()
         self.replay.pause()
         if self.worker is not None:
             self.worker.stop()
         self.virtual.close_renderer()
         self.overview.renderer.close()
-        if self._edges_renderer is not None:
-            self._edges_renderer.close()
+        self.solved_edges.close()
         self.workbench.close()
         super().closeEvent(event)

@@ -4,7 +4,7 @@ frustum and, after a solve, the measured one; orbit (left drag), pan (right or m
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QPointF, Qt
+from PySide6.QtCore import QPointF, Qt, QTimer
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.gui.image_view import ImageView
@@ -100,6 +100,23 @@ class OverviewPane(QWidget):
         self.mark_dirty()
         self.refresh()
 
+    def play_path(self, joints_deg: list[np.ndarray], interval_ms: int = 40) -> None:
+        """Animate the model robot along joint vectors (deg) in this pane only: the robot does not
+        move and the other panes keep the real joints; at the end the pane shows them again."""
+        self._path = list(joints_deg)
+        if getattr(self, "_path_timer", None) is None:
+            self._path_timer = QTimer(self)
+            self._path_timer.timeout.connect(self._path_step)
+        self._path_timer.setInterval(interval_ms)
+        self._path_timer.start()
+
+    def _path_step(self) -> None:
+        self._shown_joints = self._path.pop(0) if self._path else None
+        if self._shown_joints is None:
+            self._path_timer.stop()
+        self.mark_dirty()
+        self.refresh()
+
     def mark_dirty(self) -> None:
         self._dirty = True
 
@@ -113,7 +130,8 @@ class OverviewPane(QWidget):
             return
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
-        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg) + list(wb.bed.extra_items))
+        q = wb.joints_deg if getattr(self, "_shown_joints", None) is None else self._shown_joints
+        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(q) + list(wb.bed.extra_items))
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if wb.session.result is not None:
             lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))

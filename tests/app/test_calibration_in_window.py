@@ -201,8 +201,8 @@ def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
     wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
     win.save_workspace(tmp_path / "w.json")
     wb.session.clear()
-    win._fill_recent_menu()
-    actions = [a for a in win.recent_menu.actions() if a.text() == str(tmp_path / "w.json")]
+    win.recent.fill()
+    actions = [a for a in win.recent.menu.actions() if a.text() == str(tmp_path / "w.json")]
     assert actions
     actions[0].trigger()
     assert len(wb.session.pairs) == 1
@@ -302,3 +302,14 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
     finally:
         win.close()
+
+
+def test_simulate_animates_the_model_in_the_overview_only(qtbot, window):
+    win, wb = window, window.workbench
+    q_before, redraws = wb.joints_deg.copy(), win.overview.redraws
+    qtbot.mouseClick(win.commands.animate, Qt.MouseButton.LeftButton)
+    assert "joints within limits" in win.commands.sim_status.text() or "of its limit" in win.commands.sim_status.text()
+    qtbot.waitUntil(lambda: win.overview.redraws >= redraws + 20, timeout=10_000)  # 31 steps at 40 ms
+    assert np.allclose(wb.joints_deg, q_before)  # the robot did not move
+    qtbot.waitUntil(lambda: not win.overview._path_timer.isActive(), timeout=10_000)
+    assert win.overview._shown_joints is None  # back to the real joints
