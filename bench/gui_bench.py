@@ -51,7 +51,7 @@ def main() -> str:
     tmp = Path(tempfile.mkdtemp(prefix="videocal-bench-"))
     # 1. Launch to window on screen, as a user starts it (a fresh process).
     t0 = time.monotonic()
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--screenshot", str(tmp / "w.png")], capture_output=True, text=True, timeout=120, env={**os.environ, "VIDEOCAL_REPORT_SHOWN": str(tmp / "shown.txt")})
+    subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--screenshot", str(tmp / "w.png")], capture_output=True, text=True, timeout=120, env={**os.environ, "VIDEOCAL_REPORT_SHOWN": str(tmp / "shown.txt")})
     shown = (tmp / "shown.txt").read_text().strip() if (tmp / "shown.txt").exists() else None
     ready = (tmp / "shown.ready").read_text().strip() if (tmp / "shown.ready").exists() else None
     launch_s = float(shown) - t0 if shown else float("nan")

@@ -72,7 +72,8 @@ class CameraPane(QWidget):
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
         layout.addWidget(self.view, 1)
-        self.last_frame = None
+        self.last_frame = None  # the frame shown (held while frozen)
+        self.last_frame_received = None  # the newest frame from the source, shown or not
         self._edges_image: np.ndarray | None = None
         self.view.clicked.connect(self._on_click)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())

@@ -449,7 +449,7 @@ class MainWindow(QMainWindow):
         self.status_line.update()
 
     def _camera_state(self) -> tuple:
-        return getattr(self.camera, "last_frame_received", None), self.worker, self.replay.playback is not None
+        return self.camera.last_frame_received, self.worker, self.replay.playback is not None
 
     # --- life cycle ------------------------------------------------------------------------
     def _restore(self) -> None:

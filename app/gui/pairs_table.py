@@ -38,7 +38,7 @@ class PairsTable(QTableWidget):
         result = self.workbench.session.result
         if result is None:
             return {}
-        numbers = self.workbench.session._context[4] if self.workbench.session._context else []
+        numbers = self.workbench.session.solved_numbers
         norms = result.solution.residual_norms_px
         return {n: float(r) for n, r in zip(numbers, norms)}
 

@@ -106,7 +106,7 @@ class ReplayBar(QWidget):
                 raise FileFormatError(path, f"its intrinsics cannot be read ({exc})", "/videocal/setup") from None
         if self.playback is None:
             s = self.workbench.session
-            self._live_state = (s.pairs.pairs(), s.result, s._context, self.workbench.intrinsics)
+            self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.workbench.intrinsics)
         # Picks and solves on the recorded frames need the camera they were recorded with.
         if recorded_intrinsics is not None and recorded_intrinsics != self.workbench.intrinsics:
             self.workbench.intrinsics = recorded_intrinsics
@@ -135,18 +135,17 @@ class ReplayBar(QWidget):
             return
         self.pause()
         branched = self.branched_at_s is not None
-        if self._live_state is not None and self._live_state[3] != self.workbench.intrinsics:
-            self.workbench.intrinsics = self._live_state[3]  # the live camera's, whatever the recording used
+        if self._live_state is not None and self._live_state[2] != self.workbench.intrinsics:
+            self.workbench.intrinsics = self._live_state[2]  # the live camera's, whatever the recording used
             self.workbench.camera_model_changed.emit()
         if not branched and self._live_state is not None:
-            pairs, result, context, _ = self._live_state
+            pairs, result, _ = self._live_state
             s = self.workbench.session
             self._applying = True
             try:
-                s.pairs._reset(pairs)
-                s.result, s._context = result, context
+                s.pairs.replace_all(pairs)
+                s.restore_result(result)
                 s.undo.clear()
-                s._changed()
             finally:
                 self._applying = False
         self.playback = self.path = self._live_state = None
@@ -234,7 +233,7 @@ class ReplayBar(QWidget):
         try:
             pairs = pb.pairs_at(t_s)
             if pairs != s.pairs.pairs():
-                s.pairs._reset(pairs)
+                s.pairs.replace_all(pairs)
             solve = pb.solve_at(t_s)
             if solve is None and self._shown_solve is not None:
                 s.clear_result()

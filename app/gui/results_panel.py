@@ -112,7 +112,7 @@ class ResultsPanel(QWidget):
             f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} pairs</td><td>{sol.iterations} iterations</td><td></td></tr>"
             "</table>"
         )
-        numbers = session._context[4] if session._context else []
+        numbers = session.solved_numbers
         self.chart.set_values([(str(n), float(e), float(l)) for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px)])
         if sol.status is SolveStatus.AMBIGUOUS:
             for i, c in enumerate(sol.candidates):

@@ -98,9 +98,8 @@ class Workbench(QObject):
 
     def record_event(self, kind: str, **detail) -> None:
         """An event for the recording, when one is running (link states, accepts, candidate choices)."""
-        rec = getattr(self, "recorder", None)
-        if rec is not None:
-            rec.record_event(kind, **detail)
+        if self.recorder is not None:
+            self.recorder.record_event(kind, **detail)
 
     def _on_sample(self, sample) -> None:
         self.last_sample_s = time.monotonic()
@@ -133,6 +132,8 @@ class Workbench(QObject):
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
         handle = self.link.move_joints(q, timeout_s=timeout_s)
+        if handle.finished:
+            handle.wait(0)  # finished before it started: nothing was sent, and this raises the link's reason
         self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)} deg")
         if wait:
             handle.wait(timeout_s)
@@ -199,20 +200,9 @@ class Workbench(QObject):
 
     def apply_hand_eye_file(self, path) -> None:
         """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""
-        import yaml
+        from calib_core.vision.hand_eye_io import load_cam2flange
 
-        from calib_core.errors import FileFormatError
-        from calib_core.frames import transform_from_xyz_rpy
-
-        path = Path(path)
-        try:
-            doc = yaml.safe_load(path.read_text())
-            pose = doc["cam2flange"]
-            cam2flange = transform_from_xyz_rpy(pose["xyz"], pose["rpy"])
-        except FileNotFoundError:
-            raise FileFormatError(path, "no such hand-eye file") from None
-        except (yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
-            raise FileFormatError(path, f"not a cam2flange file: {exc}", "cam2flange") from None
+        cam2flange = load_cam2flange(path)
         self.apply_cam2flange(cam2flange, f"camera mounting from {path}")
 
     def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
@@ -268,7 +258,7 @@ class Workbench(QObject):
         self.workcell.task_locations.update(ws.task_locations)
         if ws.target:
             self.session.set_target(ws.target)
-        self.session.pairs._reset(ws.pairs)
+        self.session.pairs.replace_all(ws.pairs)
         self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
         for task in self.session.corrections.tasks():
             while self.session.corrections.latest(task) is not None:
@@ -300,8 +290,7 @@ class Workbench(QObject):
             rec.record_frame(frame.image, frame.t_host_s)
 
     def _record_pairs_event(self, event: str, number) -> None:
-        rec = getattr(self, "recorder", None)
-        if rec is None:
+        if self.recorder is None:
             return
         from calib_core.recording.playback import pair_to_dict
 
@@ -310,7 +299,7 @@ class Workbench(QObject):
             detail.update(pair_to_dict(self.session.pairs.get(number)))
         elif event == "reset":  # a whole new set (clear, undo of a clear, a workspace): keep it all
             detail["pairs"] = [pair_to_dict(p) for p in self.session.pairs]
-        rec.record_event(f"pair_{event}", **detail)
+        self.record_event(f"pair_{event}", **detail)
 
     def close(self) -> None:
         self.stop_recording()

@@ -110,6 +110,11 @@ class CorrespondenceSet:
         self._emit("changed", pair.number)
         return old
 
+    def replace_all(self, pairs: list[Correspondence]) -> None:
+        """Put a whole other set in place, outside the undo stack: a workspace opened, a recording's
+        pairs shown at an instant of its replay. Operator edits go through the commands instead."""
+        self._reset(pairs)
+
     def _reset(self, pairs: list[Correspondence]) -> list[Correspondence]:
         old, self._pairs = self._pairs, list(pairs)
         self._emit("reset", None)

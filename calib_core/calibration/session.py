@@ -122,11 +122,7 @@ class CalibrationSession:
         prior = invert(cam2world_model) @ obj2world
         solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
-        self._context = (obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), numbers)
-        self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model)
-        self.chosen_candidate = 0
-        self._changed()
-        return self.result
+        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers)
 
     def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int]) -> EndEffectorEstimate:
         """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here."""
@@ -137,8 +133,19 @@ class CalibrationSession:
         return self.result
 
     def clear_result(self) -> None:
-        self.result = None
-        self._context = None
+        self.restore_result((None, None, 0))
+
+    @property
+    def solved_numbers(self) -> list[int]:
+        """The numbers of the pairs the last solve used (empty before a solve)."""
+        return list(self._context[4]) if self._context else []
+
+    def result_snapshot(self) -> tuple:
+        """The last result with what it was solved from, to put back later with :meth:`restore_result`."""
+        return self.result, self._context, self.chosen_candidate
+
+    def restore_result(self, snapshot: tuple) -> None:
+        self.result, self._context, self.chosen_candidate = snapshot
         self._changed()
 
     def _select(self, index: int) -> None:
