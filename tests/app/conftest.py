@@ -1,6 +1,7 @@
 """The live window shared by the window tests: the controller simulator as a child process on a pty,
-the simulated camera on its worker thread, a test bed with the robot's typical kinematic errors and the
-modelled camera mounting, images at 640 x 480 (the same workflow at a quarter of the rendering cost)."""
+the simulated camera on its worker thread, images at 640 x 480 (the same workflow at a quarter of the
+rendering cost). ``window`` has the robot's typical kinematic errors and the modelled camera mounting;
+``live_window`` makes one with other errors."""
 
 import pytest
 from PySide6.QtCore import QSettings
@@ -12,18 +13,29 @@ from calib_core.testbed.true_robot import RobotErrors
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
+def live_window(qtbot, tmp_path):
+    made = []
+
+    def make(errors: RobotErrors) -> MainWindow:
+        bed = TestBed.create(errors=errors)
+        bed.intrinsics = bed.intrinsics.scaled(0.5)
+        wb = Workbench(bed)
+        wb.start_simulated_controller()
+        win = MainWindow(wb, settings=QSettings(str(tmp_path / f"settings{len(made)}.ini"), QSettings.Format.IniFormat))
+        qtbot.addWidget(win)
+        win.resize(1500, 950)
+        win.start_camera(lambda: bed.camera(fps=10.0))
+        win.show()
+        qtbot.waitUntil(lambda: wb.link_up and win.camera.last_frame is not None, timeout=15_000)
+        made.append(win)
+        return win
+
+    yield make
+    for win in made:
+        win.close()
+
+
+@pytest.fixture
+def window(live_window):
     typical = RobotErrors.typical(0)
-    errors = RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
-    bed = TestBed.create(errors=errors)
-    bed.intrinsics = bed.intrinsics.scaled(0.5)
-    wb = Workbench(bed)
-    wb.start_simulated_controller()
-    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
-    qtbot.addWidget(win)
-    win.resize(1500, 950)
-    win.start_camera(lambda: bed.camera(fps=10.0))
-    win.show()
-    qtbot.waitUntil(lambda: wb.link_up, timeout=10_000)
-    yield win
-    win.close()
+    return live_window(RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))

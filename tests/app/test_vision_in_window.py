@@ -7,40 +7,35 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from PySide6.QtCore import QSettings, Qt
+from PySide6.QtCore import Qt
 
-from app.gui.main_window import MainWindow
 from app.gui.vision_panel import STILL_S
-from app.gui.workbench import Workbench
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
-from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
+def window(live_window):
     typical = RobotErrors.typical(0)
     # The robot's kinematics exact, the camera mounting not: what a hand-eye calibration can find.
-    bed = TestBed.create(errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
-    bed.intrinsics = bed.intrinsics.scaled(0.5)
-    wb = Workbench(bed)
-    wb.start_simulated_controller()
-    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
-    qtbot.addWidget(win)
-    win.resize(1500, 950)
-    win.start_camera(lambda: bed.camera(fps=10.0))
-    win.show()
-    qtbot.waitUntil(lambda: wb.link_up and win.camera.last_frame is not None, timeout=15_000)
-    yield win
-    win.close()
+    return live_window(RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
 
 
 def _fresh_still_frame(qtbot, win):
     """Wait until the camera shows a frame taken after the robot came to rest."""
     qtbot.waitUntil(lambda: win.vision.robot_is_still(win.camera.last_frame), timeout=10_000)
+
+
+def _visit_board_pose(qtbot, win, k: int) -> None:
+    """Next board pose (the k-th of the plan), wait for the robot there and a frame taken at rest."""
+    qtbot.mouseClick(win.vision.next_pose, Qt.MouseButton.LeftButton)
+    target = win.vision._plan[k]
+    qtbot.waitUntil(lambda: np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3, timeout=30_000)
+    qtbot.wait(int(STILL_S * 1000))
+    _fresh_still_frame(qtbot, win)
 
 
 def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
@@ -57,11 +52,7 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
 
     vision.show_board.setChecked(True)
     for k in range(8):
-        qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
-        target = vision._plan[k]
-        qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - target)) < 1e-3, timeout=30_000)
-        qtbot.wait(int(STILL_S * 1000))
-        _fresh_still_frame(qtbot, win)
+        _visit_board_pose(qtbot, win, k)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         assert len(vision.capture.views) == k + 1, vision.views.item(vision.views.count() - 1).text()
         if k == 0:
@@ -141,11 +132,7 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     vision.show_board.setChecked(True)
     win.start_recording(tmp_path / "board.mcap")
     for k in range(4):
-        qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
-        target = vision._plan[k]
-        qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - target)) < 1e-3, timeout=30_000)
-        qtbot.wait(int(STILL_S * 1000))
-        _fresh_still_frame(qtbot, win)
+        _visit_board_pose(qtbot, win, k)
         qtbot.wait(300)  # a few frames at rest into the recording
     win.stop_recording()
     plan = vision._plan[:4]

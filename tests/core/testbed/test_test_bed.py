@@ -10,7 +10,7 @@ import trimesh
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
-from calib_core.frames import apply, invert, make_transform, pose_difference
+from calib_core.frames import invert, make_transform, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.scene import SceneItem
 from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
