@@ -74,6 +74,8 @@ class CameraPane(QWidget):
         layout.addWidget(self.view, 1)
         self.last_frame = None  # the frame shown (held while frozen)
         self.last_frame_received = None  # the newest frame from the source, shown or not
+        self._board_corners: np.ndarray | None = None  # a board detection shown by the Vision mode
+        self._board_text = ""
         self._edges_image: np.ndarray | None = None
         self.view.clicked.connect(self._on_click)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
@@ -151,9 +153,8 @@ class CameraPane(QWidget):
                 overlay.image_opacity = self.opacity.value() / 100.0
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
-        corners = getattr(self, "_board_corners", None)
-        if corners is not None:
-            for u, v in corners:
+        if self._board_corners is not None:
+            for u, v in self._board_corners:
                 overlay.points.append((u, v, "", BOARD_COLOR))
             overlay.text = self._board_text
         self.view.set_overlay(overlay)

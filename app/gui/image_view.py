@@ -36,6 +36,25 @@ def qimage_from_array(array: np.ndarray) -> QImage:
     return QImage(a.data, w, h, a.strides[0], fmt).copy()
 
 
+class _Shrunk:
+    """An image shrunk to the size it is drawn at, kept until the image or that size changes. A
+    1280 x 960 camera frame drawn into a pane a third of its size costs Qt's smooth transform ~15 ms
+    a frame; OpenCV's area resize ~1 ms."""
+
+    def __init__(self) -> None:
+        self.clear()
+
+    def clear(self) -> None:
+        self._size: tuple[int, int] | None = None
+        self._image: QImage | None = None
+
+    def get(self, array: np.ndarray, width_px: int, height_px: int) -> QImage:
+        size = (max(1, width_px), max(1, height_px))
+        if self._image is None or self._size != size:
+            self._size, self._image = size, qimage_from_array(cv2.resize(array, size, interpolation=cv2.INTER_AREA))
+        return self._image
+
+
 class ImageView(QWidget):
     """Shows one image; emits ``clicked(u, v)`` in image pixels and ``hovered(u, v)``."""
 
@@ -50,10 +69,10 @@ class ImageView(QWidget):
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setMinimumSize(160, 120)
         self._qimage: QImage | None = None  # the full-size image, made when first needed
-        self._scaled: tuple[tuple, QImage] | None = None  # (key, image) shrunk to the size it is shown at
+        self._shrunk = _Shrunk()
         self._array: np.ndarray | None = None
         self._overlay_image: QImage | None = None
-        self._overlay_scaled: tuple[tuple, QImage] | None = None
+        self._overlay_shrunk = _Shrunk()
         self.overlay = Overlay()
         self.placeholder = placeholder
         self._zoom = 1.0  # relative to fit-to-window
@@ -68,7 +87,8 @@ class ImageView(QWidget):
             if self._array is None or (self._array.shape[1], self._array.shape[0]) != new_size:
                 self._centre = None
         self._array = array
-        self._qimage = self._scaled = None
+        self._qimage = None
+        self._shrunk.clear()
         self.update()
 
     @property
@@ -77,15 +97,6 @@ class ImageView(QWidget):
             self._qimage = qimage_from_array(self._array)
         return self._qimage
 
-    def _shown_image(self, width_px: int, height_px: int) -> QImage:
-        """The image shrunk to the size it is drawn at. A 1280 x 960 camera frame drawn into a pane a
-        third of its size costs Qt's smooth transform ~15 ms a frame; OpenCV's area resize ~1 ms."""
-        key = (width_px, height_px)
-        if self._scaled is None or self._scaled[0] != key:
-            small = cv2.resize(self._array, key, interpolation=cv2.INTER_AREA)
-            self._scaled = (key, qimage_from_array(small))
-        return self._scaled[1]
-
     @property
     def image_array(self) -> np.ndarray | None:
         return self._array
@@ -93,7 +104,7 @@ class ImageView(QWidget):
     def set_overlay(self, overlay: Overlay) -> None:
         self.overlay = overlay
         self._overlay_image = None if overlay.image is None else qimage_from_array(overlay.image)
-        self._overlay_scaled = None
+        self._overlay_shrunk.clear()
         self.update()
 
     def reset_view(self) -> None:
@@ -145,19 +156,16 @@ class ImageView(QWidget):
         s = self._scale()
         x0, y0 = self.image_to_widget(-0.5, -0.5)
         target = QRectF(x0, y0, self._image.width() * s, self._image.height() * s)
+        shown_w, shown_h = int(round(target.width())), int(round(target.height()))
         if s < 1.0:  # shown smaller than it is: draw it pre-shrunk, 1:1
-            shown = self._shown_image(max(1, int(round(target.width()))), max(1, int(round(target.height()))))
-            p.drawImage(target.topLeft(), shown)
+            p.drawImage(target.topLeft(), self._shrunk.get(self._array, shown_w, shown_h))
         else:
             p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, s < 2.0)
             p.drawImage(target, self._image)
         if self._overlay_image is not None:
             p.setOpacity(self.overlay.image_opacity)
             if s < 1.0:
-                key = (int(round(target.width())), int(round(target.height())))
-                if self._overlay_scaled is None or self._overlay_scaled[0] != key:
-                    self._overlay_scaled = (key, qimage_from_array(cv2.resize(self.overlay.image, (max(1, key[0]), max(1, key[1])), interpolation=cv2.INTER_AREA)))
-                p.drawImage(target.topLeft(), self._overlay_scaled[1])
+                p.drawImage(target.topLeft(), self._overlay_shrunk.get(self.overlay.image, shown_w, shown_h))
             else:
                 p.drawImage(target, self._overlay_image)
             p.setOpacity(1.0)

@@ -45,6 +45,7 @@ class MainWindow(QMainWindow):
         vision_scroll.setWidget(self.vision)
         self.commands.addTab(vision_scroll, "Vision")
         self._current_pair: int | None = None
+        self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self.solved_edges = SolvedEdges(workbench.intrinsics)
         self.worker: FrameWorker | None = None
         self.edges_drawn = 0
@@ -398,7 +399,7 @@ class MainWindow(QMainWindow):
             self._joints_dirty = True
 
     def _redraw_views(self) -> None:
-        if getattr(self, "_joints_dirty", False):
+        if self._joints_dirty:
             self._joints_dirty = False
             self.virtual.refresh_if_moved()
         self.overview.refresh()

@@ -23,6 +23,7 @@ class _OrbitView(ImageView):
         super().__init__(placeholder="rendering...")
         self.pane = pane
         self._orbit_from: QPointF | None = None
+        self._pan_from: QPointF | None = None
 
     def mousePressEvent(self, event):
         if event.button() == Qt.MouseButton.LeftButton:
@@ -37,7 +38,7 @@ class _OrbitView(ImageView):
             d = event.position() - self._orbit_from
             self._orbit_from = event.position()
             self.pane.orbit(-0.4 * d.x(), 0.3 * d.y())
-        elif getattr(self, "_pan_from", None) is not None:
+        elif self._pan_from is not None:
             d = event.position() - self._pan_from
             self._pan_from = event.position()
             self.pane.pan(d.x(), d.y())
@@ -73,6 +74,10 @@ class OverviewPane(QWidget):
         self.azimuth_deg, self.elevation_deg, self.distance_mm = -130.0, 32.0, 4300.0
         self.redraws = 0
         self._dirty = True
+        self._path: list[np.ndarray] = []  # joints still to show in an animation (play_path)
+        self._shown_joints: np.ndarray | None = None  # the animation's joints now shown, or None: the robot's
+        self._path_timer = QTimer(self)
+        self._path_timer.timeout.connect(self._path_step)
         workbench.session.subscribe(self.mark_dirty)
         workbench.scene_changed.connect(self.mark_dirty)
         workbench.session.pairs.subscribe(lambda *_: self.mark_dirty())
@@ -104,9 +109,6 @@ class OverviewPane(QWidget):
         """Animate the model robot along joint vectors (deg) in this pane only: the robot does not
         move and the other panes keep the real joints; at the end the pane shows them again."""
         self._path = list(joints_deg)
-        if getattr(self, "_path_timer", None) is None:
-            self._path_timer = QTimer(self)
-            self._path_timer.timeout.connect(self._path_step)
         self._path_timer.setInterval(interval_ms)
         self._path_timer.start()
 
@@ -130,7 +132,7 @@ class OverviewPane(QWidget):
             return
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
-        q = wb.joints_deg if getattr(self, "_shown_joints", None) is None else self._shown_joints
+        q = wb.joints_deg if self._shown_joints is None else self._shown_joints
         self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(q) + list(wb.bed.extra_items))
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if wb.session.result is not None:

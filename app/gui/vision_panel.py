@@ -170,9 +170,8 @@ class VisionPanel(QWidget):
         replaying = self.workbench.replaying
         if not replaying and not self.robot_is_still(frame):
             raise RuntimeError("the robot is moving: capture when it has stopped, so the image and the joints agree")
-        joints = None if (replaying or not self.workbench.link_up) else self.workbench.joints_deg.copy()
-        if replaying:
-            joints = self.workbench.joints_deg.copy()  # the recorded joints at this instant of the recording
+        # live: the joints the controller reports; replaying: the ones recorded with this frame
+        joints = self.workbench.joints_deg.copy() if (replaying or self.workbench.link_up) else None
         view = self.capture.add(frame.image, joints)
         if isinstance(view, RejectedView):
             self._show_corners(None, "")

@@ -285,9 +285,8 @@ class Workbench(QObject):
         self.recorder = None
 
     def record_frame(self, frame) -> None:
-        rec = getattr(self, "recorder", None)
-        if rec is not None:
-            rec.record_frame(frame.image, frame.t_host_s)
+        if self.recorder is not None:
+            self.recorder.record_frame(frame.image, frame.t_host_s)
 
     def _record_pairs_event(self, event: str, number) -> None:
         if self.recorder is None:

@@ -53,6 +53,7 @@ class RecordingPlayback:
         self._events = [m for m in contents.topic(EVENT_TOPIC) if str(m.payload.get("kind", "")).startswith("pair_")]
         self._event_times = [self._t(m) for m in self._events]
         self.solves = [RecordedSolve(int(m.payload.get("id", k + 1)), self._t(m), m.payload["inputs"], m.payload["result"], m.payload.get("context") or {}) for k, m in enumerate(contents.topic(SOLVE_TOPIC))]
+        self._solve_times = [s.t_s for s in self.solves]
         setups = contents.topic(SETUP_TOPIC)
         self.setup: dict = setups[0].payload if setups else {}
         self.duration_s = self._t(contents.messages[-1]) if contents.messages else 0.0
@@ -86,5 +87,5 @@ class RecordingPlayback:
 
     def solve_at(self, t_s: float) -> RecordedSolve | None:
         """The last solve at or before ``t_s``."""
-        i = bisect.bisect_right([s.t_s for s in self.solves], t_s) - 1
+        i = bisect.bisect_right(self._solve_times, t_s) - 1
         return None if i < 0 else self.solves[i]
