@@ -272,7 +272,10 @@ def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):
     view = win.camera.view
     image = np.zeros((480, 640, 3), np.uint8)
     image[240, 320] = (255, 0, 0)  # one red pixel to find in the loupe
-    win.camera.freeze.setChecked(False)
+    # No camera frame may replace this image before the grab: the worker stops, and frames it had already
+    # queued to the GUI thread are held off by Freeze.
+    win.worker.stop()
+    win.camera.freeze.setChecked(True)
     view.set_image(image)
     x, y = view.image_to_widget(320, 240)
     qtbot.mouseMove(view, QPoint(int(round(x)), int(round(y))))
