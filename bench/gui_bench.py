@@ -45,7 +45,7 @@ def main() -> str:
     from app.gui.workbench import Workbench
     from calib_core.camera.projection import project
     from calib_core.frames import apply, invert
-    from calib_core.testbed.test_bed import TestBed
+    from calib_core.testbed.sim_site import simulated_cell
     from calib_core.video.opencv_source import OpenCVSource
 
     tmp = Path(tempfile.mkdtemp(prefix="videocal-bench-"))
@@ -58,9 +58,8 @@ def main() -> str:
     ready_s = float(ready) - t0 if ready else float("nan")
 
     app = QApplication.instance() or QApplication([])
-    bed = TestBed.create()
-    wb = Workbench(bed)
-    wb.start_simulated_controller()
+    wb = Workbench(*simulated_cell())
+    wb.start_controller()
     win = MainWindow(wb, settings=QSettings(str(tmp / "s.ini"), QSettings.Format.IniFormat))
     win.resize(1600, 1000)
     video = tmp / "clip.avi"
@@ -91,7 +90,7 @@ def main() -> str:
     # 4. A pick to the solved overlays on screen: the last 2D pick of a complete set, then Calibrate.
     _spin(app, 3.0)  # the robot arrives at the approach pose
     fixture = wb.workcell.component("oru_1_fixture")
-    true_cam = bed.true_cam2world(wb.joints_deg)
+    true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     pick_ms, edges_ms = [], []
     for name in ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left"):
         p = apply(fixture.item2world, fixture.features[name])

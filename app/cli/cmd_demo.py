@@ -12,7 +12,9 @@ from pathlib import Path
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, default=Path("out/demo"), help="folder for the screenshots and report.json")
     parser.add_argument("--offscreen", action="store_true", help="no display needed: Qt's offscreen platform")
-    parser.add_argument("--scale", type=float, default=1.0, help="camera resolution relative to 1280 x 960")
+    parser.add_argument("--scale", type=float, default=1.0, help="camera resolution relative to the camera file's")
+    parser.add_argument("--workcell", type=Path, default=None, help="the cell to calibrate in (default: the bundled one)")
+    parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -20,7 +22,9 @@ def run(args: argparse.Namespace) -> int:
         os.environ["QT_QPA_PLATFORM"] = "offscreen"
     from app.gui.demo import run_demo
 
-    report = run_demo(args.out, scale=args.scale)
+    from calib_core.workcell import DEFAULT_WORKCELL
+
+    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location)
     print(json.dumps({k: report[k] for k in ("status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
     print(f"screenshots and report.json in {args.out}")
     return 0

@@ -1,10 +1,11 @@
-"""``videocal gui``: the operator's window with the bundled workcell, the controller simulator
-(a child process on a pty) and the simulated camera, ready to calibrate; or a real port and camera."""
+"""``videocal gui``: the operator's window on a cell (the bundled one by default): with the
+controller simulator and the simulated camera of that cell, or a real controller and camera."""
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -22,22 +23,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import subprocess
-    import tempfile
+    from calib_core.testbed.sim_site import SimulatorProcess
 
-    simulator = None
-    if not args.port:
-        # Start the controller simulator first: its start-up then overlaps the window's imports.
-        sim_dir = tempfile.TemporaryDirectory(prefix="videocal-sim-")
-        simulator = (subprocess.Popen(
-            [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(Path(sim_dir.name) / "controller")],
-            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=str(Path(__file__).resolve().parents[2]),
-        ), Path(sim_dir.name) / "controller")
+    simulated = not args.port
+    if args.camera and simulated:
+        from calib_core.errors import VideocalError
+
+        raise VideocalError("--camera needs --port: a real camera belongs to a real controller (the simulated cell brings its own camera)")
+    # Start the controller simulator first: its start-up then overlaps the window's imports. It dies with us.
+    simulator = SimulatorProcess(args.workcell) if simulated else None
+    try:
+        return _run_window(args, simulator)
+    finally:
+        if simulator is not None:
+            simulator.stop()
+
+
+def _run_window(args: argparse.Namespace, simulator) -> int:
     from PySide6.QtCore import Qt, QTimer
     from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("videocal")
+    # SIGTERM and Ctrl+C close the window like Quit does (so the simulator and the link stop with it).
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        signal.signal(sig, lambda *_: app.quit())
+    wake = QTimer()
+    wake.start(200)  # lets Python run its signal handlers while Qt's loop waits
+    wake.timeout.connect(lambda: None)
     # A window on screen at once; the workcell, robot, renderers and link load behind it (several seconds
     # of imports and set-up on a small machine).
     shell = QMainWindow()
@@ -54,29 +67,27 @@ def run(args: argparse.Namespace) -> int:
 
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
-    from calib_core.testbed.test_bed import TestBed
-    from calib_core.workcell import load_workcell
+    from calib_core.operator.cell import Cell
+    from calib_core.operator.site import RealSite
 
-    bed = TestBed.create(load_workcell(args.workcell))
-    workbench = Workbench(bed)
-    if args.hand_eye is not None:
-        workbench.apply_hand_eye_file(args.hand_eye)
-    if args.port:
-        workbench.connect_link(args.port)
-    else:
-        workbench.start_simulated_controller(simulator)
-    window = MainWindow(workbench)
-    if args.camera:
-        from calib_core.video.folder_source import ImageFolderSource
-        from calib_core.video.opencv_source import OpenCVSource
+    if simulator is not None:
+        from calib_core.testbed.sim_site import simulated_cell
 
-        spec = args.camera
-        if Path(spec).is_dir():
-            window.start_camera(lambda: ImageFolderSource(spec, loop=True))
-        else:
-            window.start_camera(lambda: OpenCVSource(int(spec) if spec.isdigit() else spec))
+        cell, site = simulated_cell(args.workcell, process=simulator)
     else:
-        window.start_camera(lambda: bed.camera(intrinsics=bed.intrinsics, fps=15.0))
+        cell, site = Cell.open(args.workcell), RealSite(args.port, args.camera)
+    workbench = Workbench(cell, site)
+    try:
+        if args.hand_eye is not None:
+            workbench.apply_hand_eye_file(args.hand_eye)
+        workbench.start_controller()
+        window = MainWindow(workbench)
+    except BaseException:
+        workbench.close()
+        raise
+    camera = site.camera_factory()
+    if camera is not None:
+        window.start_camera(camera)
     window.setGeometry(shell.geometry())
     window.show()
     if args.recording is not None:
@@ -92,4 +103,7 @@ def run(args: argparse.Namespace) -> int:
             app.quit()
 
         QTimer.singleShot(4000, shoot)
-    return int(app.exec())
+    code = int(app.exec())
+    if window.isVisible():  # quit by a signal: close as Quit does
+        window.close()
+    return code

@@ -18,8 +18,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     where.add_argument("--pty", action="store_true", help="serve on a new pseudo-terminal and print its path")
     where.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT (0 picks a free port)")
     parser.add_argument("--link", type=Path, help="with --pty: keep a symlink at this path to the current pty (stable across --reboot-after)")
-    parser.add_argument("--robot", choices=("bundled", "plain"), default="bundled", help="joint limits and speeds of the bundled arm, or a plain joint-space model")
-    parser.add_argument("--joints", help="initial joints, six values in degrees separated by commas (default: home)")
+    parser.add_argument("--workcell", type=Path, help="simulate the controller of this cell's robot: its joint count, limits, speeds, axis order and home (default: the bundled cell)")
+    parser.add_argument("--robot", choices=("cell", "plain"), default="cell", help="the cell's robot (default), or a plain six-axis joint-space model")
+    parser.add_argument("--joints", help="initial joints in the controller's axis order, degrees or mm, separated by commas (default: the cell's home)")
     parser.add_argument("--noise-rate", type=float, default=0.0, help="probability of random garbage bytes before a sentence")
     parser.add_argument("--corrupt-rate", type=float, default=0.0, help="probability of a flipped byte in a sentence")
     parser.add_argument("--drop-rate", type=float, default=0.0, help="probability that a sentence is not sent")
@@ -40,20 +41,28 @@ def run(args: argparse.Namespace) -> int:
     if args.tcp is not None and not (0 <= args.tcp <= 65535):
         raise VideocalError(f"--tcp: not a port number: {args.tcp}")
     faults = FaultInjector(args.noise_rate, args.corrupt_rate, args.drop_rate, args.seed)
-    if args.robot == "bundled":
-        from calib_core.robot import load_robot
+    if args.robot == "cell":
+        from calib_core.link.joint_map import ControllerJointModel, JointMap
+        from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
-        model = load_robot()
+        cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+        robot = cell.load_robot()
+        joint_map = JointMap.for_robot(robot.joint_names, cell.robot_spec.controller)
+        model = ControllerJointModel.of(robot, joint_map)
+        initial = joint_map.to_controller(cell.home_joints_deg)
     else:
+        if args.workcell is not None:
+            raise VideocalError("--workcell applies to --robot cell")
         model = PlainJointModel()
-    initial = np.zeros(6)
+        initial = np.zeros(6)
     if args.joints:
         try:
-            initial = np.array([float(v) for v in args.joints.split(",")])
+            values = np.array([float(v) for v in args.joints.split(",")])
         except ValueError:
-            raise VideocalError(f"--joints: expected six numbers in degrees, got {args.joints!r}") from None
-        if initial.shape != (6,):
-            raise VideocalError(f"--joints: expected six numbers in degrees, got {len(initial)}")
+            raise VideocalError(f"--joints: expected {len(initial)} numbers separated by commas, got {args.joints!r}") from None
+        if values.shape != initial.shape:
+            raise VideocalError(f"--joints: the robot has {len(initial)} joints, got {len(values)} values")
+        initial = values
     stop = {"flag": False}
 
     def on_signal(signum, frame):

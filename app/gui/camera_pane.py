@@ -80,8 +80,8 @@ class CameraPane(QWidget):
         self.view.clicked.connect(self._on_click)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
         self.opacity.valueChanged.connect(lambda _: self.refresh_overlay())
-        workbench.session.pairs.subscribe(lambda *_: self.refresh_overlay())
-        workbench.session.subscribe(self._on_solved)
+        workbench.session.pairs.changed.connect(lambda *_: self.refresh_overlay())
+        workbench.session.changed.connect(self._on_solved)
 
     def show_frame(self, frame) -> None:
         self.last_frame_received = frame

@@ -1,8 +1,10 @@
-"""``videocal demo``: drive the real window through a whole calibration at the paper's task location.
+"""``videocal demo``: drive the real window through a whole calibration at a task location of any cell
+(by default the bundled cell and the paper's task location).
 
 The simulated operator clicks the panes' widgets like a person would: at the task location it picks each
 feature in the virtual camera, zooms the camera image around the same feature and clicks it (sub-pixel
-refinement on corners), accepts, calibrates and stores the correction; then it moves to the corrected
+refinement on corners), accepts, calibrates and stores the correction; the features are those of the task's
+component that the camera sees; then it moves to the corrected
 location, looks again the same way, stores the refined correction and moves there. Where the
 features are in the camera image it learns from the test bed's truth, as a person learns it by looking.
 A PNG of the window is written after each step, and ``report.json`` with the figures.
@@ -23,10 +25,30 @@ from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot import solve_ik
-from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.sim_site import simulated_cell
 from calib_core.testbed.true_robot import RobotErrors
+from calib_core.workcell import DEFAULT_WORKCELL
 
-FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left", "boss_top_right", "boss_bottom_right", "boss_bottom_left")
+_MIN_FEATURES = 4
+_EDGE_MARGIN_PX = 12.0
+
+
+def _is_corner(name: str) -> bool:
+    """Features the demo's operator refines to sub-pixel (cornerSubPix): sharp corners by name."""
+    return name.startswith("plate") or "corner" in name
+
+
+def _visible_features(component, cam2world: np.ndarray, intrinsics) -> list[str]:
+    """Features of ``component`` in front of the camera and inside the image (by their projection)."""
+    names = []
+    for name, point in component.features.items():
+        p_cam = apply(invert(cam2world), apply(component.item2world, point)[None])
+        if p_cam[0, 2] <= 1.0:
+            continue
+        u, v = project(p_cam, intrinsics)[0]
+        if _EDGE_MARGIN_PX <= u <= intrinsics.width - 1 - _EDGE_MARGIN_PX and _EDGE_MARGIN_PX <= v <= intrinsics.height - 1 - _EDGE_MARGIN_PX:
+            names.append(name)
+    return names
 
 
 def _wait(app: QApplication, condition, timeout_s: float, what: str) -> None:
@@ -58,23 +80,29 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
     _click(view, *view.image_to_widget(u, v))
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
+def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None) -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
+    from calib_core.workcell import load_workcell
 
     out_dir.mkdir(parents=True, exist_ok=True)
     app = QApplication.instance() or QApplication([])
-    # One view cannot see an error in the camera's mounting: until the hand-eye calibration (issue #7) exists
-    # the demo's true robot keeps its joint, link and base errors but has the modelled camera mounting.
-    typical = RobotErrors.typical(0)
-    bed = TestBed.create(errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
-    if scale != 1.0:
-        bed.intrinsics = bed.intrinsics.scaled(scale)
-    wb = Workbench(bed)
-    wb.start_simulated_controller()
+    # One view cannot see an error in the camera's mounting (a hand-eye calibration takes the robot's kinematics
+    # as exact): the demo's true robot has typical joint, link and base errors and the modelled camera mounting.
+    n_joints = load_workcell(workcell).load_robot().n_joints
+    typical = RobotErrors.typical(0, n_joints=n_joints)
+    cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale)
+    bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
+    wb = Workbench(cell, site)
+    if location is not None:
+        wb.set_task(location)
+    if wb.task is None or wb.task.component is None:
+        wb.close()
+        raise ValueError(f"{workcell}: the demo needs a task location with a component to look at (task_locations[].component)")
+    wb.start_controller()
     win = MainWindow(wb, settings=QSettings(str(out_dir / "settings.ini"), QSettings.Format.IniFormat))
     win.resize(1600, 1000)
-    win.start_camera(lambda: bed.camera(fps=15.0))
+    win.start_camera(site.camera_factory())
     win.show()
     shots = []
 
@@ -84,6 +112,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
         win.grab().save(str(path))
         shots.append(path.name)
 
+    skipped: list[str] = []
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
         shot("start")
@@ -106,18 +135,27 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
                 _click(win.commands.clear, 10, 10)
             fixture = wb.workcell.component(wb.session.target)
             model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
-            for name in FEATURES:
+            names = [n for n in _visible_features(fixture, model_cam, wb.intrinsics) if n in _visible_features(fixture, true_cam, wb.intrinsics)]
+            picked = []
+            for name in names:
                 p_world = apply(fixture.item2world, fixture.features[name])
                 uv_model = project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0]
                 _click_image(win.virtual.view, *uv_model)
-                if wb.session.pairs.pending() is None:
-                    raise RuntimeError(f"demo: the pick of {name} in the virtual camera did not take: {win.virtual.info.text()}")
+                pending = wb.session.pairs.pending()
+                if pending is None or pending.feature != name:
+                    if pending is not None:
+                        wb.session.delete(pending.number)
+                    skipped.append(f"{round_name}: {name} ({win.virtual.info.text() or 'hidden in the virtual camera'})")
+                    continue
+                picked.append(name)
                 uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
-                win.camera.subpixel.setChecked(name.startswith("plate"))
+                win.camera.subpixel.setChecked(_is_corner(name))
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
                 win.camera.view.reset_view()
                 win._accept()
                 app.processEvents()
+            if len(picked) < _MIN_FEATURES:
+                raise RuntimeError(f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} ({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}")
             shot(f"{round_name}_pairs_picked")
             _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
@@ -151,7 +189,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0) -> dict:
         q_plain = solve_ik(wb.robot, task.tcp2base, wb.joints_deg).q_deg
         plain_d, plain_r = pose_difference(bed.true_robot.fk(q_plain), task.tcp2base)
         report = {
+            "workcell": str(Path(workcell).resolve()),
+            "robot_joints": n_joints,
             "task_location": task.name,
+            "target": wb.session.target,
+            "features_skipped": skipped,
             "status": r.solution.status.value,
             "pairs": len(wb.session.pairs.usable()),
             "rms_px": r.solution.rms_px,

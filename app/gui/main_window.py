@@ -172,10 +172,10 @@ class MainWindow(QMainWindow):
         wb.camera_model_changed.connect(self._camera_model_changed)
         wb.link_state.connect(self.status_line.show_link_state)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
-        wb.session.undo.subscribe(self._update_actions)
-        wb.session.pairs.subscribe(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
-        wb.session.corrections.subscribe(lambda task: self._update_corrections())
-        wb.session.subscribe(self._after_solve)
+        wb.session.undo.changed.connect(self._update_actions)
+        wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
+        wb.session.corrections.changed.connect(lambda task: self._update_corrections())
+        wb.session.changed.connect(self._after_solve)
         self._update_actions()
 
     def _quit(self) -> None:
@@ -206,7 +206,7 @@ class MainWindow(QMainWindow):
     def start_camera(self, make_source) -> None:
         self.worker = FrameWorker(make_source, self)
         self.worker.frame.connect(self.camera.show_frame)
-        self.worker.frame.connect(self.workbench.record_frame)
+        self.worker.frame.connect(self.workbench.observe_frame)
         self.worker.failed.connect(self.show_error)
         self.worker.start()
 

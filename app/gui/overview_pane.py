@@ -78,9 +78,9 @@ class OverviewPane(QWidget):
         self._shown_joints: np.ndarray | None = None  # the animation's joints now shown, or None: the robot's
         self._path_timer = QTimer(self)
         self._path_timer.timeout.connect(self._path_step)
-        workbench.session.subscribe(self.mark_dirty)
+        workbench.session.changed.connect(self.mark_dirty)
         workbench.scene_changed.connect(self.mark_dirty)
-        workbench.session.pairs.subscribe(lambda *_: self.mark_dirty())
+        workbench.session.pairs.changed.connect(lambda *_: self.mark_dirty())
 
     def orbit(self, d_azimuth: float, d_elevation: float) -> None:
         self.azimuth_deg += d_azimuth
@@ -133,7 +133,7 @@ class OverviewPane(QWidget):
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
         q = wb.joints_deg if self._shown_joints is None else self._shown_joints
-        self.renderer.set_items(wb.workcell.components + wb.bed.visuals_for_model().scene_items(q) + list(wb.bed.extra_items))
+        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.scene_extras))
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if wb.session.result is not None:
             lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))

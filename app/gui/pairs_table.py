@@ -24,8 +24,8 @@ class PairsTable(QTableWidget):
         self.horizontalHeader().setStretchLastSection(True)
         self._updating = False
         self.itemChanged.connect(self._on_item_changed)
-        workbench.session.pairs.subscribe(lambda *_: self.refresh())
-        workbench.session.subscribe(self.refresh)
+        workbench.session.pairs.changed.connect(lambda *_: self.refresh())
+        workbench.session.changed.connect(self.refresh)
 
     def selected_number(self) -> int | None:
         rows = self.selectionModel().selectedRows()

@@ -86,7 +86,7 @@ class ReplayBar(QWidget):
         self._timer.setInterval(33)
         self._timer.timeout.connect(self._tick)
         self._set_play_icon()
-        workbench.session.undo.subscribe(self._on_edit)
+        workbench.session.undo.changed.connect(self._on_edit)
         self.hide()
 
     # --- opening and closing -------------------------------------------------------------------
@@ -108,9 +108,8 @@ class ReplayBar(QWidget):
             s = self.workbench.session
             self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.workbench.intrinsics)
         # Picks and solves on the recorded frames need the camera they were recorded with.
-        if recorded_intrinsics is not None and recorded_intrinsics != self.workbench.intrinsics:
-            self.workbench.intrinsics = recorded_intrinsics
-            self.workbench.camera_model_changed.emit()
+        if recorded_intrinsics is not None:
+            self.workbench.use_intrinsics(recorded_intrinsics)
         self.playback, self.path = playback, path
         self.workbench.replaying = True
         self.branched_at_s = None
@@ -135,9 +134,8 @@ class ReplayBar(QWidget):
             return
         self.pause()
         branched = self.branched_at_s is not None
-        if self._live_state is not None and self._live_state[2] != self.workbench.intrinsics:
-            self.workbench.intrinsics = self._live_state[2]  # the live camera's, whatever the recording used
-            self.workbench.camera_model_changed.emit()
+        if self._live_state is not None:
+            self.workbench.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
         if not branched and self._live_state is not None:
             pairs, result, _ = self._live_state
             s = self.workbench.session

@@ -72,7 +72,7 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.details)
         layout.addLayout(self.candidates)
         layout.addWidget(self.chart, 1)
-        workbench.session.subscribe(self.refresh)
+        workbench.session.changed.connect(self.refresh)
 
     def _choose(self, index: int, *_) -> None:
         self.candidate_chosen.emit(index)

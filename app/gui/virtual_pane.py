@@ -41,8 +41,8 @@ class VirtualPane(QWidget):
         layout.addWidget(self.view, 1)
         self.intrinsics = workbench.intrinsics.without_distortion().scaled(RENDER_SCALE)
         self.view.clicked.connect(self._on_click)
-        workbench.session.pairs.subscribe(lambda *_: self.refresh())
-        workbench.session.subscribe(self.refresh)
+        workbench.session.pairs.changed.connect(lambda *_: self.refresh())
+        workbench.session.changed.connect(self.refresh)
         workbench.camera_model_changed.connect(self._camera_model_changed)
         workbench.scene_changed.connect(self.refresh)
         self._last_joints = None
@@ -57,9 +57,9 @@ class VirtualPane(QWidget):
     def refresh(self) -> None:
         """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
         wb = self.workbench
-        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, tuple(item.name for item in wb.bed.extra_items))
+        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, tuple(item.name for item in wb.scene_extras))
         if key != self._render_key:
-            items = wb.workcell.components + wb.bed.visuals_for_model().scene_items(wb.joints_deg) + list(wb.bed.extra_items)
+            items = wb.workcell.components + wb.cell.model_visuals().scene_items(wb.joints_deg) + list(wb.scene_extras)
             self.renderer.set_items(items)
             # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
             # cover the very surface points the picker tests for visibility.

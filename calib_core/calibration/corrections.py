@@ -3,6 +3,8 @@ effector from the model, with its history, and the corrected target to command."
 
 from __future__ import annotations
 
+from psygnal import Signal
+
 import time
 from dataclasses import dataclass, field
 
@@ -39,26 +41,22 @@ class Correction:
 
 
 class CorrectionTable:
-    """Corrections per task location, oldest first; listeners hear every change."""
+    """Corrections per task location, oldest first. Event: ``changed(task)`` on every add or removal."""
+
+    changed = Signal(str)
 
     def __init__(self) -> None:
         self._table: dict[str, list[Correction]] = {}
-        self._listeners = []
-
-    def subscribe(self, listener) -> None:
-        self._listeners.append(listener)
 
     def add(self, correction: Correction) -> None:
         self._table.setdefault(correction.task, []).append(correction)
-        for listener in list(self._listeners):
-            listener(correction.task)
+        self.changed.emit(correction.task)
 
     def remove_last(self, task: str) -> Correction:
         c = self._table[task].pop()
         if not self._table[task]:
             del self._table[task]
-        for listener in list(self._listeners):
-            listener(task)
+        self.changed.emit(task)
         return c
 
     def history(self, task: str) -> list[Correction]:

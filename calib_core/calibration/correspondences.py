@@ -8,7 +8,8 @@ Listeners are told of every change; panes subscribe and never reach into each ot
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from psygnal import Signal
+
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -39,20 +40,19 @@ class Correspondence:
 
 class CorrespondenceSet:
     """The ordered pairs of a calibration. Edits go through the commands in
-    :mod:`calib_core.calibration.commands` so they can be undone."""
+    :mod:`calib_core.calibration.commands` so they can be undone.
+
+    Event: ``changed(event, number)``, event ``added``, ``removed``, ``changed`` or ``reset``
+    (``number`` None for a reset)."""
+
+    changed = Signal(str, object)
 
     def __init__(self) -> None:
         self._pairs: list[Correspondence] = []
-        self._listeners: list[Callable[[str, int | None], None]] = []
         self._next_number = 1
 
-    def subscribe(self, listener: Callable[[str, int | None], None]) -> None:
-        """``listener(event, number)``: event ``added``, ``removed``, ``changed`` or ``reset``."""
-        self._listeners.append(listener)
-
     def _emit(self, event: str, number: int | None) -> None:
-        for listener in list(self._listeners):
-            listener(event, number)
+        self.changed.emit(event, number)
 
     def __len__(self) -> int:
         return len(self._pairs)

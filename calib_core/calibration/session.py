@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from psygnal import Signal
+
 import numpy as np
 
 from calib_core.calibration.commands import AddPoint3D, ClearPairs, DeletePair, SetEnabled, SetPixel
@@ -16,12 +18,13 @@ from calib_core.calibration.correspondences import CorrespondenceSet
 from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution
 from calib_core.calibration.undo import Command, UndoStack
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.errors import VideocalError
 from calib_core.frames import apply, invert
 from calib_core.recording.replay import solve_inputs
 from calib_core.solver import SolveStatus, solve_pose
 
 
-class CalibrationError(ValueError):
+class CalibrationError(VideocalError, ValueError):
     """A calibration step that cannot be taken now; the message says what to do instead."""
 
 
@@ -55,15 +58,12 @@ class CalibrationSession:
     chosen_candidate: int = 0
     _context: tuple | None = None
     last_solve_inputs: dict | None = None
-    _listeners: list = field(default_factory=list)
 
-    def subscribe(self, listener) -> None:
-        """``listener()`` after every solve, candidate choice or target change."""
-        self._listeners.append(listener)
+    changed = Signal()
+    """After every solve, candidate choice, cleared result or target change."""
 
     def _changed(self) -> None:
-        for listener in list(self._listeners):
-            listener()
+        self.changed.emit()
 
     @property
     def required_pairs(self) -> int:
@@ -171,7 +171,7 @@ class CalibrationSession:
         if r.solution.status is SolveStatus.FAILED:
             raise CalibrationError(f"the last solve failed ({r.solution.reason}); nothing to store")
         _, _, _, joints, numbers = self._context
-        correction = Correction(task, r.tcp2base_model, r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg, np.zeros(6) if joints is None else joints, r.solution.rms_px, len(numbers), source=source or f"pairs {', '.join(map(str, numbers))}")
+        correction = Correction(task, r.tcp2base_model, r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg, np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source or f"pairs {', '.join(map(str, numbers))}")
         self.undo.push(_StoreCorrection(self.corrections, correction))
         return correction
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from psygnal import Signal
 
 
 class Command:
@@ -18,20 +18,18 @@ class Command:
 
 
 class UndoStack:
-    """Executes commands and keeps them for undo and redo; listeners hear every change."""
+    """Executes commands and keeps them for undo and redo. Event: ``changed()`` after every push,
+    undo, redo or clear."""
+
+    changed = Signal()
 
     def __init__(self, limit: int = 500):
         self._done: list[Command] = []
         self._undone: list[Command] = []
         self._limit = limit
-        self._listeners: list[Callable[[], None]] = []
-
-    def subscribe(self, listener: Callable[[], None]) -> None:
-        self._listeners.append(listener)
 
     def _changed(self) -> None:
-        for listener in list(self._listeners):
-            listener()
+        self.changed.emit()
 
     def push(self, command: Command) -> None:
         """Do ``command`` and record it (clears the redo history)."""

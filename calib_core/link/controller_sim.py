@@ -15,6 +15,7 @@ import numpy as np
 
 from calib_core.link.joint_motion import JointModel, PlainJointModel, TrapezoidMove
 from calib_core.link.protocol import (
+    PROTOCOL_VERSION,
     SEQ_MODULUS,
     Ack,
     Done,
@@ -24,8 +25,10 @@ from calib_core.link.protocol import (
     ProtocolError,
     RequestJoints,
     RequestState,
+    RequestVersion,
     StateReport,
     Stream,
+    VersionReport,
     parse_body,
 )
 
@@ -44,7 +47,10 @@ class ControllerLogic:
         self.model = joint_model or PlainJointModel()
         self.clock = clock
         self.t_start = clock()
-        self.joints_deg = np.zeros(6) if initial_deg is None else np.asarray(initial_deg, dtype=float).copy()
+        n = len(np.asarray(self.model.lower_limits_deg))
+        self.joints_deg = np.zeros(n) if initial_deg is None else np.asarray(initial_deg, dtype=float).copy()
+        if self.joints_deg.shape != (n,):
+            raise ValueError(f"the controller drives {n} joints; initial joints have {self.joints_deg.size} values")
         self.move: TrapezoidMove | None = None
         self.move_id: str | None = None
         self.stream_hz = 0.0
@@ -84,13 +90,17 @@ class ControllerLogic:
                 self.stream_hz = msg.hz
                 self._next_stream_t = now
                 out.append(Ack("STR", "-"))
+        elif isinstance(msg, RequestVersion):
+            out.append(VersionReport(PROTOCOL_VERSION, len(self.joints_deg)))
         elif isinstance(msg, MoveJoints):
             goal = np.asarray(msg.joints_deg, dtype=float)
             lo, hi = np.asarray(self.model.lower_limits_deg), np.asarray(self.model.upper_limits_deg)
-            bad = np.flatnonzero((goal < lo) | (goal > hi))
-            if len(bad):
+            bad = np.flatnonzero((goal < lo) | (goal > hi)) if goal.shape == lo.shape else []
+            if goal.shape != lo.shape:
+                out.append(ErrorReply("SYNTAX", f"move {msg.id}: {goal.size} joint values for a robot of {lo.size}"))
+            elif len(bad):
                 j = int(bad[0])
-                out.append(ErrorReply("LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} deg outside [{lo[j]:.1f}; {hi[j]:.1f}]"))
+                out.append(ErrorReply("LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} outside [{lo[j]:.1f}; {hi[j]:.1f}]"))
             elif self.move is not None:
                 out.append(ErrorReply("BUSY", f"move {msg.id}: still executing move {self.move_id}"))
             else:

@@ -22,7 +22,6 @@ import serial
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
 from calib_core.link.protocol import (
-    N_JOINTS,
     SEQ_MODULUS,
     Ack,
     Done,
@@ -32,8 +31,10 @@ from calib_core.link.protocol import (
     ProtocolError,
     RequestJoints,
     RequestState,
+    RequestVersion,
     StateReport,
     Stream,
+    VersionReport,
     encode,
     parse_body,
 )
@@ -46,14 +47,17 @@ MODES = ("poll", "stream")
 class ControllerLink:
     """A link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
     ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
-    at least 0.25 s). Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
+    at least 0.25 s); ``n_joints``: how many joints the robot has (samples with another count are
+    counted in ``stats.wrong_joint_count`` and not delivered; ``None`` takes any count).
+    Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
 
-    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, **serial_settings):
+    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None, **serial_settings):
         if mode not in MODES:
             raise ValueError(f"mode must be 'poll' or 'stream', got {mode!r}")
         if not (0 < rate_hz <= 250):
             raise ValueError(f"rate must lie in (0, 250] Hz, got {rate_hz}")
         self.url = url
+        self.n_joints = n_joints
         self.mode = mode
         self.rate_hz = float(rate_hz)
         self.stale_after_s = stale_after_s if stale_after_s is not None else max(5.0 / rate_hz, 0.25)
@@ -75,6 +79,7 @@ class ControllerLink:
         self._moves: dict[str, MoveHandle] = {}
         self._awaiting_ack: deque[MoveHandle] = deque()
         self._state_reports: deque[StateReport] = deque(maxlen=16)
+        self._version_reports: deque[VersionReport] = deque(maxlen=4)
         self._state_event = threading.Condition(self._lock)
         self._ids = itertools.count(1)
         self._port: serial.SerialBase | None = None
@@ -146,8 +151,8 @@ class ControllerLink:
     def move_joints(self, joints_deg, *, timeout_s: float = 60.0) -> MoveHandle:
         """Send ``$MVJ`` and return its handle at once."""
         q = tuple(float(v) for v in joints_deg)
-        if len(q) != N_JOINTS:
-            raise ValueError(f"a move needs {N_JOINTS} joint values, got {len(q)}")
+        if self.n_joints is not None and len(q) != self.n_joints:
+            raise ValueError(f"a move needs {self.n_joints} joint values, got {len(q)}")
         handle = MoveHandle(f"m{next(self._ids)}", q, time.monotonic() + timeout_s)
         with self._lock:
             self._moves[handle.id] = handle
@@ -168,6 +173,16 @@ class ControllerLink:
         with self._state_event:
             self._state_event.wait_for(lambda: bool(self._state_reports), timeout_s)
             return self._state_reports.popleft() if self._state_reports else None
+
+    def request_version(self, timeout_s: float = 1.0) -> VersionReport | None:
+        """Ask ``$VER``: the controller's protocol version and joint count (``None`` on timeout;
+        a version-1 controller answers ``ERR,UNKNOWN``, which counts in ``stats.errors``)."""
+        with self._lock:
+            self._version_reports.clear()
+        self._send(RequestVersion().body())
+        with self._state_event:
+            self._state_event.wait_for(lambda: bool(self._version_reports), timeout_s)
+            return self._version_reports.popleft() if self._version_reports else None
 
     def wait_for_samples(self, count: int, timeout_s: float) -> bool:
         """Block until ``count`` samples have been delivered in all (``stats.samples``)."""
@@ -296,6 +311,11 @@ class ControllerLink:
                     self._field_errors += 1
             return False
         if isinstance(msg, JointSample):
+            if self.n_joints is not None and len(msg.joints_deg) != self.n_joints:
+                with self._lock:
+                    self.stats.wrong_joint_count += 1
+                self.last_error = f"the controller reports {len(msg.joints_deg)} joints, the robot has {self.n_joints}: is this the cell's controller?"
+                return False
             self._deliver(TimedSample(msg, t_host))
             return True
         if isinstance(msg, Ack) and msg.cmd == "MVJ":
@@ -322,6 +342,10 @@ class ControllerLink:
         elif isinstance(msg, StateReport):
             with self._state_event:
                 self._state_reports.append(msg)
+                self._state_event.notify_all()
+        elif isinstance(msg, VersionReport):
+            with self._state_event:
+                self._version_reports.append(msg)
                 self._state_event.notify_all()
         return False
 

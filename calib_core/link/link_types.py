@@ -38,7 +38,7 @@ class TimedSample:
 class LinkStats:
     """Counters since the link started. Sentences: ``sentences`` verified, ``garbage_bytes``,
     ``bad_checksum``, ``too_long``, ``malformed`` (framing or fields), ``non_finite``,
-    ``unknown`` types. Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
+    ``unknown`` types, ``wrong_joint_count`` (samples for another robot). Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
     jumped) and ``missing_samples`` (how many it skipped). Link: ``reconnects``, ``errors``
     (ERR replies and callback failures)."""
 
@@ -49,6 +49,7 @@ class LinkStats:
     malformed: int = 0
     non_finite: int = 0
     unknown: int = 0
+    wrong_joint_count: int = 0
     samples: int = 0
     seq_gaps: int = 0
     missing_samples: int = 0
@@ -82,15 +83,36 @@ class MoveHandle:
         self.acked = False
         self._event = threading.Event()
         self._error: MoveError | None = None
+        self._callbacks: list = []
+        self._callback_lock = threading.Lock()
 
     @property
     def finished(self) -> bool:
         return self._event.is_set()
 
+    @property
+    def error(self) -> MoveError | None:
+        """Why the move failed, once it has finished (``None`` while running or when it arrived)."""
+        return self._error
+
+    def on_finished(self, callback) -> None:
+        """``callback(handle)`` once the move has ended (done, refused, timed out), on the link's
+        reader thread; at once if it has already ended."""
+        with self._callback_lock:
+            if not self._event.is_set():
+                self._callbacks.append(callback)
+                return
+        callback(self)
+
     def _finish(self, error: MoveError | None = None) -> None:
-        if not self._event.is_set():
+        with self._callback_lock:
+            if self._event.is_set():
+                return
             self._error = error
             self._event.set()
+            callbacks, self._callbacks = self._callbacks, []
+        for callback in callbacks:
+            callback(self)
 
     def wait(self, timeout: float | None = None) -> None:
         """Block until the move is done (at most ``timeout`` s, then :class:`MoveTimeout`)."""

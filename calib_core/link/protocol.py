@@ -10,9 +10,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-MAX_SENTENCE_BYTES = 128
+PROTOCOL_VERSION = 2
+# Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences.
+MAX_SENTENCE_BYTES = 256
+MAX_JOINTS = 16
 SEQ_MODULUS = 2**32
-N_JOINTS = 6
 
 
 class ProtocolError(ValueError):
@@ -49,8 +51,8 @@ def format_angle(deg: float) -> str:
 # --- messages from the controller ------------------------------------------------------------
 @dataclass(frozen=True)
 class JointSample:
-    """``$JNT,<seq>,<t_ms>,<q1>,...,<q6>``: a joint sample. ``seq`` counts up and wraps at 2^32;
-    ``t_ms`` is the controller's clock; ``joints_deg`` (6,) degrees."""
+    """``$JNT,<seq>,<t_ms>,<q1>,...,<qn>``: a joint sample. ``seq`` counts up and wraps at 2^32;
+    ``t_ms`` is the controller's clock; ``joints_deg`` (n,) deg or mm, in the controller's axis order."""
 
     seq: int
     t_ms: int
@@ -124,13 +126,32 @@ class Stream:
 
 @dataclass(frozen=True)
 class MoveJoints:
-    """``$MVJ,<id>,<q1>,...,<q6>``: move to these joints (degrees)."""
+    """``$MVJ,<id>,<q1>,...,<qn>``: move to these joints (deg or mm, the controller's axis order)."""
 
     id: str
     joints_deg: tuple[float, ...]
 
     def body(self) -> str:
         return ",".join(["MVJ", self.id] + [format_angle(q) for q in self.joints_deg])
+
+
+@dataclass(frozen=True)
+class RequestVersion:
+    """``$VER``: which protocol version the controller speaks and how many joints it drives."""
+
+    def body(self) -> str:
+        return "VER"
+
+
+@dataclass(frozen=True)
+class VersionReport:
+    """``$VER,<version>,<n_joints>``: the controller's answer to ``$VER``."""
+
+    version: int
+    n_joints: int
+
+    def body(self) -> str:
+        return f"VER,{self.version},{self.n_joints}"
 
 
 @dataclass(frozen=True)
@@ -141,7 +162,7 @@ class RequestState:
         return "STA"
 
 
-Message = JointSample | Ack | Done | StateReport | ErrorReply | RequestJoints | Stream | MoveJoints | RequestState
+Message = JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion
 
 
 def _number(text: str, what: str) -> float:
@@ -172,8 +193,8 @@ def parse_body(body: str) -> Message:
     kind = fields[0]
     n = len(fields)
     if kind == "JNT":
-        if n != 3 + N_JOINTS:
-            raise ProtocolError("malformed", f"JNT needs {3 + N_JOINTS} fields, got {n}")
+        if not 4 <= n <= 3 + MAX_JOINTS:
+            raise ProtocolError("malformed", f"JNT needs a sequence number, a time and 1 to {MAX_JOINTS} joint values; got {n} fields")
         seq = _integer(fields[1], "JNT seq")
         if seq >= SEQ_MODULUS:
             raise ProtocolError("malformed", f"JNT seq {seq} exceeds 2^32 - 1")
@@ -188,6 +209,10 @@ def parse_body(body: str) -> Message:
         return StateReport(_token(fields[1], "STA state"), fields[2])
     if kind == "ERR" and n == 3:
         return ErrorReply(_token(fields[1], "ERR code"), fields[2])
+    if kind == "VER" and n == 1:
+        return RequestVersion()
+    if kind == "VER" and n == 3:
+        return VersionReport(_integer(fields[1], "VER version"), _integer(fields[2], "VER n_joints"))
     if kind == "RQJ" and n == 1:
         return RequestJoints()
     if kind == "STR" and n == 2:
@@ -196,9 +221,9 @@ def parse_body(body: str) -> Message:
             raise ProtocolError("malformed", f"STR hz must be >= 0, got {hz}")
         return Stream(hz)
     if kind == "MVJ":
-        if n != 2 + N_JOINTS:
-            raise ProtocolError("malformed", f"MVJ needs {2 + N_JOINTS} fields, got {n}")
+        if not 3 <= n <= 2 + MAX_JOINTS:
+            raise ProtocolError("malformed", f"MVJ needs an id and 1 to {MAX_JOINTS} joint values; got {n} fields")
         return MoveJoints(_token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:])))
-    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ"):
+    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER"):
         raise ProtocolError("malformed", f"{kind} with {n - 1} fields")
     raise ProtocolError("unknown", f"unknown sentence type {kind!r}")

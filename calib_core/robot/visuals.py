@@ -1,7 +1,8 @@
-"""The robot's visual geometry as scene items, posed at given joints.
+"""The robot's geometry (visual or collision) as scene items, posed at given joints.
 
-Pinocchio reads the URDF's visual primitives (boxes, cylinders) with their colours; they are
-turned into trimesh meshes once, and only their poses change with the joints.
+Pinocchio reads the URDF's geometry (boxes, cylinders, spheres, and meshes in STL, OBJ, DAE,
+glTF through coal's loader) with its colours and placements; each shape becomes a trimesh mesh
+in mm once (meshes are cached by file), and only the poses change with the joints.
 """
 
 from __future__ import annotations
@@ -14,47 +15,88 @@ import pinocchio as pin
 import trimesh
 from numpy.typing import ArrayLike
 
+from calib_core.errors import FileFormatError
 from calib_core.robot.model import RobotModel, _to_mm
 from calib_core.scene import SceneItem
 
 _CYLINDER_SECTIONS = 32
+_KINDS = {"visual": pin.GeometryType.VISUAL, "collision": pin.GeometryType.COLLISION}
 
 
-def _mesh_of(geometry) -> trimesh.Trimesh:
-    """A trimesh (mm) of a coal primitive (m) in its own frame."""
+def _bvh_arrays(geometry) -> tuple[np.ndarray, np.ndarray]:
+    vertices = np.ascontiguousarray(geometry.vertices(), dtype=float)
+    triangles = np.empty((geometry.num_tris, 3), dtype=np.int64)
+    for i in range(geometry.num_tris):
+        t = geometry.tri_indices(i)
+        triangles[i] = (t[0], t[1], t[2])
+    return vertices, triangles
+
+
+_MESH_CACHE: dict[tuple, trimesh.Trimesh] = {}
+
+
+def _mesh_of(g: pin.GeometryObject, where: str) -> trimesh.Trimesh:
+    """A trimesh (mm) of a coal shape (m) in its own frame."""
+    geometry = g.geometry
     if isinstance(geometry, coal.Box):
         return trimesh.creation.box(extents=2000.0 * np.asarray(geometry.halfSide))
     if isinstance(geometry, coal.Cylinder):
         return trimesh.creation.cylinder(radius=1000.0 * geometry.radius, height=2000.0 * geometry.halfLength, sections=_CYLINDER_SECTIONS)
     if isinstance(geometry, coal.Sphere):
         return trimesh.creation.icosphere(radius=1000.0 * geometry.radius, subdivisions=2)
-    raise ValueError(f"robot visual of type {type(geometry).__name__} is not supported (use boxes, cylinders or spheres)")
+    if isinstance(geometry, coal.Capsule):
+        return trimesh.creation.capsule(radius=1000.0 * geometry.radius, height=2000.0 * geometry.halfLength)
+    if isinstance(geometry, coal.BVHModelBase):
+        key = (g.meshPath, tuple(np.round(np.asarray(g.meshScale), 9)))
+        if key not in _MESH_CACHE:
+            vertices, triangles = _bvh_arrays(geometry)
+            if len(triangles) == 0:
+                raise FileFormatError(g.meshPath, f"{where}: the mesh has no triangles")
+            _MESH_CACHE[key] = trimesh.Trimesh(vertices * 1000.0, triangles, process=False)
+        return _MESH_CACHE[key]
+    raise FileFormatError(g.meshPath or "(URDF)", f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres or capsules)")
+
+
+def geometry_model(robot: RobotModel, kind: str = "visual") -> pin.GeometryModel:
+    """Pinocchio's geometry model of ``kind`` (``visual`` or ``collision``) for ``robot``'s
+    driven joints; :class:`FileFormatError` names the URDF when a mesh cannot be read."""
+    full = robot.full_model if robot.full_model is not None else robot.model
+    try:
+        gm = pin.buildGeomFromUrdfString(full, robot.urdf_xml, _KINDS[kind]) if robot.urdf_xml else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])
+    except (RuntimeError, ValueError) as exc:
+        raise FileFormatError(robot.urdf_path, f"cannot read the robot's {kind} geometry: {exc}") from None
+    if robot.locked_joint_ids:
+        _, (gm,) = pin.buildReducedModel(full, [gm], list(robot.locked_joint_ids), robot.locked_configuration)
+    return gm
 
 
 @dataclass
 class RobotVisuals:
-    """The robot's visual meshes; :meth:`scene_items` poses them at joints ``q_deg``."""
+    """The robot's meshes; :meth:`scene_items` poses them at joints ``q_deg`` in the base frame."""
 
     robot: RobotModel
     geometry_model: pin.GeometryModel
     meshes: list[trimesh.Trimesh]
 
     @classmethod
-    def from_robot(cls, robot: RobotModel) -> RobotVisuals:
-        gm = pin.buildGeomFromUrdf(robot.model, str(robot.urdf_path), pin.GeometryType.VISUAL)
-        return cls(robot, gm, [_mesh_of(g.geometry) for g in gm.geometryObjects])
+    def from_robot(cls, robot: RobotModel, kind: str = "visual") -> RobotVisuals:
+        gm = geometry_model(robot, kind)
+        meshes = [_mesh_of(g, f"link geometry '{g.name}'") for g in gm.geometryObjects]
+        return cls(robot, gm, meshes)
 
     def poses(self, q_deg: ArrayLike) -> list[np.ndarray]:
         """``visual2base`` (4, 4) mm of every visual at ``q_deg``."""
-        q = np.radians(self.robot.check_joints(q_deg))
+        q = self.robot.configuration(q_deg)
         data = self.geometry_model.createData()
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geometry_model, data, q)
-        return [_to_mm(p) for p in data.oMg]
+        root2base = np.linalg.inv(self.robot.base2root)
+        return [root2base @ _to_mm(p) for p in data.oMg]
 
     def scene_items(self, q_deg: ArrayLike) -> list[SceneItem]:
         """One :class:`SceneItem` per visual, named ``robot/<link>_<index>``, kind ``robot``."""
         items = []
-        for i, (g, mesh, pose) in enumerate(zip(self.geometry_model.geometryObjects, self.meshes, self.poses(q_deg))):
+        for g, mesh, pose in zip(self.geometry_model.geometryObjects, self.meshes, self.poses(q_deg)):
             color = tuple(float(c) for c in np.asarray(g.meshColor)[:3])
             items.append(SceneItem(name=f"robot/{g.name}", mesh=mesh, item2world=pose, color=color, kind="robot"))
         return items
+

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
-from calib_core.robot.model import RobotModel, load_robot
+from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
 from calib_core.scene import SceneItem
 from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
@@ -30,7 +30,7 @@ class TestBed:
     true_robot: TrueRobot
     intrinsics: Intrinsics
     visuals: RobotVisuals
-    joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extra_items: list[SceneItem] = field(default_factory=list)
     """Things put into the real cell for a while (a calibration board): the camera sees them, the CAD does not."""
     _model_visuals: RobotVisuals | None = field(default=None, repr=False)
@@ -41,8 +41,8 @@ class TestBed:
     def create(cls, workcell: Workcell | None = None, errors: RobotErrors | None = None, intrinsics: Intrinsics | None = None) -> TestBed:
         """The bundled workcell with typical robot errors (seed 0) unless told otherwise."""
         cell = workcell or load_workcell()
-        model = load_robot(cell.robot_urdf)
-        true = TrueRobot(model, RobotErrors.typical(0) if errors is None else errors)
+        model = cell.load_robot()
+        true = TrueRobot(model, RobotErrors.typical(0, n_joints=model.n_joints) if errors is None else errors)
         intr = intrinsics or load_intrinsics(cell.intrinsics_path)
         return cls(cell, model, true, intr, RobotVisuals.from_robot(true.robot), np.array(cell.home_joints_deg, dtype=float))
 

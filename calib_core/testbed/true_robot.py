@@ -23,15 +23,16 @@ from calib_core.robot.model import RobotModel
 class RobotErrors:
     """How the true robot differs from the model.
 
-    ``joint_offsets_deg`` (n,): added to every commanded joint. ``link_errors_mm`` (n, 3): added
-    to each joint's placement in its parent (the link lengths and offsets). ``base_xyz_mm``,
+    ``joint_offsets_deg`` (n,): added to every commanded joint (deg or mm). ``link_errors_mm`` (n, 3):
+    added to each joint's placement in its parent (the link lengths and offsets). Empty (the
+    default) means zero for every joint, whatever the robot's count. ``base_xyz_mm``,
     ``base_rpy_deg``: the true base placement relative to the modelled one.
     ``hand_eye_xyz_mm``, ``hand_eye_rpy_deg``: the true camera mounting relative to the
     modelled one, in the modelled camera frame.
     """
 
-    joint_offsets_deg: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    link_errors_mm: np.ndarray = field(default_factory=lambda: np.zeros((6, 3)))
+    joint_offsets_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    link_errors_mm: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     base_xyz_mm: np.ndarray = field(default_factory=lambda: np.zeros(3))
     base_rpy_deg: np.ndarray = field(default_factory=lambda: np.zeros(3))
     hand_eye_xyz_mm: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -63,6 +64,15 @@ class RobotErrors:
         )
 
 
+def _per_joint(values, shape: tuple[int, ...], name: str) -> np.ndarray:
+    values = np.asarray(values, dtype=float)
+    if values.size == 0:
+        return np.zeros(shape)
+    if values.shape != shape:
+        raise ValueError(f"RobotErrors.{name}: expected shape {shape} for this robot, got {values.shape}")
+    return values
+
+
 class TrueRobot:
     """The physical robot of the simulated test bed: the model with :class:`RobotErrors` applied."""
 
@@ -70,9 +80,12 @@ class TrueRobot:
         self.errors = errors
         self.model_robot = model
         self.robot = model.copy()
+        n = model.n_joints
+        self.joint_offsets = _per_joint(errors.joint_offsets_deg, (n,), "joint_offsets_deg")
+        link_errors = _per_joint(errors.link_errors_mm, (n, 3), "link_errors_mm")
         for j in range(1, self.robot.model.njoints):
             placement = self.robot.model.jointPlacements[j]
-            delta = np.asarray(errors.link_errors_mm[j - 1], dtype=float) / 1000.0
+            delta = link_errors[j - 1] / 1000.0
             self.robot.model.jointPlacements[j] = pin.SE3(placement.rotation, placement.translation + delta)
         self.base_true2base_model = transform_from_xyz_rpy(errors.base_xyz_mm, errors.base_rpy_deg)
         cam_error = transform_from_xyz_rpy(errors.hand_eye_xyz_mm, errors.hand_eye_rpy_deg)
@@ -80,7 +93,7 @@ class TrueRobot:
 
     def true_joints(self, q_commanded_deg: ArrayLike) -> np.ndarray:
         """Where the joints really are when ``q_commanded_deg`` is commanded (and reported)."""
-        return self.robot.check_joints(q_commanded_deg) + self.errors.joint_offsets_deg
+        return self.robot.check_joints(q_commanded_deg) + self.joint_offsets
 
     def fk(self, q_commanded_deg: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """The true ``frame2base`` (4, 4) mm, in the modelled base frame, at commanded joints."""

@@ -15,17 +15,21 @@ import yaml
 
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
+from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
 from calib_core.workcell.model import TaskLocation, Workcell
+from calib_core.workcell.robot_section import check_against_robot, read_robot_section
 
 DEFAULT_WORKCELL = Path(__file__).resolve().parents[2] / "resources" / "workcell" / "workcell.yaml"
-SCHEMA_VERSION = 1
-_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations"}
+SCHEMA_VERSION = 2
+# Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
+_READABLE_VERSIONS = (1, 2)
+_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board"}
 _COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
 _TASK_KEYS = {"name", "component", "tcp2base", "approach_mm"}
 _KINDS = {"component", "fixture"}
 _MESH_SCALE = {"mm": 1.0, "m": 1000.0}
-_MESH_SUFFIXES = {".stl", ".obj", ".glb", ".gltf", ".ply"}
+_MESH_SUFFIXES = {".stl", ".obj", ".dae", ".glb", ".gltf", ".ply"}
 
 
 class _Reader:
@@ -86,7 +90,7 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         raise reader.fail(f"{f}.mesh_units", f"must be 'mm' or 'm', got {units!r}")
     mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
     if mesh_path.suffix.lower() not in _MESH_SUFFIXES:
-        raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, glTF/GLB or PLY")
+        raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
     try:
         mesh = trimesh.load(mesh_path, force="mesh")
     except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
@@ -132,14 +136,14 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     except yaml.YAMLError as exc:
         raise reader.fail(None, f"not valid YAML: {exc}") from None
     data = reader.mapping(data, "(top level)", _TOP_KEYS, {"schema_version", "units", "robot", "components"})
-    if data["schema_version"] != SCHEMA_VERSION:
-        raise reader.fail("schema_version", f"this videocal reads version {SCHEMA_VERSION}, the file is version {data['schema_version']!r}")
+    if data["schema_version"] not in _READABLE_VERSIONS:
+        raise reader.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}")
     units = reader.mapping(data["units"], "units", {"length", "angle"}, {"length", "angle"})
     if units["length"] != "mm" or units["angle"] != "deg":
         raise reader.fail("units", f"placements must be in mm and deg, got {units['length']!r} and {units['angle']!r}")
-    robot = reader.mapping(data["robot"], "robot", {"urdf", "home_joints_deg"}, {"urdf"})
-    urdf = reader.file(robot["urdf"], "robot.urdf")
-    home = reader.vector(robot.get("home_joints_deg", [0.0] * 6), 6, "robot.home_joints_deg")
+    robot_spec = read_robot_section(reader, data["robot"])
+    robot = load_robot(robot_spec)
+    home = check_against_robot(reader, robot_spec, robot)
     intrinsics_path = None
     if data.get("camera") is not None:
         camera = reader.mapping(data["camera"], "camera", {"intrinsics"}, {"intrinsics"})
@@ -162,4 +166,8 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
         if task.name in tasks:
             raise reader.fail(f"task_locations[{i}].name", f"duplicate task location name {task.name!r}")
         tasks[task.name] = task
-    return Workcell(str(data.get("name", path.stem)), path, components, tasks, urdf, intrinsics_path, home)
+    meta = {}
+    if data.get("hand_eye_board") is not None:
+        # Where the hand-eye board's centre stands (x along its columns, y down its rows, z into it).
+        meta["hand_eye_board_centre"] = reader.placement(data["hand_eye_board"], "hand_eye_board")
+    return Workcell(str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta)

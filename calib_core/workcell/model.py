@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from calib_core.frames import apply, make_transform
+from calib_core.robot.model import RobotModel, load_robot
+from calib_core.robot.spec import RobotSpec
 from calib_core.scene import SceneItem
 
 
@@ -30,17 +32,26 @@ class TaskLocation:
 
 @dataclass
 class Workcell:
-    """Components (as :class:`SceneItem`, placed in the robot base frame), task locations,
-    and the files of the robot and camera the cell uses."""
+    """Components (as :class:`SceneItem`, placed in the robot's ``base`` frame), task locations,
+    the robot (``robot_spec``: its description, frames and joints) and the camera file the cell
+    uses; ``home_joints_deg`` (n,) deg/mm for the driven joints."""
 
     name: str
     path: Path
     components: list[SceneItem]
     task_locations: dict[str, TaskLocation]
-    robot_urdf: Path
+    robot_spec: RobotSpec
     intrinsics_path: Path | None
     home_joints_deg: np.ndarray
     meta: dict = field(default_factory=dict)
+
+    @property
+    def robot_urdf(self) -> Path:
+        return self.robot_spec.urdf
+
+    def load_robot(self) -> RobotModel:
+        """A fresh model of the cell's robot (its frames, held joints and base as the file says)."""
+        return load_robot(self.robot_spec)
 
     def component(self, name: str) -> SceneItem:
         """The component called ``name``; ``KeyError`` names the known ones."""

@@ -1,5 +1,6 @@
-"""The workspace file (JSON, ``schema_version`` 1): the workcell in use, the intrinsics, the task
-locations, the point pairs and the correction table with its history.
+"""The workspace file (JSON, ``schema_version`` 2): the workcell in use and its identity (name and
+content hash: a workspace opens only on its own cell), the intrinsics, the task locations, the
+point pairs and the correction table with its history. Version 1 files (no identity) still open.
 
 Saving is atomic (a crash mid-save leaves the old file intact). Loading is strict: a corrupt,
 truncated, unknown-version or foreign file gives a :class:`FileFormatError` naming the file and
@@ -24,7 +25,8 @@ from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+_READABLE_VERSIONS = (1, 2)
 KIND = "videocal-workspace"
 
 
@@ -39,6 +41,8 @@ class Workspace:
     pairs: list[Correspondence] = field(default_factory=list)
     corrections: CorrectionTable = field(default_factory=CorrectionTable)
     created_s: float = field(default_factory=time.time)
+    cell: dict | None = None
+    """``{"name", "content_hash"}`` of the cell it was made on (:class:`~calib_core.operator.cell.CellIdentity`)."""
 
 
 def _pose(T: np.ndarray) -> dict:
@@ -64,6 +68,7 @@ def workspace_to_dict(ws: Workspace) -> dict:
         "created_s": ws.created_s,
         "saved_s": time.time(),
         "workcell": ws.workcell_path,
+        "cell": ws.cell,
         "intrinsics": ws.intrinsics.to_dict(),
         "target": ws.target,
         "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
@@ -103,6 +108,13 @@ class _Fields:
             raise self.fail(where, f"must be {n} finite numbers, got {value!r}")
         return arr
 
+    def joints(self, value, where: str) -> np.ndarray:
+        """A joint vector of any robot: 1 to 16 finite numbers (deg or mm)."""
+        n = len(value) if isinstance(value, list) else -1
+        if not 1 <= n <= 16:
+            raise self.fail(where, f"must be a list of 1 to 16 joint values (deg or mm), got {value!r}")
+        return self.vector(value, n, where)
+
     def pose(self, value, where: str) -> np.ndarray:
         return transform_from_xyz_rpy(self.vector(self.get(value, "xyz", where), 3, f"{where}.xyz"), self.vector(self.get(value, "rpy", where), 3, f"{where}.rpy"))
 
@@ -123,8 +135,11 @@ def load_workspace(path: str | Path) -> Workspace:
     if not isinstance(data, dict) or data.get("kind") != KIND:
         raise f.fail("kind", f"not a videocal workspace (kind must be {KIND!r})")
     version = data.get("schema_version")
-    if version != SCHEMA_VERSION:
-        raise f.fail("schema_version", f"this videocal reads version {SCHEMA_VERSION}, the file is version {version!r}")
+    if version not in _READABLE_VERSIONS:
+        raise f.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {version!r}")
+    cell = data.get("cell")
+    if cell is not None and not (isinstance(cell, dict) and isinstance(cell.get("name"), str) and isinstance(cell.get("content_hash"), str)):
+        raise f.fail("cell", f"must be {{name, content_hash}} strings, got {cell!r}")
     try:
         intrinsics = Intrinsics.from_dict(f.get(data, "intrinsics", "", dict))
     except (KeyError, TypeError, ValueError) as exc:
@@ -150,10 +165,10 @@ def load_workspace(path: str | Path) -> Workspace:
             rotation_deg=f.vector(f.get(c, "rotation_deg", where), 3, f"{where}.rotation_deg"),
             std_displacement_mm=np.asarray(f.get(c, "std_displacement_mm", where), dtype=float),
             std_rotation_deg=np.asarray(f.get(c, "std_rotation_deg", where), dtype=float),
-            joints_deg=f.vector(f.get(c, "joints_deg", where), 6, f"{where}.joints_deg"),
+            joints_deg=f.joints(f.get(c, "joints_deg", where), f"{where}.joints_deg"),
             rms_px=float(f.get(c, "rms_px", where, (int, float))),
             pairs=int(f.get(c, "pairs", where, int)),
             time_s=float(c.get("time_s", 0.0)),
             source=str(c.get("source", "")),
         ))
-    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)))
+    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)), cell)

@@ -8,7 +8,7 @@ from PySide6.QtCore import QSettings
 
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
-from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.sim_site import simulated_cell
 from calib_core.testbed.true_robot import RobotErrors
 
 
@@ -17,14 +17,13 @@ def live_window(qtbot, tmp_path):
     made = []
 
     def make(errors: RobotErrors) -> MainWindow:
-        bed = TestBed.create(errors=errors)
-        bed.intrinsics = bed.intrinsics.scaled(0.5)
-        wb = Workbench(bed)
-        wb.start_simulated_controller()
+        cell, site = simulated_cell(errors=errors, image_scale=0.5)
+        wb = Workbench(cell, site)
+        wb.start_controller()
         win = MainWindow(wb, settings=QSettings(str(tmp_path / f"settings{len(made)}.ini"), QSettings.Format.IniFormat))
         qtbot.addWidget(win)
         win.resize(1500, 950)
-        win.start_camera(lambda: bed.camera(fps=10.0))
+        win.start_camera(site.camera_factory(fps=10.0))
         win.show()
         qtbot.waitUntil(lambda: wb.link_up and win.camera.last_frame is not None, timeout=15_000)
         made.append(win)

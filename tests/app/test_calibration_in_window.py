@@ -12,7 +12,7 @@ from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
-from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.sim_site import simulated_cell
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
@@ -42,7 +42,7 @@ def _go_to_task(qtbot, win):
 def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window):
     win = window
     wb = win.workbench
-    bed = wb.bed
+    bed = wb.site.bed  # the truth, for the operator's eyes and the score
     _go_to_task(qtbot, win)
     fixture = wb.workcell.component("oru_1_fixture")
     model_cam = wb.model_cam2world()
@@ -168,7 +168,7 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     win._update_status()
     qtbot.waitUntil(lambda: (win._update_status(), "no frame for" in win.fps_label.text())[1], timeout=10_000)
     # The link: the controller process dies; the state shows it and no pair is lost.
-    wb._sim_process.kill()
+    wb.site.process.process.kill()
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
     qtbot.waitUntil(lambda: "up" not in win.link_label.text().split(",")[0], timeout=5_000)
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
@@ -246,7 +246,7 @@ def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
     wb = win.workbench
     _go_to_task(qtbot, win)
     fixture = wb.workcell.component("oru_1_fixture")
-    true_cam = wb.bed.true_cam2world(wb.joints_deg)
+    true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     for name in ("plate_top_left", "plate_top_right", "pin_tip"):  # three pairs: P3P has several exact poses
         p = apply(fixture.item2world, fixture.features[name])
         wb.session.pick_3d("oru_1_fixture", name, p)
@@ -293,10 +293,10 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
 
     settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
     settings.setValue("files/autosave_dir", str(tmp_path))
-    bed = TestBed.create()
+    cell, site = simulated_cell()
     (tmp_path / "recovery").mkdir()
-    save_workspace(tmp_path / "recovery" / "autosave.json", Workspace("cell", bed.intrinsics, {}, "oru_1_fixture", [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))]))
-    wb = Workbench(bed)
+    save_workspace(tmp_path / "recovery" / "autosave.json", Workspace("cell", cell.intrinsics, {}, "oru_1_fixture", [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))], cell=cell.identity.to_dict()))
+    wb = Workbench(cell, site)
     win = MainWindow(wb, settings=settings)
     qtbot.addWidget(win)
     try:

@@ -13,7 +13,7 @@ from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
 from calib_core.recording.playback import RecordingPlayback
 from calib_core.recording.reader import read_recording
-from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.sim_site import simulated_cell
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "recordings" / "sample_session.mcap"
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
@@ -21,7 +21,7 @@ OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
 @pytest.fixture
 def window(qtbot, tmp_path):
-    wb = Workbench(TestBed.create())
+    wb = Workbench(*simulated_cell())
     win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
     qtbot.addWidget(win)
     win.resize(1500, 950)

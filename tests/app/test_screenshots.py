@@ -21,7 +21,7 @@ from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.robot import solve_ik
-from calib_core.testbed.test_bed import TestBed
+from calib_core.testbed.sim_site import simulated_cell
 from calib_core.video.frame import Frame
 
 BASELINES = Path(__file__).resolve().parents[1] / "baselines"
@@ -40,9 +40,9 @@ TOLERANCES = {
 
 @pytest.fixture
 def calibrated_window(qtbot, tmp_path):
-    bed = TestBed.create()
-    bed.intrinsics = bed.intrinsics.scaled(0.5)
-    wb = Workbench(bed)
+    cell, site = simulated_cell(image_scale=0.5)
+    bed = site.bed  # the truth: where the operator's eyes find the features
+    wb = Workbench(cell, site)
     win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
     qtbot.addWidget(win)
     win.resize(1400, 900)

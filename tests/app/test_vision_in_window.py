@@ -65,14 +65,14 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
 
     # Intrinsics against the test bed's lens.
     qtbot.mouseClick(vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
-    got, truth = vision.intrinsics_result.intrinsics, wb.bed.intrinsics
+    got, truth = vision.intrinsics_result.intrinsics, wb.site.bed.intrinsics
     assert abs(got.fu / truth.fu - 1) < 0.005 and abs(got.fv / truth.fv - 1) < 0.005
     assert abs(got.cx - truth.cx) < 2.0 and abs(got.cy - truth.cy) < 2.0
     assert vision.intrinsics_result.rms_px < 0.3 and "Intrinsics" in vision.result.text()
 
     # The camera's mounting against the true one (the model's is off by ~1 mm and ~0.2 deg).
     qtbot.mouseClick(vision.calibrate_hand_eye_button, Qt.MouseButton.LeftButton)
-    true_robot = wb.bed.true_robot.robot
+    true_robot = wb.site.bed.true_robot.robot
     true_cam2flange = np.linalg.inv(true_robot.frame_placement("flange")) @ true_robot.frame_placement("camera")
     model_cam2flange = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
     d_model, r_model = pose_difference(model_cam2flange, true_cam2flange)

@@ -5,12 +5,13 @@ import pytest
 import yaml
 
 from app.gui.workbench import Workbench
+from calib_core.testbed.sim_site import simulated_cell
 from calib_core.errors import FileFormatError
 from calib_core.frames import pose_difference
 
 
 def test_hand_eye_file_moves_the_modelled_camera(qapp, tmp_path):
-    wb = Workbench()
+    wb = Workbench(*simulated_cell())
     try:
         q = np.array([-20.0, 10.0, 5.0, 0.0, -15.0, 0.0])
         before = wb.robot.fk(q, "camera")

@@ -109,7 +109,7 @@ def test_undo_redo_and_workflow_errors(bed):
 def test_listeners_hear_every_change():
     s = CalibrationSession()
     events = []
-    s.pairs.subscribe(lambda event, number: events.append((event, number)))
+    s.pairs.changed.connect(lambda event, number: events.append((event, number)))
     s.pick_3d("a", None, (0, 0, 1))
     s.pick_2d((1, 2))
     s.undo.undo()

@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import assume, given, settings, strategies as st
 
 from calib_core.link.assembler import SentenceAssembler
-from calib_core.link.protocol import JointSample, encode
+from calib_core.link.protocol import MAX_SENTENCE_BYTES, JointSample, encode
 
 _VALID = re.compile(rb"\$([^$*\r\n]{3,})\*([0-9A-F]{2})\r\n")
 
@@ -35,7 +35,7 @@ def test_clean_stream_in_odd_chunks():
 def test_each_kind_of_damage_is_rejected_and_counted():
     good = encode(_sample(1))
     bad_sum = good[:-4] + b"00\r\n" if good[-4:-2] != b"00" else good[:-4] + b"11\r\n"
-    too_long = b"$" + b"A" * 200 + b"\r\n"
+    too_long = b"$" + b"A" * (MAX_SENTENCE_BYTES + 10) + b"\r\n"
     no_cr = good[:-2] + b"\n"
     fragment = good[:20]
     a = SentenceAssembler()

@@ -11,7 +11,7 @@ from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.render import RenderOptions, SceneRenderer
-from calib_core.robot import load_robot, solve_ik
+from calib_core.robot import solve_ik
 from calib_core.robot.visuals import RobotVisuals
 from calib_core.workcell import load_workcell
 
@@ -21,7 +21,7 @@ OUTPUT = Path(__file__).resolve().parents[2] / "output"
 @pytest.fixture(scope="module")
 def scene():
     cell = load_workcell()
-    robot = load_robot(cell.robot_urdf)
+    robot = cell.load_robot()
     q = solve_ik(robot, cell.task("oru_1_grasp").tcp2base, cell.home_joints_deg).q_deg
     intr = load_intrinsics(cell.intrinsics_path).without_distortion().scaled(0.5)
     renderer = SceneRenderer()

@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from calib_core.errors import FileFormatError
-from calib_core.robot import load_robot, solve_ik
+from calib_core.robot import solve_ik
 from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
 
@@ -23,7 +23,7 @@ def test_bundled_workcell():
     pin_axis_point = cell.feature_in_base("oru_1_fixture", "pin_tip")
     assert np.linalg.norm(pin_axis_point - grasp.tcp2base[:3, 3]) == pytest.approx(20.0, abs=0.1)
     # Both the grasp and its approach are reachable.
-    robot = load_robot(cell.robot_urdf)
+    robot = cell.load_robot()
     q = solve_ik(robot, grasp.tcp2base, cell.home_joints_deg).q_deg
     solve_ik(robot, grasp.approach2base, q)
     assert np.allclose(grasp.approach2base[:3, 3], grasp.tcp2base[:3, 3] - 200 * grasp.tcp2base[:3, 2])
@@ -54,7 +54,7 @@ def _write(path: Path, data) -> Path:
         (lambda d: d["components"][1]["placement"].update(rpy=[0, "ten", 0]), "components[1].placement.rpy[1]", "finite number"),
         (lambda d: d["components"][1]["placement"].update(xyz=[0, 0]), "components[1].placement.xyz", "list of 3 numbers"),
         (lambda d: d.update(units={"length": "m", "angle": "deg"}), "units", "mm and deg"),
-        (lambda d: d.update(schema_version=7), "schema_version", "version 1"),
+        (lambda d: d.update(schema_version=7), "schema_version", "versions 1, 2"),
         (lambda d: d["task_locations"][0].update(component="oru_9"), "task_locations[0].component", "no component called 'oru_9'"),
         (lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]), "components[2].features.pin_tip", "list of 3 numbers"),
     ],

@@ -73,7 +73,9 @@ def test_a_failed_save_leaves_the_old_file_whole(tmp_path, workspace, monkeypatc
     [
         (lambda t: t[: len(t) // 2], None, "not valid JSON"),
         (lambda t: json.dumps({"hello": 1}), "kind", "not a videocal workspace"),
-        (lambda t: t.replace('"schema_version": 1', '"schema_version": 9'), "schema_version", "version 1, the file is version 9"),
+        (lambda t: t.replace('"schema_version": 2', '"schema_version": 9'), "schema_version", "versions 1, 2, the file is version 9"),
+        (lambda t: _edit(t, lambda d: d["corrections"][0].update(joints_deg=[])), "corrections[0].joints_deg", "1 to 16 joint values"),
+        (lambda t: _edit(t, lambda d: d.update(cell="my cell")), "cell", "name, content_hash"),
         (lambda t: _edit(t, lambda d: d["pairs"][0].update(point_world_mm=[1, 2])), "pairs[0].point_world_mm", "3 finite numbers"),
         (lambda t: _edit(t, lambda d: d["corrections"][1].pop("rms_px")), "corrections[1].rms_px", "missing"),
         (lambda t: _edit(t, lambda d: d["task_locations"][0]["tcp2base"].update(rpy=[0, "x", 0])), "task_locations[0].tcp2base.rpy", "3 finite numbers"),

@@ -1,0 +1,334 @@
+"""The operator core: the program's state and workflow without a window.
+
+One object holds the cell (:class:`~calib_core.operator.cell.Cell`), the devices (the controller
+link, from a :class:`~calib_core.operator.site.Site`) and the workflow (the target and its pairs
+in the :class:`CalibrationSession`, the task location, options, corrections, moves and how they
+ended). It declares typed psygnal events; the window, the command line, the recorder
+(:mod:`calib_core.operator.recording_tap`) and the tests subscribe.
+
+Threads: the link calls back on its reader thread. The core hands those calls to ``call_soon``
+(default: run at once), so its state changes and its events happen on the owner's thread; the
+window passes a function that queues them into the Qt event loop.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from psygnal import Signal
+
+from calib_core.calibration.commands import SetTaskApproach
+from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.link.driver import ControllerLink
+from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
+from calib_core.operator.cell import Cell
+from calib_core.operator.site import Site
+from calib_core.robot import solve_ik
+from calib_core.scene import SceneItem
+from calib_core.workcell import TaskLocation
+
+
+class OperatorCore:
+    """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
+    (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
+    status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
+    ``scene_changed()``, ``move_finished(what, error)`` (``error`` empty when the move arrived),
+    ``frame_observed(frame)``, ``correction_stored(correction)``, ``event(kind, detail)``
+    (operator actions worth recording)."""
+
+    joints_changed = Signal(object)
+    sample_received = Signal(object, object)
+    link_state = Signal(str)
+    message = Signal(str)
+    solved = Signal()
+    task_changed = Signal(str)
+    camera_model_changed = Signal()
+    scene_changed = Signal()
+    move_finished = Signal(str, str)
+    frame_observed = Signal(object)
+    correction_stored = Signal(object)
+    event = Signal(str, object)
+
+    def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
+        self.cell = cell
+        self.site = site
+        self._call_soon = call_soon or (lambda fn, *args: fn(*args))
+        self.session = CalibrationSession()
+        self.joints_deg = cell.home_joints
+        self.task: TaskLocation | None = next(iter(self.workcell.task_locations.values()), None)
+        if self.task is not None and self.task.component:
+            self.session.set_target(self.task.component)
+        self.link: ControllerLink | None = None
+        self.recorder = None
+        self._tap = None
+        self.replaying = False
+        self.last_sample_s: float | None = None
+        self.scene_extras: list[SceneItem] = []
+        """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
+
+    # --- the cell -------------------------------------------------------------------------------
+    @property
+    def workcell(self):
+        return self.cell.workcell
+
+    @property
+    def robot(self):
+        return self.cell.robot
+
+    @property
+    def intrinsics(self) -> Intrinsics:
+        return self.cell.intrinsics
+
+    # --- robot and link -----------------------------------------------------------------------
+    def start_controller(self) -> str:
+        """Ask the site for its controller and connect to it; returns the link URL."""
+        if self.site is None:
+            raise CalibrationError("no site: give a controller (--port) or use the simulated cell")
+        url = self.site.start_controller()
+        self.connect_link(url)
+        return url
+
+    def connect_link(self, url: str, rate_hz: float = 50.0) -> None:
+        if self.link is not None:
+            self.link.close()
+        self.link = ControllerLink(url, mode="stream", rate_hz=rate_hz, n_joints=self.robot.n_joints)
+        self.link.on_sample(lambda sample: self._call_soon(self._on_sample, sample))
+        self.link.on_state(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
+        if self.site is not None:
+            self.site.attach(self.link)
+        self.link.start()
+        self.message.emit(f"controller link: {url}")
+
+    def _on_link_state(self, state: str, why: str) -> None:
+        self.record_event("link_state", state=state, why=why)
+        self.link_state.emit(f"{state}: {why}")
+
+    def record_event(self, kind: str, **detail) -> None:
+        """An operator action or a link change worth keeping in a recording."""
+        self.event.emit(kind, detail)
+
+    def _on_sample(self, sample: TimedSample) -> None:
+        self.last_sample_s = time.monotonic()
+        q = self.cell.joint_map.to_model(sample.joints_deg)
+        self.sample_received.emit(sample, q)
+        if self.replaying:
+            return  # the recorded joints drive the views while a recording is replayed
+        self.joints_deg = q
+        self.joints_changed.emit(self.joints_deg)
+
+    def show_replayed_joints(self, joints_deg) -> None:
+        """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
+        self.joints_deg = np.array(joints_deg, dtype=float)
+        self.joints_changed.emit(self.joints_deg)
+
+    @property
+    def link_up(self) -> bool:
+        return self.link is not None and self.link.state is LinkState.UP
+
+    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0) -> MoveHandle:
+        """IK for the TCP target (4, 4) mm in base from the current joints, then a joint move."""
+        q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
+        return self.move_joints(q, what, wait=wait, timeout_s=timeout_s)
+
+    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0) -> MoveHandle:
+        """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended."""
+        if self.replaying:
+            raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
+        if self.link is None:
+            raise CalibrationError("no controller link: connect one first")
+        q = self.robot.check_joints(q)
+        handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
+        if handle.finished:
+            handle.wait(0)  # finished before it started: nothing was sent, and this raises the link's reason
+        self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
+        handle.on_finished(lambda h: self._call_soon(self._move_ended, what, h))
+        if wait:
+            handle.wait(timeout_s)
+        return handle
+
+    def _move_ended(self, what: str, handle: MoveHandle) -> None:
+        error = handle.error
+        self.record_event("move_finished", what=what, error=str(error) if error else "")
+        self.move_finished.emit(what, str(error) if error else "")
+        self.message.emit(f"move to {what} failed: {error}" if error else f"arrived at {what}")
+
+    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False) -> MoveHandle:
+        if self.task is None:
+            raise CalibrationError("choose a task location first")
+        target = self.task.approach2base if approach else self.task.tcp2base
+        if corrected:
+            if self.session.corrections.latest(self.task.name) is None:
+                raise CalibrationError(f"no stored correction for {self.task.name}: calibrate and store one first")
+            target = self.session.corrections.corrected_target(self.task.name, target)
+        what = f"{self.task.name} ({'approach' if approach else 'task'}{', corrected' if corrected else ''})"
+        return self.move_to(target, what, wait=wait)
+
+    def set_task_approach(self, name: str, approach_mm: float) -> None:
+        """Edit a task location's approach distance (mm): an undoable edit."""
+        if abs(self.workcell.task(name).approach_mm - approach_mm) < 1e-9:
+            return
+        self.session.undo.push(SetTaskApproach(self.workcell.task_locations, name, approach_mm, self._task_edited))
+
+    def _task_edited(self, name: str) -> None:
+        if self.task is not None and self.task.name == name:
+            self.task = self.workcell.task(name)
+        self.task_changed.emit(name)
+
+    def set_task(self, name: str) -> None:
+        self.task = self.workcell.task(name)
+        if self.task.component:
+            self.session.set_target(self.task.component)
+        self.task_changed.emit(name)
+
+    def add_task_location(self, name: str) -> TaskLocation:
+        """A task location at the current TCP pose, for the current target."""
+        if name in self.workcell.task_locations:
+            raise CalibrationError(f"there is already a task location called {name!r}")
+        task = TaskLocation(name, self.model_tcp2base(), 0.0, self.session.target)
+        self.workcell.task_locations[name] = task
+        self.task_changed.emit(name)
+        return task
+
+    # --- frames of reference -------------------------------------------------------------------
+    def model_cam2world(self) -> np.ndarray:
+        return self.robot.fk(self.joints_deg, "camera")
+
+    def model_tcp2base(self) -> np.ndarray:
+        return self.robot.fk(self.joints_deg, "tcp")
+
+    def observe_frame(self, frame) -> None:
+        """A camera frame arrived (from the window's camera worker, or a command-line loop)."""
+        self.frame_observed.emit(frame)
+
+    # --- calibration -------------------------------------------------------------------------
+    def calibrate(self):
+        target = self.session.target
+        if target is None:
+            raise CalibrationError("choose the target object first")
+        obj2world = self.workcell.component(target).item2world
+        result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
+        self.solved.emit()
+        return result
+
+    def store_correction(self):
+        if self.task is None:
+            raise CalibrationError("choose the task location the correction is for")
+        c = self.session.store_correction(self.task.name)
+        self.correction_stored.emit(c)
+        self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
+        return c
+
+    def apply_hand_eye_file(self, path) -> None:
+        """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""
+        from calib_core.vision.hand_eye_io import load_cam2flange
+
+        self.apply_cam2flange(load_cam2flange(path), f"camera mounting from {path}")
+
+    def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
+        """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
+        flange = self.robot.frame_placement("flange")
+        self.robot.set_frame_placement("camera", flange @ np.asarray(cam2flange, dtype=float))
+        self.camera_model_changed.emit()
+        self.message.emit(why)
+
+    def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
+        """Use calibrated intrinsics for picking, solving and the virtual camera (the size must match)."""
+        if (intrinsics.width, intrinsics.height) != (self.intrinsics.width, self.intrinsics.height):
+            raise CalibrationError(f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px")
+        self.use_intrinsics(intrinsics)
+        self.message.emit(why)
+
+    def use_intrinsics(self, intrinsics: Intrinsics) -> None:
+        """Picks, solves and the virtual camera use ``intrinsics`` from now on (a replay uses the
+        recording's camera while it plays, whatever its size)."""
+        if intrinsics != self.cell.intrinsics:
+            self.cell.intrinsics = intrinsics
+            self.camera_model_changed.emit()
+
+    # --- the calibration board --------------------------------------------------------------------
+    def board_placement(self, spec) -> np.ndarray:
+        """Where the hand-eye board stands: the workcell's ``hand_eye_board`` placement, or upright
+        in front of the robot within its reach. ``board2base`` (4, 4) mm."""
+        from calib_core.vision.board_placement import board_from_centre, board_in_front_of_robot
+
+        centre = self.workcell.meta.get("hand_eye_board_centre")
+        return board_from_centre(spec, centre) if centre is not None else board_in_front_of_robot(spec, self.robot)
+
+    def show_calibration_board(self, spec, on: bool = True) -> np.ndarray:
+        """Put a ChArUco board up in the cell (or take it down). Returns its ``board2base`` (4, 4) mm."""
+        from calib_core.vision.board import board_item
+
+        board2base = self.board_placement(spec)
+        self.scene_extras = [board_item(spec, board2base)] if on else []
+        if self.site is not None:
+            self.site.put_up(list(self.scene_extras))
+        self.scene_changed.emit()
+        return board2base
+
+    def board_view_plan(self, spec, n: int = 12) -> list[np.ndarray]:
+        """Joint vectors (deg/mm) from which the modelled camera sees the board from different directions."""
+        from calib_core.vision.board_placement import board_view_joints
+
+        return board_view_joints(self.robot, self.cell.home_joints, spec, self.board_placement(spec), n)
+
+    # --- workspace and recording --------------------------------------------------------------
+    def workspace(self):
+        from calib_core.workspace.workspace import Workspace
+
+        return Workspace(str(self.workcell.path), self.intrinsics, dict(self.workcell.task_locations), self.session.target, self.session.pairs.pairs(), self.session.corrections, cell=self.cell.identity.to_dict())
+
+    def save_workspace(self, path) -> None:
+        from calib_core.workspace.workspace import save_workspace
+
+        save_workspace(path, self.workspace())
+        self.message.emit(f"workspace saved to {path}")
+
+    def open_workspace(self, path) -> None:
+        """Load pairs, corrections and task locations. A file of another cell, or a bad one, is
+        refused before anything changes."""
+        from calib_core.workspace.workspace import load_workspace
+
+        ws = load_workspace(path)  # raises before anything is changed
+        self.cell.check_identity(ws.cell, f"workspace {path}")
+        if ws.target and ws.target not in {c.name for c in self.workcell.components}:
+            raise CalibrationError(f"workspace {path}: target {ws.target!r} is not a component of the open cell {self.cell.name!r}")
+        self.workcell.task_locations.update(ws.task_locations)
+        if ws.target:
+            self.session.set_target(ws.target)
+        self.session.pairs.replace_all(ws.pairs)
+        self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
+        for task in self.session.corrections.tasks():
+            while self.session.corrections.latest(task) is not None:
+                self.session.corrections.remove_last(task)
+        for task in ws.corrections.tasks():
+            for c in ws.corrections.history(task):
+                self.session.corrections.add(c)
+        self.session.undo.clear()
+        self.message.emit(f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations")
+
+    def start_recording(self, path) -> None:
+        from calib_core.operator.recording_tap import RecordingTap
+        from calib_core.recording.recorder import SessionRecorder
+
+        self.stop_recording()
+        self.recorder = SessionRecorder(path)
+        self._tap = RecordingTap(self, self.recorder)
+        self.message.emit(f"recording to {path}")
+
+    def stop_recording(self) -> None:
+        rec = self.recorder
+        if rec is not None:
+            self._tap.detach()
+            rec.close()
+            self.message.emit(f"recording {rec.path} closed ({rec.messages} messages)")
+        self.recorder, self._tap = None, None
+
+    def close(self) -> None:
+        self.stop_recording()
+        if self.link is not None:
+            self.link.close()
+        if self.site is not None:
+            self.site.close()

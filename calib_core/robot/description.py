@@ -1,0 +1,110 @@
+"""From a robot description file on disk to URDF text Pinocchio can read.
+
+Vendors ship xacro files and URDFs whose meshes are named ``package://pkg/path`` or by a path
+relative to the URDF. Here a xacro file is expanded with the ``xacro`` package, and every mesh
+reference is resolved to an absolute path through the cell's package paths (then
+``ROS_PACKAGE_PATH``), so what Pinocchio gets needs no ROS. A mesh that cannot be found is an
+error naming the URDF, the link and every place looked in.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Iterable
+from pathlib import Path
+
+from calib_core.errors import FileFormatError
+
+_MESH_SUFFIXES = {".stl", ".obj", ".dae", ".gltf", ".glb", ".ply"}
+
+
+def _is_xacro(path: Path, text: str) -> bool:
+    return path.suffix == ".xacro" or path.name.endswith(".urdf.xacro") or "http://www.ros.org/wiki/xacro" in text[:4000]
+
+
+def _expand_xacro(path: Path) -> str:
+    try:
+        import xacro
+    except ImportError:  # a dependency of videocal: only a broken install gets here
+        raise FileFormatError(path, "this is a xacro file and the 'xacro' package is not installed") from None
+    try:
+        document = xacro.process_file(str(path))
+    except Exception as exc:  # xacro raises its own XacroException, NameError, IOError...: all mean "cannot expand"
+        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise FileFormatError(path, f"cannot expand xacro: {message}") from None
+    return document.toxml()
+
+
+def package_search_roots(package_paths: Iterable[str | Path]) -> list[Path]:
+    """The folders searched for ``package://`` packages: the cell's package paths, then each
+    entry of ``ROS_PACKAGE_PATH``."""
+    roots = [Path(p) for p in package_paths]
+    roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    return roots
+
+
+def _package_candidates(package: str, rest: str, roots: list[Path]) -> list[Path]:
+    # A root is either a folder that holds packages (root/pkg/rest) or a package itself (root/rest).
+    candidates = []
+    for root in roots:
+        candidates.append(root / package / rest)
+        if root.name == package:
+            candidates.append(root / rest)
+    return candidates
+
+
+def resolve_uri(uri: str, urdf_dir: Path, roots: list[Path]) -> tuple[Path | None, list[Path]]:
+    """The file a mesh reference names, and every place looked in (for the error message)."""
+    if uri.startswith("package://"):
+        package, _, rest = uri[len("package://"):].partition("/")
+        looked = _package_candidates(package, rest, roots)
+    elif uri.startswith("file://"):
+        looked = [Path(uri[len("file://"):])]
+    else:
+        looked = [Path(uri) if Path(uri).is_absolute() else urdf_dir / uri]
+    for candidate in looked:
+        if candidate.is_file():
+            return candidate.resolve(), looked
+    return None, looked
+
+
+def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path]) -> None:
+    for link in root.iter("link"):
+        for role in ("visual", "collision"):
+            for element in link.iter(role):
+                for mesh in element.iter("mesh"):
+                    uri = mesh.get("filename", "")
+                    found, looked = resolve_uri(uri, path.parent, roots)
+                    where = f"link '{link.get('name')}' {role} mesh"
+                    if found is None:
+                        places = "; ".join(str(p) for p in looked) or "(no package path: add robot.package_paths to the workcell)"
+                        raise FileFormatError(path, f"{where} {uri!r} not found; looked in: {places}")
+                    if found.suffix.lower() not in _MESH_SUFFIXES:
+                        raise FileFormatError(path, f"{where} {uri!r}: unsupported format {found.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
+                    mesh.set("filename", str(found))
+
+
+def read_description(path: str | Path, package_paths: Iterable[str | Path] = ()) -> str:
+    """URDF text of a URDF or xacro file with every mesh as an absolute path.
+
+    :class:`FileFormatError` names the file for a missing, unreadable or malformed file, a xacro
+    that cannot be expanded, and (with the link) a mesh that cannot be found.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileFormatError(path, "no such robot description file") from None
+    except (IsADirectoryError, UnicodeDecodeError, PermissionError) as exc:
+        raise FileFormatError(path, f"cannot read: {exc}") from None
+    if _is_xacro(path, text):
+        text = _expand_xacro(path)
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise FileFormatError(path, f"not valid XML: {exc}") from None
+    if root.tag != "robot":
+        raise FileFormatError(path, f"not a URDF: the top element is <{root.tag}>, not <robot>")
+    _resolve_meshes(root, path, package_search_roots(package_paths))
+    return ET.tostring(root, encoding="unicode")

@@ -1,0 +1,275 @@
+"""A starting cell for a robot description: ``videocal new-cell``.
+
+From a vendor URDF (or xacro) it writes a folder that loads and renders at once: the workcell
+file (the robot with its frames named, no vendor file edited), a floor, an example target
+component with named features, the camera file, and a task location the robot reaches with the
+camera seeing the target. The operator then replaces the example by the real components.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import trimesh
+
+from calib_core.errors import VideocalError
+from calib_core.frames import make_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.robot import UnreachableTargetError, solve_ik
+from calib_core.robot.model import RobotModel, load_robot
+from calib_core.robot.spec import NewFrame, RobotSpec
+from calib_core.vision.board_placement import reach_of
+
+BUNDLED_CAMERA = Path(__file__).resolve().parents[2] / "resources" / "camera" / "gripper_camera.yaml"
+TCP_MM = 150.0
+CAMERA_OUT_MM = 40.0
+"""The example camera sits this far out along the tool from the flange, off the tool axis on the
+side where the hand leaves room (the side the task location points up)."""
+GRASP_STANDOFF_MM = 30.0
+"""The task location puts the TCP this far in front of the target's face (at its pin tip)."""
+APPROACH_MM = 150.0
+
+# The example target, in its own frame: x out of its front face (toward the robot), y left, z up.
+PLATE = (10.0, 100.0, 70.0)
+BLOCK = (10.0, 50.0, 30.0)
+# Left and right as seen from the robot (the target's y points to the robot's right).
+FEATURES = {
+    "plate_corner_top_left": [0.0, -50.0, 35.0],
+    "plate_corner_top_right": [0.0, 50.0, 35.0],
+    "plate_corner_bottom_left": [0.0, -50.0, -35.0],
+    "plate_corner_bottom_right": [0.0, 50.0, -35.0],
+    "block_corner_top_left": [10.0, -25.0, 15.0],
+    "block_corner_top_right": [10.0, 25.0, 15.0],
+    "block_corner_bottom_left": [10.0, -25.0, -15.0],
+    "block_corner_bottom_right": [10.0, 25.0, -15.0],
+    "pin_tip": [GRASP_STANDOFF_MM, 0.0, 0.0],
+}
+
+
+class StarterCellError(VideocalError, RuntimeError):
+    """No starting cell can be made for this robot (the message says why)."""
+
+
+@dataclass(frozen=True)
+class StarterCell:
+    """What :func:`write_starter_cell` wrote: the workcell file, and the frames and poses it chose."""
+
+    workcell_path: Path
+    flange: str
+    base: str | None
+    held_joints: dict[str, float]
+    home_joints: np.ndarray
+    task_tcp2base: np.ndarray
+    target2base: np.ndarray
+
+
+def _target_mesh() -> trimesh.Trimesh:
+    plate = trimesh.creation.box(extents=PLATE)
+    plate.apply_translation([-PLATE[0] / 2, 0.0, 0.0])
+    block = trimesh.creation.box(extents=BLOCK)
+    block.apply_translation([BLOCK[0] / 2, 0.0, 0.0])
+    pin = trimesh.creation.cylinder(radius=4.0, height=GRASP_STANDOFF_MM - BLOCK[0], sections=24)
+    pin.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    pin.apply_translation([BLOCK[0] + (GRASP_STANDOFF_MM - BLOCK[0]) / 2, 0.0, 0.0])
+    return trimesh.util.concatenate([plate, block, pin])
+
+
+def _chain_to(full_model, frame: str) -> set[int]:
+    """Joint ids on the path from the root to ``frame``."""
+    return set(_chain_ids(full_model, full_model.frames[full_model.getFrameId(frame)].parentJoint))
+
+
+def _choose_flange(robot: RobotModel, flange: str | None) -> str:
+    if flange is not None:
+        if not robot.model.existFrame(flange):
+            raise StarterCellError(f"the URDF has no frame {flange!r}; frames: {', '.join(robot.frame_names)}")
+        return flange
+    for name in ("tool0", "flange", "ee_link"):
+        if robot.model.existFrame(name):
+            return name
+    # Follow the arm from the root while it does not branch; the flange is the last link fixed to its
+    # last joint (a gripper's fingers branch off there and are not part of the arm).
+    model = robot.full_model
+    joint = 0
+    while True:
+        children = [j for j in range(1, model.njoints) if model.parents[j] == joint]
+        if len(children) != 1:
+            break
+        joint = children[0]
+    if children:  # the link the gripper's joints hang from (Panda: panda_hand)
+        joint_frame = model.frames[model.getFrameId(model.names[children[0]], pin.FrameType.JOINT)]
+        return model.frames[joint_frame.parentFrame].name
+    bodies = [f.name for f in model.frames if f.parentJoint == joint and f.type == pin.FrameType.BODY]
+    return bodies[-1] if bodies else model.names[joint]
+
+
+def _chain_ids(model, joint: int) -> list[int]:
+    out = []
+    while joint > 0:
+        out.append(joint)
+        joint = model.parents[joint]
+    return out
+
+
+def _tool_side(robot: RobotModel, flange: str) -> tuple[float, float]:
+    """Where the camera clears the tool: (yaw of the TCP about the flange z, deg; the camera's offset
+    from the tool axis, mm). The camera goes on the side where the links fixed to the flange (hand,
+    fingers) reach out least between the flange and the TCP."""
+    from calib_core.robot.visuals import RobotVisuals
+
+    visuals = RobotVisuals.from_robot(robot)
+    q = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
+    flange2base = robot.fk(q, flange)
+    last_joint = robot.model.frames[robot.frame_id(flange)].parentJoint
+    points = []
+    for g, mesh, pose in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q)):
+        if g.parentJoint == last_joint:
+            p = np.linalg.inv(flange2base) @ pose @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T
+            points.append(p[:3].T)
+    points = np.concatenate(points) if points else np.zeros((1, 3))
+    points = points[(points[:, 2] > -20.0) & (points[:, 2] < TCP_MM)]
+    if len(points) == 0:
+        points = np.zeros((1, 3))
+    # yaw such that the TCP's -y (where the camera sits) is this flange direction
+    sides = {0.0: -points[:, 1].min(), 180.0: points[:, 1].max(), 90.0: points[:, 0].max(), -90.0: -points[:, 0].min()}
+    yaw = min(sides, key=sides.get)
+    return yaw, max(float(sides[yaw]) + 25.0, 50.0)
+
+
+def _camera_frame(offset_mm: float) -> np.ndarray:
+    """cam2tcp-aligned frame: off-axis on the TCP's -y side, ``CAMERA_OUT_MM`` out along the tool,
+    looking along the tool axis, tilted to aim at the target face at the grasp."""
+    aim = TCP_MM + GRASP_STANDOFF_MM
+    tilt = -np.degrees(np.arctan2(offset_mm, aim - CAMERA_OUT_MM))  # about x: the optical axis turns toward the tool axis
+    return transform_from_xyz_rpy([0.0, -offset_mm, CAMERA_OUT_MM], [tilt, 0.0, 0.0])
+
+
+def _find_task(robot: RobotModel, home: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A reachable grasp (tcp2base) facing +x in front of the robot, and the joints that reach it and
+    its approach. Tries distances and heights from the middle of the workspace outward."""
+    reach, height = reach_of(robot)
+    # Tool z along base +x (toward the target), y down, x to the right: the camera (OpenCV axes, on
+    # flange -y) looks from above with the image upright.
+    R = np.column_stack([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+    for fraction in (0.55, 0.45, 0.65, 0.35, 0.75):
+        for z in (height, 0.8 * height, 1.2 * height, 0.5 * reach):
+            tcp = make_transform(R, [fraction * reach, 0.0, max(z, 150.0)])
+            approach = tcp @ make_transform(np.eye(3), [0.0, 0.0, -APPROACH_MM])
+            try:
+                q_approach = solve_ik(robot, approach, home, extra_seeds=16).q_deg
+                solve_ik(robot, tcp, q_approach, extra_seeds=4)
+            except UnreachableTargetError:
+                continue
+            return tcp, q_approach
+    raise StarterCellError("found no grasp pose in front of the robot that it reaches with the tool pointing forward; give --flange (the frame whose z points out of the tool)")
+
+
+def _yaml_pose(T: np.ndarray) -> str:
+    xyz, rpy = xyz_rpy_from_transform(T)
+    return "{xyz: [%s], rpy: [%s]}" % (", ".join(f"{v:.2f}" for v in xyz), ", ".join(f"{v:.4f}" for v in rpy))
+
+
+def _frame_yaml(parent: str, T: np.ndarray) -> str:
+    xyz, rpy = xyz_rpy_from_transform(T)
+    return "{parent: %s, xyz: [%s], rpy: [%s]}" % (parent, ", ".join(f"{v:.2f}" for v in xyz), ", ".join(f"{v:.4f}" for v in rpy))
+
+
+def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list[str | Path] = (), *, flange: str | None = None, name: str | None = None) -> StarterCell:
+    """Write a starting cell for the robot ``urdf`` into ``folder`` (created; an existing
+    ``workcell.yaml`` there is refused). Returns what was chosen."""
+    folder = Path(folder)
+    urdf = Path(urdf).resolve()
+    package_paths = [Path(p).resolve() for p in package_paths]
+    if (folder / "workcell.yaml").exists():
+        raise StarterCellError(f"{folder / 'workcell.yaml'} exists already: choose an empty folder")
+    plain = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": None}))
+    flange = _choose_flange(plain, flange)
+    base = "base" if plain.model.existFrame("base") and plain.model.frames[plain.model.getFrameId("base")].parentJoint == 0 else None
+    driven = _chain_to(plain.full_model, flange)
+    held = {plain.full_model.names[j]: 0.0 for j in range(1, plain.full_model.njoints) if j not in driven}
+    robot = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": base}, None, held))
+    yaw, offset = _tool_side(robot, flange)
+    turn = transform_from_xyz_rpy([0, 0, 0], [0, 0, yaw])
+    frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, turn @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])), "camera": NewFrame(flange, turn @ _camera_frame(offset))}
+    robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held))
+    home = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
+    tcp, q_approach = _find_task(robot, home)
+    home = q_approach  # start where the camera already sees the target from the approach
+    # The target's face centre sits GRASP_STANDOFF_MM beyond the TCP, facing the robot (its x toward -x base).
+    target2base = make_transform(np.column_stack([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]), tcp[:3, 3] + [GRASP_STANDOFF_MM, 0.0, 0.0])
+    reach, _ = reach_of(robot)
+
+    folder.mkdir(parents=True, exist_ok=True)
+    meshes = folder / "meshes"
+    meshes.mkdir(exist_ok=True)
+    floor = trimesh.creation.box(extents=(3.0 * reach, 3.0 * reach, 10.0))
+    floor.apply_translation([0.0, 0.0, -5.0])
+    floor.export(meshes / "floor.stl")
+    target = _target_mesh()
+    post_height = max(target2base[2, 3] - PLATE[2] / 2, 1.0)
+    post = trimesh.creation.box(extents=(20.0, 20.0, post_height))  # from the plate's back down to the floor
+    post.apply_translation([-PLATE[0] - 10.0, 0.0, -PLATE[2] / 2 - post_height / 2 + 20.0])
+    trimesh.util.concatenate([target, post]).export(meshes / "target.stl")
+    shutil.copyfile(BUNDLED_CAMERA, folder / "camera.yaml")
+
+    rel = lambda p: os.path.relpath(p, folder.resolve())  # noqa: E731 - paths relative to the workcell file
+    lines = [
+        f"# A starting cell for {urdf.name}, written by videocal new-cell. Schema: docs/workcell.md.",
+        "# Replace the example target by your components (placements as surveyed, in the robot's base frame).",
+        "schema_version: 2",
+        f"name: {name or urdf.stem + ' cell'}",
+        "units: {length: mm, angle: deg}",
+        "",
+        "robot:",
+        f"  urdf: {rel(urdf)}",
+    ]
+    if package_paths:
+        lines.append("  package_paths: [" + ", ".join(rel(p) for p in package_paths) + "]")
+    lines += [
+        "  frames:",
+        f"    base: {base if base else '~'}" + ("" if base else "                # the URDF's root link"),
+        f"    flange: {flange}",
+        f"    tcp: {_frame_yaml(flange, frames['tcp'].frame2parent)}",
+        f"    camera: {_frame_yaml(flange, frames['camera'].frame2parent)}   # OpenCV axes",
+        "  home_joints_deg: [" + ", ".join(f"{v:.3f}" for v in home) + "]",
+    ]
+    if held:
+        lines.append("  held_joints: {" + ", ".join(f"{k}: 0" for k in held) + "}   # not driven (deg or mm)")
+    lines += [
+        "",
+        "camera:",
+        "  intrinsics: camera.yaml",
+        "",
+        "components:",
+        "  - name: floor",
+        "    kind: fixture",
+        "    mesh: meshes/floor.stl",
+        "    mesh_units: mm",
+        "    color: [0.55, 0.56, 0.58]",
+        "    placement: {xyz: [0, 0, 0], rpy: [0, 0, 0]}",
+        "  - name: target",
+        "    kind: component",
+        "    mesh: meshes/target.stl",
+        "    mesh_units: mm",
+        "    color: [0.80, 0.78, 0.72]",
+        f"    placement: {_yaml_pose(target2base)}",
+        "    features:",
+    ] + [f"      {k}: [{', '.join(f'{v:g}' for v in p)}]" for k, p in FEATURES.items()] + [
+        "",
+        "task_locations:",
+        "  - name: target_grasp",
+        "    component: target",
+        f"    tcp2base: {_yaml_pose(tcp)}",
+        f"    approach_mm: {APPROACH_MM:g}",
+        "",
+    ]
+    path = folder / "workcell.yaml"
+    path.write_text("\n".join(lines), encoding="utf-8")
+    from calib_core.workcell.loader import load_workcell
+
+    load_workcell(path)  # what was written must load
+    return StarterCell(path, flange, base, held, home, tcp, target2base)
