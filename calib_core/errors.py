@@ -26,3 +26,15 @@ class FileFormatError(VideocalError, ValueError):
         self.detail = message
         where = f"{self.path}: field '{field}': " if field else f"{self.path}: "
         super().__init__(where + message)
+
+
+class OperatorError(VideocalError, ValueError):
+    """An action that cannot be taken now (nothing picked, no camera frame, a recording open...);
+    the message says what to do instead."""
+
+
+class UnknownNameError(VideocalError, KeyError):
+    """A name (component, task location, feature, pair) that is not there; the message lists the known ones."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""

@@ -14,6 +14,7 @@ from calib_core.errors import VideocalError
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", choices=("sim",), help="'sim': the simulated test bed (a real robot and camera need the window's capture mode, not built yet)")
+    parser.add_argument("--workcell", type=Path, help="the cell whose robot and camera are simulated (default: the bundled one); the board stands where its hand_eye_board says, or in front of the robot")
     parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100")
     parser.add_argument("--poses", type=int, default=10)
     parser.add_argument("--out", type=Path, required=True, help="YAML file for cam2flange (xyz mm, rpy deg) and its 1-sigma")
@@ -27,14 +28,17 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.vision.board import BoardSpec
     from calib_core.vision.hand_eye import calibrate_hand_eye
     from calib_core.vision.hand_eye_io import save_hand_eye
-    from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
+    from calib_core.vision.board_placement import board_in_cell
+    from calib_core.vision.hand_eye_sim import hand_eye_poses, simulated_hand_eye_images
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
     from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 
     spec = BoardSpec.parse(args.board)
-    typical = RobotErrors.typical(0)
+    cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+    typical = RobotErrors.typical(0, n_joints=cell.load_robot().n_joints)
     errors = typical if args.robot_errors else RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
-    bed = TestBed.create(errors=errors)
-    board2base = board_facing_robot(spec)
+    bed = TestBed.create(cell, errors=errors)
+    board2base = board_in_cell(spec, cell, bed.model_robot)
     joints = hand_eye_poses(bed, spec, board2base, args.poses)
     if len(joints) < 3:
         raise VideocalError(f"only {len(joints)} reachable poses see the board")

@@ -1,5 +1,5 @@
-"""``videocal export WORKSPACE --format json|csv|pdl2 [--out FILE]``: the correction table for the
-controller or a spreadsheet (stdout without ``--out``)."""
+"""``videocal export WORKSPACE --format F [--out FILE]``: the corrected task locations for a robot
+controller (URScript, RAPID, KRL, FANUC TP, PDL2) or a spreadsheet (CSV, JSON); stdout without ``--out``."""
 
 from __future__ import annotations
 
@@ -7,20 +7,23 @@ import argparse
 import sys
 from pathlib import Path
 
+from calib_core.workspace.exports import EXPORT_FORMATS
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("workspace", type=Path)
-    parser.add_argument("--format", choices=("json", "csv", "pdl2"), default="csv")
+    parser.add_argument("--format", choices=EXPORT_FORMATS, default="csv",
+                        help="csv, json (every correction, with the target to command), or a controller listing: urscript (UR), rapid (ABB), krl (KUKA), fanuc (FANUC TP), pdl2 (COMAU)")
     parser.add_argument("--out", type=Path)
 
 
 def run(args: argparse.Namespace) -> int:
     from calib_core.atomic_file import atomic_write_text
-    from calib_core.workspace.exports import corrections_csv, corrections_json, corrections_pdl2
+    from calib_core.workspace.exports import export_corrections
     from calib_core.workspace.workspace import load_workspace
 
     ws = load_workspace(args.workspace)
-    text = {"json": lambda: corrections_json(ws.corrections), "csv": lambda: corrections_csv(ws.corrections), "pdl2": lambda: corrections_pdl2(ws.corrections, ws.task_locations)}[args.format]()
+    text = export_corrections(args.format, ws.corrections, ws.task_locations)
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")

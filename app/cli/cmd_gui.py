@@ -65,29 +65,9 @@ def _run_window(args: argparse.Namespace, simulator) -> int:
     if report:  # the bench measures launch-to-window from outside
         Path(report).write_text(f"{time.monotonic()}")
 
-    from app.gui.main_window import MainWindow
-    from app.gui.workbench import Workbench
-    from calib_core.operator.cell import Cell
-    from calib_core.operator.site import RealSite
+    from app.gui.cell_launcher import CellLauncher
 
-    if simulator is not None:
-        from calib_core.testbed.sim_site import simulated_cell
-
-        cell, site = simulated_cell(args.workcell, process=simulator)
-    else:
-        cell, site = Cell.open(args.workcell), RealSite(args.port, args.camera)
-    workbench = Workbench(cell, site)
-    try:
-        if args.hand_eye is not None:
-            workbench.apply_hand_eye_file(args.hand_eye)
-        workbench.start_controller()
-        window = MainWindow(workbench)
-    except BaseException:
-        workbench.close()
-        raise
-    camera = site.camera_factory()
-    if camera is not None:
-        window.start_camera(camera)
+    window = CellLauncher(args.port, args.camera, args.hand_eye).open(args.workcell, simulator)
     window.setGeometry(shell.geometry())
     window.show()
     if args.recording is not None:
@@ -104,6 +84,7 @@ def _run_window(args: argparse.Namespace, simulator) -> int:
 
         QTimer.singleShot(4000, shoot)
     code = int(app.exec())
-    if window.isVisible():  # quit by a signal: close as Quit does
-        window.close()
+    for widget in app.topLevelWidgets():  # quit by a signal: close as Quit does (the window of a cell opened since too)
+        if isinstance(widget, QMainWindow) and widget.isVisible():
+            widget.close()
     return code

@@ -24,7 +24,7 @@ VIEWS = ("virtual", "overview", "true")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--joints", help="six joint values in degrees, comma separated")
+    where.add_argument("--joints", help="one value per driven joint (deg, or mm for a prismatic joint), comma separated")
     where.add_argument("--location", help="a task location: the robot goes to its approach pose")
     parser.add_argument("--view", choices=VIEWS, default="virtual", help="virtual (modelled camera), overview, or true (the simulated camera on the true robot)")
     parser.add_argument("--out", type=Path, required=True, help="PNG file to write")
@@ -38,9 +38,9 @@ def _joints(text: str) -> np.ndarray:
     try:
         values = [float(v) for v in text.split(",")]
     except ValueError:
-        raise VideocalError(f"--joints: expected six numbers in degrees separated by commas, got {text!r}") from None
-    if len(values) != 6 or not np.all(np.isfinite(values)):
-        raise VideocalError(f"--joints: expected six finite numbers in degrees, got {len(values)}: {text!r}")
+        raise VideocalError(f"--joints: expected numbers (deg or mm) separated by commas, got {text!r}") from None
+    if not np.all(np.isfinite(values)):
+        raise VideocalError(f"--joints: expected finite numbers, got {text!r}")
     return np.array(values)
 
 
@@ -59,7 +59,10 @@ def run(args: argparse.Namespace) -> int:
     highlight = args.highlight
     q = np.array(cell.home_joints_deg, dtype=float)
     if args.joints:
-        q = bed.model_robot.check_joints(_joints(args.joints))
+        try:
+            q = bed.model_robot.check_joints(_joints(args.joints))
+        except ValueError as exc:
+            raise VideocalError(f"--joints: {exc}") from None
     elif args.location:
         try:
             task = cell.task(args.location)

@@ -11,7 +11,7 @@ from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSp
 
 from app.gui.camera_pane import CameraPane
 from app.gui.command_panel import CommandPanel
-from app.gui.error_boundary import guarded
+from app.gui.error_boundary import attempt, guarded
 from app.gui.frame_worker import FrameWorker
 from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
@@ -24,12 +24,14 @@ from app.gui.virtual_pane import VirtualPane
 from app.gui.vision_panel import VisionPanel
 from app.gui.workbench import Workbench
 from calib_core.robot import solve_ik
+from calib_core.errors import OperatorError
 
 
 class MainWindow(QMainWindow):
-    def __init__(self, workbench: Workbench, *, settings: QSettings | None = None):
+    def __init__(self, workbench: Workbench, *, settings: QSettings | None = None, launcher=None):
         super().__init__()
         self.workbench = workbench
+        self.launcher = launcher  # opens another cell in a new window (File > Open cell); None: this window's cell only
         self.settings = settings or QSettings("videocal", "videocal")
         self.setWindowTitle(f"videocal - {workbench.workcell.name}")
         self.camera = CameraPane(workbench)
@@ -102,8 +104,16 @@ class MainWindow(QMainWindow):
 
     def _build_menus(self) -> None:
         file_menu = self.file_menu = self.menuBar().addMenu("&File")
+        self.open_cell_action = QAction("Open &cell...", self, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog)
+        file_menu.addAction(self.open_cell_action)
+        self.recent_cells = RecentFiles(self.settings, file_menu.addMenu("Recent ce&lls"), self.open_cell, key="files/recent_cells")
+        if self.launcher is None:
+            self.open_cell_action.setEnabled(False)
+            self.open_cell_action.setToolTip("this window was opened on one cell only")
+        file_menu.addSeparator()
         file_menu.addAction(QAction("&Open workspace...", self, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
         file_menu.addAction(QAction("&Save workspace as...", self, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
+        file_menu.addAction(QAction("E&xport corrections...", self, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
         file_menu.addSeparator()
         self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
         file_menu.addAction(self.record_action)
@@ -112,7 +122,7 @@ class MainWindow(QMainWindow):
         self.addAction(self.play_action)
         self.recent = RecentFiles(self.settings, file_menu.addMenu("Recent &files"), self.open_recent)
         file_menu.addSeparator()
-        quit_action = QAction("&Quit", self, shortcut=QKeySequence.StandardKey.Quit, triggered=self._quit)
+        quit_action = QAction("&Quit", self, shortcut=QKeySequence("Ctrl+Q"), triggered=self._quit)  # StandardKey.Quit is empty on some platforms
         file_menu.addAction(quit_action)
         edit = self.menuBar().addMenu("&Edit")
         self.undo_action = QAction("&Undo", self, shortcut=QKeySequence.StandardKey.Undo, triggered=self._undo)
@@ -127,6 +137,7 @@ class MainWindow(QMainWindow):
         cal.addAction(QAction("&Store correction", self, triggered=self._store))
         view = self.menuBar().addMenu("&View")
         view.addAction(QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view))
+        view.addAction(QAction("&Fit the overview to the cell", self, shortcut=QKeySequence("Ctrl+F"), triggered=lambda: (self.overview.fit_view(), self.overview.refresh())))
         robot = self.menuBar().addMenu("&Robot")
         robot.addAction(QAction("Go to &approach", self, triggered=lambda: self._go(approach=True)))
         robot.addAction(QAction("Go to task, &corrected", self, triggered=lambda: self._go(approach=False, corrected=True)))
@@ -171,12 +182,19 @@ class MainWindow(QMainWindow):
         self.replay.closed.connect(self._replay_closed)
         wb.camera_model_changed.connect(self._camera_model_changed)
         wb.link_state.connect(self.status_line.show_link_state)
+        wb.move_finished.connect(self._move_finished)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.changed.connect(self._update_actions)
         wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
         wb.session.corrections.changed.connect(lambda task: self._update_corrections())
         wb.session.changed.connect(self._after_solve)
         self._update_actions()
+
+    def _move_finished(self, what: str, error: str) -> None:
+        if error:
+            self.show_error(f"move to {what} failed: {error}")
+        else:
+            self.statusBar().showMessage(f"arrived at {what}", 8000)
 
     def _quit(self) -> None:
         self.close()
@@ -241,9 +259,9 @@ class MainWindow(QMainWindow):
     def _accept_impl(self) -> None:
         pending = self.workbench.session.pairs.pending()
         if pending is not None:
-            raise ValueError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
+            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
         if self._current_pair is None:
-            raise ValueError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
+            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
         self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
         self.workbench.record_event("pair_accepted", number=self._current_pair)
         self._current_pair = None
@@ -254,7 +272,7 @@ class MainWindow(QMainWindow):
     def _delete_impl(self) -> None:
         number = self.table.selected_number() or self._current_pair
         if number is None:
-            raise ValueError("select a pair in the table to delete it")
+            raise OperatorError("select a pair in the table to delete it")
         self.workbench.session.delete(number)
         if number == self._current_pair:
             self._current_pair = None
@@ -286,7 +304,7 @@ class MainWindow(QMainWindow):
     def _animate(self) -> None:
         wb = self.workbench
         if wb.task is None:
-            raise ValueError("choose a task location")
+            raise OperatorError("choose a task location")
         goal = solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg).q_deg
         start = wb.joints_deg.copy()
         margin = np.minimum(goal - wb.robot.lower_limits_deg, wb.robot.upper_limits_deg - goal)
@@ -304,14 +322,54 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
 
     # --- files -------------------------------------------------------------------------------
-    def save_workspace(self, path) -> None:
-        self.report(self.workbench.save_workspace)(path)
+    def save_workspace(self, path) -> bool:
+        """Save; only a save that succeeded joins the recent files and counts as saved for the autosave."""
+        if not attempt(self.show_error, self.workbench.save_workspace, path):
+            return False
         self.recent.remember(path)
         self.autosave.mark_saved()
+        return True
 
-    def open_workspace(self, path) -> None:
-        self.report(self.workbench.open_workspace)(path)
+    def open_workspace(self, path) -> bool:
+        if not attempt(self.show_error, self.workbench.open_workspace, path):
+            return False
         self.recent.remember(path)
+        return True
+
+    def open_cell(self, path: str) -> bool:
+        """Open another cell: a new window on it (with its own simulator or the same real devices) takes
+        this one's place. A cell that does not load leaves this window as it is."""
+        if self.launcher is None:
+            self.show_error("this window was opened on one cell only: start videocal gui --workcell FILE")
+            return False
+        from calib_core.operator.cell import Cell
+
+        if not attempt(self.show_error, Cell.open, path):  # check the file before anything stops
+            return False
+        opened = []
+        if not attempt(self.show_error, lambda: opened.append(self.launcher.open(path))):
+            return False
+        window = opened[0]
+        window.setGeometry(self.geometry())
+        window.show()
+        self.close()
+        return True
+
+    def _open_cell_dialog(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Open cell", str(self.workbench.workcell.path.parent), "videocal workcell (*.yaml *.yml)")
+        if path:
+            self.open_cell(path)
+
+    def _export_dialog(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        filters = {"URScript, Universal Robots (*.script)": "urscript", "RAPID module, ABB (*.mod)": "rapid", "KRL data, KUKA (*.dat)": "krl",
+                   "TP program, FANUC (*.ls)": "fanuc", "PDL2, COMAU (*.pdl)": "pdl2", "CSV (*.csv)": "csv", "JSON (*.json)": "json"}
+        path, chosen = QFileDialog.getSaveFileName(self, "Export corrections", "corrections.script", ";;".join(filters))
+        if path:
+            self.report(self.workbench.export_corrections)(path, filters.get(chosen, "csv"))
 
     def open_recent(self, path: str) -> None:
         """A workspace (.json) or a recording (.mcap) from the recent list."""
@@ -347,7 +405,7 @@ class MainWindow(QMainWindow):
 
     def _open_recording(self, path) -> None:
         if self.workbench.recorder is not None:
-            raise RuntimeError("stop recording before replaying a recording")
+            raise OperatorError("stop recording before replaying a recording")
         self.replay.open(path)
         self.commands.live.setChecked(False)
         self.recent.remember(path)

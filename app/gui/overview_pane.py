@@ -16,6 +16,17 @@ MODEL_FRUSTUM = (0.35, 0.6, 1.0)
 MEASURED_FRUSTUM = (0.2, 1.0, 0.4)
 
 
+def _world_corners(item) -> np.ndarray:
+    lo, hi = item.mesh.bounds
+    box = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    return (item.item2world @ box.T).T[:, :3]
+
+
+def _is_slab(item) -> bool:
+    extents = np.sort(item.mesh.extents)
+    return extents[0] < 0.05 * extents[2]
+
+
 class _OrbitView(ImageView):
     """An image view whose left drag orbits and wheel zooms the camera instead of the image."""
 
@@ -70,8 +81,9 @@ class OverviewPane(QWidget):
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
         layout.addWidget(self.view, 1)
-        self.target = np.array([700.0, 0.0, 800.0])
+        self.target = np.zeros(3)
         self.azimuth_deg, self.elevation_deg, self.distance_mm = -130.0, 32.0, 4300.0
+        self.fit_view()
         self.redraws = 0
         self._dirty = True
         self._path: list[np.ndarray] = []  # joints still to show in an animation (play_path)
@@ -104,6 +116,18 @@ class OverviewPane(QWidget):
         self.distance_mm = float(np.clip(self.distance_mm * factor, 800.0, 15000.0))
         self.mark_dirty()
         self.refresh()
+
+    def fit_view(self) -> None:
+        """Frame the cell: its components and the robot where it stands (a floor or a wall, far wider
+        than it is thick, does not count), seen from the current direction."""
+        wb = self.workbench
+        items = [c for c in wb.workcell.components if not _is_slab(c)] + wb.cell.model_visuals().scene_items(wb.joints_deg)
+        corners = np.concatenate([_world_corners(item) for item in items]) if items else np.zeros((1, 3))
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        self.target = (lo + hi) / 2.0
+        radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 200.0)
+        self.distance_mm = float(np.clip(1.1 * radius / np.sin(np.radians(20.0)), 800.0, 15000.0))
+        self.mark_dirty()
 
     def play_path(self, joints_deg: list[np.ndarray], interval_ms: int = 40) -> None:
         """Animate the model robot along joint vectors (deg) in this pane only: the robot does not

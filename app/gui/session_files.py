@@ -1,6 +1,6 @@
 """The window's memory of files: the recent list (a menu) and the minute-by-minute autosave.
 
-Both live in the window's ``QSettings``: ``files/recent`` (newest first) and ``files/last_saved_time``
+Both live in the window's ``QSettings``: ``files/recent`` and ``files/recent_cells`` (newest first) and ``files/last_saved_time``
 (Unix s of the last deliberate save). The autosave goes to ``<user data>/recovery/autosave.json``
 (``files/autosave_dir`` overrides the folder) and is offered again when it is newer than that save.
 """
@@ -23,18 +23,20 @@ AUTOSAVE_INTERVAL_MS = 60_000
 class RecentFiles:
     """Workspaces and recordings opened or saved, newest first, as a menu whose entries call ``open_path``."""
 
-    def __init__(self, settings: QSettings, menu: QMenu, open_path: Callable[[str], None]):
+    def __init__(self, settings: QSettings, menu: QMenu, open_path: Callable[[str], None], key: str = "files/recent"):
         self.settings = settings
         self.menu = menu
+        self.key = key
         self._open_path = open_path
         menu.aboutToShow.connect(self.fill)
 
     def paths(self) -> list[str]:
-        return [p for p in (self.settings.value("files/recent") or []) if p]
+        value = self.settings.value(self.key) or []
+        return [p for p in ([value] if isinstance(value, str) else value) if p]
 
     def remember(self, path) -> None:
         recent = [str(path)] + [p for p in self.paths() if p != str(path)]
-        self.settings.setValue("files/recent", recent[:RECENT_MAX])
+        self.settings.setValue(self.key, recent[:RECENT_MAX])
 
     def fill(self) -> None:
         self.menu.clear()

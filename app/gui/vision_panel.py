@@ -23,6 +23,7 @@ from calib_core.vision.capture import BoardCapture
 from calib_core.vision.hand_eye import HandEyeCalibration
 from calib_core.vision.hand_eye_io import save_hand_eye
 from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
+from calib_core.errors import OperatorError
 
 STILL_S = 0.3
 """A view is only captured from a frame taken this long after the robot last moved (joints and image agree)."""
@@ -147,7 +148,7 @@ class VisionPanel(QWidget):
         if not self._plan:
             self._plan = self.workbench.board_view_plan(self.capture.spec)
             if not self._plan:
-                raise RuntimeError("no reachable robot pose sees the board")
+                raise OperatorError("no reachable robot pose sees the board")
         q = self._plan[self._plan_index % len(self._plan)]
         self._plan_index += 1
         self.workbench.move_joints(q, f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}")
@@ -166,10 +167,10 @@ class VisionPanel(QWidget):
         """Detect the board in the current frame; keep it (with the joints) or say why not."""
         frame = self._current_frame()
         if frame is None:
-            raise RuntimeError("no camera frame yet: start the camera (Execution > Live) or open a recording")
+            raise OperatorError("no camera frame yet: start the camera (Execution > Live) or open a recording")
         replaying = self.workbench.replaying
         if not replaying and not self.robot_is_still(frame):
-            raise RuntimeError("the robot is moving: capture when it has stopped, so the image and the joints agree")
+            raise OperatorError("the robot is moving: capture when it has stopped, so the image and the joints agree")
         # live: the joints the controller reports; replaying: the ones recorded with this frame
         joints = self.workbench.joints_deg.copy() if (replaying or self.workbench.link_up) else None
         view = self.capture.add(frame.image, joints)
@@ -184,7 +185,7 @@ class VisionPanel(QWidget):
     def _remove_selected(self) -> None:
         item = self.views.currentItem()
         if item is None or item.data(Qt.ItemDataRole.UserRole) is None:
-            raise RuntimeError("select an accepted view to remove")
+            raise OperatorError("select an accepted view to remove")
         self.capture.remove(item.data(Qt.ItemDataRole.UserRole))
         self._refresh()
 
@@ -235,12 +236,12 @@ class VisionPanel(QWidget):
 
     def apply_intrinsics(self) -> None:
         if self.intrinsics_result is None:
-            raise RuntimeError("calibrate the intrinsics first")
+            raise OperatorError("calibrate the intrinsics first")
         self.workbench.apply_intrinsics(self.intrinsics_result.intrinsics, f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)")
 
     def apply_hand_eye(self) -> None:
         if self.hand_eye_result is None:
-            raise RuntimeError("calibrate the hand-eye first")
+            raise OperatorError("calibrate the hand-eye first")
         self.workbench.apply_cam2flange(self.hand_eye_result.cam2flange, f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)")
 
     def save_intrinsics(self, path, fmt: str = "opencv") -> None:

@@ -6,6 +6,7 @@ from dataclasses import replace
 
 from calib_core.calibration.correspondences import Correspondence, CorrespondenceSet, with_pixel
 from calib_core.calibration.undo import Command
+from calib_core.errors import OperatorError
 
 
 class AddPoint3D(Command):
@@ -91,7 +92,7 @@ class SetTaskApproach(Command):
 
     def __init__(self, task_locations: dict, name: str, approach_mm: float, on_change=None):
         if approach_mm < 0:
-            raise ValueError(f"the approach of {name} must be >= 0 mm, got {approach_mm}")
+            raise OperatorError(f"the approach of {name} must be >= 0 mm, got {approach_mm}")
         self.tasks = task_locations
         self.name = name
         self.new = float(approach_mm)

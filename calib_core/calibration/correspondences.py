@@ -13,6 +13,7 @@ from psygnal import Signal
 from dataclasses import dataclass, replace
 
 import numpy as np
+from calib_core.errors import UnknownNameError
 
 
 @dataclass(frozen=True)
@@ -67,13 +68,13 @@ class CorrespondenceSet:
         for p in self._pairs:
             if p.number == number:
                 return p
-        raise KeyError(f"no pair number {number}")
+        raise UnknownNameError(f"no pair number {number}")
 
     def index_of(self, number: int) -> int:
         for i, p in enumerate(self._pairs):
             if p.number == number:
                 return i
-        raise KeyError(f"no pair number {number}")
+        raise UnknownNameError(f"no pair number {number}")
 
     def new_number(self) -> int:
         n = self._next_number

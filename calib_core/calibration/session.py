@@ -18,13 +18,13 @@ from calib_core.calibration.correspondences import CorrespondenceSet
 from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution
 from calib_core.calibration.undo import Command, UndoStack
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.errors import VideocalError
+from calib_core.errors import OperatorError
 from calib_core.frames import apply, invert
 from calib_core.recording.replay import solve_inputs
 from calib_core.solver import SolveStatus, solve_pose
 
 
-class CalibrationError(VideocalError, ValueError):
+class CalibrationError(OperatorError):
     """A calibration step that cannot be taken now; the message says what to do instead."""
 
 

@@ -162,6 +162,7 @@ class ControllerLink:
                 self._moves.pop(handle.id, None)
                 if handle in self._awaiting_ack:
                     self._awaiting_ack.remove(handle)
+            handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
         return handle
 

@@ -81,6 +81,7 @@ class MoveHandle:
         self.joints_deg = joints_deg
         self.deadline_s = deadline_s
         self.acked = False
+        self.sent = True  # False when the link could not send it (then it has finished with the reason)
         self._event = threading.Event()
         self._error: MoveError | None = None
         self._callbacks: list = []

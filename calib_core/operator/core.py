@@ -140,9 +140,16 @@ class OperatorCore:
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
         q = self.robot.check_joints(q)
+        outside = np.flatnonzero(~self.robot.within_limits(q))
+        if len(outside):
+            j = int(outside[0])
+            raise CalibrationError(
+                f"not moving to {what}: joint {self.robot.joint_names[j]} target {q[j]:.2f} {self.robot.joint_units[j]} is outside its limits "
+                f"[{self.robot.lower_limits_deg[j]:g}, {self.robot.upper_limits_deg[j]:g}]"
+            )
         handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
-        if handle.finished:
-            handle.wait(0)  # finished before it started: nothing was sent, and this raises the link's reason
+        if not handle.sent:
+            handle.wait(0)  # raises the link's reason
         self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
         handle.on_finished(lambda h: self._call_soon(self._move_ended, what, h))
         if wait:
@@ -252,10 +259,9 @@ class OperatorCore:
     def board_placement(self, spec) -> np.ndarray:
         """Where the hand-eye board stands: the workcell's ``hand_eye_board`` placement, or upright
         in front of the robot within its reach. ``board2base`` (4, 4) mm."""
-        from calib_core.vision.board_placement import board_from_centre, board_in_front_of_robot
+        from calib_core.vision.board_placement import board_in_cell
 
-        centre = self.workcell.meta.get("hand_eye_board_centre")
-        return board_from_centre(spec, centre) if centre is not None else board_in_front_of_robot(spec, self.robot)
+        return board_in_cell(spec, self.workcell, self.robot)
 
     def show_calibration_board(self, spec, on: bool = True) -> np.ndarray:
         """Put a ChArUco board up in the cell (or take it down). Returns its ``board2base`` (4, 4) mm."""
@@ -308,6 +314,16 @@ class OperatorCore:
                 self.session.corrections.add(c)
         self.session.undo.clear()
         self.message.emit(f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations")
+
+    def export_corrections(self, path, fmt: str) -> None:
+        """Write the corrected task locations as ``fmt`` (``videocal export``'s formats) to ``path``, atomically."""
+        from calib_core.atomic_file import atomic_write_text
+        from calib_core.workspace.exports import export_corrections
+
+        if not self.session.corrections.tasks():
+            raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
+        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations))
+        self.message.emit(f"corrections exported to {path} ({fmt})")
 
     def start_recording(self, path) -> None:
         from calib_core.operator.recording_tap import RecordingTap

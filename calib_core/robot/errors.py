@@ -25,3 +25,13 @@ class UnreachableTargetError(RobotModelError):
     def __init__(self, message: str, best: tuple[float, float]):
         self.best = best
         super().__init__(message)
+
+
+class RobotSpecError(RobotModelError):
+    """A workcell's robot section that does not fit its URDF (a frame, joint or base it names).
+    ``field`` is the workcell field (``robot.frames.flange``), ``detail`` the reason."""
+
+    def __init__(self, field: str, detail: str, urdf=None):
+        self.field = field
+        self.detail = detail
+        super().__init__(f"{urdf}: {field}: {detail}" if urdf else f"{field}: {detail}")

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from calib_core.errors import FileFormatError
 from calib_core.robot.description import read_description
-from calib_core.robot.errors import RobotModelError, UnknownFrameError
+from calib_core.robot.errors import RobotModelError, RobotSpecError, UnknownFrameError
 from calib_core.robot.spec import DEFAULT_FRAMES, FRAME_ROLES, NewFrame, RobotSpec
 
 RESOURCES = Path(__file__).resolve().parents[2] / "resources" / "robot"
@@ -207,11 +207,11 @@ def _held_configuration(full: pin.Model, held: dict[str, float], path: Path) -> 
     ids = []
     for name, value in held.items():
         if not full.existJointName(name):
-            raise FileFormatError(path, f"robot.held_joints: the URDF has no joint {name!r}; joints: {', '.join(full.names[1:])}")
+            raise RobotSpecError("robot.held_joints", f"the URDF has no joint {name!r}; joints: {', '.join(full.names[1:])}", path)
         jid = full.getJointId(name)
         kind = _joint_kind(full.joints[jid])
         if kind is None:
-            raise FileFormatError(path, f"robot.held_joints: joint {name!r} is of an unsupported kind ({full.joints[jid].shortname()})")
+            raise RobotSpecError(f"robot.held_joints.{name}", f"joint {name!r} is of an unsupported kind ({full.joints[jid].shortname()})", path)
         iq = full.joints[jid].idx_q
         internal = float(value) * _INTERNAL_PER_USER[kind]
         if kind == CONTINUOUS:
@@ -224,7 +224,7 @@ def _held_configuration(full: pin.Model, held: dict[str, float], path: Path) -> 
 
 def _add_frame(model: pin.Model, name: str, spec: NewFrame, path: Path, role: str) -> None:
     if not model.existFrame(spec.parent):
-        raise FileFormatError(path, f"robot.frames.{role}.parent: the URDF has no frame {spec.parent!r}")
+        raise RobotSpecError(f"robot.frames.{role}.parent", f"the URDF has no frame {spec.parent!r}", path)
     parent_id = model.getFrameId(spec.parent)
     parent = model.frames[parent_id]
     placement = parent.placement * _to_se3(spec.frame2parent)
@@ -245,7 +245,7 @@ def _assign_roles(model: pin.Model, frames: dict, path: Path) -> dict[str, str]:
         elif model.existFrame(spec):
             roles[role] = spec
         elif role in frames:  # named on purpose but absent: say so now rather than at the first FK
-            raise FileFormatError(path, f"robot.frames.{role}: the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: [...]}}")
+            raise RobotSpecError(f"robot.frames.{role}", f"the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: [...]}}", path)
     return roles
 
 
@@ -272,10 +272,7 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
     data = model.createData()
     base_id = model.getFrameId(roles["base"])
     if model.frames[base_id].parentJoint != 0:
-        raise FileFormatError(path, f"robot.frames.base: frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world")
+        raise RobotSpecError("robot.frames.base", f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world", path)
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     base2root = _to_mm(data.oMf[base_id])
-    robot = RobotModel(model, data, path, xml, roles, base2root, full, tuple(locked), q_ref)
-    if spec.home_joints is not None:
-        robot.check_joints(spec.home_joints)
-    return robot
+    return RobotModel(model, data, path, xml, roles, base2root, full, tuple(locked), q_ref)

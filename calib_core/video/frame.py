@@ -6,6 +6,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
+from calib_core.errors import VideocalError
 
 
 @dataclass(frozen=True)
@@ -59,5 +60,5 @@ class FrameSource(ABC):
         self.close()
 
 
-class VideoSourceError(RuntimeError):
+class VideoSourceError(VideocalError, RuntimeError):
     """A video source could not be opened or stopped delivering frames; the message names it."""

@@ -46,6 +46,12 @@ def board_in_front_of_robot(spec: BoardSpec, robot: RobotModel, home_deg=None) -
     return board_from_centre(spec, make_transform(_FACING_ROBOT, centre))
 
 
+def board_in_cell(spec: BoardSpec, workcell, robot: RobotModel) -> np.ndarray:
+    """``board2base`` (4, 4) mm: where the workcell's ``hand_eye_board`` says, else in front of the robot."""
+    centre = workcell.meta.get("hand_eye_board_centre")
+    return board_from_centre(spec, centre) if centre is not None else board_in_front_of_robot(spec, robot)
+
+
 def board_view_joints(robot: RobotModel, start_deg, spec: BoardSpec, board2base: np.ndarray, n: int = 10, seed: int = 0) -> list[np.ndarray]:
     """Joint vectors (deg/mm) from which the modelled camera looks at the board from different
     directions, rolled about its axis: reachable ones only, each IK seeded from the one before."""

@@ -12,13 +12,14 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.vision.board import BoardSpec
+from calib_core.errors import VideocalError
 
 MIN_CORNERS = 8
 MIN_VIEWS = 3
 PARAMETERS = ("fu", "fv", "cx", "cy", "k1", "k2", "p1", "p2", "k3")
 
 
-class CalibrationInputError(ValueError):
+class CalibrationInputError(VideocalError, ValueError):
     """Views that cannot give a calibration (too few, all rejected); the message says why."""
 
 

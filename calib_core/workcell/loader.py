@@ -15,6 +15,7 @@ import yaml
 
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
+from calib_core.robot.errors import RobotSpecError
 from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
 from calib_core.workcell.model import TaskLocation, Workcell
@@ -142,7 +143,10 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     if units["length"] != "mm" or units["angle"] != "deg":
         raise reader.fail("units", f"placements must be in mm and deg, got {units['length']!r} and {units['angle']!r}")
     robot_spec = read_robot_section(reader, data["robot"])
-    robot = load_robot(robot_spec)
+    try:
+        robot = load_robot(robot_spec)
+    except RobotSpecError as exc:  # the workcell names something its URDF lacks: name the workcell's field
+        raise reader.fail(exc.field, f"{exc.detail} (in {robot_spec.urdf.name})") from None
     home = check_against_robot(reader, robot_spec, robot)
     intrinsics_path = None
     if data.get("camera") is not None:

@@ -1,51 +1,77 @@
-"""Exports of the correction table: JSON, CSV, and a PDL2-style listing of the corrected
-positions for the robot controller."""
+"""Exports of the correction table: JSON and CSV with every stored correction (the displacement, its
+sigma and the corrected target pose to command), and controller listings
+(:mod:`calib_core.workspace.controller_formats`). Poses are in the cell's base frame, mm and degrees."""
 
 from __future__ import annotations
 
 import csv
 import io
 import json
-import time
 
-import numpy as np
-from scipy.spatial.transform import Rotation
-
-from calib_core.calibration.corrections import CorrectionTable
+from calib_core.calibration.corrections import Correction, CorrectionTable
+from calib_core.frames import invert, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
-from calib_core.workspace.workspace import _correction_dict
+from calib_core.workspace.controller_formats import FORMATS, controller_listing
+from calib_core.workspace.workspace import _correction_dict, _pose
 
-CSV_COLUMNS = ("task", "time_s", "dx_mm", "dy_mm", "dz_mm", "rx_deg", "ry_deg", "rz_deg", "sd_dx_mm", "sd_dy_mm", "sd_dz_mm", "sd_rx_deg", "sd_ry_deg", "sd_rz_deg", "rms_px", "pairs", "source")
+CSV_COLUMNS = (
+    "task", "time_s", "dx_mm", "dy_mm", "dz_mm", "rx_deg", "ry_deg", "rz_deg", "sd_dx_mm", "sd_dy_mm", "sd_dz_mm", "sd_rx_deg", "sd_ry_deg", "sd_rz_deg",
+    "target_x_mm", "target_y_mm", "target_z_mm", "target_roll_deg", "target_pitch_deg", "target_yaw_deg", "rms_px", "pairs", "source",
+)
+EXPORT_FORMATS = ("json", "csv") + FORMATS
 
 
-def corrections_json(table: CorrectionTable) -> str:
-    return json.dumps({"corrections": [_correction_dict(c) for t in table.tasks() for c in table.history(t)]}, indent=1)
+def _target(c: Correction, tasks: dict[str, TaskLocation]):
+    """The pose to command so the real tool reaches the planned location, with this correction."""
+    task = tasks.get(c.task)
+    return None if task is None else invert(c.delta_base) @ task.tcp2base
 
 
-def corrections_csv(table: CorrectionTable) -> str:
-    """Every stored correction (history included), one row each, mm and degrees."""
+def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:
+    """Every correction; with ``tasks``, each also with ``target_to_command`` ({xyz mm, rpy deg} in base)."""
+    rows = []
+    for t in table.tasks():
+        for c in table.history(t):
+            row = _correction_dict(c)
+            target = _target(c, tasks or {})
+            if target is not None:
+                row["target_to_command"] = _pose(target)
+            rows.append(row)
+    return json.dumps({"frame": "base", "units": {"length": "mm", "angle": "deg", "rpy": "fixed axes x, y, z"}, "corrections": rows}, indent=1)
+
+
+def _cell(text: str) -> str:
+    # A spreadsheet runs a cell that starts with one of these as a formula: keep it text.
+    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
+
+
+def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:
+    """Every stored correction (history included), one row each, mm and degrees; the target columns
+    are empty for a task location the workspace does not know."""
     out = io.StringIO()
     w = csv.writer(out)
     w.writerow(CSV_COLUMNS)
     for task in table.tasks():
         for c in table.history(task):
-            w.writerow([c.task, f"{c.time_s:.3f}", *(f"{v:.4f}" for v in c.displacement_mm), *(f"{v:.5f}" for v in c.rotation_deg), *(f"{v:.4f}" for v in c.std_displacement_mm), *(f"{v:.5f}" for v in c.std_rotation_deg), f"{c.rms_px:.3f}", c.pairs, c.source])
+            target = _target(c, tasks or {})
+            pose = [""] * 6
+            if target is not None:
+                xyz, rpy = xyz_rpy_from_transform(target)
+                pose = [f"{v:.4f}" for v in xyz] + [f"{v:.5f}" for v in rpy]
+            w.writerow([_cell(c.task), f"{c.time_s:.3f}", *(f"{v:.4f}" for v in c.displacement_mm), *(f"{v:.5f}" for v in c.rotation_deg), *(f"{v:.4f}" for v in c.std_displacement_mm),
+                        *(f"{v:.5f}" for v in c.std_rotation_deg), *pose, f"{c.rms_px:.3f}", c.pairs, _cell(c.source)])
     return out.getvalue()
 
 
 def corrections_pdl2(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> str:
-    """A PDL2-style listing: for each corrected task, ``POS(x, y, z, e1, e2, e3, '')`` of the target to
-    command (mm; Euler angles ZYZ in degrees, COMAU's convention), with the measured displacement."""
-    lines = [f"-- videocal corrected task locations, {time.strftime('%Y-%m-%d %H:%M:%S')}", "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
-    body = []
-    for name in table.tasks():
-        if name not in tasks:
-            continue
-        c = table.latest(name)
-        target = table.corrected_target(name, tasks[name].tcp2base)
-        e = Rotation.from_matrix(target[:3, :3]).as_euler("ZYZ", degrees=True)
-        var = "".join(ch if ch.isalnum() else "_" for ch in name)[:24] + "_c"
-        lines.append(f"  {var} : POSITION  -- displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs")
-        x, y, z = target[:3, 3]
-        body.append(f"  {var} := POS({x:.3f}, {y:.3f}, {z:.3f}, {e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f}, '')")
-    return "\n".join(lines + ["BEGIN"] + body + ["END", ""])
+    """A PDL2 listing of the corrected targets."""
+    return controller_listing("pdl2", table, tasks)
+
+
+def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation]) -> str:
+    """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`)."""
+    if fmt == "json":
+        return corrections_json(table, tasks)
+    if fmt == "csv":
+        return corrections_csv(table, tasks)
+    return controller_listing(fmt, table, tasks)

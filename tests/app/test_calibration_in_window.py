@@ -316,3 +316,24 @@ def test_simulate_animates_the_model_in_the_overview_only(qtbot, window):
     assert np.allclose(wb.joints_deg, q_before)  # the robot did not move
     qtbot.waitUntil(lambda: not win.overview._path_timer.isActive(), timeout=10_000)
     assert win.overview._shown_joints is None  # back to the real joints
+
+
+def test_a_refused_move_is_shown_and_ctrl_q_stops_the_simulator(qtbot, window):
+    win, wb = window, window.workbench
+    q = wb.joints_deg.copy()
+    q[2] = wb.robot.upper_limits_deg[2] + 10.0
+    win.report(lambda: wb.move_joints(q, "a pose past the elbow's limit"))()
+    assert "outside its limits" in win.results.status.text()  # the core refuses it: nothing is sent
+    # A model whose limits are wider than the controller's: the controller refuses the move, and the window says so.
+    wb.robot.model.upperPositionLimit[2] += np.radians(20.0)
+    wb.move_joints(q, "a pose past the elbow's limit")
+    qtbot.waitUntil(lambda: "LIMIT" in win.results.status.text(), timeout=10_000)
+    assert "move to a pose past the elbow's limit failed" in win.results.status.text()
+    process = wb.site.process
+    assert process.running
+    from PySide6.QtGui import QKeySequence
+
+    quit_action = next(a for a in win.file_menu.actions() if a.shortcut() == QKeySequence("Ctrl+Q"))
+    quit_action.trigger()
+    qtbot.waitUntil(lambda: not process.running, timeout=10_000)
+    assert not win.isVisible()

@@ -34,8 +34,8 @@ def test_home_pose_by_default_and_joints(tmp_path):
     "args, message",
     [
         (["--location", "nowhere"], "no task location 'nowhere'"),
-        (["--joints", "1,2,3"], "six finite numbers"),
-        (["--joints", "a,b,c,d,e,f"], "six numbers"),
+        (["--joints", "1,2,3"], "expected 6 joint values"),
+        (["--joints", "a,b,c,d,e,f"], "expected numbers"),
         (["--highlight", "rack_9"], "no component 'rack_9'"),
         (["--workcell", "missing.yaml"], "no such workcell file"),
     ],

@@ -57,6 +57,17 @@ def _write(path: Path, data) -> Path:
         (lambda d: d.update(schema_version=7), "schema_version", "versions 1, 2"),
         (lambda d: d["task_locations"][0].update(component="oru_9"), "task_locations[0].component", "no component called 'oru_9'"),
         (lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]), "components[2].features.pin_tip", "list of 3 numbers"),
+        (lambda d: d["robot"]["frames"].update(flange="tool0"), "robot.frames.flange", "the URDF has no frame 'tool0'"),
+        (lambda d: d["robot"]["frames"].update(tcp={"parent": "wrist", "xyz": [0, 0, 1], "rpy": [0, 0, 0]}), "robot.frames.tcp.parent", "no frame 'wrist'"),
+        (lambda d: d["robot"]["frames"].update(tool="flange"), "robot.frames", "unknown key(s) tool"),
+        (lambda d: d["robot"]["frames"].update(base="link_2"), "robot.frames.base", "moves with joint"),
+        (lambda d: d["robot"].update(home_joints_deg=[0, 0, 0, 0, 0, 0, 0]), "robot.home_joints_deg", "drives 6 joints (joint_1"),
+        (lambda d: d["robot"].update(home_joints_deg=[0, 0, 300, 0, 0, 0]), "robot.home_joints_deg[2]", "outside joint 'joint_3' limits"),
+        (lambda d: d["robot"].update(held_joints={"finger": 3}), "robot.held_joints", "no joint 'finger'"),
+        (lambda d: d["robot"].update(package_paths=["nowhere"]), "robot.package_paths[0]", "folder not found"),
+        (lambda d: d["robot"].update(controller={"joints": ["joint_1", "joint_2"]}), "robot.controller.joints", "must name each driven joint once"),
+        (lambda d: d["robot"].update(controller={"joints": ["joint_1"], "zero_offsets": [1, 2]}), "robot.controller.zero_offsets", "one value per controller joint"),
+        (lambda d: d.update(hand_eye_board={"xyz": [1, 2]}), "hand_eye_board", "missing key(s) rpy"),
     ],
 )
 def test_bad_files_name_file_and_field(cell_copy, mutate, field, message):

@@ -1,0 +1,153 @@
+"""Corrected task locations in the conventions of the controllers people have.
+
+Each writer takes poses in the cell's ``base`` frame (4, 4, mm) and prints them as the vendor's
+language declares a Cartesian target:
+
+- Universal Robots URScript: ``p[x, y, z, rx, ry, rz]``, metres and a rotation vector in radians;
+- ABB RAPID: ``robtarget`` ``[[x, y, z], [q1, q2, q3, q4], conf, extax]``, mm and a unit quaternion,
+  scalar first;
+- KUKA KRL: ``FRAME {X, Y, Z, A, B, C}``, mm and degrees, ``R = Rz(A) Ry(B) Rx(C)``;
+- FANUC TP: a position ``(X, Y, Z, W, P, R)``, mm and degrees, ``R = Rz(R) Ry(P) Rx(W)``;
+- COMAU PDL2: ``POS(x, y, z, e1, e2, e3, '')``, mm and Euler ZYZ degrees.
+
+A pose alone does not fix the arm's configuration (ABB ``confdata``, FANUC ``CONFIG``, KUKA
+``S``/``T``): the listings say so, and leave it to be taught on the controller.
+Variable names are made unique within a listing after the vendor's length limit.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from calib_core.calibration.corrections import CorrectionTable
+from calib_core.workcell.model import TaskLocation
+
+
+def unique_identifiers(names: list[str], max_len: int, suffix: str = "_c") -> dict[str, str]:
+    """Identifiers (letters, digits, ``_``; starting with a letter) for ``names``, at most
+    ``max_len`` characters with ``suffix``, all different: truncated ones that collide get a number."""
+    out: dict[str, str] = {}
+    used: set[str] = set()
+    for name in names:
+        base = "".join(ch if ch.isalnum() and ch.isascii() else "_" for ch in name) or "task"
+        if not base[0].isalpha():
+            base = "t_" + base
+        stem = base[: max_len - len(suffix)]
+        ident, k = stem + suffix, 2
+        while ident.lower() in used:
+            tail = f"{k}{suffix}"
+            ident, k = stem[: max_len - len(tail)] + tail, k + 1
+        used.add(ident.lower())
+        out[name] = ident
+    return out
+
+
+def urscript_pose(T: np.ndarray) -> str:
+    x, y, z = T[:3, 3] / 1000.0
+    rx, ry, rz = Rotation.from_matrix(T[:3, :3]).as_rotvec()
+    return f"p[{x:.6f}, {y:.6f}, {z:.6f}, {rx:.6f}, {ry:.6f}, {rz:.6f}]"
+
+
+def rapid_robtarget(T: np.ndarray) -> str:
+    x, y, z = T[:3, 3]
+    qx, qy, qz, qw = Rotation.from_matrix(T[:3, :3]).as_quat()
+    if qw < 0:  # the same rotation; RAPID's examples keep q1 >= 0
+        qw, qx, qy, qz = -qw, -qx, -qy, -qz
+    return f"[[{x:.3f},{y:.3f},{z:.3f}],[{qw:.8f},{qx:.8f},{qy:.8f},{qz:.8f}],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+
+
+def krl_frame(T: np.ndarray) -> str:
+    x, y, z = T[:3, 3]
+    a, b, c = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+    return f"{{X {x:.3f},Y {y:.3f},Z {z:.3f},A {a:.4f},B {b:.4f},C {c:.4f}}}"
+
+
+def fanuc_position(T: np.ndarray) -> tuple[float, ...]:
+    """(X, Y, Z, W, P, R): mm and degrees."""
+    w, p, r = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
+    x, y, z = T[:3, 3]
+    return float(x), float(y), float(z), float(w), float(p), float(r)
+
+
+def pdl2_pos(T: np.ndarray) -> str:
+    x, y, z = T[:3, 3]
+    e = Rotation.from_matrix(T[:3, :3]).as_euler("ZYZ", degrees=True)
+    return f"POS({x:.3f}, {y:.3f}, {z:.3f}, {e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f}, '')"
+
+
+Entry = tuple[str, np.ndarray, str]
+"""(variable name, target pose (4, 4) mm in base, a remark)."""
+
+
+def _urscript(entries: list[Entry], when: str) -> list[str]:
+    lines = [f"# videocal corrected task locations, {when}",
+             "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location"]
+    for ident, T, note in entries:
+        lines += [f"# {note}", f"global {ident} = {urscript_pose(T)}"]
+    return lines
+
+
+def _rapid(entries: list[Entry], when: str) -> list[str]:
+    lines = ["MODULE videocal_corrections", f"  ! videocal corrected task locations, {when}",
+             "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0); confdata [0,0,0,0] must be taught"]
+    for ident, T, note in entries:
+        lines += [f"  ! {note}", f"  CONST robtarget {ident} := {rapid_robtarget(T)};"]
+    return lines + ["ENDMODULE"]
+
+
+def _krl(entries: list[Entry], when: str) -> list[str]:
+    lines = ["DEFDAT videocal_corrections PUBLIC", f"; videocal corrected task locations, {when}",
+             "; FRAME {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; S and T are taught"]
+    for ident, T, note in entries:
+        lines += [f"; {note}", f"DECL GLOBAL FRAME {ident}={krl_frame(T)}"]
+    return lines + ["ENDDAT"]
+
+
+def _fanuc(entries: list[Entry], when: str) -> list[str]:
+    notes = [f"videocal corrected task locations, {when}", "X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W)) in the robot's world frame; CONFIG must be taught"]
+    notes += [f"P[{k}] {ident}: {note}" for k, (ident, _, note) in enumerate(entries, start=1)]
+    lines = ["/PROG VIDEOCAL_CORR", "/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
+    for k, (ident, T, _) in enumerate(entries, start=1):
+        x, y, z, w, p, r = fanuc_position(T)
+        lines += [
+            f'P[{k}:"{ident}"]{{', "   GP1:", "\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',",
+            f"\tX = {x:10.3f}  mm,\tY = {y:10.3f}  mm,\tZ = {z:10.3f}  mm,",
+            f"\tW = {w:10.3f} deg,\tP = {p:10.3f} deg,\tR = {r:10.3f} deg", "};",
+        ]
+    return lines + ["/END"]
+
+
+def _pdl2(entries: list[Entry], when: str) -> list[str]:
+    lines = [f"-- videocal corrected task locations, {when}",
+             "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
+    lines += [f"  {ident} : POSITION  -- {note}" for ident, _, note in entries]
+    return lines + ["BEGIN"] + [f"  {ident} := {pdl2_pos(T)}" for ident, T, _ in entries] + ["END"]
+
+
+# format -> (writer, longest variable name the language takes)
+LISTINGS: dict[str, tuple[Callable[[list[Entry], str], list[str]], int]] = {
+    "urscript": (_urscript, 63), "rapid": (_rapid, 32), "krl": (_krl, 24), "fanuc": (_fanuc, 16), "pdl2": (_pdl2, 24),
+}
+FORMATS = tuple(LISTINGS)
+
+
+def corrected_targets(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> dict[str, np.ndarray]:
+    """The target to command (4, 4) mm in base for every corrected task location the workspace knows."""
+    return {name: table.corrected_target(name, tasks[name].tcp2base) for name in table.tasks() if name in tasks}
+
+
+def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation]) -> str:
+    """The corrected targets as a ``fmt`` listing (:data:`FORMATS`), one variable per task location,
+    each with its measured displacement as a remark."""
+    writer, max_name = LISTINGS[fmt]
+    targets = corrected_targets(table, tasks)
+    idents = unique_identifiers(list(targets), max_name)
+    entries = []
+    for name, T in targets.items():
+        c = table.latest(name)
+        entries.append((idents[name], T, f"{name}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
+    return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S")) + [""])

@@ -1,0 +1,78 @@
+"""``videocal gui`` leaves no controller simulator behind: not after a failed start, not after SIGTERM."""
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from calib_core.workcell import DEFAULT_WORKCELL
+
+
+@pytest.fixture
+def cell_copy(tmp_path):
+    """The bundled cell under a unique path, so its simulator can be told from any other."""
+    root = DEFAULT_WORKCELL.parents[1]
+    for sub in ("workcell", "robot", "camera"):
+        shutil.copytree(root / sub, tmp_path / sub)
+    return tmp_path / "workcell" / "workcell.yaml"
+
+
+def _simulators_for(marker: Path) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            cmdline = (entry / "cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if b"sim-controller" in cmdline and str(marker).encode() in cmdline:
+            found.append(int(entry.name))
+    return found
+
+
+def _gui(*args, env=None):
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", **(env or {})}
+    return subprocess.Popen([sys.executable, "-m", "app.cli.main", "gui", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+
+
+def _wait_gone(marker: Path, timeout_s: float = 10.0) -> list[int]:
+    deadline = time.monotonic() + timeout_s
+    while (left := _simulators_for(marker)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return left
+
+
+def test_a_failed_start_stops_the_simulator(cell_copy, tmp_path):
+    bad = tmp_path / "hand_eye.yaml"
+    bad.write_text("cam2flange: {xyz: [1, 2]}")
+    gui = _gui("--workcell", str(cell_copy), "--hand-eye", str(bad))
+    out, err = gui.communicate(timeout=120)
+    assert gui.returncode == 2, err
+    assert "not a cam2flange file" in err and "Traceback" not in err
+    assert _wait_gone(cell_copy) == []
+
+
+def test_sigterm_closes_the_window_and_the_simulator(cell_copy, tmp_path):
+    shown = tmp_path / "shown.txt"
+    gui = _gui("--workcell", str(cell_copy), env={"VIDEOCAL_REPORT_SHOWN": str(shown)})
+    try:
+        deadline = time.monotonic() + 120
+        while not shown.with_suffix(".ready").exists():
+            assert gui.poll() is None, gui.stderr.read()
+            assert time.monotonic() < deadline, "the window did not come up"
+            time.sleep(0.2)
+        assert len(_simulators_for(cell_copy)) == 1
+        gui.send_signal(signal.SIGTERM)
+        gui.wait(timeout=30)
+        assert gui.returncode == 0
+        assert _wait_gone(cell_copy) == []
+    finally:
+        if gui.poll() is None:
+            gui.kill()
+        gui.communicate()

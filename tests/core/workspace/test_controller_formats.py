@@ -1,0 +1,109 @@
+"""Corrected targets in each controller's conventions, checked against an independent conversion
+(scipy, rebuilt from the printed numbers with the vendor's own definition) and against examples in
+the vendors' documentation."""
+
+import csv
+import io
+import json
+import re
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from calib_core.calibration.corrections import Correction, CorrectionTable
+from calib_core.frames import make_transform, transform_from_xyz_rpy
+from calib_core.workcell.model import TaskLocation
+from calib_core.workspace.controller_formats import controller_listing, fanuc_position, krl_frame, rapid_robtarget, unique_identifiers, urscript_pose
+from calib_core.workspace.exports import CSV_COLUMNS, corrections_csv, corrections_json
+
+RNG = np.random.default_rng(3)
+POSES = [transform_from_xyz_rpy(RNG.uniform(-900, 900, 3), RNG.uniform(-170, 170, 3)) for _ in range(20)]
+_NUM = r"(-?\d+\.?\d*(?:E\d+)?)"
+
+
+def _numbers(text: str) -> np.ndarray:
+    return np.array([float(v) for v in re.findall(_NUM, text)])
+
+
+@pytest.mark.parametrize("T", POSES)
+def test_urscript_rotation_vector_in_metres(T):
+    x, y, z, rx, ry, rz = _numbers(urscript_pose(T))
+    assert np.allclose([x, y, z], T[:3, 3] / 1000, atol=1e-6)
+    assert np.allclose(Rotation.from_rotvec([rx, ry, rz]).as_matrix(), T[:3, :3], atol=1e-5)
+
+
+@pytest.mark.parametrize("T", POSES)
+def test_rapid_quaternion_scalar_first(T):
+    values = _numbers(rapid_robtarget(T))
+    xyz, (q1, q2, q3, q4) = values[:3], values[3:7]
+    assert np.allclose(xyz, T[:3, 3], atol=1e-3)
+    assert q1 >= 0 and abs(np.linalg.norm([q1, q2, q3, q4]) - 1) < 1e-7
+    assert np.allclose(Rotation.from_quat([q2, q3, q4, q1]).as_matrix(), T[:3, :3], atol=1e-7)  # scipy: scalar last
+
+
+@pytest.mark.parametrize("T", POSES)
+def test_krl_abc_is_z_then_y_then_x(T):
+    x, y, z, a, b, c = _numbers(krl_frame(T))
+    R = Rotation.from_euler("z", a, degrees=True) * Rotation.from_euler("y", b, degrees=True) * Rotation.from_euler("x", c, degrees=True)
+    assert np.allclose([x, y, z], T[:3, 3], atol=1e-3) and np.allclose(R.as_matrix(), T[:3, :3], atol=1e-5)
+
+
+@pytest.mark.parametrize("T", POSES)
+def test_fanuc_wpr_is_fixed_x_then_y_then_z(T):
+    x, y, z, w, p, r = fanuc_position(T)
+    R = Rotation.from_euler("z", r, degrees=True) * Rotation.from_euler("y", p, degrees=True) * Rotation.from_euler("x", w, degrees=True)
+    assert np.allclose([x, y, z], T[:3, 3]) and np.allclose(R.as_matrix(), T[:3, :3], atol=1e-9)
+
+
+def test_examples_from_the_vendors_documentation():
+    # URScript manual: p[0.2, 0.5, 0.1, 1.57, 0, 0] is 200, 500, 100 mm turned 90 deg about x.
+    assert urscript_pose(transform_from_xyz_rpy([200, 500, 100], [90, 0, 0])) == "p[0.200000, 0.500000, 0.100000, 1.570796, 0.000000, 0.000000]"
+    # RAPID manual, robtarget: [[600, 500, 225.3], [1, 0, 0, 0], ...] is the base orientation.
+    assert rapid_robtarget(make_transform(np.eye(3), [600, 500, 225.3])).startswith("[[600.000,500.000,225.300],[1.00000000,0.00000000,0.00000000,0.00000000]")
+    # ...and a tool turned 180 deg about y (pointing down): [0, 0, 1, 0].
+    assert "[0.00000000,0.00000000,1.00000000,0.00000000]" in rapid_robtarget(transform_from_xyz_rpy([0, 0, 0], [0, 180, 0]))
+    # KRL: {X 100, Y 200, Z 300, A 90, B 0, C 0}: A turns about Z.
+    assert krl_frame(transform_from_xyz_rpy([100, 200, 300], [0, 0, 90])) == "{X 100.000,Y 200.000,Z 300.000,A 90.0000,B 0.0000,C 0.0000}"
+    # FANUC: W, P, R about the fixed x, y, z axes: the tool pointing down is W 180.
+    assert np.allclose(fanuc_position(transform_from_xyz_rpy([0, 0, 0], [180, 0, 0]))[3:], [180, 0, 0])
+
+
+def test_names_stay_unique_after_the_vendors_length_limit():
+    names = ["rack_2_orbital_unit_grasp_A", "rack_2_orbital_unit_grasp_B", "1st pose", "Rack_2_orbital_unit_grasp_C"]
+    idents = unique_identifiers(names, 24)
+    assert len(set(v.lower() for v in idents.values())) == 4
+    assert all(len(v) <= 24 and v[0].isalpha() and re.fullmatch(r"\w+", v) for v in idents.values())
+
+
+@pytest.fixture
+def table():
+    tasks = {name: TaskLocation(name, transform_from_xyz_rpy([800 + 10 * k, -200, 900], [20, 90, 0]), 150.0, None) for k, name in enumerate(["rack_2_orbital_unit_grasp_A", "rack_2_orbital_unit_grasp_B"])}
+    t = CorrectionTable()
+    for k, (name, task) in enumerate(tasks.items()):
+        measured = transform_from_xyz_rpy([1.5 + k, -2.0, 0.7], [0.1, -0.2, 0.05]) @ task.tcp2base
+        t.add(Correction(name, task.tcp2base, measured, np.array([1.5 + k, -2.0, 0.7]), np.array([0.1, -0.2, 0.05]), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.4, 9, source="=HYPERLINK(1)"))
+    return t, tasks
+
+
+@pytest.mark.parametrize("fmt, declaration", [("urscript", "global "), ("rapid", "CONST robtarget "), ("krl", "DECL GLOBAL FRAME "), ("fanuc", "\"]{"), ("pdl2", " := POS(")])
+def test_listings_declare_each_corrected_target_once(table, fmt, declaration):
+    t, tasks = table
+    text = controller_listing(fmt, t, tasks)
+    assert text.count(declaration) == 2
+    # The second target is the first shifted by 10 mm in x, and the listing holds the corrected one.
+    target = t.corrected_target("rack_2_orbital_unit_grasp_B", tasks["rack_2_orbital_unit_grasp_B"].tcp2base)
+    expected_x = target[0, 3] / (1000.0 if fmt == "urscript" else 1.0)
+    assert f"{expected_x:.3f}" in text
+
+
+def test_csv_and_json_hold_the_target_to_command(table):
+    t, tasks = table
+    rows = list(csv.reader(io.StringIO(corrections_csv(t, tasks))))
+    assert tuple(rows[0]) == CSV_COLUMNS
+    row = dict(zip(rows[0], rows[1]))
+    target = t.corrected_target(row["task"], tasks[row["task"]].tcp2base)
+    assert float(row["target_x_mm"]) == pytest.approx(target[0, 3], abs=1e-3)
+    assert row["source"].startswith("'=")  # a spreadsheet must not run it
+    data = json.loads(corrections_json(t, tasks))
+    assert data["frame"] == "base" and np.allclose(data["corrections"][0]["target_to_command"]["xyz"], target[:3, 3])
