@@ -28,6 +28,17 @@ class FileFormatError(VideocalError, ValueError):
         super().__init__(where + message)
 
 
+class FileWriteError(VideocalError, OSError):
+    """A file could not be written (no such folder, no permission, disk full); ``path`` is the file."""
+
+    def __init__(self, path: str | Path, message: str):
+        self.path = Path(path)
+        super().__init__(f"{self.path}: {message}")
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 class OperatorError(VideocalError, ValueError):
     """An action that cannot be taken now (nothing picked, no camera frame, a recording open...);
     the message says what to do instead."""

@@ -11,6 +11,7 @@ import tempfile  # noqa: E402
 # throw-away folders, never into the home of whoever runs the tests.
 os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="videocal-test-data-")
 os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="videocal-test-config-")
+os.environ["XDG_STATE_HOME"] = tempfile.mkdtemp(prefix="videocal-test-state-")
 
 
 import sys

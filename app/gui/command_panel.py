@@ -133,3 +133,30 @@ class CommandPanel(QTabWidget):
         el.addStretch(1)
         self.addTab(ex, "Execute")
         self.setCurrentIndex(2)
+        workbench.task_changed.connect(self._sync_tasks)
+        workbench.scene_changed.connect(self._sync_targets)
+
+    def _sync_tasks(self, name: str = "") -> None:
+        """The task list follows the cell (a location added or undone)."""
+        names = list(self.workbench.workcell.task_locations)
+        if [self.tasks.item(i).text() for i in range(self.tasks.count())] == names:
+            return
+        current = self.tasks.currentItem().text() if self.tasks.currentItem() else None
+        self.tasks.blockSignals(True)
+        self.tasks.clear()
+        self.tasks.addItems(names)
+        if current in names:
+            self.tasks.setCurrentRow(names.index(current))
+        self.tasks.blockSignals(False)
+
+    def _sync_targets(self) -> None:
+        """The target choice follows the cell's components (one added or undone)."""
+        names = [c.name for c in self.workbench.workcell.components if c.kind == "component"]
+        if [self.target.itemText(i) for i in range(self.target.count())] == names:
+            return
+        self.target.blockSignals(True)
+        self.target.clear()
+        self.target.addItems(names)
+        if self.workbench.session.target in names:
+            self.target.setCurrentText(self.workbench.session.target)
+        self.target.blockSignals(False)

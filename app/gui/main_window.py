@@ -10,6 +10,7 @@ from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
 
 from app.gui.camera_pane import CameraPane
+from app.gui.cell_panel import CellPanel
 from app.gui.command_panel import CommandPanel
 from app.gui.error_boundary import attempt, guarded
 from app.gui.frame_worker import FrameWorker
@@ -46,6 +47,11 @@ class MainWindow(QMainWindow):
         vision_scroll.setWidgetResizable(True)
         vision_scroll.setWidget(self.vision)
         self.commands.addTab(vision_scroll, "Vision")
+        self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
+        cell_scroll = QScrollArea()
+        cell_scroll.setWidgetResizable(True)
+        cell_scroll.setWidget(self.cell_panel)
+        self.commands.addTab(cell_scroll, "Cell")
         self._current_pair: int | None = None
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self.solved_edges = SolvedEdges(workbench.intrinsics)
@@ -113,6 +119,7 @@ class MainWindow(QMainWindow):
         file_menu.addSeparator()
         file_menu.addAction(QAction("&Open workspace...", self, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
         file_menu.addAction(QAction("&Save workspace as...", self, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
+        file_menu.addAction(QAction("Save ce&ll", self, shortcut=QKeySequence("Ctrl+Shift+S"), triggered=lambda: self.report(self.workbench.save_cell)()))
         file_menu.addAction(QAction("E&xport corrections...", self, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
         file_menu.addSeparator()
         self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
@@ -177,6 +184,8 @@ class MainWindow(QMainWindow):
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self._add_location))
         c.live.toggled.connect(self._live_toggled)
+        self.cell_panel.pick_features.toggled.connect(self._feature_mode)
+        self.cell_panel.component.currentTextChanged.connect(lambda _: self._feature_mode(self.cell_panel.picking_features))
         self.results.candidate_chosen.connect(self.report(self._choose_candidate))
         wb.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
@@ -216,6 +225,11 @@ class MainWindow(QMainWindow):
         self.commands.approach.setValue(task.approach_mm)
         self.commands.approach.blockSignals(False)
 
+    def _feature_mode(self, on: bool) -> None:
+        """While features are named by clicking, the virtual camera picks on the chosen component."""
+        self.virtual.feature_component = self.cell_panel.component.currentText() if on else None
+        self.virtual.refresh()
+
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
             self.worker.paused = not on
@@ -234,6 +248,9 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(text, 15000)
 
     def _on_pick_3d(self, hit) -> None:
+        if self.cell_panel.picking_features:
+            self.cell_panel.feature_clicked(hit, self.workbench.model_cam2world(), self.virtual.intrinsics.fu)
+            return
         if self.workbench.session.pairs.pending() is not None:
             # A new model pick replaces a pair still waiting for its image point.
             self.workbench.session.delete(self.workbench.session.pairs.pending().number)
@@ -313,12 +330,9 @@ class MainWindow(QMainWindow):
         self.overview.play_path([start + (goal - start) * (k / 30) for k in range(31)])
 
     def _add_location(self, name: str | None = None) -> None:
-        from calib_core.workcell.model import TaskLocation
-
         wb = self.workbench
         name = name or f"location_{len(wb.workcell.task_locations) + 1}"
-        wb.workcell.task_locations[name] = TaskLocation(name, wb.model_tcp2base(), 0.0, wb.session.target)
-        self.commands.tasks.addItem(name)
+        wb.add_task_location(name)
         self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
 
     # --- files -------------------------------------------------------------------------------

@@ -47,6 +47,7 @@ class VirtualPane(QWidget):
         workbench.scene_changed.connect(self.refresh)
         self._last_joints = None
         self._render_key = None
+        self.feature_component: str | None = None  # naming features: picks land on this component, unsnapped
         self.renders = 0
 
     def _camera_model_changed(self) -> None:
@@ -57,7 +58,7 @@ class VirtualPane(QWidget):
     def refresh(self) -> None:
         """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
         wb = self.workbench
-        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, tuple(item.name for item in wb.scene_extras))
+        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, wb.scene_version)
         if key != self._render_key:
             items = wb.workcell.components + wb.cell.model_visuals().scene_items(wb.joints_deg) + list(wb.scene_extras)
             self.renderer.set_items(items)
@@ -69,8 +70,9 @@ class VirtualPane(QWidget):
             self.renders += 1
         overlay = Overlay()
         world2cam = invert(wb.model_cam2world())
-        if wb.session.target is not None:
-            target = wb.workcell.component(wb.session.target)
+        shown = self.feature_component or wb.session.target
+        if shown is not None:
+            target = wb.workcell.component(shown)
             if target.features:
                 pts = apply(world2cam, apply(target.item2world, np.array(list(target.features.values()))))
                 for uv in project(pts, self.intrinsics, distort=False):
@@ -93,10 +95,11 @@ class VirtualPane(QWidget):
             self.refresh()
 
     def _on_click(self, u: float, v: float) -> None:
-        target = self.workbench.session.target
-        hit: PickResult | None = self.renderer.pick(u, v, snap_radius_px=10, components=None if target is None else {target})
+        target = self.feature_component or self.workbench.session.target
+        snap = 0.0 if self.feature_component else 10.0  # naming a feature: the core snaps it to the mesh
+        hit: PickResult | None = self.renderer.pick(u, v, snap_radius_px=snap, components=None if target is None else {target})
         if hit is None:
-            self.info.setText("nothing of the target object there")
+            self.info.setText(f"nothing of {target or 'the target object'} there")
             return
         self.info.setText(f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm")
         self.picked.emit(hit)

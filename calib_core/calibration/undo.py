@@ -16,6 +16,10 @@ class Command:
     def undo(self) -> None:
         raise NotImplementedError
 
+    def merge(self, later: "Command") -> bool:
+        """Absorb ``later`` (already done) into this command, so one undo reverts both; False: keep apart."""
+        return False
+
 
 class UndoStack:
     """Executes commands and keeps them for undo and redo. Event: ``changed()`` after every push,
@@ -32,8 +36,12 @@ class UndoStack:
         self.changed.emit()
 
     def push(self, command: Command) -> None:
-        """Do ``command`` and record it (clears the redo history)."""
+        """Do ``command`` and record it (clears the redo history). A command the last one can
+        :meth:`~Command.merge` (the same spin box turned again) joins it as one undo step."""
         command.do()
+        if self._done and not self._undone and self._done[-1].merge(command):
+            self._changed()
+            return
         self._done.append(command)
         del self._done[: -self._limit]
         self._undone.clear()

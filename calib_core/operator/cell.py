@@ -88,6 +88,10 @@ class Cell:
         """(n,) deg/mm, model joint order."""
         return np.array(self.workcell.home_joints_deg, dtype=float)
 
+    def refresh_identity(self) -> None:
+        """After an edit of the cell: its identity follows its content."""
+        self.identity = cell_identity(self.workcell, self.robot)
+
     def model_visuals(self) -> RobotVisuals:
         """The modelled robot's meshes (loaded once)."""
         if self._visuals is None:

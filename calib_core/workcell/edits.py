@@ -1,0 +1,139 @@
+"""Edits of the cell, as in the paper's RobCAD component and workcell environments: add a
+component from a mesh file, place it by numbers (its surveyed placement), add named features,
+add task locations. Each is an undoable command; ``on_change(kind, name)`` is called after every
+do and undo (``kind``: ``component`` or ``task``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from calib_core.calibration.undo import Command
+from calib_core.errors import FileFormatError, OperatorError
+from calib_core.frames import check_transform
+from calib_core.scene import SceneItem
+from calib_core.workcell.model import TaskLocation, Workcell
+
+MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
+_SCALE = {"mm": 1.0, "m": 1000.0}
+
+Notify = Callable[[str, str], None]
+
+
+def _check_name(name: str, what: str) -> str:
+    name = str(name).strip()
+    if not name or any(c in name for c in "\n\r\t:#{}[],&*!|>'\"%@`"):
+        raise OperatorError(f"{what} name {name!r}: use letters, digits, '_', '-', '.' or spaces")
+    return name
+
+
+def load_component_mesh(path: str | Path, units: str = "mm") -> trimesh.Trimesh:
+    """A component's mesh (mm) from a file; :class:`FileFormatError` names the file."""
+    path = Path(path)
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        raise FileFormatError(path, f"unsupported mesh format {path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
+    if units not in _SCALE:
+        raise OperatorError(f"mesh units must be 'mm' or 'm', got {units!r}")
+    try:
+        mesh = trimesh.load(path, force="mesh")
+    except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
+        raise FileFormatError(path, f"cannot read the mesh: {exc}") from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise FileFormatError(path, "the mesh has no triangles")
+    if _SCALE[units] != 1.0:
+        mesh.apply_scale(_SCALE[units])
+    return mesh
+
+
+class AddComponent(Command):
+    def __init__(self, workcell: Workcell, item: SceneItem, mesh_file: Path, mesh_units: str, notify: Notify):
+        if any(c.name == item.name for c in workcell.components):
+            raise OperatorError(f"the cell has a component called {item.name!r} already")
+        self.workcell, self.item, self.notify = workcell, item, notify
+        self.source = (Path(mesh_file).resolve(), mesh_units)
+        self.label = f"Add component {item.name}"
+
+    def do(self) -> None:
+        self.workcell.components.append(self.item)
+        self.workcell.meta.setdefault("mesh_files", {})[self.item.name] = self.source
+        self.notify("component", self.item.name)
+
+    def undo(self) -> None:
+        self.workcell.components.remove(self.item)
+        self.workcell.meta["mesh_files"].pop(self.item.name, None)
+        self.notify("component", self.item.name)
+
+
+class PlaceComponent(Command):
+    """Move a component to ``item2world`` (4, 4) mm in base. Successive placements of one component
+    (a spin box being turned) merge into one undo step."""
+
+    def __init__(self, workcell: Workcell, name: str, item2world: np.ndarray, notify: Notify):
+        self.item = workcell.component(name)
+        self.old = self.item.item2world.copy()
+        self.new = check_transform(item2world, name=f"placement of {name}")
+        self.notify = notify
+        self.label = f"Place {name}"
+
+    def do(self) -> None:
+        self.item.item2world = self.new.copy()
+        self.notify("component", self.item.name)
+
+    def undo(self) -> None:
+        self.item.item2world = self.old.copy()
+        self.notify("component", self.item.name)
+
+    def merge(self, later: Command) -> bool:
+        if isinstance(later, PlaceComponent) and later.item is self.item:
+            self.new = later.new
+            return True
+        return False
+
+
+class AddFeature(Command):
+    """A named feature point ``point_mm`` (3,) in the component's own frame."""
+
+    def __init__(self, workcell: Workcell, component: str, name: str, point_mm, notify: Notify):
+        self.item = workcell.component(component)
+        self.name = _check_name(name, "feature")
+        if self.name in self.item.features:
+            raise OperatorError(f"component {component!r} has a feature called {self.name!r} already")
+        point = np.asarray(point_mm, dtype=float).reshape(3)
+        if not np.all(np.isfinite(point)):
+            raise OperatorError(f"feature {self.name!r}: the point must be finite, got {point.tolist()}")
+        self.point, self.notify = point, notify
+        self.label = f"Add feature {component}/{self.name}"
+
+    def do(self) -> None:
+        self.item.features[self.name] = self.point.copy()
+        self.notify("component", self.item.name)
+
+    def undo(self) -> None:
+        self.item.features.pop(self.name, None)
+        self.notify("component", self.item.name)
+
+
+class AddTaskLocation(Command):
+    def __init__(self, workcell: Workcell, task: TaskLocation, notify: Notify):
+        _check_name(task.name, "task location")
+        if task.name in workcell.task_locations:
+            raise OperatorError(f"there is already a task location called {task.name!r}")
+        if not np.isfinite(task.approach_mm) or task.approach_mm < 0:
+            raise OperatorError(f"task location {task.name!r}: the approach must be >= 0 mm, got {task.approach_mm}")
+        if task.component is not None:
+            workcell.component(task.component)
+        check_transform(task.tcp2base, name=f"task location {task.name}")
+        self.workcell, self.task, self.notify = workcell, task, notify
+        self.label = f"Add task location {task.name}"
+
+    def do(self) -> None:
+        self.workcell.task_locations[self.task.name] = self.task
+        self.notify("task", self.task.name)
+
+    def undo(self) -> None:
+        self.workcell.task_locations.pop(self.task.name, None)
+        self.notify("task", self.task.name)

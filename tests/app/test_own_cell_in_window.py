@@ -1,0 +1,114 @@
+"""Another cell in the window: File > Open cell starts that cell's simulator and shows its robot; a bad cell
+changes nothing; a workspace of another cell is refused before anything changes; a bug is logged, not shown raw."""
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QSettings
+
+from app.gui.cell_launcher import CellLauncher
+from app.gui.error_boundary import internal_error_log
+from calib_core.workcell import DEFAULT_WORKCELL
+from calib_core.workcell.starter import write_starter_cell
+from tests.vendor_robots import SHARE, UR5, require
+
+
+@pytest.fixture(scope="module")
+def ur5_cell(tmp_path_factory):
+    return write_starter_cell(tmp_path_factory.mktemp("ur5") / "cell", require(UR5), [SHARE]).workcell_path
+
+
+@pytest.fixture
+def launcher(tmp_path):
+    return CellLauncher(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+
+
+def test_open_cell_replaces_the_window_with_the_cells_robot_and_simulator(qtbot, launcher, ur5_cell, tmp_path):
+    win = launcher.open(DEFAULT_WORKCELL)
+    qtbot.addWidget(win)
+    win.show()
+    old = win.workbench
+    qtbot.waitUntil(lambda: old.link_up, timeout=15_000)
+    # A file that is not a cell: an error, and the window and its simulator go on.
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("schema_version: 2\nunits: {length: mm, angle: deg}\nrobot: {urdf: nothing.urdf}\ncomponents: []\n")
+    assert not win.open_cell(str(bad))
+    assert "robot.urdf" in win.results.status.text() and win.isVisible() and old.site.process.running
+    # The UR5 cell: a new window with its robot, and the old simulator stops.
+    assert win.open_cell(str(ur5_cell))
+    new = next(w for w in _shown_windows() if w is not win)
+    qtbot.addWidget(new)
+    try:
+        assert not win.isVisible() and not old.site.process.running
+        wb = new.workbench
+        assert wb.robot.joint_names[0] == "shoulder_pan_joint" and wb.cell.name == "ur5_robot cell"
+        qtbot.waitUntil(lambda: wb.link_up, timeout=15_000)
+        assert np.allclose(wb.joints_deg, wb.cell.home_joints, atol=1e-3)  # the UR5's simulator, at its home
+        assert new.recent_cells.paths()[0] == str(ur5_cell.resolve())
+    finally:
+        new.close()
+    assert not wb.site.process.running
+
+
+def _shown_windows():
+    from PySide6.QtWidgets import QApplication
+
+    from app.gui.main_window import MainWindow
+
+    return [w for w in QApplication.topLevelWidgets() if isinstance(w, MainWindow) and w.isVisible()]
+
+
+def test_a_workspace_of_another_cell_is_refused_and_nothing_changes(qtbot, launcher, ur5_cell, tmp_path):
+    bundled = launcher.open(DEFAULT_WORKCELL)
+    qtbot.addWidget(bundled)
+    wb = bundled.workbench
+    fixture = wb.workcell.component("oru_1_fixture")
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", fixture.item2world[:3, 3])
+    wb.session.pick_2d((100.0, 100.0))
+    path = tmp_path / "bundled_workspace.json"
+    assert bundled.save_workspace(path)
+    bundled.close()
+    ur5 = launcher.open(ur5_cell)
+    qtbot.addWidget(ur5)
+    try:
+        tasks_before = dict(ur5.workbench.workcell.task_locations)
+        assert not ur5.open_workspace(path)
+        text = ur5.results.status.text()
+        assert "belongs to the cell 'space station robotic test bed'" in text and "ur5_robot cell" in text
+        assert ur5.workbench.workcell.task_locations == tasks_before and len(ur5.workbench.session.pairs) == 0
+    finally:
+        ur5.close()
+
+
+def test_a_bug_is_logged_with_its_traceback_and_named_to_the_operator(qtbot, launcher):
+    win = launcher.open(DEFAULT_WORKCELL)
+    qtbot.addWidget(win)
+    try:
+        def broken():
+            return {}["no such key"]
+
+        win.report(broken)()
+        log = internal_error_log()
+        assert "internal error (KeyError" in win.results.status.text() and str(log) in win.results.status.text()
+        assert "Traceback" in log.read_text() and "broken" in log.read_text()
+        # A user's mistake is shown as it is, and logs nothing.
+        size = log.stat().st_size
+        win.report(win.workbench.set_task)("nowhere")
+        assert win.results.status.text().count("no task location 'nowhere'") == 1
+        assert log.stat().st_size == size
+    finally:
+        win.close()
+
+
+def test_a_failed_save_is_neither_recent_nor_saved(qtbot, launcher, tmp_path):
+    win = launcher.open(DEFAULT_WORKCELL)
+    qtbot.addWidget(win)
+    try:
+        saved_before = win.settings.value("files/last_saved_time")
+        target = tmp_path / "no such folder" / "workspace.json"
+        assert not win.save_workspace(target)
+        assert str(target) not in win.recent.paths()
+        assert win.settings.value("files/last_saved_time") == saved_before
+        assert win.save_workspace(tmp_path / "workspace.json")
+        assert win.recent.paths()[0] == str(tmp_path / "workspace.json")
+    finally:
+        win.close()
