@@ -34,6 +34,9 @@ class CommandPanel(QTabWidget):
         super().__init__(parent)
         self.workbench = workbench
         self.setMinimumWidth(250)
+        # Six tabs (the paper's four modes, Vision and Cell) fit the panel without scroll arrows.
+        self.setStyleSheet("QTabBar::tab { padding: 4px 5px; }")
+        self.tabBar().setUsesScrollButtons(False)
         # Short verbs for the paper's four modes (programming, simulation, calibration, execution) and Vision,
         # so all five tabs fit the panel without scroll arrows.
 

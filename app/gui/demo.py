@@ -7,7 +7,8 @@ refinement on corners), accepts, calibrates and stores the correction; the featu
 component that the camera sees; then it moves to the corrected
 location, looks again the same way, stores the refined correction and moves there. Where the
 features are in the camera image it learns from the test bed's truth, as a person learns it by looking.
-A PNG of the window is written after each step, and ``report.json`` with the figures.
+A PNG of the window is written after each step, ``report.json`` with the figures and ``workspace.json`` with the
+pairs and the corrections (for ``videocal export``).
 """
 
 from __future__ import annotations
@@ -216,6 +217,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                     "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they are); the "
                     "correction is measured at the task location, then again from the corrected location, and the second one is stored last",
         }
+        wb.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
+        report["workspace"] = "workspace.json"
         atomic_write_text(out_dir / "report.json", json.dumps(report, indent=2))
         return report
     finally:
