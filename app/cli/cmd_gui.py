@@ -23,7 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.testbed.sim_site import SimulatorProcess
+    from calib_core.testbed.sim_process import SimulatorProcess
 
     simulated = not args.port
     if args.camera and simulated:
@@ -65,13 +65,19 @@ def _run_window(args: argparse.Namespace, simulator) -> int:
     if report:  # the bench measures launch-to-window from outside
         Path(report).write_text(f"{time.monotonic()}")
 
-    from app.gui.cell_launcher import CellLauncher
+    from app.gui.cell_launcher import CellLauncher, real_site
 
-    window = CellLauncher(args.port, args.camera, args.hand_eye).open(args.workcell, simulator)
+    if args.port:
+        open_site = real_site(args.port, args.camera)
+    else:
+        from calib_core.testbed.sim_site import simulated_cell
+
+        open_site = lambda workcell, process=None: simulated_cell(workcell, process=process)  # noqa: E731
+    window = CellLauncher(open_site, args.hand_eye).open(args.workcell, simulator)
     window.setGeometry(shell.geometry())
     window.show()
     if args.recording is not None:
-        window.open_recording(args.recording)
+        window.files.open_recording(args.recording)
     shell.close()
     if report:
         ready = Path(report).with_suffix(".ready")

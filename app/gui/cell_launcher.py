@@ -1,43 +1,47 @@
-"""Opening a cell in a window: the cell, its site (the simulator and simulated camera of that cell,
-or a real controller and camera), the operator core and the main window, in one place for the
-command line and for File > Open cell."""
+"""Opening a cell in a window: the cell and its site, the operator core and the main window, in one
+place for the command line and for File > Open cell. Which kind of site a run uses (a real
+controller and camera, or the simulated site of each cell opened) is the caller's choice: the
+window never knows."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import QSettings
 
 
+def real_site(port: str, camera: str | None) -> Callable:
+    """``open_site`` for a real controller at ``port`` and a real ``camera`` spec."""
+    from calib_core.operator.cell import Cell
+    from calib_core.operator.site import RealSite
+
+    return lambda workcell, simulator=None: (Cell.open(workcell), RealSite(port, camera))
+
+
 @dataclass(frozen=True)
 class CellLauncher:
-    """How windows are opened in this run: a real controller ``port`` and ``camera``, or (no port)
-    the simulated site of each cell opened."""
+    """``open_site(workcell, simulator)`` gives ``(cell, site)`` for a workcell file (``simulator``:
+    a controller process already started for it, or None); ``hand_eye``: a measured camera mounting
+    for every cell opened; ``settings``: the windows' QSettings."""
 
-    port: str | None = None
-    camera: str | None = None
+    open_site: Callable
     hand_eye: Path | None = None
     settings: QSettings | None = None
 
     def open(self, workcell: str | Path, simulator=None):
-        """A shown :class:`MainWindow` on ``workcell``. Nothing is left running if it fails."""
+        """A :class:`MainWindow` on ``workcell``, its controller connected and its camera running.
+        Nothing is left running if it fails."""
         from app.gui.main_window import MainWindow
         from app.gui.workbench import Workbench
-        from calib_core.operator.cell import Cell
-        from calib_core.operator.site import RealSite
 
-        if self.port is None:
-            from calib_core.testbed.sim_site import simulated_cell
-
-            try:
-                cell, site = simulated_cell(workcell, process=simulator)
-            except BaseException:
-                if simulator is not None:
-                    simulator.stop()
-                raise
-        else:
-            cell, site = Cell.open(workcell), RealSite(self.port, self.camera)
+        try:
+            cell, site = self.open_site(workcell, simulator)
+        except BaseException:
+            if simulator is not None:
+                simulator.stop()
+            raise
         workbench = Workbench(cell, site)
         try:
             if self.hand_eye is not None:
@@ -50,5 +54,5 @@ class CellLauncher:
         camera = site.camera_factory()
         if camera is not None:
             window.start_camera(camera)
-        window.recent_cells.remember(Path(workcell).resolve())
+        window.files.recent_cells.remember(Path(workcell).resolve())
         return window

@@ -123,7 +123,7 @@ class CellPanel(QWidget):
         self.add_component.clicked.connect(self._add_component_dialog)
         self.take_pose.clicked.connect(self.fill_current_pose)
         self.add_task.clicked.connect(lambda: self._attempt(self.add_task_location))
-        self.save.clicked.connect(lambda: self._attempt(self.workbench.save_cell))
+        self.save.clicked.connect(lambda: self._attempt(self.workbench.editor.save))
         workbench.scene_changed.connect(self._sync)
         self._sync()
         self.fill_current_pose()
@@ -156,7 +156,7 @@ class CellPanel(QWidget):
         if self._showing:
             return
         name = self.component.currentText()
-        self._attempt(self.workbench.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
+        self._attempt(self.workbench.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
 
     def _add_component_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Add component", str(self.workbench.workcell.path.parent), "Meshes (*.stl *.obj *.dae *.glb *.gltf *.ply)")
@@ -168,7 +168,7 @@ class CellPanel(QWidget):
 
     def add_component_file(self, path, name: str) -> None:
         """Add the component and select it, so its placement can be typed at once."""
-        if self._attempt(self.workbench.add_component, path, name):
+        if self._attempt(self.workbench.editor.add_component, path, name):
             self.component.setCurrentText(name.strip())
 
     def fill_current_pose(self) -> None:
@@ -180,7 +180,7 @@ class CellPanel(QWidget):
         wb = self.workbench
         name = self.task_name.text().strip() or f"location_{len(wb.workcell.task_locations) + 1}"
         T = transform_from_xyz_rpy([b.value() for b in self.task_xyz], [b.value() for b in self.task_rpy])
-        wb.add_task_location(name, T, self.task_approach.value())
+        wb.editor.add_task_location(name, T, self.task_approach.value())
         self.task_name.clear()
         wb.message.emit(f"task location {name} added")
 
@@ -192,10 +192,10 @@ class CellPanel(QWidget):
         """A click on the chosen component in the virtual camera: snap it, name it, add it."""
         wb = self.workbench
         depth_mm = float(np.linalg.norm(hit.point_world_mm - cam2world[:3, 3]))
-        snap = wb.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
+        snap = wb.editor.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
         item = wb.workcell.component(hit.component)
         name = self.feature_name.text().strip() or f"feature_{len(item.features) + 1}"
-        wb.add_feature(hit.component, name, snap.point_mm)
+        wb.editor.add_feature(hit.component, name, snap.point_mm)
         self.feature_name.clear()
         world = apply(item.item2world, np.asarray(snap.point_mm)[None])[0]
         self.feature_info.setText(f"{hit.component}/{name}: {snap.kind.replace('_', ' ')} at ({', '.join(f'{v:.1f}' for v in snap.point_mm)}) mm, "

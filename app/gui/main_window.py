@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
@@ -18,7 +17,7 @@ from app.gui.overview_pane import OverviewPane
 from app.gui.pairs_table import PairsTable
 from app.gui.replay_bar import ReplayBar
 from app.gui.results_panel import ResultsPanel
-from app.gui.session_files import Autosave, RecentFiles
+from app.gui.file_menu import FileMenu
 from app.gui.solved_edges import SolvedEdges
 from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
@@ -68,8 +67,7 @@ class MainWindow(QMainWindow):
         self._redraw.start()
         self.virtual.refresh()
         self.overview.refresh()
-        self.autosave = Autosave(self.settings, self.workbench.save_workspace, lambda text: self.statusBar().showMessage(text, 8000), self)
-        self._offer_recovery()
+        self.files.start_autosave()
 
     # --- layout ----------------------------------------------------------------------------
     def _build_layout(self) -> None:
@@ -109,28 +107,9 @@ class MainWindow(QMainWindow):
         self.resize(1600, 1000)
 
     def _build_menus(self) -> None:
-        file_menu = self.file_menu = self.menuBar().addMenu("&File")
-        self.open_cell_action = QAction("Open &cell...", self, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog)
-        file_menu.addAction(self.open_cell_action)
-        self.recent_cells = RecentFiles(self.settings, file_menu.addMenu("Recent ce&lls"), self.open_cell, key="files/recent_cells")
-        if self.launcher is None:
-            self.open_cell_action.setEnabled(False)
-            self.open_cell_action.setToolTip("this window was opened on one cell only")
-        file_menu.addSeparator()
-        file_menu.addAction(QAction("&Open workspace...", self, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
-        file_menu.addAction(QAction("&Save workspace as...", self, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
-        file_menu.addAction(QAction("Save ce&ll", self, shortcut=QKeySequence("Ctrl+Shift+S"), triggered=lambda: self.report(self.workbench.save_cell)()))
-        file_menu.addAction(QAction("E&xport corrections...", self, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
-        file_menu.addSeparator()
-        self.record_action = QAction("&Record session...", self, checkable=True, triggered=self._record_toggled)
-        file_menu.addAction(self.record_action)
-        file_menu.addAction(QAction("Open r&ecording...", self, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
+        self.files = FileMenu(self, self.menuBar().addMenu("&File"))
         self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
         self.addAction(self.play_action)
-        self.recent = RecentFiles(self.settings, file_menu.addMenu("Recent &files"), self.open_recent)
-        file_menu.addSeparator()
-        quit_action = QAction("&Quit", self, shortcut=QKeySequence("Ctrl+Q"), triggered=self._quit)  # StandardKey.Quit is empty on some platforms
-        file_menu.addAction(quit_action)
         edit = self.menuBar().addMenu("&Edit")
         self.undo_action = QAction("&Undo", self, shortcut=QKeySequence.StandardKey.Undo, triggered=self._undo)
         self.redo_action = QAction("&Redo", self, shortcut=QKeySequence.StandardKey.Redo, triggered=self._redo)
@@ -204,9 +183,6 @@ class MainWindow(QMainWindow):
             self.show_error(f"move to {what} failed: {error}")
         else:
             self.statusBar().showMessage(f"arrived at {what}", 8000)
-
-    def _quit(self) -> None:
-        self.close()
 
     def _task_selected(self, name: str) -> None:
         if name:
@@ -332,137 +308,11 @@ class MainWindow(QMainWindow):
     def _add_location(self, name: str | None = None) -> None:
         wb = self.workbench
         name = name or f"location_{len(wb.workcell.task_locations) + 1}"
-        wb.add_task_location(name)
+        wb.editor.add_task_location(name)
         self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
-
-    # --- files -------------------------------------------------------------------------------
-    def save_workspace(self, path) -> bool:
-        """Save; only a save that succeeded joins the recent files and counts as saved for the autosave."""
-        if not attempt(self.show_error, self.workbench.save_workspace, path):
-            return False
-        self.recent.remember(path)
-        self.autosave.mark_saved()
-        return True
-
-    def open_workspace(self, path) -> bool:
-        if not attempt(self.show_error, self.workbench.open_workspace, path):
-            return False
-        self.recent.remember(path)
-        return True
-
-    def open_cell(self, path: str) -> bool:
-        """Open another cell: a new window on it (with its own simulator or the same real devices) takes
-        this one's place. A cell that does not load leaves this window as it is."""
-        if self.launcher is None:
-            self.show_error("this window was opened on one cell only: start videocal gui --workcell FILE")
-            return False
-        from calib_core.operator.cell import Cell
-
-        if not attempt(self.show_error, Cell.open, path):  # check the file before anything stops
-            return False
-        opened = []
-        if not attempt(self.show_error, lambda: opened.append(self.launcher.open(path))):
-            return False
-        window = opened[0]
-        window.setGeometry(self.geometry())
-        window.show()
-        self.close()
-        return True
-
-    def _open_cell_dialog(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getOpenFileName(self, "Open cell", str(self.workbench.workcell.path.parent), "videocal workcell (*.yaml *.yml)")
-        if path:
-            self.open_cell(path)
-
-    def _export_dialog(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        filters = {"URScript, Universal Robots (*.script)": "urscript", "RAPID module, ABB (*.mod)": "rapid", "KRL data, KUKA (*.dat)": "krl",
-                   "TP program, FANUC (*.ls)": "fanuc", "PDL2, COMAU (*.pdl)": "pdl2", "CSV (*.csv)": "csv", "JSON (*.json)": "json"}
-        path, chosen = QFileDialog.getSaveFileName(self, "Export corrections", "corrections.script", ";;".join(filters))
-        if path:
-            self.report(self.workbench.export_corrections)(path, filters.get(chosen, "csv"))
-
-    def open_recent(self, path: str) -> None:
-        """A workspace (.json) or a recording (.mcap) from the recent list."""
-        if path.endswith(".mcap"):
-            self.open_recording(path)
-        else:
-            self.open_workspace(path)
-
-    def _save_dialog(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getSaveFileName(self, "Save workspace", "workspace.json", "videocal workspace (*.json)")
-        if path:
-            self.save_workspace(path)
-
-    def _open_dialog(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getOpenFileName(self, "Open workspace", "", "videocal workspace (*.json)")
-        if path:
-            self.open_workspace(path)
-
-    def _open_recording_dialog(self) -> None:
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getOpenFileName(self, "Open recording", "", "MCAP recording (*.mcap)")
-        if path:
-            self.open_recording(path)
-
-    def open_recording(self, path) -> None:
-        """Replay a recording: the live camera pauses, the views follow the recording (see ReplayBar)."""
-        self.report(self._open_recording)(path)
-
-    def _open_recording(self, path) -> None:
-        if self.workbench.recorder is not None:
-            raise OperatorError("stop recording before replaying a recording")
-        self.replay.open(path)
-        self.commands.live.setChecked(False)
-        self.recent.remember(path)
 
     def _replay_closed(self) -> None:
         self.commands.live.setChecked(True)
-
-    def start_recording(self, path) -> None:
-        if self.replay.playback is not None:
-            self.show_error("close the replay before recording: a recording records the live camera and robot")
-            return
-        self.report(self.workbench.start_recording)(path)
-        self.record_action.setChecked(self.workbench.recorder is not None)
-
-    def stop_recording(self) -> None:
-        self.workbench.stop_recording()
-        self.record_action.setChecked(False)
-
-    def _record_toggled(self, on: bool) -> None:
-        if not on:
-            self.stop_recording()
-            return
-        from PySide6.QtWidgets import QFileDialog
-
-        path, _ = QFileDialog.getSaveFileName(self, "Record session", "session.mcap", "MCAP recording (*.mcap)")
-        if path:
-            self.start_recording(path)
-        else:
-            self.record_action.setChecked(False)
-
-    def _offer_recovery(self) -> None:
-        """An autosave newer than the last saved workspace means the last session ended without saving:
-        offer it (File > Restore autosave) rather than load it unasked."""
-        autosaved = self.autosave.unsaved_since()
-        if autosaved is None:
-            return
-        stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(autosaved))
-        self.restore_action = QAction(f"Restore &autosave of {stamp}", self, triggered=self.restore_autosave)
-        self.file_menu.insertAction(self.file_menu.actions()[0], self.restore_action)
-        self.statusBar().showMessage(f"an unsaved session from {stamp} was autosaved: File > Restore autosave", 30000)
-
-    def restore_autosave(self) -> None:
-        self.open_workspace(self.autosave.path)
 
     # --- updates ---------------------------------------------------------------------------
     def _on_joints(self, q) -> None:
@@ -544,7 +394,7 @@ class MainWindow(QMainWindow):
         self.settings.setValue("window/split_top", self.top_splitter.saveState())
         self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
         self._redraw.stop()
-        self.autosave.timer.stop()  # a closed window writes nothing more
+        self.files.autosave.timer.stop()  # a closed window writes nothing more
         self.status_line.timer.stop()
         self.replay.pause()
         if self.worker is not None:

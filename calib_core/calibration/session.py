@@ -21,7 +21,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, invert
 from calib_core.recording.replay import solve_inputs
-from calib_core.solver import SolveStatus, solve_pose
+from calib_core.solver.solution import SolveStatus
 
 
 class CalibrationError(OperatorError):
@@ -120,6 +120,8 @@ class CalibrationSession:
         points_world, pixels, numbers = self.pairs.arrays()
         points_obj = apply(invert(obj2world), points_world)
         prior = invert(cam2world_model) @ obj2world
+        from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on the first solve
+
         solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers)

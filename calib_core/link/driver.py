@@ -168,22 +168,21 @@ class ControllerLink:
 
     def request_state(self, timeout_s: float = 1.0) -> StateReport | None:
         """Ask ``$STA`` and wait for the report (``None`` on timeout)."""
-        with self._lock:
-            self._state_reports.clear()
-        self._send(RequestState().body())
-        with self._state_event:
-            self._state_event.wait_for(lambda: bool(self._state_reports), timeout_s)
-            return self._state_reports.popleft() if self._state_reports else None
+        return self._ask(RequestState().body(), self._state_reports, timeout_s)
 
     def request_version(self, timeout_s: float = 1.0) -> VersionReport | None:
         """Ask ``$VER``: the controller's protocol version and joint count (``None`` on timeout;
         a version-1 controller answers ``ERR,UNKNOWN``, which counts in ``stats.errors``)."""
+        return self._ask(RequestVersion().body(), self._version_reports, timeout_s)
+
+    def _ask(self, body: str, replies: deque, timeout_s: float):
+        """Send a request and wait for the first reply the reader thread puts in ``replies``."""
         with self._lock:
-            self._version_reports.clear()
-        self._send(RequestVersion().body())
+            replies.clear()
+        self._send(body)
         with self._state_event:
-            self._state_event.wait_for(lambda: bool(self._version_reports), timeout_s)
-            return self._version_reports.popleft() if self._version_reports else None
+            self._state_event.wait_for(lambda: bool(replies), timeout_s)
+            return replies.popleft() if replies else None
 
     def wait_for_samples(self, count: int, timeout_s: float) -> bool:
         """Block until ``count`` samples have been delivered in all (``stats.samples``)."""

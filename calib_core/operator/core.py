@@ -25,6 +25,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
+from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.site import Site
 from calib_core.robot import solve_ik
 from calib_core.scene import SceneItem
@@ -69,8 +70,9 @@ class OperatorCore:
         self.scene_extras: list[SceneItem] = []
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
         self.scene_version = 0
-        """Counts the edits of the cell's components (the CAD views re-render when it changes)."""
-        self.cell_dirty = False
+        """Counts the changes of what the CAD views show (components edited, a board put up)."""
+        self.editor = CellEditor(self)
+        """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
 
     # --- the cell -------------------------------------------------------------------------------
     @property
@@ -192,69 +194,6 @@ class OperatorCore:
         if self.task.component:
             self.session.set_target(self.task.component)
         self.task_changed.emit(name)
-
-    # --- editing the cell (undoable; File > Save cell writes them back) ---------------------------
-    def _cell_edited(self, kind: str, name: str) -> None:
-        self.cell.refresh_identity()
-        self.cell_dirty = True
-        if kind == "task":
-            if self.task is not None and self.task.name == name and name not in self.workcell.task_locations:
-                self.task = None
-            self.task_changed.emit(name)
-        else:
-            self.scene_version += 1
-            self.scene_changed.emit()
-
-    def add_task_location(self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None) -> TaskLocation:
-        """A task location at ``tcp2base`` (4, 4) mm in base (default: the current TCP pose), for
-        ``component`` (default: the current target). Undoable."""
-        from calib_core.workcell.edits import AddTaskLocation
-
-        task = TaskLocation(str(name).strip(), self.model_tcp2base() if tcp2base is None else np.asarray(tcp2base, dtype=float), float(approach_mm), component or self.session.target)
-        self.session.undo.push(AddTaskLocation(self.workcell, task, self._cell_edited))
-        return task
-
-    def add_component(self, mesh_file, name: str, *, kind: str = "component", units: str = "mm", color=(0.7, 0.7, 0.7), item2world: np.ndarray | None = None) -> None:
-        """A component from a mesh file, placed at ``item2world`` (default: 1 m in front of the robot). Undoable."""
-        from calib_core.scene import SceneItem
-        from calib_core.workcell.edits import AddComponent, _check_name, load_component_mesh
-
-        name = _check_name(name, "component")
-        if kind not in ("component", "fixture"):
-            raise CalibrationError(f"a component's kind is 'component' or 'fixture', got {kind!r}")
-        mesh = load_component_mesh(mesh_file, units)
-        placement = np.array(item2world, dtype=float) if item2world is not None else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
-        item = SceneItem(name, mesh, placement, tuple(float(c) for c in color), kind, {})
-        self.session.undo.push(AddComponent(self.workcell, item, mesh_file, units, self._cell_edited))
-
-    def place_component(self, name: str, xyz_mm, rpy_deg) -> None:
-        """Place a component by numbers (its surveyed placement: mm, deg, in base). Successive
-        placements of one component are one undo step."""
-        from calib_core.frames import transform_from_xyz_rpy
-        from calib_core.workcell.edits import PlaceComponent
-
-        self.session.undo.push(PlaceComponent(self.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._cell_edited))
-
-    def snap_feature(self, component: str, point_component_mm, radius_mm: float):
-        """Where a click on ``component`` defines a feature (circle centre, corner, vertex or the surface point)."""
-        from calib_core.workcell.snapping import snap_point
-
-        return snap_point(self.workcell.component(component).mesh, point_component_mm, radius_mm)
-
-    def add_feature(self, component: str, name: str, point_component_mm) -> None:
-        """A named feature ``point_component_mm`` (3,) in the component's frame. Undoable."""
-        from calib_core.workcell.edits import AddFeature
-
-        self.session.undo.push(AddFeature(self.workcell, component, name, point_component_mm, self._cell_edited))
-
-    def save_cell(self, path=None):
-        """Write the edited cell back into its workcell YAML (comments and untouched entries kept)."""
-        from calib_core.workcell.writer import save_workcell
-
-        written = save_workcell(self.workcell, path)
-        self.cell_dirty = False
-        self.message.emit(f"cell saved to {written}")
-        return written
 
     # --- frames of reference -------------------------------------------------------------------
     def model_cam2world(self) -> np.ndarray:

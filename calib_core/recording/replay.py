@@ -15,7 +15,6 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import make_transform
 from calib_core.recording.reader import read_recording
 from calib_core.recording.schemas import SOLVE_TOPIC
-from calib_core.solver import solve_pose
 
 
 def solve_inputs(points_3d, points_2d, intrinsics: Intrinsics, *, prior=None, estimate_focal=False, model="pinhole", sigma_px=None, robust=False) -> dict:
@@ -38,6 +37,8 @@ def solve_from_inputs(inputs: dict):
     prior = None
     if inputs.get("prior"):
         prior = make_transform(inputs["prior"]["R_obj2cam"], inputs["prior"]["t_obj2cam_mm"])
+    from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on first use
+
     return solve_pose(
         inputs["points_3d"], inputs["points_2d"], Intrinsics.from_dict(inputs["intrinsics"]), prior=prior,
         estimate_focal=inputs.get("estimate_focal", False), model=inputs.get("model", "pinhole"),

@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import vtk
-from vtk.util import numpy_support
+from calib_core.render import vtk_api as vtk
+from calib_core.render.vtk_api import numpy_support
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project

@@ -9,7 +9,7 @@ centre of the top-left pixel is (0, 0)), so a point lands on the pixel ``project
 from __future__ import annotations
 
 import numpy as np
-import vtk
+from calib_core.render import vtk_api as vtk
 
 from calib_core.camera.intrinsics import Intrinsics
 

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-import pyvista as pv
-import vtk
+from calib_core.render import vtk_api as vtk
 
 from calib_core.scene import SceneItem
 
@@ -17,12 +16,26 @@ def vtk_matrix(T: np.ndarray) -> vtk.vtkMatrix4x4:
     return m
 
 
+def polydata_of(mesh) -> vtk.vtkPolyData:
+    """A trimesh mesh as VTK triangles (the points and connectivity copied once)."""
+    points = vtk.vtkPoints()
+    points.SetData(vtk.numpy_support.numpy_to_vtk(np.ascontiguousarray(mesh.vertices, dtype=float), deep=True))
+    faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
+    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
+    cells = vtk.vtkCellArray()
+    cells.SetData(vtk.numpy_support.numpy_to_vtkIdTypeArray(offsets, deep=True), vtk.numpy_support.numpy_to_vtkIdTypeArray(faces.ravel(), deep=True))
+    data = vtk.vtkPolyData()
+    data.SetPoints(points)
+    data.SetPolys(cells)
+    return data
+
+
 class ItemActor:
     """One scene item: a surface actor, and lazily its feature-edge actor for overlays."""
 
     def __init__(self, item: SceneItem):
         self.item = item
-        self.polydata = pv.wrap(item.mesh)
+        self.polydata = polydata_of(item.mesh)
         mapper = vtk.vtkPolyDataMapper()
         mapper.SetInputData(self.polydata)
         mapper.ScalarVisibilityOff()
@@ -34,9 +47,7 @@ class ItemActor:
         self.set_pose(item.item2world)
 
     def _apply_texture(self, item: SceneItem) -> None:
-        from vtk.util import numpy_support
-
-        tcoords = numpy_support.numpy_to_vtk(np.ascontiguousarray(item.texture_coords, dtype=np.float32), deep=True)
+        tcoords = vtk.numpy_support.numpy_to_vtk(np.ascontiguousarray(item.texture_coords, dtype=np.float32), deep=True)
         tcoords.SetName("TCoords")
         self.polydata.GetPointData().SetTCoords(tcoords)
         image = item.texture if item.texture.ndim == 3 else np.repeat(item.texture[:, :, None], 3, axis=2)
@@ -44,7 +55,7 @@ class ItemActor:
         data = vtk.vtkImageData()
         data.SetDimensions(w, h, 1)
         # VTK images start at the bottom row.
-        pixels = numpy_support.numpy_to_vtk(np.ascontiguousarray(image[::-1].reshape(-1, 3)), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
+        pixels = vtk.numpy_support.numpy_to_vtk(np.ascontiguousarray(image[::-1].reshape(-1, 3)), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
         pixels.SetNumberOfComponents(3)
         data.GetPointData().SetScalars(pixels)
         texture = vtk.vtkTexture()

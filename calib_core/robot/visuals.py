@@ -57,9 +57,23 @@ def _mesh_of(g: pin.GeometryObject, where: str) -> trimesh.Trimesh:
     raise FileFormatError(g.meshPath or "(URDF)", f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres or capsules)")
 
 
+_GEOMETRY_CACHE: dict[tuple, pin.GeometryModel] = {}
+
+
 def geometry_model(robot: RobotModel, kind: str = "visual") -> pin.GeometryModel:
     """Pinocchio's geometry model of ``kind`` (``visual`` or ``collision``) for ``robot``'s
-    driven joints; :class:`FileFormatError` names the URDF when a mesh cannot be read."""
+    driven joints; :class:`FileFormatError` names the URDF when a mesh cannot be read.
+
+    Shapes are placed on their parent joints, so one model serves every copy of a robot (the
+    modelled and the true one of the simulated site): it is built once per description and
+    never modified (each pose computation makes its own data)."""
+    key = (hash(robot.urdf_xml), str(robot.urdf_path), kind, robot.locked_joint_ids, None if robot.locked_configuration is None else robot.locked_configuration.tobytes())
+    if key not in _GEOMETRY_CACHE:
+        _GEOMETRY_CACHE[key] = _build_geometry_model(robot, kind)
+    return _GEOMETRY_CACHE[key]
+
+
+def _build_geometry_model(robot: RobotModel, kind: str) -> pin.GeometryModel:
     full = robot.full_model if robot.full_model is not None else robot.model
     try:
         gm = pin.buildGeomFromUrdfString(full, robot.urdf_xml, _KINDS[kind]) if robot.urdf_xml else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])

@@ -4,19 +4,24 @@
 did; ``solve_pose_batch`` solves many independent problems at once.
 """
 
-from calib_core.solver.batch import BatchPoseSolution, solve_pose_batch
-from calib_core.solver.errors import (
-    DegenerateGeometryError,
-    DuplicatePointsError,
-    InvalidIntrinsicsError,
-    MismatchedPointsError,
-    NonFiniteInputError,
-    PointsBehindCameraError,
-    SolverInputError,
-    TooFewPointsError,
-)
-from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
-from calib_core.solver.solve import refine_pose, solve_pose
+import importlib
+
+# Submodule of each public name. They load on first use (PEP 562): the numba kernels behind
+# ``solve_pose`` cost a few tenths of a second to import, which the window's start need not pay.
+_WHERE = {
+    "BatchPoseSolution": "batch", "solve_pose_batch": "batch",
+    "DegenerateGeometryError": "errors", "DuplicatePointsError": "errors", "InvalidIntrinsicsError": "errors", "MismatchedPointsError": "errors",
+    "NonFiniteInputError": "errors", "PointsBehindCameraError": "errors", "SolverInputError": "errors", "TooFewPointsError": "errors",
+    "PoseCandidate": "solution", "PoseSolution": "solution", "SolveStatus": "solution",
+    "refine_pose": "solve", "solve_pose": "solve",
+}
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(importlib.import_module(f"calib_core.solver.{_WHERE[name]}"), name)
+    raise AttributeError(f"module 'calib_core.solver' has no attribute {name!r}")
+
 
 __all__ = [
     "solve_pose", "refine_pose", "solve_pose_batch", "PoseSolution", "PoseCandidate", "SolveStatus", "BatchPoseSolution",

@@ -7,8 +7,12 @@ from enum import Enum
 
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from calib_core.frames import invert, make_transform
-from calib_core.solver.uncertainty import PoseUncertainty
+
+if TYPE_CHECKING:  # the uncertainty module imports the compiled kernels: not needed to read a result
+    from calib_core.solver.uncertainty import PoseUncertainty
 
 
 class SolveStatus(str, Enum):

@@ -18,7 +18,7 @@ VIEW_DISTANCE_MM = (420.0, 600.0)
 
 # Board x (columns) along base -y, y (rows) down along base -z, z (into the board) along base +x:
 # upright, facing the robot, which stands on the base's -x side of it.
-_FACING_ROBOT = np.column_stack([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+FACING_ROBOT = np.column_stack([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
 
 
 def board_from_centre(spec: BoardSpec, centre2base: np.ndarray) -> np.ndarray:
@@ -43,7 +43,7 @@ def board_in_front_of_robot(spec: BoardSpec, robot: RobotModel, home_deg=None) -
     camera views it from :data:`VIEW_DISTANCE_MM` with the flange at about 45 % of the reach."""
     reach, height = reach_of(robot)
     centre = np.array([0.45 * reach + np.mean(VIEW_DISTANCE_MM), 0.0, max(height, 0.25 * reach)])
-    return board_from_centre(spec, make_transform(_FACING_ROBOT, centre))
+    return board_from_centre(spec, make_transform(FACING_ROBOT, centre))
 
 
 def board_in_cell(spec: BoardSpec, workcell, robot: RobotModel) -> np.ndarray:

@@ -8,12 +8,12 @@ from calib_core.frames import make_transform
 from calib_core.testbed.sim_camera import SimulatedCamera
 from calib_core.testbed.test_bed import TestBed
 from calib_core.vision.board import BoardSpec, board_item
-from calib_core.vision.board_placement import _FACING_ROBOT, board_from_centre, board_view_joints
+from calib_core.vision.board_placement import FACING_ROBOT, board_from_centre, board_view_joints
 
 def board_facing_robot(spec: BoardSpec) -> np.ndarray:
     """``board2base``: the board upright 950 mm in front of the bundled robot, centred at 1 m
     height, facing -x (the bundled cell's ``hand_eye_board``)."""
-    return board_from_centre(spec, make_transform(_FACING_ROBOT, [950.0, 0.0, 1000.0]))
+    return board_from_centre(spec, make_transform(FACING_ROBOT, [950.0, 0.0, 1000.0]))
 
 
 def hand_eye_poses(bed: TestBed, spec: BoardSpec, board2base: np.ndarray, n: int = 10, seed: int = 0) -> list[np.ndarray]:

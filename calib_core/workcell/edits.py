@@ -24,7 +24,7 @@ _SCALE = {"mm": 1.0, "m": 1000.0}
 Notify = Callable[[str, str], None]
 
 
-def _check_name(name: str, what: str) -> str:
+def check_name(name: str, what: str) -> str:
     name = str(name).strip()
     if not name or any(c in name for c in "\n\r\t:#{}[],&*!|>'\"%@`"):
         raise OperatorError(f"{what} name {name!r}: use letters, digits, '_', '-', '.' or spaces")
@@ -99,7 +99,7 @@ class AddFeature(Command):
 
     def __init__(self, workcell: Workcell, component: str, name: str, point_mm, notify: Notify):
         self.item = workcell.component(component)
-        self.name = _check_name(name, "feature")
+        self.name = check_name(name, "feature")
         if self.name in self.item.features:
             raise OperatorError(f"component {component!r} has a feature called {self.name!r} already")
         point = np.asarray(point_mm, dtype=float).reshape(3)
@@ -119,7 +119,7 @@ class AddFeature(Command):
 
 class AddTaskLocation(Command):
     def __init__(self, workcell: Workcell, task: TaskLocation, notify: Notify):
-        _check_name(task.name, "task location")
+        check_name(task.name, "task location")
         if task.name in workcell.task_locations:
             raise OperatorError(f"there is already a task location called {task.name!r}")
         if not np.isfinite(task.approach_mm) or task.approach_mm < 0:

@@ -6,6 +6,7 @@ rendering cost). ``window`` has the robot's typical kinematic errors and the mod
 import pytest
 from PySide6.QtCore import QSettings
 
+from app.gui.cell_launcher import CellLauncher
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
 from calib_core.testbed.sim_site import simulated_cell
@@ -38,3 +39,9 @@ def live_window(qtbot, tmp_path):
 def window(live_window):
     typical = RobotErrors.typical(0)
     return live_window(RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
+
+
+@pytest.fixture
+def launcher(tmp_path):
+    """Opens windows as `videocal gui` does on the simulated site: each cell with its own simulator."""
+    return CellLauncher(lambda workcell, process=None: simulated_cell(workcell, process=process), settings=QSettings(str(tmp_path / "launcher.ini"), QSettings.Format.IniFormat))

@@ -199,10 +199,10 @@ def test_the_approach_is_edited_undone_and_the_overview_pans(qtbot, window):
 def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
     win, wb = window, window.workbench
     wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
-    win.save_workspace(tmp_path / "w.json")
+    win.files.save_workspace(tmp_path / "w.json")
     wb.session.clear()
-    win.recent.fill()
-    actions = [a for a in win.recent.menu.actions() if a.text() == str(tmp_path / "w.json")]
+    win.files.recent.fill()
+    actions = [a for a in win.files.recent.menu.actions() if a.text() == str(tmp_path / "w.json")]
     assert actions
     actions[0].trigger()
     assert len(wb.session.pairs) == 1
@@ -214,8 +214,8 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
 
     win = window
     wb = win.workbench
-    win.start_recording(tmp_path / "session.mcap")
-    assert win.record_action.isChecked()
+    win.files.start_recording(tmp_path / "session.mcap")
+    assert win.files.record_action.isChecked()
     win._on_pick_3d(type("Hit", (), {"component": "oru_1_fixture", "feature": "pin_tip", "point_world_mm": (1.0, 2.0, 3.0)})())
     win._on_pick_2d(100.0, 120.0)
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
@@ -223,8 +223,8 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     qtbot.wait(1100)
     win._update_status()
     assert "REC" in win.record_label.text()
-    win.save_workspace(tmp_path / "w.json")
-    win.stop_recording()
+    win.files.save_workspace(tmp_path / "w.json")
+    win.files.stop_recording()
     contents = read_recording(tmp_path / "session.mcap")
     assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
     # (link_state events may come and go with the controller; the operator's edits are these)
@@ -232,11 +232,11 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     # Clear, then open the saved workspace: the pair comes back.
     wb.session.clear()
     assert len(wb.session.pairs) == 0
-    win.open_workspace(tmp_path / "w.json")
+    win.files.open_workspace(tmp_path / "w.json")
     assert [p.feature for p in wb.session.pairs] == ["pin_tip"] and win.table.rowCount() == 1
     # A bad file is a message; nothing is lost.
     (tmp_path / "bad.json").write_text("{broken")
-    win.open_workspace(tmp_path / "bad.json")
+    win.files.open_workspace(tmp_path / "bad.json")
     assert "not valid JSON" in win.results.status.text()
     assert len(wb.session.pairs) == 1
 
@@ -300,8 +300,8 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
     win = MainWindow(wb, settings=settings)
     qtbot.addWidget(win)
     try:
-        assert "Restore" in win.restore_action.text()
-        win.restore_action.trigger()
+        assert "Restore" in win.files.restore_action.text()
+        win.files.restore_action.trigger()
         assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
     finally:
         win.close()
@@ -333,7 +333,7 @@ def test_a_refused_move_is_shown_and_ctrl_q_stops_the_simulator(qtbot, window):
     assert process.running
     from PySide6.QtGui import QKeySequence
 
-    quit_action = next(a for a in win.file_menu.actions() if a.shortcut() == QKeySequence("Ctrl+Q"))
+    quit_action = next(a for a in win.files.menu.actions() if a.shortcut() == QKeySequence("Ctrl+Q"))
     quit_action.trigger()
     qtbot.waitUntil(lambda: not process.running, timeout=10_000)
     assert not win.isVisible()

@@ -6,20 +6,18 @@ import shutil
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtCore import QPoint, Qt
 
-from app.gui.cell_launcher import CellLauncher
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
+def window(qtbot, tmp_path, launcher):
     root = DEFAULT_WORKCELL.parents[1]
     for sub in ("workcell", "robot", "camera"):
         shutil.copytree(root / sub, tmp_path / sub)
-    launcher = CellLauncher(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
     win = launcher.open(tmp_path / "workcell" / "workcell.yaml")
     qtbot.addWidget(win)
     win.resize(1500, 950)

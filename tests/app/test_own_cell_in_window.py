@@ -3,9 +3,7 @@ changes nothing; a workspace of another cell is refused before anything changes;
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QSettings
 
-from app.gui.cell_launcher import CellLauncher
 from app.gui.error_boundary import internal_error_log
 from calib_core.workcell import DEFAULT_WORKCELL
 from calib_core.workcell.starter import write_starter_cell
@@ -17,11 +15,6 @@ def ur5_cell(tmp_path_factory):
     return write_starter_cell(tmp_path_factory.mktemp("ur5") / "cell", require(UR5), [SHARE]).workcell_path
 
 
-@pytest.fixture
-def launcher(tmp_path):
-    return CellLauncher(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
-
-
 def test_open_cell_replaces_the_window_with_the_cells_robot_and_simulator(qtbot, launcher, ur5_cell, tmp_path):
     win = launcher.open(DEFAULT_WORKCELL)
     qtbot.addWidget(win)
@@ -31,10 +24,10 @@ def test_open_cell_replaces_the_window_with_the_cells_robot_and_simulator(qtbot,
     # A file that is not a cell: an error, and the window and its simulator go on.
     bad = tmp_path / "bad.yaml"
     bad.write_text("schema_version: 2\nunits: {length: mm, angle: deg}\nrobot: {urdf: nothing.urdf}\ncomponents: []\n")
-    assert not win.open_cell(str(bad))
+    assert not win.files.open_cell(str(bad))
     assert "robot.urdf" in win.results.status.text() and win.isVisible() and old.site.process.running
     # The UR5 cell: a new window with its robot, and the old simulator stops.
-    assert win.open_cell(str(ur5_cell))
+    assert win.files.open_cell(str(ur5_cell))
     new = next(w for w in _shown_windows() if w is not win)
     qtbot.addWidget(new)
     try:
@@ -43,7 +36,7 @@ def test_open_cell_replaces_the_window_with_the_cells_robot_and_simulator(qtbot,
         assert wb.robot.joint_names[0] == "shoulder_pan_joint" and wb.cell.name == "ur5_robot cell"
         qtbot.waitUntil(lambda: wb.link_up, timeout=15_000)
         assert np.allclose(wb.joints_deg, wb.cell.home_joints, atol=1e-3)  # the UR5's simulator, at its home
-        assert new.recent_cells.paths()[0] == str(ur5_cell.resolve())
+        assert new.files.recent_cells.paths()[0] == str(ur5_cell.resolve())
     finally:
         new.close()
     assert not wb.site.process.running
@@ -65,13 +58,13 @@ def test_a_workspace_of_another_cell_is_refused_and_nothing_changes(qtbot, launc
     wb.session.pick_3d("oru_1_fixture", "pin_tip", fixture.item2world[:3, 3])
     wb.session.pick_2d((100.0, 100.0))
     path = tmp_path / "bundled_workspace.json"
-    assert bundled.save_workspace(path)
+    assert bundled.files.save_workspace(path)
     bundled.close()
     ur5 = launcher.open(ur5_cell)
     qtbot.addWidget(ur5)
     try:
         tasks_before = dict(ur5.workbench.workcell.task_locations)
-        assert not ur5.open_workspace(path)
+        assert not ur5.files.open_workspace(path)
         text = ur5.results.status.text()
         assert "belongs to the cell 'space station robotic test bed'" in text and "ur5_robot cell" in text
         assert ur5.workbench.workcell.task_locations == tasks_before and len(ur5.workbench.session.pairs) == 0
@@ -105,10 +98,10 @@ def test_a_failed_save_is_neither_recent_nor_saved(qtbot, launcher, tmp_path):
     try:
         saved_before = win.settings.value("files/last_saved_time")
         target = tmp_path / "no such folder" / "workspace.json"
-        assert not win.save_workspace(target)
-        assert str(target) not in win.recent.paths()
+        assert not win.files.save_workspace(target)
+        assert str(target) not in win.files.recent.paths()
         assert win.settings.value("files/last_saved_time") == saved_before
-        assert win.save_workspace(tmp_path / "workspace.json")
-        assert win.recent.paths()[0] == str(tmp_path / "workspace.json")
+        assert win.files.save_workspace(tmp_path / "workspace.json")
+        assert win.files.recent.paths()[0] == str(tmp_path / "workspace.json")
     finally:
         win.close()

@@ -46,7 +46,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     truth = RecordingPlayback(read_recording(recording))
     live_pair = wb.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
     before = _digest(recording)
-    win.open_recording(recording)
+    win.files.open_recording(recording)
     bar = win.replay
     assert bar.isVisible() and wb.replaying and not win.commands.live.isChecked()
     assert "replaying session.mcap" in win.statusBar().currentMessage()
@@ -94,7 +94,7 @@ def test_an_edit_branches_a_new_session_and_leaves_the_file_alone(qtbot, window,
     win, wb = window, window.workbench
     truth = RecordingPlayback(read_recording(recording))
     before = _digest(recording)
-    win.open_recording(recording)
+    win.files.open_recording(recording)
     bar = win.replay
     bar.seek(truth.duration_s)
     n = len(wb.session.pairs)
@@ -117,14 +117,14 @@ def test_bad_and_cut_off_recordings(qtbot, window, tmp_path, recording):
     win, wb = window, window.workbench
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"not a recording")
-    win.open_recording(junk)
+    win.files.open_recording(junk)
     assert "not an MCAP recording" in win.results.status.text() and "junk.mcap" in win.results.status.text()
     assert not win.replay.isVisible() and not wb.replaying
     # A recording cut off by a crash opens with what it holds and offers recovery.
     data = recording.read_bytes()
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(data[: len(data) * 2 // 3])
-    win.open_recording(cut)
+    win.files.open_recording(cut)
     assert win.replay.isVisible() and not win.replay.recover_button.isHidden()
     qtbot.mouseClick(win.replay.recover_button, Qt.MouseButton.LeftButton)
     recovered = read_recording(tmp_path / "cut-recovered.mcap")
@@ -133,7 +133,7 @@ def test_bad_and_cut_off_recordings(qtbot, window, tmp_path, recording):
 
 def test_replay_screenshot(qtbot, window, recording):
     win = window
-    win.open_recording(recording)
+    win.files.open_recording(recording)
     win.replay.seek(win.replay.playback.duration_s)
     qtbot.waitUntil(win.virtual.is_current, timeout=10_000)
     qtbot.wait(200)
@@ -163,7 +163,7 @@ def test_a_recording_from_another_camera_mode_replays_with_its_own_intrinsics(qt
         for k in range(3):
             rec.record_frame(image, k / 15)
             rec.record_joints(k, 20 * k, k / 15, list(wb.joints_deg))
-    win.open_recording(path)
+    win.files.open_recording(path)
     from app.gui.virtual_pane import RENDER_SCALE
 
     assert wb.intrinsics == half

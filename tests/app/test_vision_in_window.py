@@ -41,8 +41,7 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
 def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     win, wb = window, window.workbench
     vision = win.vision
-    win.commands.setCurrentIndex(win.commands.count() - 1)
-    assert win.commands.tabText(win.commands.currentIndex()) == "Vision"
+    win.commands.setCurrentIndex(next(i for i in range(win.commands.count()) if win.commands.tabText(i) == "Vision"))
     assert not vision.calibrate_intrinsics_button.isEnabled()
 
     # At home the camera does not see the board: the view is rejected and said why.
@@ -130,14 +129,14 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     win, wb = window, window.workbench
     vision = win.vision
     vision.show_board.setChecked(True)
-    win.start_recording(tmp_path / "board.mcap")
+    win.files.start_recording(tmp_path / "board.mcap")
     for k in range(4):
         _visit_board_pose(qtbot, win, k)
         qtbot.wait(300)  # a few frames at rest into the recording
-    win.stop_recording()
+    win.files.stop_recording()
     plan = vision._plan[:4]
     playback = RecordingPlayback(read_recording(tmp_path / "board.mcap"))
-    win.open_recording(tmp_path / "board.mcap")
+    win.files.open_recording(tmp_path / "board.mcap")
     assert wb.replaying
     for q in plan:
         # the moment the recorded joints reached this pose, plus a little: frame and joints at rest

@@ -92,3 +92,15 @@ def test_unreadable_files(tmp_path, cell_copy):
     path.write_text((DEFAULT_WORKCELL).read_text())
     with pytest.raises(FileFormatError, match=r"components\[1\].mesh"):
         load_workcell(path)
+
+
+def test_a_dae_component_from_a_vendor_package_loads_in_metres(cell_copy):
+    from tests.vendor_robots import ROBOTS, require
+
+    path, data = cell_copy
+    dae = require(ROBOTS / "ur_description" / "meshes" / "ur5" / "visual" / "base.dae")
+    data["components"][1].update(mesh=str(dae), mesh_units="m")
+    cell = load_workcell(_write(path, data))
+    mesh = cell.components[1].mesh
+    assert len(mesh.faces) > 1000
+    assert 100 < mesh.extents[0] < 160  # the UR5's base, about 120 mm across, in mm

@@ -1,0 +1,170 @@
+"""The File menu and what it does: cells, workspaces, exports, recordings, the recent lists and the
+autosave. Every action goes through the window's error boundary; one that fails changes nothing
+(a failed save is not a recent file and does not count as saved)."""
+
+from __future__ import annotations
+
+import time
+
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QFileDialog, QMenu
+
+from app.gui.error_boundary import attempt
+from app.gui.session_files import Autosave, RecentFiles
+from calib_core.errors import OperatorError
+
+EXPORT_FILTERS = {
+    "URScript, Universal Robots (*.script)": "urscript", "RAPID module, ABB (*.mod)": "rapid", "KRL data, KUKA (*.dat)": "krl",
+    "TP program, FANUC (*.ls)": "fanuc", "PDL2, COMAU (*.pdl)": "pdl2", "CSV (*.csv)": "csv", "JSON (*.json)": "json",
+}
+
+
+class FileMenu:
+    """Builds ``menu`` for ``window`` (a :class:`~app.gui.main_window.MainWindow`) and handles it."""
+
+    def __init__(self, window, menu: QMenu):
+        self.window = window
+        self.menu = menu
+        self.autosave: Autosave | None = None
+        self.restore_action: QAction | None = None
+        w = window
+        self.open_cell_action = QAction("Open &cell...", w, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog)
+        menu.addAction(self.open_cell_action)
+        self.recent_cells = RecentFiles(w.settings, menu.addMenu("Recent ce&lls"), self.open_cell, key="files/recent_cells")
+        if w.launcher is None:
+            self.open_cell_action.setEnabled(False)
+            self.open_cell_action.setToolTip("this window was opened on one cell only")
+        menu.addSeparator()
+        menu.addAction(QAction("&Open workspace...", w, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
+        menu.addAction(QAction("&Save workspace as...", w, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
+        menu.addAction(QAction("Save ce&ll", w, shortcut=QKeySequence("Ctrl+Shift+S"), triggered=lambda: w.report(w.workbench.editor.save)()))
+        menu.addAction(QAction("E&xport corrections...", w, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
+        menu.addSeparator()
+        self.record_action = QAction("&Record session...", w, checkable=True, triggered=self._record_toggled)
+        menu.addAction(self.record_action)
+        menu.addAction(QAction("Open r&ecording...", w, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
+        self.recent = RecentFiles(w.settings, menu.addMenu("Recent &files"), self.open_recent)
+        menu.addSeparator()
+        # StandardKey.Quit is empty on some platforms (the offscreen one among them).
+        menu.addAction(QAction("&Quit", w, shortcut=QKeySequence("Ctrl+Q"), triggered=w.close))
+
+    def _status(self, text: str, ms: int = 8000) -> None:
+        self.window.statusBar().showMessage(text, ms)
+
+    # --- cells ---------------------------------------------------------------------------------------
+    def open_cell(self, path: str) -> bool:
+        """Open another cell: a new window on it (with its own simulator or the same real devices) takes
+        this one's place. A cell that does not load leaves this window as it is."""
+        w = self.window
+        if w.launcher is None:
+            w.show_error("this window was opened on one cell only: start videocal gui --workcell FILE")
+            return False
+        from calib_core.operator.cell import Cell
+
+        if not attempt(w.show_error, Cell.open, path):  # check the file before anything stops
+            return False
+        opened = []
+        if not attempt(w.show_error, lambda: opened.append(w.launcher.open(path))):
+            return False
+        opened[0].setGeometry(w.geometry())
+        opened[0].show()
+        w.close()
+        return True
+
+    def _open_cell_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open cell", str(self.window.workbench.workcell.path.parent), "videocal workcell (*.yaml *.yml)")
+        if path:
+            self.open_cell(path)
+
+    # --- workspaces and exports ---------------------------------------------------------------------
+    def save_workspace(self, path) -> bool:
+        """Save; only a save that succeeded joins the recent files and counts as saved for the autosave."""
+        if not attempt(self.window.show_error, self.window.workbench.save_workspace, path):
+            return False
+        self.recent.remember(path)
+        self.autosave.mark_saved()
+        return True
+
+    def open_workspace(self, path) -> bool:
+        if not attempt(self.window.show_error, self.window.workbench.open_workspace, path):
+            return False
+        self.recent.remember(path)
+        return True
+
+    def open_recent(self, path: str) -> None:
+        """A workspace (.json) or a recording (.mcap) from the recent list."""
+        if path.endswith(".mcap"):
+            self.open_recording(path)
+        else:
+            self.open_workspace(path)
+
+    def _save_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self.window, "Save workspace", "workspace.json", "videocal workspace (*.json)")
+        if path:
+            self.save_workspace(path)
+
+    def _open_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open workspace", "", "videocal workspace (*.json)")
+        if path:
+            self.open_workspace(path)
+
+    def _export_dialog(self) -> None:
+        path, chosen = QFileDialog.getSaveFileName(self.window, "Export corrections", "corrections.script", ";;".join(EXPORT_FILTERS))
+        if path:
+            self.window.report(self.window.workbench.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
+
+    # --- recordings -----------------------------------------------------------------------------------
+    def _open_recording_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open recording", "", "MCAP recording (*.mcap)")
+        if path:
+            self.open_recording(path)
+
+    def open_recording(self, path) -> None:
+        """Replay a recording: the live camera pauses, the views follow the recording (see ReplayBar)."""
+        self.window.report(self._open_recording)(path)
+
+    def _open_recording(self, path) -> None:
+        w = self.window
+        if w.workbench.recorder is not None:
+            raise OperatorError("stop recording before replaying a recording")
+        w.replay.open(path)
+        w.commands.live.setChecked(False)
+        self.recent.remember(path)
+
+    def start_recording(self, path) -> None:
+        w = self.window
+        if w.replay.playback is not None:
+            w.show_error("close the replay before recording: a recording records the live camera and robot")
+            return
+        w.report(w.workbench.start_recording)(path)
+        self.record_action.setChecked(w.workbench.recorder is not None)
+
+    def stop_recording(self) -> None:
+        self.window.workbench.stop_recording()
+        self.record_action.setChecked(False)
+
+    def _record_toggled(self, on: bool) -> None:
+        if not on:
+            self.stop_recording()
+            return
+        path, _ = QFileDialog.getSaveFileName(self.window, "Record session", "session.mcap", "MCAP recording (*.mcap)")
+        if path:
+            self.start_recording(path)
+        else:
+            self.record_action.setChecked(False)
+
+    # --- the autosave ---------------------------------------------------------------------------------
+    def start_autosave(self) -> None:
+        """Autosave every minute; an autosave newer than the last saved workspace means the last session
+        ended without saving: offer it (File > Restore autosave) rather than load it unasked."""
+        self.autosave = Autosave(self.window.settings, self.window.workbench.save_workspace, self._status, self.window)
+        autosaved = self.autosave.unsaved_since()
+        if autosaved is None:
+            return
+        stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(autosaved))
+        self.restore_action = QAction(f"Restore &autosave of {stamp}", self.window, triggered=self.restore_autosave)
+        self.menu.insertAction(self.menu.actions()[0], self.restore_action)
+        self._status(f"an unsaved session from {stamp} was autosaved: File > Restore autosave", 30000)
+
+    def restore_autosave(self) -> None:
+        self.open_workspace(self.autosave.path)

@@ -1,0 +1,74 @@
+"""The controller simulator as a child process for a cell: ``videocal sim-controller --pty`` with a
+stable link path in a private folder. Standard library only, so the window can start it before it
+imports anything heavy (the simulator's start-up then overlaps the window's)."""
+
+from __future__ import annotations
+
+import ctypes
+import signal
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from calib_core.errors import VideocalError
+
+_PROJECT = Path(__file__).resolve().parents[2]
+_PR_SET_PDEATHSIG = 1
+
+
+class SiteError(VideocalError, RuntimeError):
+    """A device of the site could not be started; the message says why."""
+
+
+def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
+    # The simulator must not outlive the program that started it, even one killed with SIGKILL.
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    except OSError:
+        pass
+
+
+class SimulatorProcess:
+    """``videocal sim-controller --pty`` for the cell at ``workcell_path``, as a child process with
+    a stable link path in a private folder. It starts at once; :meth:`wait_ready` returns the path."""
+
+    def __init__(self, workcell_path: str | Path, joints_controller=None):
+        self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-")
+        folder = Path(self._folder.name)
+        self.link_path = folder / "controller"
+        self._stderr_path = folder / "stderr.txt"
+        cmd = [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(self.link_path), "--workcell", str(workcell_path)]
+        if joints_controller is not None:
+            cmd += ["--joints", ",".join(f"{v:.4f}" for v in joints_controller)]
+        with open(self._stderr_path, "w") as err:
+            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), preexec_fn=_die_with_parent)
+        self.device: str | None = None
+
+    def wait_ready(self) -> str:
+        """The link path once the simulator serves; :class:`SiteError` with its own message if it failed."""
+        if self.device is None:
+            line = self.process.stdout.readline().strip()
+            if not line:
+                self.process.wait(timeout=5)
+                why = self._stderr_path.read_text().strip().splitlines()
+                raise SiteError(f"the controller simulator did not start: {why[-1] if why else f'exit code {self.process.returncode}'}")
+            self.device = line
+        return str(self.link_path)
+
+    @property
+    def running(self) -> bool:
+        return self.process.poll() is None
+
+    def stop(self) -> None:
+        """Terminate (then kill) the child and remove its folder; safe to call twice."""
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=3)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(timeout=3)
+        if self.process.stdout is not None:
+            self.process.stdout.close()
+        self._folder.cleanup()
