@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from PySide6.QtCore import QSignalBlocker
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -49,7 +50,6 @@ class CellPanel(QWidget):
         super().__init__(parent)
         self.workbench = workbench
         self._attempt = attempt
-        self._showing = False
         layout = QVBoxLayout(self)
 
         comps = QGroupBox("Components")
@@ -144,17 +144,12 @@ class CellPanel(QWidget):
         if not name:
             return
         xyz, rpy = xyz_rpy_from_transform(self.workbench.workcell.component(name).item2world)
-        self._showing = True
-        try:
-            for box, v in zip(self.xyz + self.rpy, list(xyz) + list(rpy)):
+        for box, v in zip(self.xyz + self.rpy, list(xyz) + list(rpy)):
+            with QSignalBlocker(box):  # showing the core's placement is not an edit of it
                 box.setValue(float(v))
-        finally:
-            self._showing = False
 
     # --- edits ------------------------------------------------------------------------------------
     def _placement_edited(self) -> None:
-        if self._showing:
-            return
         name = self.component.currentText()
         self._attempt(self.workbench.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
 

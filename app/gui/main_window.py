@@ -51,7 +51,6 @@ class MainWindow(QMainWindow):
         cell_scroll.setWidgetResizable(True)
         cell_scroll.setWidget(self.cell_panel)
         self.commands.addTab(cell_scroll, "Cell")
-        self._current_pair: int | None = None
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self.solved_edges = SolvedEdges(workbench.intrinsics)
         self.worker: FrameWorker | None = None
@@ -227,63 +226,33 @@ class MainWindow(QMainWindow):
         if self.cell_panel.picking_features:
             self.cell_panel.feature_clicked(hit, self.workbench.model_cam2world(), self.virtual.intrinsics.fu)
             return
-        if self.workbench.session.pairs.pending() is not None:
-            # A new model pick replaces a pair still waiting for its image point.
-            self.workbench.session.delete(self.workbench.session.pairs.pending().number)
-        self._current_pair = self.workbench.session.pick_3d(hit.component, hit.feature, hit.point_world_mm)
-        self.statusBar().showMessage(f"pair {self._current_pair}: now pick {hit.feature or 'the point'} on the camera image", 8000)
+        number = self.workbench.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
+        self.statusBar().showMessage(f"pair {number}: now pick {hit.feature or 'the point'} on the camera image", 8000)
 
     def _on_pick_2d(self, u: float, v: float) -> None:
-        session = self.workbench.session
-        if session.pairs.pending() is not None:
-            self._current_pair = session.pick_2d((u, v))
-        elif self._current_pair is not None and self._current_pair in [p.number for p in session.pairs]:
-            session.move_2d(self._current_pair, (u, v))  # not yet accepted: the click moves its image point
-        else:
-            session.pick_2d((u, v))  # raises with a clear message
+        self.workbench.pick_image_point((u, v))
 
     def _choose_candidate(self, index: int) -> None:
-        self.workbench.session.choose_candidate(index)
-        self.workbench.record_event("candidate_chosen", index=index, solution=index + 1)
+        self.workbench.choose_candidate(index)
 
     def _accept(self) -> None:
-        self.report(self._accept_impl)()
-
-    def _accept_impl(self) -> None:
-        pending = self.workbench.session.pairs.pending()
-        if pending is not None:
-            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
-        if self._current_pair is None:
-            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
-        self.statusBar().showMessage(f"pair {self._current_pair} accepted", 5000)
-        self.workbench.record_event("pair_accepted", number=self._current_pair)
-        self._current_pair = None
+        self.report(lambda: self.statusBar().showMessage(f"pair {self.workbench.accept_pair()} accepted", 5000))()
 
     def _delete(self) -> None:
-        self.report(self._delete_impl)()
-
-    def _delete_impl(self) -> None:
-        number = self.table.selected_number() or self._current_pair
-        if number is None:
-            raise OperatorError("select a pair in the table to delete it")
-        self.workbench.session.delete(number)
-        if number == self._current_pair:
-            self._current_pair = None
+        self.report(lambda: self.workbench.delete_pair(self.table.selected_number()))()
 
     def _undo(self) -> None:
-        label = self.workbench.session.undo.undo()
-        self._current_pair = None
+        label = self.workbench.undo()
         self.statusBar().showMessage(f"undone: {label}" if label else "nothing to undo", 5000)
 
     def _redo(self) -> None:
-        label = self.workbench.session.undo.redo()
+        label = self.workbench.redo()
         self.statusBar().showMessage(f"redone: {label}" if label else "nothing to redo", 5000)
 
     def _calibrate(self) -> None:
         self.report(self._calibrate_impl)()
 
     def _calibrate_impl(self) -> None:
-        self._current_pair = None
         result = self.workbench.calibrate()
         s = result.solution
         self.statusBar().showMessage(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)

@@ -22,6 +22,7 @@ from psygnal import Signal
 from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.errors import OperatorError
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
@@ -69,6 +70,8 @@ class OperatorCore:
         self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
+        self.current_pair: int | None = None
+        """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
         self.scene_version = 0
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
@@ -195,6 +198,62 @@ class OperatorCore:
             self.session.set_target(self.task.component)
         self.task_changed.emit(name)
 
+    # --- the pair being made (the paper's Point and Accept) -------------------------------------------
+    def pick_model_point(self, component: str, feature: str | None, point_world_mm) -> int:
+        """*Point*, first half: a point on the target's model (3,) mm in base. A new model pick
+        replaces a pair still waiting for its image point. Returns the pair's number."""
+        pending = self.session.pairs.pending()
+        if pending is not None:
+            self.session.delete(pending.number)
+        self.current_pair = self.session.pick_3d(component, feature, point_world_mm)
+        return self.current_pair
+
+    def pick_image_point(self, pixel) -> int:
+        """*Point*, second half: the same point on the camera image (u, v) px. Until *Accept*, a
+        second click moves it."""
+        session = self.session
+        if session.pairs.pending() is not None:
+            self.current_pair = session.pick_2d(pixel)
+        elif self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]:
+            session.move_2d(self.current_pair, pixel)
+        else:
+            session.pick_2d(pixel)  # raises with what to do instead
+        return self.current_pair
+
+    def accept_pair(self) -> int:
+        """*Accept*: the pair being made is done. Returns its number."""
+        pending = self.session.pairs.pending()
+        if pending is not None:
+            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
+        if self.current_pair is None:
+            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
+        number, self.current_pair = self.current_pair, None
+        self.record_event("pair_accepted", number=number)
+        return number
+
+    def delete_pair(self, number: int | None = None) -> int:
+        """Delete pair ``number`` (default: the pair being made). Undoable."""
+        number = number if number is not None else self.current_pair
+        if number is None:
+            raise OperatorError("select a pair in the table to delete it")
+        self.session.delete(number)
+        if number == self.current_pair:
+            self.current_pair = None
+        return number
+
+    def undo(self) -> str | None:
+        """Undo the last edit (its label, None if there was none); the pair being made is let go."""
+        self.current_pair = None
+        return self.session.undo.undo()
+
+    def redo(self) -> str | None:
+        return self.session.undo.redo()
+
+    def choose_candidate(self, index: int) -> None:
+        """Take solution ``index`` of an ambiguous solve (undoable)."""
+        self.session.choose_candidate(index)
+        self.record_event("candidate_chosen", index=index, solution=index + 1)
+
     # --- frames of reference -------------------------------------------------------------------
     def model_cam2world(self) -> np.ndarray:
         return self.robot.fk(self.joints_deg, "camera")
@@ -212,6 +271,7 @@ class OperatorCore:
         if target is None:
             raise CalibrationError("choose the target object first")
         obj2world = self.workcell.component(target).item2world
+        self.current_pair = None
         result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
         self.solved.emit()
         return result
