@@ -3,7 +3,7 @@
 
 The simulated operator clicks the panes' widgets like a person would: at the task location it picks each
 feature in the virtual camera, zooms the camera image around the same feature and clicks it (sub-pixel
-refinement on corners), accepts, calibrates and stores the correction; the features are those of the task's
+refinement on corners, clicked again without it when the refined cross-hair leaves the corner), accepts, calibrates and stores the correction; the features are those of the task's
 component that the camera sees; then it moves to the corrected
 location, looks again the same way, stores the refined correction and moves there. Where the
 features are in the camera image it learns from the test bed's truth, as a person learns it by looking.
@@ -31,6 +31,7 @@ from calib_core.testbed.true_robot import RobotErrors
 from calib_core.workcell import DEFAULT_WORKCELL
 
 _MIN_FEATURES = 4
+_REFINE_TRUST_PX = 0.35
 _EDGE_MARGIN_PX = 12.0
 
 
@@ -114,6 +115,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         shots.append(path.name)
 
     skipped: list[str] = []
+    refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
         shot("start")
@@ -152,6 +154,13 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
                 win.camera.subpixel.setChecked(_is_corner(name))
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
+                refined = wb.session.pairs.get(wb.current_pair).pixel
+                if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
+                    # The operator sees the refined cross-hair leave the corner (a junction of faces the
+                    # refinement takes for another corner): clicks it again, refinement off.
+                    win.camera.subpixel.setChecked(False)
+                    _click_image(win.camera.view, *uv_true)
+                    refined_away.append(f"{round_name}: {name}")
                 win.camera.view.reset_view()
                 win._accept()
                 app.processEvents()
@@ -195,6 +204,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "task_location": task.name,
             "target": wb.session.target,
             "features_skipped": skipped,
+            "subpixel_refinement_refused": refined_away,
             "status": r.solution.status.value,
             "pairs": len(wb.session.pairs.usable()),
             "rms_px": r.solution.rms_px,

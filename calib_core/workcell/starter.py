@@ -33,19 +33,29 @@ GRASP_STANDOFF_MM = 30.0
 """The task location puts the TCP this far in front of the target's face (at its pin tip)."""
 APPROACH_MM = 150.0
 
-# The example target, in its own frame: x out of its front face (toward the robot), y left, z up.
-PLATE = (10.0, 100.0, 70.0)
-BLOCK = (10.0, 50.0, 30.0)
-# Left and right as seen from the robot (the target's y points to the robot's right).
+# The example target, in its own frame: x out of its front face (toward the robot), y to the robot's
+# right, z up. A plate with a raised block on it, turned up by BLOCK_TILT_DEG about y so that its face
+# is lit differently from the plate's and its four corners stand out in the camera image, and a pin.
+PLATE = (10.0, 130.0, 90.0)
+BLOCK = (12.0, 70.0, 40.0)
+BLOCK_TILT_DEG = 20.0
+_BLOCK2TARGET = transform_from_xyz_rpy([0.0, 0.0, 0.0], [0.0, -BLOCK_TILT_DEG, 0.0])
+
+
+def _block_corner(y: float, z: float) -> list[float]:
+    return [float(v) for v in (_BLOCK2TARGET @ np.array([BLOCK[0], y, z, 1.0]))[:3]]
+
+
+# Left and right as seen from the robot.
 FEATURES = {
-    "plate_corner_top_left": [0.0, -50.0, 35.0],
-    "plate_corner_top_right": [0.0, 50.0, 35.0],
-    "plate_corner_bottom_left": [0.0, -50.0, -35.0],
-    "plate_corner_bottom_right": [0.0, 50.0, -35.0],
-    "block_corner_top_left": [10.0, -25.0, 15.0],
-    "block_corner_top_right": [10.0, 25.0, 15.0],
-    "block_corner_bottom_left": [10.0, -25.0, -15.0],
-    "block_corner_bottom_right": [10.0, 25.0, -15.0],
+    "plate_corner_top_left": [0.0, -PLATE[1] / 2, PLATE[2] / 2],
+    "plate_corner_top_right": [0.0, PLATE[1] / 2, PLATE[2] / 2],
+    "plate_corner_bottom_left": [0.0, -PLATE[1] / 2, -PLATE[2] / 2],
+    "plate_corner_bottom_right": [0.0, PLATE[1] / 2, -PLATE[2] / 2],
+    "block_corner_top_left": _block_corner(-BLOCK[1] / 2, BLOCK[2] / 2),
+    "block_corner_top_right": _block_corner(BLOCK[1] / 2, BLOCK[2] / 2),
+    "block_corner_bottom_left": _block_corner(-BLOCK[1] / 2, -BLOCK[2] / 2),
+    "block_corner_bottom_right": _block_corner(BLOCK[1] / 2, -BLOCK[2] / 2),
     "pin_tip": [GRASP_STANDOFF_MM, 0.0, 0.0],
 }
 
@@ -72,6 +82,7 @@ def _target_mesh() -> trimesh.Trimesh:
     plate.apply_translation([-PLATE[0] / 2, 0.0, 0.0])
     block = trimesh.creation.box(extents=BLOCK)
     block.apply_translation([BLOCK[0] / 2, 0.0, 0.0])
+    block.apply_transform(_BLOCK2TARGET)
     pin = trimesh.creation.cylinder(radius=4.0, height=GRASP_STANDOFF_MM - BLOCK[0], sections=24)
     pin.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
     pin.apply_translation([BLOCK[0] + (GRASP_STANDOFF_MM - BLOCK[0]) / 2, 0.0, 0.0])
@@ -258,7 +269,7 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
         "    color: [0.80, 0.78, 0.72]",
         f"    placement: {_yaml_pose(target2base)}",
         "    features:",
-    ] + [f"      {k}: [{', '.join(f'{v:g}' for v in p)}]" for k, p in FEATURES.items()] + [
+    ] + [f"      {k}: [{', '.join(f'{v:.6g}' for v in p)}]" for k, p in FEATURES.items()] + [
         "",
         "task_locations:",
         "  - name: target_grasp",
