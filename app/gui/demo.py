@@ -32,6 +32,7 @@ from calib_core.workcell import DEFAULT_WORKCELL
 
 _MIN_FEATURES = 4
 _REFINE_TRUST_PX = 0.35
+_HAND_PX = 0.3  # how close to a corner the operator's own click lands, zoomed in (image px)
 _EDGE_MARGIN_PX = 12.0
 
 
@@ -116,6 +117,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
 
     skipped: list[str] = []
     refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
+    hand = np.random.default_rng(0)
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
         shot("start")
@@ -159,7 +161,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
                     # refinement takes for another corner): clicks it again, refinement off.
                     win.camera.subpixel.setChecked(False)
-                    _click_image(win.camera.view, *uv_true)
+                    _click_image(win.camera.view, *(uv_true + hand.uniform(-_HAND_PX, _HAND_PX, 2)))
                     refined_away.append(f"{round_name}: {name}")
                 win.camera.view.reset_view()
                 win._accept()
