@@ -103,7 +103,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         wb.close()
         raise ValueError(f"{workcell}: the demo needs a task location with a component to look at (task_locations[].component)")
     wb.start_controller()
-    win = MainWindow(wb, settings=QSettings(str(out_dir / "settings.ini"), QSettings.Format.IniFormat))
+    settings = QSettings(str(out_dir / "settings.ini"), QSettings.Format.IniFormat)
+    settings.setValue("files/autosave_dir", str(out_dir))  # the demo's session stays in its folder
+    win = MainWindow(wb, settings=settings)
     win.resize(1600, 1000)
     win.start_camera(site.camera_factory())
     win.show()

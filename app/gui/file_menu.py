@@ -5,6 +5,7 @@ autosave. Every action goes through the window's error boundary; one that fails 
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QFileDialog, QMenu
@@ -155,16 +156,32 @@ class FileMenu:
 
     # --- the autosave ---------------------------------------------------------------------------------
     def start_autosave(self) -> None:
-        """Autosave every minute; an autosave newer than the last saved workspace means the last session
-        ended without saving: offer it (File > Restore autosave) rather than load it unasked."""
-        self.autosave = Autosave(self.window.settings, self.window.workbench.save_workspace, self._status, self.window)
-        autosaved = self.autosave.unsaved_since()
-        if autosaved is None:
-            return
-        stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(autosaved))
-        self.restore_action = QAction(f"Restore &autosave of {stamp}", self.window, triggered=self.restore_autosave)
-        self.menu.insertAction(self.menu.actions()[0], self.restore_action)
-        self._status(f"an unsaved session from {stamp} was autosaved: File > Restore autosave", 30000)
+        """Autosave every minute when the session changed. Sessions that ended without saving left their
+        autosave: offer each (File > Restore autosave of ...) rather than load one unasked."""
+        wb = self.window.workbench
+        self.autosave = Autosave(self.window.settings, lambda: wb.revision, wb.save_workspace, self._status, self.window)
+        self.restore_actions: dict[str, QAction] = {}
+        for path in self.autosave.orphans():
+            stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))
+            action = QAction(f"Restore &autosave of {stamp}", self.window, triggered=lambda checked=False, p=path: self.restore_autosave(p))
+            self.menu.insertAction(self.menu.actions()[0], action)
+            self.restore_actions[str(path)] = action
+        self.restore_action = next(iter(self.restore_actions.values()), None)
+        if self.restore_actions:
+            self._status(f"{len(self.restore_actions)} unsaved session(s) were autosaved: File > Restore autosave", 30000)
 
-    def restore_autosave(self) -> None:
-        self.open_workspace(self.autosave.path)
+    def restore_autosave(self, path=None) -> bool:
+        """Open an autosave (the newest by default); once restored it is not offered again."""
+        if path is None:
+            if not self.restore_actions:
+                return False
+            path = next(iter(self.restore_actions))
+        path = Path(path)
+        if not self.open_workspace(path):
+            return False
+        self.autosave.set_aside(path)
+        action = self.restore_actions.pop(str(path), None)
+        if action is not None:
+            self.menu.removeAction(action)
+        self.restore_action = next(iter(self.restore_actions.values()), None)
+        return True

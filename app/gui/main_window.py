@@ -363,7 +363,7 @@ class MainWindow(QMainWindow):
         self.settings.setValue("window/split_top", self.top_splitter.saveState())
         self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
         self._redraw.stop()
-        self.files.autosave.timer.stop()  # a closed window writes nothing more
+        self.files.autosave.finish()  # unsaved work stays recoverable; a closed window writes nothing more
         self.status_line.timer.stop()
         self.replay.pause()
         if self.worker is not None:

@@ -1,12 +1,14 @@
 """The window's memory of files: the recent list (a menu) and the minute-by-minute autosave.
 
-Both live in the window's ``QSettings``: ``files/recent`` and ``files/recent_cells`` (newest first) and ``files/last_saved_time``
-(Unix s of the last deliberate save). The autosave goes to ``<user data>/recovery/autosave.json``
-(``files/autosave_dir`` overrides the folder) and is offered again when it is newer than that save.
+The recent lists live in the window's ``QSettings`` (``files/recent`` and ``files/recent_cells``, newest
+first). Each window autosaves to its own ``<user data>/recovery/autosave-<pid>-<start>.json``
+(``files/autosave_dir`` overrides the folder), only when the session changed; a session that ended without
+saving leaves its file, and the next window offers it.
 """
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -15,6 +17,8 @@ import platformdirs
 from PySide6.QtCore import QSettings, QTimer
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu
+
+from calib_core.errors import VideocalError
 
 RECENT_MAX = 8
 AUTOSAVE_INTERVAL_MS = 60_000
@@ -48,34 +52,77 @@ class RecentFiles:
 
 
 class Autosave:
-    """Every minute, ``save(path)`` of the session to the recovery file; ``report(text)`` when it fails."""
+    """Every minute, the session to this window's own recovery file, when it changed since the last save.
 
-    def __init__(self, settings: QSettings, save: Callable[[Path], None], report: Callable[[str], None], parent):
+    ``revision()`` counts the session's changes (the core's ``revision``); ``save(path)`` writes it;
+    ``report(text)`` tells the operator when a write fails. The file is
+    ``<recovery folder>/autosave-<pid>-<start time>.json``: two windows never share one, and a new window
+    never writes over the autosave of a session that ended without saving, which :meth:`orphans` finds.
+    """
+
+    def __init__(self, settings: QSettings, revision: Callable[[], int], save: Callable[[Path], None], report: Callable[[str], None], parent):
         self.settings = settings
+        self._revision = revision
         self._save = save
         self._report = report
-        self.path = Path(settings.value("files/autosave_dir") or platformdirs.user_data_dir("videocal")) / "recovery" / "autosave.json"
+        self.folder = Path(settings.value("files/autosave_dir") or platformdirs.user_data_dir("videocal")) / "recovery"
+        self.path = self.folder / f"autosave-{os.getpid()}-{int(time.time())}.json"
+        self._written = revision()  # the revision last written to a file (autosave or deliberate save)
+        self._saved = revision()  # the revision last saved by the operator
         self.timer = QTimer(parent)
         self.timer.setInterval(AUTOSAVE_INTERVAL_MS)
         self.timer.timeout.connect(self.save_now)
         self.timer.start()
 
-    def save_now(self) -> None:
+    def save_now(self) -> bool:
+        """Write the session if it changed since the last write; True if a file was written."""
+        revision = self._revision()
+        if revision == self._written:
+            return False
         try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.folder.mkdir(parents=True, exist_ok=True)
             self._save(self.path)
-        except OSError as exc:
+        except (OSError, VideocalError) as exc:
             self._report(f"autosave failed: {exc}")
+            return False
+        self._written = revision
+        return True
 
     def mark_saved(self) -> None:
-        """The operator saved the session: the autosave is no longer newer than the saved file."""
-        self.settings.setValue("files/last_saved_time", time.time())
+        """The operator saved the session: nothing is left to recover from this window."""
+        self._saved = self._written = self._revision()
+        self.path.unlink(missing_ok=True)
 
-    def unsaved_since(self) -> float | None:
-        """The autosave's time (Unix s) when it is newer than the last deliberate save, else ``None``:
-        the last session then ended without saving."""
-        if not self.path.is_file():
-            return None
-        autosaved = self.path.stat().st_mtime
-        last_saved = self.settings.value("files/last_saved_time")
-        return None if last_saved is not None and float(last_saved) >= autosaved else autosaved
+    def finish(self) -> None:
+        """The window closes: unsaved work stays in the recovery file (offered at the next start); saved work leaves none."""
+        self.timer.stop()
+        if self._revision() == self._saved:
+            self.path.unlink(missing_ok=True)
+        else:
+            self.save_now()
+
+    def orphans(self) -> list[Path]:
+        """Autosaves of sessions that ended without saving (their window is gone), newest first."""
+        if not self.folder.is_dir():
+            return []
+        found = []
+        for path in self.folder.glob("autosave*.json"):
+            parts = path.stem.split("-")
+            pid = int(parts[1]) if len(parts) == 3 and parts[1].isdigit() else None
+            if path != self.path and (pid is None or not _alive(pid)):
+                found.append(path)
+        return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True)
+
+    def set_aside(self, path: Path) -> None:
+        """A restored autosave is not offered again (kept as ``recovered-...``)."""
+        path.replace(path.with_name("recovered-" + path.name))
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True

@@ -70,12 +70,20 @@ class OperatorCore:
         self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
+        self.revision = 0
+        """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the
+        target): the autosave writes only when it moved."""
+        for signal in (self.session.pairs.changed, self.session.corrections.changed, self.session.undo.changed, self.session.changed, self.task_changed):
+            signal.connect(self._count_change)
         self.current_pair: int | None = None
         """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
         self.scene_version = 0
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
+
+    def _count_change(self, *_) -> None:
+        self.revision += 1
 
     # --- the cell -------------------------------------------------------------------------------
     @property

@@ -4,10 +4,10 @@ rendering cost). ``window`` has the robot's typical kinematic errors and the mod
 ``live_window`` makes one with other errors."""
 
 import pytest
-from PySide6.QtCore import QSettings
 
 from app.gui.cell_launcher import CellLauncher
 from app.gui.main_window import MainWindow
+from tests.app.windows import window_settings
 from app.gui.workbench import Workbench
 from calib_core.testbed.sim_site import simulated_cell
 from calib_core.testbed.true_robot import RobotErrors
@@ -21,7 +21,7 @@ def live_window(qtbot, tmp_path):
         cell, site = simulated_cell(errors=errors, image_scale=0.5)
         wb = Workbench(cell, site)
         wb.start_controller()
-        win = MainWindow(wb, settings=QSettings(str(tmp_path / f"settings{len(made)}.ini"), QSettings.Format.IniFormat))
+        win = MainWindow(wb, settings=window_settings(tmp_path, f"settings{len(made)}"))
         qtbot.addWidget(win)
         win.resize(1500, 950)
         win.start_camera(site.camera_factory(fps=10.0))
@@ -44,4 +44,4 @@ def window(live_window):
 @pytest.fixture
 def launcher(tmp_path):
     """Opens windows as `videocal gui` does on the simulated site: each cell with its own simulator."""
-    return CellLauncher(lambda workcell, process=None: simulated_cell(workcell, process=process), settings=QSettings(str(tmp_path / "launcher.ini"), QSettings.Format.IniFormat))
+    return CellLauncher(lambda workcell, process=None: simulated_cell(workcell, process=process), settings=window_settings(tmp_path, "launcher"))

@@ -96,12 +96,53 @@ def test_a_failed_save_is_neither_recent_nor_saved(qtbot, launcher, tmp_path):
     win = launcher.open(DEFAULT_WORKCELL)
     qtbot.addWidget(win)
     try:
-        saved_before = win.settings.value("files/last_saved_time")
+        wb, autosave = win.workbench, win.files.autosave
+        assert not autosave.save_now()  # nothing changed: nothing written
+        wb.pick_model_point("oru_1_fixture", "pin_tip", wb.workcell.component("oru_1_fixture").item2world[:3, 3])
         target = tmp_path / "no such folder" / "workspace.json"
         assert not win.files.save_workspace(target)
-        assert str(target) not in win.files.recent.paths()
-        assert win.settings.value("files/last_saved_time") == saved_before
+        assert str(target) not in win.files.recent.paths() and "no such folder" in win.results.status.text()
+        assert autosave.save_now() and autosave.path.is_file()  # the work is still unsaved: the autosave keeps it
         assert win.files.save_workspace(tmp_path / "workspace.json")
         assert win.files.recent.paths()[0] == str(tmp_path / "workspace.json")
+        assert not autosave.path.exists() and not autosave.save_now()  # saved: nothing left to recover
     finally:
         win.close()
+
+
+def test_each_window_autosaves_alone_and_an_unsaved_session_is_offered_once(qtbot, launcher, tmp_path):
+    launcher.settings.setValue("files/autosave_dir", str(tmp_path))
+    first, second = launcher.open(DEFAULT_WORKCELL), launcher.open(DEFAULT_WORKCELL)
+    for win in (first, second):
+        qtbot.addWidget(win)
+    fixture = first.workbench.workcell.component("oru_1_fixture")
+    for win, feature in ((first, "pin_tip"), (second, "plate_top_left")):
+        win.workbench.pick_model_point("oru_1_fixture", feature, fixture.item2world[:3, 3])
+        assert win.files.autosave.save_now()
+    assert first.files.autosave.path != second.files.autosave.path and len(list((tmp_path / "recovery").glob("autosave-*.json"))) == 2
+    assert first.files.autosave.orphans() == []  # the other window is alive: its file is not an orphan
+    # The first window quits with unsaved work (and, as a crash would, from another process id).
+    first.close()
+    orphan = first.files.autosave.path
+    crashed = orphan.with_name(f"autosave-{_dead_pid()}-1.json")
+    orphan.replace(crashed)
+    second.close()  # saved nothing either: it leaves its own file too
+    third = launcher.open(DEFAULT_WORKCELL)
+    qtbot.addWidget(third)
+    try:
+        offered = third.files.autosave.orphans()
+        assert crashed in offered and len(third.files.restore_actions) == len(offered)
+        assert third.files.restore_autosave(crashed)
+        assert [p.feature for p in third.workbench.session.pairs] == ["pin_tip"]
+        assert crashed not in third.files.autosave.orphans() and str(crashed) not in third.files.restore_actions
+    finally:
+        third.close()
+
+
+def _dead_pid() -> int:
+    """The process id of a process that has ended (as a crashed window's)."""
+    import subprocess
+
+    p = subprocess.Popen(["true"])
+    p.wait()
+    return p.pid

@@ -7,9 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtCore import QPoint, Qt
 
 from app.gui.main_window import MainWindow
+from tests.app.windows import window_settings
 from app.gui.workbench import Workbench
 from calib_core.recording.playback import RecordingPlayback
 from calib_core.recording.reader import read_recording
@@ -22,7 +23,7 @@ OUTPUT = Path(__file__).resolve().parents[1] / "output"
 @pytest.fixture
 def window(qtbot, tmp_path):
     wb = Workbench(*simulated_cell())
-    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+    win = MainWindow(wb, settings=window_settings(tmp_path))
     qtbot.addWidget(win)
     win.resize(1500, 950)
     win.show()

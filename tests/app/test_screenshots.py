@@ -14,9 +14,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from PySide6.QtCore import QSettings
 
 from app.gui.main_window import MainWindow
+from tests.app.windows import window_settings
 from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
@@ -43,7 +43,7 @@ def calibrated_window(qtbot, tmp_path):
     cell, site = simulated_cell(image_scale=0.5)
     bed = site.bed  # the truth: where the operator's eyes find the features
     wb = Workbench(cell, site)
-    win = MainWindow(wb, settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat))
+    win = MainWindow(wb, settings=window_settings(tmp_path))
     qtbot.addWidget(win)
     win.resize(1400, 900)
     win.show()
