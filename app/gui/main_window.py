@@ -27,6 +27,9 @@ from calib_core.robot import solve_ik
 from calib_core.errors import OperatorError
 
 
+VIRTUAL_EVERY_TICKS = 2  # the virtual camera follows a moving robot at 10 fps, the overview at 20
+
+
 class MainWindow(QMainWindow):
     def __init__(self, workbench: Workbench, *, settings: QSettings | None = None, launcher=None):
         super().__init__()
@@ -52,6 +55,7 @@ class MainWindow(QMainWindow):
         cell_scroll.setWidget(self.cell_panel)
         self.commands.addTab(cell_scroll, "Cell")
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
+        self._ticks = 0
         self.solved_edges = SolvedEdges(workbench.intrinsics)
         self.worker: FrameWorker | None = None
         self.edges_drawn = 0
@@ -290,7 +294,10 @@ class MainWindow(QMainWindow):
             self._joints_dirty = True
 
     def _redraw_views(self) -> None:
-        if self._joints_dirty:
+        # While the robot moves, the virtual camera (for picking, on a still robot) redraws at half the
+        # overview's rate: on a CPU renderer the two renders of a vendor robot do not fit one 50 ms tick.
+        self._ticks += 1
+        if self._joints_dirty and self._ticks % VIRTUAL_EVERY_TICKS == 0:
             self._joints_dirty = False
             self.virtual.refresh_if_moved()
         self.overview.refresh()
