@@ -12,7 +12,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.scene import SceneItem
-from calib_core.testbed.lens import distortion_map
+from calib_core.camera.distortion_map import distortion_map
 
 
 class SolvedEdges:
