@@ -12,6 +12,7 @@ import tempfile  # noqa: E402
 os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="videocal-test-data-")
 os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="videocal-test-config-")
 os.environ["XDG_STATE_HOME"] = tempfile.mkdtemp(prefix="videocal-test-state-")
+os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp(prefix="videocal-test-cache-")
 
 
 import sys

@@ -16,6 +16,7 @@ import trimesh
 from numpy.typing import ArrayLike
 
 from calib_core.errors import FileFormatError
+from calib_core.robot import mesh_cache
 from calib_core.robot.model import RobotModel, _to_mm
 from calib_core.scene import SceneItem
 
@@ -73,14 +74,21 @@ def geometry_model(robot: RobotModel, kind: str = "visual") -> pin.GeometryModel
     return _GEOMETRY_CACHE[key]
 
 
+_CACHED_MESHES: dict[int, dict[str, trimesh.Trimesh]] = {}  # id(geometry model) -> meshes from the disk cache
+
+
 def _build_geometry_model(robot: RobotModel, kind: str) -> pin.GeometryModel:
     full = robot.full_model if robot.full_model is not None else robot.model
+    placeholder = mesh_cache.placeholder_description(robot.urdf_xml, kind) if robot.urdf_xml and kind == "visual" else None
+    xml = placeholder[0] if placeholder else robot.urdf_xml
     try:
-        gm = pin.buildGeomFromUrdfString(full, robot.urdf_xml, _KINDS[kind]) if robot.urdf_xml else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])
+        gm = pin.buildGeomFromUrdfString(full, xml, _KINDS[kind]) if xml else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])
     except (RuntimeError, ValueError) as exc:
         raise FileFormatError(robot.urdf_path, f"cannot read the robot's {kind} geometry: {exc}") from None
     if robot.locked_joint_ids:
         _, (gm,) = pin.buildReducedModel(full, [gm], list(robot.locked_joint_ids), robot.locked_configuration)
+    if placeholder:
+        _CACHED_MESHES[id(gm)] = placeholder[1]
     return gm
 
 
@@ -95,7 +103,15 @@ class RobotVisuals:
     @classmethod
     def from_robot(cls, robot: RobotModel, kind: str = "visual") -> RobotVisuals:
         gm = geometry_model(robot, kind)
-        meshes = [_mesh_of(g, f"link geometry '{g.name}'") for g in gm.geometryObjects]
+        cached = _CACHED_MESHES.get(id(gm), {})
+        meshes = []
+        for g in gm.geometryObjects:
+            mesh = cached.get(g.name)
+            if mesh is None:
+                mesh = _mesh_of(g, f"link geometry '{g.name}'")
+                if kind == "visual" and isinstance(g.geometry, coal.BVHModelBase):
+                    mesh_cache.store(g.meshPath, tuple(np.asarray(g.meshScale)), mesh)
+            meshes.append(mesh)
         return cls(robot, gm, meshes)
 
     def poses(self, q_deg: ArrayLike) -> list[np.ndarray]:

@@ -155,3 +155,22 @@ def test_a_xacro_file_is_expanded_and_a_broken_one_named(tmp_path):
     with pytest.raises(FileFormatError, match="cannot expand xacro") as info:
         load_robot(bad)
     assert str(bad) in str(info.value)
+
+
+def test_meshes_from_the_disk_cache_are_the_loaders_own(tmp_path, monkeypatch):
+    import calib_core.robot.visuals as visuals_module
+    from calib_core.robot import mesh_cache
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    spec = RobotSpec(require(PANDA), (SHARE,), {"flange": "panda_hand", "tcp": "panda_hand_tcp"}, held_joints={"panda_finger_joint1": 10.0, "panda_finger_joint2": 10.0})
+    q = np.array([10.0, -30.0, 5.0, -100.0, 20.0, 70.0, 30.0])
+    robot = load_robot(spec)
+    fresh = RobotVisuals.from_robot(robot)  # through Pinocchio's loader: fills the cache
+    assert len(list(mesh_cache.cache_folder().glob("*.npz"))) >= 10
+    visuals_module._GEOMETRY_CACHE.clear()
+    cached = RobotVisuals.from_robot(load_robot(spec))  # the description with placeholders, meshes from disk
+    assert id(cached.geometry_model) in visuals_module._CACHED_MESHES
+    for a, b, pa, pb, ga, gb in zip(fresh.meshes, cached.meshes, fresh.poses(q), cached.poses(q), fresh.geometry_model.geometryObjects, cached.geometry_model.geometryObjects):
+        assert ga.name == gb.name and np.allclose(ga.meshColor, gb.meshColor)
+        assert np.array_equal(a.faces, b.faces) and np.allclose(a.vertices, b.vertices)
+        assert np.allclose(pa, pb, atol=1e-9)
