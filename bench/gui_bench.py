@@ -20,6 +20,14 @@ import numpy as np
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "gui.md"
 
 
+
+def _settings(path):
+    from PySide6.QtCore import QSettings
+
+    settings = QSettings(str(path), QSettings.Format.IniFormat)
+    settings.setValue("window/ask_unsaved", False)  # closing a bench window asks nothing
+    return settings
+
 def _spin(app, seconds: float) -> None:
     end = time.monotonic() + seconds
     while time.monotonic() < end:
@@ -50,7 +58,6 @@ def _launch(tmp: Path, tag: str, *args: str) -> tuple[float, float]:
 
 def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
     """Overview redraws per second while the robot moves to the first task's approach (50 Hz joint stream)."""
-    from PySide6.QtCore import QSettings
 
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
@@ -58,7 +65,7 @@ def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
 
     wb = Workbench(*simulated_cell(workcell))
     wb.start_controller()
-    win = MainWindow(wb, settings=QSettings(str(tmp / "s_follow.ini"), QSettings.Format.IniFormat))
+    win = MainWindow(wb, settings=_settings(tmp / "s_follow.ini"))
     win.resize(1600, 1000)
     win.show()
     _spin(app, 2.0)
@@ -77,7 +84,6 @@ def _demo(workcell: Path | None, tmp: Path, tag: str) -> dict | None:
 
 
 def main() -> str:
-    from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QApplication
 
     from app.gui.main_window import MainWindow
@@ -101,7 +107,7 @@ def main() -> str:
     app = QApplication.instance() or QApplication([])
     wb = Workbench(*simulated_cell())
     wb.start_controller()
-    win = MainWindow(wb, settings=QSettings(str(tmp / "s.ini"), QSettings.Format.IniFormat))
+    win = MainWindow(wb, settings=_settings(tmp / "s.ini"))
     win.resize(1600, 1000)
     video = tmp / "clip.avi"
     _video_file(video)
@@ -122,7 +128,7 @@ def main() -> str:
     lat = []
     for _ in range(10):
         t_arrive = time.monotonic()
-        wb._on_sample(type("S", (), {"joints_deg": tuple(wb.joints_deg + 0.5), "sample": type("J", (), {"seq": 0, "t_ms": 0})(), "t_host_s": t_arrive})())
+        wb.observe_sample(type("S", (), {"joints_deg": tuple(wb.joints_deg + 0.5), "sample": type("J", (), {"seq": 0, "t_ms": 0})(), "t_host_s": t_arrive})())
         before = win.overview.redraws
         while win.overview.redraws == before and time.monotonic() - t_arrive < 1.0:
             app.processEvents()

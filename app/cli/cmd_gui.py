@@ -46,8 +46,12 @@ def _run_window(args: argparse.Namespace, simulator) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("videocal")
     # SIGTERM and Ctrl+C close the window like Quit does (so the simulator and the link stop with it).
+    def quit_by_signal(*_):
+        app.setProperty("videocal_quit_by_signal", True)  # closing asks nothing; unsaved work stays in the autosave
+        app.quit()
+
     for sig in (signal.SIGTERM, signal.SIGINT):
-        signal.signal(sig, lambda *_: app.quit())
+        signal.signal(sig, quit_by_signal)
     wake = QTimer()
     wake.start(200)  # lets Python run its signal handlers while Qt's loop waits
     wake.timeout.connect(lambda: None)

@@ -11,7 +11,9 @@ from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QSlider, QVBoxLayo
 
 from app.gui.image_view import ImageView, Overlay
 from app.gui.workbench import Workbench
+from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.camera.projection import project_points
+from calib_core.errors import OperatorError
 from calib_core.frames import apply, invert
 
 PICK_COLOR = QColor(255, 214, 10)
@@ -21,6 +23,7 @@ RESIDUAL_COLOR = QColor(255, 70, 70)
 RESIDUAL_SCALE = 10.0
 GHOST_COLOR = QColor(255, 60, 220)
 BOARD_COLOR = QColor(60, 230, 90)
+STALE_COLOR = QColor(120, 120, 120)
 
 
 def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
@@ -40,7 +43,12 @@ def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int 
 
 
 class CameraPane(QWidget):
-    """Shows frames; ``picked(u, v)`` when the operator picks a pixel (refined if asked)."""
+    """Shows the core's frames; ``picked(u, v)`` when the operator picks a pixel (refined if asked).
+
+    Picks are made on a still: the core holds a frame at the first image pick of a set (``Hold``
+    shows it; unticking it goes back to the live image) and the live video goes on in the corner.
+    What is drawn belongs to a robot state: picks and results made at another pose than the one
+    the image shows are greyed or hidden, with a banner that says so."""
 
     picked = Signal(float, float)
     pick_rejected = Signal(str)  # a click that picks nothing, and why
@@ -49,8 +57,8 @@ class CameraPane(QWidget):
         super().__init__(parent)
         self.workbench = workbench
         self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
-        self.freeze = QCheckBox("Freeze")
-        self.freeze.setToolTip("Hold the current frame while picking")
+        self.freeze = QCheckBox("Hold")
+        self.freeze.setToolTip("Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner")
         self.subpixel = QCheckBox("Sub-pixel")
         self.subpixel.setChecked(True)
         self.subpixel.setToolTip("Refine each pick to the nearest corner (cv2.cornerSubPix)")
@@ -72,23 +80,63 @@ class CameraPane(QWidget):
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
         layout.addWidget(self.view, 1)
-        self.last_frame = None  # the frame shown (held while frozen)
+        self.last_frame = None  # the frame shown (the held one while a still is held)
         self.last_frame_received = None  # the newest frame from the source, shown or not
         self._board_corners: np.ndarray | None = None  # a board detection shown by the Vision mode
+        self._board_joints: np.ndarray | None = None  # the robot state it was detected at
         self._board_text = ""
         self._edges_image: np.ndarray | None = None
+        self._drawn_state: tuple | None = None
         self.view.clicked.connect(self._on_click)
+        self.freeze.toggled.connect(self._hold_toggled)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
         self.opacity.valueChanged.connect(lambda _: self.refresh_overlay())
+        workbench.frame_observed.connect(self.show_frame)
+        workbench.still_changed.connect(self._still_changed)
         workbench.session.pairs.changed.connect(lambda *_: self.refresh_overlay())
         workbench.session.changed.connect(self._on_solved)
+        workbench.joints_changed.connect(self._joints_changed)
+
+    # --- frames ---------------------------------------------------------------------------------
+    @property
+    def held(self):
+        return self.workbench.observations.still
 
     def show_frame(self, frame) -> None:
         self.last_frame_received = frame
-        if self.freeze.isChecked() and self.last_frame is not None:
+        if self.held is not None:
+            self.view.set_inset(frame.image, "live")
             return
         self.last_frame = frame
         self.view.set_image(frame.image)
+
+    def _hold_toggled(self, on: bool) -> None:
+        if on and self.held is None:
+            try:
+                self.workbench.hold_frame()
+            except OperatorError as exc:
+                self.freeze.blockSignals(True)
+                self.freeze.setChecked(False)
+                self.freeze.blockSignals(False)
+                self.pick_rejected.emit(str(exc))
+        elif not on and self.held is not None:
+            self.workbench.release_frame()
+
+    def _still_changed(self, held) -> None:
+        self.freeze.blockSignals(True)
+        self.freeze.setChecked(held is not None)
+        self.freeze.blockSignals(False)
+        if held is not None:
+            self.last_frame = held.frame
+            self.view.set_image(held.frame.image)
+            self.info.setText(f"held: frame {held.stamp.frame_index}")
+        else:
+            self.view.set_inset(None)
+            self.info.setText("")
+            if self.last_frame_received is not None:
+                self.last_frame = self.last_frame_received
+                self.view.set_image(self.last_frame.image)
+        self.refresh_overlay()
 
     def _on_click(self, u: float, v: float) -> None:
         if self.last_frame is None:
@@ -98,13 +146,22 @@ class CameraPane(QWidget):
         if not (-0.5 <= u < w - 0.5 and -0.5 <= v < h - 0.5):
             self.pick_rejected.emit(f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked")
             return
+        if self.held is None:
+            # The first pick of a set holds the newest frame; refine on that one.
+            try:
+                self.workbench.hold_frame()
+            except OperatorError as exc:
+                self.pick_rejected.emit(f"nothing picked: {exc}")
+                return
         if self.subpixel.isChecked():
             u, v = refine_subpixel(self.last_frame.image, u, v)
         self.picked.emit(u, v)
 
     def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
-        """Show a board detection (n, 2) px over the image (``None`` hides it)."""
+        """Show a board detection (n, 2) px over the image (``None`` hides it); it belongs to the
+        robot state it was detected at and is hidden when the robot moves."""
         self._board_corners = None if corners_px is None else np.asarray(corners_px, dtype=float)
+        self._board_joints = None if corners_px is None else np.array(self.workbench.joints_deg, dtype=float)
         self._board_text = text
         self.refresh_overlay()
 
@@ -115,46 +172,88 @@ class CameraPane(QWidget):
     def _on_solved(self) -> None:
         self.refresh_overlay()
 
+    # --- which robot state the image shows ----------------------------------------------------------
+    def shown_joints(self) -> np.ndarray:
+        """The joints (deg/mm) of the robot state the image shows: the held frame's, else the robot's now."""
+        held = self.held
+        return np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.workbench.joints_deg, dtype=float)
+
+    def _same_state(self, joints) -> bool:
+        if joints is None:
+            return True
+        a, b = np.asarray(joints, float), self.shown_joints()
+        return a.shape == b.shape and float(np.max(np.abs(a - b))) <= SAME_STATE_DEG
+
+    def _state_key(self) -> tuple:
+        session = self.workbench.session
+        context = session.context
+        pairs = tuple(p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None)
+        result = context is None or context.joints_deg is None or self._same_state(context.joints_deg)
+        board = self._board_joints is None or self._same_state(self._board_joints)
+        return pairs, result, board
+
+    def _joints_changed(self, _q) -> None:
+        # the robot moved: redraw only when what belongs to the shown state changed
+        if self._state_key() != self._drawn_state:
+            self.refresh_overlay()
+
     def refresh_overlay(self) -> None:
         session = self.workbench.session
+        self._drawn_state = (pairs_current, result_current, board_current) = self._state_key()
         overlay = Overlay()
+        banner = []
         pending = session.pairs.pending()
-        for pair in session.pairs:
-            if pair.pixel is not None:
-                color = PICK_COLOR if pair.enabled else QColor(130, 130, 130)
-                overlay.points.append((pair.pixel[0], pair.pixel[1], str(pair.number), color))
+        picked = [p for p in session.pairs if p.pixel is not None]
+        for pair, current in zip(picked, pairs_current):
+            color = (PICK_COLOR if pair.enabled else QColor(130, 130, 130)) if current else STALE_COLOR
+            overlay.points.append((pair.pixel[0], pair.pixel[1], str(pair.number) if current else f"{pair.number}?", color))
+        if not all(pairs_current):
+            banner.append(f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)")
         result = session.result
-        if result is not None:
-            obj2cam = invert(result.cam2world_measured) @ result.obj2world
-            for pair in session.pairs:
-                if pair.pixel is None:
-                    continue
-                p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-                uv = project_points(p_obj, obj2cam, self.workbench.intrinsics)[0]
-                if np.all(np.isfinite(uv)):
-                    overlay.points.append((uv[0], uv[1], "", REPROJECTED_COLOR))
-                    end = np.array(pair.pixel) + RESIDUAL_SCALE * (np.array(pair.pixel) - uv)
-                    overlay.segments.append((uv[0], uv[1], end[0], end[1], RESIDUAL_COLOR))
-            overlay.text = f"cyan: model points from the solved pose; red: residuals x{RESIDUAL_SCALE:g}"
-            candidates = result.solution.candidates
-            if len(candidates) > 1:
-                # Ghosts of the other poses that fit as well, so the operator can tell them apart.
-                for k, candidate in enumerate(candidates):
-                    if k == session.chosen_candidate:
-                        continue
-                    for pair in session.pairs:
-                        p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-                        uv = project_points(p_obj, candidate.obj2cam, self.workbench.intrinsics)[0]
-                        if np.all(np.isfinite(uv)):
-                            overlay.points.append((uv[0], uv[1], f"s{k + 1}", GHOST_COLOR))
-                overlay.text = f"{len(candidates)} poses fit: magenta ghosts show the others; choose one in Results"
-            if self.edges.isChecked() and self._edges_image is not None:
-                overlay.image = self._edges_image
-                overlay.image_opacity = self.opacity.value() / 100.0
+        stale = session.stale_reason
+        if result is not None and not result_current:
+            banner.append("the last result was solved at another robot pose: not drawn")
+        elif result is not None:
+            self._draw_result(overlay, session, result)
+            if stale:
+                banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
         if self._board_corners is not None:
-            for u, v in self._board_corners:
-                overlay.points.append((u, v, "", BOARD_COLOR))
-            overlay.text = self._board_text
+            if board_current:
+                for u, v in self._board_corners:
+                    overlay.points.append((u, v, "", BOARD_COLOR))
+                overlay.text = self._board_text
+            else:
+                banner.append("the board detection was made at another robot pose: not drawn")
+        overlay.banner = "; ".join(banner)
         self.view.set_overlay(overlay)
+
+    def _draw_result(self, overlay: Overlay, session, result) -> None:
+        obj2cam = invert(result.cam2world_measured) @ result.obj2world
+        used = set(session.solved_numbers)
+        for pair in session.pairs:
+            if pair.pixel is None or pair.number not in used:
+                continue
+            p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
+            uv = project_points(p_obj, obj2cam, self.workbench.intrinsics)[0]
+            if np.all(np.isfinite(uv)):
+                overlay.points.append((uv[0], uv[1], "", REPROJECTED_COLOR))
+                end = np.array(pair.pixel) + RESIDUAL_SCALE * (np.array(pair.pixel) - uv)
+                overlay.segments.append((uv[0], uv[1], end[0], end[1], RESIDUAL_COLOR))
+        overlay.text = f"cyan: model points from the solved pose; red: residuals x{RESIDUAL_SCALE:g}"
+        candidates = result.solution.candidates
+        if len(candidates) > 1:
+            # Ghosts of the other poses that fit as well, so the operator can tell them apart.
+            for k, candidate in enumerate(candidates):
+                if k == session.chosen_candidate:
+                    continue
+                for pair in session.pairs:
+                    p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
+                    uv = project_points(p_obj, candidate.obj2cam, self.workbench.intrinsics)[0]
+                    if np.all(np.isfinite(uv)):
+                        overlay.points.append((uv[0], uv[1], f"s{k + 1}", GHOST_COLOR))
+            overlay.text = f"{len(candidates)} poses fit: magenta ghosts show the others; choose one in Results"
+        if self.edges.isChecked() and self._edges_image is not None:
+            overlay.image = self._edges_image
+            overlay.image_opacity = self.opacity.value() / 100.0

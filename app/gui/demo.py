@@ -105,6 +105,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     wb.start_controller()
     settings = QSettings(str(out_dir / "settings.ini"), QSettings.Format.IniFormat)
     settings.setValue("files/autosave_dir", str(out_dir))  # the demo's session stays in its folder
+    settings.setValue("window/ask_unsaved", False)  # a scripted run: its workspace is saved, nobody answers questions
     win = MainWindow(wb, settings=settings)
     win.resize(1600, 1000)
     win.start_camera(site.camera_factory())
@@ -129,10 +130,12 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             return np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]) < 0.01
 
         def settle(what: str) -> None:
-            frames = []
-            win.worker.frame.connect(frames.append)
-            _wait(app, lambda: len(frames) >= 2, 30, f"a camera frame {what}")
-            win.worker.frame.disconnect(frames.append)
+            # a frame the core accepts for picks: captured after the robot had settled (its own rule)
+            def usable() -> bool:
+                frame = win.camera.last_frame_received
+                return frame is not None and wb.observations.stillness(frame).settled
+
+            _wait(app, usable, 30, f"a camera frame with the robot settled {what}")
             _wait(app, win.virtual.is_current, 10, "the virtual camera")
 
         def pick_and_calibrate(round_name: str) -> None:
@@ -158,7 +161,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
                 win.camera.subpixel.setChecked(_is_corner(name))
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
-                refined = wb.session.pairs.get(wb.current_pair).pixel
+                refined = wb.session.pairs.get(pending.number).pixel
+                if refined is None:
+                    raise RuntimeError(f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}")
                 if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
                     # refinement takes for another corner): clicks it again, refinement off.
@@ -174,7 +179,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
             shot(f"{round_name}_calibrated")
+            stored_before = len(wb.session.corrections.history(task.name))
             _click(win.commands.store, 10, 10)
+            if len(wb.session.corrections.history(task.name)) != stored_before + 1:
+                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
             win.camera.freeze.setChecked(False)
 
         # As in the paper, the camera looks at the object from the task location itself: the correction is

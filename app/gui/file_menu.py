@@ -28,6 +28,7 @@ class FileMenu:
         self.menu = menu
         self.autosave: Autosave | None = None
         self.restore_action: QAction | None = None
+        self.workspace_path: str | None = None  # the workspace last saved or opened: Save goes there
         w = window
         self.open_cell_action = QAction("Open &cell...", w, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog)
         menu.addAction(self.open_cell_action)
@@ -37,7 +38,8 @@ class FileMenu:
             self.open_cell_action.setToolTip("this window was opened on one cell only")
         menu.addSeparator()
         menu.addAction(QAction("&Open workspace...", w, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
-        menu.addAction(QAction("&Save workspace as...", w, shortcut=QKeySequence.StandardKey.Save, triggered=self._save_dialog))
+        menu.addAction(QAction("&Save workspace", w, shortcut=QKeySequence.StandardKey.Save, triggered=lambda: self.save_workspace_dialog()))
+        menu.addAction(QAction("Save workspace &as...", w, shortcut=QKeySequence("Ctrl+Alt+S"), triggered=self._save_dialog))
         menu.addAction(QAction("Save ce&ll", w, shortcut=QKeySequence("Ctrl+Shift+S"), triggered=lambda: w.report(w.workbench.editor.save)()))
         menu.addAction(QAction("E&xport corrections...", w, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
         menu.addSeparator()
@@ -84,12 +86,14 @@ class FileMenu:
             return False
         self.recent.remember(path)
         self.autosave.mark_saved()
+        self.workspace_path = str(path)
         return True
 
     def open_workspace(self, path) -> bool:
         if not attempt(self.window.show_error, self.window.workbench.open_workspace, path):
             return False
         self.recent.remember(path)
+        self.workspace_path = str(path)
         return True
 
     def open_recent(self, path: str) -> None:
@@ -100,9 +104,14 @@ class FileMenu:
             self.open_workspace(path)
 
     def _save_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self.window, "Save workspace", "workspace.json", "videocal workspace (*.json)")
-        if path:
-            self.save_workspace(path)
+        self.save_workspace_dialog(ask_path=True)
+
+    def save_workspace_dialog(self, ask_path: bool = False) -> bool:
+        """Save to the workspace last saved or opened (or ask where); True when it was saved."""
+        path = None if ask_path else self.workspace_path
+        if path is None:
+            path, _ = QFileDialog.getSaveFileName(self.window, "Save workspace", "workspace.json", "videocal workspace (*.json)")
+        return bool(path) and self.save_workspace(path)
 
     def _open_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Open workspace", "", "videocal workspace (*.json)")

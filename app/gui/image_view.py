@@ -26,6 +26,7 @@ class Overlay:
     text: str = ""
     image: np.ndarray | None = None  # RGBA overlay (same size as the image), e.g. CAD edges
     image_opacity: float = 0.7
+    banner: str = ""  # a warning across the bottom (what is drawn is from an earlier state)
 
 
 def qimage_from_array(array: np.ndarray) -> QImage:
@@ -79,6 +80,8 @@ class ImageView(QWidget):
         self._centre: QPointF | None = None  # image point shown at the widget centre
         self._drag_from: QPointF | None = None
         self._mouse: QPointF | None = None
+        self._inset: QImage | None = None
+        self._inset_label = ""
 
     # --- content -------------------------------------------------------------------------
     def set_image(self, array: np.ndarray | None) -> None:
@@ -100,6 +103,17 @@ class ImageView(QWidget):
     @property
     def image_array(self) -> np.ndarray | None:
         return self._array
+
+    def set_inset(self, array: np.ndarray | None, label: str = "", width_px: int = 220) -> None:
+        """A small second image in the top-right corner (the live video while a still is held)."""
+        if array is None:
+            self._inset = None
+        else:
+            h, w = array.shape[:2]
+            small = cv2.resize(array, (width_px, max(1, int(round(h * width_px / w)))), interpolation=cv2.INTER_AREA)
+            self._inset = qimage_from_array(small)
+        self._inset_label = label
+        self.update()
 
     def set_overlay(self, overlay: Overlay) -> None:
         self.overlay = overlay
@@ -198,6 +212,18 @@ class ImageView(QWidget):
         if self.overlay.text:
             p.setPen(QColor(230, 230, 230))
             p.drawText(QRectF(8, 6, self.width() - 16, 40), Qt.AlignmentFlag.AlignLeft, self.overlay.text)
+        if self.overlay.banner:
+            box = QRectF(0, self.height() - 26, self.width(), 26)
+            p.fillRect(box, QColor(120, 70, 0, 220))
+            p.setPen(QColor(255, 235, 200))
+            p.drawText(box.adjusted(8, 0, -8, 0), Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, self.overlay.banner)
+        if self._inset is not None:
+            w, h = self._inset.width(), self._inset.height()
+            box = QRectF(self.width() - w - 8, 8, w, h)
+            p.drawImage(box, self._inset)
+            p.setPen(QPen(QColor(255, 214, 10), 1.5))
+            p.drawRect(box)
+            p.drawText(box.adjusted(4, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop, self._inset_label)
 
     def _paint_crosshair(self, p: QPainter) -> None:
         u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())

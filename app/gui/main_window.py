@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import getpass
+from datetime import datetime, timezone
 
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
@@ -23,6 +25,8 @@ from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
 from app.gui.vision_panel import VisionPanel
 from app.gui.workbench import Workbench
+from app.gui.confirm import ask, ask_save
+from calib_core.calibration.session import ConfirmationNeeded
 from calib_core.robot import solve_ik
 from calib_core.errors import OperatorError
 
@@ -43,7 +47,7 @@ class MainWindow(QMainWindow):
         self.table = PairsTable(workbench)
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
-        self.replay = ReplayBar(workbench, self.camera.show_frame)
+        self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error)
         vision_scroll = QScrollArea()
         vision_scroll.setWidgetResizable(True)
@@ -216,8 +220,7 @@ class MainWindow(QMainWindow):
     # --- camera ----------------------------------------------------------------------------
     def start_camera(self, make_source) -> None:
         self.worker = FrameWorker(make_source, self)
-        self.worker.frame.connect(self.camera.show_frame)
-        self.worker.frame.connect(self.workbench.observe_frame)
+        self.worker.frame.connect(self.workbench.observe_frame)  # the camera pane shows what the core observed
         self.worker.failed.connect(self.show_error)
         self.worker.start()
 
@@ -262,7 +265,18 @@ class MainWindow(QMainWindow):
         self.statusBar().showMessage(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)
 
     def _store(self) -> None:
-        self.report(self.workbench.store_correction)()
+        self.report(self._store_impl)()
+
+    def _store_impl(self) -> None:
+        try:
+            self.workbench.store_correction()
+        except ConfirmationNeeded as exc:
+            question = "\n".join(["This result is not OK:", *[f"- {r}" for r in exc.reasons], "", "Store it as the correction for this task location anyway?",
+                                   "Your confirmation is kept with the correction."])
+            if not ask(self, "Store an implausible result?", question, "Store anyway"):
+                self.statusBar().showMessage("nothing stored", 5000)
+                return
+            self.workbench.store_correction(confirmation=f"confirmed in the window by {getpass.getuser()} at {datetime.now(timezone.utc).isoformat(timespec='seconds')}: {'; '.join(exc.reasons)}")
 
     def _go(self, *, approach: bool, corrected: bool = False) -> None:
         self.report(lambda: self.workbench.go_to_task(approach=approach, corrected=corrected))()
@@ -351,6 +365,27 @@ class MainWindow(QMainWindow):
         return self.camera.last_frame_received, self.worker, self.replay.playback is not None
 
     # --- life cycle ------------------------------------------------------------------------
+    def _may_close(self) -> bool:
+        """Unsaved work: ask to save it, discard it (it stays in the recovery file) or stay. A quit by a
+        signal (SIGTERM, Ctrl+C in the terminal) or with ``window/ask_unsaved`` off asks nothing."""
+        from PySide6.QtWidgets import QApplication
+
+        autosave = getattr(self.files, "autosave", None)
+        if autosave is None or not autosave.unsaved or QApplication.instance().property("videocal_quit_by_signal"):
+            return True
+        if str(self.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
+            return True
+        s = self.workbench.session
+        what = f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored corrections"
+        choice = ask_save(self, "Unsaved work", f"The session has changes that are not saved in a workspace file ({what}). Save them before closing?\n"
+                          "Discard closes the window; the changes stay in the recovery file, offered at the next start.")
+        if choice == "cancel":
+            return False
+        if choice == "save":
+            return self.files.save_workspace_dialog()
+        return True
+
+
     def _restore(self) -> None:
         geometry = self.settings.value("window/geometry")
         if geometry is not None:
@@ -364,6 +399,9 @@ class MainWindow(QMainWindow):
                 splitter.restoreState(value)
 
     def closeEvent(self, event) -> None:
+        if not self._may_close():
+            event.ignore()
+            return
         self.settings.setValue("window/geometry", self.saveGeometry())
         self.settings.setValue("window/state", self.saveState())
         self.settings.setValue("window/split_main", self.splitter.saveState())

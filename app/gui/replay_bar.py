@@ -20,6 +20,7 @@ from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QSlid
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import FileFormatError
+from calib_core.link.joint_history import JointHistory
 from calib_core.recording.playback import RecordedSolve, RecordingPlayback
 from calib_core.recording.reader import read_recording, recover
 from calib_core.recording.replay import solve_from_inputs
@@ -111,7 +112,8 @@ class ReplayBar(QWidget):
         if recorded_intrinsics is not None:
             self.workbench.use_intrinsics(recorded_intrinsics)
         self.playback, self.path = playback, path
-        self.workbench.replaying = True
+        history = JointHistory.from_arrays(playback.joint_times_s, playback.joints_deg, self.workbench.workcell.safety.settle_rule, self.workbench.robot.joint_names)
+        self.workbench.begin_replay(history, path.name)
         self.branched_at_s = None
         self._shown_frame = self._shown_solve = None
         self._applying = True  # clearing the live session's undo history is not an operator edit
@@ -147,7 +149,7 @@ class ReplayBar(QWidget):
             finally:
                 self._applying = False
         self.playback = self.path = self._live_state = None
-        self.workbench.replaying = False
+        self.workbench.end_replay()
         self.hide()
         self.workbench.message.emit("replay closed: " + ("the branched session stays open" if branched else "the live session is back as it was"))
         self.closed.emit()
@@ -217,7 +219,8 @@ class ReplayBar(QWidget):
             image = pb.frames.image(k)
             if image is not None:
                 self._shown_frame = k
-                self._show_frame(Frame(image, k, time.monotonic(), float(pb.frames.times_s[k])))
+                # on the recording's time axis, the clock of its joint history
+                self._show_frame(Frame(image, k, float(pb.frames.times_s[k]), float(pb.frames.times_s[k])))
         q = pb.joints_at(t_s)
         if q is not None:
             self.workbench.show_replayed_joints(q)

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import functools
+import html
 
 import numpy as np
 from PySide6.QtCore import QRectF, Qt, Signal
@@ -11,7 +12,10 @@ from PySide6.QtGui import QColor, QPainter
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.gui.workbench import Workbench
+from calib_core.calibration.verdict import Verdict
 from calib_core.solver import SolveStatus
+
+_VERDICT_COLORS = {Verdict.OK: "#5fd35f", Verdict.AMBIGUOUS: "#ffb347", Verdict.UNCERTAIN: "#ffb347", Verdict.IMPLAUSIBLE: "#ff8c42", Verdict.FAILED: "#ff6b6b"}
 
 
 class ResidualChart(QWidget):
@@ -58,7 +62,13 @@ class ResultsPanel(QWidget):
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
         self.workbench = workbench
-        self.status = QLabel("No solve yet.")
+        self.verdict = QLabel("No solve yet.")
+        self.verdict.setObjectName("verdict")
+        self.verdict.setWordWrap(True)
+        self.verdict.setTextFormat(Qt.TextFormat.RichText)
+        self.status = QLabel("")
+        """The last message (a refused click, a failed step): never replaces the verdict."""
+        self.status.setObjectName("message")
         self.status.setWordWrap(True)
         self.status.setTextFormat(Qt.TextFormat.RichText)
         self.details = QLabel("")
@@ -68,17 +78,19 @@ class ResultsPanel(QWidget):
         self.candidates = QHBoxLayout()
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
+        layout.addWidget(self.verdict)
         layout.addWidget(self.status)
         layout.addWidget(self.details)
         layout.addLayout(self.candidates)
         layout.addWidget(self.chart, 1)
         workbench.session.changed.connect(self.refresh)
+        workbench.session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
 
     def _choose(self, index: int, *_) -> None:
         self.candidate_chosen.emit(index)
 
     def show_error(self, text: str) -> None:
-        self.status.setText(f"<span style='color:#ff6b6b'><b>{text}</b></span>")
+        self.status.setText(f"<span style='color:#ff6b6b'>{html.escape(text, quote=False)}</span>")
 
     def refresh(self) -> None:
         session = self.workbench.session
@@ -88,18 +100,27 @@ class ResultsPanel(QWidget):
             if w is not None:
                 w.deleteLater()
         if r is None:
-            self.status.setText("No solve yet. Pick at least %d pairs, then Calibrate." % session.required_pairs)
+            self.verdict.setText("No solve yet. Pick at least %d pairs, then Calibrate." % session.required_pairs)
             self.details.setText("")
             self.chart.set_values([])
             return
         sol = r.solution
-        color = {SolveStatus.OK: "#5fd35f", SolveStatus.AMBIGUOUS: "#ffb347", SolveStatus.FAILED: "#ff6b6b"}[sol.status]
-        text = f"<span style='color:{color}'><b>{sol.status.value.upper()}</b></span>"
-        if sol.reason:
-            text += f" - {sol.reason}"
+        verdict = session.verdict
+        stale = session.stale_reason
+        if stale:
+            text = f"<span style='color:#9a9a9a'><b>FROM AN EARLIER STATE</b></span> - {html.escape(stale, quote=False)}"
+            text += f"<br><span style='color:#9a9a9a'>it was: {html.escape(verdict.text if verdict else sol.status.value, quote=False)}</span>"
+        else:
+            color = _VERDICT_COLORS[verdict.verdict if verdict else Verdict(sol.status.value)]
+            text = f"<span style='color:{color}'><b>{(verdict.verdict.value if verdict else sol.status.value).upper()}</b></span>"
+            reasons = list(verdict.reasons) if verdict else ([sol.reason] if sol.reason else [])
+            if sol.reason and sol.reason not in reasons:
+                reasons.append(sol.reason)
+            if reasons:
+                text += " - " + html.escape("; ".join(reasons), quote=False)
         for w in sol.warnings:
-            text += f"<br><span style='color:#ccb'>note: {w}</span>"
-        self.status.setText(text)
+            text += f"<br><span style='color:#ccb'>note: {html.escape(w, quote=False)}</span>"
+        self.verdict.setText(text)
         d, rv, sd, sr = r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
         cam = r.cam2world_measured[:3, 3]
         self.details.setText(
@@ -113,7 +134,10 @@ class ResultsPanel(QWidget):
             "</table>"
         )
         numbers = session.solved_numbers
-        self.chart.set_values([(str(n), float(e), float(l)) for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px)])
+        present = {p.number for p in session.pairs.usable()}
+        # bars only for pairs that still exist as they were solved; a stale result shows none
+        bars = [] if stale else [(str(n), float(e), float(l)) for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px) if n in present]
+        self.chart.set_values(bars)
         if sol.status is SolveStatus.AMBIGUOUS:
             for i, c in enumerate(sol.candidates):
                 button = QPushButton(f"Use solution {i + 1} ({c.rms_px:.2f} px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})")

@@ -88,6 +88,11 @@ class Autosave:
         self._written = revision
         return True
 
+    @property
+    def unsaved(self) -> bool:
+        """The session changed since the operator last saved it (or since the window opened)."""
+        return self._revision() != self._saved
+
     def mark_saved(self) -> None:
         """The operator saved the session: nothing is left to recover from this window."""
         self._saved = self._written = self._revision()

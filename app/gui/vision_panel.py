@@ -8,7 +8,6 @@ planned viewing poses; with a real camera the operator holds up or places a boar
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
@@ -24,10 +23,6 @@ from calib_core.vision.hand_eye import HandEyeCalibration
 from calib_core.vision.hand_eye_io import save_hand_eye
 from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
 from calib_core.errors import OperatorError
-
-STILL_S = 0.3
-"""A view is only captured from a frame taken this long after the robot last moved (joints and image agree)."""
-
 
 def _button(text: str, name: str, tip: str) -> QPushButton:
     b = QPushButton(text)
@@ -53,8 +48,6 @@ class VisionPanel(QWidget):
         self.hand_eye_result: HandEyeCalibration | None = None
         self._plan: list[np.ndarray] = []
         self._plan_index = 0
-        self._last_motion_s = 0.0
-        self._last_joints = workbench.joints_deg.copy()
 
         board = QGroupBox("Board")
         bl = QVBoxLayout(board)
@@ -119,7 +112,6 @@ class VisionPanel(QWidget):
         layout.addWidget(board)
         layout.addWidget(views, 1)
         layout.addWidget(cal)
-        workbench.joints_changed.connect(self._on_joints)
         self._spec_changed()
 
     # --- board ---------------------------------------------------------------------------------
@@ -153,26 +145,17 @@ class VisionPanel(QWidget):
         self._plan_index += 1
         self.workbench.move_joints(q, f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}")
 
-    def _on_joints(self, q) -> None:
-        q = np.asarray(q, dtype=float)
-        if np.max(np.abs(q - self._last_joints)) > 1e-6:
-            self._last_motion_s = time.monotonic()
-        self._last_joints = q.copy()
-
     # --- capturing -----------------------------------------------------------------------------
-    def robot_is_still(self, frame) -> bool:
-        return frame.t_host_s - self._last_motion_s >= STILL_S
-
     def capture_view(self) -> None:
         """Detect the board in the current frame; keep it (with the joints) or say why not."""
         frame = self._current_frame()
         if frame is None:
             raise OperatorError("no camera frame yet: start the camera (Execution > Live) or open a recording")
-        replaying = self.workbench.replaying
-        if not replaying and not self.robot_is_still(frame):
-            raise OperatorError("the robot is moving: capture when it has stopped, so the image and the joints agree")
-        # live: the joints the controller reports; replaying: the ones recorded with this frame
-        joints = self.workbench.joints_deg.copy() if (replaying or self.workbench.link_up) else None
+        # The joints at the frame's capture (live: from the link's samples; replaying: the recorded ones),
+        # and only when the robot had settled before it: a refusal says why, nothing is captured.
+        # Without a robot (no link, no replay) a view serves the intrinsics only.
+        has_robot = self.workbench.replaying or self.workbench.link is not None
+        joints = np.array(self.workbench.stamp_frame(frame).joints_deg) if has_robot else None
         view = self.capture.add(frame.image, joints)
         if isinstance(view, RejectedView):
             self._show_corners(None, "")

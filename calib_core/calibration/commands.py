@@ -27,15 +27,16 @@ class AddPoint3D(Command):
 class SetPixel(Command):
     """Set (or move) the 2D point of a pair, px."""
 
-    def __init__(self, pairs: CorrespondenceSet, number: int, pixel):
+    def __init__(self, pairs: CorrespondenceSet, number: int, pixel, view=None):
         self.pairs = pairs
         self.number = number
         self.pixel = (float(pixel[0]), float(pixel[1]))
+        self.view = view
         self.old = None
         self.label = f"Pick 2D point of pair {number}"
 
     def do(self) -> None:
-        self.old = self.pairs._replace(with_pixel(self.pairs.get(self.number), self.pixel))
+        self.old = self.pairs._replace(with_pixel(self.pairs.get(self.number), self.pixel, self.view))
 
     def undo(self) -> None:
         self.pairs._replace(self.old)

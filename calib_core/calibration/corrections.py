@@ -19,7 +19,9 @@ class Correction:
 
     ``tcp2base_model``/``tcp2base_measured`` (4, 4) mm at ``joints_deg``; ``displacement_mm``,
     ``rotation_deg`` (3,) with 1-sigma; ``rms_px`` and ``pairs`` of the solve; ``time_s``
-    (Unix time); ``source``: where it came from (e.g. a recording and pick numbers)."""
+    (Unix time); ``source``: where it came from (e.g. a recording and pick numbers); ``verdict``
+    of the result (``ok``, or what the operator confirmed) and ``confirmation``: who confirmed a
+    result that was not ``ok``, when and why (empty for an ``ok`` one)."""
 
     task: str
     tcp2base_model: np.ndarray
@@ -33,6 +35,8 @@ class Correction:
     pairs: int
     time_s: float = field(default_factory=time.time)
     source: str = ""
+    verdict: str = "ok"
+    confirmation: str = ""
 
     @property
     def delta_base(self) -> np.ndarray:

@@ -13,6 +13,7 @@ from psygnal import Signal
 from dataclasses import dataclass, replace
 
 import numpy as np
+from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import UnknownNameError
 
 
@@ -21,7 +22,9 @@ class Correspondence:
     """One pair. ``number``: shown to the operator, from 1, never reused in a session.
     ``point_world_mm`` (3,): the picked 3D point in the robot base frame; ``component`` and
     ``feature`` where it was picked (feature ``None`` for a plain surface point);
-    ``pixel`` (2,) px or ``None`` until the 2D point is picked; ``enabled``: used by the solve."""
+    ``pixel`` (2,) px or ``None`` until the 2D point is picked; ``enabled``: used by the solve;
+    ``view``: the frame the pixel was picked on and the robot's joints then (``None``: picked outside
+    the operator core, e.g. by a script, or by a videocal older than the stamps)."""
 
     number: int
     component: str
@@ -29,6 +32,7 @@ class Correspondence:
     point_world_mm: tuple[float, float, float]
     pixel: tuple[float, float] | None = None
     enabled: bool = True
+    view: ViewStamp | None = None
 
     @property
     def complete(self) -> bool:
@@ -122,5 +126,24 @@ class CorrespondenceSet:
         return old
 
 
-def with_pixel(pair: Correspondence, pixel: tuple[float, float] | None) -> Correspondence:
-    return replace(pair, pixel=None if pixel is None else (float(pixel[0]), float(pixel[1])))
+def with_pixel(pair: Correspondence, pixel: tuple[float, float] | None, view: ViewStamp | None = None) -> Correspondence:
+    return replace(pair, pixel=None if pixel is None else (float(pixel[0]), float(pixel[1])), view=None if pixel is None else view)
+
+
+def pair_to_dict(pair: Correspondence) -> dict:
+    """The JSON form of a pair (workspaces, recorded ``pair_*`` events)."""
+    d = {"number": pair.number, "component": pair.component, "feature": pair.feature, "point_world_mm": list(pair.point_world_mm), "pixel": None if pair.pixel is None else list(pair.pixel), "enabled": pair.enabled}
+    if pair.view is not None:
+        d["view"] = pair.view.to_dict()
+    return d
+
+
+def pair_from_dict(d: dict) -> Correspondence:
+    """The inverse of :func:`pair_to_dict` (``KeyError``/``TypeError``/``ValueError`` on a bad dict)."""
+    pixel = d.get("pixel")
+    view = d.get("view")
+    return Correspondence(
+        int(d["number"]), str(d["component"]), d.get("feature"), tuple(float(v) for v in d["point_world_mm"]),
+        None if pixel is None else (float(pixel[0]), float(pixel[1])), bool(d.get("enabled", True)),
+        None if view is None or pixel is None else ViewStamp.from_dict(view),
+    )

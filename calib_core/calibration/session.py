@@ -17,6 +17,7 @@ from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.calibration.correspondences import CorrespondenceSet
 from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution
 from calib_core.calibration.undo import Command, UndoStack
+from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, invert
@@ -26,6 +27,32 @@ from calib_core.solver.solution import SolveStatus
 
 class CalibrationError(OperatorError):
     """A calibration step that cannot be taken now; the message says what to do instead."""
+
+
+class ConfirmationNeeded(CalibrationError):
+    """The step can be taken only with the operator's explicit confirmation (``reasons``: why)."""
+
+    def __init__(self, message: str, reasons: tuple[str, ...]):
+        super().__init__(message)
+        self.reasons = reasons
+
+
+def _pairs_key(pairs) -> dict:
+    return {p.number: (p.point_world_mm, p.pixel, p.view) for p in pairs}
+
+
+@dataclass(frozen=True)
+class SolveContext:
+    """What a result was computed from: the target's placement, the modelled camera and TCP poses
+    (4, 4) mm at ``joints_deg`` (the joints of the pairs' frame), and the pairs (by number, with
+    their points and pixels as they were)."""
+
+    obj2world: np.ndarray
+    cam2world_model: np.ndarray
+    tcp2base_model: np.ndarray
+    joints_deg: np.ndarray | None
+    numbers: tuple[int, ...]
+    pairs: dict
 
 
 class ChooseCandidate(Command):
@@ -56,8 +83,13 @@ class CalibrationSession:
     robust: bool = False
     result: EndEffectorEstimate | None = None
     chosen_candidate: int = 0
-    _context: tuple | None = None
+    _context: SolveContext | None = None
     last_solve_inputs: dict | None = None
+    verdict: ResultVerdict | None = None
+    """The last result's verdict (``None`` before a solve)."""
+    judge: object = None
+    """``judge(estimate) -> ResultVerdict`` (the operator core sets the cell's limits and the task's
+    tolerance); ``None``: the defaults of :func:`~calib_core.calibration.verdict.judge`."""
 
     changed = Signal()
     """After every solve, candidate choice, cleared result or target change."""
@@ -88,16 +120,17 @@ class CalibrationSession:
         self.undo.push(cmd)
         return cmd.pair.number
 
-    def pick_2d(self, pixel) -> int:
-        """``Point``, second half: the same point on the camera image (px)."""
+    def pick_2d(self, pixel, view=None) -> int:
+        """``Point``, second half: the same point on the camera image (px), picked on ``view`` (a
+        :class:`~calib_core.calibration.view_stamp.ViewStamp`)."""
         pending = self.pairs.pending()
         if pending is None:
             raise CalibrationError("pick the point on the model (virtual camera) first, then on the camera image")
-        self.undo.push(SetPixel(self.pairs, pending.number, pixel))
+        self.undo.push(SetPixel(self.pairs, pending.number, pixel, view))
         return pending.number
 
-    def move_2d(self, number: int, pixel) -> None:
-        self.undo.push(SetPixel(self.pairs, number, pixel))
+    def move_2d(self, number: int, pixel, view=None) -> None:
+        self.undo.push(SetPixel(self.pairs, number, pixel, view))
 
     def delete(self, number: int) -> None:
         self.undo.push(DeletePair(self.pairs, number))
@@ -128,26 +161,62 @@ class CalibrationSession:
 
     def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int]) -> EndEffectorEstimate:
         """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here."""
-        self._context = (obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), list(numbers))
+        used = [p for p in self.pairs if p.number in set(numbers)]
+        self._context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used))
         self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model)
         self.chosen_candidate = 0
+        self.verdict = self._judge(self.result)
         self._changed()
         return self.result
 
+    def _judge(self, estimate) -> ResultVerdict:
+        return (self.judge or judge)(estimate)
+
+    def rejudge(self) -> None:
+        """Judge the result again (the task, and with it the tolerance, changed)."""
+        if self.result is not None:
+            self.verdict = self._judge(self.result)
+            self._changed()
+
     def clear_result(self) -> None:
-        self.restore_result((None, None, 0))
+        self.restore_result((None, None, 0, None))
 
     @property
     def solved_numbers(self) -> list[int]:
         """The numbers of the pairs the last solve used (empty before a solve)."""
-        return list(self._context[4]) if self._context else []
+        return list(self._context.numbers) if self._context else []
+
+    @property
+    def context(self) -> SolveContext | None:
+        return self._context
+
+    @property
+    def stale_reason(self) -> str | None:
+        """Why the result no longer belongs to the pairs on screen (``None``: it does, or there is none)."""
+        if self.result is None or self._context is None:
+            return None
+        then, now = self._context.pairs, _pairs_key(self.pairs.usable())
+        if then == now:
+            return None
+        gone = sorted(set(then) - set(now))
+        new = sorted(set(now) - set(then))
+        moved = sorted(n for n in set(then) & set(now) if then[n] != now[n])
+        parts = []
+        if gone:
+            parts.append(f"pair{'s' if len(gone) > 1 else ''} {', '.join(map(str, gone))} {'are' if len(gone) > 1 else 'is'} no longer used")
+        if new:
+            parts.append(f"pair{'s' if len(new) > 1 else ''} {', '.join(map(str, new))} {'were' if len(new) > 1 else 'was'} added")
+        if moved:
+            parts.append(f"pair{'s' if len(moved) > 1 else ''} {', '.join(map(str, moved))} changed")
+        return "; ".join(parts) + " since the solve: calibrate again"
 
     def result_snapshot(self) -> tuple:
         """The last result with what it was solved from, to put back later with :meth:`restore_result`."""
-        return self.result, self._context, self.chosen_candidate
+        return self.result, self._context, self.chosen_candidate, self.verdict
 
     def restore_result(self, snapshot: tuple) -> None:
-        self.result, self._context, self.chosen_candidate = snapshot
+        self.result, self._context, self.chosen_candidate = snapshot[:3]
+        self.verdict = snapshot[3] if len(snapshot) > 3 else (None if self.result is None else self._judge(self.result))
         self._changed()
 
     def _select(self, index: int) -> None:
@@ -156,24 +225,38 @@ class CalibrationSession:
         candidates = self.result.solution.candidates
         if not 0 <= index < max(len(candidates), 1):
             raise CalibrationError(f"there is no solution {index + 1}")
-        obj2world, cam_model, tcp_model, _, _ = self._context
+        c = self._context
         obj2cam = candidates[index].obj2cam if candidates else None
-        self.result = end_effector_from_solution(self.result.solution, obj2world, cam_model, tcp_model, obj2cam)
+        self.result = end_effector_from_solution(self.result.solution, c.obj2world, c.cam2world_model, c.tcp2base_model, obj2cam)
         self.chosen_candidate = index
+        self.verdict = self._judge(self.result)
         self._changed()
 
     def choose_candidate(self, index: int) -> None:
         self.undo.push(ChooseCandidate(self, index))
 
-    def store_correction(self, task: str, source: str = "") -> Correction:
-        """``Store correction`` for a task location from the last solve."""
+    def store_correction(self, task: str, source: str = "", *, confirmation: str = "") -> Correction:
+        """``Store correction`` for a task location from the last solve. A result that is not ``ok``
+        (implausible, uncertain, ambiguous) raises :class:`ConfirmationNeeded` unless
+        ``confirmation`` says who accepted it and why; that text is stored with the correction."""
         r = self.result
         if r is None:
             raise CalibrationError("calibrate first")
         if r.solution.status is SolveStatus.FAILED:
             raise CalibrationError(f"the last solve failed ({r.solution.reason}); nothing to store")
-        _, _, _, joints, numbers = self._context
-        correction = Correction(task, r.tcp2base_model, r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg, np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source or f"pairs {', '.join(map(str, numbers))}")
+        stale = self.stale_reason
+        if stale:
+            raise CalibrationError(f"the result is from an earlier state ({stale}); nothing stored")
+        verdict = self.verdict or self._judge(r)
+        if not verdict.ok and not confirmation.strip():
+            raise ConfirmationNeeded(f"the result is {verdict.verdict.value}: {'; '.join(verdict.reasons)}. Storing it needs your confirmation", verdict.reasons)
+        c = self._context
+        joints, numbers = c.joints_deg, c.numbers
+        correction = Correction(
+            task, r.tcp2base_model, r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg,
+            np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source or f"pairs {', '.join(map(str, numbers))}",
+            verdict=verdict.verdict.value, confirmation="" if verdict.ok else confirmation.strip(),
+        )
         self.undo.push(_StoreCorrection(self.corrections, correction))
         return correction
 

@@ -24,9 +24,14 @@ from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
 from calib_core.link.driver import ControllerLink
+from calib_core.calibration.verdict import ResultVerdict, judge
+from calib_core.calibration.view_stamp import ViewStamp
+from calib_core.link.joint_history import JointHistory
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
+from calib_core.operator.motion import Motion, MotionState, ended
+from calib_core.operator.observations import HeldFrame, Observations
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
 from calib_core.robot import solve_ik
@@ -40,7 +45,9 @@ class OperatorCore(SessionFiles):
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
     ``scene_changed()``, ``move_finished(what, error)`` (``error`` empty when the move arrived),
     ``frame_observed(frame)``, ``correction_stored(correction)``, ``event(kind, detail)``
-    (operator actions worth recording)."""
+    (operator actions worth recording), ``still_changed(held)`` (the frame held for picking, a
+    :class:`~calib_core.operator.observations.HeldFrame`, or ``None`` when released),
+    ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`)."""
 
     joints_changed = Signal(object)
     sample_received = Signal(object, object)
@@ -54,6 +61,8 @@ class OperatorCore(SessionFiles):
     frame_observed = Signal(object)
     correction_stored = Signal(object)
     event = Signal(str, object)
+    still_changed = Signal(object)
+    motion_changed = Signal(object)
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
@@ -82,6 +91,13 @@ class OperatorCore(SessionFiles):
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
+        self.live = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names))
+        """The live frames and the link's joint history."""
+        self.observations = self.live
+        """What picks are stamped by: the live one, or a recording's while it is replayed."""
+        self.motion = MotionState()
+        self.session.judge = self._judge
+        self.session.pairs.changed.connect(self._release_unused_still)
 
     def _count_change(self, *_) -> None:
         self.revision += 1
@@ -112,7 +128,7 @@ class OperatorCore(SessionFiles):
         if self.link is not None:
             self.link.close()
         self.link = ControllerLink(url, mode="stream", rate_hz=rate_hz, n_joints=self.robot.n_joints)
-        self.link.on_sample(lambda sample: self._call_soon(self._on_sample, sample))
+        self.link.on_sample(lambda sample: self._call_soon(self.observe_sample, sample))
         self.link.on_state(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
         if self.site is not None:
             self.site.attach(self.link)
@@ -121,15 +137,28 @@ class OperatorCore(SessionFiles):
 
     def _on_link_state(self, state: str, why: str) -> None:
         self.record_event("link_state", state=state, why=why)
+        if state in ("down", "stale", "closed"):
+            # Without samples the robot may move unseen: no earlier sample vouches for a later frame.
+            self.live.history.forget(time.monotonic())
+            if self.motion.motion is Motion.MOVING:
+                self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
         self.link_state.emit(f"{state}: {why}")
+
+    def _set_motion(self, state: MotionState) -> None:
+        self.motion = state
+        self.motion_changed.emit(state)
 
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
         self.event.emit(kind, detail)
 
-    def _on_sample(self, sample: TimedSample) -> None:
+    def observe_sample(self, sample: TimedSample) -> None:
+        """A joint sample from the link (its reader thread hands it here through ``call_soon``)."""
         self.last_sample_s = time.monotonic()
         q = self.cell.joint_map.to_model(sample.joints_deg)
+        self.live.history.add(sample.t_host_s, q)
+        if self.motion.motion is Motion.UNKNOWN:
+            self._set_motion(MotionState(Motion.IDLE, self.motion.what, "the link is back: the robot stands where its joints say"))
         self.sample_received.emit(sample, q)
         if self.replaying:
             return  # the recorded joints drive the views while a recording is replayed
@@ -168,6 +197,7 @@ class OperatorCore(SessionFiles):
         if not handle.sent:
             handle.wait(0)  # raises the link's reason
         self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
+        self._set_motion(MotionState(Motion.MOVING, what))
         handle.on_finished(lambda h: self._call_soon(self._move_ended, what, h))
         if wait:
             handle.wait(timeout_s)
@@ -175,6 +205,8 @@ class OperatorCore(SessionFiles):
 
     def _move_ended(self, what: str, handle: MoveHandle) -> None:
         error = handle.error
+        if self.motion.motion is Motion.MOVING and self.motion.what == what:
+            self._set_motion(ended(what, error))
         self.record_event("move_finished", what=what, error=str(error) if error else "")
         self.move_finished.emit(what, str(error) if error else "")
         self.message.emit(f"move to {what} failed: {error}" if error else f"arrived at {what}")
@@ -205,6 +237,7 @@ class OperatorCore(SessionFiles):
         self.task = self.workcell.task(name)
         if self.task.component:
             self.session.set_target(self.task.component)
+        self.session.rejudge()  # the task's tolerance is part of the verdict
         self.task_changed.emit(name)
 
     # --- the pair being made (the paper's Point and Accept) -------------------------------------------
@@ -219,15 +252,79 @@ class OperatorCore(SessionFiles):
 
     def pick_image_point(self, pixel) -> int:
         """*Point*, second half: the same point on the camera image (u, v) px. Until *Accept*, a
-        second click moves it."""
+        second click moves it. The pick is made on the held frame; the first pick of a set holds
+        the newest one, and only when the robot had settled before it (else
+        :class:`~calib_core.operator.observations.NotSettledError`, nothing picked)."""
         session = self.session
-        if session.pairs.pending() is not None:
-            self.current_pair = session.pick_2d(pixel)
-        elif self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]:
-            session.move_2d(self.current_pair, pixel)
-        else:
+        pending = session.pairs.pending()
+        moving = pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
+        if pending is None and not moving:
             session.pick_2d(pixel)  # raises with what to do instead
+        view = self._view_for_pick(self.current_pair if moving else pending.number)
+        if moving:
+            session.move_2d(self.current_pair, pixel, view)
+        else:
+            self.current_pair = session.pick_2d(pixel, view)
         return self.current_pair
+
+    def _view_for_pick(self, number: int) -> ViewStamp:
+        held = self.observations.still
+        if held is None:
+            held = self.hold_frame()
+        others = [p for p in self.session.pairs if p.complete and p.number != number]
+        self.check_same_state(others, held.stamp)
+        return held.stamp
+
+    def check_same_state(self, pairs, view: ViewStamp | None = None) -> None:
+        """Refuse pairs from different robot states: each with ``view`` (or with the first)."""
+        stamped = [p for p in pairs if p.view is not None]
+        reference = view or (stamped[0].view if stamped else None)
+        if reference is None:
+            return
+        other = [p for p in stamped if not p.view.same_state(reference)]
+        if other:
+            worst = max(other, key=lambda p: p.view.joint_difference(reference))
+            names = ", ".join(str(p.number) for p in other)
+            raise CalibrationError(
+                f"pair{'s' if len(other) > 1 else ''} {names} {'were' if len(other) > 1 else 'was'} picked with the robot at another pose "
+                f"(a joint differs by {worst.view.joint_difference(reference):.2f} deg from {reference.label}): "
+                "one set of pairs must come from one robot pose. Delete them (or Clear), or go back to that pose"
+            )
+
+    # --- frames ---------------------------------------------------------------------------------
+    def hold_frame(self) -> HeldFrame:
+        """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
+        held = self.observations.hold()
+        self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
+        self.still_changed.emit(held)
+        return held
+
+    def stamp_frame(self, frame) -> ViewStamp:
+        """``frame``'s stamp (its joints at capture), refused while the robot was not settled."""
+        return self.observations.stamp(frame)
+
+    def release_frame(self) -> None:
+        """Back to the live image for picking (the pairs keep their stamps)."""
+        if self.observations.still is not None:
+            self.observations.release()
+            self.still_changed.emit(None)
+
+    def _release_unused_still(self, *_) -> None:
+        if self.observations.still is not None and not any(p.complete for p in self.session.pairs):
+            self.release_frame()
+
+    def robot_settled(self):
+        """Whether the robot is still now (a :class:`~calib_core.link.joint_history.Stillness`), from
+        the newest frame's time (or the newest sample's)."""
+        obs = self.observations
+        t = obs.latest.t_host_s if obs.latest is not None else obs.history.latest_s
+        if t is None:
+            return obs.history.stillness(time.monotonic())
+        return obs.history.stillness(t)
+
+    def _judge(self, estimate) -> ResultVerdict:
+        tolerance = self.task.tolerance_mm if self.task is not None else None
+        return judge(estimate, self.workcell.safety, tolerance) if tolerance is not None else judge(estimate, self.workcell.safety)
 
     def accept_pair(self) -> int:
         """*Accept*: the pair being made is done. Returns its number."""
@@ -270,9 +367,24 @@ class OperatorCore(SessionFiles):
     def model_tcp2base(self) -> np.ndarray:
         return self.robot.fk(self.joints_deg, "tcp")
 
-    def observe_frame(self, frame) -> None:
-        """A camera frame arrived (from the window's camera worker, or a command-line loop)."""
+    def observe_frame(self, frame, *, replayed: bool = False) -> None:
+        """A camera frame arrived: from the camera (the window's worker, a command-line loop) or,
+        with ``replayed``, from the recording being replayed. Live frames are ignored during a replay."""
+        if self.replaying != replayed:
+            return
+        self.observations.observe(frame)
         self.frame_observed.emit(frame)
+
+    def begin_replay(self, history: JointHistory, name: str) -> None:
+        """A recording is being replayed: its frames and joints stand in for the live ones."""
+        self.release_frame()
+        self.replaying = True
+        self.observations = Observations(history, source=name)
+
+    def end_replay(self) -> None:
+        self.release_frame()
+        self.replaying = False
+        self.observations = self.live
 
     # --- calibration -------------------------------------------------------------------------
     def calibrate(self):
@@ -280,15 +392,28 @@ class OperatorCore(SessionFiles):
         if target is None:
             raise CalibrationError("choose the target object first")
         obj2world = self.workcell.component(target).item2world
+        use = self.session.pairs.usable()
+        unbound = [p.number for p in use if p.view is None]
+        if unbound:
+            raise CalibrationError(
+                f"pair{'s' if len(unbound) > 1 else ''} {', '.join(map(str, unbound))} {'carry' if len(unbound) > 1 else 'carries'} no robot pose "
+                "(picked outside the program's frames, or saved by an older videocal): pick the image point again, on a frame of this pose"
+            )
+        self.check_same_state(use)
+        joints = np.array(use[0].view.joints_deg) if use else self.joints_deg
         self.current_pair = None
-        result = self.session.calibrate(self.intrinsics, obj2world, self.model_cam2world(), self.model_tcp2base(), self.joints_deg)
+        result = self.session.calibrate(self.intrinsics, obj2world, self.robot.fk(joints, "camera"), self.robot.fk(joints, "tcp"), joints)
         self.solved.emit()
         return result
 
-    def store_correction(self):
+    def store_correction(self, *, confirmation: str = ""):
+        """Store the last result for the task location. One that is not ``ok`` needs ``confirmation``
+        (who accepted it and why: kept with the correction and recorded)."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        c = self.session.store_correction(self.task.name)
+        c = self.session.store_correction(self.task.name, confirmation=confirmation)
+        if c.confirmation:
+            self.record_event("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)
         self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
         return c

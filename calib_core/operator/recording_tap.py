@@ -6,7 +6,7 @@ every stored correction, link states, moves and operator events.
 
 from __future__ import annotations
 
-from calib_core.recording.playback import pair_to_dict
+from calib_core.calibration.correspondences import pair_to_dict
 
 
 class RecordingTap:

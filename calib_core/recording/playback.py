@@ -11,20 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from calib_core.calibration.correspondences import Correspondence
+from calib_core.calibration.correspondences import Correspondence, pair_from_dict
 from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.reader import RecordedMessage, RecordingContents
 from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC
-
-
-def pair_to_dict(pair: Correspondence) -> dict:
-    """The JSON form of a pair, as recorded in ``pair_*`` events."""
-    return {"number": pair.number, "component": pair.component, "feature": pair.feature, "point_world_mm": list(pair.point_world_mm), "pixel": None if pair.pixel is None else list(pair.pixel), "enabled": pair.enabled}
-
-
-def pair_from_dict(d: dict) -> Correspondence:
-    pixel = d.get("pixel")
-    return Correspondence(int(d["number"]), str(d["component"]), d.get("feature"), tuple(float(v) for v in d["point_world_mm"]), None if pixel is None else (float(pixel[0]), float(pixel[1])), bool(d.get("enabled", True)))
 
 
 @dataclass(frozen=True)

@@ -96,9 +96,12 @@ class SimulatedCamera(FrameSource):
         return image, CameraTruth(cam2world, q, self.intrinsics)
 
     def read(self) -> Frame | None:
+        # The exposure is the moment the robot's pose is taken; the render after it is the camera's
+        # latency. The frame carries the exposure time, as a camera's capture timestamp does.
+        t_capture = time.monotonic()
         image, truth = self.render(self._joints())
         self.last_truth = truth
-        frame = Frame(image, self._index, time.monotonic(), self._index / self._fps if self._fps else None)
+        frame = Frame(image, self._index, t_capture, self._index / self._fps if self._fps else None)
         self._index += 1
         return frame
 

@@ -15,8 +15,11 @@ class Frame:
 
     ``image``: (height, width, 3) uint8, **RGB** (converted from OpenCV's BGR at the source).
     ``index``: frame number in its source, from 0. ``t_host_s``: host clock
-    (``time.monotonic()``) when the frame was received. ``t_source_s``: the source's own
-    timestamp (position in a file, capture time of a recording), or None.
+    (``time.monotonic()``) when the frame was captured, as near as the source knows (an OpenCV
+    device: when ``read`` returned it, its latency later; the simulated camera: the exposure). The
+    joint history stamps picks with the joints at this time, so the cell's settle time must cover
+    the camera's latency. ``t_source_s``: the source's own timestamp (position in a file, capture
+    time of a recording), or None.
     """
 
     image: np.ndarray

@@ -20,14 +20,15 @@ from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
 from calib_core.workcell.model import TaskLocation, Workcell
 from calib_core.workcell.robot_section import check_against_robot, read_robot_section
+from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SAFETY_KEYS, SafetyLimits
 
 DEFAULT_WORKCELL = Path(__file__).resolve().parents[2] / "resources" / "workcell" / "workcell.yaml"
 SCHEMA_VERSION = 2
 # Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
 _READABLE_VERSIONS = (1, 2)
-_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board"}
+_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board", "safety"}
 _COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
-_TASK_KEYS = {"name", "component", "tcp2base", "approach_mm"}
+_TASK_KEYS = {"name", "component", "tcp2base", "approach_mm", "tolerance_mm"}
 _KINDS = {"component", "fixture"}
 _MESH_SCALE = {"mm": 1.0, "m": 1000.0}
 _MESH_SUFFIXES = {".stl", ".obj", ".dae", ".glb", ".gltf", ".ply"}
@@ -119,7 +120,23 @@ def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:
     approach = reader.number(raw.get("approach_mm", 0.0), f"{f}.approach_mm")
     if approach < 0:
         raise reader.fail(f"{f}.approach_mm", f"must be >= 0, got {approach}")
-    return TaskLocation(reader.text(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component)
+    tolerance = reader.number(raw.get("tolerance_mm", DEFAULT_TOLERANCE_MM), f"{f}.tolerance_mm")
+    if tolerance <= 0:
+        raise reader.fail(f"{f}.tolerance_mm", f"must be > 0 mm, got {tolerance}")
+    return TaskLocation(reader.text(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component, tolerance)
+
+
+def _safety(reader: _Reader, raw) -> SafetyLimits:
+    if raw is None:
+        return SafetyLimits()
+    raw = reader.mapping(raw, "safety", SAFETY_KEYS, set())
+    values = {}
+    for key, value in raw.items():
+        number = reader.number(value, f"safety.{key}")
+        if number <= 0:
+            raise reader.fail(f"safety.{key}", f"must be > 0, got {number}")
+        values[key] = number
+    return SafetyLimits(**values)
 
 
 def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
@@ -174,4 +191,5 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     if data.get("hand_eye_board") is not None:
         # Where the hand-eye board's centre stands (x along its columns, y down its rows, z into it).
         meta["hand_eye_board_centre"] = reader.placement(data["hand_eye_board"], "hand_eye_board")
-    return Workcell(str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta)
+    safety = _safety(reader, data.get("safety"))
+    return Workcell(str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta, safety)

@@ -12,18 +12,22 @@ from calib_core.robot.model import RobotModel, load_robot
 from calib_core.robot.spec import RobotSpec
 from calib_core.scene import SceneItem
 from calib_core.errors import UnknownNameError
+from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SafetyLimits
 
 
 @dataclass(frozen=True)
 class TaskLocation:
     """A named task location. ``tcp2base`` (4, 4) mm: where the tool centre point must be;
     ``approach_mm``: how far back along the tool's approach axis (its z) the robot stops
-    first, where the camera sees the component; ``component``: the object it works on."""
+    first, where the camera sees the component; ``component``: the object it works on;
+    ``tolerance_mm``: how close the task needs the tool (a calibration whose 1-sigma is above it
+    cannot vouch for the task)."""
 
     name: str
     tcp2base: np.ndarray
     approach_mm: float = 0.0
     component: str | None = None
+    tolerance_mm: float = DEFAULT_TOLERANCE_MM
 
     @property
     def approach2base(self) -> np.ndarray:
@@ -45,6 +49,7 @@ class Workcell:
     intrinsics_path: Path | None
     home_joints_deg: np.ndarray
     meta: dict = field(default_factory=dict)
+    safety: SafetyLimits = field(default_factory=SafetyLimits)
 
     @property
     def robot_urdf(self) -> Path:

@@ -18,6 +18,7 @@ from calib_core.atomic_file import atomic_write_text
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import Workcell
+from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM
 
 _DECIMALS = 4
 
@@ -72,6 +73,8 @@ def _task_entry(task) -> CommentedMap:
         entry["component"] = task.component
     entry["tcp2base"] = _placement(task.tcp2base)
     entry["approach_mm"] = float(round(task.approach_mm, _DECIMALS))
+    if task.tolerance_mm != DEFAULT_TOLERANCE_MM:
+        entry["tolerance_mm"] = float(task.tolerance_mm)
     return entry
 
 
@@ -115,6 +118,8 @@ def save_workcell(workcell: Workcell, path: str | Path | None = None) -> Path:
             entry["tcp2base"] = _placement(task.tcp2base)
         if abs(float(entry.get("approach_mm", 0.0)) - task.approach_mm) > 1e-9:
             entry["approach_mm"] = float(round(task.approach_mm, _DECIMALS))
+        if abs(float(entry.get("tolerance_mm", DEFAULT_TOLERANCE_MM)) - task.tolerance_mm) > 1e-12:
+            entry["tolerance_mm"] = float(task.tolerance_mm)
     for i in reversed(range(len(tasks))):
         if tasks[i]["name"] not in workcell.task_locations:
             del tasks[i]

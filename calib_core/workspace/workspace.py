@@ -19,11 +19,13 @@ import numpy as np
 from calib_core import __version__
 from calib_core.atomic_file import atomic_write_text
 from calib_core.calibration.corrections import Correction, CorrectionTable
-from calib_core.calibration.correspondences import Correspondence
+from calib_core.calibration.correspondences import Correspondence, pair_to_dict
+from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
+from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM
 
 SCHEMA_VERSION = 2
 _READABLE_VERSIONS = (1, 2)
@@ -56,7 +58,7 @@ def _correction_dict(c: Correction) -> dict:
         "tcp2base_model": _pose(c.tcp2base_model), "tcp2base_measured": _pose(c.tcp2base_measured),
         "displacement_mm": c.displacement_mm.tolist(), "rotation_deg": c.rotation_deg.tolist(),
         "std_displacement_mm": c.std_displacement_mm.tolist(), "std_rotation_deg": c.std_rotation_deg.tolist(),
-        "rms_px": c.rms_px, "pairs": c.pairs,
+        "rms_px": c.rms_px, "pairs": c.pairs, "verdict": c.verdict, "confirmation": c.confirmation,
     }
 
 
@@ -71,8 +73,8 @@ def workspace_to_dict(ws: Workspace) -> dict:
         "cell": ws.cell,
         "intrinsics": ws.intrinsics.to_dict(),
         "target": ws.target,
-        "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
-        "pairs": [{"number": p.number, "component": p.component, "feature": p.feature, "point_world_mm": list(p.point_world_mm), "pixel": None if p.pixel is None else list(p.pixel), "enabled": p.enabled} for p in ws.pairs],
+        "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tolerance_mm": t.tolerance_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
+        "pairs": [pair_to_dict(p) for p in ws.pairs],
         "corrections": [_correction_dict(c) for task in ws.corrections.tasks() for c in ws.corrections.history(task)],
     }
 
@@ -119,6 +121,13 @@ class _Fields:
         return transform_from_xyz_rpy(self.vector(self.get(value, "xyz", where), 3, f"{where}.xyz"), self.vector(self.get(value, "rpy", where), 3, f"{where}.rpy"))
 
 
+def _tolerance(f, t: dict, where: str) -> float:
+    value = t.get("tolerance_mm", DEFAULT_TOLERANCE_MM)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+        raise f.fail(f"{where}.tolerance_mm", f"must be a number > 0 (mm), got {value!r}")
+    return float(value)
+
+
 def load_workspace(path: str | Path) -> Workspace:
     path = Path(path)
     f = _Fields(path)
@@ -148,12 +157,18 @@ def load_workspace(path: str | Path) -> Workspace:
     for i, t in enumerate(f.get(data, "task_locations", "", list)):
         where = f"task_locations[{i}]"
         name = f.get(t, "name", where, str)
-        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), float(f.get(t, "approach_mm", where, (int, float))), t.get("component"))
+        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), float(f.get(t, "approach_mm", where, (int, float))), t.get("component"), _tolerance(f, t, where))
     pairs = []
     for i, p in enumerate(f.get(data, "pairs", "", list)):
         where = f"pairs[{i}]"
         pixel = p.get("pixel") if isinstance(p, dict) else None
-        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.get(p, "component", where, str), p.get("feature"), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True))))
+        view = None
+        if pixel is not None and p.get("view") is not None:
+            try:
+                view = ViewStamp.from_dict(p["view"])
+            except (KeyError, TypeError, ValueError) as exc:
+                raise f.fail(f"{where}.view", f"not a frame stamp: {exc}") from None
+        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.get(p, "component", where, str), p.get("feature"), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True)), view))
     table = CorrectionTable()
     for i, c in enumerate(f.get(data, "corrections", "", list)):
         where = f"corrections[{i}]"
@@ -170,5 +185,7 @@ def load_workspace(path: str | Path) -> Workspace:
             pairs=int(f.get(c, "pairs", where, int)),
             time_s=float(c.get("time_s", 0.0)),
             source=str(c.get("source", "")),
+            verdict=str(c.get("verdict", "ok")),
+            confirmation=str(c.get("confirmation", "")),
         ))
     return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)), cell)

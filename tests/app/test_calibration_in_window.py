@@ -13,6 +13,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
 from calib_core.testbed.sim_site import simulated_cell
+from tests.app.windows import pick_pair, wait_for_settled_frame
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
@@ -32,10 +33,8 @@ def _go_to_task(qtbot, win):
     task = wb.task
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000)
-    # A frame rendered at the final joints, and the virtual camera redrawn there.
-    frames = []
-    win.worker.frame.connect(frames.append)
-    qtbot.waitUntil(lambda: len(frames) >= 2, timeout=10_000)
+    # A frame taken with the robot settled there, and the virtual camera redrawn there.
+    wait_for_settled_frame(qtbot, win)
     qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
 
 
@@ -71,7 +70,7 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     assert result.solution.rms_px < 1.0
     d_true, r_true = pose_difference(bed.true_robot.fk(wb.joints_deg), bed.model_robot.fk(wb.joints_deg))
     assert np.linalg.norm(result.displacement_mm - d_true) < 1.0
-    assert "OK" in win.results.status.text()
+    assert "OK" in win.results.verdict.text()
     # The CAD edges from the solved pose follow the points (next turn of the event loop) and lie on the
     # plate's outline: the overlay is opaque at the projected corners' neighbourhood.
     qtbot.waitUntil(lambda: win.edges_drawn > 0, timeout=5_000)
@@ -141,9 +140,9 @@ def test_a_degenerate_point_set_is_explained_and_loses_no_pair(qtbot, window):
     win, wb = window, window.workbench
     fixture = wb.workcell.component("oru_1_fixture")
     # Four points on one straight line of the plate: no pose follows from them.
+    wait_for_settled_frame(qtbot, win)
     for k, y in enumerate((-60.0, -20.0, 20.0, 60.0)):
-        wb.session.pick_3d("oru_1_fixture", None, apply(fixture.item2world, np.array([0.0, y, 0.0])))
-        wb.session.pick_2d((100.0 + 50 * k, 200.0))
+        pick_pair(wb, "oru_1_fixture", None, apply(fixture.item2world, np.array([0.0, y, 0.0])), (100.0 + 50 * k, 200.0))
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
     text = win.results.status.text().lower()
     assert "line" in text or "degenerate" in text or "collinear" in text, text
@@ -249,8 +248,7 @@ def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
     true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     for name in ("plate_top_left", "plate_top_right", "pin_tip"):  # three pairs: P3P has several exact poses
         p = apply(fixture.item2world, fixture.features[name])
-        wb.session.pick_3d("oru_1_fixture", name, p)
-        wb.session.pick_2d(project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
+        pick_pair(wb, "oru_1_fixture", name, p, project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
     solution = wb.session.result.solution
     if solution.status is not SolveStatus.AMBIGUOUS:
@@ -293,6 +291,7 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
 
     settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
     settings.setValue("files/autosave_dir", str(tmp_path))
+    settings.setValue("window/ask_unsaved", False)
     cell, site = simulated_cell()
     (tmp_path / "recovery").mkdir()
     save_workspace(tmp_path / "recovery" / "autosave.json", Workspace("cell", cell.intrinsics, {}, "oru_1_fixture", [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))], cell=cell.identity.to_dict()))

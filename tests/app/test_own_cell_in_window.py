@@ -7,6 +7,7 @@ import pytest
 from app.gui.error_boundary import internal_error_log
 from calib_core.workcell import DEFAULT_WORKCELL
 from calib_core.workcell.starter import write_starter_cell
+from tests.app.windows import pick_pair, wait_for_settled_frame
 from tests.vendor_robots import SHARE, UR5, require
 
 
@@ -55,8 +56,8 @@ def test_a_workspace_of_another_cell_is_refused_and_nothing_changes(qtbot, launc
     qtbot.addWidget(bundled)
     wb = bundled.workbench
     fixture = wb.workcell.component("oru_1_fixture")
-    wb.session.pick_3d("oru_1_fixture", "pin_tip", fixture.item2world[:3, 3])
-    wb.session.pick_2d((100.0, 100.0))
+    wait_for_settled_frame(qtbot, bundled)
+    pick_pair(wb, "oru_1_fixture", "pin_tip", fixture.item2world[:3, 3], (100.0, 100.0))
     path = tmp_path / "bundled_workspace.json"
     assert bundled.files.save_workspace(path)
     bundled.close()

@@ -68,7 +68,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     result = wb.session.result
     assert result is not None and win.commands.calibrate.isEnabled()
     assert np.array_equal(result.solution.to_dict()["t_obj2cam_mm"], truth.solves[-1].result["t_obj2cam_mm"])
-    assert "OK" in win.results.status.text() and "mm" in win.results.details.text()
+    assert "OK" in win.results.verdict.text() and "mm" in win.results.details.text()
 
     # Back before the first pick: no pairs, no result.
     bar.seek(0.0)

@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from app.gui.main_window import MainWindow
-from tests.app.windows import window_settings
+from tests.app.windows import pick_pair, window_settings
+from tests.core.operator.still_robot import still_for
 from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
@@ -50,17 +51,17 @@ def calibrated_window(qtbot, tmp_path):
     task = wb.task
     q = solve_ik(wb.robot, task.tcp2base, wb.joints_deg).q_deg
     bed.joints_deg = q.copy()
-    wb.show_replayed_joints(q)  # the joints without a controller: the views follow, nothing moves
+    # No controller: joint samples of a robot standing at q, as the link would give them; the views follow.
+    t = still_for(wb, joints_deg=q)
     camera = bed.camera(seed=7)
     image, _ = camera.render(q)
     camera.close()
-    win.camera.show_frame(Frame(image, 0, 0.0))
+    wb.observe_frame(Frame(image, 0, t))
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = bed.true_cam2world(q)
     for name in FEATURES:
         p = apply(fixture.item2world, fixture.features[name])
-        wb.session.pick_3d("oru_1_fixture", name, p)
-        wb.session.pick_2d(project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
+        pick_pair(wb, "oru_1_fixture", name, p, project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
     win._calibrate()
     qtbot.waitUntil(lambda: win.edges_drawn > 0, timeout=5_000)
     win.virtual.refresh()

@@ -9,7 +9,6 @@ import pytest
 import yaml
 from PySide6.QtCore import Qt
 
-from app.gui.vision_panel import STILL_S
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
 from calib_core.testbed.true_robot import RobotErrors
@@ -25,17 +24,18 @@ def window(live_window):
 
 
 def _fresh_still_frame(qtbot, win):
-    """Wait until the camera shows a frame taken after the robot came to rest."""
-    qtbot.waitUntil(lambda: win.vision.robot_is_still(win.camera.last_frame), timeout=10_000)
+    """Wait until the camera shows a frame the core accepts: taken after the robot had settled."""
+    wb = win.workbench
+    qtbot.waitUntil(lambda: win.camera.last_frame is not None and wb.observations.stillness(win.camera.last_frame).settled, timeout=10_000)
 
 
 def _visit_board_pose(qtbot, win, k: int) -> None:
-    """Next board pose (the k-th of the plan), wait for the robot there and a frame taken at rest."""
+    """Next board pose (the k-th of the plan), wait for the controller's done and a frame taken at rest."""
     qtbot.mouseClick(win.vision.next_pose, Qt.MouseButton.LeftButton)
     target = win.vision._plan[k]
-    qtbot.waitUntil(lambda: np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3, timeout=30_000)
-    qtbot.wait(int(STILL_S * 1000))
+    qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
     _fresh_still_frame(qtbot, win)
+    assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3
 
 
 def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
@@ -114,9 +114,10 @@ def test_bad_vision_input_gives_messages(qtbot, window):
     qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
     start = wb.joints_deg.copy()
     qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 0.5, timeout=10_000)
-    qtbot.waitUntil(lambda: win.camera.last_frame.t_host_s > vision._last_motion_s - 0.05, timeout=5_000)
+    # a frame the core's rule calls unsettled (what the capture applies)
+    qtbot.waitUntil(lambda: not wb.observations.stillness(win.camera.last_frame).settled, timeout=5_000)
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
-    assert "the robot is moving" in win.results.status.text()
+    assert "the robot was moving" in win.results.status.text() and "deg/s" in win.results.status.text()
     assert not vision.capture.views and not vision.capture.rejected
 
 
@@ -141,7 +142,7 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     for q in plan:
         # the moment the recorded joints reached this pose, plus a little: frame and joints at rest
         at = next(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
-        win.replay.seek(at + STILL_S + 0.15)
+        win.replay.seek(at + wb.workcell.safety.settle_time_s + 0.15)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert len(vision.capture.views) == 4, [vision.views.item(i).text() for i in range(vision.views.count())]
     for recorded, q in zip(vision.capture.joints_deg, plan):

@@ -7,4 +7,24 @@ def window_settings(folder, name: str = "settings") -> QSettings:
     """A window's settings in ``folder``, its autosaves there too (a test's windows never see another test's)."""
     settings = QSettings(str(folder / f"{name}.ini"), QSettings.Format.IniFormat)
     settings.setValue("files/autosave_dir", str(folder / f"{name}_autosave"))
+    settings.setValue("window/ask_unsaved", False)  # a test that wants the question turns it on
     return settings
+
+
+def wait_for_settled_frame(qtbot, win, timeout_ms: int = 15_000) -> None:
+    """Wait until the camera's newest frame is one the core accepts for picks: the robot had settled
+    before it was captured (the predicate the core applies to a pick)."""
+    wb = win.workbench
+
+    def settled() -> bool:
+        frame = win.camera.last_frame_received
+        return frame is not None and wb.observations.stillness(frame).settled
+
+    qtbot.waitUntil(settled, timeout=timeout_ms)
+
+
+def pick_pair(wb, component: str, feature, point_world_mm, pixel) -> int:
+    """One pair through the core, as the panes' clicks make it (the image point on the held frame)."""
+    wb.pick_model_point(component, feature, point_world_mm)
+    wb.pick_image_point(pixel)
+    return wb.accept_pair()

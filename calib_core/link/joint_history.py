@@ -1,0 +1,155 @@
+"""The robot's recent joint history, from the link's time-stamped samples: where the robot was when a
+camera frame was captured, and whether it had been still long enough before it for the frame and
+the joints to agree.
+
+Times are one clock: the host's monotonic seconds for a live link (``TimedSample.t_host_s`` and
+``Frame.t_host_s``), seconds on the recording's time axis in a replay. Joints are the model's (deg
+for revolute joints, mm for prismatic ones).
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SettleRule:
+    """The robot counts as still when every joint moves slower than ``speed_deg_s`` (deg/s, or mm/s
+    for a prismatic joint) for ``hold_s`` seconds up to the frame's capture. ``max_gap_s``: the
+    longest gap between samples that still counts as known motion (a longer one: the pose is
+    unknown in between)."""
+
+    speed_deg_s: float = 0.5
+    hold_s: float = 0.3
+    max_gap_s: float = 0.25
+
+
+@dataclass(frozen=True)
+class Stillness:
+    """Whether the robot was settled at a time: ``settled``; ``reason`` says why not (empty when
+    settled); ``still_for_s``: how long it had been still up to that time; ``speed_deg_s``: the
+    fastest joint speed in the hold window (deg/s or mm/s) and ``joint`` its index (``None`` when
+    no sample covers the window)."""
+
+    settled: bool
+    reason: str
+    still_for_s: float
+    speed_deg_s: float = 0.0
+    joint: int | None = None
+
+
+@dataclass(frozen=True)
+class JointsAt:
+    """The joints (n,) deg/mm at a time, interpolated between the samples around it;
+    ``stamp_gap_s``: the distance from that time to the nearest sample."""
+
+    joints_deg: np.ndarray
+    stamp_gap_s: float
+
+
+class JointHistory:
+    """The last ``keep_s`` seconds of joint samples, oldest first. :meth:`forget` marks the pose as
+    unknown (the link dropped): nothing before it is used again."""
+
+    def __init__(self, keep_s: float = 30.0, rule: SettleRule | None = None, joint_names: list[str] | None = None):
+        self.keep_s = float(keep_s)
+        self.rule = rule or SettleRule()
+        self.joint_names = list(joint_names or [])
+        self._t: deque[float] = deque()
+        self._q: deque[np.ndarray] = deque()
+        self.unknown_since_s: float | None = None
+        """Set when the pose became unknown (``forget``); cleared by the next sample."""
+
+    @classmethod
+    def from_arrays(cls, times_s, joints_deg, rule: SettleRule | None = None, joint_names: list[str] | None = None) -> JointHistory:
+        """A whole recorded history: ``times_s`` (n,) s, non-decreasing; ``joints_deg`` (n, j)."""
+        history = cls(keep_s=float("inf"), rule=rule, joint_names=joint_names)
+        for t, q in zip(np.asarray(times_s, float), np.asarray(joints_deg, float)):
+            history.add(t, q)
+        return history
+
+    def __len__(self) -> int:
+        return len(self._t)
+
+    @property
+    def latest_s(self) -> float | None:
+        return self._t[-1] if self._t else None
+
+    def add(self, t_s: float, joints_deg) -> None:
+        """A sample at ``t_s``; one older than the newest is dropped (the history stays in order)."""
+        if self._t and t_s < self._t[-1]:
+            return
+        self._t.append(float(t_s))
+        self._q.append(np.array(joints_deg, dtype=float))
+        self.unknown_since_s = None
+        while self._t and self._t[-1] - self._t[0] > self.keep_s:
+            self._t.popleft()
+            self._q.popleft()
+
+    def forget(self, t_s: float) -> None:
+        """The link dropped at ``t_s``: the robot may have moved without a word; the pose is unknown
+        until a fresh sample arrives, and no earlier sample vouches for a later frame."""
+        self._t.clear()
+        self._q.clear()
+        self.unknown_since_s = float(t_s)
+
+    def joints_at(self, t_s: float) -> JointsAt | None:
+        """The joints at ``t_s``, or ``None`` when no sample lies within ``max_gap_s`` of it."""
+        if not self._t:
+            return None
+        times = self._t
+        i = bisect.bisect_left(times, t_s)
+        gap_before = t_s - times[i - 1] if i > 0 else np.inf
+        gap_after = times[i] - t_s if i < len(times) else np.inf
+        gap = min(gap_before, gap_after)
+        if gap > self.rule.max_gap_s:
+            return None
+        if i == 0:
+            return JointsAt(self._q[0].copy(), gap)
+        if i == len(times):
+            return JointsAt(self._q[-1].copy(), gap)
+        t0, t1 = times[i - 1], times[i]
+        w = 0.0 if t1 <= t0 else (t_s - t0) / (t1 - t0)
+        return JointsAt((1 - w) * self._q[i - 1] + w * self._q[i], gap)
+
+    def stillness(self, t_s: float) -> Stillness:
+        """Whether the robot was still for ``rule.hold_s`` up to ``t_s``, from the samples."""
+        rule = self.rule
+        if not self._t:
+            why = "the link dropped: the robot's pose is unknown until a fresh joint sample arrives" if self.unknown_since_s is not None else "no joint samples: the robot's pose is unknown (is the controller link up?)"
+            return Stillness(False, why, 0.0)
+        times = np.fromiter(self._t, float)
+        if t_s - times[-1] > rule.max_gap_s:
+            return Stillness(False, f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown", 0.0)
+        if t_s < times[0]:
+            return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
+        end = bisect.bisect_right(self._t, t_s)  # samples at or before the capture
+        stop = min(end + 1, len(times))  # and the one after it: the step across the capture counts
+        q = np.array([self._q[k] for k in range(stop)])
+        dt = np.diff(times[:stop])
+        speed = np.abs(np.diff(q, axis=0)) / np.maximum(dt, 1e-9)[:, None] if stop > 1 else np.zeros((0, q.shape[1]))
+        fast = speed.max(axis=1) >= rule.speed_deg_s
+        gap = dt > rule.max_gap_s
+        broken = np.flatnonzero(fast | gap)
+        if not len(broken):
+            still_for = t_s - times[0]
+            if still_for + 1e-9 < rule.hold_s:
+                return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({rule.hold_s:g} s of stillness needed)", still_for)
+            return Stillness(True, "", still_for)
+        b = int(broken[-1])
+        still_for = max(0.0, t_s - times[b + 1])
+        if still_for + 1e-9 >= rule.hold_s:
+            return Stillness(True, "", still_for)
+        if fast[b]:
+            joint = int(np.argmax(speed[b]))
+            top = float(speed[b, joint])
+            when = "when the frame was taken" if still_for == 0.0 else f"{still_for:.2f} s before the frame"
+            return Stillness(False, f"the robot was moving {when} ({self._name(joint)} at {top:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)", still_for, top, joint)
+        return Stillness(False, f"the joint samples stop for {dt[b]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen", still_for)
+
+    def _name(self, joint: int) -> str:
+        return self.joint_names[joint] if joint < len(self.joint_names) else f"joint {joint + 1}"

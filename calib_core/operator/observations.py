@@ -1,0 +1,76 @@
+"""Camera frames bound to the robot state they were captured in.
+
+Every frame the operator sees passes through here. A frame becomes usable for picks (and board
+views) only with a :class:`~calib_core.calibration.view_stamp.ViewStamp`: the joints at its
+capture time from the joint history, and proof that the robot had settled before it. The first
+image pick of a set holds that frame (a still): the operator picks on it while the live video
+goes on; every pick of the set carries the still's stamp.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+
+from calib_core.calibration.view_stamp import ViewStamp
+from calib_core.errors import OperatorError
+from calib_core.link.joint_history import JointHistory, Stillness
+from calib_core.video.frame import Frame
+
+
+class NotSettledError(OperatorError):
+    """A frame cannot be used: the robot was moving, or its pose at the frame is unknown."""
+
+
+@dataclass(frozen=True)
+class HeldFrame:
+    """A frame held for picking, with its stamp."""
+
+    frame: Frame
+    stamp: ViewStamp
+
+
+class Observations:
+    """The newest frame (``latest``), the held one (``still``) and the joint ``history`` that
+    stamps them. ``source``: ``live``, or the name of the recording being replayed (then the
+    history is the recording's, on its time axis)."""
+
+    def __init__(self, history: JointHistory, source: str = "live"):
+        self.history = history
+        self.source = source
+        self.latest: Frame | None = None
+        self.still: HeldFrame | None = None
+
+    def observe(self, frame: Frame) -> None:
+        self.latest = frame
+
+    def stillness(self, frame: Frame) -> Stillness:
+        return self.history.stillness(frame.t_host_s)
+
+    def stamp(self, frame: Frame) -> ViewStamp:
+        """The frame's stamp; :class:`NotSettledError` when the robot was not still before it or
+        its pose then is unknown."""
+        still = self.stillness(frame)
+        if not still.settled:
+            raise NotSettledError(f"frame {frame.index} cannot be used: {still.reason}")
+        at = self.history.joints_at(frame.t_host_s)
+        if at is None:
+            raise NotSettledError(f"frame {frame.index} cannot be used: no joint sample near its capture time")
+        if self.source == "live":
+            age_s = max(0.0, time.monotonic() - frame.t_host_s)
+            captured_at = (datetime.now(timezone.utc) - timedelta(seconds=age_s)).isoformat(timespec="milliseconds")
+        else:
+            captured_at = f"{frame.t_host_s:.3f} s into {self.source}"
+        return ViewStamp(int(frame.index), float(frame.t_host_s), tuple(float(v) for v in at.joints_deg), float(at.stamp_gap_s), captured_at, self.source)
+
+    def hold(self, frame: Frame | None = None) -> HeldFrame:
+        """Hold ``frame`` (default: the newest) for picking."""
+        frame = frame if frame is not None else self.latest
+        if frame is None:
+            raise OperatorError("no camera image yet: start the camera (Execute > Live) or open a recording")
+        self.still = HeldFrame(frame, self.stamp(frame))
+        return self.still
+
+    def release(self) -> None:
+        self.still = None

@@ -1,0 +1,52 @@
+"""The joint history: joints at a frame's capture time (known answers) and whether the robot had
+settled before it, from the samples alone."""
+
+import numpy as np
+import pytest
+
+from calib_core.link.joint_history import JointHistory, SettleRule
+
+
+def _ramp(history, t0, t1, q0, q1, rate_hz=50.0):
+    for t in np.arange(t0, t1 + 1e-9, 1.0 / rate_hz):
+        w = (t - t0) / (t1 - t0)
+        history.add(t, (1 - w) * np.asarray(q0, float) + w * np.asarray(q1, float))
+
+
+def test_joints_between_two_samples_are_interpolated_and_the_gap_is_kept():
+    h = JointHistory()
+    h.add(10.0, [0.0, 10.0])
+    h.add(10.02, [1.0, 10.0])
+    at = h.joints_at(10.005)
+    np.testing.assert_allclose(at.joints_deg, [0.25, 10.0])
+    assert at.stamp_gap_s == pytest.approx(0.005)
+    assert h.joints_at(10.02 + 0.3) is None  # beyond max_gap_s: unknown, not extrapolated
+    h.add(10.01, [5.0, 5.0])  # older than the newest: dropped, the history stays in order
+    np.testing.assert_allclose(h.joints_at(10.02).joints_deg, [1.0, 10.0])
+
+
+def test_a_robot_is_settled_only_after_holding_still_for_the_set_time():
+    h = JointHistory(rule=SettleRule(speed_deg_s=0.5, hold_s=0.3), joint_names=["a", "b"])
+    _ramp(h, 0.0, 1.0, [0, 0], [0, 20])  # b at 20 deg/s
+    _ramp(h, 1.02, 2.0, [0, 20], [0, 20])  # then still
+    moving = h.stillness(0.5)
+    assert not moving.settled and moving.joint == 1 and moving.speed_deg_s == pytest.approx(20.0, rel=1e-6)
+    assert "b at 20.00 deg/s" in moving.reason
+    early = h.stillness(1.2)  # still since the last moving sample at 1.0 s: 0.2 s only
+    assert not early.settled and early.still_for_s == pytest.approx(0.2, abs=1e-6)
+    late = h.stillness(1.5)
+    assert late.settled and late.still_for_s == pytest.approx(0.5, abs=1e-6)
+
+
+def test_encoder_noise_below_the_threshold_is_still_and_a_gap_is_not():
+    rng = np.random.default_rng(0)
+    h = JointHistory(rule=SettleRule(speed_deg_s=0.5, hold_s=0.3, max_gap_s=0.1))
+    for k in range(50):
+        h.add(k * 0.02, rng.normal(0.0, 0.001, 6))  # 1 mdeg noise: ~0.07 deg/s between samples
+    assert h.stillness(0.98).settled
+    h.add(1.5, np.zeros(6))  # 0.52 s without a sample
+    h.add(1.52, np.zeros(6))
+    gap = h.stillness(1.52)
+    assert not gap.settled and "may have moved unseen" in gap.reason
+    h.forget(1.6)
+    assert not h.stillness(1.6).settled and "link dropped" in h.stillness(1.6).reason

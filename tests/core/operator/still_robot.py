@@ -1,0 +1,35 @@
+"""Feeding the operator core a still robot and a camera frame, as the link and the camera would."""
+
+import time
+
+import numpy as np
+
+from calib_core.link.link_types import TimedSample
+from calib_core.link.protocol import JointSample
+from calib_core.video.frame import Frame
+
+_seq = iter(range(10**9))
+
+
+def sample(core, joints_deg, t_s: float) -> None:
+    """One joint sample (model joints) at host time ``t_s``, through the core's own entry point."""
+    q = core.cell.joint_map.to_controller(np.asarray(joints_deg, dtype=float))
+    core.observe_sample(TimedSample(JointSample(next(_seq), int(t_s * 1000), tuple(float(v) for v in q)), t_s))
+
+
+def still_for(core, seconds: float = 0.6, joints_deg=None, rate_hz: float = 50.0, start_s: float | None = None) -> float:
+    """Samples of a robot standing at ``joints_deg`` (default: the core's joints) for ``seconds``
+    from ``start_s`` (default: the last ``seconds`` up to now); returns the time of the last one."""
+    q = core.joints_deg if joints_deg is None else joints_deg
+    start = time.monotonic() - seconds if start_s is None else start_s
+    times = start + np.arange(int(seconds * rate_hz) + 1) / rate_hz
+    for t in times:
+        sample(core, q, float(t))
+    return float(times[-1])
+
+
+def frame_now(core, index: int = 0, image=None, t_s: float | None = None) -> Frame:
+    """A camera frame captured at ``t_s`` (default now) given to the core."""
+    frame = Frame(np.zeros((480, 640, 3), np.uint8) if image is None else image, index, time.monotonic() if t_s is None else t_s)
+    core.observe_frame(frame)
+    return frame
