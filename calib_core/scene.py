@@ -25,7 +25,7 @@ class SceneItem:
     ``features``: named feature points, (3,) mm each, in the item's own frame.
     ``texture``: an optional image (h, w) or (h, w, 3) uint8 printed on the mesh, with
     ``texture_coords`` (n_vertices, 2): per vertex (s, t) in [0, 1], s to the right and t up
-    the image (OpenGL's convention).
+    the image (OpenGL's convention). ``opacity`` in (0, 1].
     """
 
     name: str
@@ -36,3 +36,5 @@ class SceneItem:
     features: dict[str, np.ndarray] = field(default_factory=dict)
     texture: np.ndarray | None = None
     texture_coords: np.ndarray | None = None
+    opacity: float = 1.0
+    """Below 1: drawn see-through (a ghost robot of a previewed move)."""

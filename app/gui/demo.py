@@ -120,6 +120,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
 
     skipped: list[str] = []
     refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
+    confirmed: list[str] = []  # moves the operator confirmed in the overview (large joint changes)
     hand = np.random.default_rng(0)
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
@@ -137,6 +138,15 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
 
             _wait(app, usable, 30, f"a camera frame with the robot settled {what}")
             _wait(app, win.virtual.is_current, 10, "the virtual camera")
+
+        def go(button) -> None:
+            """A move button; the operator looks at the ghost in the overview and presses Move when asked."""
+            _click(button, 10, 10)
+            if win.overview.preview_bar.isVisible() and win.overview.move_button.isVisible():
+                confirmed.append(win.overview.preview.what)
+                _click(win.overview.move_button, 10, 10)
+            if wb.motion.motion.value not in ("moving", "arrived"):
+                raise RuntimeError(f"demo: the move was not sent: {win.results.status.text()}")
 
         def pick_and_calibrate(round_name: str) -> None:
             """One calibration where the robot stands: every feature picked in both panes, solved, stored."""
@@ -188,19 +198,19 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         # As in the paper, the camera looks at the object from the task location itself: the correction is
         # measured where it is used. Moving by the correction changes the robot's error a little (its joints
         # change), so a second look from the corrected location refines it.
-        _click(win.commands.go_task, 10, 10)
+        go(win.commands.go_task)
         _wait(app, lambda: at(task.tcp2base), 60, "the robot at the task location")
         settle("at the task location")
         shot("at_task")
         q_first = wb.joints_deg.copy()
         pick_and_calibrate("first")
         first = wb.session.result
-        _click(win.commands.go_corrected, 10, 10)
+        go(win.commands.go_corrected)
         _wait(app, lambda: at(wb.session.corrections.corrected_target(task.name, task.tcp2base)), 60, "the robot at the corrected task location")
         settle("at the corrected task location")
         q_measured = wb.joints_deg.copy()
         pick_and_calibrate("second")
-        _click(win.commands.go_corrected, 10, 10)
+        go(win.commands.go_corrected)
         corrected = wb.session.corrections.corrected_target(task.name, task.tcp2base)
         _wait(app, lambda: at(corrected), 60, "the robot at the twice-corrected task location")
         shot("at_corrected_task")
@@ -217,6 +227,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "target": wb.session.target,
             "features_skipped": skipped,
             "subpixel_refinement_refused": refined_away,
+            "moves_confirmed": confirmed,
             "status": r.solution.status.value,
             "pairs": len(wb.session.pairs.usable()),
             "rms_px": r.solution.rms_px,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import getpass
+from collections.abc import Callable
 from datetime import datetime, timezone
 
 import numpy as np
@@ -27,6 +28,7 @@ from app.gui.vision_panel import VisionPanel
 from app.gui.workbench import Workbench
 from app.gui.confirm import ask, ask_save
 from calib_core.calibration.session import ConfirmationNeeded
+from calib_core.operator.move_preview import MoveNeedsConfirmation
 from calib_core.robot import solve_ik
 from calib_core.errors import OperatorError
 
@@ -48,7 +50,7 @@ class MainWindow(QMainWindow):
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
         self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
-        self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error)
+        self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error, lambda send: self.move(send))
         vision_scroll = QScrollArea()
         vision_scroll.setWidgetResizable(True)
         vision_scroll.setWidget(self.vision)
@@ -279,7 +281,19 @@ class MainWindow(QMainWindow):
             self.workbench.store_correction(confirmation=f"confirmed in the window by {getpass.getuser()} at {datetime.now(timezone.utc).isoformat(timespec='seconds')}: {'; '.join(exc.reasons)}")
 
     def _go(self, *, approach: bool, corrected: bool = False) -> None:
-        self.report(lambda: self.workbench.go_to_task(approach=approach, corrected=corrected))()
+        self.move(lambda confirmed: self.workbench.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))
+
+    def move(self, send: Callable[[bool], object]) -> None:
+        """Send a move (``send(confirmed)`` calls the core). The core previews it in the overview; one
+        that needs a confirmation waits there for *Move*; a refused one says why."""
+        self.report(self._move_impl)(send)
+
+    def _move_impl(self, send: Callable[[bool], object]) -> None:
+        try:
+            send(False)
+        except MoveNeedsConfirmation as exc:
+            self.overview.show_preview(exc.preview, lambda: self.report(send)(True))
+            self.statusBar().showMessage(f"{exc}: press Move in the overview to send it", 15000)
 
     def _animate(self) -> None:
         wb = self.workbench

@@ -3,14 +3,18 @@ frustum and, after a solve, the measured one; orbit (left drag), pan (right or m
 
 from __future__ import annotations
 
+import html
+from collections.abc import Callable
+
 import numpy as np
 from PySide6.QtCore import QPointF, Qt, QTimer
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.gui.image_view import ImageView
 from app.gui.workbench import Workbench
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.render.frustum import frustum_polyline
+from calib_core.scene import SceneItem
 
 MODEL_FRUSTUM = (0.35, 0.6, 1.0)
 MEASURED_FRUSTUM = (0.2, 1.0, 0.4)
@@ -77,10 +81,30 @@ class OverviewPane(QWidget):
         bar.addStretch(1)
         legend = QLabel("<span style='color:#5a9aff'>model camera</span>  <span style='color:#33ff66'>measured camera</span>")
         bar.addWidget(legend)
+        self.preview_bar = QWidget()
+        self.preview_bar.setObjectName("move_preview")
+        pb = QHBoxLayout(self.preview_bar)
+        pb.setContentsMargins(4, 2, 4, 2)
+        self.preview_text = QLabel("")
+        self.preview_text.setWordWrap(True)
+        self.move_button = QPushButton("Move")
+        self.move_button.setObjectName("confirm_move")
+        self.move_button.setToolTip("Send the previewed move to the controller")
+        self.cancel_button = QPushButton("Cancel")
+        self.cancel_button.setObjectName("cancel_move")
+        pb.addWidget(self.preview_text, 1)
+        pb.addWidget(self.move_button)
+        pb.addWidget(self.cancel_button)
+        self.preview_bar.hide()
+        self.move_button.clicked.connect(self._confirm)
+        self.cancel_button.clicked.connect(lambda: self.show_preview(None))
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
+        layout.addWidget(self.preview_bar)
         layout.addWidget(self.view, 1)
+        self.preview = None  # the move shown as a ghost (a MovePreview), or None
+        self._send: Callable[[], None] | None = None  # sends the previewed move once confirmed
         self.target = np.zeros(3)
         self.azimuth_deg, self.elevation_deg, self.distance_mm = -130.0, 32.0, 4300.0
         self.fit_view()
@@ -93,6 +117,50 @@ class OverviewPane(QWidget):
         workbench.session.changed.connect(self.mark_dirty)
         workbench.scene_changed.connect(self.mark_dirty)
         workbench.session.pairs.changed.connect(lambda *_: self.mark_dirty())
+        workbench.move_previewed.connect(lambda preview: self.show_preview(preview))
+        workbench.motion_changed.connect(self._motion_changed)
+
+    # --- previewed moves ------------------------------------------------------------------------
+    def show_preview(self, preview, send: Callable[[], None] | None = None) -> None:
+        """Draw ``preview`` (a MovePreview) as a ghost robot at its goal with the tool's path; with
+        ``send``, the move waits for *Move* (or *Cancel*). ``None`` clears it."""
+        self.preview, self._send = preview, send
+        if preview is None:
+            self.preview_bar.hide()
+        else:
+            state = "refused" if preview.blocked else ("waiting for your confirmation" if send is not None else "moving")
+            color = "#ff6b6b" if preview.blocked else ("#ffb347" if send is not None else "#9ad0ff")
+            self.preview_text.setText(f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - {html.escape(preview.summary, quote=False)}")
+            self.move_button.setVisible(send is not None and not preview.blocked)
+            self.cancel_button.setText("Cancel" if send is not None else "Hide")
+            self.preview_bar.show()
+        self.mark_dirty()
+
+    def _confirm(self) -> None:
+        send, self._send = self._send, None
+        self.move_button.hide()
+        if send is not None:
+            send()
+
+    def _motion_changed(self, state) -> None:
+        # The ghost stays while the robot moves there; it goes when the move ended well, and stays
+        # with the reason when it did not.
+        if self.preview is not None and self._send is None and state.what == self.preview.what:
+            if state.motion.value == "arrived":
+                self.show_preview(None)
+            elif state.motion.value in ("refused", "failed", "unknown"):
+                self.preview_text.setText(f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - {html.escape(state.text, quote=False)}")
+
+    def _ghost_items(self) -> list:
+        p = self.preview
+        if p is None:
+            return []
+        color = (1.0, 0.3, 0.3) if p.blocked else ((1.0, 0.7, 0.3) if self._send is not None else (0.45, 0.75, 1.0))
+        q = p.path_deg[p.contact_step] if (p.blocked and p.contact_step is not None) else p.goal_deg
+        items = []
+        for item in self.workbench.cell.model_visuals().scene_items(q):
+            items.append(SceneItem(name="ghost/" + item.name, mesh=item.mesh, item2world=item.item2world, color=color, kind="ghost", opacity=0.35))
+        return items
 
     def orbit(self, d_azimuth: float, d_elevation: float) -> None:
         self.azimuth_deg += d_azimuth
@@ -157,8 +225,10 @@ class OverviewPane(QWidget):
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
         q = wb.joints_deg if self._shown_joints is None else self._shown_joints
-        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.scene_extras))
+        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.scene_extras) + self._ghost_items())
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
+        if self.preview is not None and self.preview.tcp_path_mm is not None and len(self.preview.tcp_path_mm) > 1:
+            lines.append((self.preview.tcp_path_mm, (1.0, 0.7, 0.3)))
         if wb.session.result is not None:
             lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))
         markers = [(np.array(p.point_world_mm), (1.0, 0.84, 0.04)) for p in wb.session.pairs]

@@ -7,6 +7,7 @@ frame came for ``STALE_CAMERA_S`` while live.
 
 from __future__ import annotations
 
+import html
 import time
 from collections.abc import Callable
 
@@ -28,8 +29,11 @@ class StatusLine:
         self.link_label = QLabel("link: not connected")
         self.fps_label = QLabel("camera: -")
         self.pairs_label = QLabel("pairs: 0")
-        for w in (self.record_label, self.link_label, self.fps_label, self.pairs_label):
+        self.motion_label = QLabel("robot: no move yet")
+        self.motion_label.setObjectName("motion")
+        for w in (self.motion_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
             bar.addPermanentWidget(w)
+        workbench.motion_changed.connect(self.show_motion)
         self._samples_then: tuple[float, int] | None = None
         self.timer = QTimer(parent)
         self.timer.setInterval(1000)
@@ -59,6 +63,12 @@ class StatusLine:
             self.link_label.setText(text)
         rec = self.workbench.recorder
         self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
+
+    def show_motion(self, state) -> None:
+        """Moving / arrived / refused / pose unknown, from the controller's answers."""
+        color = {"moving": "#9ad0ff", "arrived": "#5fd35f", "refused": "#ff6b6b", "failed": "#ff6b6b", "unknown": "#ff9a30"}.get(state.motion.value)
+        self.motion_label.setText(f"<span style='color:{color}'>{html.escape(state.text, quote=False)}</span>" if color else html.escape(state.text))
+        self.motion_label.setToolTip(state.text)
 
     def show_pairs(self, usable: int, required: int) -> None:
         self.pairs_label.setText(f"pairs: {usable}/{required} needed")

@@ -36,9 +36,10 @@ class VisionPanel(QWidget):
     draws a detection on the camera pane; ``show_error`` puts a failed step's reason in the window;
     progress goes to the workbench's messages (the status bar)."""
 
-    def __init__(self, workbench, current_frame: Callable, show_corners: Callable, show_error: Callable[[str], None], parent=None):
+    def __init__(self, workbench, current_frame: Callable, show_corners: Callable, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
         super().__init__(parent)
         self.workbench = workbench
+        self._move = move or (lambda send: send(False))  # the window previews and confirms moves
         self._current_frame = current_frame
         self._show_corners = show_corners
         self._report = workbench.message.emit
@@ -143,7 +144,8 @@ class VisionPanel(QWidget):
                 raise OperatorError("no reachable robot pose sees the board")
         q = self._plan[self._plan_index % len(self._plan)]
         self._plan_index += 1
-        self.workbench.move_joints(q, f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}")
+        what = f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}"
+        self._move(lambda confirmed: self.workbench.move_joints(q, what, confirmed=confirmed))
 
     # --- capturing -----------------------------------------------------------------------------
     def capture_view(self) -> None:

@@ -51,6 +51,38 @@ class JointsAt:
     stamp_gap_s: float
 
 
+class ControllerClock:
+    """Maps the controller's sample clock to the host's. A sample's host arrival time is its send
+    time plus a delay that varies (serial buffering, a reader thread that waits for the CPU); the
+    smallest ``t_host - t_controller`` seen is the best estimate of the clock offset (the delay of
+    the fastest sample), so ``t_controller + offset`` stamps every sample as it was sent, free of
+    the reader's jitter. A controller clock that jumps back (a restart) starts the estimate again.
+    ``delay_s`` is the last sample's arrival delay over that, the stamp difference kept per sample."""
+
+    def __init__(self, drift_allowance: float = 1e-4):
+        self.offset_s: float | None = None
+        self._last_controller_s: float | None = None
+        self._last_host_s: float | None = None
+        self.drift_allowance = drift_allowance
+        self.delay_s = 0.0
+        self.restarts = 0
+
+    def stamp(self, t_host_s: float, t_controller_s: float) -> float:
+        """The host time at which the controller sent a sample stamped ``t_controller_s``."""
+        if self._last_controller_s is not None and t_controller_s < self._last_controller_s:
+            self.offset_s = None
+            self.restarts += 1
+        offset = t_host_s - t_controller_s
+        if self.offset_s is not None and self._last_host_s is not None:
+            # The two clocks drift apart slowly: let the estimate rise by a little over time.
+            self.offset_s += self.drift_allowance * max(0.0, t_host_s - self._last_host_s)
+        if self.offset_s is None or offset < self.offset_s:
+            self.offset_s = offset
+        self._last_controller_s, self._last_host_s = t_controller_s, t_host_s
+        self.delay_s = offset - self.offset_s
+        return t_controller_s + self.offset_s
+
+
 class JointHistory:
     """The last ``keep_s`` seconds of joint samples, oldest first. :meth:`forget` marks the pose as
     unknown (the link dropped): nothing before it is used again."""

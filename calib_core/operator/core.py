@@ -26,11 +26,13 @@ from calib_core.errors import OperatorError
 from calib_core.link.driver import ControllerLink
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.calibration.view_stamp import ViewStamp
-from calib_core.link.joint_history import JointHistory
+from calib_core.link.joint_history import ControllerClock, JointHistory
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.motion import Motion, MotionState, ended
+from calib_core.operator.move_preview import MoveNeedsConfirmation, MovePreview, MoveRefused, joint_path, preview_move
+from calib_core.robot.collision import CollisionWorld
 from calib_core.operator.observations import HeldFrame, Observations
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
@@ -47,7 +49,9 @@ class OperatorCore(SessionFiles):
     ``frame_observed(frame)``, ``correction_stored(correction)``, ``event(kind, detail)``
     (operator actions worth recording), ``still_changed(held)`` (the frame held for picking, a
     :class:`~calib_core.operator.observations.HeldFrame`, or ``None`` when released),
-    ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`)."""
+    ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`),
+    ``move_previewed(preview)`` (a :class:`~calib_core.operator.move_preview.MovePreview`, before
+    every move, sent or not)."""
 
     joints_changed = Signal(object)
     sample_received = Signal(object, object)
@@ -63,6 +67,7 @@ class OperatorCore(SessionFiles):
     event = Signal(str, object)
     still_changed = Signal(object)
     motion_changed = Signal(object)
+    move_previewed = Signal(object)
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
@@ -94,8 +99,13 @@ class OperatorCore(SessionFiles):
         self.live = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names))
         """The live frames and the link's joint history."""
         self.observations = self.live
+        self.controller_clock = ControllerClock()
+        """Stamps each joint sample with its controller time on the host clock (not its arrival)."""
         """What picks are stamped by: the live one, or a recording's while it is replayed."""
         self.motion = MotionState()
+        self._pending_move: tuple[str, MoveHandle] | None = None
+        self._collision_world = None  # built on the first move preview, again when the cell changes
+        self._collision_version = -1
         self.session.judge = self._judge
         self.session.pairs.changed.connect(self._release_unused_still)
 
@@ -137,8 +147,9 @@ class OperatorCore(SessionFiles):
 
     def _on_link_state(self, state: str, why: str) -> None:
         self.record_event("link_state", state=state, why=why)
-        if state in ("down", "stale", "closed"):
-            # Without samples the robot may move unseen: no earlier sample vouches for a later frame.
+        if state in ("down", "closed"):
+            # The device is gone: the robot may move unseen, no earlier sample vouches for a later frame.
+            # (A stale link, open but late, leaves a gap in the samples: the settle rule sees it.)
             self.live.history.forget(time.monotonic())
             if self.motion.motion is Motion.MOVING:
                 self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
@@ -156,9 +167,17 @@ class OperatorCore(SessionFiles):
         """A joint sample from the link (its reader thread hands it here through ``call_soon``)."""
         self.last_sample_s = time.monotonic()
         q = self.cell.joint_map.to_model(sample.joints_deg)
-        self.live.history.add(sample.t_host_s, q)
+        restarts = self.controller_clock.restarts
+        t_sent = self.controller_clock.stamp(sample.t_host_s, sample.sample.t_ms / 1000.0)
+        if self.controller_clock.restarts != restarts:
+            self.live.history.forget(sample.t_host_s)  # a restarted controller: nothing before vouches for now
+        self.live.history.add(t_sent, q)
         if self.motion.motion is Motion.UNKNOWN:
-            self._set_motion(MotionState(Motion.IDLE, self.motion.what, "the link is back: the robot stands where its joints say"))
+            pending = self._pending_move
+            if pending is not None and not pending[1].finished:
+                self._set_motion(MotionState(Motion.MOVING, pending[0], "the link is back"))
+            else:
+                self._set_motion(MotionState(Motion.IDLE, self.motion.what, "the link is back: the robot stands where its joints say"))
         self.sample_received.emit(sample, q)
         if self.replaying:
             return  # the recorded joints drive the views while a recording is replayed
@@ -174,13 +193,29 @@ class OperatorCore(SessionFiles):
     def link_up(self) -> bool:
         return self.link is not None and self.link.state is LinkState.UP
 
-    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0) -> MoveHandle:
+    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
         """IK for the TCP target (4, 4) mm in base from the current joints, then a joint move."""
         q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
-        return self.move_joints(q, what, wait=wait, timeout_s=timeout_s)
+        return self.move_joints(q, what, wait=wait, timeout_s=timeout_s, confirmed=confirmed, allowed_contacts=allowed_contacts)
 
-    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0) -> MoveHandle:
-        """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended."""
+    def collision_world(self) -> CollisionWorld:
+        """The robot's collision bodies and the cell's components (and what is put up in it, a board)."""
+        if self._collision_world is None or self._collision_version != self.scene_version:
+            self._collision_world = CollisionWorld(self.robot, list(self.workcell.components) + list(self.scene_extras), self.cell.home_joints)
+            self._collision_version = self.scene_version
+        return self._collision_world
+
+    def preview_move(self, q, what: str, allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
+        """The move from the current joints to ``q`` (deg/mm), checked; ``move_previewed`` shows it."""
+        preview = preview_move(self.robot, self.collision_world(), self.joints_deg, q, what, self.workcell.safety, allowed_contacts)
+        self.move_previewed.emit(preview)
+        return preview
+
+    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
+        """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended.
+        The move is previewed first: refused (:class:`MoveRefused`) outside the limits or into a
+        collision, and sent only with ``confirmed`` when it turns a joint further than the cell's
+        ``confirm_joint_change_deg`` (:class:`MoveNeedsConfirmation`)."""
         if self.replaying:
             raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
         if self.link is None:
@@ -193,11 +228,21 @@ class OperatorCore(SessionFiles):
                 f"not moving to {what}: joint {self.robot.joint_names[j]} target {q[j]:.2f} {self.robot.joint_units[j]} is outside its limits "
                 f"[{self.robot.lower_limits_deg[j]:g}, {self.robot.upper_limits_deg[j]:g}]"
             )
+        if self.motion.motion is Motion.UNKNOWN:
+            raise CalibrationError(f"not moving to {what}: the robot's pose is unknown (the link dropped); wait for a fresh joint sample")
+        preview = self.preview_move(q, what, allowed_contacts)
+        if preview.blocked:
+            raise MoveRefused(preview)
+        if preview.needs_confirmation:
+            if not confirmed:
+                raise MoveNeedsConfirmation(preview)
+            self.record_event("move_confirmed", what=what, reasons=list(preview.confirm_reasons))
         handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
         if not handle.sent:
             handle.wait(0)  # raises the link's reason
         self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
         self._set_motion(MotionState(Motion.MOVING, what))
+        self._pending_move = (what, handle)
         handle.on_finished(lambda h: self._call_soon(self._move_ended, what, h))
         if wait:
             handle.wait(timeout_s)
@@ -211,7 +256,7 @@ class OperatorCore(SessionFiles):
         self.move_finished.emit(what, str(error) if error else "")
         self.message.emit(f"move to {what} failed: {error}" if error else f"arrived at {what}")
 
-    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False) -> MoveHandle:
+    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False, confirmed: bool = False) -> MoveHandle:
         if self.task is None:
             raise CalibrationError("choose a task location first")
         target = self.task.approach2base if approach else self.task.tcp2base
@@ -220,7 +265,9 @@ class OperatorCore(SessionFiles):
                 raise CalibrationError(f"no stored correction for {self.task.name}: calibrate and store one first")
             target = self.session.corrections.corrected_target(self.task.name, target)
         what = f"{self.task.name} ({'approach' if approach else 'task'}{', corrected' if corrected else ''})"
-        return self.move_to(target, what, wait=wait)
+        # at the task pose itself the tool works on the task's object: touching it is the task
+        allowed = frozenset({self.task.component}) if (not approach and self.task.component) else frozenset()
+        return self.move_to(target, what, wait=wait, confirmed=confirmed, allowed_contacts=allowed)
 
     def set_task_approach(self, name: str, approach_mm: float) -> None:
         """Edit a task location's approach distance (mm): an undoable edit."""
@@ -466,10 +513,18 @@ class OperatorCore(SessionFiles):
         return board2base
 
     def board_view_plan(self, spec, n: int = 12) -> list[np.ndarray]:
-        """Joint vectors (deg/mm) from which the modelled camera sees the board from different directions."""
+        """Joint vectors (deg/mm) from which the modelled camera sees the board from different
+        directions, in an order whose every move (from the current joints on) is free of collisions
+        with the robot itself and the cell (the board among it); a pose without such a path is left out."""
         from calib_core.vision.board_placement import board_view_joints
 
-        return board_view_joints(self.robot, self.cell.home_joints, spec, self.board_placement(spec), n)
+        world = self.collision_world()
+        plan, q = [], np.asarray(self.joints_deg, dtype=float)
+        for goal in board_view_joints(self.robot, self.cell.home_joints, spec, self.board_placement(spec), n):
+            if not any(world.check(p) for p in joint_path(q, goal)):
+                plan.append(goal)
+                q = goal
+        return plan
 
     def close(self) -> None:
         self.stop_recording()

@@ -141,6 +141,7 @@ class SceneRenderer:
             a = actor.surface
             prop = a.GetProperty()
             prop.SetColor(*color)
+            prop.SetOpacity(actor.item.opacity)
             prop.SetAmbient(0.25)
             prop.SetDiffuse(0.75)
             prop.SetSpecular(0.15)
@@ -149,7 +150,7 @@ class SceneRenderer:
             else:
                 prop.SetRepresentationToSurface()
             self.renderer.AddActor(a)
-            if options.show_edges and options.style == "surface" and actor.item.kind != "fixture" or highlighted:
+            if options.show_edges and options.style == "surface" and actor.item.kind not in ("fixture", "ghost") or highlighted:
                 e = actor.edges
                 e.GetProperty().SetColor(*((0.55, 0.25, 0.0) if highlighted else tuple(0.35 * c for c in actor.item.color)))
                 e.GetProperty().SetLineWidth(1.5 if highlighted else 1.0)

@@ -13,7 +13,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
 from calib_core.testbed.sim_site import simulated_cell
-from tests.app.windows import pick_pair, wait_for_settled_frame
+from tests.app.windows import confirm_move_if_asked, pick_pair, wait_for_settled_frame
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
@@ -32,6 +32,7 @@ def _go_to_task(qtbot, win):
     wb = win.workbench
     task = wb.task
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000)
     # A frame taken with the robot settled there, and the virtual camera redrawn there.
     wait_for_settled_frame(qtbot, win)
@@ -95,6 +96,7 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
 
     # Execute the task with its correction: the real tool ends close to the planned location.
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     corrected = wb.session.corrections.corrected_target(wb.task.name, wb.task.tcp2base)
     qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), corrected)[0]) < 0.01, timeout=20_000)
     miss = np.linalg.norm(pose_difference(bed.true_robot.fk(wb.joints_deg), wb.task.tcp2base)[0])
@@ -120,6 +122,7 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     assert "complete pairs; calibrating needs 3" in win.results.status.text()
     # Going to a corrected location that has no correction.
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     assert "no stored correction" in win.results.status.text()
     # Accept with nothing picked, then with only the 3D point.
     qtbot.mouseClick(win.commands.accept, Qt.MouseButton.LeftButton)
@@ -171,6 +174,7 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
     qtbot.waitUntil(lambda: "up" not in win.link_label.text().split(",")[0], timeout=5_000)
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     assert "nothing was sent" in win.results.status.text()  # the link's reason, not "moving to ..."
     assert len(wb.session.pairs) == 1 and wb.session.pairs.pairs()[0].pixel == (320.0, 240.0)
     assert win.isVisible()
@@ -320,14 +324,16 @@ def test_simulate_animates_the_model_in_the_overview_only(qtbot, window):
 def test_a_refused_move_is_shown_and_ctrl_q_stops_the_simulator(qtbot, window):
     win, wb = window, window.workbench
     q = wb.joints_deg.copy()
-    q[2] = wb.robot.upper_limits_deg[2] + 10.0
-    win.report(lambda: wb.move_joints(q, "a pose past the elbow's limit"))()
+    q[5] = wb.robot.upper_limits_deg[5] + 10.0
+    win.report(lambda: wb.move_joints(q, "a pose past the wrist's limit"))()
     assert "outside its limits" in win.results.status.text()  # the core refuses it: nothing is sent
     # A model whose limits are wider than the controller's: the controller refuses the move, and the window says so.
-    wb.robot.model.upperPositionLimit[2] += np.radians(20.0)
-    wb.move_joints(q, "a pose past the elbow's limit")
+    wb.robot.model.upperPositionLimit[5] += np.radians(20.0)
+    win.move(lambda confirmed: wb.move_joints(q, "a pose past the wrist's limit", confirmed=confirmed))
+    confirm_move_if_asked(qtbot, win)
     qtbot.waitUntil(lambda: "LIMIT" in win.results.status.text(), timeout=10_000)
-    assert "move to a pose past the elbow's limit failed" in win.results.status.text()
+    assert "move to a pose past the wrist's limit failed" in win.results.status.text()
+    assert wb.motion.motion.value == "refused" and "refused" in win.status_line.motion_label.text()
     process = wb.site.process
     assert process.running
     from PySide6.QtGui import QKeySequence

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
 
+from tests.app.windows import confirm_move_if_asked
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
@@ -51,6 +52,7 @@ def test_a_component_is_added_placed_by_numbers_and_undone_in_one_step(qtbot, wi
 def test_a_feature_named_by_a_click_snaps_to_the_boss_centre_and_the_cell_is_saved(qtbot, window):
     win, wb, panel = window, window.workbench, window.cell_panel
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), wb.task.tcp2base)[0]) < 0.01, timeout=20_000)
     qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
     panel.component.setCurrentText("oru_1_fixture")

@@ -12,6 +12,7 @@ from PySide6.QtCore import QPoint, Qt
 from app.gui.main_window import MainWindow
 from tests.app.windows import window_settings
 from app.gui.workbench import Workbench
+from tests.app.windows import confirm_move_if_asked
 from calib_core.recording.playback import RecordingPlayback
 from calib_core.recording.reader import read_recording
 from calib_core.testbed.sim_site import simulated_cell
@@ -76,6 +77,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
 
     # The robot is not moved while the views show a recording.
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     assert "close the replay before moving the robot" in win.results.status.text()
 
     # Play runs the clock forward.

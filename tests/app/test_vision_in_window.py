@@ -12,6 +12,7 @@ from PySide6.QtCore import Qt
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
 from calib_core.testbed.true_robot import RobotErrors
+from tests.app.windows import confirm_move_if_asked
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
@@ -32,8 +33,12 @@ def _fresh_still_frame(qtbot, win):
 def _visit_board_pose(qtbot, win, k: int) -> None:
     """Next board pose (the k-th of the plan), wait for the controller's done and a frame taken at rest."""
     qtbot.mouseClick(win.vision.next_pose, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)  # a large joint change waits for Move in the overview
     target = win.vision._plan[k]
-    qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
+    try:
+        qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
+    except Exception:
+        raise AssertionError(f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; {win.overview.preview_text.text()}") from None
     _fresh_still_frame(qtbot, win)
     assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3
 
@@ -112,6 +117,7 @@ def test_bad_vision_input_gives_messages(qtbot, window):
     # Capturing while the robot moves: refused, nothing kept.
     vision.show_board.setChecked(True)
     qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
     start = wb.joints_deg.copy()
     qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 0.5, timeout=10_000)
     # a frame the core's rule calls unsettled (what the capture applies)
@@ -139,11 +145,13 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     playback = RecordingPlayback(read_recording(tmp_path / "board.mcap"))
     win.files.open_recording(tmp_path / "board.mcap")
     assert wb.replaying
+    messages = []
     for q in plan:
         # the moment the recorded joints reached this pose, plus a little: frame and joints at rest
         at = next(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
         win.replay.seek(at + wb.workcell.safety.settle_time_s + 0.15)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
-    assert len(vision.capture.views) == 4, [vision.views.item(i).text() for i in range(vision.views.count())]
+        messages.append(win.results.status.text())
+    assert len(vision.capture.views) == 4, ([vision.views.item(i).text() for i in range(vision.views.count())], messages)
     for recorded, q in zip(vision.capture.joints_deg, plan):
         assert np.max(np.abs(recorded - q)) < 1e-3

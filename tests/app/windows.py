@@ -1,6 +1,6 @@
 """Helpers for the window tests."""
 
-from PySide6.QtCore import QSettings
+from PySide6.QtCore import QSettings, Qt
 
 
 def window_settings(folder, name: str = "settings") -> QSettings:
@@ -28,3 +28,13 @@ def pick_pair(wb, component: str, feature, point_world_mm, pixel) -> int:
     wb.pick_model_point(component, feature, point_world_mm)
     wb.pick_image_point(pixel)
     return wb.accept_pair()
+
+
+def confirm_move_if_asked(qtbot, win) -> bool:
+    """Press *Move* in the overview when the previewed move waits for a confirmation (a large joint
+    change); True if it did."""
+    button = win.overview.move_button
+    if win.overview.preview_bar.isVisible() and button.isVisible():
+        qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+        return True
+    return False
