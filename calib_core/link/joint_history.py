@@ -18,8 +18,9 @@ import numpy as np
 
 @dataclass(frozen=True)
 class SettleRule:
-    """The robot counts as still when every joint moves slower than ``speed_deg_s`` (deg/s, or mm/s
-    for a prismatic joint) for ``hold_s`` seconds up to the frame's capture. ``max_gap_s``: the
+    """The robot counts as still when, for ``hold_s`` seconds up to the frame's capture, no joint
+    leaves a band of ``speed_deg_s * hold_s`` (deg, or mm for a prismatic joint): slower than
+    ``speed_deg_s`` on average, and blind to sample-time jitter and encoder noise. ``max_gap_s``: the
     longest gap between samples that still counts as known motion (a longer one: the pose is
     unknown in between)."""
 
@@ -160,28 +161,39 @@ class JointHistory:
         if t_s < times[0]:
             return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
         end = bisect.bisect_right(self._t, t_s)  # samples at or before the capture
-        stop = min(end + 1, len(times))  # and the one after it: the step across the capture counts
+        stop = min(end + 1, len(times))  # and the one after it: the motion across the capture counts
         q = np.array([self._q[k] for k in range(stop)])
-        dt = np.diff(times[:stop])
-        speed = np.abs(np.diff(q, axis=0)) / np.maximum(dt, 1e-9)[:, None] if stop > 1 else np.zeros((0, q.shape[1]))
-        fast = speed.max(axis=1) >= rule.speed_deg_s
-        gap = dt > rule.max_gap_s
-        broken = np.flatnonzero(fast | gap)
-        if not len(broken):
-            still_for = t_s - times[0]
-            if still_for + 1e-9 < rule.hold_s:
-                return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({rule.hold_s:g} s of stillness needed)", still_for)
-            return Stillness(True, "", still_for)
-        b = int(broken[-1])
-        still_for = max(0.0, t_s - times[b + 1])
+        band = rule.speed_deg_s * rule.hold_s
+        # Walk back from the capture while every joint stays within a band of speed x hold and the samples
+        # have no gap: a displacement test, blind to how the samples' times jitter.
+        lo = hi = q[stop - 1]
+        k = stop - 1
+        while k > 0:
+            if times[k] - times[k - 1] > rule.max_gap_s:
+                break
+            new_lo, new_hi = np.minimum(lo, q[k - 1]), np.maximum(hi, q[k - 1])
+            if np.any(new_hi - new_lo > band):
+                break
+            lo, hi, k = new_lo, new_hi, k - 1
+        still_for = max(0.0, t_s - times[k])
         if still_for + 1e-9 >= rule.hold_s:
             return Stillness(True, "", still_for)
-        if fast[b]:
-            joint = int(np.argmax(speed[b]))
-            top = float(speed[b, joint])
-            when = "when the frame was taken" if still_for == 0.0 else f"{still_for:.2f} s before the frame"
-            return Stillness(False, f"the robot was moving {when} ({self._name(joint)} at {top:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)", still_for, top, joint)
-        return Stillness(False, f"the joint samples stop for {dt[b]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen", still_for)
+        if k == 0:
+            return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({rule.hold_s:g} s of stillness needed)", still_for)
+        if times[k] - times[k - 1] > rule.max_gap_s:
+            return Stillness(False, f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen", still_for)
+        # moving: the fastest joint speed in the hold window, over sample pairs >= 0.1 s apart
+        first = max(0, bisect.bisect_left(self._t, t_s - rule.hold_s) - 1)
+        speed, joint = 0.0, 0
+        for a in range(first, stop - 1):
+            b = bisect.bisect_left(self._t, times[a] + 0.1, lo=a + 1, hi=stop)
+            b = min(b, stop - 1)
+            if times[b] > times[a]:
+                v = np.abs(q[b] - q[a]) / (times[b] - times[a])
+                if v.max() > speed:
+                    speed, joint = float(v.max()), int(np.argmax(v))
+        when = "when the frame was taken" if still_for < 0.05 else f"{still_for:.2f} s before the frame"
+        return Stillness(False, f"the robot was moving {when} ({self._name(joint)} at {speed:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)", still_for, speed, joint)
 
     def _name(self, joint: int) -> str:
         return self.joint_names[joint] if joint < len(self.joint_names) else f"joint {joint + 1}"

@@ -120,8 +120,13 @@ def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goa
         warnings.append(f"near a singularity {where} (smallest singular value {singular[k_sing]:.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot")
     contact_step, contacts = None, []
     if world is not None:
-        for k, q in enumerate(path):
-            hits = world.check(q)
+        # Contacts the robot is in already (the tool at its task, on its object) are how it leaves them,
+        # not collisions of the move: said, not refused. A new contact along the path is.
+        at_start = set(world.check(path[0]))
+        if at_start:
+            warnings.append("leaves its contact with " + ", ".join(sorted({c.b[5:] if c.b.startswith("cell/") else c.b for c in at_start})))
+        for k, q in enumerate(path[1:], start=1):
+            hits = [c for c in world.check(q) if c not in at_start]
             if hits:
                 contact_step, contacts = k, hits
                 break

@@ -7,11 +7,12 @@ Times are seconds since the recording's first message (``0 .. duration_s``).
 from __future__ import annotations
 
 import bisect
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from calib_core.calibration.correspondences import Correspondence, pair_from_dict
+from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.reader import RecordedMessage, RecordingContents
 from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC
@@ -68,12 +69,25 @@ class RecordingPlayback:
         for m in self._events[: bisect.bisect_right(self._event_times, t_s)]:
             kind, d = m.payload["kind"], m.payload.get("detail", {})
             if kind in ("pair_added", "pair_changed") and "point_world_mm" in d:
-                pairs[int(d["number"])] = pair_from_dict(d)
+                pair = pair_from_dict(d)
+                if pair.pixel is not None and pair.view is None:
+                    pair = replace(pair, view=self._view_at(self._t(m)))
+                pairs[int(d["number"])] = pair
             elif kind == "pair_removed":
                 pairs.pop(int(d["number"]), None)
             elif kind == "pair_reset":
                 pairs = {int(p["number"]): pair_from_dict(p) for p in d.get("pairs", [])}
         return list(pairs.values())
+
+    def _view_at(self, t_s: float) -> ViewStamp | None:
+        """For a pair recorded without its frame stamp (older recordings): the frame shown and the
+        recorded joints when its image point was picked."""
+        q = self.joints_at(t_s)
+        if q is None:
+            return None
+        i = bisect.bisect_right(self.joint_times_s, t_s) - 1
+        k = self.frame_index_at(t_s)
+        return ViewStamp(-1 if k is None else int(k), float(t_s), tuple(float(v) for v in q), float(t_s - self.joint_times_s[i]), f"{t_s:.3f} s into the recording", "recording (joints at the pick)")
 
     def solve_at(self, t_s: float) -> RecordedSolve | None:
         """The last solve at or before ``t_s``."""

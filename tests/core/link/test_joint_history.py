@@ -4,7 +4,7 @@ settled before it, from the samples alone."""
 import numpy as np
 import pytest
 
-from calib_core.link.joint_history import JointHistory, SettleRule
+from calib_core.link.joint_history import ControllerClock, JointHistory, SettleRule
 
 
 def _ramp(history, t0, t1, q0, q1, rate_hz=50.0):
@@ -50,3 +50,30 @@ def test_encoder_noise_below_the_threshold_is_still_and_a_gap_is_not():
     assert not gap.settled and "may have moved unseen" in gap.reason
     h.forget(1.6)
     assert not h.stillness(1.6).settled and "link dropped" in h.stillness(1.6).reason
+
+
+def test_jittered_sample_times_and_quantised_joints_do_not_make_a_still_robot_move():
+    """Samples that arrive in bursts (0.1 ms apart) with a last-digit flicker of the controller's
+    0.0001 deg: a pairwise speed would be 1 deg/s; the band test sees a still robot."""
+    rng = np.random.default_rng(1)
+    h = JointHistory(rule=SettleRule(speed_deg_s=0.5, hold_s=0.3))
+    t = 0.0
+    for _ in range(60):
+        t += rng.choice([0.0001, 0.02, 0.039])
+        h.add(t, np.round(rng.choice([0.0, 0.0001], 6), 4))
+    assert h.stillness(t).settled
+
+
+def test_the_controller_clock_removes_the_arrival_delay():
+    """Known answer: sent every 20 ms on the controller's clock (offset 100 s), delayed on arrival by
+    5 to 80 ms; the stamps are the send times plus the smallest delay seen (5 ms)."""
+    rng = np.random.default_rng(2)
+    clock = ControllerClock(drift_allowance=0.0)
+    sent = np.arange(200) * 0.02
+    delays = rng.uniform(0.005, 0.08, 200)
+    delays[3] = 0.005
+    stamps = [clock.stamp(100.0 + s + d, s) for s, d in zip(sent, delays)]
+    np.testing.assert_allclose(stamps[3:], 100.0 + sent[3:] + 0.005, atol=1e-12)
+    assert clock.delay_s == pytest.approx(delays[-1] - 0.005)
+    clock.stamp(200.0, 1.0)  # the controller's clock went back: a restart, the estimate starts again
+    assert clock.restarts == 1 and clock.offset_s == pytest.approx(199.0)

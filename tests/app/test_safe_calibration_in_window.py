@@ -1,0 +1,186 @@
+"""The findings of "Safe calibration" through the real window: a restored session's pairs solve with
+their own joints, an implausible result needs a confirmation to be stored, a click while the robot
+moves picks nothing, overlays of an earlier pose are not drawn over the live image, a refused click
+leaves the verdict, a move into an obstacle is refused, a replay solves with the recorded joints, and
+quitting with unsaved work asks."""
+
+import numpy as np
+import trimesh
+from PySide6.QtCore import QPoint, QTimer, Qt
+from PySide6.QtWidgets import QApplication, QMessageBox
+
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert
+from tests.app.windows import confirm_move_if_asked, wait_for_settled_frame
+
+FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
+
+
+def _answer(qtbot, button_text: str) -> list:
+    """Click ``button_text`` in the next modal question (a QMessageBox) as soon as it is up."""
+    answered = []
+
+    def look() -> None:
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox):
+            for b in box.buttons():
+                if b.text().replace("&", "") == button_text:
+                    answered.append(box.text())
+                    b.click()
+                    return
+        QTimer.singleShot(20, look)
+
+    QTimer.singleShot(0, look)
+    return answered
+
+
+def _go(qtbot, win, button) -> None:
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
+    wait_for_settled_frame(qtbot, win)
+
+
+def _pick_features(qtbot, win) -> None:
+    """Pick each feature through the panes (the truth tells the operator's eyes where it is)."""
+    wb = win.workbench
+    fixture = wb.workcell.component("oru_1_fixture")
+    true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
+    win.camera.subpixel.setChecked(False)
+    for name in FEATURES:
+        p = apply(fixture.item2world, fixture.features[name])
+        uv_model = project(apply(invert(wb.model_cam2world()), p[None]), win.virtual.intrinsics, distort=False)[0]
+        x, y = win.virtual.view.image_to_widget(*uv_model)
+        qtbot.mouseClick(win.virtual.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+        uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0]
+        x, y = win.camera.view.image_to_widget(*uv)
+        qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+        qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)
+    assert len(wb.session.pairs.usable()) == len(FEATURES), win.results.status.text()
+
+
+def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale_is_drawn(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    _go(qtbot, win, win.commands.go_task)
+    _pick_features(qtbot, win)
+    assert win.camera.held is not None and "held: frame" in win.camera.info.text()  # picked on a still
+    q_task = np.array(wb.joints_deg)
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    at_task = wb.session.result
+    assert "OK" in win.results.verdict.text()
+    win.files.save_workspace(tmp_path / "w.json")
+    # A refused click (outside the image) says why on its own line; the verdict stays.
+    win.camera.view.set_zoom(0.5)
+    qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(2, 2))
+    assert "outside the camera image" in win.results.status.text() and "OK" in win.results.verdict.text()
+    win.camera.view.reset_view()
+
+    # The robot goes home; the still is let go (untick Hold): the picks and the result are of another pose.
+    win.camera.freeze.setChecked(False)
+    wb.move_joints(wb.cell.home_joints, "home", confirmed=True)
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
+    wait_for_settled_frame(qtbot, win)
+    overlay = win.camera.view.overlay
+    assert "another robot pose" in overlay.banner
+    assert not any(c == (0, 220, 255) for *_, c in [(p[0], p[1], p[2], p[3].getRgb()[:3]) for p in overlay.points])  # no reprojected points
+    # Quit, start again (a new session on the same cell), the robot at home: the workspace's pairs solve as at the task.
+    wb.session.clear()
+    assert win.files.open_workspace(tmp_path / "w.json")
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    restored = wb.session.result
+    np.testing.assert_allclose(restored.displacement_mm, at_task.displacement_mm, atol=1e-9)
+    np.testing.assert_allclose(wb.session.context.joints_deg, q_task, atol=1e-9)
+    assert np.linalg.norm(restored.displacement_mm) < 25.0 and "OK" in win.results.verdict.text()
+
+
+def test_an_implausible_result_is_stored_only_with_a_confirmation(qtbot, window):
+    win, wb = window, window.workbench
+    _go(qtbot, win, win.commands.go_task)
+    _pick_features(qtbot, win)
+    # The pairs solved with the home joints (what the old code did after a restore): 100s of mm off.
+    home = wb.cell.home_joints
+    obj2world = wb.workcell.component("oru_1_fixture").item2world
+    wb.session.calibrate(wb.intrinsics, obj2world, wb.robot.fk(home, "camera"), wb.robot.fk(home, "tcp"), home)
+    assert "IMPLAUSIBLE" in win.results.verdict.text() and "model error of 25 mm" in win.results.verdict.text()
+    asked = _answer(qtbot, "Cancel")
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    assert asked and "not OK" in asked[0] and wb.session.corrections.latest(wb.task.name) is None
+    asked = _answer(qtbot, "Store anyway")
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    stored = wb.session.corrections.latest(wb.task.name)
+    assert asked and stored is not None and stored.verdict == "implausible" and "confirmed in the window by" in stored.confirmation
+
+
+def test_a_click_while_the_robot_moves_picks_nothing(qtbot, window):
+    win, wb = window, window.workbench
+    qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    start = np.array(wb.joints_deg)
+    qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 1.0, timeout=10_000)
+    qtbot.waitUntil(lambda: not wb.observations.stillness(win.camera.last_frame_received).settled, timeout=5_000)
+    fixture = wb.workcell.component("oru_1_fixture")
+    wb.pick_model_point("oru_1_fixture", "pin_tip", apply(fixture.item2world, fixture.features["pin_tip"]))
+    qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(200, 150))
+    assert "nothing picked" in win.results.status.text() and "deg/s" in win.results.status.text()
+    assert wb.session.pairs.pending() is not None and win.camera.held is None
+    assert "moving to" in win.status_line.motion_label.text()
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
+    assert "arrived at" in win.status_line.motion_label.text()
+
+
+def test_a_move_into_an_obstacle_is_refused_and_shown(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    # A crate put where the arm passes on its way to the task location.
+    q_goal = wb.robot.check_joints(__import__("calib_core.robot", fromlist=["solve_ik"]).solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg).q_deg)
+    elbow = wb.robot.fk((np.asarray(wb.joints_deg) + q_goal) / 2, "flange")[:3, 3]
+    trimesh.creation.box((150.0, 150.0, 150.0)).export(tmp_path / "crate.stl")
+    wb.editor.add_component(tmp_path / "crate.stl", "crate")
+    wb.editor.place_component("crate", list(elbow), [0, 0, 0])
+    before = np.array(wb.joints_deg)
+    qtbot.mouseClick(win.commands.go_approach, Qt.MouseButton.LeftButton)
+    assert "collision" in win.results.status.text() and "crate" in win.results.status.text()
+    assert win.overview.preview is not None and win.overview.preview.blocked and "refused" in win.overview.preview_text.text()
+    assert not win.overview.move_button.isVisible()
+    qtbot.wait(300)  # nothing was sent: the robot stays (a move would have started by now)
+    assert np.max(np.abs(wb.joints_deg - before)) < 1e-6 and wb.motion.motion.value == "idle"
+    # Take the crate away (undo): the same move is free, ghosted, and goes.
+    wb.undo()
+    wb.undo()
+    qtbot.mouseClick(win.commands.go_approach, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    assert win.overview.preview is not None and not win.overview.preview.blocked
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
+
+
+def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    _go(qtbot, win, win.commands.go_task)
+    win.files.start_recording(tmp_path / "s.mcap")
+    qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # joint samples and frames flow in
+    _pick_features(qtbot, win)
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    live = wb.session.result.displacement_mm.copy()
+    done = wb.recorder.messages
+    qtbot.waitUntil(lambda: wb.recorder.messages > done + 20, timeout=10_000)
+    win.files.stop_recording()
+    win.camera.freeze.setChecked(False)
+    wb.move_joints(wb.cell.home_joints, "home", confirmed=True)
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
+    win.files.open_recording(tmp_path / "s.mcap")
+    assert win.replay.playback is not None, win.results.status.text()
+    win.replay.seek(win.replay.playback.duration_s)
+    assert all(p.view is not None for p in wb.session.pairs)
+    qtbot.keyClick(win, Qt.Key.Key_F5)  # a solve in the replay: the pairs' recorded joints, not the robot's
+    np.testing.assert_allclose(wb.session.result.displacement_mm, live, atol=1e-9)
+
+
+def test_quit_with_unsaved_work_asks(qtbot, window):
+    win, wb = window, window.workbench
+    win.settings.setValue("window/ask_unsaved", True)
+    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    asked = _answer(qtbot, "Cancel")
+    win.close()
+    assert asked and "not saved" in asked[0] and win.isVisible()
+    asked = _answer(qtbot, "Discard")
+    win.close()
+    assert asked and not win.isVisible() and not wb.site.process.running
