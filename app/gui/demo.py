@@ -121,6 +121,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     skipped: list[str] = []
     refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
     confirmed: list[str] = []  # moves the operator confirmed in the overview (large joint changes)
+    moves_seen: list[str] = []
+    wb.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
@@ -131,10 +133,13 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             return np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]) < 0.01
 
         def settle(what: str) -> None:
-            # a frame the core accepts for picks: captured after the robot had settled (its own rule)
+            # a frame the core accepts for picks (the robot settled before it, its own rule), captured after the
+            # robot arrived: the scripted operator clicks where the features are now, not on an older still
+            since = time.monotonic()
+
             def usable() -> bool:
                 frame = win.camera.last_frame_received
-                return frame is not None and wb.observations.stillness(frame).settled
+                return frame is not None and frame.t_host_s >= since and wb.observations.stillness(frame).settled
 
             _wait(app, usable, 30, f"a camera frame with the robot settled {what}")
             _wait(app, win.virtual.is_current, 10, "the virtual camera")
@@ -173,7 +178,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
                 refined = wb.session.pairs.get(pending.number).pixel
                 if refined is None:
-                    raise RuntimeError(f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}")
+                    h = wb.live.history
+                    tail = [(round(t - h.latest_s, 3), np.round(q, 3).tolist()) for t, q in list(zip(h._t, h._q))[-40::4]]
+                    frame = win.camera.last_frame_received
+                    raise RuntimeError(f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; {wb.motion.text}; "
+                                       f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events {moves_seen}")
                 if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
                     # refinement takes for another corner): clicks it again, refinement off.

@@ -160,6 +160,9 @@ class JointHistory:
             return Stillness(False, f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown", 0.0)
         if t_s < times[0]:
             return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
+        if times[-1] < t_s:
+            # Judged before the samples around the capture have arrived, a frame would be judged on older ones.
+            return Stillness(False, f"waiting for the joint samples of the frame's time (the newest is {t_s - times[-1]:.2f} s older)", 0.0)
         end = bisect.bisect_right(self._t, t_s)  # samples at or before the capture
         stop = min(end + 1, len(times))  # and the one after it: the motion across the capture counts
         q = np.array([self._q[k] for k in range(stop)])

@@ -1,5 +1,7 @@
 """Helpers for the window tests."""
 
+import time
+
 from PySide6.QtCore import QSettings, Qt
 
 
@@ -12,13 +14,14 @@ def window_settings(folder, name: str = "settings") -> QSettings:
 
 
 def wait_for_settled_frame(qtbot, win, timeout_ms: int = 15_000) -> None:
-    """Wait until the camera's newest frame is one the core accepts for picks: the robot had settled
-    before it was captured (the predicate the core applies to a pick)."""
+    """Wait until the camera's newest frame, captured after this call, is one the core accepts for
+    picks: the robot had settled before it was captured (the predicate the core applies to a pick)."""
     wb = win.workbench
+    since = time.monotonic()
 
     def settled() -> bool:
         frame = win.camera.last_frame_received
-        return frame is not None and wb.observations.stillness(frame).settled
+        return frame is not None and frame.t_host_s >= since and wb.observations.stillness(frame).settled
 
     qtbot.waitUntil(settled, timeout=timeout_ms)
 

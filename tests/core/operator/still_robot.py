@@ -29,7 +29,9 @@ def still_for(core, seconds: float = 0.6, joints_deg=None, rate_hz: float = 50.0
 
 
 def frame_now(core, index: int = 0, image=None, t_s: float | None = None) -> Frame:
-    """A camera frame captured at ``t_s`` (default now) given to the core."""
-    frame = Frame(np.zeros((480, 640, 3), np.uint8) if image is None else image, index, time.monotonic() if t_s is None else t_s)
+    """A camera frame captured at ``t_s`` (default: the newest joint sample's time, or now) given to the core."""
+    if t_s is None:
+        t_s = core.observations.history.latest_s or time.monotonic()
+    frame = Frame(np.zeros((480, 640, 3), np.uint8) if image is None else image, index, t_s)
     core.observe_frame(frame)
     return frame
