@@ -22,26 +22,24 @@ from psygnal import Signal
 from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.errors import OperatorError
 from calib_core.link.driver import ControllerLink
 from calib_core.calibration.verdict import ResultVerdict, judge
-from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.link.joint_history import ControllerClock, JointHistory
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
-from calib_core.operator.motion import Motion, MotionState, ended
-from calib_core.operator.move_preview import MoveNeedsConfirmation, MovePreview, MoveRefused, joint_path, preview_move
-from calib_core.robot.collision import CollisionWorld
-from calib_core.operator.observations import HeldFrame, Observations
+from calib_core.operator.motion import Motion, MotionState
+from calib_core.operator.move_preview import joint_path
+from calib_core.operator.observations import Observations
+from calib_core.operator.moves import Moves
+from calib_core.operator.picking import Picking
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
-from calib_core.robot import solve_ik
 from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles):
+class OperatorCore(SessionFiles, Picking, Moves):
     """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
@@ -155,10 +153,6 @@ class OperatorCore(SessionFiles):
                 self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
         self.link_state.emit(f"{state}: {why}")
 
-    def _set_motion(self, state: MotionState) -> None:
-        self.motion = state
-        self.motion_changed.emit(state)
-
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
         self.event.emit(kind, detail)
@@ -193,82 +187,6 @@ class OperatorCore(SessionFiles):
     def link_up(self) -> bool:
         return self.link is not None and self.link.state is LinkState.UP
 
-    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
-        """IK for the TCP target (4, 4) mm in base from the current joints, then a joint move."""
-        q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
-        return self.move_joints(q, what, wait=wait, timeout_s=timeout_s, confirmed=confirmed, allowed_contacts=allowed_contacts)
-
-    def collision_world(self) -> CollisionWorld:
-        """The robot's collision bodies and the cell's components (and what is put up in it, a board)."""
-        if self._collision_world is None or self._collision_version != self.scene_version:
-            self._collision_world = CollisionWorld(self.robot, list(self.workcell.components) + list(self.scene_extras), self.cell.home_joints)
-            self._collision_version = self.scene_version
-        return self._collision_world
-
-    def preview_move(self, q, what: str, allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
-        """The move from the current joints to ``q`` (deg/mm), checked; ``move_previewed`` shows it."""
-        preview = preview_move(self.robot, self.collision_world(), self.joints_deg, q, what, self.workcell.safety, allowed_contacts)
-        self.move_previewed.emit(preview)
-        return preview
-
-    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
-        """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended.
-        The move is previewed first: refused (:class:`MoveRefused`) outside the limits or into a
-        collision, and sent only with ``confirmed`` when it turns a joint further than the cell's
-        ``confirm_joint_change_deg`` (:class:`MoveNeedsConfirmation`)."""
-        if self.replaying:
-            raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
-        if self.link is None:
-            raise CalibrationError("no controller link: connect one first")
-        q = self.robot.check_joints(q)
-        outside = np.flatnonzero(~self.robot.within_limits(q))
-        if len(outside):
-            j = int(outside[0])
-            raise CalibrationError(
-                f"not moving to {what}: joint {self.robot.joint_names[j]} target {q[j]:.2f} {self.robot.joint_units[j]} is outside its limits "
-                f"[{self.robot.lower_limits_deg[j]:g}, {self.robot.upper_limits_deg[j]:g}]"
-            )
-        if self.motion.motion is Motion.UNKNOWN:
-            raise CalibrationError(f"not moving to {what}: the robot's pose is unknown (the link dropped); wait for a fresh joint sample")
-        preview = self.preview_move(q, what, allowed_contacts)
-        if preview.blocked:
-            raise MoveRefused(preview)
-        if preview.needs_confirmation:
-            if not confirmed:
-                raise MoveNeedsConfirmation(preview)
-            self.record_event("move_confirmed", what=what, reasons=list(preview.confirm_reasons))
-        handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
-        if not handle.sent:
-            handle.wait(0)  # raises the link's reason
-        self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
-        self._set_motion(MotionState(Motion.MOVING, what))
-        self._pending_move = (what, handle)
-        handle.on_finished(lambda h: self._call_soon(self._move_ended, what, h))
-        if wait:
-            handle.wait(timeout_s)
-        return handle
-
-    def _move_ended(self, what: str, handle: MoveHandle) -> None:
-        error = handle.error
-        if self.motion.motion is Motion.MOVING and self.motion.what == what:
-            self._set_motion(ended(what, error))
-        self.record_event("move_finished", what=what, error=str(error) if error else "")
-        self.move_finished.emit(what, str(error) if error else "")
-        self.message.emit(f"move to {what} failed: {error}" if error else f"arrived at {what}")
-
-    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False, confirmed: bool = False) -> MoveHandle:
-        if self.task is None:
-            raise CalibrationError("choose a task location first")
-        target = self.task.approach2base if approach else self.task.tcp2base
-        if corrected:
-            if self.session.corrections.latest(self.task.name) is None:
-                raise CalibrationError(f"no stored correction for {self.task.name}: calibrate and store one first")
-            target = self.session.corrections.corrected_target(self.task.name, target)
-        what = f"{self.task.name} ({'approach' if approach else 'task'}{', corrected' if corrected else ''})"
-        # at the task pose itself the tool works on the task's object: touching it is the task
-        allowed = frozenset({self.task.component}) if (not approach and self.task.component) else frozenset()
-        return self.move_to(target, what, wait=wait, confirmed=confirmed, allowed_contacts=allowed)
-
     def set_task_approach(self, name: str, approach_mm: float) -> None:
         """Edit a task location's approach distance (mm): an undoable edit."""
         if abs(self.workcell.task(name).approach_mm - approach_mm) < 1e-9:
@@ -287,112 +205,9 @@ class OperatorCore(SessionFiles):
         self.session.rejudge()  # the task's tolerance is part of the verdict
         self.task_changed.emit(name)
 
-    # --- the pair being made (the paper's Point and Accept) -------------------------------------------
-    def pick_model_point(self, component: str, feature: str | None, point_world_mm) -> int:
-        """*Point*, first half: a point on the target's model (3,) mm in base. A new model pick
-        replaces a pair still waiting for its image point. Returns the pair's number."""
-        pending = self.session.pairs.pending()
-        if pending is not None:
-            self.session.delete(pending.number)
-        self.current_pair = self.session.pick_3d(component, feature, point_world_mm)
-        return self.current_pair
-
-    def pick_image_point(self, pixel) -> int:
-        """*Point*, second half: the same point on the camera image (u, v) px. Until *Accept*, a
-        second click moves it. The pick is made on the held frame; the first pick of a set holds
-        the newest one, and only when the robot had settled before it (else
-        :class:`~calib_core.operator.observations.NotSettledError`, nothing picked)."""
-        session = self.session
-        pending = session.pairs.pending()
-        moving = pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
-        if pending is None and not moving:
-            session.pick_2d(pixel)  # raises with what to do instead
-        view = self._view_for_pick(self.current_pair if moving else pending.number)
-        if moving:
-            session.move_2d(self.current_pair, pixel, view)
-        else:
-            self.current_pair = session.pick_2d(pixel, view)
-        return self.current_pair
-
-    def _view_for_pick(self, number: int) -> ViewStamp:
-        held = self.observations.still
-        if held is None:
-            held = self.hold_frame()
-        others = [p for p in self.session.pairs if p.complete and p.number != number]
-        self.check_same_state(others, held.stamp)
-        return held.stamp
-
-    def check_same_state(self, pairs, view: ViewStamp | None = None) -> None:
-        """Refuse pairs from different robot states: each with ``view`` (or with the first)."""
-        stamped = [p for p in pairs if p.view is not None]
-        reference = view or (stamped[0].view if stamped else None)
-        if reference is None:
-            return
-        other = [p for p in stamped if not p.view.same_state(reference)]
-        if other:
-            worst = max(other, key=lambda p: p.view.joint_difference(reference))
-            names = ", ".join(str(p.number) for p in other)
-            raise CalibrationError(
-                f"pair{'s' if len(other) > 1 else ''} {names} {'were' if len(other) > 1 else 'was'} picked with the robot at another pose "
-                f"(a joint differs by {worst.view.joint_difference(reference):.2f} deg from {reference.label}): "
-                "one set of pairs must come from one robot pose. Delete them (or Clear), or go back to that pose"
-            )
-
-    # --- frames ---------------------------------------------------------------------------------
-    def hold_frame(self) -> HeldFrame:
-        """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
-        held = self.observations.hold()
-        self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
-        self.still_changed.emit(held)
-        return held
-
-    def stamp_frame(self, frame) -> ViewStamp:
-        """``frame``'s stamp (its joints at capture), refused while the robot was not settled."""
-        return self.observations.stamp(frame)
-
-    def release_frame(self) -> None:
-        """Back to the live image for picking (the pairs keep their stamps)."""
-        if self.observations.still is not None:
-            self.observations.release()
-            self.still_changed.emit(None)
-
-    def _release_unused_still(self, *_) -> None:
-        if self.observations.still is not None and not any(p.complete for p in self.session.pairs):
-            self.release_frame()
-
-    def robot_settled(self):
-        """Whether the robot is still now (a :class:`~calib_core.link.joint_history.Stillness`), from
-        the newest frame's time (or the newest sample's)."""
-        obs = self.observations
-        t = obs.latest.t_host_s if obs.latest is not None else obs.history.latest_s
-        if t is None:
-            return obs.history.stillness(time.monotonic())
-        return obs.history.stillness(t)
-
     def _judge(self, estimate) -> ResultVerdict:
         tolerance = self.task.tolerance_mm if self.task is not None else None
         return judge(estimate, self.workcell.safety, tolerance) if tolerance is not None else judge(estimate, self.workcell.safety)
-
-    def accept_pair(self) -> int:
-        """*Accept*: the pair being made is done. Returns its number."""
-        pending = self.session.pairs.pending()
-        if pending is not None:
-            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
-        if self.current_pair is None:
-            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
-        number, self.current_pair = self.current_pair, None
-        self.record_event("pair_accepted", number=number)
-        return number
-
-    def delete_pair(self, number: int | None = None) -> int:
-        """Delete pair ``number`` (default: the pair being made). Undoable."""
-        number = number if number is not None else self.current_pair
-        if number is None:
-            raise OperatorError("select a pair in the table to delete it")
-        self.session.delete(number)
-        if number == self.current_pair:
-            self.current_pair = None
-        return number
 
     def undo(self) -> str | None:
         """Undo the last edit (its label, None if there was none); the pair being made is let go."""
@@ -413,25 +228,6 @@ class OperatorCore(SessionFiles):
 
     def model_tcp2base(self) -> np.ndarray:
         return self.robot.fk(self.joints_deg, "tcp")
-
-    def observe_frame(self, frame, *, replayed: bool = False) -> None:
-        """A camera frame arrived: from the camera (the window's worker, a command-line loop) or,
-        with ``replayed``, from the recording being replayed. Live frames are ignored during a replay."""
-        if self.replaying != replayed:
-            return
-        self.observations.observe(frame)
-        self.frame_observed.emit(frame)
-
-    def begin_replay(self, history: JointHistory, name: str) -> None:
-        """A recording is being replayed: its frames and joints stand in for the live ones."""
-        self.release_frame()
-        self.replaying = True
-        self.observations = Observations(history, source=name)
-
-    def end_replay(self) -> None:
-        self.release_frame()
-        self.replaying = False
-        self.observations = self.live
 
     # --- calibration -------------------------------------------------------------------------
     def calibrate(self):

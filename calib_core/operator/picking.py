@@ -1,0 +1,142 @@
+"""The paper's *Point* and *Accept* on frames bound to the robot state they were captured in.
+
+A mixin of :class:`~calib_core.operator.core.OperatorCore`. Frames arrive through
+:meth:`Picking.observe_frame` (live, or from a recording being replayed); the first image pick of
+a set holds the newest frame, only when the robot had settled before it; every image pick
+carries that frame's :class:`~calib_core.calibration.view_stamp.ViewStamp`; pairs of two robot
+poses are refused.
+"""
+
+from __future__ import annotations
+
+import time
+
+from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.view_stamp import ViewStamp
+from calib_core.errors import OperatorError
+from calib_core.link.joint_history import JointHistory
+from calib_core.operator.observations import HeldFrame, Observations
+
+
+class Picking:
+    """Frames, the held still and the pair being made."""
+
+    def pick_model_point(self, component: str, feature: str | None, point_world_mm) -> int:
+        """*Point*, first half: a point on the target's model (3,) mm in base. A new model pick
+        replaces a pair still waiting for its image point. Returns the pair's number."""
+        pending = self.session.pairs.pending()
+        if pending is not None:
+            self.session.delete(pending.number)
+        self.current_pair = self.session.pick_3d(component, feature, point_world_mm)
+        return self.current_pair
+
+    def pick_image_point(self, pixel) -> int:
+        """*Point*, second half: the same point on the camera image (u, v) px. Until *Accept*, a
+        second click moves it. The pick is made on the held frame; the first pick of a set holds
+        the newest one, and only when the robot had settled before it (else
+        :class:`~calib_core.operator.observations.NotSettledError`, nothing picked)."""
+        session = self.session
+        pending = session.pairs.pending()
+        moving = pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
+        if pending is None and not moving:
+            session.pick_2d(pixel)  # raises with what to do instead
+        view = self._view_for_pick(self.current_pair if moving else pending.number)
+        if moving:
+            session.move_2d(self.current_pair, pixel, view)
+        else:
+            self.current_pair = session.pick_2d(pixel, view)
+        return self.current_pair
+
+    def _view_for_pick(self, number: int) -> ViewStamp:
+        held = self.observations.still
+        if held is None:
+            held = self.hold_frame()
+        others = [p for p in self.session.pairs if p.complete and p.number != number]
+        self.check_same_state(others, held.stamp)
+        return held.stamp
+
+    def check_same_state(self, pairs, view: ViewStamp | None = None) -> None:
+        """Refuse pairs from different robot states: each with ``view`` (or with the first)."""
+        stamped = [p for p in pairs if p.view is not None]
+        reference = view or (stamped[0].view if stamped else None)
+        if reference is None:
+            return
+        other = [p for p in stamped if not p.view.same_state(reference)]
+        if other:
+            worst = max(other, key=lambda p: p.view.joint_difference(reference))
+            names = ", ".join(str(p.number) for p in other)
+            raise CalibrationError(
+                f"pair{'s' if len(other) > 1 else ''} {names} {'were' if len(other) > 1 else 'was'} picked with the robot at another pose "
+                f"(a joint differs by {worst.view.joint_difference(reference):.2f} deg from {reference.label}): "
+                "one set of pairs must come from one robot pose. Delete them (or Clear), or go back to that pose"
+            )
+
+    def hold_frame(self) -> HeldFrame:
+        """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
+        held = self.observations.hold()
+        self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
+        self.still_changed.emit(held)
+        return held
+
+    def stamp_frame(self, frame) -> ViewStamp:
+        """``frame``'s stamp (its joints at capture), refused while the robot was not settled."""
+        return self.observations.stamp(frame)
+
+    def release_frame(self) -> None:
+        """Back to the live image for picking (the pairs keep their stamps)."""
+        if self.observations.still is not None:
+            self.observations.release()
+            self.still_changed.emit(None)
+
+    def _release_unused_still(self, *_) -> None:
+        if self.observations.still is not None and not any(p.complete for p in self.session.pairs):
+            self.release_frame()
+
+    def robot_settled(self):
+        """Whether the robot is still now (a :class:`~calib_core.link.joint_history.Stillness`), from
+        the newest frame's time (or the newest sample's)."""
+        obs = self.observations
+        t = obs.latest.t_host_s if obs.latest is not None else obs.history.latest_s
+        if t is None:
+            return obs.history.stillness(time.monotonic())
+        return obs.history.stillness(t)
+
+    def accept_pair(self) -> int:
+        """*Accept*: the pair being made is done. Returns its number."""
+        pending = self.session.pairs.pending()
+        if pending is not None:
+            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
+        if self.current_pair is None:
+            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
+        number, self.current_pair = self.current_pair, None
+        self.record_event("pair_accepted", number=number)
+        return number
+
+    def delete_pair(self, number: int | None = None) -> int:
+        """Delete pair ``number`` (default: the pair being made). Undoable."""
+        number = number if number is not None else self.current_pair
+        if number is None:
+            raise OperatorError("select a pair in the table to delete it")
+        self.session.delete(number)
+        if number == self.current_pair:
+            self.current_pair = None
+        return number
+
+    def observe_frame(self, frame, *, replayed: bool = False) -> None:
+        """A camera frame arrived: from the camera (the window's worker, a command-line loop) or,
+        with ``replayed``, from the recording being replayed. Live frames are ignored during a replay."""
+        if self.replaying != replayed:
+            return
+        self.observations.observe(frame)
+        self.frame_observed.emit(frame)
+
+    def begin_replay(self, history: JointHistory, name: str) -> None:
+        """A recording is being replayed: its frames and joints stand in for the live ones."""
+        self.release_frame()
+        self.replaying = True
+        self.observations = Observations(history, source=name)
+
+    def end_replay(self) -> None:
+        self.release_frame()
+        self.replaying = False
+        self.observations = self.live
