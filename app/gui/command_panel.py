@@ -130,6 +130,8 @@ class CommandPanel(QTabWidget):
         self.go_uncorrected = _button("Go to task, uncorrected", "go_uncorrected")
         el.addWidget(self.go_corrected)
         el.addWidget(self.go_uncorrected)
+        self.verify = _button("Verify: look again", "verify", "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree")
+        el.addWidget(self.verify)
         self.corrections = QLabel("No corrections stored.")
         self.corrections.setWordWrap(True)
         el.addWidget(self.corrections)

@@ -169,6 +169,7 @@ class MainWindow(QMainWindow):
         c.go_task.clicked.connect(lambda: self._go(approach=False))
         c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
         c.go_uncorrected.clicked.connect(lambda: self._go(approach=False, corrected=False))
+        c.verify.clicked.connect(self.report(self._verify))
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self._add_location))
         c.live.toggled.connect(self._live_toggled)
@@ -265,6 +266,10 @@ class MainWindow(QMainWindow):
         result = self.workbench.calibrate()
         s = result.solution
         self.statusBar().showMessage(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)
+
+    def _verify(self) -> None:
+        v = self.workbench.verify()
+        self.results.show_message(v.text, ok=v.agree)
 
     def _store(self) -> None:
         self.report(self._store_impl)()
@@ -369,7 +374,13 @@ class MainWindow(QMainWindow):
         lines = []
         for task in table.tasks():
             c = table.latest(task)
-            lines.append(f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored)")
+            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored"
+            line += f", {c.verdict} confirmed)" if c.confirmation else ")"
+            looks = table.verifications(task)
+            if looks:
+                v = looks[-1]
+                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), looks {'agree' if v.agree else 'DISAGREE'}"
+            lines.append(line)
         self.commands.corrections.setText("\n".join(lines) or "No corrections stored.")
 
     def _update_status(self) -> None:

@@ -89,6 +89,10 @@ class ResultsPanel(QWidget):
     def _choose(self, index: int, *_) -> None:
         self.candidate_chosen.emit(index)
 
+    def show_message(self, text: str, ok: bool = True) -> None:
+        """A step's outcome on the message line (green, or orange when it found a problem)."""
+        self.status.setText(f"<span style='color:{'#5fd35f' if ok else '#ffb347'}'>{html.escape(text, quote=False)}</span>")
+
     def show_error(self, text: str) -> None:
         self.status.setText(f"<span style='color:#ff6b6b'>{html.escape(text, quote=False)}</span>")
 

@@ -51,6 +51,24 @@ class CorrectionTable:
 
     def __init__(self) -> None:
         self._table: dict[str, list[Correction]] = {}
+        self._verifications: dict[str, list] = {}
+
+    def add_verification(self, verification) -> None:
+        """A second look after executing a correction (a
+        :class:`~calib_core.calibration.verification.Verification`), kept with the location's history."""
+        self._verifications.setdefault(verification.task, []).append(verification)
+        self.changed.emit(verification.task)
+
+    def replace_with(self, other: CorrectionTable) -> None:
+        """Every correction and verification of ``other`` in place of this table's (a workspace opened)."""
+        tasks = set(self._table) | set(other._table) | set(self._verifications) | set(other._verifications)
+        self._table = {t: list(h) for t, h in other._table.items()}
+        self._verifications = {t: list(v) for t, v in other._verifications.items()}
+        for task in sorted(tasks):
+            self.changed.emit(task)
+
+    def verifications(self, task: str) -> list:
+        return list(self._verifications.get(task, []))
 
     def add(self, correction: Correction) -> None:
         self._table.setdefault(correction.task, []).append(correction)

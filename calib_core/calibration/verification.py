@@ -10,7 +10,8 @@ when the correction predicted where the tool went: the real tool at the correcte
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -32,6 +33,7 @@ class Verification:
     agree_within_mm: float
     rms_px: float
     pairs: int
+    time_s: float = field(default_factory=time.time)
 
     @property
     def agree(self) -> bool:

@@ -24,6 +24,8 @@ from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.link.driver import ControllerLink
 from calib_core.calibration.verdict import ResultVerdict, judge
+from calib_core.calibration.verification import Verification, verify
+from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.link.joint_history import ControllerClock, JointHistory
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
@@ -260,6 +262,30 @@ class OperatorCore(SessionFiles, Picking, Moves):
         self.correction_stored.emit(c)
         self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
         return c
+
+    def verify(self) -> Verification:
+        """*Verify*: after executing the task with its correction, solve the pairs picked from there and
+        report the tool's remaining error against the task location with its 1-sigma, and whether this look
+        agrees with the one the correction came from. Kept in the correction table's history."""
+        task = self.task
+        if task is None:
+            raise CalibrationError("choose the task location to verify")
+        correction = self.session.corrections.latest(task.name)
+        if correction is None:
+            raise CalibrationError(f"no stored correction for {task.name}: calibrate, store and execute one first")
+        executed = f"{task.name} (task, corrected)"
+        if self.motion.motion is not Motion.ARRIVED or self.motion.what != executed:
+            raise CalibrationError(f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({self.motion.text})")
+        use = self.session.pairs.usable()
+        here = [p for p in use if p.view is not None and np.max(np.abs(np.array(p.view.joints_deg) - self.joints_deg)) <= SAME_STATE_DEG]
+        if len(here) != len(use) or not use:
+            raise CalibrationError("the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify")
+        look = self.calibrate()
+        v = verify(task.name, task.tcp2base, correction, look)
+        self.session.corrections.add_verification(v)
+        self.record_event("verified", task=task.name, remaining_mm=v.remaining_mm.tolist(), std_remaining_mm=v.std_remaining_mm.tolist(), disagreement_mm=v.disagreement_mm, agree=v.agree)
+        self.message.emit(v.text)
+        return v
 
     def apply_hand_eye_file(self, path) -> None:
         """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""

@@ -33,12 +33,7 @@ class SessionFiles:
             self.session.set_target(ws.target)
         self.session.pairs.replace_all(ws.pairs)
         self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
-        for task in self.session.corrections.tasks():
-            while self.session.corrections.latest(task) is not None:
-                self.session.corrections.remove_last(task)
-        for task in ws.corrections.tasks():
-            for c in ws.corrections.history(task):
-                self.session.corrections.add(c)
+        self.session.corrections.replace_with(ws.corrections)
         self.session.undo.clear()
         self.message.emit(f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations")
 

@@ -20,6 +20,7 @@ from calib_core import __version__
 from calib_core.atomic_file import atomic_write_text
 from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.calibration.correspondences import Correspondence, pair_to_dict
+from calib_core.calibration.verification import Verification
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import FileFormatError
@@ -76,7 +77,13 @@ def workspace_to_dict(ws: Workspace) -> dict:
         "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tolerance_mm": t.tolerance_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
         "pairs": [pair_to_dict(p) for p in ws.pairs],
         "corrections": [_correction_dict(c) for task in ws.corrections.tasks() for c in ws.corrections.history(task)],
+        "verifications": [_verification_dict(v) for task in ws.corrections.tasks() for v in ws.corrections.verifications(task)],
     }
+
+
+def _verification_dict(v: Verification) -> dict:
+    return {"task": v.task, "time_s": v.time_s, "remaining_mm": v.remaining_mm.tolist(), "remaining_deg": v.remaining_deg.tolist(), "std_remaining_mm": v.std_remaining_mm.tolist(),
+            "disagreement_mm": v.disagreement_mm, "agree_within_mm": v.agree_within_mm, "rms_px": v.rms_px, "pairs": v.pairs}
 
 
 def save_workspace(path: str | Path, ws: Workspace) -> None:
@@ -188,4 +195,13 @@ def load_workspace(path: str | Path) -> Workspace:
             verdict=str(c.get("verdict", "ok")),
             confirmation=str(c.get("confirmation", "")),
         ))
+    for i, v in enumerate(data.get("verifications", []) or []):
+        where = f"verifications[{i}]"
+        try:
+            table.add_verification(Verification(
+                str(v["task"]), np.asarray(v["remaining_mm"], float).reshape(3), np.asarray(v["remaining_deg"], float).reshape(3),
+                np.asarray(v["std_remaining_mm"], float).reshape(3), float(v["disagreement_mm"]), float(v["agree_within_mm"]), float(v["rms_px"]), int(v["pairs"]), float(v.get("time_s", 0.0)),
+            ))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise f.fail(where, f"not a verification: {exc}") from None
     return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)), cell)

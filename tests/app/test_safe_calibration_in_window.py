@@ -185,3 +185,36 @@ def test_quit_with_unsaved_work_asks(qtbot, window):
     asked = _answer(qtbot, "Discard")
     win.close()
     assert asked and not win.isVisible() and not wb.site.process.running
+
+
+def test_verify_looks_again_after_executing_the_correction(qtbot, window, tmp_path):
+    from calib_core.frames import pose_difference
+
+    win, wb = window, window.workbench
+    qtbot.mouseClick(win.commands.verify, Qt.MouseButton.LeftButton)
+    assert "no stored correction" in win.results.status.text()
+    _go(qtbot, win, win.commands.go_task)
+    _pick_features(qtbot, win)
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(win.commands.verify, Qt.MouseButton.LeftButton)
+    assert "execute the task with its correction first" in win.results.status.text()
+    _go(qtbot, win, win.commands.go_corrected)
+    qtbot.mouseClick(win.commands.verify, Qt.MouseButton.LeftButton)
+    assert "not picked from where the robot stands now" in win.results.status.text()
+    qtbot.mouseClick(win.commands.clear, Qt.MouseButton.LeftButton)
+    _pick_features(qtbot, win)
+    qtbot.mouseClick(win.commands.verify, Qt.MouseButton.LeftButton)
+    v = wb.session.corrections.verifications(wb.task.name)[-1]
+    assert "the two looks agree" in win.results.status.text() and v.agree
+    # Scored by the truth: the remaining error it reports is the real tool's, within its stated 3-sigma
+    # (the clicks are whole screen pixels, about 1 px of the image).
+    true_remaining, _ = pose_difference(wb.site.bed.true_robot.fk(wb.joints_deg), wb.task.tcp2base)
+    assert np.linalg.norm(v.remaining_mm - true_remaining) < 3.0 * np.linalg.norm(v.std_remaining_mm)
+    assert np.linalg.norm(true_remaining) < wb.task.tolerance_mm
+    assert "verified:" in win.commands.corrections.text()
+    # The history is kept in the workspace.
+    win.files.save_workspace(tmp_path / "w.json")
+    from calib_core.workspace.workspace import load_workspace
+
+    assert len(load_workspace(tmp_path / "w.json").corrections.verifications(wb.task.name)) == 1
