@@ -14,6 +14,7 @@ import numpy as np
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QPushButton, QVBoxLayout, QWidget
 
+from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.camera.intrinsics_io import save_intrinsics
 from calib_core.frames import pose_difference
@@ -22,6 +23,7 @@ from calib_core.vision.capture import BoardCapture
 from calib_core.vision.hand_eye import HandEyeCalibration
 from calib_core.vision.hand_eye_io import save_hand_eye
 from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
+from calib_core.vision.result_checks import hand_eye_problems, intrinsics_problems, views_with_lost_corners
 from calib_core.errors import OperatorError
 
 def _button(text: str, name: str, tip: str) -> QPushButton:
@@ -47,6 +49,9 @@ class VisionPanel(QWidget):
         self.capture: BoardCapture | None = None
         self.intrinsics_result: IntrinsicsCalibration | None = None
         self.hand_eye_result: HandEyeCalibration | None = None
+        self._intrinsics_text = ""  # both results stay on screen, one under the other
+        self._hand_eye_text = ""
+        self.hand_eye_problems: list[str] = []
         self._plan: list[np.ndarray] = []
         self._plan_index = 0
 
@@ -164,7 +169,9 @@ class VisionPanel(QWidget):
             self._report(f"{view.name} rejected: {view.reason}")
         else:
             self._show_corners(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
-            self._report(f"{view.name}: {len(view.ids)} corners" + ("" if joints is not None else " (no robot pose: not usable for hand-eye)"))
+            lost = views_with_lost_corners([len(v.ids) for v in self.capture.views]).get(len(self.capture.views) - 1)
+            self._report(f"{view.name}: {len(view.ids)} corners" + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
+                         + ("" if lost is None else f"; it lost corners against its neighbours ({lost:.0f}): look at it, remove it if the board was cut off or blurred"))
         self._refresh()
 
     def _remove_selected(self) -> None:
@@ -177,8 +184,10 @@ class VisionPanel(QWidget):
     def _refresh(self) -> None:
         c = self.capture
         self.views.clear()
-        for v, q in zip(c.views, c.joints_deg):
-            self.views.addItem(f"{v.name}: {len(v.ids)} corners" + ("" if q is not None else ", no robot pose"))
+        lost = views_with_lost_corners([len(v.ids) for v in c.views])
+        for k, (v, q) in enumerate(zip(c.views, c.joints_deg)):
+            flag = f", lost corners ({len(v.ids)} where its neighbours have {lost[k]:.0f})" if k in lost else ""
+            self.views.addItem(f"{v.name}: {len(v.ids)} corners" + ("" if q is not None else ", no robot pose") + flag)
             self.views.item(self.views.count() - 1).setData(Qt.ItemDataRole.UserRole, v.name)
         for r in c.rejected:
             self.views.addItem(f"x {r.name}: {r.reason}")
@@ -202,8 +211,13 @@ class VisionPanel(QWidget):
             "k1 k2 p1 p2 k3: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
         ]
         lines += [f"&bull; {a}" for a in r.advice]
-        self.result.setText("<br>".join(lines))
+        lines += [f"<span style='color:#e0a030'>check: {p}</span>" for p in intrinsics_problems(r, self.workbench.intrinsics)]
+        self._intrinsics_text = "<br>".join(lines)
+        self._show_results()
         self._refresh()
+
+    def _show_results(self) -> None:
+        self.result.setText("<br><br>".join(t for t in (self._intrinsics_text, self._hand_eye_text) if t))
 
     def calibrate_hand_eye(self) -> None:
         intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
@@ -215,18 +229,36 @@ class VisionPanel(QWidget):
             "position " + ", ".join(f"{v:.2f}" for v in r.cam2flange[:3, 3]) + " mm (1-sigma " + ", ".join(f"{v:.3f}" for v in r.std_xyz_mm) + ")",
             f"differs from the model by {np.linalg.norm(d):.2f} mm and {np.linalg.norm(rot):.3f} deg",
         ]
-        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in r.warnings]
-        self.result.setText("<br>".join(lines))
+        noise = self.intrinsics_result.rms_px if self.intrinsics_result is not None else None
+        self.hand_eye_problems = hand_eye_problems(r, (float(np.linalg.norm(d)), float(np.linalg.norm(rot))), noise, self.workbench.workcell.safety)
+        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in self.hand_eye_problems]
+        self._hand_eye_text = "<br>".join(lines)
+        self._show_results()
         self._refresh()
+
+    def _confirmed(self, what: str, problems: list[str]) -> bool:
+        """A result that fails its own checks is applied only when the operator says so (recorded)."""
+        if not problems:
+            return True
+        text = "\n".join([f"The {what} failed its checks:", *[f"- {p}" for p in problems], "", f"Use this {what} anyway?"])
+        if not ask(self, f"Apply a {what} that failed its checks?", text, "Apply anyway"):
+            self._report(f"{what} not applied")
+            return False
+        self.workbench.record_event("vision_result_confirmed", what=what, problems=problems)
+        return True
 
     def apply_intrinsics(self) -> None:
         if self.intrinsics_result is None:
             raise OperatorError("calibrate the intrinsics first")
+        if not self._confirmed("intrinsics calibration", intrinsics_problems(self.intrinsics_result, self.workbench.intrinsics)):
+            return
         self.workbench.apply_intrinsics(self.intrinsics_result.intrinsics, f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)")
 
     def apply_hand_eye(self) -> None:
         if self.hand_eye_result is None:
             raise OperatorError("calibrate the hand-eye first")
+        if not self._confirmed("camera mounting", self.hand_eye_problems):
+            return
         self.workbench.apply_cam2flange(self.hand_eye_result.cam2flange, f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)")
 
     def save_intrinsics(self, path, fmt: str = "opencv") -> None:

@@ -155,3 +155,29 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     assert len(vision.capture.views) == 4, ([vision.views.item(i).text() for i in range(vision.views.count())], messages)
     for recorded, q in zip(vision.capture.joints_deg, plan):
         assert np.max(np.abs(recorded - q)) < 1e-3
+
+
+def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, live_window):
+    """A robot with its typical kinematic errors: the views disagree (hand-eye takes the kinematics as
+    exact), so Apply mounting asks first; the intrinsics result stays on screen under the hand-eye."""
+    from tests.app.test_safe_calibration_in_window import _answer
+
+    win = live_window(RobotErrors.typical(0))
+    wb, vision = win.workbench, win.vision
+    vision.show_board.setChecked(True)
+    for k in range(5):
+        _visit_board_pose(qtbot, win, k)
+        qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(vision.calibrate_hand_eye_button, Qt.MouseButton.LeftButton)
+    assert "Intrinsics" in vision.result.text() and "Camera mounting" in vision.result.text()
+    assert vision.hand_eye_problems and "do not agree" in " ".join(vision.hand_eye_problems)
+    before = wb.robot.frame_placement("camera").copy()
+    asked = _answer(qtbot, "Cancel")
+    qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
+    assert asked and "failed its checks" in asked[0] and np.array_equal(wb.robot.frame_placement("camera"), before)
+    events = []
+    wb.event.connect(lambda kind, detail: events.append(kind))
+    asked = _answer(qtbot, "Apply anyway")
+    qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
+    assert asked and not np.array_equal(wb.robot.frame_placement("camera"), before) and "vision_result_confirmed" in events
