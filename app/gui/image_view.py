@@ -104,8 +104,8 @@ class ImageView(QWidget):
     def image_array(self) -> np.ndarray | None:
         return self._array
 
-    def set_inset(self, array: np.ndarray | None, label: str = "", width_px: int = 220) -> None:
-        """A small second image in the top-right corner (the live video while a still is held)."""
+    def set_inset(self, array: np.ndarray | None, label: str = "", width_px: int = 180) -> None:
+        """A small second image in the bottom-right corner (the live video while a still is held)."""
         if array is None:
             self._inset = None
         else:
@@ -213,17 +213,23 @@ class ImageView(QWidget):
             p.setPen(QColor(230, 230, 230))
             p.drawText(QRectF(8, 6, self.width() - 16, 40), Qt.AlignmentFlag.AlignLeft, self.overlay.text)
         if self.overlay.banner:
-            box = QRectF(0, self.height() - 26, self.width(), 26)
+            flags = int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter) | int(Qt.TextFlag.TextWordWrap)
+            needed = p.boundingRect(QRectF(8, 0, self.width() - 16, 1000), flags, self.overlay.banner).height() + 8
+            box = QRectF(0, self.height() - needed, self.width(), needed)
             p.fillRect(box, QColor(120, 70, 0, 220))
             p.setPen(QColor(255, 235, 200))
-            p.drawText(box.adjusted(8, 0, -8, 0), Qt.AlignmentFlag.AlignVCenter | Qt.AlignmentFlag.AlignLeft, self.overlay.banner)
+            p.drawText(box.adjusted(8, 0, -8, 0), flags, self.overlay.banner)
         if self._inset is not None:
             w, h = self._inset.width(), self._inset.height()
-            box = QRectF(self.width() - w - 8, 8, w, h)
-            p.drawImage(box, self._inset)
-            p.setPen(QPen(QColor(255, 214, 10), 1.5))
-            p.drawRect(box)
-            p.drawText(box.adjusted(4, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop, self._inset_label)
+            box = QRectF(self.width() - w - 8, self.height() - h - 34, w, h)
+            # The inset steps aside while the cursor is over it: a pick under it stays possible.
+            if self._mouse is None or not box.contains(self._mouse) or not self.underMouse():
+                p.setOpacity(0.9)
+                p.drawImage(box, self._inset)
+                p.setOpacity(1.0)
+                p.setPen(QPen(QColor(255, 214, 10), 1.5))
+                p.drawRect(box)
+                p.drawText(box.adjusted(4, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop, self._inset_label)
 
     def _paint_crosshair(self, p: QPainter) -> None:
         u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())

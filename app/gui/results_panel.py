@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWi
 
 from app.gui.workbench import Workbench
 from calib_core.calibration.verdict import Verdict
+from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.solver import SolveStatus
 
 _VERDICT_COLORS = {Verdict.OK: "#5fd35f", Verdict.AMBIGUOUS: "#ffb347", Verdict.UNCERTAIN: "#ffb347", Verdict.IMPLAUSIBLE: "#ff8c42", Verdict.FAILED: "#ff6b6b"}
@@ -85,6 +86,20 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.chart, 1)
         workbench.session.changed.connect(self.refresh)
         workbench.session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
+        self._elsewhere = False
+        workbench.joints_changed.connect(self._joints_changed)
+
+    def _solved_elsewhere(self) -> bool:
+        """The last result was solved from another robot pose than the robot's now."""
+        context = self.workbench.session.context
+        if context is None or context.joints_deg is None or self.workbench.session.result is None:
+            return False
+        now = np.asarray(self.workbench.joints_deg, float)
+        return context.joints_deg.shape != now.shape or float(np.max(np.abs(context.joints_deg - now))) > SAME_STATE_DEG
+
+    def _joints_changed(self, _q) -> None:
+        if self._solved_elsewhere() != self._elsewhere:
+            self.refresh()
 
     def _choose(self, index: int, *_) -> None:
         self.candidate_chosen.emit(index)
@@ -124,6 +139,9 @@ class ResultsPanel(QWidget):
                 text += " - " + html.escape("; ".join(reasons), quote=False)
         for w in sol.warnings:
             text += f"<br><span style='color:#ccb'>note: {html.escape(w, quote=False)}</span>"
+        self._elsewhere = self._solved_elsewhere()
+        if self._elsewhere:
+            text += "<br><span style='color:#ff9a30'>solved from another robot pose than the robot's now (the pairs' frame): it describes that pose</span>"
         self.verdict.setText(text)
         d, rv, sd, sr = r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
         cam = r.cam2world_measured[:3, 3]

@@ -31,7 +31,9 @@ class StatusLine:
         self.pairs_label = QLabel("pairs: 0")
         self.motion_label = QLabel("robot: no move yet")
         self.motion_label.setObjectName("motion")
-        for w in (self.motion_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
+        self.settled_label = QLabel("")
+        self.settled_label.setObjectName("settled")
+        for w in (self.motion_label, self.settled_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
             bar.addPermanentWidget(w)
         workbench.motion_changed.connect(self.show_motion)
         self._samples_then: tuple[float, int] | None = None
@@ -61,6 +63,7 @@ class StatusLine:
             if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)
+        self._show_settled()
         rec = self.workbench.recorder
         self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
 
@@ -69,6 +72,17 @@ class StatusLine:
         color = {"moving": "#9ad0ff", "arrived": "#5fd35f", "refused": "#ff6b6b", "failed": "#ff6b6b", "unknown": "#ff9a30"}.get(state.motion.value)
         self.motion_label.setText(f"<span style='color:{color}'>{html.escape(state.text, quote=False)}</span>" if color else html.escape(state.text))
         self.motion_label.setToolTip(state.text)
+        self._show_settled()
+
+    def _show_settled(self) -> None:
+        """Whether the newest frame can be picked on: the settle rule, from the joint samples."""
+        wb = self.workbench
+        if wb.link is None and not wb.replaying:
+            self.settled_label.setText("")
+            return
+        still = wb.robot_settled()
+        self.settled_label.setText("<span style='color:#5fd35f'>settled</span>" if still.settled else "<span style='color:#ff9a30'>not settled</span>")
+        self.settled_label.setToolTip(still.reason or f"still for {still.still_for_s:.1f} s: frames can be picked on")
 
     def show_pairs(self, usable: int, required: int) -> None:
         self.pairs_label.setText(f"pairs: {usable}/{required} needed")

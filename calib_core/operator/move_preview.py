@@ -114,10 +114,11 @@ def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goa
     for j in np.flatnonzero(margin < 0):
         problems.append(f"joint {robot.joint_names[j]} would go {-margin[j]:.2f} {robot.joint_units[j]} beyond its limits [{lower[j]:g}, {upper[j]:g}]")
     singular = np.array([scaled_min_singular(robot, q) for q in path])
-    k_sing = int(np.argmin(singular))
-    if singular[k_sing] < limits.singularity_margin:
-        where = "at the goal" if k_sing == len(path) - 1 else ("at the start" if k_sing == 0 else f"{100 * k_sing / (len(path) - 1):.0f} % along the path")
-        warnings.append(f"near a singularity {where} (smallest singular value {singular[k_sing]:.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot")
+    near = np.flatnonzero(singular < limits.singularity_margin)
+    k_sing = int(near[0]) if len(near) else int(np.argmin(singular))  # where it first comes near
+    if len(near):
+        where = "at the goal" if k_sing == len(path) - 1 else ("from the start" if k_sing == 0 else f"{100 * k_sing / (len(path) - 1):.0f} % along the path")
+        warnings.append(f"near a singularity {where} (smallest singular value {singular.min():.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot")
     contact_step, contacts = None, []
     if world is not None:
         # Contacts the robot is in already (the tool at its task, on its object) are how it leaves them,
@@ -142,4 +143,4 @@ def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goa
     if len(big):
         confirm.append("large joint change: " + ", ".join(f"{robot.joint_names[j]} {change[j]:+.1f} {robot.joint_units[j]}" for j in big) + f" (over {limits.confirm_joint_change_deg:g})")
     tcp = np.array([robot.fk(q, "tcp")[:3, 3] for q in path])
-    return MovePreview(what, start, goal, path, change, margin, float(singular[k_sing]), k_sing, contact_step, contacts, tuple(problems), tuple(warnings), tuple(confirm), tcp, tuple(robot.joint_names))
+    return MovePreview(what, start, goal, path, change, margin, float(singular.min()), k_sing, contact_step, contacts, tuple(problems), tuple(warnings), tuple(confirm), tcp, tuple(robot.joint_names))
