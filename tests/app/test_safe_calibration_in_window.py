@@ -218,3 +218,19 @@ def test_verify_looks_again_after_executing_the_correction(qtbot, window, tmp_pa
     from calib_core.workspace.workspace import load_workspace
 
     assert len(load_workspace(tmp_path / "w.json").corrections.verifications(wb.task.name)) == 1
+
+
+def test_a_quit_by_signal_asks_nothing_and_keeps_the_unsaved_work(qtbot, window):
+    """What `videocal gui` does on SIGTERM or Ctrl+C: the windows close as Quit does, without a question,
+    and the unsaved session stays in the recovery file (offered at the next start)."""
+    win, wb = window, window.workbench
+    win.settings.setValue("window/ask_unsaved", True)
+    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    app = QApplication.instance()
+    app.setProperty("videocal_quit_by_signal", True)
+    try:
+        win.close()
+    finally:
+        app.setProperty("videocal_quit_by_signal", False)
+    assert not win.isVisible() and not wb.site.process.running
+    assert win.files.autosave.path.is_file() and "pin_tip" in win.files.autosave.path.read_text()
