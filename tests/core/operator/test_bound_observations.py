@@ -26,6 +26,16 @@ def _task_joints(core) -> np.ndarray:
     return solve_ik(core.robot, core.task.approach2base, core.cell.home_joints).q_deg
 
 
+def _picked_at_task(cell, site) -> tuple[OperatorCore, np.ndarray]:
+    """A core whose pairs were picked (perfectly) on a still at the task location's approach."""
+    core = OperatorCore(cell, site)
+    q_task = _task_joints(core)
+    still_for(core, joints_deg=q_task)
+    frame_now(core)
+    _pick_all(core, site.bed, q_task)
+    return core, q_task
+
+
 def _pick_all(core, bed, q) -> None:
     """Pick each feature on the model and its true image (what a perfect operator clicks)."""
     fixture = core.workcell.component(core.task.component)
@@ -74,11 +84,7 @@ def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_a
 def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_and_site):
     """The same pixels solved with the home joints (what the old code did) are refused as implausible."""
     cell, site = cell_and_site
-    core = OperatorCore(cell, site)
-    q_task = _task_joints(core)
-    still_for(core, joints_deg=q_task)
-    frame_now(core)
-    _pick_all(core, site.bed, q_task)
+    core, _ = _picked_at_task(cell, site)
     obj2world = core.workcell.component(core.session.target).item2world
     home = cell.home_joints
     result = core.session.calibrate(core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home)
@@ -97,11 +103,7 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
 
 def test_a_result_whose_pairs_changed_is_stale_and_cannot_be_stored(cell_and_site):
     cell, site = cell_and_site
-    core = OperatorCore(cell, site)
-    q_task = _task_joints(core)
-    still_for(core, joints_deg=q_task)
-    frame_now(core)
-    _pick_all(core, site.bed, q_task)
+    core, _ = _picked_at_task(cell, site)
     core.calibrate()
     assert core.session.stale_reason is None
     core.delete_pair(2)
