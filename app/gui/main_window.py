@@ -134,6 +134,9 @@ class MainWindow(QMainWindow):
         view.addAction(QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view))
         view.addAction(QAction("&Fit the overview to the cell", self, shortcut=QKeySequence("Ctrl+F"), triggered=lambda: (self.overview.fit_view(), self.overview.refresh())))
         robot = self.menuBar().addMenu("&Robot")
+        self.stop_action = QAction("&Stop the robot", self, shortcut=QKeySequence("Esc"), triggered=lambda: self.report(self.workbench.stop_robot)())
+        self.stop_action.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
+        robot.addAction(self.stop_action)
         robot.addAction(QAction("Go to &approach", self, triggered=lambda: self._go(approach=True)))
         robot.addAction(QAction("Go to task, &corrected", self, triggered=lambda: self._go(approach=False, corrected=True)))
 

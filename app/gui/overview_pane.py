@@ -97,7 +97,7 @@ class OverviewPane(QWidget):
         pb.addWidget(self.cancel_button)
         self.preview_bar.hide()
         self.move_button.clicked.connect(self._confirm)
-        self.cancel_button.clicked.connect(lambda: self.show_preview(None))
+        self.cancel_button.clicked.connect(self._cancel)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
@@ -132,9 +132,16 @@ class OverviewPane(QWidget):
             color = "#ff6b6b" if preview.blocked else ("#ffb347" if send is not None else "#9ad0ff")
             self.preview_text.setText(f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - {html.escape(preview.summary, quote=False)}")
             self.move_button.setVisible(send is not None and not preview.blocked)
-            self.cancel_button.setText("Cancel" if send is not None else "Hide")
+            self.cancel_button.setText("Cancel" if send is not None else ("Hide" if preview.blocked else "Stop"))
             self.preview_bar.show()
         self.mark_dirty()
+
+    def _cancel(self) -> None:
+        """Cancel a move waiting for Move; while one runs, the button is Stop (``$STP``)."""
+        if self._send is None and self.preview is not None and self.workbench.motion.motion.value == "moving" and self.workbench.motion.what == self.preview.what:
+            self.workbench.stop_robot()
+            return
+        self.show_preview(None)
 
     def _confirm(self) -> None:
         send, self._send = self._send, None
@@ -149,6 +156,7 @@ class OverviewPane(QWidget):
             if state.motion.value == "arrived":
                 self.show_preview(None)
             elif state.motion.value in ("refused", "failed", "unknown"):
+                self.cancel_button.setText("Hide")
                 self.preview_text.setText(f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - {html.escape(state.text, quote=False)}")
 
     def _ghost_items(self) -> list:

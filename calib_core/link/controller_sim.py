@@ -27,6 +27,8 @@ from calib_core.link.protocol import (
     RequestState,
     RequestVersion,
     StateReport,
+    Stop,
+    Heartbeat,
     Stream,
     VersionReport,
     parse_body,
@@ -55,6 +57,8 @@ class ControllerLogic:
         self.move_id: str | None = None
         self.stream_hz = 0.0
         self._next_stream_t = 0.0
+        self.deadman_s = 0.0  # armed by the first HBT with a timeout: no heartbeat for this long stops a move
+        self._last_heartbeat_t = 0.0
         self.seq = seq_start % SEQ_MODULUS
 
     def _sample(self) -> JointSample:
@@ -62,8 +66,18 @@ class ControllerLogic:
         self.seq = (self.seq + 1) % SEQ_MODULUS
         return sample
 
+    def _halt(self, now: float, code: str, why: str) -> list:
+        """Stop where the robot is now and end the running move with ``ERR,<code>``."""
+        if self.move is None:
+            return []
+        self.joints_deg = self.move.position(now)
+        move_id, self.move, self.move_id = self.move_id, None, None
+        return [ErrorReply(code, f"move {move_id}: {why}")]
+
     def _update_motion(self, now: float) -> list:
         out = []
+        if self.move is not None and self.deadman_s > 0 and now - self._last_heartbeat_t > self.deadman_s:
+            return self._halt(now, "DEADMAN", f"no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: stopped")
         if self.move is not None:
             self.joints_deg = self.move.position(now)
             if self.move.finished(now):
@@ -103,10 +117,18 @@ class ControllerLogic:
                 out.append(ErrorReply("LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} outside [{lo[j]:.1f}; {hi[j]:.1f}]"))
             elif self.move is not None:
                 out.append(ErrorReply("BUSY", f"move {msg.id}: still executing move {self.move_id}"))
+            elif self.deadman_s > 0 and now - self._last_heartbeat_t > self.deadman_s:
+                out.append(ErrorReply("DEADMAN", f"move {msg.id}: no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: not moving"))
             else:
                 self.move = TrapezoidMove.plan(self.joints_deg, goal, np.asarray(self.model.max_speed_deg_s), now)
                 self.move_id = msg.id
                 out.append(Ack("MVJ", msg.id))
+        elif isinstance(msg, Stop):
+            out += self._halt(now, "STOPPED", "stopped by the workstation")
+            out.append(Ack("STP", "-"))
+        elif isinstance(msg, Heartbeat):
+            self.deadman_s = msg.timeout_ms / 1000.0
+            self._last_heartbeat_t = now
         elif isinstance(msg, RequestState):
             state = "MOVING" if self.move is not None else "IDLE"
             out.append(StateReport(state, f"stream {self.stream_hz:g} Hz"))
@@ -133,4 +155,6 @@ class ControllerLogic:
             deadlines.append(self._next_stream_t)
         if self.move is not None:
             deadlines.append(self.move.t0_s + self.move.duration_s)
+            if self.deadman_s > 0:
+                deadlines.append(self._last_heartbeat_t + self.deadman_s + 1e-3)
         return min(deadlines)

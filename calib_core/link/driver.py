@@ -12,6 +12,8 @@ the reader thread except as a reported error. :meth:`ControllerLink.close` retur
 from __future__ import annotations
 
 import itertools
+import re
+import secrets
 import threading
 import time
 from collections import deque
@@ -33,6 +35,8 @@ from calib_core.link.protocol import (
     RequestState,
     RequestVersion,
     StateReport,
+    Stop,
+    Heartbeat,
     Stream,
     VersionReport,
     encode,
@@ -40,6 +44,8 @@ from calib_core.link.protocol import (
 )
 
 _READ_TIMEOUT_S = 0.01
+_MOVE_IN_ERROR = re.compile(r"move ([A-Za-z0-9_.-]+):")
+_RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
 MODES = ("poll", "stream")
 
@@ -51,13 +57,18 @@ class ControllerLink:
     counted in ``stats.wrong_joint_count`` and not delivered; ``None`` takes any count).
     Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
 
-    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None, **serial_settings):
+    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
+                 deadman_ms: int = 1000, **serial_settings):
         if mode not in MODES:
             raise ValueError(f"mode must be 'poll' or 'stream', got {mode!r}")
         if not (0 < rate_hz <= 250):
             raise ValueError(f"rate must lie in (0, 250] Hz, got {rate_hz}")
         self.url = url
         self.n_joints = n_joints
+        if not (0 <= deadman_ms <= 60_000):
+            raise ValueError(f"the dead-man time must lie in [0, 60000] ms, got {deadman_ms}")
+        self.deadman_ms = int(deadman_ms)
+        """The controller stops a move when no heartbeat came for this long (0: no dead-man)."""
         self.mode = mode
         self.rate_hz = float(rate_hz)
         self.stale_after_s = stale_after_s if stale_after_s is not None else max(5.0 / rate_hz, 0.25)
@@ -82,6 +93,7 @@ class ControllerLink:
         self._version_reports: deque[VersionReport] = deque(maxlen=4)
         self._state_event = threading.Condition(self._lock)
         self._ids = itertools.count(1)
+        self._session = secrets.token_hex(2)  # move ids unique across processes: "<session>.<n>"
         self._port: serial.SerialBase | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -104,7 +116,10 @@ class ControllerLink:
         return self
 
     def close(self) -> None:
-        """Stop the thread and close the device (within about 1 s)."""
+        """Stop the thread and close the device (within about 1 s). A move still running is stopped
+        first (``$STP``): a workstation that goes away leaves no robot moving."""
+        if self._moves:
+            self._send(Stop().body())
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=1.0)
@@ -153,7 +168,9 @@ class ControllerLink:
         q = tuple(float(v) for v in joints_deg)
         if self.n_joints is not None and len(q) != self.n_joints:
             raise ValueError(f"a move needs {self.n_joints} joint values, got {len(q)}")
-        handle = MoveHandle(f"m{next(self._ids)}", q, time.monotonic() + timeout_s)
+        if not all(abs(v) < 1e6 for v in q):
+            raise ValueError(f"a move needs finite joint values within 1e6, got {q}")
+        handle = MoveHandle(f"m{self._session}.{next(self._ids)}", q, time.monotonic() + timeout_s)
         with self._lock:
             self._moves[handle.id] = handle
             self._awaiting_ack.append(handle)
@@ -165,6 +182,11 @@ class ControllerLink:
             handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
         return handle
+
+    def stop(self) -> bool:
+        """``$STP``: the controller stops the robot where it is; the running move ends with its
+        ``ERR,STOPPED``. True if the sentence went out."""
+        return self._send(Stop().body())
 
     def request_state(self, timeout_s: float = 1.0) -> StateReport | None:
         """Ask ``$STA`` and wait for the report (``None`` on timeout)."""
@@ -246,6 +268,7 @@ class ControllerLink:
     def _run(self) -> None:
         backoff = iter(_BACKOFF_S)
         next_poll = 0.0
+        next_heartbeat = 0.0
         last_sample_t = time.monotonic()
         while not self._stop.is_set():
             if self._port is None:
@@ -281,6 +304,10 @@ class ControllerLink:
             if self.mode == "poll" and now >= next_poll:
                 self._send(RequestJoints().body())
                 next_poll = max(next_poll + 1.0 / self.rate_hz, now)
+            if self.deadman_ms and now >= next_heartbeat:
+                # five heartbeats per dead-man time: a reader thread that waits for the CPU does not trip it
+                self._send(Heartbeat(self.deadman_ms).body())
+                next_heartbeat = now + self.deadman_ms / 5000.0
             if self._state in (LinkState.UP, LinkState.CONNECTING) and now - last_sample_t > self.stale_after_s:
                 self._set_state(LinkState.STALE, f"no joint sample for {now - last_sample_t:.2f} s")
                 if self.mode == "stream":
@@ -327,15 +354,28 @@ class ControllerLink:
                         self._awaiting_ack.remove(handle)
         elif isinstance(msg, Done):
             with self._lock:
-                handle = self._moves.pop(msg.id, None)
+                handle = self._moves.get(msg.id)
+                if handle is not None and not handle.acked:
+                    # a DON for a move the controller never accepted: not believed
+                    self.stats.errors += 1
+                    self.last_error = f"DON for move {msg.id} without its ACK: ignored"
+                    handle = None
+                elif handle is not None:
+                    self._moves.pop(msg.id, None)
             if handle is not None:
                 handle._finish()
         elif isinstance(msg, ErrorReply):
             with self._lock:
                 self.stats.errors += 1
-                handle = self._awaiting_ack.popleft() if self._awaiting_ack else None
+                # the move the reply names ("move <id>: ..."), else the oldest one waiting for its ACK
+                named = _MOVE_IN_ERROR.match(msg.text)
+                handle = self._moves.get(named.group(1)) if named else None
+                if handle is None and not named and self._awaiting_ack:
+                    handle = self._awaiting_ack[0]
                 if handle is not None:
                     self._moves.pop(handle.id, None)
+                    if handle in self._awaiting_ack:
+                        self._awaiting_ack.remove(handle)
             self.last_error = f"controller error {msg.code}: {msg.text}"
             if handle is not None:
                 handle._finish(MoveError(f"move {handle.id} refused by the controller: {msg.code}: {msg.text}"))
@@ -352,6 +392,16 @@ class ControllerLink:
     def _deliver(self, sample: TimedSample) -> None:
         seq = sample.sample.seq
         with self._lock:
+            last_t = self._latest.sample.t_ms if self._latest is not None else None
+            if self._last_seq is not None and last_t is not None:
+                back = (self._last_seq - seq) % SEQ_MODULUS
+                if 0 < back < SEQ_MODULUS // 2 or (back == 0) or sample.sample.t_ms < last_t:
+                    if last_t - sample.sample.t_ms > _RESTART_BACK_MS:
+                        self.stats.controller_restarts += 1  # its clock and count start again: fresh
+                        self._last_seq = None
+                    else:
+                        self.stats.backwards_samples += 1  # a repeat or an old sample: not the robot now
+                        return
             if self._last_seq is not None:
                 expected = (self._last_seq + 1) % SEQ_MODULUS
                 if seq != expected:

@@ -39,8 +39,10 @@ class LinkStats:
     """Counters since the link started. Sentences: ``sentences`` verified, ``garbage_bytes``,
     ``bad_checksum``, ``too_long``, ``malformed`` (framing or fields), ``non_finite``,
     ``unknown`` types, ``wrong_joint_count`` (samples for another robot). Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
-    jumped) and ``missing_samples`` (how many it skipped). Link: ``reconnects``, ``errors``
-    (ERR replies and callback failures)."""
+    jumped) and ``missing_samples`` (how many it skipped), ``backwards_samples`` (a repeated or
+    older sequence number or time: not delivered), ``controller_restarts`` (its clock went back over
+    1 s: counted, delivered). Link: ``reconnects``, ``errors`` (ERR replies, a DON without its ACK,
+    callback failures)."""
 
     sentences: int = 0
     garbage_bytes: int = 0
@@ -55,6 +57,8 @@ class LinkStats:
     missing_samples: int = 0
     reconnects: int = 0
     errors: int = 0
+    backwards_samples: int = 0
+    controller_restarts: int = 0
 
     def as_dict(self) -> dict[str, int]:
         return dict(self.__dict__)

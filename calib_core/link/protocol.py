@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 # Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences.
 MAX_SENTENCE_BYTES = 256
 MAX_JOINTS = 16
@@ -136,6 +136,27 @@ class MoveJoints:
 
 
 @dataclass(frozen=True)
+class Stop:
+    """``$STP``: stop now. The controller brings the robot to rest where it is and ends the move
+    that was running with ``ERR,STOPPED,move <id>: ...``; it answers ``ACK,STP,-``."""
+
+    def body(self) -> str:
+        return "STP"
+
+
+@dataclass(frozen=True)
+class Heartbeat:
+    """``$HBT,<timeout_ms>``: the workstation is alive. Once one has arrived, the controller stops a
+    running move (``ERR,DEADMAN,move <id>: ...``) when no heartbeat follows within ``timeout_ms``;
+    ``0`` disarms the dead-man. No reply."""
+
+    timeout_ms: int
+
+    def body(self) -> str:
+        return f"HBT,{self.timeout_ms}"
+
+
+@dataclass(frozen=True)
 class RequestVersion:
     """``$VER``: which protocol version the controller speaks and how many joints it drives."""
 
@@ -162,7 +183,7 @@ class RequestState:
         return "STA"
 
 
-Message = JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion
+Message = JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion | Stop | Heartbeat
 
 
 def _number(text: str, what: str) -> float:
@@ -215,6 +236,13 @@ def parse_body(body: str) -> Message:
         return VersionReport(_integer(fields[1], "VER version"), _integer(fields[2], "VER n_joints"))
     if kind == "RQJ" and n == 1:
         return RequestJoints()
+    if kind == "STP" and n == 1:
+        return Stop()
+    if kind == "HBT" and n == 2:
+        timeout = _integer(fields[1], "HBT timeout_ms")
+        if timeout > 60_000:
+            raise ProtocolError("malformed", f"HBT timeout {timeout} ms above 60000 ms")
+        return Heartbeat(timeout)
     if kind == "STR" and n == 2:
         hz = _number(fields[1], "STR hz")
         if hz < 0:
@@ -224,6 +252,6 @@ def parse_body(body: str) -> Message:
         if not 3 <= n <= 2 + MAX_JOINTS:
             raise ProtocolError("malformed", f"MVJ needs an id and 1 to {MAX_JOINTS} joint values; got {n} fields")
         return MoveJoints(_token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:])))
-    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER"):
+    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER", "STP", "HBT"):
         raise ProtocolError("malformed", f"{kind} with {n - 1} fields")
     raise ProtocolError("unknown", f"unknown sentence type {kind!r}")

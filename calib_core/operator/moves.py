@@ -100,3 +100,13 @@ class Moves:
         # at the task pose itself the tool works on the task's object: touching it is the task
         allowed = frozenset({self.task.component}) if (not approach and self.task.component) else frozenset()
         return self.move_to(target, what, wait=wait, confirmed=confirmed, allowed_contacts=allowed)
+
+    def stop_robot(self) -> bool:
+        """Stop now (``$STP``): the controller halts the robot where it is; the running move ends with
+        its ``STOPPED`` reason. True if the stop went out."""
+        if self.link is None:
+            raise CalibrationError("no controller link: nothing to stop")
+        sent = self.link.stop()
+        self.record_event("stop", sent=sent, during=self.motion.what if self.motion.motion is Motion.MOVING else "")
+        self.message.emit("stop sent to the controller" if sent else f"stop NOT sent: the link is {self.link.state.value}")
+        return sent

@@ -234,3 +234,19 @@ def test_a_quit_by_signal_asks_nothing_and_keeps_the_unsaved_work(qtbot, window)
         app.setProperty("videocal_quit_by_signal", False)
     assert not win.isVisible() and not wb.site.process.running
     assert win.files.autosave.path.is_file() and "pin_tip" in win.files.autosave.path.read_text()
+
+
+def test_stop_halts_a_running_move_from_the_overview(qtbot, window):
+    win, wb = window, window.workbench
+    q = np.array(wb.joints_deg)
+    q[0] += 120.0
+    win.move(lambda confirmed: wb.move_joints(q, "a turn of the base", confirmed=confirmed))
+    assert confirm_move_if_asked(qtbot, win)  # 120 deg: it waited for Move
+    qtbot.waitUntil(lambda: abs(wb.joints_deg[0] - q[0]) < 118.0, timeout=10_000)
+    assert wb.motion.motion.value == "moving"
+    assert win.overview.cancel_button.text() == "Stop"
+    qtbot.mouseClick(win.overview.cancel_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "refused", timeout=10_000)
+    assert "STOPPED" in wb.motion.detail and "refused" in win.overview.preview_text.text()
+    wait_for_settled_frame(qtbot, win)
+    assert abs(wb.joints_deg[0] - q[0]) > 0.5  # halted on the way, not at the goal

@@ -14,6 +14,7 @@ import yaml
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.link.driver import ControllerLink
+from calib_core.link.protocol import PROTOCOL_VERSION
 from calib_core.link.link_types import MoveError
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
@@ -88,7 +89,7 @@ def test_the_simulator_takes_the_cell_joint_count_limits_and_home(cells):
             assert link.wait_for_samples(5, 5.0)
             assert np.allclose(link.latest.joints_deg, cell.home_joints_deg, atol=1e-3)
             version = link.request_version()
-            assert (version.version, version.n_joints) == (2, 7)
+            assert (version.version, version.n_joints) == (PROTOCOL_VERSION, 7)
             beyond = np.array(cell.home_joints_deg)
             beyond[3] = robot.upper_limits_deg[3] + 5.0  # panda_joint4 stops at -4 deg
             with pytest.raises(MoveError, match=r"LIMIT: .*joint 4 target 1.00 outside \[-176.0; -4.0\]"):
