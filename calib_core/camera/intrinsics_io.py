@@ -44,7 +44,12 @@ def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv
         raise ValueError(f"unknown intrinsics format {fmt!r}; expected one of {', '.join(FORMATS)}")
     path = Path(path)
     if fmt == "opencv":
-        with atomic_path(path) as tmp:
+        def same(tmp: Path) -> None:  # cv2.FileStorage reports no write error: read it back
+            back = _load_opencv(tmp)
+            if not np.allclose(back.K, intrinsics.K) or (back.width, back.height) != (intrinsics.width, intrinsics.height):
+                raise ValueError("the written camera matrix or image size differs")
+
+        with atomic_path(path, same) as tmp:
             fs = cv2.FileStorage(str(tmp), cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_FORMAT_YAML)
             fs.write("image_width", intrinsics.width)
             fs.write("image_height", intrinsics.height)
