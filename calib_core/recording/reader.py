@@ -13,6 +13,7 @@ from mcap.exceptions import McapError
 from mcap.records import Channel, Footer, Message
 from mcap.stream_reader import StreamReader
 
+from calib_core.atomic_file import atomic_path
 from calib_core.errors import FileFormatError
 from calib_core.recording.recorder import SessionRecorder
 from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
@@ -106,10 +107,18 @@ def decode_frame(payload: dict) -> np.ndarray:
 def recover(path: str | Path, out: str | Path) -> RecordingContents:
     """Rewrite a cut-off recording as a complete one with every message before the cut."""
     contents = read_recording(path)
-    writer = SessionRecorder(out)
     topics = {FRAME_TOPIC, VIDEO_TOPIC, JOINTS_TOPIC, EVENT_TOPIC, SOLVE_TOPIC, CORRECTION_TOPIC, SETUP_TOPIC}
-    for m in contents.messages:
-        if m.topic in topics:
-            writer.write_raw(m.topic, m.raw, log_time_ns=m.log_time_ns)
-    writer.close()
+
+    def complete(tmp: Path) -> None:  # the copy reads back whole, or nothing replaces ``out``
+        back = read_recording(tmp)
+        if not back.complete:
+            raise ValueError(back.problem)
+
+    # written beside ``out`` and put in place whole: an existing file there is never left half overwritten
+    with atomic_path(out, complete) as tmp:
+        writer = SessionRecorder(tmp)
+        for m in contents.messages:
+            if m.topic in topics:
+                writer.write_raw(m.topic, m.raw, log_time_ns=m.log_time_ns)
+        writer.close()
     return contents
