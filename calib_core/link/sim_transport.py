@@ -9,6 +9,7 @@ then back with a fresh joint-sample sequence).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import select
 import socket
@@ -21,7 +22,7 @@ from pathlib import Path
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.controller_sim import ControllerLogic
 from calib_core.link.faults import FaultInjector
-from calib_core.link.protocol import encode
+from calib_core.link.protocol import ErrorReply, encode
 
 
 @dataclass
@@ -84,7 +85,18 @@ class _TcpEndpoint:
         self.server.bind(("127.0.0.1", port))
         self.server.listen(1)
         self.client: socket.socket | None = None
+        self.refused = 0
         self.path = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
+
+    @staticmethod
+    def _alive(client: socket.socket) -> bool:
+        """The connected client is still there (a peer that closed reads as end of stream)."""
+        try:
+            return client.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) != b""
+        except BlockingIOError:
+            return True
+        except OSError:
+            return False
 
     def fds(self) -> list:
         return [self.server] + ([self.client] if self.client else [])
@@ -93,6 +105,13 @@ class _TcpEndpoint:
         if fd is self.server:
             conn, _ = self.server.accept()
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            if self.client is not None and self._alive(self.client):
+                # One workstation at a time: a second client does not take the robot over.
+                with contextlib.suppress(OSError):
+                    conn.sendall(encode(ErrorReply("BUSY", "another workstation is connected; this connection is closed").body()))
+                conn.close()
+                self.refused += 1
+                return b""
             if self.client is not None:
                 self.client.close()
             self.client = conn

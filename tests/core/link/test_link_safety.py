@@ -12,7 +12,7 @@ from calib_core.link.driver import ControllerLink
 from calib_core.link.link_types import LinkState, MoveError
 from calib_core.link.protocol import Ack, Done, ErrorReply, JointSample, encode
 
-from tests.core.link.sim_process import SimProcess
+
 from tests.core.link.test_link_with_simulator import sim  # noqa: F401 (the fixture)
 
 
@@ -105,3 +105,24 @@ def test_replies_are_matched_by_id_and_samples_going_back_are_not_fresh():
         link.close()
     assert link.state is LinkState.CLOSED
     assert encode("STP").startswith(b"$STP*")
+
+
+def test_a_second_workstation_cannot_take_the_robot_over(sim):  # noqa: F811
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    sim("--tcp", str(port), link=False)
+    url = f"socket://127.0.0.1:{port}"
+    with ControllerLink(url, rate_hz=50) as first:
+        assert first.wait_for_samples(3, 5.0)
+        with socket.create_connection(("127.0.0.1", port), timeout=5) as intruder:
+            intruder.sendall(encode("MVJ,x.1,90,0,0,0,0,0"))
+            answer = intruder.recv(4096)
+            assert b"ERR,BUSY,another workstation is connected" in answer
+        time.sleep(0.3)
+        assert np.allclose(first.latest.joints_deg, 0.0)  # the intruder's move did not run
+        assert first.state is LinkState.UP
+    with ControllerLink(url, rate_hz=50) as second:  # once the first is gone, the next one gets in
+        assert second.wait_for_samples(3, 5.0)
