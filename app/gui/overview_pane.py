@@ -150,8 +150,9 @@ class OverviewPane(QWidget):
             send()
 
     def _motion_changed(self, state) -> None:
-        # The ghost stays while the robot moves there; it goes when the move ended well, and stays
-        # with the reason when it did not.
+        # The ghost shows where a move would go until it runs; it goes when the move ended well, and comes
+        # back with the reason when it did not.
+        self.mark_dirty()
         if self.preview is not None and self._send is None and state.what == self.preview.what:
             if state.motion.value == "arrived":
                 self.show_preview(None)
@@ -161,7 +162,10 @@ class OverviewPane(QWidget):
 
     def _ghost_items(self) -> list:
         p = self.preview
-        if p is None:
+        moving = self._send is None and not p.blocked and self.workbench.motion.motion.value == "moving" if p is not None else False
+        if p is None or moving:
+            # While the robot runs the move the real one heads there: the tool's path line is enough, and a
+            # second robot would halve the overview's rate with a vendor robot's meshes.
             return []
         color = (1.0, 0.3, 0.3) if p.blocked else ((1.0, 0.7, 0.3) if self._send is not None else (0.45, 0.75, 1.0))
         q = p.path_deg[p.contact_step] if (p.blocked and p.contact_step is not None) else p.goal_deg

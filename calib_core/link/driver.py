@@ -45,7 +45,8 @@ from calib_core.link.protocol import (
 
 _READ_TIMEOUT_S = 0.01
 _MOVE_IN_ERROR = re.compile(r"move ([A-Za-z0-9_.-]+):")
-_RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted
+_RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted ...
+_FRESH_CLOCK_MS = 500  # ... as has one that went back to its first half second
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
 MODES = ("poll", "stream")
 
@@ -396,7 +397,7 @@ class ControllerLink:
             if self._last_seq is not None and last_t is not None:
                 back = (self._last_seq - seq) % SEQ_MODULUS
                 if 0 < back < SEQ_MODULUS // 2 or (back == 0) or sample.sample.t_ms < last_t:
-                    if last_t - sample.sample.t_ms > _RESTART_BACK_MS:
+                    if last_t - sample.sample.t_ms > _RESTART_BACK_MS or sample.sample.t_ms < _FRESH_CLOCK_MS:
                         self.stats.controller_restarts += 1  # its clock and count start again: fresh
                         self._last_seq = None
                     else:

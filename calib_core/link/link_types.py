@@ -41,7 +41,7 @@ class LinkStats:
     ``unknown`` types, ``wrong_joint_count`` (samples for another robot). Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
     jumped) and ``missing_samples`` (how many it skipped), ``backwards_samples`` (a repeated or
     older sequence number or time: not delivered), ``controller_restarts`` (its clock went back over
-    1 s: counted, delivered). Link: ``reconnects``, ``errors`` (ERR replies, a DON without its ACK,
+    1 s, or to its first 0.5 s: counted, delivered). Link: ``reconnects``, ``errors`` (ERR replies, a DON without its ACK,
     callback failures)."""
 
     sentences: int = 0
