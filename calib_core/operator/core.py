@@ -334,7 +334,7 @@ class OperatorCore(SessionFiles, Picking, Moves):
         self.scene_changed.emit()
         return board2base
 
-    def board_view_plan(self, spec, n: int = 12) -> list[np.ndarray]:
+    def board_view_plan(self, spec, n: int = 16) -> list[np.ndarray]:
         """Joint vectors (deg/mm) from which the modelled camera sees the board from different
         directions, in an order whose every move (from the current joints on) is free of collisions
         with the robot itself and the cell (the board among it); a pose without such a path is left out."""

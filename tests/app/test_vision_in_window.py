@@ -55,7 +55,8 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     assert len(vision.capture.rejected) == 1 and "no board found" in win.statusBar().currentMessage()
 
     vision.show_board.setChecked(True)
-    for k in range(8):
+    # 12 poses of the plan (those of 16 candidates that see the board on collision-free paths): a stable set
+    for k in range(12):
         _visit_board_pose(qtbot, win, k)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         assert len(vision.capture.views) == k + 1, vision.views.item(vision.views.count() - 1).text()
@@ -65,7 +66,7 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
             # the detection is drawn over the camera image
             assert len(win.camera.view.overlay.points) >= 20 and "board corners" in win.camera.view.overlay.text
     assert vision.calibrate_intrinsics_button.isEnabled() and vision.calibrate_hand_eye_button.isEnabled()
-    assert vision.views.count() == 9 and vision.views.item(8).text().startswith("x view_01")
+    assert vision.views.count() == 13 and vision.views.item(12).text().startswith("x view_01")
 
     # Intrinsics against the test bed's lens.
     qtbot.mouseClick(vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
@@ -81,7 +82,7 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     model_cam2flange = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
     d_model, r_model = pose_difference(model_cam2flange, true_cam2flange)
     d, r = pose_difference(vision.hand_eye_result.cam2flange, true_cam2flange)
-    # 8 views at 640 x 480 with the intrinsics calibrated from the same views: a few tenths of a mm remain
+    # 12 views at 640 x 480 with the intrinsics calibrated from the same views: a few tenths of a mm remain
     assert np.linalg.norm(d) < 0.5 * np.linalg.norm(d_model) and np.linalg.norm(r) < 0.5 * np.linalg.norm(r_model)
     assert "Camera mounting" in vision.result.text()
 
@@ -99,7 +100,7 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     assert load_intrinsics(tmp_path / "camera.yaml").fu == pytest.approx(got.fu)
     vision.save_hand_eye(tmp_path / "hand_eye.yaml")
     doc = yaml.safe_load((tmp_path / "hand_eye.yaml").read_text())
-    assert doc["units"] == {"length": "mm", "angle": "deg"} and doc["poses"] == 8
+    assert doc["units"] == {"length": "mm", "angle": "deg"} and doc["poses"] == 12
     wb.apply_hand_eye_file(tmp_path / "hand_eye.yaml")
     again = np.linalg.inv(wb.robot.frame_placement("flange")) @ wb.robot.frame_placement("camera")
     assert np.linalg.norm(pose_difference(again, vision.hand_eye_result.cam2flange)[0]) < 1e-3
