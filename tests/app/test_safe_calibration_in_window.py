@@ -142,8 +142,9 @@ def test_a_move_into_an_obstacle_is_refused_and_shown(qtbot, window, tmp_path):
     assert "collision" in win.results.status.text() and "crate" in win.results.status.text()
     assert win.overview.preview is not None and win.overview.preview.blocked and "refused" in win.overview.preview_text.text()
     assert not win.overview.move_button.isVisible()
-    qtbot.wait(300)  # nothing was sent: the robot stays (a move would have started by now)
-    assert np.max(np.abs(wb.joints_deg - before)) < 1e-6 and wb.motion.motion.value == "idle"
+    # nothing was sent: no move handle exists, the robot stands where it stood
+    assert wb._pending_move is None and wb.motion.motion.value == "idle"
+    assert np.max(np.abs(wb.joints_deg - before)) < 1e-6
     # Take the crate away (undo): the same move is free, ghosted, and goes.
     wb.undo()
     wb.undo()
