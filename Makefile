@@ -19,6 +19,13 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
+# The Foxglove ecosystem's MCAP reader (@mcap/core), which tests read recordings with. Without npm the
+# tests that need it are skipped and say why.
+NODE_STAMP := tests/node/node_modules/.installed
+$(NODE_STAMP): tests/node/package.json tests/node/package-lock.json
+	@if command -v npm >/dev/null 2>&1; then npm ci --prefix tests/node --no-audit --no-fund --loglevel=error && touch $@; \
+	else echo "npm not found: the tests that read recordings with @mcap/core will be skipped"; fi
+
 # With a display: the window. Without one: the window driven through a whole calibration offscreen,
 # its screenshots and report.json in out/demo (open them with any image viewer).
 run: $(STAMP)
@@ -26,7 +33,7 @@ run: $(STAMP)
 	else echo "no display: running the calibration demo offscreen; screenshots and report.json go to out/demo"; \
 	$(BIN)/videocal demo --offscreen --out out/demo; fi
 
-test: $(STAMP)
+test: $(STAMP) $(NODE_STAMP)
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest
 
 bench: $(STAMP)

@@ -47,19 +47,37 @@ class SessionFiles:
         atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations))
         self.message.emit(f"corrections exported to {path} ({fmt})")
 
-    def start_recording(self, path) -> None:
+    def start_recording(self, path, **options) -> None:
+        """Record the session to ``path`` (MCAP); ``options`` go to the
+        :class:`~calib_core.recording.recorder.SessionRecorder` (``frames="jpeg"``, ``clock``...)."""
         from calib_core.operator.recording_tap import RecordingTap
         from calib_core.recording.recorder import SessionRecorder
 
         self.stop_recording()
-        self.recorder = SessionRecorder(path)
+        self.recorder = SessionRecorder(path, **options)
         self._tap = RecordingTap(self, self.recorder)
         self.message.emit(f"recording to {path}")
+
+    def recording_failure(self) -> str | None:
+        """Poll the recorder (the window does on its status tick): when its disk or encoder failed, the
+        recording is stopped and the reason returned, once. ``None`` while all is well."""
+        rec = self.recorder
+        if rec is None or rec.failure is None:
+            return None
+        failure = rec.failure
+        self.stop_recording()
+        return failure
 
     def stop_recording(self) -> None:
         rec = self.recorder
         if rec is not None:
             self._tap.detach()
             rec.close()
-            self.message.emit(f"recording {rec.path} closed ({rec.messages} messages)")
+            if rec.failure is not None:
+                self.message.emit(f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal recover` completes it")
+            elif not rec.finished:
+                self.message.emit(f"recording {rec.path}: the file is being finished in the background")
+            else:
+                dropped = f", {rec.frames_dropped} frames dropped" if rec.frames_dropped else ""
+                self.message.emit(f"recording {rec.path} closed ({rec.messages} messages, {rec.frames_written} frames{dropped})")
         self.recorder, self._tap = None, None

@@ -3,20 +3,26 @@
 from __future__ import annotations
 
 import base64
+import io
 import json
-from dataclasses import dataclass
+import mmap
+import os
+import struct
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import cv2
 import numpy as np
-from mcap.exceptions import McapError
-from mcap.records import Channel, Footer, Message
-from mcap.stream_reader import StreamReader
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.records import Attachment, Channel, Chunk, Footer, Message
+from mcap.stream_reader import breakup_chunk
+from mcap.writer import MCAP0_MAGIC as MAGIC
 
 from calib_core.atomic_file import atomic_path
 from calib_core.errors import FileFormatError
 from calib_core.recording.recorder import SessionRecorder
-from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
+from calib_core.recording.schemas import KNOWN_TOPICS, VIDEO_TOPIC
 
 
 @dataclass(frozen=True)
@@ -29,6 +35,7 @@ class RecordedMessage:
     log_time_ns: int
     payload: dict
     raw: bytes = b""
+    encoding: str = "json"
 
 
 def _video_payload(data: bytes) -> dict:
@@ -40,58 +47,103 @@ def _video_payload(data: bytes) -> dict:
 
 @dataclass
 class RecordingContents:
-    """What a pass over a file found: the messages, whether it ended cleanly, and why not."""
+    """What a pass over a file found: the messages, whether it ended cleanly, and why not;
+    its attachments ``(name, media_type, data)`` and its channels by topic."""
 
     messages: list[RecordedMessage]
     complete: bool
     problem: str | None = None
+    attachments: list[tuple[str, str, bytes]] = field(default_factory=list)
+    channels: dict = field(default_factory=dict)
 
     def topic(self, name: str) -> list[RecordedMessage]:
         return [m for m in self.messages if m.topic == name]
 
 
+
+_RECORD_HEADER = struct.Struct("<BQ")
+_READERS = {Opcode.CHANNEL: Channel, Opcode.MESSAGE: Message, Opcode.CHUNK: Chunk, Opcode.ATTACHMENT: Attachment, Opcode.FOOTER: Footer}
+
+
+def _records(data: bytes | mmap.mmap, problems: list[str]):
+    """The file's top-level records in order, with the records inside each chunk. A damaged
+    record (a chunk whose CRC fails, a record that does not parse) is skipped and described in
+    ``problems``; reading goes on with the next one. Stops at the footer or where the file ends."""
+    pos = len(MAGIC)
+    chunk = 0
+    while pos + _RECORD_HEADER.size <= len(data):
+        opcode, length = _RECORD_HEADER.unpack_from(data, pos)
+        body_start, end = pos + _RECORD_HEADER.size, pos + _RECORD_HEADER.size + length
+        if end > len(data):
+            problems.append(f"the file ends abruptly inside a record at byte {pos} (a crash or a cut)")
+            return
+        reader = _READERS.get(opcode)
+        if reader is not None:
+            try:
+                stream = ReadDataStream(io.BytesIO(data[body_start:end]))
+                record = reader.read(stream, length) if reader is Message else reader.read(stream)
+                if isinstance(record, Chunk):
+                    chunk += 1
+                    yield from breakup_chunk(record, validate_crc=True)
+                else:
+                    yield record
+            except Exception as exc:  # the mcap records raise assorted errors on damaged bytes
+                what = f"chunk {chunk} at byte {pos}" if opcode == Opcode.CHUNK else f"record at byte {pos}"
+                problems.append(f"{what} is damaged ({type(exc).__name__}): skipped")
+            if opcode == Opcode.FOOTER:
+                return
+        pos = end
+    if pos < len(data):
+        problems.append(f"the file ends abruptly inside a record at byte {pos} (a crash or a cut)")
+
+
 def read_recording(path: str | Path) -> RecordingContents:
-    """Every readable message of a recording; a file cut short gives ``complete=False`` with the
-    messages before the cut. A file that is not a videocal MCAP recording raises ``FileFormatError``."""
+    """Every readable message of a recording, in file order. A file cut short gives
+    ``complete=False`` with the messages before the cut; a damaged chunk or message is skipped
+    (``problem`` says which) and reading goes on. A file that is not an MCAP recording raises
+    ``FileFormatError``."""
     path = Path(path)
     try:
         handle = open(path, "rb")
     except FileNotFoundError:
         raise FileFormatError(path, "no such recording") from None
-    channels: dict[int, str] = {}
-    encodings: dict[int, str] = {}
-    messages: list[RecordedMessage] = []
-    complete, problem = False, None
+    except OSError as exc:
+        raise FileFormatError(path, f"cannot be read ({exc.strerror})") from None
     with handle:
-        try:
-            for record in StreamReader(handle, skip_magic=False).records:
-                if isinstance(record, Channel):
-                    channels[record.id] = record.topic
-                    encodings[record.id] = record.message_encoding
-                elif isinstance(record, Message):
-                    topic = channels.get(record.channel_id)
-                    if topic is None:
-                        continue
-                    encoding = encodings.get(record.channel_id)
-                    try:
-                        payload = _video_payload(record.data) if topic == VIDEO_TOPIC and encoding == "protobuf" else json.loads(record.data)
-                    except Exception:  # json and protobuf raise different errors on bad bytes
-                        problem = f"message {len(messages) + 1} on {topic} is not valid {encoding}"
-                        break
-                    messages.append(RecordedMessage(topic, record.log_time, payload, bytes(record.data)))
-                elif isinstance(record, Footer):
-                    complete = True
-        except (McapError, ValueError, EOFError, OSError) as exc:
-            if not messages and not channels:
-                raise FileFormatError(path, f"not an MCAP recording ({exc})") from None
-            problem = f"the file ends abruptly after {len(messages)} messages ({type(exc).__name__})"
-        except Exception as exc:  # the mcap stream reader raises assorted errors on a truncated record
-            if not messages and not channels:
-                raise FileFormatError(path, f"not an MCAP recording ({exc})") from None
-            problem = f"the file ends abruptly after {len(messages)} messages ({type(exc).__name__})"
-    if not complete and problem is None:
-        problem = f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)"
-    return RecordingContents(messages, complete, problem)
+        size = os.fstat(handle.fileno()).st_size
+        if size < len(MAGIC) or handle.read(len(MAGIC)) != MAGIC:
+            raise FileFormatError(path, "not an MCAP recording (no MCAP magic at its start)")
+        data = mmap.mmap(handle.fileno(), 0, access=mmap.ACCESS_READ)
+    channels: dict[int, Channel] = {}
+    messages: list[RecordedMessage] = []
+    attachments: list[Attachment] = []
+    problems: list[str] = []
+    complete = bad_messages = 0
+    with data:
+        for record in _records(data, problems):
+            if isinstance(record, Channel):
+                channels[record.id] = record
+            elif isinstance(record, Message):
+                channel = channels.get(record.channel_id)
+                if channel is None:
+                    bad_messages += 1
+                    continue
+                try:
+                    payload = _video_payload(record.data) if channel.topic == VIDEO_TOPIC and channel.message_encoding == "protobuf" else (
+                        json.loads(record.data) if channel.message_encoding == "json" else {})
+                except Exception:  # json and protobuf raise different errors on bad bytes
+                    bad_messages += 1
+                    continue
+                messages.append(RecordedMessage(channel.topic, record.log_time, payload, bytes(record.data), channel.message_encoding))
+            elif isinstance(record, Attachment):
+                attachments.append(record)
+            elif isinstance(record, Footer):
+                complete = True
+    if bad_messages:
+        problems.append(f"{bad_messages} message{'s' if bad_messages > 1 else ''} could not be decoded: skipped")
+    if not complete and not any("ends" in p for p in problems):
+        problems.append(f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)")
+    return RecordingContents(messages, bool(complete), "; ".join(problems) or None, [(a.name, a.media_type, bytes(a.data)) for a in attachments], {c.topic: c for c in channels.values()})
 
 
 def decode_frame(payload: dict) -> np.ndarray:
@@ -105,20 +157,24 @@ def decode_frame(payload: dict) -> np.ndarray:
 
 
 def recover(path: str | Path, out: str | Path) -> RecordingContents:
-    """Rewrite a cut-off recording as a complete one with every message before the cut."""
+    """Rewrite a cut-off or damaged recording as a complete, indexed one with every readable
+    message, in log-time order (older recordings were not always in order), with its attachments."""
     contents = read_recording(path)
-    topics = {FRAME_TOPIC, VIDEO_TOPIC, JOINTS_TOPIC, EVENT_TOPIC, SOLVE_TOPIC, CORRECTION_TOPIC, SETUP_TOPIC}
+    kept = [m for m in contents.messages if m.topic in KNOWN_TOPICS]  # a channel of another program has no schema here
 
     def complete(tmp: Path) -> None:  # the copy reads back whole, or nothing replaces ``out``
         back = read_recording(tmp)
-        if not back.complete:
-            raise ValueError(back.problem)
+        if not back.complete or len(back.messages) != len(kept):
+            raise ValueError(back.problem or f"{len(back.messages)} of {len(kept)} messages read back")
 
     # written beside ``out`` and put in place whole: an existing file there is never left half overwritten
     with atomic_path(out, complete) as tmp:
-        writer = SessionRecorder(tmp)
-        for m in contents.messages:
-            if m.topic in topics:
-                writer.write_raw(m.topic, m.raw, log_time_ns=m.log_time_ns)
-        writer.close()
+        writer = SessionRecorder(tmp, hold_s=1e9)  # held until close, then written sorted by log time
+        for name, media_type, data in contents.attachments:
+            writer.record_attachment(name, media_type, data)
+        for m in kept:
+            writer.write_raw(m.topic, m.raw, log_time_ns=m.log_time_ns)
+        writer.close(timeout_s=None)
+        if writer.failure:
+            raise OSError(f"writing {out}: {writer.failure}")
     return contents

@@ -178,6 +178,26 @@ class RobotModel:
         poses.update({role: poses[name] for role, name in self.roles.items()})
         return poses
 
+    def frame_tree(self, q_deg: ArrayLike) -> list[tuple[str | None, str, np.ndarray]]:
+        """The robot's links and added frames as a tree at ``q_deg``: ``(parent, child, child2parent)``
+        with ``child2parent`` (4, 4) mm, parents before children; the URDF root's parent is ``None``
+        and its transform is ``root2base``. Joint frames are folded into the links they move (what a
+        tf tree or Foxglove's FrameTransforms holds)."""
+        pin.framesForwardKinematics(self.model, self.data, self.configuration(q_deg))
+        frames = self.model.frames
+        kept = [i for i in range(1, len(frames)) if frames[i].type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)]
+        kept_set = set(kept)
+        tree = []
+        for i in kept:
+            parent = frames[i].parentFrame
+            while parent != 0 and parent not in kept_set:
+                parent = frames[parent].parentFrame
+            if parent == 0 or parent == i:
+                tree.append((None, frames[i].name, self._root2base @ _to_mm(self.data.oMf[i])))
+            else:
+                tree.append((frames[parent].name, frames[i].name, _to_mm(self.data.oMf[parent].actInv(self.data.oMf[i]))))
+        return tree
+
     def jacobian(self, q_deg: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """Frame Jacobian (6, n) in base axes at the frame's origin: rows ``v`` (mm) then ``omega``
         (rad), per internal joint unit (rad or m); multiply column j by ``internal_per_user[j]``

@@ -1,7 +1,7 @@
 """Real crashes: a recording process and a saving process killed with SIGKILL at an arbitrary moment.
 
-A killed recorder leaves a file that holds every message it had reported written, and ``recover``
-makes it whole. A process killed while saving a workspace leaves the old file or the new one,
+A killed recorder leaves a file that holds every message it had reported written (it counts
+what is in chunks handed to the OS) and all but the last second, and ``recover`` makes it whole. A process killed while saving a workspace leaves the old file or the new one,
 always loadable, never half of either.
 """
 
@@ -23,7 +23,7 @@ pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
 
 RECORDER = textwrap.dedent(
     """
-    import sys, numpy as np
+    import sys, time, numpy as np
     from calib_core.recording.recorder import SessionRecorder
     rec = SessionRecorder(sys.argv[1], drop_when_busy=False)
     rec.record_setup(note="killed on purpose")
@@ -31,11 +31,13 @@ RECORDER = textwrap.dedent(
     while True:
         image = np.zeros((240, 320, 3), np.uint8) + np.linspace(0, 200, 320).astype(np.uint8)[None, :, None]
         image[100:140, (k * 3) % 280 : (k * 3) % 280 + 40] = (240, 40, 40)
-        rec.record_frame(image, k / 15)
+        now = time.monotonic()
+        rec.record_frame(image, now)
         for j in range(3):
-            rec.record_joints(3 * k + j, 20 * (3 * k + j), k / 15, [0.1 * k] * 6)
+            rec.record_joints(3 * k + j, 20 * (3 * k + j), now, [0.1 * k] * 6)
         k += 1
         print(rec.messages, rec.frames_written, flush=True)
+        time.sleep(1 / 30)
     """
 )
 
@@ -79,6 +81,7 @@ def test_a_recorder_killed_mid_recording_keeps_every_reported_message(tmp_path):
     path = tmp_path / "killed.mcap"
     proc = _start(RECORDER, path)
     last = _read_until(proc, lambda line: int(line.split()[1]) >= 45)  # past a keyframe interval
+    killed_at_ns = time.time_ns()
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(10)
     proc.stdout.close()
@@ -87,6 +90,8 @@ def test_a_recorder_killed_mid_recording_keeps_every_reported_message(tmp_path):
     contents = read_recording(path)
     assert not contents.complete and contents.problem
     assert len(contents.messages) >= reported_messages
+    # the file is chunked: what the kill lost is the chunk in progress, at most the last second
+    assert max(m.log_time_ns for m in contents.messages) >= killed_at_ns - 1_000_000_000
     assert len(contents.topic(VIDEO_TOPIC)) >= reported_frames and len(contents.topic(JOINTS_TOPIC)) >= 3 * (reported_frames - 1)
     fixed = tmp_path / "fixed.mcap"
     recover(path, fixed)

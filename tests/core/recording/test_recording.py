@@ -29,15 +29,29 @@ def _image(i, rng, noise=3.0):
     return image if noise == 0 else np.clip(image + rng.normal(0, noise, image.shape), 0, 255).astype(np.uint8)
 
 
+class SimulatedClock:
+    """Host seconds that a test sets: a recording made faster than real time, stamped consistently."""
+
+    def __init__(self, t_s: float = 0.0):
+        self.t_s = t_s
+
+    def __call__(self) -> float:
+        return self.t_s
+
+
 def _record(path, n_frames=3, n_solves=2, frames="jpeg"):
     rng = np.random.default_rng(0)
-    with SessionRecorder(path, frames=frames, drop_when_busy=False) as rec:
+    clock = SimulatedClock()
+    with SessionRecorder(path, frames=frames, drop_when_busy=False, clock=clock) as rec:
         rec.record_setup(intrinsics=GRIPPER_CAMERA.to_dict())
         for i in range(n_frames):
             image = _image(i, rng)
+            clock.t_s = i + 0.02  # each frame reaches the recorder 20 ms after its capture
             rec.record_frame(image, float(i))
-            rec.record_joints(i, 10 * i, float(i), [1.0, 2.0, 3.0, 4.0, 5.0, float(i)])
+            rec.record_joints(i, 10 * i, i + 0.01, [1.0, 2.0, 3.0, 4.0, 5.0, float(i)])
             rec.record_event("pick", number=i)
+            if i % 3 == 2:
+                rec.flush()  # several chunks, as a recording of some seconds has
         for _ in range(n_solves):
             truth = random_pose(rng)
             P = random_points(rng, 6)
@@ -95,8 +109,13 @@ def test_video_frames_use_foxglove_compressed_video(tmp_path):
     # Annex B with SPS and PPS before the IDR slice, as Foxglove requires of a keyframe
     types = nal_unit_types(message.data)
     assert message.data.startswith(b"\x00\x00\x00\x01") and types.index(7) < types.index(5) and 8 in types
+    assert not any(c.topic == FRAME_TOPIC for c in summary.channels.values())  # only the frame topic in use
+    jpeg = _record(tmp_path / "j.mcap", n_frames=2, n_solves=0, frames="jpeg")
+    with open(jpeg, "rb") as f:
+        summary = make_reader(f).get_summary()
     image = next(c for c in summary.channels.values() if c.topic == FRAME_TOPIC)
     assert summary.schemas[image.schema_id].name == "foxglove.CompressedImage" and image.message_encoding == "json"
+    assert not any(c.topic == VIDEO_TOPIC for c in summary.channels.values())
 
 
 def test_a_busy_encoder_drops_frames_and_counts_them(tmp_path):
@@ -119,7 +138,7 @@ def test_every_message_before_a_cut_survives_and_recovers(tmp_path, frames):
         contents = read_recording(cut_path)
         assert not contents.complete and "ends" in contents.problem
         n = len(contents.messages)
-        assert 0 < n <= len(full)  # a cut inside the summary at the end loses no message
+        assert 0 < n <= len(full)  # whole chunks before the cut survive; a cut inside the summary loses no message
         assert [m.payload for m in contents.messages] == [m.payload for m in full[:n]]
         fixed = recover(cut_path, tmp_path / f"fixed{cut}.mcap")
         again = read_recording(tmp_path / f"fixed{cut}.mcap")
