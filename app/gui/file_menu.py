@@ -7,9 +7,11 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QFileDialog, QMenu
 
+from app.gui.confirm import ask
 from app.gui.error_boundary import attempt
 from app.gui.session_files import Autosave, RecentFiles
 from calib_core.errors import OperatorError
@@ -47,6 +49,7 @@ class FileMenu:
         menu.addAction(self.record_action)
         menu.addAction(QAction("Open r&ecording...", w, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
         self.recent = RecentFiles(w.settings, menu.addMenu("Recent &files"), self.open_recent)
+        self.recorder_watch = QTimer(w, interval=250, timeout=self.watch_recorder)
         menu.addSeparator()
         # StandardKey.Quit is empty on some platforms (the offscreen one among them).
         menu.addAction(QAction("&Quit", w, shortcut=QKeySequence("Ctrl+Q"), triggered=w.close))
@@ -141,17 +144,37 @@ class FileMenu:
         w.commands.live.setChecked(False)
         self.recent.remember(path)
 
-    def start_recording(self, path) -> None:
+    def start_recording(self, path, **options) -> None:
         w = self.window
         if w.replay.playback is not None:
             w.show_error("close the replay before recording: a recording records the live camera and robot")
             return
-        w.report(w.workbench.start_recording)(path)
+        w.report(w.workbench.start_recording)(path, **options)
         self.record_action.setChecked(w.workbench.recorder is not None)
+        if w.workbench.recorder is not None:
+            self.recorder_watch.start()
 
     def stop_recording(self) -> None:
+        self.recorder_watch.stop()
         self.window.workbench.stop_recording()
         self.record_action.setChecked(False)
+
+    def watch_recorder(self) -> None:
+        """A recorder whose disk or encoder failed has stopped: REC goes off, the operator learns why and
+        may record on, as JPEG frames (no video encoder) into a new file."""
+        w = self.window
+        rec = w.workbench.recorder
+        failure = w.workbench.recording_failure()
+        if failure is None:
+            return
+        self.recorder_watch.stop()
+        self.record_action.setChecked(False)
+        w.show_error(f"recording {rec.path.name} stopped: {failure}")
+        again = rec.path.with_name(f"{rec.path.stem}-jpeg{rec.path.suffix}")
+        text = (f"Recording to {rec.path} stopped: {failure}.\n\nThe file keeps what was written before the failure "
+                f"(videocal recover completes it). Record on to {again.name}, with JPEG frames instead of H.264 video?")
+        if ask(w, "Recording stopped", text, "Record as JPEG"):
+            self.start_recording(again, frames="jpeg")
 
     def _record_toggled(self, on: bool) -> None:
         if not on:

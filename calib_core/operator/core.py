@@ -349,7 +349,10 @@ class OperatorCore(SessionFiles, Picking, Moves):
         return plan
 
     def close(self) -> None:
+        rec = self.recorder
         self.stop_recording()
+        if rec is not None:
+            rec.wait_finished(5.0)  # a file finishing in the background is not cut off by the exit
         if self.link is not None:
             self.link.close()
         if self.site is not None:

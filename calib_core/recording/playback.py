@@ -40,7 +40,11 @@ class RecordingPlayback:
         self.frames = FrameTrack(contents)
         joints = contents.topic(JOINTS_TOPIC)
         self.joint_times_s = np.array([self._t(m) for m in joints])
-        self.joints_deg = np.array([m.payload["joints_deg"] for m in joints], dtype=float).reshape(len(joints), -1)
+        rows = [m.payload["joints_deg"] for m in joints]
+        if len({len(r) for r in rows}) > 1:
+            raise ValueError(f"the joint samples of the recording have {' and '.join(str(n) for n in sorted({len(r) for r in rows}))} values")
+        # A recording of a camera alone has no joint samples: its frames replay, nothing is robot-bound.
+        self.joints_deg = np.array(rows, dtype=float).reshape(len(rows), len(rows[0]) if rows else 0)
         self._events = [m for m in contents.topic(EVENT_TOPIC) if str(m.payload.get("kind", "")).startswith("pair_")]
         self._event_times = [self._t(m) for m in self._events]
         self.solves = [RecordedSolve(int(m.payload.get("id", k + 1)), self._t(m), m.payload["inputs"], m.payload["result"], m.payload.get("context") or {}) for k, m in enumerate(contents.topic(SOLVE_TOPIC))]

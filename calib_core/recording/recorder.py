@@ -265,6 +265,8 @@ class SessionRecorder:
     def _encode(self, item) -> None:
         order, image, capture_ns, t_host_s, frame_id = item
         try:
+            if image.ndim == 2 or image.shape[2] == 1:  # a monochrome camera: recorded as grey RGB
+                image = np.repeat(image.reshape(image.shape[0], image.shape[1], 1), 3, axis=2)
             if self.frames == "jpeg":
                 ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality])
                 if not ok:

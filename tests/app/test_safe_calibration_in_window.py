@@ -6,32 +6,14 @@ quitting with unsaved work asks."""
 
 import numpy as np
 import trimesh
-from PySide6.QtCore import QPoint, QTimer, Qt
-from PySide6.QtWidgets import QApplication, QMessageBox
+from PySide6.QtCore import QPoint, Qt
+from PySide6.QtWidgets import QApplication
 
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
-from tests.app.windows import confirm_move_if_asked, wait_for_settled_frame
+from tests.app.windows import answer_next_question as _answer, confirm_move_if_asked, wait_for_settled_frame
 
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
-
-
-def _answer(qtbot, button_text: str) -> list:
-    """Click ``button_text`` in the next modal question (a QMessageBox) as soon as it is up."""
-    answered = []
-
-    def look() -> None:
-        box = QApplication.activeModalWidget()
-        if isinstance(box, QMessageBox):
-            for b in box.buttons():
-                if b.text().replace("&", "") == button_text:
-                    answered.append(box.text())
-                    b.click()
-                    return
-        QTimer.singleShot(20, look)
-
-    QTimer.singleShot(0, look)
-    return answered
 
 
 def _go(qtbot, win, button) -> None:

@@ -2,7 +2,8 @@
 
 import time
 
-from PySide6.QtCore import QSettings, Qt
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtWidgets import QApplication, QMessageBox
 
 
 def window_settings(folder, name: str = "settings") -> QSettings:
@@ -41,3 +42,21 @@ def confirm_move_if_asked(qtbot, win) -> bool:
         qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
         return True
     return False
+
+
+def answer_next_question(qtbot, button_text: str) -> list:
+    """Click ``button_text`` in the next modal question (a QMessageBox) as soon as it is up."""
+    answered = []
+
+    def look() -> None:
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox):
+            for b in box.buttons():
+                if b.text().replace("&", "") == button_text:
+                    answered.append(box.text())
+                    b.click()
+                    return
+        QTimer.singleShot(20, look)
+
+    QTimer.singleShot(0, look)
+    return answered

@@ -55,6 +55,16 @@ def test_a_frame_is_logged_at_its_capture_and_samples_that_came_while_it_was_enc
     assert rec.late_messages == 0
 
 
+def test_a_monochrome_camera_is_recorded_as_grey_video(tmp_path):
+    from calib_core.recording.frame_track import FrameTrack
+
+    grey = _image(0, None, noise=0.0)[..., 1]
+    with SessionRecorder(tmp_path / "mono.mcap", drop_when_busy=False) as rec:
+        rec.record_frame(grey, time.monotonic())
+    image = FrameTrack(read_recording(tmp_path / "mono.mcap")).image(0)
+    assert image.shape == grey.shape + (3,) and np.abs(image.astype(int) - grey[..., None]).mean() < 4
+
+
 def test_a_frame_later_than_what_was_written_keeps_its_capture_time_and_the_file_its_order(tmp_path):
     clock = SimulatedClock(5.0)
     rec = SessionRecorder(tmp_path / "late.mcap", clock=clock, hold_s=0.0, drop_when_busy=False)
@@ -73,7 +83,7 @@ def test_a_failing_encoder_stops_the_recorder_without_raising_into_the_caller(tm
     rec = SessionRecorder(path)
     rec.record_event("before", n=1)
     assert rec.flush()
-    rec.record_frame(np.zeros((48, 64), np.uint8), time.monotonic())  # a grey frame: PyAV refuses it as rgb24
+    rec.record_frame(np.zeros((48, 64, 3), np.uint16), time.monotonic())  # 16 bits a channel: PyAV refuses it as rgb24
     deadline = time.monotonic() + 30
     while rec.failure is None and time.monotonic() < deadline:
         rec.flush(timeout_s=0.2)
