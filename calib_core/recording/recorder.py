@@ -5,8 +5,9 @@ frames go to the encoder (H.264 by default, see ``video_codec``; or JPEG), every
 a time-ordered buffer. The writer thread writes messages in log-time order, holding each for
 ``hold_s`` and until no frame captured before it is still being encoded, so log times never go
 backwards in the file even though a frame is written after the joint samples that arrived while
-it was encoded. Every ``chunk_every_s`` it closes a chunk (with its CRC and message index) and
-hands it to the operating system: a killed process loses at most that much plus the hold.
+it was encoded. A chunk spans ``chunk_every_s`` of log time; it is closed (with its CRC and
+message index) and handed to the operating system when the next message is past that, or when
+the recorder's clock is (a quiet spell): a killed process loses at most that much plus the hold.
 ``close`` writes the summary (chunk index, statistics) that indexed readers open the file by.
 
 A failing disk or encoder does not raise into the caller: the recorder stops, ``failure`` says
@@ -85,7 +86,7 @@ class SessionRecorder:
         self.camera_frame = camera_frame
         self.clock = clock
         self._unix_minus_host_ns = time.time_ns() - int(round(clock() * 1e9))
-        self.chunk_every_s, self.hold_ns = chunk_every_s, int(hold_s * 1e9)
+        self.chunk_every_ns, self.hold_ns = int(chunk_every_s * 1e9), int(hold_s * 1e9)
         self._file = open(self.path, "wb")
         self._writer = Writer(self._file, compression=CompressionType.LZ4, chunk_size=4 * 1024 * 1024, enable_crcs=True, enable_data_crcs=True)
         self._writer.start(profile=PROFILE, library=f"videocal {__version__}")
@@ -100,6 +101,7 @@ class SessionRecorder:
         self._encoder: H264Encoder | None = None
         self._last_written_ns = 0
         self._chunk_messages = self._chunk_frames = 0
+        self._chunk_start_ns: int | None = None  # log time of the first message of the open chunk
         self._bytes = self._file.tell()
         self.messages = self.frames_written = self.frames_dropped = self.late_messages = self.messages_lost = 0
         self.failure: str | None = None
@@ -201,7 +203,6 @@ class SessionRecorder:
 
     # --- the writer thread -----------------------------------------------------------------------
     def _run(self) -> None:
-        last_chunk = time.monotonic()
         try:
             while True:
                 try:
@@ -213,15 +214,13 @@ class SessionRecorder:
                 if isinstance(item, tuple) and item[0] is _FLUSH:
                     self._release(None)
                     self._flush_chunk()
-                    last_chunk = time.monotonic()
                     item[1].set()
                     continue
                 if item is not None:
                     self._take(item)
                 self._release(self.unix_ns() - self.hold_ns)
-                if time.monotonic() - last_chunk >= self.chunk_every_s:
-                    self._flush_chunk()
-                    last_chunk = time.monotonic()
+                if self._chunk_start_ns is not None and self.unix_ns() - self._chunk_start_ns >= self.chunk_every_ns + self.hold_ns:
+                    self._flush_chunk()  # a quiet spell: what was written reaches the disk anyway
             self._drain()
             self._release(None)
             self._writer.finish()
@@ -313,6 +312,11 @@ class SessionRecorder:
                 name, media_type, blob = data
                 self._writer.add_attachment(create_time=log_ns, log_time=log_ns, name=name, media_type=media_type, data=blob)
                 continue
+            if self._chunk_start_ns is None:
+                self._chunk_start_ns = log_ns
+            elif log_ns - self._chunk_start_ns >= self.chunk_every_ns:
+                self._flush_chunk()  # a chunk spans chunk_every_s of log time: what a crash can lose, what a seek reads
+                self._chunk_start_ns = log_ns
             self._sequence[topic] += 1
             self._writer.add_message(self._channel(topic), log_time=log_ns, data=data, publish_time=log_ns, sequence=self._sequence[topic])
             self._chunk_messages += 1
@@ -320,6 +324,7 @@ class SessionRecorder:
 
     def _flush_chunk(self) -> None:
         self._writer.flush()  # closes the chunk in progress, with its CRC and message index
+        self._chunk_start_ns = None
         self._bytes = self._file.tell()
         self.messages += self._chunk_messages
         self.frames_written += self._chunk_frames
