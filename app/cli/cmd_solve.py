@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.documents import read_json
 from calib_core.errors import FileFormatError
 from calib_core.frames import make_transform
 from calib_core.solver import SolveStatus, solve_pose
@@ -80,12 +81,7 @@ def _option(data: dict, name: str, kind, default, path: Path):
 
 def run(args: argparse.Namespace) -> int:
     path: Path = args.input
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(path, f"not valid JSON: {exc}") from None
-    except UnicodeDecodeError:
-        raise FileFormatError(path, "not a UTF-8 text file") from None
+    data = read_json(path, "solve input file")
     if not isinstance(data, dict):
         raise FileFormatError(path, "the top level must be a JSON object")
     unknown = set(data) - _KNOWN_FIELDS

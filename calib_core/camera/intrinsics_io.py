@@ -15,6 +15,7 @@ import yaml
 
 from calib_core.atomic_file import atomic_path, atomic_write_text
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.documents import parse_yaml, read_text
 from calib_core.errors import FileFormatError
 
 FORMATS = ("opencv", "ros")
@@ -23,15 +24,12 @@ FORMATS = ("opencv", "ros")
 def load_intrinsics(path: str | Path) -> Intrinsics:
     """Read intrinsics from an OpenCV FileStorage YAML or a ROS camera_info YAML file."""
     path = Path(path)
-    if not path.is_file():
-        raise FileFormatError(path, "no such file" if not path.exists() else "not a regular file")
-    text = path.read_text(encoding="utf-8", errors="replace")
+    if path.exists() and not path.is_file():
+        raise FileFormatError(path, "not a regular file")
+    text = read_text(path, "intrinsics file", max_bytes=1024 * 1024)
     if text.lstrip().startswith("%YAML") or "!!opencv-matrix" in text:
         return _load_opencv(path)
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise FileFormatError(path, f"not valid YAML ({_first_line(exc)})") from None
+    data = parse_yaml(text, path)
     if isinstance(data, dict) and "camera_matrix" in data and isinstance(data["camera_matrix"], dict):
         return _load_ros(path, data)
     raise FileFormatError(path, "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "

@@ -20,6 +20,7 @@ import base64
 import heapq
 import itertools
 import json
+import math
 import os
 import queue
 import threading
@@ -42,11 +43,14 @@ CLOSE_TIMEOUT_S = 1.0
 
 
 def to_jsonable(value):
-    """numpy arrays and scalars as lists and numbers, recursively."""
+    """numpy arrays and scalars as lists and numbers, recursively; JSON has no NaN or infinity: a
+    non-finite number is written as ``null``."""
     if isinstance(value, np.ndarray):
-        return value.tolist()
+        return to_jsonable(value.tolist())
     if isinstance(value, (np.floating, np.integer)):
-        return value.item()
+        value = value.item()
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
     if isinstance(value, dict):
         return {str(k): to_jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

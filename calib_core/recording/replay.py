@@ -14,6 +14,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import make_transform
 from calib_core.recording.reader import read_recording
+from calib_core.recording.recorder import to_jsonable
 from calib_core.recording.schemas import SOLVE_TOPIC
 
 
@@ -61,10 +62,13 @@ class ReplayedSolve:
 
 
 def _diff(a, b) -> float:
-    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    """Largest difference; JSON keeps a non-finite number as null: two missing values agree."""
+    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
     if a.shape != b.shape:
         return float("inf")
-    return float(np.max(np.abs(a - b))) if a.size else 0.0
+    d = np.abs(a - b)
+    d[np.isnan(a) & np.isnan(b)] = 0.0
+    return float(np.max(np.where(np.isnan(d), np.inf, d))) if a.size else 0.0
 
 
 def replay(path: str | Path) -> list[ReplayedSolve]:
@@ -72,10 +76,10 @@ def replay(path: str | Path) -> list[ReplayedSolve]:
     out = []
     for message in contents.topic(SOLVE_TOPIC):
         recorded = message.payload["result"]
-        recomputed = solve_from_inputs(message.payload["inputs"]).to_dict()
+        recomputed = to_jsonable(solve_from_inputs(message.payload["inputs"]).to_dict())  # as it would be recorded
         dt = _diff(recorded["t_obj2cam_mm"], recomputed["t_obj2cam_mm"])
         dr = _diff(recorded["R_obj2cam"], recomputed["R_obj2cam"])
-        drms = abs(float(recorded["rms_px"]) - float(recomputed["rms_px"]))
+        drms = _diff(recorded["rms_px"], recomputed["rms_px"])
         agree = recorded["status"] == recomputed["status"] and dt == 0.0 and dr == 0.0 and drms == 0.0
         out.append(ReplayedSolve(int(message.payload["id"]), recorded, recomputed, agree, dt, dr, drms))
     return out

@@ -11,6 +11,7 @@ import yaml
 import numpy as np
 
 from calib_core.atomic_file import atomic_write_text
+from calib_core.documents import finite_number, read_yaml
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.vision.hand_eye import HandEyeCalibration
@@ -34,13 +35,24 @@ def save_hand_eye(path: str | Path, result: HandEyeCalibration) -> None:
 
 
 def load_cam2flange(path: str | Path) -> np.ndarray:
-    """``cam2flange`` (4, 4) mm from a hand-eye file; ``FileFormatError`` names the file and what is wrong."""
+    """``cam2flange`` (4, 4) mm from a hand-eye file; ``FileFormatError`` names the file and the field.
+
+    ``cam2flange.xyz`` (mm) and ``cam2flange.rpy`` (deg) are three finite numbers each; a ``units``
+    section, when there is one, must say mm and deg (a file in metres would put the camera a thousand
+    times too close)."""
     path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text())
-        pose = doc["cam2flange"]
-        return transform_from_xyz_rpy(pose["xyz"], pose["rpy"])
-    except FileNotFoundError:
-        raise FileFormatError(path, "no such hand-eye file") from None
-    except (yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
-        raise FileFormatError(path, f"not a cam2flange file: {exc}", "cam2flange") from None
+    doc = read_yaml(path, "hand-eye file", max_bytes=1024 * 1024)
+    if not isinstance(doc, dict) or not isinstance(doc.get("cam2flange"), dict):
+        raise FileFormatError(path, "not a hand-eye file: expected a cam2flange section with xyz (mm) and rpy (deg)", "cam2flange")
+    units = doc.get("units")
+    if units is not None:
+        if not isinstance(units, dict) or units.get("length", "mm") != "mm" or units.get("angle", "deg") != "deg":
+            raise FileFormatError(path, f"videocal reads cam2flange in mm and deg, the file says {units!r}", "units")
+    pose = doc["cam2flange"]
+    values = {}
+    for key in ("xyz", "rpy"):
+        v = pose.get(key)
+        if not isinstance(v, list) or len(v) != 3:
+            raise FileFormatError(path, f"must be a list of 3 numbers, got {v!r}", f"cam2flange.{key}")
+        values[key] = [finite_number(x, path, f"cam2flange.{key}[{i}]") for i, x in enumerate(v)]
+    return transform_from_xyz_rpy(values["xyz"], values["rpy"])

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
-import yaml
+from calib_core.documents import read_yaml
 
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
@@ -143,16 +143,7 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     """Read and validate a workcell file; raise :class:`FileFormatError` naming the field at fault."""
     path = Path(path)
     reader = _Reader(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise reader.fail(None, "no such workcell file") from None
-    except (IsADirectoryError, UnicodeDecodeError, PermissionError) as exc:
-        raise reader.fail(None, f"cannot read: {exc}") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise reader.fail(None, f"not valid YAML: {exc}") from None
+    data = read_yaml(path, "workcell file")  # size, nesting and aliases bounded before anything is built
     data = reader.mapping(data, "(top level)", _TOP_KEYS, {"schema_version", "units", "robot", "components"})
     if data["schema_version"] not in _READABLE_VERSIONS:
         raise reader.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}")

@@ -23,6 +23,7 @@ from calib_core.calibration.correspondences import Correspondence, pair_to_dict
 from calib_core.calibration.verification import Verification
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.documents import read_json
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
@@ -138,16 +139,7 @@ def _tolerance(f, t: dict, where: str) -> float:
 def load_workspace(path: str | Path) -> Workspace:
     path = Path(path)
     f = _Fields(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise f.fail(None, "no such workspace file") from None
-    except (UnicodeDecodeError, IsADirectoryError, PermissionError) as exc:
-        raise f.fail(None, f"cannot read: {exc}") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise f.fail(None, f"not valid JSON (truncated or corrupt?): {exc}") from None
+    data = read_json(path, "workspace file", max_bytes=64 * 1024 * 1024)  # size and nesting bounded first
     if not isinstance(data, dict) or data.get("kind") != KIND:
         raise f.fail("kind", f"not a videocal workspace (kind must be {KIND!r})")
     version = data.get("schema_version")
