@@ -54,7 +54,7 @@ def test_a_failed_start_stops_the_simulator(cell_copy, tmp_path):
     gui = _gui("--workcell", str(cell_copy), "--hand-eye", str(bad))
     out, err = gui.communicate(timeout=120)
     assert gui.returncode == 2, err
-    assert "not a cam2flange file" in err and "Traceback" not in err
+    assert "cam2flange.xyz" in err and "must be a list of 3 numbers" in err and "Traceback" not in err
     assert _wait_gone(cell_copy) == []
 
 

@@ -53,7 +53,7 @@ def test_save_failure_keeps_old_file(tmp_path):
 
 
 BAD_FILES = {
-    "missing.yaml": (None, "no such file"),
+    "missing.yaml": (None, "no such intrinsics file"),
     "garbage.yaml": ("camera_matrix: [1, 2\n  : ]]\n", "not valid YAML"),
     "foreign.yaml": ("name: robot\njoints: 6\n", "not an intrinsics file"),
     "ros_short.yaml": (
