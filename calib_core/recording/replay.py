@@ -63,7 +63,7 @@ class ReplayedSolve:
 
 def _diff(a, b) -> float:
     """Largest difference; JSON keeps a non-finite number as null: two missing values agree."""
-    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
+    a, b = np.atleast_1d(np.array(a, dtype=float)), np.atleast_1d(np.array(b, dtype=float))
     if a.shape != b.shape:
         return float("inf")
     d = np.abs(a - b)

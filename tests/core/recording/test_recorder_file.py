@@ -105,7 +105,7 @@ FULL_DISK = textwrap.dedent(
     import resource, signal, sys, time, numpy as np
     from calib_core.recording.recorder import SessionRecorder
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG, as on a full disk
-    resource.setrlimit(resource.RLIMIT_FSIZE, (300_000, 300_000))
+    resource.setrlimit(resource.RLIMIT_FSIZE, (3_000_000, 3_000_000))  # a few chunks of noise video
     rec = SessionRecorder(sys.argv[1])
     rng = np.random.default_rng(0)
     k = 0

@@ -1,0 +1,186 @@
+"""The bad inputs of "Hardening" item 7 and 8, through the real command line: each ends with one
+``error:`` line naming the file or option at fault and exit 2, no traceback, and within a bound on
+the child's memory (a 22 GiB allocation or a YAML alias bomb would blow it). The time and memory
+each one takes are measured in bench/reliability_bench.py, not here."""
+
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from calib_core.workcell import DEFAULT_WORKCELL
+
+ADDRESS_SPACE = 6 * 1024**3  # far above any good run of these commands, far below a runaway allocation
+
+
+def _limits() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+
+
+def _videocal(*args, cwd=None, preexec=_limits, timeout=120) -> subprocess.CompletedProcess:
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    return subprocess.run([sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout, cwd=cwd, env=env, preexec_fn=preexec)
+
+
+def _refused(run: subprocess.CompletedProcess, *expected: str) -> str:
+    assert "Traceback" not in run.stderr, run.stderr[-3000:]
+    assert run.returncode == 2, (run.returncode, run.stderr[-2000:])
+    errors = [line for line in run.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1, run.stderr
+    for text in expected:
+        assert text in errors[0], errors[0]
+    return errors[0]
+
+
+@pytest.fixture
+def cell(tmp_path):
+    """A copy of the bundled cell (workcell, meshes, robot, camera) to break; returns a function that
+    writes the workcell with ``edit(data)`` applied and returns its path."""
+    root = DEFAULT_WORKCELL.parents[1]
+    for sub in ("workcell", "robot", "camera"):
+        shutil.copytree(root / sub, tmp_path / sub)
+    path = tmp_path / "workcell" / "workcell.yaml"
+
+    def write(edit=None, text: str | None = None) -> Path:
+        if text is None:
+            data = yaml.safe_load(path.read_text())
+            if edit is not None:
+                edit(data)
+            text = yaml.safe_dump(data, sort_keys=False)
+        out = tmp_path / "workcell" / "edited.yaml"
+        out.write_text(text)
+        return out
+
+    write.folder = tmp_path
+    return write
+
+
+def _render(workcell: Path, tmp: Path) -> subprocess.CompletedProcess:
+    return _videocal("render", "--workcell", workcell, "--out", tmp / "out.png", "--scale", "0.25")
+
+
+# --- documents that are too deep, too big, too aliased --------------------------------------------
+def test_a_workcell_nested_10000_deep(cell):
+    deep = "name: " + "[" * 10000 + "]" * 10000 + "\n"
+    _refused(_render(cell(text=deep), cell.folder), "edited.yaml", "nests deeper than")
+
+
+def test_a_json_nested_10000_deep(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 10000 + "]" * 10000)
+    _refused(_videocal("solve", path), "deep.json", "nests deeper than")
+    _refused(_videocal("export", path), "deep.json", "nests deeper than")
+
+
+def test_an_alias_bomb_in_a_workcell_name(cell):
+    bomb = "".join(f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]\n" for i in range(1, 9))
+    text = cell().read_text().replace("name: space station robotic test bed", "a0: &a0 [x]\n" + bomb + "name: *a8")
+    _refused(_render(cell(text=text), cell.folder), "edited.yaml", "aliases")
+
+
+def test_a_huge_all_comment_workcell(cell):
+    path = cell.folder / "workcell" / "comments.yaml"
+    with open(path, "w") as f:
+        line = "# " + "x" * 98 + "\n"
+        for _ in range(170_000):  # 17 MB
+            f.write(line)
+    _refused(_render(path, cell.folder), "comments.yaml", "at most")
+
+
+# --- fields of the wrong type or out of range -----------------------------------------------------
+def test_a_workcell_without_a_camera(cell):
+    for edit in (lambda d: d.pop("camera"), lambda d: d.update(camera=None)):
+        _refused(_render(cell(edit), cell.folder), "camera")
+
+
+def test_a_task_component_given_as_a_list(cell):
+    def edit(d):
+        d["task_locations"][0]["component"] = ["oru_1", "oru_2"]
+
+    _refused(_render(cell(edit), cell.folder), "component")
+
+
+def _camera_file(cell, text: str) -> Path:
+    (cell.folder / "camera" / "bad.yaml").write_text(text)
+    return cell(lambda d: d.update(camera={"intrinsics": "../camera/bad.yaml"}))
+
+
+def test_an_opencv_intrinsics_file_whose_rows_and_cols_disagree_with_its_data(cell):
+    text = (cell.folder / "camera" / "gripper_camera.yaml").read_text().replace("rows: 3", "rows: 4", 1)
+    _refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix")
+
+
+def test_ros_rows_given_as_text_and_an_absurd_image_size(cell):
+    ros = yaml.safe_load((cell.folder / "camera" / "gripper_camera_ros.yaml").read_text())
+    text = yaml.safe_dump({**ros, "camera_matrix": {**ros["camera_matrix"], "rows": "3"}})
+    _refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix.rows")
+    huge = yaml.safe_dump({**ros, "image_width": 10**12})
+    _refused(_render(_camera_file(cell, huge), cell.folder), "bad.yaml", "image_width")
+
+
+def test_export_with_std_or_time_as_objects(tmp_path):
+    from calib_core.calibration.corrections import CorrectionTable
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.workcell import load_workcell
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    cell = load_workcell()
+    path = tmp_path / "w.json"
+    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], CorrectionTable()))
+    data = json.loads(path.read_text())
+    good = {
+        "task": "oru_1_grasp", "tcp2base_model": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+        "tcp2base_measured": [[1, 0, 0, 1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "displacement_mm": [1, 0, 0],
+        "rotation_deg": [0, 0, 0], "std_displacement_mm": [0.1, 0.1, 0.1], "std_rotation_deg": [0.01, 0.01, 0.01],
+        "joints_deg": [0, 0, 0, 0, 0, 0], "rms_px": 0.3, "pairs": 6, "time_s": 1.0,
+    }
+    for field, value in (("std_displacement_mm", {"x": 1}), ("time_s", {"when": "now"})):
+        data["corrections"] = [{**good, field: value}]
+        path.write_text(json.dumps(data))
+        _refused(_videocal("export", path), "w.json", field)
+
+
+def test_a_recorded_solve_without_its_result(tmp_path):
+    from calib_core.recording.recorder import SessionRecorder
+    from calib_core.recording.schemas import SOLVE_TOPIC
+
+    path = tmp_path / "s.mcap"
+    with SessionRecorder(path) as rec:
+        rec._write(SOLVE_TOPIC, {"id": 1, "inputs": {}})
+    _refused(_videocal("replay", path), "s.mcap", "solve 1")
+
+
+# --- options out of range -------------------------------------------------------------------------
+@pytest.mark.parametrize("args, expected", [
+    (("calibrate-intrinsics", "sim", "--views", "0", "--out", "{tmp}/i.yaml"), "--views"),
+    (("calibrate-intrinsics", "sim", "--board", "charuco:100000x100000:30:22:DICT_5X5_100", "--out", "{tmp}/i.yaml"), "board"),
+    (("calibrate-hand-eye", "sim", "--poses", "1000000", "--out", "{tmp}/h.yaml"), "--poses"),
+    (("demo", "--offscreen", "--scale", "100", "--out", "{tmp}/demo"), "--scale"),
+    (("demo", "--offscreen", "--out", "{tmp}/a_file"), "a_file"),
+    (("monitor", "loop://", "--timeout", "nan"), "--timeout"),
+    (("monitor", "loop://", "--timeout", "inf"), "--timeout"),
+    (("render", "--scale", "1e6", "--out", "{tmp}/r.png"), "--scale"),
+])
+def test_options_out_of_range(tmp_path, args, expected):
+    (tmp_path / "a_file").write_text("I am a file, not a folder")
+    _refused(_videocal(*[a.format(tmp=tmp_path) for a in args]), expected)
+
+
+def test_a_full_disk_is_an_error_not_a_traceback(tmp_path):
+    def small_files() -> None:
+        import signal
+
+        _limits()
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))
+
+    out = tmp_path / "r.png"
+    run = _videocal("render", "--out", out, "--scale", "0.5", preexec=small_files)
+    _refused(run, "r.png")
+    assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
