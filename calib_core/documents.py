@@ -72,6 +72,8 @@ def parse_yaml(text: str, path: str | Path, *, max_depth: int = MAX_DEPTH, max_a
                     raise FileFormatError(path, f"uses more than {max_aliases} YAML aliases (*name); write the values out (line {event.start_mark.line + 1})")
         return yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as exc:
+        if "flow level" in str(exc):  # libyaml's own nesting limit
+            raise FileFormatError(path, f"nests deeper than {max_depth} levels") from None
         raise FileFormatError(path, f"not valid YAML ({_first_line(exc)})") from None
     except RecursionError:
         raise FileFormatError(path, f"nests deeper than {max_depth} levels") from None
@@ -99,17 +101,13 @@ def _json_depth_exceeds(text: str, max_depth: int) -> bool:
 
 
 def parse_json(text: str, path: str | Path, *, max_depth: int = MAX_DEPTH):
-    """The JSON document in ``text``, its nesting checked first; ``NaN`` and ``Infinity`` (which
-    Python's json accepts and JSON does not have) are refused."""
+    """The JSON document in ``text``, its nesting checked first. ``NaN`` and ``Infinity`` (which
+    Python writes for an unknown sigma) parse as floats: the fields that must be finite say so."""
     path = Path(path)
     if _json_depth_exceeds(text, max_depth):
         raise FileFormatError(path, f"nests deeper than {max_depth} levels")
-
-    def no_constant(name: str):
-        raise ValueError(f"{name} is not a JSON number")
-
     try:
-        return json.loads(text, parse_constant=no_constant)
+        return json.loads(text)
     except (json.JSONDecodeError, ValueError) as exc:
         raise FileFormatError(path, f"not valid JSON ({exc})") from None
     except RecursionError:

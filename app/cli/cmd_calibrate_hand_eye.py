@@ -10,13 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from calib_core.errors import VideocalError
+from app.cli.options import bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", choices=("sim",), help="'sim': the simulated test bed (a real robot and camera need the window's capture mode, not built yet)")
     parser.add_argument("--workcell", type=Path, help="the cell whose robot and camera are simulated (default: the bundled one); the board stands where its hand_eye_board says, or in front of the robot")
     parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100")
-    parser.add_argument("--poses", type=int, default=10)
+    parser.add_argument("--poses", type=bounded_int(3, 200), default=10, help="robot poses to view the board from (3 to 200)")
     parser.add_argument("--out", type=Path, required=True, help="YAML file for cam2flange (xyz mm, rpy deg) and its 1-sigma")
     parser.add_argument("--robot-errors", action="store_true", help="give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
 

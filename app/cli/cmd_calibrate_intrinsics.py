@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from calib_core.errors import VideocalError
+from app.cli.options import bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -20,8 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, help="intrinsics file to write (YAML)")
     parser.add_argument("--format", choices=("opencv", "ros"), default="opencv")
     parser.add_argument("--no-distortion", action="store_true", help="fit the pinhole only (as the paper's tool did)")
-    parser.add_argument("--every", type=int, default=15, help="with a video: use every n-th frame")
-    parser.add_argument("--views", type=int, default=15, help="with 'sim': how many views to render")
+    parser.add_argument("--every", type=bounded_int(1, 100_000), default=15, help="with a video: use every n-th frame")
+    parser.add_argument("--views", type=bounded_int(3, 500), default=15, help="with 'sim': how many views to render")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
 

@@ -12,18 +12,20 @@ import json
 import sys
 import time
 
+from app.cli.options import bounded_float, bounded_int
+
 EXIT_TIMEOUT = 4
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("url", help="a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port or loop://")
     rate = parser.add_mutually_exclusive_group()
-    rate.add_argument("--poll", type=float, metavar="HZ", help="request samples at this rate (the paper's cyclic request)")
-    rate.add_argument("--stream", type=float, metavar="HZ", help="ask the controller to stream at this rate (default 20)")
-    parser.add_argument("--count", type=int, help="stop after this many samples")
-    parser.add_argument("--timeout", type=float, default=5.0, help="give up after this many seconds without a sample (default 5)")
+    rate.add_argument("--poll", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="request samples at this rate (the paper's cyclic request)")
+    rate.add_argument("--stream", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="ask the controller to stream at this rate (default 20)")
+    parser.add_argument("--count", type=bounded_int(1, 10**12), help="stop after this many samples")
+    parser.add_argument("--timeout", type=bounded_float(0.0, 86400.0, exclusive_low=True), default=5.0, help="give up after this many seconds without a sample (default 5)")
     parser.add_argument("--json", action="store_true", help="one JSON object per line: seq, t_ms, joints_deg")
-    parser.add_argument("--baud", type=int, default=115200, help="serial baud rate")
+    parser.add_argument("--baud", type=bounded_int(50, 20_000_000), default=115200, help="serial baud rate")
     parser.add_argument("--parity", choices=("N", "E", "O"), default="N", help="serial parity")
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from calib_core.atomic_file import atomic_write_bytes
 from calib_core.errors import VideocalError
 from calib_core.workcell import DEFAULT_WORKCELL
+from app.cli.options import bounded_float
 
 VIEWS = ("virtual", "overview", "true")
 
@@ -31,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--highlight", help="component to highlight (default: the location's component)")
     parser.add_argument("--features", action="store_true", help="show feature points and their names")
     parser.add_argument("--style", choices=("surface", "wireframe", "edges"), default="surface")
-    parser.add_argument("--scale", type=float, default=1.0, help="image size relative to the camera's (virtual and true views)")
+    parser.add_argument("--scale", type=bounded_float(0.05, 4.0), default=1.0, help="image size relative to the camera's (virtual and true views)")
 
 
 def _joints(text: str) -> np.ndarray:

@@ -38,5 +38,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.recording}: {len(results)} solves")
         for r in results:
             verdict = "agrees" if r.agree else f"DIFFERS (translation {r.translation_diff_mm:.3g} mm, rotation {r.rotation_diff:.3g}, rms {r.rms_diff_px:.3g} px)"
-            print(f"  solve {r.id}: recorded {r.recorded['status']} rms {r.recorded['rms_px']:.3f} px, re-computed {r.recomputed['status']}: {verdict}")
+            rms = "n/a" if r.recorded["rms_px"] is None else f"{r.recorded['rms_px']:.3f} px"
+            print(f"  solve {r.id}: recorded {r.recorded['status']} rms {rms}, re-computed {r.recomputed['status']}: {verdict}")
     return 0 if all(r.agree for r in results) else EXIT_DIFFERS

@@ -35,6 +35,16 @@ def _field(data: dict, name: str, path: Path):
     return data[name]
 
 
+def _points(data: dict, name: str, dim: int, path: Path) -> np.ndarray:
+    raw = _field(data, name, path)
+    if not isinstance(raw, list) or not all(isinstance(p, list) and len(p) == dim and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in raw):
+        raise FileFormatError(path, f"must be a list of [{', '.join('xyz'[:dim] if dim == 3 else 'uv')}] numbers", name)
+    points = np.array(raw, dtype=float).reshape(len(raw), dim)
+    if not np.all(np.isfinite(points)):
+        raise FileFormatError(path, "contains NaN or infinite values", name)
+    return points
+
+
 def _intrinsics(data: dict, path: Path) -> Intrinsics:
     raw = _field(data, "intrinsics", path)
     if not isinstance(raw, dict):
@@ -79,24 +89,32 @@ def _option(data: dict, name: str, kind, default, path: Path):
     raise FileFormatError(path, f"must be a {kind.__name__}, got {value!r}", name)
 
 
-def run(args: argparse.Namespace) -> int:
-    path: Path = args.input
+MAX_POINTS = 10_000
+
+
+def read_solve_inputs(path: Path) -> dict:
+    """The arguments of :func:`~calib_core.solver.solve_pose` from a solve input file, every field
+    checked; ``FileFormatError`` names the file and the field."""
     data = read_json(path, "solve input file")
     if not isinstance(data, dict):
         raise FileFormatError(path, "the top level must be a JSON object")
     unknown = set(data) - _KNOWN_FIELDS
     if unknown:
         raise FileFormatError(path, f"unknown field(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KNOWN_FIELDS))}")
-    solution = solve_pose(
-        _field(data, "points_3d", path),
-        _field(data, "points_2d", path),
-        _intrinsics(data, path),
-        prior=_prior(data, path),
-        estimate_focal=_option(data, "estimate_focal", bool, False, path),
-        model=_option(data, "model", str, "pinhole", path),
-        sigma_px=_option(data, "sigma_px", float, None, path),
-        robust=_option(data, "robust", bool, False, path),
-    )
+    for name in ("points_3d", "points_2d"):
+        if isinstance(data.get(name), list) and len(data[name]) > MAX_POINTS:
+            raise FileFormatError(path, f"{len(data[name])} points; a solve takes at most {MAX_POINTS}", name)
+    return {
+        "points_3d": _points(data, "points_3d", 3, path), "points_2d": _points(data, "points_2d", 2, path), "intrinsics": _intrinsics(data, path),
+        "prior": _prior(data, path), "estimate_focal": _option(data, "estimate_focal", bool, False, path),
+        "model": _option(data, "model", str, "pinhole", path), "sigma_px": _option(data, "sigma_px", float, None, path),
+        "robust": _option(data, "robust", bool, False, path),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    inputs = read_solve_inputs(args.input)
+    solution = solve_pose(inputs.pop("points_3d"), inputs.pop("points_2d"), inputs.pop("intrinsics"), **inputs)
     json.dump(solution.to_dict(), sys.stdout, indent=args.indent or None)
     sys.stdout.write("\n")
     return EXIT_FAILED if solution.status is SolveStatus.FAILED else 0

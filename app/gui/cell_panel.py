@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSignalBlocker
+from PySide6.QtCore import QSignalBlocker, Qt
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -85,6 +85,7 @@ class CellPanel(QWidget):
         name_row.addRow("Name", self.feature_name)
         fl.addLayout(name_row)
         self.feature_info = QLabel("")
+        self.feature_info.setTextFormat(Qt.TextFormat.PlainText)  # names from the cell file: never markup
         self.feature_info.setWordWrap(True)
         fl.addWidget(self.feature_info)
         layout.addWidget(feats)

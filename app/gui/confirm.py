@@ -3,12 +3,14 @@ buttons say what they do."""
 
 from __future__ import annotations
 
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox, QWidget
 
 
 def ask(parent: QWidget, title: str, text: str, yes_label: str) -> bool:
     """``True`` when the operator chose ``yes_label`` (the default button is the safe one: no)."""
     box = QMessageBox(QMessageBox.Icon.Warning, title, text, parent=parent)
+    box.setTextFormat(Qt.TextFormat.PlainText)  # file and component names come from files: never markup
     yes = box.addButton(yes_label, QMessageBox.ButtonRole.AcceptRole)
     no = box.addButton("Cancel", QMessageBox.ButtonRole.RejectRole)
     box.setDefaultButton(no)
@@ -21,6 +23,7 @@ def ask(parent: QWidget, title: str, text: str, yes_label: str) -> bool:
 def ask_save(parent: QWidget, title: str, text: str) -> str:
     """``save``, ``discard`` or ``cancel``."""
     box = QMessageBox(QMessageBox.Icon.Question, title, text, parent=parent)
+    box.setTextFormat(Qt.TextFormat.PlainText)
     box.setObjectName("confirm")
     box.setStandardButtons(QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel)
     box.setDefaultButton(QMessageBox.StandardButton.Save)

@@ -88,4 +88,4 @@ class StatusLine:
         self.pairs_label.setText(f"pairs: {usable}/{required} needed")
 
     def show_link_state(self, text: str) -> None:
-        self.link_label.setText(f"link: {text}")
+        self.link_label.setText(f"link: {html.escape(text, quote=False)}")  # the label shows markup (warnings); a device's text is not

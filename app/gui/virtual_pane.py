@@ -4,7 +4,7 @@ current joints, hand-eye, intrinsics), the target highlighted; a click picks a 3
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.gui.image_view import ImageView, Overlay
@@ -30,6 +30,7 @@ class VirtualPane(QWidget):
         self.renderer = SceneRenderer()
         self.view = ImageView(placeholder="rendering...")
         self.info = QLabel("")
+        self.info.setTextFormat(Qt.TextFormat.PlainText)  # names from the cell file: never markup
         self.info.setStyleSheet("color: #9aa;")
         bar = QHBoxLayout()
         bar.addWidget(QLabel("<b>Virtual camera</b> (CAD model)"))

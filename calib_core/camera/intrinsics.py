@@ -9,6 +9,10 @@ import numpy as np
 DISTORTION_NAMES = ("k1", "k2", "p1", "p2", "k3")
 
 
+MAX_IMAGE_SIDE_PX = 20000
+"""Larger than any camera's sensor; a bigger number is a typo that would allocate gigabytes."""
+
+
 @dataclass(frozen=True)
 class Intrinsics:
     """A pinhole camera with OpenCV's 5-parameter lens distortion.
@@ -38,6 +42,8 @@ class Intrinsics:
             v = getattr(self, name)
             if int(v) != v or int(v) <= 0:
                 raise ValueError(f"intrinsics: {name} must be a positive whole number of pixels, got {v}")
+            if int(v) > MAX_IMAGE_SIDE_PX:
+                raise ValueError(f"intrinsics: {name} is {v} pixels; videocal takes images up to {MAX_IMAGE_SIDE_PX} pixels a side")
             object.__setattr__(self, name, int(v))
         d = tuple(float(x) for x in np.asarray(self.distortion, dtype=float).ravel())
         if len(d) != 5:

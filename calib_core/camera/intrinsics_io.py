@@ -14,7 +14,7 @@ import numpy as np
 import yaml
 
 from calib_core.atomic_file import atomic_path, atomic_write_text
-from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.intrinsics import MAX_IMAGE_SIDE_PX, Intrinsics
 from calib_core.documents import parse_yaml, read_text
 from calib_core.errors import FileFormatError
 
@@ -84,7 +84,10 @@ def _fs_matrix(fs: cv2.FileStorage, path: Path, key: str, shape: tuple[int, int]
     node = fs.getNode(key)
     if node.empty() or node.isNone():
         raise FileFormatError(path, "missing", key)
-    m = node.mat()
+    try:
+        m = node.mat()
+    except cv2.error:  # rows x cols disagrees with the data: OpenCV asserts
+        raise FileFormatError(path, "its rows and cols do not match the number of values in data", key) from None
     if m is None:
         raise FileFormatError(path, "expected an !!opencv-matrix", key)
     m = np.asarray(m, dtype=float)
@@ -97,8 +100,8 @@ def _fs_int(fs: cv2.FileStorage, path: Path, key: str) -> int:
     node = fs.getNode(key)
     if node.empty() or node.isNone():
         raise FileFormatError(path, "missing", key)
-    if not node.isInt():
-        raise FileFormatError(path, "expected a whole number of pixels", key)
+    if not node.isInt() or not 0 < node.real() <= MAX_IMAGE_SIDE_PX:
+        raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}", key)
     return int(node.real())
 
 
@@ -111,8 +114,8 @@ def _load_ros(path: Path, data: dict) -> Intrinsics:
     for key in ("image_width", "image_height"):
         if key not in data:
             raise FileFormatError(path, "missing", key)
-        if isinstance(data[key], bool) or not isinstance(data[key], int):
-            raise FileFormatError(path, f"expected a whole number of pixels, got {data[key]!r}", key)
+        if isinstance(data[key], bool) or not isinstance(data[key], int) or not 0 < data[key] <= MAX_IMAGE_SIDE_PX:
+            raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}, got {data[key]!r}", key)
     model = data.get("distortion_model", "plumb_bob")
     if model not in ("plumb_bob", "rational_polynomial"):
         raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
@@ -131,6 +134,9 @@ def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarra
     if size is not None and len(values) != size:
         raise FileFormatError(path, f"expected {size} numbers, got {len(values)}", f"{key}.data")
     rows, cols = node.get("rows"), node.get("cols")
+    for name, v in (("rows", rows), ("cols", cols)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v <= 0):
+            raise FileFormatError(path, f"must be a positive whole number, got {v!r}", f"{key}.{name}")
     if rows is not None and cols is not None and rows * cols != len(values):
         raise FileFormatError(path, f"rows x cols = {rows} x {cols} does not match {len(values)} numbers", key)
     return np.asarray(values, dtype=float)

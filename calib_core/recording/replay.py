@@ -13,6 +13,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import make_transform
+from calib_core.errors import FileFormatError
 from calib_core.recording.reader import read_recording
 from calib_core.recording.recorder import to_jsonable
 from calib_core.recording.schemas import SOLVE_TOPIC
@@ -74,9 +75,16 @@ def _diff(a, b) -> float:
 def replay(path: str | Path) -> list[ReplayedSolve]:
     contents = read_recording(path)
     out = []
-    for message in contents.topic(SOLVE_TOPIC):
-        recorded = message.payload["result"]
-        recomputed = to_jsonable(solve_from_inputs(message.payload["inputs"]).to_dict())  # as it would be recorded
+    for k, message in enumerate(contents.topic(SOLVE_TOPIC)):
+        payload = message.payload
+        number = payload.get("id", k + 1) if isinstance(payload, dict) else k + 1
+        recorded = payload.get("result") if isinstance(payload, dict) else None
+        if not isinstance(recorded, dict) or not all(key in recorded for key in ("status", "t_obj2cam_mm", "R_obj2cam", "rms_px")):
+            raise FileFormatError(path, f"solve {number} has no complete result (status, R_obj2cam, t_obj2cam_mm, rms_px)", SOLVE_TOPIC)
+        try:
+            recomputed = to_jsonable(solve_from_inputs(payload["inputs"]).to_dict())  # as it would be recorded
+        except (KeyError, TypeError, ValueError) as exc:
+            raise FileFormatError(path, f"solve {number}: its inputs cannot be solved again ({type(exc).__name__}: {exc})", SOLVE_TOPIC) from None
         dt = _diff(recorded["t_obj2cam_mm"], recomputed["t_obj2cam_mm"])
         dr = _diff(recorded["R_obj2cam"], recomputed["R_obj2cam"])
         drms = _diff(recorded["rms_px"], recomputed["rms_px"])

@@ -9,6 +9,8 @@ error naming the URDF, the link and every place looked in.
 
 from __future__ import annotations
 
+import math
+
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
@@ -106,5 +108,37 @@ def read_description(path: str | Path, package_paths: Iterable[str | Path] = ())
         raise FileFormatError(path, f"not valid XML: {exc}") from None
     if root.tag != "robot":
         raise FileFormatError(path, f"not a URDF: the top element is <{root.tag}>, not <robot>")
+    _check_numbers(root, path)
     _resolve_meshes(root, path, package_search_roots(package_paths))
     return ET.tostring(root, encoding="unicode")
+
+
+def _numbers(text: str | None, n: int) -> list[float] | None:
+    try:
+        values = [float(v) for v in (text or "").split()]
+    except ValueError:
+        return None
+    return values if len(values) == n else None
+
+
+def _check_numbers(root: ET.Element, path: Path) -> None:
+    """Origins finite (a NaN origin made Pinocchio drop the visual without a word) and joint limits
+    in order: the robot model every move is previewed with must be the one the file says."""
+    for parent in root.iter():
+        for origin in parent.findall("origin"):
+            for attr in ("xyz", "rpy"):
+                if origin.get(attr) is None:
+                    continue
+                values = _numbers(origin.get(attr), 3)
+                if values is None or not all(math.isfinite(v) for v in values):
+                    owner = f"{parent.tag} '{parent.get('name')}'" if parent.get("name") else f"a {parent.tag}"
+                    raise FileFormatError(path, f"{owner}: origin {attr}={origin.get(attr)!r} must be three finite numbers")
+    for joint in root.iter("joint"):
+        limit = joint.find("limit")
+        if limit is None or joint.get("type") not in ("revolute", "prismatic"):
+            continue
+        lo, hi = (_numbers(limit.get(k, "0"), 1) for k in ("lower", "upper"))
+        if lo is None or hi is None or not all(math.isfinite(v) for v in lo + hi):
+            raise FileFormatError(path, f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be finite numbers")
+        if lo[0] > hi[0]:
+            raise FileFormatError(path, f"joint '{joint.get('name')}': limit lower ({lo[0]:g}) is above upper ({hi[0]:g})")

@@ -12,6 +12,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.errors import VideocalError
 from calib_core.link.joint_map import JointMap
 from calib_core.operator.cell import Cell
 from calib_core.scene import SceneItem
@@ -60,6 +61,8 @@ def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: Robo
     """The cell at ``workcell_path`` and a simulated site for it: the true robot has ``errors``
     (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels)."""
     workcell = load_workcell(workcell_path)
+    if workcell.intrinsics_path is None:
+        raise VideocalError(f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated camera needs one")
     nominal: Intrinsics = load_intrinsics(workcell.intrinsics_path)
     if image_scale != 1.0:
         nominal = nominal.scaled(image_scale)

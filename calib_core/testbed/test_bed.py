@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.errors import VideocalError
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
 from calib_core.scene import SceneItem
@@ -43,6 +44,8 @@ class TestBed:
         cell = workcell or load_workcell()
         model = cell.load_robot()
         true = TrueRobot(model, RobotErrors.typical(0, n_joints=model.n_joints) if errors is None else errors)
+        if intrinsics is None and cell.intrinsics_path is None:
+            raise VideocalError(f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)")
         intr = intrinsics or load_intrinsics(cell.intrinsics_path)
         return cls(cell, model, true, intr, RobotVisuals.from_robot(true.robot), np.array(cell.home_joints_deg, dtype=float))
 

@@ -115,6 +115,8 @@ def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:
     f = f"task_locations[{i}]"
     raw = reader.mapping(raw, f, _TASK_KEYS, {"name", "tcp2base"})
     component = raw.get("component")
+    if component is not None and not isinstance(component, str):
+        raise reader.fail(f"{f}.component", f"must be the name of one component, got {component!r}")
     if component is not None and component not in components:
         raise reader.fail(f"{f}.component", f"no component called {component!r}")
     approach = reader.number(raw.get("approach_mm", 0.0), f"{f}.approach_mm")

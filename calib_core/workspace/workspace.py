@@ -118,6 +118,21 @@ class _Fields:
             raise self.fail(where, f"must be {n} finite numbers, got {value!r}")
         return arr
 
+    def sigmas(self, value, n: int, where: str) -> np.ndarray:
+        """``n`` 1-sigma values: non-negative numbers, or null / NaN for one that is not known."""
+        if not isinstance(value, list) or len(value) != n or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in value):
+            raise self.fail(where, f"must be {n} numbers (null for an unknown one), got {value!r}")
+        arr = np.array([np.nan if v is None else v for v in value], dtype=float)
+        if np.any(arr < 0) or np.any(np.isinf(arr)):
+            raise self.fail(where, f"must be {n} non-negative finite numbers, got {value!r}")
+        return arr
+
+    def number(self, value, where: str, low: float = -np.inf, high: float = np.inf, allow_nan: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or (np.isnan(value) and not allow_nan) or np.isinf(value) or not (np.isnan(value) or low <= value <= high):
+            bounds = "" if low == -np.inf and high == np.inf else f" from {low:g} to {high:g}"
+            raise self.fail(where, f"must be a finite number{bounds}, got {value!r}")
+        return float(value)
+
     def joints(self, value, where: str) -> np.ndarray:
         """A joint vector of any robot: 1 to 16 finite numbers (deg or mm)."""
         n = len(value) if isinstance(value, list) else -1
@@ -156,7 +171,11 @@ def load_workspace(path: str | Path) -> Workspace:
     for i, t in enumerate(f.get(data, "task_locations", "", list)):
         where = f"task_locations[{i}]"
         name = f.get(t, "name", where, str)
-        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), float(f.get(t, "approach_mm", where, (int, float))), t.get("component"), _tolerance(f, t, where))
+        component = t.get("component")
+        if component is not None and not isinstance(component, str):
+            raise f.fail(f"{where}.component", f"must be the name of one component, got {component!r}")
+        approach = f.number(f.get(t, "approach_mm", where), f"{where}.approach_mm", 0.0, 10000.0)
+        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), approach, component, _tolerance(f, t, where))
     pairs = []
     for i, p in enumerate(f.get(data, "pairs", "", list)):
         where = f"pairs[{i}]"
@@ -177,12 +196,12 @@ def load_workspace(path: str | Path) -> Workspace:
             tcp2base_measured=f.pose(f.get(c, "tcp2base_measured", where, dict), f"{where}.tcp2base_measured"),
             displacement_mm=f.vector(f.get(c, "displacement_mm", where), 3, f"{where}.displacement_mm"),
             rotation_deg=f.vector(f.get(c, "rotation_deg", where), 3, f"{where}.rotation_deg"),
-            std_displacement_mm=np.asarray(f.get(c, "std_displacement_mm", where), dtype=float),
-            std_rotation_deg=np.asarray(f.get(c, "std_rotation_deg", where), dtype=float),
+            std_displacement_mm=f.sigmas(f.get(c, "std_displacement_mm", where), 3, f"{where}.std_displacement_mm"),
+            std_rotation_deg=f.sigmas(f.get(c, "std_rotation_deg", where), 3, f"{where}.std_rotation_deg"),
             joints_deg=f.joints(f.get(c, "joints_deg", where), f"{where}.joints_deg"),
-            rms_px=float(f.get(c, "rms_px", where, (int, float))),
+            rms_px=f.number(f.get(c, "rms_px", where), f"{where}.rms_px", 0.0, 1e6, allow_nan=True),
             pairs=int(f.get(c, "pairs", where, int)),
-            time_s=float(c.get("time_s", 0.0)),
+            time_s=f.number(c.get("time_s", 0.0), f"{where}.time_s"),
             source=str(c.get("source", "")),
             verdict=str(c.get("verdict", "ok")),
             confirmation=str(c.get("confirmation", "")),
@@ -196,4 +215,7 @@ def load_workspace(path: str | Path) -> Workspace:
             ))
         except (KeyError, TypeError, ValueError) as exc:
             raise f.fail(where, f"not a verification: {exc}") from None
-    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, data.get("target"), pairs, table, float(data.get("created_s", 0.0)), cell)
+    target = data.get("target")
+    if target is not None and not isinstance(target, str):
+        raise f.fail("target", f"must be the name of one component, got {target!r}")
+    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, target, pairs, table, f.number(data.get("created_s", 0.0), "created_s"), cell)

@@ -125,23 +125,25 @@ def test_ros_rows_given_as_text_and_an_absurd_image_size(cell):
 
 
 def test_export_with_std_or_time_as_objects(tmp_path):
-    from calib_core.calibration.corrections import CorrectionTable
+    import numpy as np
+
+    from calib_core.calibration.corrections import Correction, CorrectionTable
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.workcell import load_workcell
     from calib_core.workspace.workspace import Workspace, save_workspace
 
     cell = load_workcell()
+    table = CorrectionTable()
+    measured = np.eye(4)
+    measured[0, 3] = 1.0
+    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, 0, 0]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
     path = tmp_path / "w.json"
-    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], CorrectionTable()))
-    data = json.loads(path.read_text())
-    good = {
-        "task": "oru_1_grasp", "tcp2base_model": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
-        "tcp2base_measured": [[1, 0, 0, 1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "displacement_mm": [1, 0, 0],
-        "rotation_deg": [0, 0, 0], "std_displacement_mm": [0.1, 0.1, 0.1], "std_rotation_deg": [0.01, 0.01, 0.01],
-        "joints_deg": [0, 0, 0, 0, 0, 0], "rms_px": 0.3, "pairs": 6, "time_s": 1.0,
-    }
-    for field, value in (("std_displacement_mm", {"x": 1}), ("time_s", {"when": "now"})):
-        data["corrections"] = [{**good, field: value}]
+    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], table))
+    assert _videocal("export", path).returncode == 0
+    original = json.loads(path.read_text())
+    for field, value in (("std_displacement_mm", {"x": 1}), ("time_s", {"when": "now"}), ("std_rotation_deg", [0.1, 0.1])):
+        data = json.loads(json.dumps(original))
+        data["corrections"][0][field] = value
         path.write_text(json.dumps(data))
         _refused(_videocal("export", path), "w.json", field)
 
