@@ -75,6 +75,8 @@ def _load_opencv(path: Path) -> Intrinsics:
             dist = _fs_matrix(fs, path, "distortion_coefficients", None).ravel()
         width = _fs_int(fs, path, "image_width")
         height = _fs_int(fs, path, "image_height")
+    except cv2.error as exc:  # a node of another shape than the file's kind says (OpenCV asserts)
+        raise FileFormatError(path, f"not an OpenCV intrinsics file ({_first_line(exc).split('error: ')[-1]})") from None
     finally:
         fs.release()
     return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")

@@ -97,8 +97,15 @@ def _color(target, rgba) -> None:
     target.r, target.g, target.b, target.a = map(float, rgba)
 
 
+def _corner_origin(uv) -> tuple[float, float]:
+    """videocal's pixels (OpenCV: (0, 0) is the centre of the top-left pixel) in Foxglove's image
+    coordinates, whose origin is the top-left pixel's top-left corner."""
+    return float(uv[0]) + 0.5, float(uv[1]) + 0.5
+
+
 def image_annotations(picks, t_ns: int, reprojected=None, stale_numbers=()):
-    """``foxglove.ImageAnnotations`` on the camera image: ``picks`` ``[(number, (u, v) px)]`` as
+    """``foxglove.ImageAnnotations`` on the camera image: ``picks`` ``[(number, (u, v) px)]`` (OpenCV
+    pixels, shifted half a pixel to Foxglove's corner origin) as
     circles labelled with the pair numbers the window shows (grey when in ``stale_numbers``:
     picked at another robot state), and, after a solve, ``reprojected`` ``[(number, (u, v))]``
     model points as crosses with a line from each pick (the residual)."""
@@ -109,7 +116,7 @@ def image_annotations(picks, t_ns: int, reprojected=None, stale_numbers=()):
     stale = set(stale_numbers)
     picked = {}
     for number, uv in picks:
-        u, v = map(float, uv)
+        u, v = _corner_origin(uv)
         picked[number] = (u, v)
         circle = message.circles.add(diameter=14.0, thickness=2.0)
         _stamp(circle, t_ns)
@@ -128,7 +135,7 @@ def image_annotations(picks, t_ns: int, reprojected=None, stale_numbers=()):
         _color(crosses.outline_color, _MODEL)
         _color(residuals.outline_color, (1.0, 0.2, 0.2, 1.0))
         for number, uv in reprojected:
-            u, v = map(float, uv)
+            u, v = _corner_origin(uv)
             for (du, dv) in ((-6, -6), (6, 6), (-6, 6), (6, -6)):
                 p = crosses.points.add()
                 p.x, p.y = u + du, v + dv

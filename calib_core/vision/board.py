@@ -9,10 +9,15 @@ import cv2
 import numpy as np
 import trimesh
 
+from calib_core.errors import VideocalError
 from calib_core.scene import SceneItem
 
 DEFAULT_SPEC = "charuco:9x7:30:22:DICT_5X5_100"
 MAX_SQUARES = 100
+
+
+class BoardSpecError(VideocalError, ValueError):
+    """A board specification (``--board``, a hand-eye board) that does not describe a usable board."""
 
 
 @dataclass(frozen=True)
@@ -35,21 +40,21 @@ class BoardSpec:
             sx, sy = (int(v) for v in parts[1].lower().split("x"))
             spec = cls(sx, sy, float(parts[2]), float(parts[3]), parts[4])
         except ValueError:
-            raise ValueError(f"board spec {text!r}: expected charuco:<columns>x<rows>:<square mm>:<marker mm>:<ArUco dictionary>, e.g. {DEFAULT_SPEC}") from None
+            raise BoardSpecError(f"board spec {text!r}: expected charuco:<columns>x<rows>:<square mm>:<marker mm>:<ArUco dictionary>, e.g. {DEFAULT_SPEC}") from None
         if spec.squares_x < 3 or spec.squares_y < 3:
-            raise ValueError(f"board spec {text!r}: at least 3 x 3 squares")
+            raise BoardSpecError(f"board spec {text!r}: at least 3 x 3 squares")
         if spec.squares_x > MAX_SQUARES or spec.squares_y > MAX_SQUARES:
-            raise ValueError(f"board spec {text!r}: at most {MAX_SQUARES} x {MAX_SQUARES} squares")
+            raise BoardSpecError(f"board spec {text!r}: at most {MAX_SQUARES} x {MAX_SQUARES} squares")
         if not (math.isfinite(spec.square_mm) and 0 < spec.square_mm <= 1000):
-            raise ValueError(f"board spec {text!r}: the square must be more than 0 and at most 1000 mm")
+            raise BoardSpecError(f"board spec {text!r}: the square must be more than 0 and at most 1000 mm")
         if not 0 < spec.marker_mm < spec.square_mm:
-            raise ValueError(f"board spec {text!r}: the marker ({spec.marker_mm} mm) must be smaller than the square ({spec.square_mm} mm)")
+            raise BoardSpecError(f"board spec {text!r}: the marker ({spec.marker_mm} mm) must be smaller than the square ({spec.square_mm} mm)")
         if not spec.dictionary.startswith("DICT_") or not hasattr(cv2.aruco, spec.dictionary):
-            raise ValueError(f"board spec {text!r}: unknown ArUco dictionary {spec.dictionary!r}")
+            raise BoardSpecError(f"board spec {text!r}: unknown ArUco dictionary {spec.dictionary!r}")
         markers = spec.squares_x * spec.squares_y // 2
         available = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, spec.dictionary)).bytesList.shape[0]
         if markers > available:
-            raise ValueError(f"board spec {text!r}: a {spec.squares_x} x {spec.squares_y} ChArUco board has {markers} markers, {spec.dictionary} only {available}")
+            raise BoardSpecError(f"board spec {text!r}: a {spec.squares_x} x {spec.squares_y} ChArUco board has {markers} markers, {spec.dictionary} only {available}")
         return spec
 
     def __str__(self) -> str:

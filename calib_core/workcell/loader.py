@@ -64,6 +64,11 @@ class _Reader:
             raise self.fail(field, f"must be a list of {n} numbers, got {value!r}")
         return np.array([self.number(v, f"{field}[{i}]") for i, v in enumerate(value)])
 
+    def choice(self, value, field: str, options) -> str:
+        if not isinstance(value, str) or value not in options:
+            raise self.fail(field, f"must be one of {', '.join(sorted(options))}, got {value!r}")
+        return value
+
     def text(self, value, field: str) -> str:
         if not isinstance(value, str) or not value.strip():
             raise self.fail(field, f"must be a non-empty string, got {value!r}")
@@ -84,12 +89,8 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
     f = f"components[{i}]"
     raw = reader.mapping(raw, f, _COMPONENT_KEYS, {"name", "mesh", "mesh_units", "placement"})
     name = reader.text(raw["name"], f"{f}.name")
-    kind = raw.get("kind", "component")
-    if kind not in _KINDS:
-        raise reader.fail(f"{f}.kind", f"must be one of {', '.join(sorted(_KINDS))}, got {kind!r}")
-    units = raw["mesh_units"]
-    if units not in _MESH_SCALE:
-        raise reader.fail(f"{f}.mesh_units", f"must be 'mm' or 'm', got {units!r}")
+    kind = reader.choice(raw.get("kind", "component"), f"{f}.kind", _KINDS)
+    units = reader.choice(raw["mesh_units"], f"{f}.mesh_units", set(_MESH_SCALE))
     mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
     if mesh_path.suffix.lower() not in _MESH_SUFFIXES:
         raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
@@ -147,7 +148,7 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     reader = _Reader(path)
     data = read_yaml(path, "workcell file")  # size, nesting and aliases bounded before anything is built
     data = reader.mapping(data, "(top level)", _TOP_KEYS, {"schema_version", "units", "robot", "components"})
-    if data["schema_version"] not in _READABLE_VERSIONS:
+    if isinstance(data["schema_version"], bool) or not isinstance(data["schema_version"], int) or data["schema_version"] not in _READABLE_VERSIONS:
         raise reader.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}")
     units = reader.mapping(data["units"], "units", {"length", "angle"}, {"length", "angle"})
     if units["length"] != "mm" or units["angle"] != "deg":

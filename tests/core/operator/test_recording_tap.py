@@ -106,13 +106,14 @@ def test_the_annotations_sit_on_the_picks_and_on_an_independent_reprojection(rec
     last = ImageAnnotations.FromString(contents.topic(ANNOTATIONS_TOPIC)[-1].raw)
     pairs = {p.number: p.pixel for p in core.session.pairs}
     assert sorted(t.text for t in last.texts) == sorted(f"#{n}" for n in pairs)
-    circles = {(round(c.position.x, 6), round(c.position.y, 6)) for c in last.circles}
+    # Foxglove's image coordinates start at the top-left pixel's corner, videocal's (OpenCV's) at its centre
+    circles = {(round(c.position.x - 0.5, 6), round(c.position.y - 0.5, 6)) for c in last.circles}
     assert circles == {(round(float(u), 6), round(float(v), 6)) for u, v in pairs.values()}
     crosses, residuals = last.points
-    centres = np.array([[p.x, p.y] for p in crosses.points]).reshape(-1, 4, 2).mean(axis=1)
+    centres = np.array([[p.x, p.y] for p in crosses.points]).reshape(-1, 4, 2).mean(axis=1) - 0.5
     expected = project(apply(solution.obj2cam, points_obj), core.intrinsics)
     assert np.allclose(centres, expected, atol=1e-6)
-    lines = np.array([[p.x, p.y] for p in residuals.points]).reshape(-1, 2, 2)
+    lines = np.array([[p.x, p.y] for p in residuals.points]).reshape(-1, 2, 2) - 0.5
     assert np.allclose(lines[:, 0], [pairs[n] for n in numbers]) and np.allclose(lines[:, 1], expected, atol=1e-6)
 
 

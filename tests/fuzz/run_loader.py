@@ -1,0 +1,229 @@
+"""Generated bad documents against one loader, in this process under resource limits:
+``python -m tests.fuzz.run_loader LOADER EXAMPLES [SEED]`` prints one JSON line
+``{loader, examples, accepted, refused, unexpected: [...], slowest_s, peak_rss_mb, baseline_rss_mb}``.
+
+Each document is a good one (the bundled cell's own files) with hypothesis's mutations: a value
+anywhere replaced by another type, a huge, non-finite or negative number, deep nesting or a long
+string; keys deleted or added; the text cut, aliased or nested past the limits. A loader may accept
+a document or refuse it with a ``VideocalError`` (what the command line turns into one ``error:``
+line); anything else is a finding, recorded with its traceback. Every document has a time limit
+(SIGALRM) and the process an address-space limit.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import resource
+import shutil
+import signal
+import sys
+import tempfile
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+ROOT = Path(__file__).resolve().parents[2]
+ADDRESS_SPACE = 4 * 1024**3
+DOCUMENT_S = 10
+
+
+class DocumentTimeout(Exception):
+    pass
+
+
+# --- values and mutations -------------------------------------------------------------------------
+def _deep(depth: int):
+    value: object = 1
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
+nasty_values = st.one_of(
+    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -1, 1e308, -1e308, 10**12, 1e-320, "", "nan", ".inf", "1e12", "3", "../../etc/passwd", "<img src=x>", "\x00"]),
+    st.text(max_size=30), st.lists(st.integers(-5, 5), max_size=6), st.dictionaries(st.text(max_size=5), st.integers(), max_size=3),
+    st.integers(1, 120).map(_deep), st.integers(10_000, 200_000).map(lambda n: "x" * n),
+)
+
+
+def _paths(doc, prefix=()):
+    """Every path to a value in a document of dicts and lists."""
+    yield prefix
+    if isinstance(doc, dict):
+        for k, v in doc.items():
+            yield from _paths(v, prefix + (k,))
+    elif isinstance(doc, list):
+        for i, v in enumerate(doc):
+            yield from _paths(v, prefix + (i,))
+
+
+@st.composite
+def mutated(draw, doc):
+    """``doc`` with one to three mutations."""
+    doc = copy.deepcopy(doc)
+    for _ in range(draw(st.integers(1, 3))):
+        paths = [p for p in _paths(doc) if p]
+        if not paths:
+            break
+        path = draw(st.sampled_from(paths))
+        parent = doc
+        for key in path[:-1]:
+            parent = parent[key]
+        key = path[-1]
+        op = draw(st.sampled_from(["replace", "replace", "replace", "delete", "add", "wrap"]))
+        if op == "replace":
+            parent[key] = draw(nasty_values)
+        elif op == "delete":
+            del parent[key]
+        elif op == "add" and isinstance(parent, dict):
+            parent[draw(st.text(min_size=1, max_size=8))] = draw(nasty_values)
+        elif op == "wrap":
+            parent[key] = [parent[key]]
+    return doc
+
+
+@st.composite
+def mutated_text(draw, text: str):
+    """The text of a document cut, with bytes inserted, aliased or nested past the limits."""
+    op = draw(st.sampled_from(["cut", "insert", "alias_bomb", "deep", "none"]))
+    if op == "cut":
+        return text[: draw(st.integers(0, len(text)))]
+    if op == "insert":
+        at = draw(st.integers(0, len(text)))
+        return text[:at] + draw(st.text(max_size=20)) + text[at:]
+    if op == "alias_bomb":
+        levels = draw(st.integers(2, 12))
+        bomb = "x0: &x0 [lol]\n" + "".join(f"x{i}: &x{i} [" + ", ".join([f"*x{i - 1}"] * 9) + "]\n" for i in range(1, levels))
+        return bomb + text
+    if op == "deep":
+        n = draw(st.integers(50, 20_000))
+        return text + "\ndeep: " + "[" * n + "]" * n + "\n"
+    return text
+
+
+# --- the loaders ----------------------------------------------------------------------------------
+def _cell_folder() -> Path:
+    folder = Path(tempfile.mkdtemp(prefix="fuzz_cell_"))
+    for sub in ("workcell", "robot", "camera"):
+        shutil.copytree(ROOT / "resources" / sub, folder / sub)
+    return folder
+
+
+def loaders(folder: Path) -> dict:
+    from app.cli.cmd_solve import read_solve_inputs
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.hand_eye_io import load_cam2flange
+    from calib_core.workcell import load_workcell
+    from calib_core.workspace.workspace import load_workspace
+
+    workcell_doc = yaml.safe_load((folder / "workcell" / "workcell.yaml").read_text())
+    ros_doc = yaml.safe_load((folder / "camera" / "gripper_camera_ros.yaml").read_text())
+    opencv_text = (folder / "camera" / "gripper_camera.yaml").read_text()
+    hand_eye_doc = {"cam2flange": {"xyz": [81.0, -1.0, 88.0], "rpy": [-100.0, 0.0, -90.0]}, "units": {"length": "mm", "angle": "deg"}, "std": {"xyz_mm": [0.1, 0.1, 0.1]}}
+    solve_doc = json.loads((ROOT / "resources" / "examples" / "pairs.json").read_text())
+    workspace_doc = _workspace_doc(folder)
+    out = folder / "workcell"
+
+    def yaml_file(name: str, doc=None, text: str | None = None) -> Path:
+        path = out / name
+        path.write_text(text if text is not None else yaml.safe_dump(doc, sort_keys=False, allow_unicode=True))
+        return path
+
+    def json_file(name: str, doc) -> Path:
+        path = out / name
+        path.write_text(json.dumps(doc))
+        return path
+
+    return {
+        "workcell": (st.one_of(mutated(workcell_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(workcell_doc, sort_keys=False)).map(lambda t: ("text", t))),
+                     lambda v: load_workcell(yaml_file("fuzz.yaml", v[1]) if v[0] == "doc" else yaml_file("fuzz.yaml", text=v[1]))),
+        "intrinsics_ros": (st.one_of(mutated(ros_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(ros_doc)).map(lambda t: ("text", t))),
+                           lambda v: load_intrinsics(yaml_file("ros.yaml", v[1]) if v[0] == "doc" else yaml_file("ros.yaml", text=v[1]))),
+        "intrinsics_opencv": (mutated_text(opencv_text), lambda t: load_intrinsics(yaml_file("opencv.yaml", text=t))),
+        "hand_eye": (st.one_of(mutated(hand_eye_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(hand_eye_doc)).map(lambda t: ("text", t))),
+                     lambda v: load_cam2flange(yaml_file("he.yaml", v[1]) if v[0] == "doc" else yaml_file("he.yaml", text=v[1]))),
+        "workspace": (mutated(workspace_doc), lambda d: load_workspace(json_file("ws.json", d))),
+        "solve_inputs": (mutated(solve_doc), lambda d: read_solve_inputs(json_file("solve.json", d))),
+        "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"charuco:-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}", fullmatch=True)), BoardSpec.parse),
+    }
+
+
+def _workspace_doc(folder: Path) -> dict:
+    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.calibration.correspondences import Correspondence
+    from calib_core.calibration.view_stamp import ViewStamp
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.workcell import load_workcell
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    cell = load_workcell(folder / "workcell" / "workcell.yaml")
+    table = CorrectionTable()
+    measured = np.eye(4)
+    measured[:3, 3] = [1.0, -2.0, 0.5]
+    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, -2.0, 0.5]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    view = ViewStamp(3, 12.5, (0.0,) * 6, 0.01, "2026-12-01 12:00:00", "camera")
+    pairs = [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (100.0, 200.0), True, view)]
+    path = folder / "workcell" / "seed_workspace.json"
+    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", pairs, table))
+    return json.loads(path.read_text())
+
+
+# --- the run --------------------------------------------------------------------------------------
+def _rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def main(name: str, examples: int, seed: int = 0) -> dict:
+    from calib_core.errors import VideocalError
+
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+    folder = _cell_folder()
+    strategy, load = loaders(folder)[name]
+    baseline = _rss_mb()
+    stats = {"loader": name, "examples": 0, "accepted": 0, "refused": 0, "unexpected": [], "slowest_s": 0.0, "baseline_rss_mb": baseline}
+
+    def alarm(*_):
+        raise DocumentTimeout(f"no answer within {DOCUMENT_S} s")
+
+    signal.signal(signal.SIGALRM, alarm)
+
+    @settings(max_examples=examples, deadline=None, database=None, derandomize=True, suppress_health_check=list(HealthCheck), print_blob=False)
+    @given(strategy)
+    def fuzz(value):
+        stats["examples"] += 1
+        started = time.perf_counter()
+        signal.alarm(DOCUMENT_S)
+        try:
+            load(value)
+            stats["accepted"] += 1
+        except VideocalError:
+            stats["refused"] += 1
+        except BaseException as exc:  # a finding: anything but a clear refusal
+            if isinstance(exc, KeyboardInterrupt):
+                raise
+            if len(stats["unexpected"]) < 10:
+                stats["unexpected"].append({"error": f"{type(exc).__name__}: {exc}"[:500], "traceback": traceback.format_exc()[-1500:], "input": repr(value)[:400]})
+            else:
+                stats["unexpected"].append({"error": f"{type(exc).__name__}"})
+        finally:
+            signal.alarm(0)
+            stats["slowest_s"] = max(stats["slowest_s"], time.perf_counter() - started)
+
+    fuzz()
+    stats["peak_rss_mb"] = _rss_mb()
+    shutil.rmtree(folder, ignore_errors=True)
+    return stats
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    print(json.dumps(main(sys.argv[1], int(sys.argv[2]), int(sys.argv[3]) if len(sys.argv) > 3 else 0)))
