@@ -132,11 +132,13 @@ def link_lost_mid_move() -> float:
         while not core.link_up and time.monotonic() < deadline:
             time.sleep(0.01)
         q = np.array(cell.home_joints, float)
-        q[0] += 25.0
-        core.move_joints(q, "a 25 deg turn", confirmed=True)
+        q[0] += 120.0  # long enough to be killed in the middle of
+        core.move_joints(q, "a 120 deg turn", confirmed=True)
         while core.motion.motion is not Motion.MOVING and time.monotonic() < deadline:
             time.sleep(0.005)
-        time.sleep(0.3)
+        time.sleep(0.1)
+        if core.motion.motion is not Motion.MOVING:
+            raise RuntimeError(f"the move ended before the kill: {core.motion.text}")
         os.kill(site.process.process.pid, signal.SIGKILL)
         killed = time.perf_counter()
         while core.motion.motion is Motion.MOVING and time.perf_counter() - killed < 10:

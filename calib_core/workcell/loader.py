@@ -7,6 +7,8 @@ names, malformed numbers. The schema is in ``docs/workcell.md``.
 
 from __future__ import annotations
 
+import math
+
 from pathlib import Path
 
 import numpy as np
@@ -55,9 +57,13 @@ class _Reader:
         return value
 
     def number(self, value, field: str) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        try:
+            v = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else math.nan
+        except OverflowError:  # an integer past any float
+            v = math.nan
+        if not math.isfinite(v):
             raise self.fail(field, f"must be a finite number, got {value!r}")
-        return float(value)
+        return v
 
     def vector(self, value, n: int, field: str) -> np.ndarray:
         if not isinstance(value, (list, tuple)) or len(value) != n:
@@ -79,8 +85,13 @@ class _Reader:
         return transform_from_xyz_rpy(self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy"))
 
     def file(self, value, field: str) -> Path:
-        path = (self.path.parent / self.text(value, field)).resolve()
-        if not path.is_file():
+        text = self.text(value, field)
+        try:
+            path = (self.path.parent / text).resolve()
+            found = path.is_file()
+        except (ValueError, OSError) as exc:  # a NUL byte, a name longer than the file system takes
+            raise self.fail(field, f"not a usable file name ({exc.strerror if isinstance(exc, OSError) and exc.strerror else exc}): {text[:80]!r}") from None
+        if not found:
             raise self.fail(field, f"file not found: {path}")
         return path
 

@@ -10,6 +10,7 @@ the field. Files are data only: nothing in them is executed.
 from __future__ import annotations
 
 import json
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -128,10 +129,14 @@ class _Fields:
         return arr
 
     def number(self, value, where: str, low: float = -np.inf, high: float = np.inf, allow_nan: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or (np.isnan(value) and not allow_nan) or np.isinf(value) or not (np.isnan(value) or low <= value <= high):
-            bounds = "" if low == -np.inf and high == np.inf else f" from {low:g} to {high:g}"
+        bounds = "" if low == -np.inf and high == np.inf else f" from {low:g} to {high:g}"
+        try:
+            v = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+        except OverflowError:  # an integer past any float
+            v = None
+        if v is None or (math.isnan(v) and not allow_nan) or math.isinf(v) or not (math.isnan(v) or low <= v <= high):
             raise self.fail(where, f"must be a finite number{bounds}, got {value!r}")
-        return float(value)
+        return v
 
     def joints(self, value, where: str) -> np.ndarray:
         """A joint vector of any robot: 1 to 16 finite numbers (deg or mm)."""
@@ -145,10 +150,10 @@ class _Fields:
 
 
 def _tolerance(f, t: dict, where: str) -> float:
-    value = t.get("tolerance_mm", DEFAULT_TOLERANCE_MM)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+    value = f.number(t.get("tolerance_mm", DEFAULT_TOLERANCE_MM), f"{where}.tolerance_mm", 0.0, 1e6)
+    if value <= 0:
         raise f.fail(f"{where}.tolerance_mm", f"must be a number > 0 (mm), got {value!r}")
-    return float(value)
+    return value
 
 
 def load_workspace(path: str | Path) -> Workspace:
@@ -206,7 +211,10 @@ def load_workspace(path: str | Path) -> Workspace:
             verdict=str(c.get("verdict", "ok")),
             confirmation=str(c.get("confirmation", "")),
         ))
-    for i, v in enumerate(data.get("verifications", []) or []):
+    verifications = data.get("verifications", []) or []
+    if not isinstance(verifications, list):
+        raise f.fail("verifications", f"must be a list, got {type(verifications).__name__}")
+    for i, v in enumerate(verifications):
         where = f"verifications[{i}]"
         try:
             table.add_verification(Verification(
