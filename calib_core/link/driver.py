@@ -278,6 +278,7 @@ class ControllerLink:
                 except LinkError as exc:
                     self.last_error = str(exc)
                     self._set_state(LinkState.DOWN, str(exc))
+                    self._expire_moves(time.monotonic())  # a move's timeout runs on while the link is down
                     if not self.reconnect:
                         return
                     self._stop.wait(next(backoff, _BACKOFF_S[-1]))

@@ -126,3 +126,19 @@ def test_a_second_workstation_cannot_take_the_robot_over(sim):  # noqa: F811
         assert first.state is LinkState.UP
     with ControllerLink(url, rate_hz=50) as second:  # once the first is gone, the next one gets in
         assert second.wait_for_samples(3, 5.0)
+
+
+def test_a_pending_move_times_out_while_the_link_is_down(sim):  # noqa: F811
+    from calib_core.link.link_types import MoveTimeout
+
+    s = sim("--pty", "--joints", "0,0,0,0,0,0")
+    with ControllerLink(s.url, rate_hz=50, deadman_ms=300) as link:
+        assert link.wait_for_samples(3, 5.0)
+        handle = link.move_joints((150.0, 0, 0, 0, 0, 0), timeout_s=1.5)
+        s.proc.kill()  # the controller is gone for good: the link stays down, reconnecting
+        s.proc.wait(5)
+        deadline = time.monotonic() + 15
+        while not handle.finished and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert link.state is LinkState.DOWN
+        assert handle.finished and isinstance(handle.error, MoveTimeout) and handle.id in str(handle.error)
