@@ -39,14 +39,14 @@ def read_text(path: str | Path, what: str, max_bytes: int = MAX_DOCUMENT_BYTES) 
     if path.is_dir():
         raise FileFormatError(path, f"is a folder, not a {what}")
     if size > max_bytes:
-        raise FileFormatError(path, f"is {size / 1e6:.1f} MB; a {what} is at most {max_bytes / 1e6:.0f} MB")
+        raise FileFormatError(path, f"is {_size(size)}; a {what} is at most {_size(max_bytes)}")
     try:
         with open(path, "rb") as f:
             data = f.read(max_bytes + 1)  # a file that grew (or a device) is still cut at the limit
     except OSError as exc:
         raise FileFormatError(path, f"cannot be read ({exc.strerror})") from None
     if len(data) > max_bytes:
-        raise FileFormatError(path, f"is over {max_bytes / 1e6:.0f} MB; a {what} is at most that")
+        raise FileFormatError(path, f"is over {_size(max_bytes)}; a {what} is at most that")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -136,6 +136,10 @@ def finite_number(value, path: str | Path, field: str, *, low: float = -math.inf
         bounds = f"{'above' if exclusive_low else 'at least'} {low:g}" if high == math.inf else f"between {low:g} and {high:g}"
         raise FileFormatError(path, f"must be {bounds}, got {value!r}", field)
     return v
+
+
+def _size(n_bytes: int) -> str:
+    return f"{n_bytes / 1e6:.1f} MB" if n_bytes >= 100_000 else f"{n_bytes / 1e3:.1f} kB"
 
 
 def _first_line(exc: Exception) -> str:

@@ -48,13 +48,12 @@ def _video_payload(data: bytes) -> dict:
 @dataclass
 class RecordingContents:
     """What a pass over a file found: the messages, whether it ended cleanly, and why not;
-    its attachments ``(name, media_type, data)`` and its channels by topic."""
+    its attachments ``(name, media_type, data)``."""
 
     messages: list[RecordedMessage]
     complete: bool
     problem: str | None = None
     attachments: list[tuple[str, str, bytes]] = field(default_factory=list)
-    channels: dict = field(default_factory=dict)
 
     def topic(self, name: str) -> list[RecordedMessage]:
         return [m for m in self.messages if m.topic == name]
@@ -143,7 +142,7 @@ def read_recording(path: str | Path) -> RecordingContents:
         problems.append(f"{bad_messages} message{'s' if bad_messages > 1 else ''} could not be decoded: skipped")
     if not complete and not any("ends" in p for p in problems):
         problems.append(f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)")
-    return RecordingContents(messages, bool(complete), "; ".join(problems) or None, [(a.name, a.media_type, bytes(a.data)) for a in attachments], {c.topic: c for c in channels.values()})
+    return RecordingContents(messages, bool(complete), "; ".join(problems) or None, [(a.name, a.media_type, bytes(a.data)) for a in attachments])
 
 
 def decode_frame(payload: dict) -> np.ndarray:

@@ -16,7 +16,6 @@ why, later messages are counted in ``messages_lost``, and ``close`` returns with
 
 from __future__ import annotations
 
-import base64
 import heapq
 import itertools
 import json
@@ -28,15 +27,13 @@ import time
 from collections import defaultdict
 from pathlib import Path
 
-import cv2
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
 from calib_core import __version__
-from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, TOPICS, VIDEO_TOPIC, schema_bytes
-from calib_core.recording.video_codec import DEFAULT_CRF, H264Encoder
-
-FRAME_FORMATS = ("h264", "jpeg")
+from calib_core.recording.frame_message import FrameEncoder
+from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, TOPICS, schema_bytes
+from calib_core.recording.video_codec import DEFAULT_CRF
 
 PROFILE = "videocal"
 CLOSE_TIMEOUT_S = 1.0
@@ -82,8 +79,7 @@ class SessionRecorder:
         queue_frames: int = 60, drop_when_busy: bool = True, clock=time.monotonic, chunk_every_s: float = 0.5, hold_s: float = 0.3,
         camera_frame: str = "camera",
     ):
-        if frames not in FRAME_FORMATS:
-            raise ValueError(f"frames must be one of {', '.join(FRAME_FORMATS)}, got {frames!r}")
+        self._frame_encoder = FrameEncoder(frames, fps=fps, crf=crf, jpeg_quality=jpeg_quality)  # checks ``frames`` first
         self.path = Path(path)
         self.frames, self.crf, self.fps, self.jpeg_quality = frames, crf, fps, jpeg_quality
         self.drop_when_busy = drop_when_busy
@@ -102,7 +98,6 @@ class SessionRecorder:
         self._order = itertools.count()
         self._frames_in_encoder: dict[int, int] = {}  # order -> capture ns, of frames queued and not yet written
         self._queue: queue.Queue = queue.Queue(maxsize=queue_frames)
-        self._encoder: H264Encoder | None = None
         self._last_written_ns = 0
         self._chunk_messages = self._chunk_frames = 0
         self._chunk_start_ns: int | None = None  # log time of the first message of the open chunk
@@ -268,29 +263,10 @@ class SessionRecorder:
     def _encode(self, item) -> None:
         order, image, capture_ns, t_host_s, frame_id = item
         try:
-            if image.ndim == 2 or image.shape[2] == 1:  # a monochrome camera: recorded as grey RGB
-                image = np.repeat(image.reshape(image.shape[0], image.shape[1], 1), 3, axis=2)
-            if self.frames == "jpeg":
-                ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality])
-                if not ok:
-                    raise ValueError("a frame could not be JPEG-encoded")
-                payload = {"timestamp": {"sec": capture_ns // 10**9, "nsec": capture_ns % 10**9}, "frame_id": frame_id, "format": "jpeg", "data": base64.b64encode(jpeg.tobytes()).decode(), "t_host_s": t_host_s}
-                topic, data = FRAME_TOPIC, json.dumps(payload, separators=(",", ":")).encode()
-            else:
-                from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
-
-                h, w = image.shape[:2]
-                image = image[: h - h % 2, : w - w % 2]  # 4:2:0 needs even sizes: drop an odd last row/column
-                if self._encoder is None or (self._encoder.height, self._encoder.width) != image.shape[:2]:
-                    self._encoder = H264Encoder(image.shape[1], image.shape[0], fps=self.fps, crf=self.crf)
-                packet = self._encoder.encode(image)
-                if not packet:
-                    return
-                message = CompressedVideo(frame_id=frame_id, data=packet, format="h264")
-                message.timestamp.FromNanoseconds(capture_ns)
-                topic, data = VIDEO_TOPIC, message.SerializeToString()
-            with self._lock:
-                heapq.heappush(self._pending, (capture_ns, order, topic, data, True))
+            message = self._frame_encoder.encode(image, capture_ns, t_host_s, frame_id)
+            if message is not None:
+                with self._lock:
+                    heapq.heappush(self._pending, (capture_ns, order, *message, True))
         finally:
             with self._lock:
                 self._frames_in_encoder.pop(order, None)

@@ -19,7 +19,7 @@ from calib_core.vision.hand_eye_io import load_cam2flange
 def test_sizes_are_checked_before_reading(tmp_path):
     path = tmp_path / "big.yaml"
     path.write_bytes(b"# " + b"x" * 2000)
-    with pytest.raises(FileFormatError, match=r"big.yaml: is 0.0 MB; a workcell file is at most 0 MB"):
+    with pytest.raises(FileFormatError, match=r"big.yaml: is 2.0 kB; a workcell file is at most 1.0 kB"):
         read_text(path, "workcell file", max_bytes=1000)
     assert read_text(path, "workcell file", max_bytes=3000).startswith("# x")
     (tmp_path / "latin1.yaml").write_bytes("name: caf\xe9".encode("latin-1"))

@@ -31,7 +31,7 @@ def test_every_generated_document_is_accepted_or_refused_clearly(loader):
     assert stats["refused"] > 0  # the mutations do reach the checks
 
 
-def test_the_fuzzer_finds_a_loader_that_fails_unclearly(tmp_path, monkeypatch):
+def test_the_fuzzer_finds_a_loader_that_fails_unclearly(tmp_path):
     """The suite can fail: a loader that lets a TypeError out is reported with its input."""
     probe = tmp_path / "probe.py"
     probe.write_text(
