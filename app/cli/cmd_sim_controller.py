@@ -28,12 +28,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--reboot-after", type=float, metavar="SECONDS", help="reboot after this many seconds: gone for --reboot-downtime, then back")
     parser.add_argument("--reboot-downtime", type=float, default=1.0, metavar="SECONDS")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fault injection")
+    parser.add_argument("--key-file", type=Path, help="the link key to require on motion sentences (default: the user's, made on first use; see `videocal link-key`)")
+    parser.add_argument("--open", action="store_true", help="no link key: a protocol-3 controller that obeys any client's MVJ (to test a workstation against an old controller)")
 
 
 def run(args: argparse.Namespace) -> int:
     from calib_core.link.controller_sim import ControllerLogic
     from calib_core.link.faults import FaultInjector
     from calib_core.link.joint_motion import PlainJointModel
+    from calib_core.link.link_key import read_key, user_key
     from calib_core.link.sim_transport import SimOptions, serve
 
     if args.link is not None and not args.pty:
@@ -41,6 +44,9 @@ def run(args: argparse.Namespace) -> int:
     if args.tcp is not None and not (0 <= args.tcp <= 65535):
         raise VideocalError(f"--tcp: not a port number: {args.tcp}")
     faults = FaultInjector(args.noise_rate, args.corrupt_rate, args.drop_rate, args.seed)
+    if args.open and args.key_file is not None:
+        raise VideocalError("--open and --key-file exclude each other")
+    key = None if args.open else (read_key(args.key_file) if args.key_file is not None else user_key())
     if args.robot == "cell":
         from calib_core.link.joint_map import ControllerJointModel, JointMap
         from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
@@ -76,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
 
     options = SimOptions(pty=args.pty, tcp_port=args.tcp, link_path=args.link, disconnect_after_s=args.disconnect_after, reboot_after_s=args.reboot_after, reboot_downtime_s=args.reboot_downtime)
     try:
-        serve(ControllerLogic(model, initial), options, faults, announce, lambda: stop["flag"])
+        logic = ControllerLogic(model, initial, key=key, on_refusal=lambda text: print(f"refused: {text}", file=sys.stderr, flush=True))
+        serve(logic, options, faults, announce, lambda: stop["flag"])
     except OSError as exc:
         raise VideocalError(f"cannot serve: {exc}") from None
     print(f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} dropped", file=sys.stderr)

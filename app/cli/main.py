@@ -31,6 +31,7 @@ _register("demo", "app.cli.cmd_demo", "drive the window through a whole calibrat
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
 _register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot controller on a pty or a TCP port")
+_register("link-key", "app.cli.cmd_link_key", "name, show or renew the controller link's pre-shared key")
 _register("monitor", "app.cli.cmd_monitor", "print the joint samples of a controller link")
 _register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results")
 _register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")

@@ -18,7 +18,7 @@ _HEX = b"0123456789ABCDEF"
 @dataclass
 class AssemblerCounts:
     """What the assembler threw away: ``garbage_bytes`` outside any sentence, ``bad_checksum``,
-    ``too_long`` (no terminator within 128 bytes), ``malformed`` (bad framing: a ``$`` inside,
+    ``too_long`` (no terminator within MAX_SENTENCE_BYTES), ``malformed`` (bad framing: a ``$`` inside,
     missing ``*HH``, a lone CR or LF)."""
 
     sentences: int = 0

@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from calib_core.link import auth
 from calib_core.link.joint_motion import JointModel, PlainJointModel, TrapezoidMove
 from calib_core.link.protocol import (
     PROTOCOL_VERSION,
@@ -22,6 +23,9 @@ from calib_core.link.protocol import (
     ErrorReply,
     JointSample,
     MoveJoints,
+    Authenticate,
+    Hello,
+    HelloReply,
     ProtocolError,
     RequestJoints,
     RequestState,
@@ -43,9 +47,15 @@ class ControllerLogic:
     ``clock`` returns seconds (monotonic); ``t_ms`` in samples counts from start-up.
     ``report_joints`` maps the true joint state to what the encoders report (identity by
     default; the test bed reports commanded joints, which is what a real controller does).
+
+    ``key`` (32 bytes): the link's pre-shared key. With one, the controller speaks protocol 4 and
+    obeys a motion sentence only when it is sealed in the current session (:mod:`calib_core.link.auth`);
+    every refusal is answered ``ERR,AUTH`` and kept in ``auth_refusals`` (and passed to ``on_refusal``).
+    Without one it is a protocol-3 controller: any client's ``MVJ`` moves it.
     """
 
-    def __init__(self, joint_model: JointModel | None = None, initial_deg=None, clock: Callable[[], float] = time.monotonic, seq_start: int = 0):
+    def __init__(self, joint_model: JointModel | None = None, initial_deg=None, clock: Callable[[], float] = time.monotonic, seq_start: int = 0,
+                 key: bytes | None = None, on_refusal: Callable[[str], None] | None = None):
         self.model = joint_model or PlainJointModel()
         self.clock = clock
         self.t_start = clock()
@@ -60,6 +70,16 @@ class ControllerLogic:
         self.deadman_s = 0.0  # armed by the first HBT with a timeout: no heartbeat for this long stops a move
         self._last_heartbeat_t = 0.0
         self.seq = seq_start % SEQ_MODULUS
+        self.key = key
+        self.on_refusal = on_refusal
+        self.auth_refusals: list[str] = []
+        self.end_session()
+
+    def end_session(self) -> None:
+        """Forget the authenticated session (the workstation went away or opened a new one)."""
+        self._hello: tuple[str, str] | None = None  # (workstation nonce, controller nonce) offered
+        self._session: bytes | None = None
+        self._last_counter = 0
 
     def _sample(self) -> JointSample:
         sample = JointSample(self.seq, int(round((self.clock() - self.t_start) * 1000.0)), tuple(float(q) for q in self.joints_deg))
@@ -90,8 +110,9 @@ class ControllerLogic:
         """Replies (messages) to one incoming sentence body."""
         now = self.clock()
         out = self._update_motion(now)
+        inner, sealed = auth.split_seal(body)
         try:
-            msg = parse_body(body)
+            msg = parse_body(inner)
         except ProtocolError as exc:
             code = "UNKNOWN" if exc.kind == "unknown" else "SYNTAX"
             return out + [ErrorReply(code, str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80])]
@@ -105,7 +126,11 @@ class ControllerLogic:
                 self._next_stream_t = now
                 out.append(Ack("STR", "-"))
         elif isinstance(msg, RequestVersion):
-            out.append(VersionReport(PROTOCOL_VERSION, len(self.joints_deg)))
+            out.append(VersionReport(PROTOCOL_VERSION if self.key is not None else 3, len(self.joints_deg)))
+        elif isinstance(msg, Hello | Authenticate) and self.key is not None:
+            out.append(self._handshake(msg))
+        elif isinstance(msg, MoveJoints) and self.key is not None and (why := self._seal_problem(inner, sealed)):
+            out.append(self._refuse(f"move {msg.id}: not obeyed: {why}"))
         elif isinstance(msg, MoveJoints):
             goal = np.asarray(msg.joints_deg, dtype=float)
             lo, hi = np.asarray(self.model.lower_limits_deg), np.asarray(self.model.upper_limits_deg)
@@ -132,9 +157,46 @@ class ControllerLogic:
         elif isinstance(msg, RequestState):
             state = "MOVING" if self.move is not None else "IDLE"
             out.append(StateReport(state, f"stream {self.stream_hz:g} Hz"))
+        elif isinstance(msg, Hello | Authenticate):
+            out.append(ErrorReply("UNKNOWN", f"{inner[:3]}: this controller has no link key (protocol 3)"))
         else:
             out.append(ErrorReply("UNEXPECTED", f"{type(msg).__name__} is sent by a controller; not accepted"))
         return out
+
+    def _refuse(self, text: str) -> ErrorReply:
+        self.auth_refusals.append(text)
+        if self.on_refusal is not None:
+            self.on_refusal(text)
+        return ErrorReply("AUTH", text)
+
+    def _handshake(self, msg) -> HelloReply | Ack | ErrorReply:
+        if isinstance(msg, Hello):
+            self.end_session()  # a new hello ends any earlier session
+            controller_nonce = auth.new_nonce()
+            self._hello = (msg.nonce, controller_nonce)
+            return HelloReply(controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce))
+        if self._hello is None:
+            return self._refuse("auth: AUT without a HEL first")
+        ws_nonce, controller_nonce = self._hello
+        self._hello = None  # one try per hello
+        if not auth.proof_is_valid(auth.workstation_proof(self.key, ws_nonce, controller_nonce), msg.proof):
+            return self._refuse("auth: wrong proof: the workstation does not hold this controller's link key")
+        self._session = auth.session_key(self.key, ws_nonce, controller_nonce)
+        self._last_counter = 0
+        return Ack("AUT", "-")
+
+    def _seal_problem(self, inner: str, sealed: auth.Seal | None) -> str | None:
+        """Why a motion sentence is not to be obeyed (``None``: it is sealed in this session)."""
+        if self._session is None:
+            return "no authenticated session (send HEL and AUT first)"
+        if sealed is None:
+            return "the sentence carries no seal"
+        if not auth.seal_is_valid(self._session, inner, sealed):
+            return "wrong seal (altered, or sealed in another session)"
+        if sealed.counter <= self._last_counter:
+            return f"counter {sealed.counter} not above {self._last_counter} (a replayed sentence)"
+        self._last_counter = sealed.counter
+        return None
 
     def tick(self) -> list:
         """Messages due now: a finished move's DON and the stream samples."""

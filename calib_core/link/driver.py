@@ -12,7 +12,6 @@ the reader thread except as a reported error. :meth:`ControllerLink.close` retur
 from __future__ import annotations
 
 import itertools
-import re
 import secrets
 import threading
 import time
@@ -22,12 +21,15 @@ from collections.abc import Callable
 import serial
 
 from calib_core.link.assembler import SentenceAssembler
-from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
+from calib_core.link.link_key import default_key_path, user_key
+from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
+from calib_core.link.move_book import MoveBook
 from calib_core.link.protocol import (
     SEQ_MODULUS,
     Ack,
     Done,
     ErrorReply,
+    HelloReply,
     JointSample,
     MoveJoints,
     ProtocolError,
@@ -43,8 +45,9 @@ from calib_core.link.protocol import (
     parse_body,
 )
 
+from calib_core.link.workstation_auth import AuthState, WorkstationAuth
+
 _READ_TIMEOUT_S = 0.01
-_MOVE_IN_ERROR = re.compile(r"move ([A-Za-z0-9_.-]+):")
 _RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted ...
 _FRESH_CLOCK_MS = 500  # ... as has one that went back to its first half second
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
@@ -56,10 +59,14 @@ class ControllerLink:
     ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
     at least 0.25 s); ``n_joints``: how many joints the robot has (samples with another count are
     counted in ``stats.wrong_joint_count`` and not delivered; ``None`` takes any count).
+    ``key``: the link's pre-shared key (32 bytes); ``"user"`` (default) the user's
+    (:func:`~calib_core.link.link_key.user_key`); ``None`` for a protocol-3 controller without
+    authentication. With a key every (re)connection opens an authenticated session, and moves are
+    sent sealed, or not at all (``auth_state``, ``auth_failure``).
     Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
 
     def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
-                 deadman_ms: int = 1000, **serial_settings):
+                 deadman_ms: int = 1000, key: bytes | str | None = "user", **serial_settings):
         if mode not in MODES:
             raise ValueError(f"mode must be 'poll' or 'stream', got {mode!r}")
         if not (0 < rate_hz <= 250):
@@ -88,8 +95,14 @@ class ControllerLink:
         self._last_seq: int | None = None
         self._sample_callbacks: list[Callable[[TimedSample], None]] = []
         self._state_callbacks: list[Callable[[LinkState, str], None]] = []
-        self._moves: dict[str, MoveHandle] = {}
-        self._awaiting_ack: deque[MoveHandle] = deque()
+        self._moves = MoveBook()
+        if key == "user":
+            self._auth = WorkstationAuth(user_key(), f"the link key in {default_key_path()}")
+        elif key is None or isinstance(key, bytes):
+            self._auth = WorkstationAuth(key)
+        else:
+            raise ValueError(f"key: 32 bytes, 'user' or None, got {type(key).__name__}")
+        self._next_hello_s = 0.0
         self._state_reports: deque[StateReport] = deque(maxlen=16)
         self._version_reports: deque[VersionReport] = deque(maxlen=4)
         self._state_event = threading.Condition(self._lock)
@@ -114,6 +127,8 @@ class ControllerLink:
             self._set_state(LinkState.CONNECTING, "opening")
         self._thread = threading.Thread(target=self._run, name=f"controller-link {self.url}", daemon=True)
         self._thread.start()
+        if wait_open:
+            self._auth.wait_settled(2.0)
         return self
 
     def close(self) -> None:
@@ -126,8 +141,7 @@ class ControllerLink:
             self._thread.join(timeout=1.0)
         self._close_port()
         self._set_state(LinkState.CLOSED, "closed by the caller")
-        for move in list(self._moves.values()):
-            move._finish(MoveError(f"move {move.id}: the link was closed"))
+        self._moves.finish_all("the link was closed")
 
     def __enter__(self) -> ControllerLink:
         return self.start()
@@ -139,6 +153,16 @@ class ControllerLink:
     @property
     def state(self) -> LinkState:
         return self._state
+
+    @property
+    def auth_state(self) -> AuthState:
+        """Whether moves can be sent: ``ready`` (sealed), ``off`` (no key), ``pending`` or ``failed``."""
+        return self._auth.state
+
+    @property
+    def auth_failure(self) -> str | None:
+        """Why the session could not be opened (the controller's key, protocol or silence)."""
+        return self._auth.failure
 
     @property
     def latest(self) -> TimedSample | None:
@@ -159,27 +183,32 @@ class ControllerLink:
         """``callback(sample)`` on the reader thread for every sample (keep it short)."""
         self._sample_callbacks.append(callback)
 
+    def on_auth(self, callback: Callable[[AuthState, str | None], None]) -> None:
+        """``callback(state, failure)`` on the reader thread when a handshake ends (``ready`` or ``failed``)."""
+        self._auth.listeners.append(callback)
+
     def on_state(self, callback: Callable[[LinkState, str], None]) -> None:
         """``callback(state, reason)`` on the reader thread when the state changes."""
         self._state_callbacks.append(callback)
 
     # --- commands --------------------------------------------------------------------------
     def move_joints(self, joints_deg, *, timeout_s: float = 60.0) -> MoveHandle:
-        """Send ``$MVJ`` and return its handle at once."""
+        """Send ``$MVJ`` (sealed) and return its handle at once. While the handshake is under way this
+        waits for it (at most 1 s); without an authenticated session the move is not sent and the
+        handle has finished with the reason."""
         q = tuple(float(v) for v in joints_deg)
         if self.n_joints is not None and len(q) != self.n_joints:
             raise ValueError(f"a move needs {self.n_joints} joint values, got {len(q)}")
         if not all(abs(v) < 1e6 for v in q):
             raise ValueError(f"a move needs finite joint values within 1e6, got {q}")
         handle = MoveHandle(f"m{self._session}.{next(self._ids)}", q, time.monotonic() + timeout_s)
-        with self._lock:
-            self._moves[handle.id] = handle
-            self._awaiting_ack.append(handle)
-        if not self._send(MoveJoints(handle.id, q).body()):
-            with self._lock:
-                self._moves.pop(handle.id, None)
-                if handle in self._awaiting_ack:
-                    self._awaiting_ack.remove(handle)
+        if self._auth.wait_settled(1.0) not in (AuthState.READY, AuthState.OFF):
+            handle.sent = False
+            handle._finish(MoveError(f"move {handle.id}: not sent: {self._auth.why_not}"))
+            return handle
+        self._moves.add(handle)
+        if not self._send(MoveJoints(handle.id, q).body(), sealed=True):
+            self._moves.withdraw(handle)
             handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
         return handle
@@ -234,6 +263,13 @@ class ControllerLink:
         self._set_state(LinkState.CONNECTING, "open, waiting for samples")
         # Polling stops any stream a previous session left running; streaming (re)starts it.
         self._send(Stream(self.rate_hz if self.mode == "stream" else 0).body())
+        self._hello()
+
+    def _hello(self) -> None:
+        hello = self._auth.hello()
+        if hello is not None:
+            self._next_hello_s = time.monotonic() + 1.0
+            self._send(hello)
 
     def _close_port(self) -> None:
         port, self._port = self._port, None
@@ -243,13 +279,13 @@ class ControllerLink:
             except Exception:  # closing a vanished device may fail in many ways; it is gone either way
                 pass
 
-    def _send(self, body: str) -> bool:
+    def _send(self, body: str, *, sealed: bool = False) -> bool:
         port = self._port
         if port is None:
             return False
         try:
-            with self._write_lock:
-                port.write(encode(body))
+            with self._write_lock:  # sealed under the lock: counters go out in order
+                port.write(encode(self._auth.seal(body) if sealed else body))
             return True
         except (serial.SerialException, OSError, ValueError) as exc:
             self.last_error = f"write failed: {exc}"
@@ -278,7 +314,7 @@ class ControllerLink:
                 except LinkError as exc:
                     self.last_error = str(exc)
                     self._set_state(LinkState.DOWN, str(exc))
-                    self._expire_moves(time.monotonic())  # a move's timeout runs on while the link is down
+                    self._moves.expire(time.monotonic())  # a move's timeout runs on while the link is down
                     if not self.reconnect:
                         return
                     self._stop.wait(next(backoff, _BACKOFF_S[-1]))
@@ -315,7 +351,8 @@ class ControllerLink:
                 if self.mode == "stream":
                     self._send(Stream(self.rate_hz).body())  # a controller that forgot the stream gets asked again
                     last_sample_t = now
-            self._expire_moves(now)
+            self._auth.check_timeout(now)
+            self._moves.expire(now)
 
     def _sync_counts(self) -> None:
         c = self._assembler.counts
@@ -348,39 +385,27 @@ class ControllerLink:
             self._deliver(TimedSample(msg, t_host))
             return True
         if isinstance(msg, Ack) and msg.cmd == "MVJ":
-            with self._lock:
-                handle = self._moves.get(msg.id)
-                if handle is not None:
-                    handle.acked = True
-                    if handle in self._awaiting_ack:
-                        self._awaiting_ack.remove(handle)
+            self._moves.acknowledged(msg.id)
+        elif isinstance(msg, Ack) and msg.cmd == "AUT":
+            self._auth.on_accepted()
+        elif isinstance(msg, HelloReply):
+            answer = self._auth.on_hello_reply(msg)
+            if answer is not None:
+                self._send(answer)
         elif isinstance(msg, Done):
-            with self._lock:
-                handle = self._moves.get(msg.id)
-                if handle is not None and not handle.acked:
-                    # a DON for a move the controller never accepted: not believed
+            unbelieved = self._moves.done(msg.id)
+            if unbelieved:  # a DON for a move the controller never accepted
+                with self._lock:
                     self.stats.errors += 1
-                    self.last_error = f"DON for move {msg.id} without its ACK: ignored"
-                    handle = None
-                elif handle is not None:
-                    self._moves.pop(msg.id, None)
-            if handle is not None:
-                handle._finish()
+                self.last_error = unbelieved
         elif isinstance(msg, ErrorReply):
             with self._lock:
                 self.stats.errors += 1
-                # the move the reply names ("move <id>: ..."), else the oldest one waiting for its ACK
-                named = _MOVE_IN_ERROR.match(msg.text)
-                handle = self._moves.get(named.group(1)) if named else None
-                if handle is None and not named and self._awaiting_ack:
-                    handle = self._awaiting_ack[0]
-                if handle is not None:
-                    self._moves.pop(handle.id, None)
-                    if handle in self._awaiting_ack:
-                        self._awaiting_ack.remove(handle)
             self.last_error = f"controller error {msg.code}: {msg.text}"
-            if handle is not None:
-                handle._finish(MoveError(f"move {handle.id} refused by the controller: {msg.code}: {msg.text}"))
+            if not self._auth.on_error(msg):
+                self._moves.refused(msg)
+            if self._auth.lost_session(msg) and t_host >= self._next_hello_s:
+                self._hello()  # the controller restarted and forgot the session: open a new one
         elif isinstance(msg, StateReport):
             with self._state_event:
                 self._state_reports.append(msg)
@@ -423,15 +448,3 @@ class ControllerLink:
             except Exception as exc:  # a caller's bug must not kill the link
                 self.stats.errors += 1
                 self.last_error = f"sample callback failed: {exc!r}"
-
-    def _expire_moves(self, now: float) -> None:
-        expired = []
-        with self._lock:
-            for move_id, handle in list(self._moves.items()):
-                if now > handle.deadline_s:
-                    expired.append(self._moves.pop(move_id))
-                    if handle in self._awaiting_ack:
-                        self._awaiting_ack.remove(handle)
-        for handle in expired:
-            what = "no DON" if handle.acked else "no ACK"
-            handle._finish(MoveTimeout(f"move {handle.id}: {what} before its timeout"))

@@ -1,7 +1,7 @@
 """The wire protocol: NMEA-0183-style ASCII sentences and their typed messages.
 
 A sentence is ``$`` + body + ``*`` + two upper-case hex digits (the XOR of every body byte)
-+ CR LF, at most 128 bytes. Fields are separated by commas; angles are degrees with up to
++ CR LF, at most 320 bytes. Fields are separated by commas; angles are degrees with up to
 4 decimals. The full description is in ``docs/controller-protocol.md``.
 """
 
@@ -10,9 +10,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-PROTOCOL_VERSION = 3
-# Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences.
-MAX_SENTENCE_BYTES = 256
+PROTOCOL_VERSION = 4
+# Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences; version 4
+# adds a 45-byte seal to motion sentences (16 joints of 1e6 still fit).
+MAX_SENTENCE_BYTES = 320
 MAX_JOINTS = 16
 SEQ_MODULUS = 2**32
 
@@ -157,6 +158,37 @@ class Heartbeat:
 
 
 @dataclass(frozen=True)
+class Hello:
+    """``$HEL,<nonce>``: the workstation opens an authenticated session (protocol 4)."""
+
+    nonce: str
+
+    def body(self) -> str:
+        return f"HEL,{self.nonce}"
+
+
+@dataclass(frozen=True)
+class HelloReply:
+    """``$HEL,<nonce>,<proof>``: the controller's nonce and its proof that it holds the key."""
+
+    nonce: str
+    proof: str
+
+    def body(self) -> str:
+        return f"HEL,{self.nonce},{self.proof}"
+
+
+@dataclass(frozen=True)
+class Authenticate:
+    """``$AUT,<proof>``: the workstation's proof that it holds the key; answered ``ACK,AUT,-``."""
+
+    proof: str
+
+    def body(self) -> str:
+        return f"AUT,{self.proof}"
+
+
+@dataclass(frozen=True)
 class RequestVersion:
     """``$VER``: which protocol version the controller speaks and how many joints it drives."""
 
@@ -183,7 +215,8 @@ class RequestState:
         return "STA"
 
 
-Message = JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion | Stop | Heartbeat
+Message = (JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion | Stop | Heartbeat
+           | Hello | HelloReply | Authenticate)
 
 
 def _number(text: str, what: str) -> float:
@@ -205,6 +238,12 @@ def _integer(text: str, what: str) -> int:
 def _token(text: str, what: str) -> str:
     if not text or not all(c.isalnum() or c in "_-." for c in text):
         raise ProtocolError("malformed", f"{what}: not a valid identifier: {text!r}")
+    return text
+
+
+def _hex(text: str, what: str) -> str:
+    if not 1 <= len(text) <= 64 or any(c not in "0123456789abcdef" for c in text):
+        raise ProtocolError("malformed", f"{what}: not 1 to 64 lower-case hex digits: {text!r}")
     return text
 
 
@@ -234,6 +273,12 @@ def parse_body(body: str) -> Message:
         return RequestVersion()
     if kind == "VER" and n == 3:
         return VersionReport(_integer(fields[1], "VER version"), _integer(fields[2], "VER n_joints"))
+    if kind == "HEL" and n == 2:
+        return Hello(_hex(fields[1], "HEL nonce"))
+    if kind == "HEL" and n == 3:
+        return HelloReply(_hex(fields[1], "HEL nonce"), _hex(fields[2], "HEL proof"))
+    if kind == "AUT" and n == 2:
+        return Authenticate(_hex(fields[1], "AUT proof"))
     if kind == "RQJ" and n == 1:
         return RequestJoints()
     if kind == "STP" and n == 1:
@@ -252,6 +297,6 @@ def parse_body(body: str) -> Message:
         if not 3 <= n <= 2 + MAX_JOINTS:
             raise ProtocolError("malformed", f"MVJ needs an id and 1 to {MAX_JOINTS} joint values; got {n} fields")
         return MoveJoints(_token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:])))
-    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER", "STP", "HBT"):
+    if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER", "STP", "HBT", "HEL", "AUT"):
         raise ProtocolError("malformed", f"{kind} with {n - 1} fields")
     raise ProtocolError("unknown", f"unknown sentence type {kind!r}")

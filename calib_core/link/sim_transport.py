@@ -86,6 +86,7 @@ class _TcpEndpoint:
         self.server.listen(1)
         self.client: socket.socket | None = None
         self.refused = 0
+        self.generation = 0  # counts client changes: a new or lost client ends the authenticated session
         self.path = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
 
     @staticmethod
@@ -115,6 +116,7 @@ class _TcpEndpoint:
             if self.client is not None:
                 self.client.close()
             self.client = conn
+            self.generation += 1
             return b""
         try:
             data = self.client.recv(4096)
@@ -123,6 +125,7 @@ class _TcpEndpoint:
         if not data:
             self.client.close()
             self.client = None
+            self.generation += 1
         return data
 
     def write(self, data: bytes) -> None:
@@ -133,6 +136,7 @@ class _TcpEndpoint:
         except OSError:
             self.client.close()
             self.client = None
+            self.generation += 1
 
     def close(self) -> None:
         if self.client is not None:
@@ -168,7 +172,8 @@ def serve(logic: ControllerLogic, options: SimOptions, faults: FaultInjector | N
             if options.reboot_after_s is not None and not rebooted and now - started >= options.reboot_after_s:
                 endpoint.close()
                 time.sleep(options.reboot_downtime_s)
-                logic.__init__(logic.model, logic.joints_deg, logic.clock)  # a rebooted controller forgets streams and moves
+                # a rebooted controller forgets streams, moves and its session
+                logic.__init__(logic.model, logic.joints_deg, logic.clock, key=logic.key, on_refusal=logic.on_refusal)
                 assembler.reset()
                 endpoint = open_endpoint()
                 announce(endpoint.path)
@@ -177,7 +182,11 @@ def serve(logic: ControllerLogic, options: SimOptions, faults: FaultInjector | N
             timeout = max(0.0, min(logic.next_deadline() - now, 0.05))
             ready, _, _ = select.select(endpoint.fds(), [], [], timeout)
             for fd in ready:
+                generation = getattr(endpoint, "generation", 0)
                 data = endpoint.read(fd)
+                if getattr(endpoint, "generation", 0) != generation:
+                    logic.end_session()
+                    assembler.reset()
                 for body in assembler.feed(data):
                     send(logic.handle(body))
             send(logic.tick())

@@ -140,6 +140,7 @@ class OperatorCore(SessionFiles, Picking, Moves):
         self.link = ControllerLink(url, mode="stream", rate_hz=rate_hz, n_joints=self.robot.n_joints)
         self.link.on_sample(lambda sample: self._call_soon(self.observe_sample, sample))
         self.link.on_state(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
+        self.link.on_auth(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
         if self.site is not None:
             self.site.attach(self.link)
         self.link.start()
@@ -154,6 +155,11 @@ class OperatorCore(SessionFiles, Picking, Moves):
             if self.motion.motion is Motion.MOVING:
                 self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
         self.link_state.emit(f"{state}: {why}")
+
+    def _on_link_auth(self, state: str, failure: str | None) -> None:
+        self.record_event("link_auth", state=state, failure=failure)
+        if failure:
+            self.message.emit(f"the robot cannot be moved: {failure}")
 
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""

@@ -1,0 +1,198 @@
+"""Protocol 4: the session handshake on the pre-shared key and the seal on motion sentences, at the
+controller's logic, through the real simulator process, and the key file itself."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import stat
+import threading
+import time
+
+import pytest
+import serial
+
+from calib_core.link import auth
+from calib_core.link.assembler import SentenceAssembler
+from calib_core.link.controller_sim import ControllerLogic
+from calib_core.link.driver import ControllerLink
+from calib_core.link.link_key import LinkKeyError, default_key_path, read_key, user_key, write_new_key
+from calib_core.link.link_types import MoveError
+from calib_core.link.protocol import Ack, ErrorReply, HelloReply, encode, parse_body
+from calib_core.link.workstation_auth import AuthState
+
+from tests.core.link.sim_process import SimProcess
+
+KEY = bytes(range(32))
+
+
+def _hmac_by_hand(key: bytes, text: str) -> str:
+    """RFC 2104 written out (ipad/opad), to check the module's HMAC a second way."""
+    block = key.ljust(64, b"\0")
+    inner = hashlib.sha256(bytes(b ^ 0x36 for b in block) + text.encode()).digest()
+    return hashlib.sha256(bytes(b ^ 0x5C for b in block) + inner).hexdigest()
+
+
+def test_proofs_and_seals_are_rfc2104_hmacs_of_the_documented_texts():
+    wn, cn = "0123456789abcdef", "fedcba9876543210"
+    assert auth.controller_proof(KEY, wn, cn) == _hmac_by_hand(KEY, f"videocal-hello|{wn}|{cn}")[:32]
+    assert auth.workstation_proof(KEY, wn, cn) == _hmac_by_hand(KEY, f"videocal-auth|{cn}|{wn}")[:32]
+    session = auth.session_key(KEY, wn, cn)
+    assert session.hex() == _hmac_by_hand(KEY, f"videocal-session|{wn}|{cn}")
+    body = "MVJ,mab12.1,10.0000,0.0000,-5.2500"
+    sealed = auth.seal(session, 7, body)
+    assert sealed == f"{body},#7:{_hmac_by_hand(session, f'7|{body}')[:32]}"
+    inner, s = auth.split_seal(sealed)
+    assert inner == body and s.counter == 7 and auth.seal_is_valid(session, inner, s)
+    assert not auth.seal_is_valid(session, body.replace("10.0000", "90.0000"), s)
+    assert auth.split_seal(body) == (body, None)
+    assert len(encode(auth.seal(session, 4_000_000_000, "MVJ,mffff.99999," + ",".join(["-999999.9999"] * 16)))) <= 320
+
+
+def _handshake(logic: ControllerLogic, key: bytes = KEY) -> bytes:
+    wn = auth.new_nonce()
+    (reply,) = logic.handle(f"HEL,{wn}")
+    assert isinstance(reply, HelloReply) and reply.proof == auth.controller_proof(KEY, wn, reply.nonce)
+    (ack,) = logic.handle(f"AUT,{auth.workstation_proof(key, wn, reply.nonce)}")
+    assert ack == Ack("AUT", "-") or key != KEY
+    return auth.session_key(key, wn, reply.nonce)
+
+
+def _moved(replies) -> bool:
+    return any(isinstance(r, Ack) and r.cmd == "MVJ" for r in replies)
+
+
+def test_a_keyed_controller_obeys_only_sealed_moves_of_its_session():
+    logic = ControllerLogic(key=KEY)
+    move = "MVJ,m1.1,10,0,0,0,0,0"
+    (refused,) = logic.handle(move)
+    assert refused.code == "AUTH" and "no authenticated session" in refused.text and logic.move is None
+    session = _handshake(logic)
+    (refused,) = logic.handle(move)  # a session, but the sentence is not sealed
+    assert refused.code == "AUTH" and "no seal" in refused.text
+    sealed = auth.seal(session, 1, move)
+    assert _moved(logic.handle(sealed))
+    logic.handle("STP")
+    assert logic.handle(sealed)[0].code == "AUTH"  # replayed: same counter
+    tampered = sealed.replace("MVJ,m1.1,10,", "MVJ,m1.1,90,")
+    assert "wrong seal" in logic.handle(tampered)[0].text
+    assert _moved(logic.handle(auth.seal(session, 5, "MVJ,m1.2,20,0,0,0,0,0")))  # counters may skip, never go back
+    _handshake(logic)  # a new session: the old one's seals are worthless
+    assert "wrong seal" in logic.handle(auth.seal(session, 9, "MVJ,m1.3,0,0,0,0,0,0"))[0].text
+    assert len(logic.auth_refusals) == 5
+
+
+def test_stop_needs_no_session_and_a_wrong_key_gets_none():
+    logic = ControllerLogic(key=KEY)
+    session = _handshake(logic)
+    assert _moved(logic.handle(auth.seal(session, 1, "MVJ,m1.1,150,0,0,0,0,0")))
+    logic.end_session()  # the workstation went away
+    stop = logic.handle("STP")
+    assert stop[0].code == "STOPPED" and stop[-1] == Ack("STP", "-") and logic.move is None
+    wrong = _handshake(logic, key=bytes(32))
+    assert logic.auth_refusals[-1].startswith("auth: wrong proof")
+    assert logic.handle(auth.seal(wrong, 1, "MVJ,m1.2,1,0,0,0,0,0"))[0].code == "AUTH"
+    (refused,) = logic.handle("AUT," + "0" * 32)
+    assert refused.code == "AUTH" and "without a HEL" in refused.text
+
+
+def test_a_protocol_3_controller_answers_hello_as_unknown():
+    logic = ControllerLogic()
+    (reply,) = logic.handle(f"HEL,{auth.new_nonce()}")
+    assert reply.code == "UNKNOWN" and "HEL" in reply.text
+    assert _moved(logic.handle("MVJ,m1.1,1,0,0,0,0,0"))
+
+
+@pytest.fixture
+def sim(tmp_path):
+    procs = []
+
+    def start(*args):
+        p = SimProcess(*args, link=tmp_path / f"controller{len(procs)}")
+        procs.append(p)
+        return p
+
+    yield start
+    for p in procs:
+        p.stop()
+
+
+def test_the_simulator_refuses_and_logs_a_raw_unauthenticated_move(sim):
+    s = sim("--pty")
+    port = serial.serial_for_url(s.url, timeout=0.05)
+    assembler, replies = SentenceAssembler(), []
+    try:
+        port.write(encode("MVJ,x1,10,0,0,0,0,0"))
+        deadline = time.monotonic() + 5
+        while not any(isinstance(r, ErrorReply) for r in replies) and time.monotonic() < deadline:
+            replies += [parse_body(b) for b in assembler.feed(port.read(256))]
+    finally:
+        port.close()
+    (err,) = [r for r in replies if isinstance(r, ErrorReply)]
+    assert err.code == "AUTH" and err.text.startswith("move x1: not obeyed")
+    s.proc.terminate()
+    assert "refused: move x1: not obeyed: no authenticated session" in s.proc.stderr.read()
+
+
+def test_the_driver_moves_only_with_the_controllers_key(sim, tmp_path):
+    s = sim("--pty")
+    with ControllerLink(s.url, rate_hz=50).start(wait_open=True) as link:
+        assert link.auth_state is AuthState.READY
+        link.move_joints((5.0, 0, 0, 0, 0, 0), timeout_s=10).wait(10)
+    other = tmp_path / "other.key"
+    with ControllerLink(s.url, rate_hz=50, key=write_new_key(other)).start(wait_open=True) as intruder:
+        assert intruder.auth_state is AuthState.FAILED and "does not hold" in intruder.auth_failure
+        handle = intruder.move_joints((40.0, 0, 0, 0, 0, 0))
+        assert not handle.sent
+        with pytest.raises(MoveError, match="not sent: the controller does not hold"):
+            handle.wait(1)
+        assert intruder.wait_for_samples(intruder.stats.samples + 5, 2)
+        assert intruder.latest.joints_deg[0] == pytest.approx(5.0, abs=1e-3)  # it did not move
+
+
+def test_a_controller_without_authentication_is_not_moved(sim):
+    s = sim("--pty", "--open")
+    with ControllerLink(s.url, rate_hz=50).start(wait_open=True) as link:
+        assert link.auth_state is AuthState.FAILED and "does not authenticate" in link.auth_failure
+        assert not link.move_joints((40.0, 0, 0, 0, 0, 0)).sent
+    with ControllerLink(s.url, rate_hz=50, key=None).start(wait_open=True) as old_style:  # the caller's explicit choice
+        old_style.move_joints((1.0, 0, 0, 0, 0, 0), timeout_s=10).wait(10)
+
+
+def test_a_rebooted_controller_gets_a_new_session_and_obeys_again(sim):
+    s = sim("--pty", "--reboot-after", "0.8", "--reboot-downtime", "0.3")
+    with ControllerLink(s.url, rate_hz=100).start(wait_open=True) as link:
+        assert link.auth_state is AuthState.READY
+        s.next_announcement()  # the reboot's new pty
+        deadline = time.monotonic() + 5
+        while link._auth.sessions < 2 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert link._auth.sessions == 2 and link.auth_state is AuthState.READY
+        link.move_joints((3.0, 0, 0, 0, 0, 0), timeout_s=10).wait(10)
+
+
+def test_the_key_file_is_private_and_made_once(tmp_path):
+    path = tmp_path / "link.key"
+    keys = []
+    threads = [threading.Thread(target=lambda: keys.append(write_new_key(path))) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(set(keys)) == 1 and read_key(path) == keys[0]
+    assert stat.S_IMODE(path.stat().st_mode) == 0o600 and [p.name for p in tmp_path.iterdir()] == ["link.key"]
+    os.chmod(path, 0o644)
+    with pytest.raises(LinkKeyError, match=r"readable by others .*chmod 600"):
+        read_key(path)
+    path.write_text("not hex\n")
+    os.chmod(path, 0o600)
+    with pytest.raises(LinkKeyError, match="not hex digits"):
+        read_key(path)
+    with pytest.raises(LinkKeyError, match="no link key there"):
+        read_key(tmp_path / "missing.key")
+    assert write_new_key(path, replace=True) != keys[0]
+
+
+def test_the_user_key_lives_in_the_config_folder():
+    assert str(default_key_path()).startswith(os.environ["XDG_CONFIG_HOME"])
+    assert user_key() == read_key(default_key_path())
