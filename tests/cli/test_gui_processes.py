@@ -76,3 +76,31 @@ def test_sigterm_closes_the_window_and_the_simulator(cell_copy, tmp_path):
         if gui.poll() is None:
             gui.kill()
         gui.communicate()
+
+
+def test_two_windows_killed_with_sigkill_leave_no_simulator(cell_copy, tmp_path):
+    """Two windows on one cell each run their own simulator; kill -9 gives neither window a chance to
+    clean up, and still no simulator outlives its window (the child dies with its parent)."""
+    guis, ready = [], []
+    try:
+        for k in range(2):
+            shown = tmp_path / f"shown{k}.txt"
+            guis.append(_gui("--workcell", str(cell_copy), env={"VIDEOCAL_REPORT_SHOWN": str(shown)}))
+            ready.append(shown.with_suffix(".ready"))
+        deadline = time.monotonic() + 180
+        while not all(r.exists() for r in ready):
+            for gui in guis:
+                assert gui.poll() is None, gui.stderr.read()
+            assert time.monotonic() < deadline, "the windows did not come up"
+            time.sleep(0.2)
+        sims = _simulators_for(cell_copy)
+        assert len(sims) == 2
+        for gui in guis:
+            gui.send_signal(signal.SIGKILL)
+            gui.wait(timeout=30)
+        assert _wait_gone(cell_copy) == []
+    finally:
+        for gui in guis:
+            if gui.poll() is None:
+                gui.kill()
+            gui.communicate()
