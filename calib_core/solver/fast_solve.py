@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.solver.finish import operator_warnings
+from calib_core.solver.finish import noise_px, operator_warnings
 from calib_core.solver.kernels.fast_path import dlt_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
 from calib_core.solver.problem import PoseProblem
@@ -38,5 +38,5 @@ def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float) ->
         status=SolveStatus.OK, obj2cam=obj2cam, fu=intr.fu, fv=intr.fv, model="pinhole", iterations=int(iterations),
         residuals_px=r, uncertainty=uncertainty_from(cov, cov_c, sigma, int(source), condition), leave_one_out_px=loo,
         outliers=np.zeros(len(r), dtype=bool), candidates=(PoseCandidate(obj2cam, intr.fu, intr.fv, float(rms)),),
-        warnings=tuple(operator_warnings(problem, condition)),
+        warnings=tuple(operator_warnings(problem, condition, noise_px(sigma_px))),
     )

@@ -28,9 +28,16 @@ def _flag_outliers(residuals: np.ndarray, noise: float) -> np.ndarray:
     return e > max(4.0 * noise, 3.0 * spread)
 
 
-def operator_warnings(problem: PoseProblem, condition_number: float) -> list[str]:
+def operator_warnings(problem: PoseProblem, condition_number: float, noise: float = DEFAULT_SIGMA_PX) -> list[str]:
     """What an operator should know about a solve that is not an error."""
     warnings = []
+    for i, j in problem.repeated_3d:
+        apart = float(np.linalg.norm(problem.points_2d[i] - problem.points_2d[j]))
+        if apart > 3.0 * np.sqrt(2.0) * noise:  # two picks of one point differ by more than their noise allows
+            warnings.append(f"{point_label(i)} and {point_label(j)} are the same 3D point picked {apart:.1f} px apart: one of the two picks is off")
+    intr = problem.intrinsics
+    if not (0.0 <= intr.cx <= intr.width and 0.0 <= intr.cy <= intr.height):
+        warnings.append(f"the principal point ({intr.cx:.1f}, {intr.cy:.1f}) px lies outside the {intr.width}x{intr.height} image: check the camera file")
     if problem.n_points * 2 <= problem.n_params:
         warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
     if condition_number > _POOR_CONDITION:
@@ -76,7 +83,7 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     elif len(candidates) > 1:
         status = SolveStatus.AMBIGUOUS
         reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
-    warnings += operator_warnings(problem, uncertainty.condition_number)
+    warnings += operator_warnings(problem, uncertainty.condition_number, noise)
     return PoseSolution(
         status=status, obj2cam=chosen.obj2cam, fu=chosen.fu, fv=chosen.fv, model=problem.model,
         iterations=iterations, residuals_px=residuals, uncertainty=uncertainty, leave_one_out_px=loo,

@@ -90,15 +90,34 @@ def ippe_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrins
     return _as_seeds(rvecs[:n], tvecs[:n]) if n else []
 
 
+_ENUMERATE_UP_TO = 12  # C(12, 3) = 220 triplets: below this, every one is looked at
+_SAMPLED_TRIPLETS = 200
+
+
 def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tuple[int, int, int]]:
-    """Up to ``limit`` triplets of point indices, the largest triangles first (best conditioned P3P)."""
-    triplets = list(combinations(range(len(points_3d)), 3))
-    if len(triplets) <= limit:
-        return triplets
-    P = points_3d
-    area = [np.linalg.norm(np.cross(P[j] - P[i], P[k] - P[i])) for i, j, k in triplets]
-    order = np.argsort(area)[::-1]
-    return [triplets[i] for i in order[:limit]]
+    """Up to ``limit`` triplets of point indices, the largest triangles first (best conditioned P3P).
+
+    Up to 12 points every triplet is ranked; beyond, a bounded set is: the triangle on the points
+    farthest apart, and 200 random triplets (seeded, so the same picks give the same seeds). Time
+    and memory O(n), never the n^3 / 6 of all combinations."""
+    P = np.asarray(points_3d, dtype=float)
+    n = len(P)
+    if n < 3:
+        return []
+    if n <= _ENUMERATE_UP_TO:
+        triplets = np.array(list(combinations(range(n), 3)))
+    else:
+        rng = np.random.default_rng(n)
+        drawn = np.sort(np.stack([rng.choice(n, 3, replace=False) for _ in range(_SAMPLED_TRIPLETS)]), axis=1)
+        i = int(np.argmax(np.linalg.norm(P - P.mean(axis=0), axis=1)))
+        j = int(np.argmax(np.linalg.norm(P - P[i], axis=1)))
+        d = P[j] - P[i]
+        off_line = np.linalg.norm(np.cross(P - P[i], d), axis=1)
+        k = int(np.argmax(off_line))
+        triplets = np.unique(np.vstack([drawn, np.sort([i, j, k])[None]]), axis=0) if len({i, j, k}) == 3 else np.unique(drawn, axis=0)
+    area = np.linalg.norm(np.cross(P[triplets[:, 1]] - P[triplets[:, 0]], P[triplets[:, 2]] - P[triplets[:, 0]]), axis=1)
+    order = np.argsort(-area, kind="stable")[:limit]
+    return [tuple(int(v) for v in triplets[o]) for o in order]
 
 
 def subset_p3p_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:

@@ -12,7 +12,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.solver.kernels.geometry_checks import COLLINEAR, DUPLICATE_2D, DUPLICATE_3D, NON_FINITE_2D, NON_FINITE_3D, check_pairs
+from scipy.spatial import cKDTree
+
+from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, NON_FINITE_3D, check_pairs
 from calib_core.solver.errors import (
     DegenerateGeometryError,
     DuplicatePointsError,
@@ -53,6 +55,8 @@ class PoseProblem:
     coplanar: bool
     distortion: np.ndarray
     off_image: tuple[int, ...] = ()
+    repeated_3d: tuple[tuple[int, int], ...] = ()
+    """Pairs of indices (i < j) naming the same 3D point (seen at two pixels: allowed)."""
 
     @property
     def n_points(self) -> int:
@@ -94,20 +98,32 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
     if len(p3) < needed:
         why = " (the focal lengths are estimated too)" if estimate_focal else ""
         raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
-    code, i, j, coplanar, n_off_image = check_pairs(p3, p2, _DUPLICATE_REL_3D, _DUPLICATE_PX, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height)
+    code, i, j, coplanar, n_off_image, spread = check_pairs(p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height)
     if code == NON_FINITE_3D or code == NON_FINITE_2D:
         bad = np.flatnonzero(~np.all(np.isfinite(p3), axis=1) | ~np.all(np.isfinite(p2), axis=1))
         raise NonFiniteInputError(f"{points_label(bad)}: coordinates are NaN or infinite", bad)
-    if code == DUPLICATE_3D or code == DUPLICATE_2D:
-        what = "3D point" if code == DUPLICATE_3D else "pixel"
-        raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same {what}", (i, j))
+    repeated = _repeated_points(p3, p2, _DUPLICATE_REL_3D * max(spread, 1.0))
+    if len(p3) - len({j for _, j in repeated}) < needed:
+        raise TooFewPointsError(f"{len(p3)} point pairs given but only {len(p3) - len({j for _, j in repeated})} distinct 3D points, at least {needed} needed")
     if code == COLLINEAR:
         raise DegenerateGeometryError(f"{points_label(range(len(p3)))}: the 3D points are collinear; pick points that span a plane or a volume", range(len(p3)))
     off_image = ()
     if n_off_image:
         u, v = p2[:, 0], p2[:, 1]
         off_image = tuple(int(k) for k in np.flatnonzero((u < -0.5) | (v < -0.5) | (u > intrinsics.width - 0.5) | (v > intrinsics.height - 0.5)))
-    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image)
+    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image, repeated)
+
+
+def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tuple[int, int], ...]:
+    """The pairs naming one 3D point twice (allowed: a feature seen at two pixels); raises
+    :class:`DuplicatePointsError` for two pairs at one pixel, or one pair given twice. O(n log n)."""
+    same_px = sorted(cKDTree(p2).query_pairs(_DUPLICATE_PX))
+    if same_px:
+        i, j = same_px[0]
+        if np.linalg.norm(p3[i] - p3[j]) <= tol3_mm:
+            raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)", (i, j))
+        raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same pixel", (i, j))
+    return tuple(sorted(cKDTree(p3).query_pairs(tol3_mm)))
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:

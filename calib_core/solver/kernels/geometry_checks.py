@@ -11,10 +11,11 @@ OK, NON_FINITE_3D, NON_FINITE_2D, DUPLICATE_3D, DUPLICATE_2D, COLLINEAR = range(
 
 
 @njit(cache=True)
-def check_pairs(P, uv, duplicate_rel_3d, duplicate_px, collinear_ratio, coplanar_ratio, width, height):
-    """Return ``(code, i, j, coplanar, off_image)``: ``code`` one of the constants above,
+def check_pairs(P, uv, collinear_ratio, coplanar_ratio, width, height):
+    """Return ``(code, i, j, coplanar, off_image, spread)``: ``code`` one of the constants above,
     ``i``/``j`` the point indices at fault (-1 when none); ``coplanar`` whether the points lie
-    in one plane; ``off_image`` how many pixels lie outside the ``width`` x ``height`` image.
+    in one plane; ``off_image`` how many pixels lie outside the ``width`` x ``height`` image;
+    ``spread`` the points' largest principal spread (mm). O(n): duplicates are found by the caller.
 
     ``P`` (n, 3) mm, ``uv`` (n, 2) px. Collinearity and coplanarity compare the square roots
     of the eigenvalues of the points' scatter matrix (their spread along the principal axes).
@@ -22,9 +23,9 @@ def check_pairs(P, uv, duplicate_rel_3d, duplicate_px, collinear_ratio, coplanar
     n = P.shape[0]
     for i in range(n):
         if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
-            return NON_FINITE_3D, i, -1, False, 0
+            return NON_FINITE_3D, i, -1, False, 0, 0.0
         if not (np.isfinite(uv[i, 0]) and np.isfinite(uv[i, 1])):
-            return NON_FINITE_2D, i, -1, False, 0
+            return NON_FINITE_2D, i, -1, False, 0, 0.0
     centre = np.zeros(3)
     for i in range(n):
         for k in range(3):
@@ -35,19 +36,10 @@ def check_pairs(P, uv, duplicate_rel_3d, duplicate_px, collinear_ratio, coplanar
             for b in range(3):
                 S[a, b] += (P[i, a] - centre[a]) * (P[i, b] - centre[b])
     spread = np.sqrt(np.maximum(symmetric_eigenvalues(S), 0.0))  # ascending
-    tol3 = duplicate_rel_3d * max(spread[2], 1.0)
-    for i in range(n):
-        for j in range(i + 1, n):
-            d3 = np.sqrt((P[i, 0] - P[j, 0]) ** 2 + (P[i, 1] - P[j, 1]) ** 2 + (P[i, 2] - P[j, 2]) ** 2)
-            if d3 <= tol3:
-                return DUPLICATE_3D, i, j, False, 0
-            d2 = np.sqrt((uv[i, 0] - uv[j, 0]) ** 2 + (uv[i, 1] - uv[j, 1]) ** 2)
-            if d2 <= duplicate_px:
-                return DUPLICATE_2D, i, j, False, 0
     if spread[1] <= collinear_ratio * spread[2]:
-        return COLLINEAR, -1, -1, False, 0
+        return COLLINEAR, -1, -1, False, 0, spread[2]
     off = 0
     for i in range(n):
         if uv[i, 0] < -0.5 or uv[i, 1] < -0.5 or uv[i, 0] > width - 0.5 or uv[i, 1] > height - 0.5:
             off += 1
-    return OK, -1, -1, n < 4 or spread[0] <= coplanar_ratio * spread[2], off
+    return OK, -1, -1, n < 4 or spread[0] <= coplanar_ratio * spread[2], off, spread[2]

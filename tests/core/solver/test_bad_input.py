@@ -54,11 +54,18 @@ def test_non_finite_values_name_the_point():
         solve_pose(p, UV, GRIPPER_CAMERA)
 
 
-def test_duplicates_name_both_points():
-    p = P.copy()
-    p[4] = p[1]
-    with pytest.raises(DuplicatePointsError, match="point 2 and point 5 have the same 3D point"):
-        solve_pose(p, UV, GRIPPER_CAMERA)
+def test_one_3d_point_at_two_pixels_is_allowed_and_a_disagreement_is_named():
+    P2, UV2 = np.vstack([P, P[1]]), np.vstack([UV, UV[1] + [0.3, -0.2]])  # picked twice, within the noise
+    again = solve_pose(P2, UV2, GRIPPER_CAMERA)
+    assert again.status.value == "ok" and not any("same 3D point" in w for w in again.warnings)
+    UV2[-1] = UV[1] + [6.0, 0.0]
+    off = solve_pose(P2, UV2, GRIPPER_CAMERA)
+    assert any(f"point 2 and point {len(P) + 1} are the same 3D point picked 6.0 px apart" in w for w in off.warnings)
+    with pytest.raises(DuplicatePointsError, match="point 2 and point 5 are the same pair"):
+        solve_pose(np.vstack([P[:4], P[1]]), np.vstack([UV[:4], UV[1]]), GRIPPER_CAMERA)
+
+
+def test_two_points_at_one_pixel_name_both():
     uv = UV.copy()
     uv[2] = uv[0]
     with pytest.raises(DuplicatePointsError, match="point 1 and point 3 have the same pixel"):
