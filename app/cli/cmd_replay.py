@@ -1,6 +1,6 @@
 """``videocal replay FILE``: re-solve every calibration in a recording and compare.
 
-Exit 0 when every re-computed result agrees with the recorded one, 5 when any differs,
+Exit 0 when every re-computed result agrees with the recorded one (exactly, or to round-off: a newer solver reaching the same minimum), 5 when any differs,
 2 for a file that cannot be read (one ``error:`` line).
 """
 
@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     results = replay(args.recording)
     if args.json:
         json.dump({"recording": str(args.recording), "complete": contents.complete, "solves": [
-            {"id": r.id, "agree": r.agree, "recorded_status": r.recorded["status"], "recomputed_status": r.recomputed["status"],
+            {"id": r.id, "agree": r.agree, "equivalent": r.equivalent, "recorded_status": r.recorded["status"], "recomputed_status": r.recomputed["status"],
              "translation_diff_mm": r.translation_diff_mm, "rotation_diff": r.rotation_diff, "rms_diff_px": r.rms_diff_px,
              "recorded": {"t_obj2cam_mm": r.recorded["t_obj2cam_mm"], "rms_px": r.recorded["rms_px"]},
              "recomputed": {"t_obj2cam_mm": r.recomputed["t_obj2cam_mm"], "rms_px": r.recomputed["rms_px"]}} for r in results]}, sys.stdout, indent=2)
@@ -37,7 +37,12 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"{args.recording}: {len(results)} solves")
         for r in results:
-            verdict = "agrees" if r.agree else f"DIFFERS (translation {r.translation_diff_mm:.3g} mm, rotation {r.rotation_diff:.3g}, rms {r.rms_diff_px:.3g} px)"
+            if r.agree:
+                verdict = "agrees"
+            elif r.equivalent:
+                verdict = f"agrees to round-off ({r.translation_diff_mm:.1g} mm: not bit for bit, another solver version)"
+            else:
+                verdict = f"DIFFERS (translation {r.translation_diff_mm:.3g} mm, rotation {r.rotation_diff:.3g}, rms {r.rms_diff_px:.3g} px)"
             rms = "n/a" if r.recorded["rms_px"] is None else f"{r.recorded['rms_px']:.3f} px"
             print(f"  solve {r.id}: recorded {r.recorded['status']} rms {rms}, re-computed {r.recomputed['status']}: {verdict}")
-    return 0 if all(r.agree for r in results) else EXIT_DIFFERS
+    return 0 if all(r.equivalent for r in results) else EXIT_DIFFERS

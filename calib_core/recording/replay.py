@@ -1,7 +1,8 @@
 """Re-solving every calibration of a recording and comparing with what was recorded.
 
 With the same version of videocal the results agree exactly (the solver is deterministic and
-JSON round-trips doubles exactly); a newer solver shows here how its answers differ.
+JSON round-trips doubles exactly); a newer solver shows here how its answers differ, and one that
+reaches the same minimum by another path (differences at round-off, below 1e-6 mm) is ``equivalent``.
 """
 
 from __future__ import annotations
@@ -50,8 +51,9 @@ def solve_from_inputs(inputs: dict):
 
 @dataclass(frozen=True)
 class ReplayedSolve:
-    """One recorded solve re-computed: ``agree`` when status and pose match exactly;
-    ``translation_diff_mm`` and ``rms_diff_px`` the largest differences."""
+    """One recorded solve re-computed: ``agree`` when status and pose match exactly; ``equivalent``
+    when they match to round-off (translation within 1e-6 mm, rotation matrix entries within 1e-9,
+    RMS within 1e-6 px); ``translation_diff_mm`` and ``rms_diff_px`` the largest differences."""
 
     id: int
     recorded: dict
@@ -60,6 +62,10 @@ class ReplayedSolve:
     translation_diff_mm: float
     rotation_diff: float
     rms_diff_px: float
+
+    @property
+    def equivalent(self) -> bool:
+        return self.agree or (self.recorded["status"] == self.recomputed["status"] and self.translation_diff_mm <= 1e-6 and self.rotation_diff <= 1e-9 and self.rms_diff_px <= 1e-6)
 
 
 def _diff(a, b) -> float:

@@ -3,12 +3,14 @@ leave-one-out residuals, status and the warnings an operator should read."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from calib_core.solver.candidates import RefinedPose, refine_seed
 from calib_core.solver.errors import point_label, points_label
 from calib_core.solver.paper_model import paper_to_metric_jacobian
-from calib_core.solver.problem import PoseProblem, make_problem
+from calib_core.solver.problem import PoseProblem
 from calib_core.solver.refine import residuals_and_jacobian
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, fit_uncertainty
@@ -60,7 +62,8 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
         inliers = np.flatnonzero(~outliers)
         if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3):
             # Least squares on the inliers alone: the Huber fit still leans slightly on the outliers.
-            sub = make_problem(problem.points_3d[inliers], problem.points_2d[inliers], problem.intrinsics, estimate_focal=problem.estimate_focal, model=problem.model)
+            # (checked already: a subset of checked pairs needs no second check)
+            sub = replace(problem, points_3d=problem.points_3d[inliers], points_2d=problem.points_2d[inliers], off_image=(), repeated_3d=())
             again = refine_seed(sub, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], chosen.fu, chosen.fv, None)
             if again is not None and again.converged:
                 iterations += again.newton.iterations

@@ -117,13 +117,23 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
 def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tuple[int, int], ...]:
     """The pairs naming one 3D point twice (allowed: a feature seen at two pixels); raises
     :class:`DuplicatePointsError` for two pairs at one pixel, or one pair given twice. O(n log n)."""
-    same_px = sorted(cKDTree(p2).query_pairs(_DUPLICATE_PX))
+    same_px = _close_pairs(p2, _DUPLICATE_PX)
     if same_px:
         i, j = same_px[0]
         if np.linalg.norm(p3[i] - p3[j]) <= tol3_mm:
             raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)", (i, j))
         raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same pixel", (i, j))
-    return tuple(sorted(cKDTree(p3).query_pairs(tol3_mm)))
+    return tuple(_close_pairs(p3, tol3_mm))
+
+
+def _close_pairs(points: np.ndarray, tol: float) -> list[tuple[int, int]]:
+    """Index pairs (i < j) of points within ``tol`` of each other, sorted: a k-d tree beyond 64
+    points (O(n log n)), all pairwise distances below (cheaper than building the tree)."""
+    if len(points) > 64:
+        return sorted(cKDTree(points).query_pairs(tol))
+    d = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
+    i, j = np.nonzero(np.triu(d <= tol, 1))
+    return list(zip(i.tolist(), j.tolist()))
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:

@@ -52,7 +52,8 @@ def _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sig
     return problem, prior2
 
 
-def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, prior: ArrayLike | None = None, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None) -> PoseSolution:
+def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, prior: ArrayLike | None = None, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None,
+               confidence: ArrayLike | None = None) -> PoseSolution:
     """Solve the object-to-camera pose from point pairs.
 
     ``points_3d`` (n, 3) mm in the object frame; ``points_2d`` (n, 2) px as observed (lens
@@ -62,7 +63,8 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     or ``"paper"`` (the paper's biased model, to reproduce it); ``sigma_px`` the pick
     noise (estimated from the residuals when omitted and there is redundancy);
     ``robust`` uses Huber's loss and flags outliers; ``max_rms_px`` the largest RMS
-    accepted as a fit (default five times the noise).
+    accepted as a fit (default five times the noise); ``confidence`` (n,) in [0, 1], a detector's
+    confidence in each pair: the robust sampler draws from the most confident first (PROSAC).
 
     Raises a :class:`~calib_core.solver.errors.SolverInputError` subclass for bad input.
     Non-convergence and poor fits are a ``failed`` status with a reason.
@@ -78,7 +80,13 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         solution = fast_solve(problem, sigma_px, limit)
         if solution is not None:
             return solution
-    sampled = robust_seed(problem, fu0, fv0, noise) if robust and problem.n_points > SMALL_PROBLEM_POINTS else None
+    order = None
+    if confidence is not None:
+        c = np.asarray(confidence, dtype=float).reshape(-1)
+        if c.shape != (problem.n_points,) or not np.all(np.isfinite(c)):
+            raise ValueError(f"confidence: one finite number per pair ({problem.n_points}), got {c.shape[0]}")
+        order = np.argsort(-c, kind="stable")
+    sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust and problem.n_points > SMALL_PROBLEM_POINTS else None
     # With a sampled seed the all-points seeds add nothing: outliers spoil them, and on a clean set the
     # sampler's seed is theirs.
     seeds = [] if sampled is not None else initial_seeds(problem, fu0, fv0)
