@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from calib_core.camera.intrinsics import Intrinsics
 from scipy.spatial import cKDTree
 
-from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, NON_FINITE_3D, check_pairs
+from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, NON_FINITE_3D, check_pairs, close_pairs
 from calib_core.solver.errors import (
     DegenerateGeometryError,
     DuplicatePointsError,
@@ -128,12 +128,10 @@ def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tu
 
 def _close_pairs(points: np.ndarray, tol: float) -> list[tuple[int, int]]:
     """Index pairs (i < j) of points within ``tol`` of each other, sorted: a k-d tree beyond 64
-    points (O(n log n)), all pairwise distances below (cheaper than building the tree)."""
+    points (O(n log n)), a compiled comparison of all pairs below (cheaper than building the tree)."""
     if len(points) > 64:
         return sorted(cKDTree(points).query_pairs(tol))
-    d = np.linalg.norm(points[:, None, :] - points[None, :, :], axis=2)
-    i, j = np.nonzero(np.triu(d <= tol, 1))
-    return list(zip(i.tolist(), j.tolist()))
+    return [(int(i), int(j)) for i, j in close_pairs(points, tol)]
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:

@@ -43,3 +43,26 @@ def check_pairs(P, uv, collinear_ratio, coplanar_ratio, width, height):
         if uv[i, 0] < -0.5 or uv[i, 1] < -0.5 or uv[i, 0] > width - 0.5 or uv[i, 1] > height - 0.5:
             off += 1
     return OK, -1, -1, n < 4 or spread[0] <= coplanar_ratio * spread[2], off, spread[2]
+
+
+@njit(cache=True)
+def close_pairs(points, tol):
+    """Index pairs (k, 2), i < j in row-major order, of points (n, d) within ``tol`` of each other:
+    all pairs compared (for the few points of a hand-picked solve; the caller uses a k-d tree for many)."""
+    n, d = points.shape
+    out = np.empty((0, 2), dtype=np.int64)
+    found = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            s = 0.0
+            for k in range(d):
+                s += (points[i, k] - points[j, k]) ** 2
+            if s <= tol * tol:
+                found.append((i, j))
+    if len(found) == 0:
+        return out
+    out = np.empty((len(found), 2), dtype=np.int64)
+    for k in range(len(found)):
+        out[k, 0] = found[k][0]
+        out[k, 1] = found[k][1]
+    return out
