@@ -23,6 +23,7 @@ class SceneItem:
     ``kind``: ``"component"`` (a workcell object that can be a calibration target),
     ``"robot"`` (a robot link, gripper or camera bracket) or ``"fixture"`` (floor, walls).
     ``features``: named feature points, (3,) mm each, in the item's own frame.
+    ``feature_kinds``: the kind of each feature that is not a corner (circle, point), for Find points.
     ``texture``: an optional image (h, w) or (h, w, 3) uint8 printed on the mesh, with
     ``texture_coords`` (n_vertices, 2): per vertex (s, t) in [0, 1], s to the right and t up
     the image (OpenGL's convention). ``opacity`` in (0, 1].
@@ -34,6 +35,7 @@ class SceneItem:
     color: tuple[float, float, float] = (0.7, 0.7, 0.7)
     kind: str = "component"
     features: dict[str, np.ndarray] = field(default_factory=dict)
+    feature_kinds: dict = field(default_factory=dict)
     texture: np.ndarray | None = None
     texture_coords: np.ndarray | None = None
     opacity: float = 1.0

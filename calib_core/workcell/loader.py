@@ -20,6 +20,7 @@ from calib_core.frames import transform_from_xyz_rpy
 from calib_core.robot.errors import RobotSpecError
 from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
+from calib_core.workcell.feature_kinds import CORNER, KINDS, FeatureKind
 from calib_core.workcell.model import TaskLocation, Workcell
 from calib_core.workcell.robot_section import check_against_robot, read_robot_section
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SAFETY_KEYS, SafetyLimits
@@ -118,9 +119,39 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         raise reader.fail(f"{f}.color", f"RGB values must lie in [0, 1], got {list(color)}")
     features_raw = raw.get("features", {}) or {}
     if not isinstance(features_raw, dict):
-        raise reader.fail(f"{f}.features", "must be a mapping of name: [x, y, z] (mm)")
-    features = {str(k): reader.vector(v, 3, f"{f}.features.{k}") for k, v in features_raw.items()}
-    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features)
+        raise reader.fail(f"{f}.features", "must be a mapping of name: [x, y, z] (mm), or name: {at: [x, y, z], kind: ...}")
+    features, kinds = {}, {}
+    for k, v in features_raw.items():
+        features[str(k)], feature_kind = _feature(reader, v, f"{f}.features.{k}")
+        if feature_kind.kind != "corner":
+            kinds[str(k)] = feature_kind
+    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features, feature_kinds=kinds)
+
+
+_FEATURE_KEYS = {"at", "kind", "radius_mm", "normal"}
+
+
+def _feature(reader, value, field: str) -> tuple[np.ndarray, FeatureKind]:
+    """A feature's point (3,) mm and its kind: ``[x, y, z]`` (a corner) or ``{at, kind, radius_mm, normal}``."""
+    if not isinstance(value, dict):
+        return reader.vector(value, 3, field), CORNER
+    entry = reader.mapping(value, field, _FEATURE_KEYS, {"at"})
+    point = reader.vector(entry["at"], 3, f"{field}.at")
+    kind = reader.choice(entry.get("kind", "corner"), f"{field}.kind", set(KINDS))
+    if kind != "circle":
+        for key in ("radius_mm", "normal"):
+            if key in entry:
+                raise reader.fail(f"{field}.{key}", f"applies to a circle only (this feature is a {kind})")
+        return point, FeatureKind(kind)
+    for key in ("radius_mm", "normal"):
+        if key not in entry:
+            raise reader.fail(f"{field}.{key}", "a circle needs radius_mm (mm) and normal ([x, y, z] in the component's frame)")
+    radius = reader.number(entry["radius_mm"], f"{field}.radius_mm")
+    normal = reader.vector(entry["normal"], 3, f"{field}.normal")
+    try:
+        return point, FeatureKind("circle", radius, tuple(normal))
+    except ValueError as exc:
+        raise reader.fail(field, str(exc)) from None
 
 
 def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:

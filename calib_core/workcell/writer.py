@@ -50,8 +50,29 @@ def _component_entry(item, source: tuple[Path, str], folder: Path) -> CommentedM
         ("color", _flow(item.color)), ("placement", _placement(item.item2world)),
     ])
     if item.features:
-        entry["features"] = CommentedMap((k, _flow(v)) for k, v in item.features.items())
+        entry["features"] = CommentedMap((k, _feature_entry(item, k)) for k in item.features)
     return entry
+
+
+def _feature_entry(item, name: str):
+    """``[x, y, z]`` for a corner, ``{at, kind, ...}`` (one line) for another kind."""
+    kind = item.feature_kinds.get(name)
+    if kind is None or kind.kind == "corner":
+        return _flow(item.features[name])
+    entry = CommentedMap(kind.to_yaml(np.round(item.features[name], _DECIMALS)))
+    entry["at"] = _flow(entry["at"])
+    if "normal" in entry:
+        entry["normal"] = _flow(np.round(entry["normal"], _DECIMALS))
+    entry.fa.set_flow_style()
+    return entry
+
+
+def _stored_point(value) -> np.ndarray | None:
+    value = value.get("at") if isinstance(value, dict) else value
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return None
 
 
 def _update_component(entry: CommentedMap, item) -> None:
@@ -61,8 +82,11 @@ def _update_component(entry: CommentedMap, item) -> None:
     if features is None and item.features:
         features = entry["features"] = CommentedMap()
     for name, point in item.features.items():
-        if name not in features or not np.allclose(np.asarray(features[name], dtype=float), point, atol=1e-6):
-            features[name] = _flow(point)
+        stored = _stored_point(features[name]) if name in features else None
+        stored_kind = features[name].get("kind", "corner") if name in features and isinstance(features[name], dict) else "corner"
+        kind = item.feature_kinds.get(name)
+        if stored is None or stored.shape != (3,) or not np.allclose(stored, point, atol=1e-6) or stored_kind != (kind.kind if kind else "corner"):
+            features[name] = _feature_entry(item, name)
     for name in [k for k in (features or {}) if k not in item.features]:
         del features[name]
 

@@ -104,3 +104,53 @@ def test_a_dae_component_from_a_vendor_package_loads_in_metres(cell_copy):
     mesh = cell.components[1].mesh
     assert len(mesh.faces) > 1000
     assert 100 < mesh.extents[0] < 160  # the UR5's base, about 120 mm across, in mm
+
+
+def test_feature_kinds_are_read_written_back_and_checked(tmp_path):
+    import shutil
+
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+    from calib_core.workcell.writer import save_workcell
+
+    cell = load_workcell(DEFAULT_WORKCELL)
+    fixture = next(c for c in cell.components if c.name == "oru_1_fixture")
+    boss = fixture.feature_kinds["boss_top_left"]
+    assert boss.kind == "circle" and boss.radius_mm == 10.0 and boss.normal == (1.0, 0.0, 0.0)
+    assert "plate_top_left" not in fixture.feature_kinds  # the plain form is a corner
+    root = DEFAULT_WORKCELL.parents[1]
+    for sub in ("workcell", "robot", "camera"):
+        shutil.copytree(root / sub, tmp_path / sub)
+    path = tmp_path / "workcell" / "workcell.yaml"
+    again = load_workcell(path)
+    again_fixture = next(c for c in again.components if c.name == "oru_1_fixture")
+    from calib_core.workcell.feature_kinds import FeatureKind
+
+    again_fixture.feature_kinds["plate_top_left"] = FeatureKind("point")
+    save_workcell(again, path)
+    text = path.read_text()
+    assert "plate_top_left: {at: [0.0, -80.0, 60.0], kind: point}" in text and "# the knob's end face" in text
+    reread = next(c for c in load_workcell(path).components if c.name == "oru_1_fixture")
+    assert reread.feature_kinds["plate_top_left"].kind == "point" and reread.feature_kinds["boss_top_left"] == boss
+
+
+@pytest.mark.parametrize("entry, message", [
+    ("{at: [0, 0, 0], kind: circle}", "a circle needs radius_mm"),
+    ("{at: [0, 0, 0], kind: circle, radius_mm: -1, normal: [1, 0, 0]}", "radius_mm in"),
+    ("{at: [0, 0, 0], kind: circle, radius_mm: 5, normal: [0, 0, 0]}", "not all zero"),
+    ("{at: [0, 0, 0], kind: edge}", "kind"),
+    ("{at: [0, 0, 0], kind: corner, radius_mm: 3}", "applies to a circle only"),
+    ("{kind: point}", "missing key(s) at"),
+])
+def test_a_bad_feature_kind_names_its_field(tmp_path, entry, message):
+    from calib_core.errors import FileFormatError
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    text = DEFAULT_WORKCELL.read_text().replace("pin_tip: {at: [45, 0, 0], kind: circle, radius_mm: 20, normal: [1, 0, 0]}", f"pin_tip: {entry}", 1)
+    path = DEFAULT_WORKCELL.parent / f".test-{tmp_path.name}.yaml"
+    path.write_text(text)
+    try:
+        with pytest.raises(FileFormatError, match="pin_tip") as info:
+            load_workcell(path)
+        assert message in str(info.value)
+    finally:
+        path.unlink()
