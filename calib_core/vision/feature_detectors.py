@@ -1,0 +1,269 @@
+"""Sub-pixel detectors for one feature each, searching a small window around where it should be.
+
+Each returns a :class:`Detection` (pixel, confidence in [0, 1]) or a :class:`NotDetected` with the
+reason an operator can act on. Pixels are (u, v) with (0, 0) the centre of the top-left pixel.
+
+- corners: Harris corners in the window (``cv2.goodFeaturesToTrack``), the one nearest the prediction,
+  refined by ``cv2.cornerSubPix``; when the refinement walks more than 1.5 px (three faces meeting),
+  the Harris position is kept with a lower confidence;
+- circles: the strongest gradient along the normals of the predicted ellipse (the projected circle,
+  shifted), an ellipse fitted to those edge points, and its centre moved by the perspective offset
+  (the image of the circle's centre minus the centre of the imaged ellipse, from the model);
+- points: the centroid of the blob at the prediction, darker or brighter than its surroundings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Detection:
+    uv_px: np.ndarray
+    confidence: float
+
+
+@dataclass(frozen=True)
+class NotDetected:
+    reason: str
+
+
+def _window(grey: np.ndarray, uv: np.ndarray, radius: int) -> tuple[np.ndarray, int, int] | None:
+    h, w = grey.shape
+    x0, y0 = int(round(uv[0])) - radius, int(round(uv[1])) - radius
+    x1, y1 = x0 + 2 * radius + 1, y0 + 2 * radius + 1
+    x0c, y0c, x1c, y1c = max(x0, 0), max(y0, 0), min(x1, w), min(y1, h)
+    if x1c - x0c < 7 or y1c - y0c < 7:
+        return None
+    return grey[y0c:y1c, x0c:x1c], x0c, y0c
+
+
+def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> Detection | NotDetected:
+    """The corner nearest ``uv_pred`` within ``radius_px``."""
+    win = _window(grey, uv_pred, int(np.ceil(radius_px)))
+    if win is None:
+        return NotDetected("at the edge of the image")
+    roi, x0, y0 = win
+    corners = cv2.goodFeaturesToTrack(roi, maxCorners=12, qualityLevel=0.05, minDistance=3, blockSize=5, useHarrisDetector=True, k=0.04)
+    if corners is None:
+        return NotDetected(f"no corner within {radius_px:.0f} px of where the model puts it")
+    cand = corners.reshape(-1, 2) + (x0, y0)
+    dist = np.linalg.norm(cand - uv_pred, axis=1)
+    k = int(np.argmin(dist))
+    if dist[k] > radius_px:
+        return NotDetected(f"no corner within {radius_px:.0f} px of where the model puts it")
+    start = cand[k].astype(np.float32).reshape(1, 1, 2).copy()
+    refined = cv2.cornerSubPix(grey, start, (4, 4), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.01)).reshape(2).astype(float)
+    confidence = 1.0
+    # a second corner close by makes the choice uncertain
+    others = np.sort(dist)[1:2]
+    if len(others) and others[0] < 2.5:
+        confidence *= 0.5
+    if np.linalg.norm(refined - cand[k]) > 1.5:
+        return Detection(cand[k].astype(float), 0.3 * confidence)  # the refinement walked off: three faces meet here
+    return Detection(refined, confidence)
+
+
+def gradient_magnitude(grey: np.ndarray) -> np.ndarray:
+    """The image's gradient magnitude (float32), lightly smoothed: what edge searches climb."""
+    g = cv2.GaussianBlur(grey, (3, 3), 0.8).astype(np.float32)
+    return np.hypot(cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3))
+
+
+def search_normals(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarray, search_px: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For each point (m, 2) the strongest gradient along its unit normal (m, 2) within +-``search_px``:
+    the edge points (m, 2) at sub-pixel precision (a parabola through the peak), their strengths (m,)
+    and which searches stayed inside the image (m,) bool. One ``cv2.remap``
+    for all searches (the moving-edges step of RAPID and ViSP's tracker)."""
+    h, w = magnitude.shape
+    steps = np.arange(-search_px, search_px + 0.25, 0.5)
+    lines = points[:, None, :] + steps[None, :, None] * normals[:, None, :]  # (m, s, 2)
+    inside = ((lines[..., 0] >= 1) & (lines[..., 0] < w - 2) & (lines[..., 1] >= 1) & (lines[..., 1] < h - 2)).all(axis=1)
+    profile = cv2.remap(magnitude, lines[..., 0].astype(np.float32), lines[..., 1].astype(np.float32), cv2.INTER_LINEAR)
+    k = np.argmax(profile, axis=1)
+    rows = np.arange(len(points))
+    kk = np.clip(k, 1, len(steps) - 2)
+    a, b, c = profile[rows, kk - 1], profile[rows, kk], profile[rows, kk + 1]
+    denom = a - 2 * b + c
+    sub = np.where((denom < 0) & (k == kk), 0.5 * (a - c) / np.where(denom < 0, denom, -1.0), 0.0)
+    offset = steps[0] + 0.5 * (k + sub)
+    return points + offset[:, None] * normals, profile[rows, k], inside
+
+
+def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.ndarray, search_px: float = 4.0, magnitude: np.ndarray | None = None,
+                  rim_has_contrast: np.ndarray | None = None) -> Detection | NotDetected:
+    """The image of a circle's centre. ``rim_px`` (m, 2): the predicted rim (the projected circle,
+    already shifted to where the target is); ``centre_offset_px`` (2,): the image of the centre minus the
+    centre of the ellipse through the predicted rim (the perspective correction); ``rim_has_contrast``
+    (m,) bool: where the model expects an edge on the rim (default: everywhere).
+
+    With edge points on most of the rim an ellipse is fitted and its centre corrected for perspective;
+    with a partial rim (a faint boss lit from one side) the predicted ellipse's shape is kept and only
+    its position fitted to the edge points along their normals, which a short arc still determines."""
+    mag = gradient_magnitude(grey) if magnitude is None else magnitude
+    centre = rim_px.mean(axis=0)
+    normals = rim_px - centre
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-9)
+    points, strengths, inside = search_normals(mag, rim_px, normals, search_px)
+    usable = inside if rim_has_contrast is None else inside & rim_has_contrast
+    if usable.sum() < 6:
+        return NotDetected("its rim is outside the image or has no contrast in the model's view")
+    floor = max(8.0, 0.35 * float(np.median(strengths[usable])))
+    strong = usable & (strengths >= floor)
+    if strong.sum() < 6:
+        return NotDetected(f"its rim has too little contrast ({int(strong.sum())} of {len(rim_px)} edge points)")
+    coverage = strong.sum() / len(rim_px)
+    if coverage >= 0.7:
+        pts = points[strong].astype(np.float32)
+        for _ in range(2):  # drop edge points off the ellipse (a shadow, a neighbouring edge) and refit
+            ellipse = cv2.fitEllipse(pts)
+            residual = _ellipse_residual(pts, ellipse)
+            keep = residual < max(0.7, 2.5 * float(np.median(residual)))
+            if keep.sum() < 8 or keep.all():
+                break
+            pts = pts[keep]
+        ellipse = cv2.fitEllipse(pts)
+        rms = float(np.sqrt(np.mean(_ellipse_residual(pts, ellipse) ** 2)))
+        return Detection(np.array(ellipse[0]) + centre_offset_px, float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)))
+    # a partial rim: the predicted ellipse moved as a whole onto the edge points (two unknowns)
+    n, r = normals[strong], np.einsum("ij,ij->i", points[strong] - rim_px[strong], normals[strong])
+    for _ in range(3):
+        A = n.T @ n
+        if np.linalg.eigvalsh(A)[0] < 0.05 * len(n):
+            return NotDetected("too short an arc of its rim shows")
+        delta = np.linalg.solve(A, n.T @ r)
+        residual = r - n @ delta
+        keep = np.abs(residual) < max(0.5, 3.0 * 1.4826 * float(np.median(np.abs(residual))))
+        if keep.all() or keep.sum() < 6:
+            break
+        n, r = n[keep], r[keep]
+    rms = float(np.sqrt(np.mean(residual**2)))
+    predicted_centre = np.array(cv2.fitEllipse(rim_px.astype(np.float32))[0]) + centre_offset_px
+    return Detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)))
+
+
+def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: list[np.ndarray], search_px: float = 3.0, magnitude: np.ndarray | None = None) -> Detection | NotDetected:
+    """A corner as the meeting point of the image lines along the model's edges that end there.
+
+    ``corner_px`` (2,): the predicted corner; ``arms_px``: for each edge ending at it, the predicted
+    pixel of its other end. Edge points are searched along each arm's normal from 4 px out (clear of
+    the junction, where three faces make ``cornerSubPix`` walk), a line fitted to each arm, and the
+    point nearest every line taken. Needs two arms that are not parallel."""
+    mag = gradient_magnitude(grey) if magnitude is None else magnitude
+    lines = []
+    for end in arms_px:
+        d = end - corner_px
+        length = float(np.linalg.norm(d))
+        if length < 8.0:
+            continue
+        d /= length
+        s = np.arange(4.0, min(0.8 * length, 40.0), 1.0)
+        if len(s) < 4:
+            continue
+        normal = np.array([-d[1], d[0]])
+        pts, strength, inside = search_normals(mag, corner_px + s[:, None] * d, np.repeat(normal[None], len(s), axis=0), search_px)
+        good = inside & (strength >= max(10.0, 0.4 * float(np.median(strength[inside])) if inside.any() else 10.0))
+        if good.sum() < 4:
+            continue
+        pts = pts[good]
+        for _ in range(2):
+            centre = pts.mean(axis=0)
+            _, _, vt = np.linalg.svd(pts - centre)
+            n = vt[1]
+            residual = np.abs((pts - centre) @ n)
+            keep = residual < max(0.5, 3.0 * float(np.median(residual)))
+            if keep.all() or keep.sum() < 4:
+                break
+            pts = pts[keep]
+        lines.append((centre, n, float(np.sqrt(np.mean(residual**2))), len(pts)))
+    if len(lines) < 2:
+        return NotDetected("fewer than two of its edges are visible in the image")
+    A = np.array([n for _, n, _, _ in lines])
+    b = np.array([n @ c for c, n, _, _ in lines])
+    if np.linalg.svd(A, compute_uv=False)[-1] < 0.25:  # the arms are nearly parallel
+        return NotDetected("its edges are nearly parallel in the image")
+    uv = np.linalg.lstsq(A, b, rcond=None)[0]
+    if np.linalg.norm(uv - corner_px) > search_px + 2.0:
+        return NotDetected("its edges meet away from where they should")
+    rms = max(r for _, _, r, _ in lines)
+    return Detection(uv, float(np.exp(-rms / 0.5)))
+
+
+def _ellipse_residual(points: np.ndarray, ellipse) -> np.ndarray:
+    """Approximate distance (px) of each point from the ellipse (radial, in the ellipse's frame)."""
+    (cx, cy), (a, b), angle = ellipse
+    t = np.radians(angle)
+    d = points - (cx, cy)
+    x = d[:, 0] * np.cos(t) + d[:, 1] * np.sin(t)
+    y = -d[:, 0] * np.sin(t) + d[:, 1] * np.cos(t)
+    r = np.hypot(x / (a / 2), y / (b / 2))
+    return np.abs(r - 1.0) * np.hypot(x, y) / np.maximum(r, 1e-9)
+
+
+def detect_blob(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> Detection | NotDetected:
+    """The centroid of the blob at ``uv_pred`` (Otsu's threshold in the window, the component nearest)."""
+    win = _window(grey, uv_pred, int(np.ceil(radius_px)))
+    if win is None:
+        return NotDetected("at the edge of the image")
+    roi, x0, y0 = win
+    _, mask = cv2.threshold(roi, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
+    centre = np.array(roi.shape[::-1]) / 2
+    inside = mask[int(min(max(uv_pred[1] - y0, 0), roi.shape[0] - 1)), int(min(max(uv_pred[0] - x0, 0), roi.shape[1] - 1))]
+    blob = (mask == inside).astype(np.uint8)
+    n, labels, stats, centroids = cv2.connectedComponentsWithStats(blob)
+    if n < 2:
+        return NotDetected("no blob there")
+    k = 1 + int(np.argmin(np.linalg.norm(centroids[1:] - centre, axis=1)))
+    x, y, bw, bh, area = stats[k]
+    if x == 0 or y == 0 or x + bw >= roi.shape[1] or y + bh >= roi.shape[0]:
+        return NotDetected(f"no blob smaller than {2 * radius_px:.0f} px there")
+    contrast = abs(float(roi[labels == k].mean()) - float(roi[labels != k].mean())) / 255.0
+    return Detection(centroids[k] + (x0, y0), float(np.clip(4 * contrast, 0, 1)))
+
+
+def register_patch(grey: np.ndarray, expected: np.ndarray, uv_expected: np.ndarray, uv_search: np.ndarray, search_px: float, half_px: int = 20) -> Detection | NotDetected:
+    """Where the neighbourhood of ``uv_expected`` in the ``expected`` image (the CAD rendered at the
+    estimated pose, as the camera would see it) lies in ``grey``, searched within ``search_px`` of
+    ``uv_search``: normalised cross-correlation, its peak refined by a parabola on each axis. Returns
+    the pixel in ``grey`` that corresponds to ``uv_expected``; the confidence is the correlation.
+    Near the image's border the patch is cut to what both images hold (at least 6 px each side).
+
+    The patch carries what no local detector knows: which edges of a corner are silhouettes, how a
+    low-contrast boss is shaded, where three faces meet."""
+    h, w = grey.shape
+    r = int(np.ceil(search_px))
+    ue, ve = int(round(uv_expected[0])), int(round(uv_expected[1]))
+    us, vs = int(round(uv_search[0])), int(round(uv_search[1]))
+    frac = np.asarray(uv_expected, dtype=float) - (ue, ve)
+    left = min(half_px, ue, us - r)
+    right = min(half_px, w - 1 - ue, w - 1 - us - r)
+    top = min(half_px, ve, vs - r)
+    bottom = min(half_px, h - 1 - ve, h - 1 - vs - r)
+    if min(left, right, top, bottom) < 6:
+        return NotDetected("too close to the edge of the image")
+    template = expected[ve - top:ve + bottom + 1, ue - left:ue + right + 1]
+    if float(template.std()) < 1.0:
+        return NotDetected("nothing to recognise around it (a flat patch)")
+    x0, y0 = us - left - r, vs - top - r
+    region = grey[y0:vs + bottom + r + 1, x0:us + right + r + 1]
+    score = cv2.matchTemplate(region, template, cv2.TM_CCOEFF_NORMED)
+    k = np.unravel_index(int(np.argmax(score)), score.shape)
+    best = float(score[k])
+    sub = np.zeros(2)
+    for axis in (0, 1):
+        i = k[axis]
+        if 0 < i < score.shape[axis] - 1:
+            lo = score[(i - 1, k[1])] if axis == 0 else score[(k[0], i - 1)]
+            hi = score[(i + 1, k[1])] if axis == 0 else score[(k[0], i + 1)]
+            denom = lo - 2 * best + hi
+            if denom < 0:
+                sub[axis] = 0.5 * (lo - hi) / denom
+    # the template's pixel (ue, ve) landed at (x0 + k1 + left, y0 + k0 + top)
+    u = x0 + k[1] + sub[1] + left + frac[0]
+    v = y0 + k[0] + sub[0] + top + frac[1]
+    if best < 0.5:
+        return NotDetected(f"its neighbourhood does not look like the model's (correlation {best:.2f})")
+    return Detection(np.array([u, v]), float(np.clip(best, 0.0, 1.0)))

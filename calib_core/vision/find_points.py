@@ -1,0 +1,292 @@
+"""Find points: the target's features located in a camera frame, to propose as pairs.
+
+1. Predict every feature's pixel from the modelled camera pose; keep those in the image and not hidden
+   by the target itself (a ray from the camera reaches the feature first).
+2. Find where the target really is: its crease edges slid over the image's edges
+   (:mod:`calib_core.vision.edge_alignment`). The robot's error is mostly this shift.
+3. Detect each feature by its kind (:mod:`calib_core.vision.feature_detectors`) a few pixels around
+   its shifted prediction.
+4. A robust pose fit (sampled by confidence, PROSAC) rejects wrong detections; the features are
+   predicted again from the fitted pose and detected once more in a tight window; a last robust fit
+   decides. What survives is proposed with its confidence; what does not is listed with the reason.
+
+The result never moves anything: the operator accepts, rejects or drags the proposals.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+import trimesh
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project_points
+from calib_core.scene import SceneItem
+from calib_core.solver import solve_pose
+from calib_core.solver.errors import SolverInputError
+from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px
+from calib_core.vision.edge_refinement import _model_shows_edge, refine_to_edges
+from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude, register_patch
+from calib_core.workcell.feature_kinds import CORNER, FeatureKind
+
+SEARCH_RADIUS_PX = 90.0
+"""How far (px) the target may lie from where the model puts it: the typical robot error, twice."""
+_FIRST_WINDOW_PX = 6.0
+_EDGE_AGREEMENT_PX = 1.0
+_SECOND_WINDOW_PX = 2.0
+_SIGMA_PX = 0.5
+_MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """A feature found: ``uv_px`` (2,) px, ``point_mm`` (3,) in the component's frame, ``confidence``
+    in [0, 1] (the detector's, times 1 when the final pose fit keeps it), ``residual_px`` its distance
+    from the final pose's projection."""
+
+    feature: str
+    kind: str
+    uv_px: np.ndarray
+    point_mm: np.ndarray
+    confidence: float
+    residual_px: float
+
+
+@dataclass(frozen=True)
+class Missed:
+    feature: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class FoundPoints:
+    """``found``: the target was located and at least four features proposed; ``message`` says what
+    happened in a sentence; ``offset_px`` (2,) the shift between model and image; ``obj2cam`` (4, 4)
+    the robust fit's pose (``None`` when not found); ``seconds`` the time taken."""
+
+    component: str
+    found: bool
+    message: str
+    proposals: tuple[Proposal, ...] = ()
+    missed: tuple[Missed, ...] = ()
+    offset_px: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    obj2cam: np.ndarray | None = None
+    seconds: float = 0.0
+
+
+def _grey(image: np.ndarray) -> np.ndarray:
+    return image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
+
+
+def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> np.ndarray:
+    """Which feature points (n, 3) a camera at ``obj2cam`` sees, not hidden by the mesh itself: no
+    triangle crosses the segment from the camera to the point short of it (Moller-Trumbore over every
+    triangle, vectorised: features are few and target meshes small)."""
+    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+    tri = mesh.triangles  # (f, 3, 3)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    out = np.ones(len(points), dtype=bool)
+    for k, p in enumerate(points):
+        d = p - centre
+        length = float(np.linalg.norm(d))
+        d /= length
+        h = np.cross(d, e2)
+        a = np.einsum("ij,ij->i", e1, h)
+        ok = np.abs(a) > 1e-12
+        f = np.where(ok, 1.0 / np.where(ok, a, 1.0), 0.0)
+        s = centre - tri[:, 0]
+        u = f * np.einsum("ij,ij->i", s, h)
+        q = np.cross(s, e1)
+        v = f * (q @ d)
+        t = f * np.einsum("ij,ij->i", e2, q)
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < length - 1.0)
+        out[k] = not hit.any()
+    return out
+
+
+def _circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+    """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
+    n = np.asarray(kind.normal)
+    a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    angles = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    rim_3d = point + kind.radius_mm * (np.cos(angles)[:, None] * a + np.sin(angles)[:, None] * b)
+    rim = project_points(rim_3d, obj2cam, intrinsics)
+    (cx, cy), _, _ = cv2.fitEllipse(rim.astype(np.float32))
+    centre = project_points(point[None], obj2cam, intrinsics)[0]
+    return rim, centre - (cx, cy)
+
+
+class _Detectors:
+    """The detectors of one image and one target: the gradient computed once, the edges that end at
+    each corner found once."""
+
+    def __init__(self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None):
+        self.grey = grey
+        self.expected = expected
+        self._rendered: tuple[np.ndarray, np.ndarray] | None = None  # (obj2cam, grey image)
+        self.use_templates = False
+        self.magnitude = gradient_magnitude(grey)
+        self.intrinsics = intrinsics
+        self.segments, self.normals = crease_segments(item.mesh)
+
+    def arms(self, point: np.ndarray, obj2cam: np.ndarray) -> list[np.ndarray]:
+        """The far ends (3,) of the visible crease edges that end at ``point``."""
+        if len(self.segments) == 0:
+            return []
+        centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+        ends = []
+        for k in range(2):
+            near = np.linalg.norm(self.segments[:, k] - point, axis=1) < 0.5
+            for e in np.flatnonzero(near):
+                if (self.normals[e] @ (centre - point) > 0).any():
+                    ends.append(self.segments[e, 1 - k])
+        return ends
+
+    def expected_image(self, obj2cam: np.ndarray) -> np.ndarray:
+        if self._rendered is None or not np.array_equal(self._rendered[0], obj2cam):
+            self._rendered = (obj2cam.copy(), _grey(self.expected(obj2cam)))
+        return self._rendered[1]
+
+    def _arm_shows_edge(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> bool:
+        d = far - corner
+        length = float(np.linalg.norm(d))
+        if length < 8.0:
+            return False
+        s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
+        return bool(len(s) >= 2 and _model_shows_edge(_grey(self.expected_image(obj2cam)), corner + s[:, None] * d / length).mean() >= 0.6)
+
+    def detect(self, kind: FeatureKind, point, obj2cam, shift, radius) -> Detection | NotDetected:
+        uv = project_points(point[None], obj2cam, self.intrinsics)[0] + shift
+        if self.expected is not None and self.use_templates:
+            half = 20
+            if kind.kind == "circle":  # the whole rim and a margin: a boss's shading is faint
+                rim, _ = _circle_rim(point, kind, obj2cam, self.intrinsics)
+                half = int(np.clip(np.ptp(rim, axis=0).max() / 2 + 8, 20, 60))
+            return register_patch(self.grey, self.expected_image(obj2cam), uv - shift, uv, radius, half_px=half)
+        if kind.kind == "corner":
+            ends = self.arms(point, obj2cam)
+            if ends:
+                far = project_points(np.array(ends), obj2cam, self.intrinsics)
+                if self.expected is not None and not shift.any():  # only the arms along which the model shows an edge
+                    far = far[[self._arm_shows_edge(uv, f, obj2cam) for f in far]]
+                found = detect_corner_from_edges(self.grey, uv, list(far + shift), search_px=radius, magnitude=self.magnitude)
+                if isinstance(found, Detection) or self.expected is not None:
+                    return found
+            return detect_corner(self.grey, uv, radius)
+        if kind.kind == "circle":
+            rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
+            shows = _model_shows_edge(_grey(self.expected_image(obj2cam)), rim) if self.expected is not None and not shift.any() else None
+            return detect_circle(self.grey, rim + shift, offset, search_px=radius, magnitude=self.magnitude, rim_has_contrast=shows)
+        return detect_blob(self.grey, uv, max(radius, 6.0))
+
+
+def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2cam_model: np.ndarray, *, kinds: dict[str, FeatureKind] | None = None,
+                search_radius_px: float = SEARCH_RADIUS_PX, expected=None) -> FoundPoints:
+    """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
+    ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
+    the item's own, corner when absent). ``expected(obj2cam) -> image``: the cell rendered as this
+    camera would see it with the item at ``obj2cam`` (lens distortion included); with it each feature is
+    found by registering its rendered neighbourhood, which knows silhouettes and shading, and the kinds'
+    detectors are the fallback without a renderer."""
+    t0 = time.perf_counter()
+    kinds = item.feature_kinds if kinds is None else kinds
+    names = list(item.features)
+    if not names:
+        return FoundPoints(item.name, False, f"component {item.name!r} has no features to find")
+    grey = _grey(image)
+    points = np.array([item.features[n] for n in names], dtype=float)
+    uv_model = project_points(points, obj2cam_model, intrinsics)
+    z = points @ obj2cam_model[2, :3] + obj2cam_model[2, 3]
+    visible = (z > 0) & intrinsics.contains(uv_model, margin_px=-search_radius_px) & _visible(item.mesh, points, obj2cam_model)
+    missed = {n: "hidden or outside the image at the modelled pose" for n, v in zip(names, visible) if not v}
+
+    distance = edge_distance_map(grey)
+    alignment = align_edges(edge_samples_px(item.mesh, obj2cam_model, intrinsics), distance, search_radius_px)
+    if alignment.matched_share < _MATCHED_SHARE:
+        return FoundPoints(item.name, False, f"{item.name} was not found near where the model puts it (only {100 * alignment.matched_share:.0f} % of its edges "
+                           f"meet an edge of the image): pick the points by hand", missed=tuple(Missed(n, "the target was not found") for n in names),
+                           offset_px=alignment.offset_px, seconds=time.perf_counter() - t0)
+    shift = alignment.offset_px
+
+    detectors = _Detectors(grey, item, intrinsics, expected)
+
+    def detect_all(indices, pose, shift_px, radius):
+        return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, shift_px, radius) for i in indices}
+
+    candidates = [i for i in range(len(names)) if visible[i]]
+    # the shift as a turn of the camera about its centre, then the edges pull the pose into place
+    shifted = _turned(obj2cam_model, shift, intrinsics)
+    edge_fit = refine_to_edges(grey, intrinsics, item.mesh, shifted, expected=detectors.expected_image(shifted) if expected is not None else None)
+    start = edge_fit.obj2cam if edge_fit.converged else shifted
+    # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
+    # times the edges' scatter keeps a detector off the neighbouring edge (a boss's base beside its rim)
+    first = detect_all(candidates, start, np.zeros(2), _FIRST_WINDOW_PX if not edge_fit.converged else float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0)))
+    if edge_fit.converged:
+        # The edges (hundreds of samples) know the pose better than any one detection: a detection far
+        # from where they put its feature found something else (a silhouette in front of a corner).
+        uv_edges = project_points(points, edge_fit.obj2cam, intrinsics)
+        for i, d in list(first.items()):
+            if isinstance(d, Detection) and np.linalg.norm(d.uv_px - uv_edges[i]) > _EDGE_AGREEMENT_PX:
+                first[i] = NotDetected(f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges put it "
+                                       "(another edge in front of it?)")
+    pose, fit = _robust_fit(first, points, intrinsics, start)
+    if pose is None:
+        for i, d in first.items():
+            missed.setdefault(names[i], d.reason if isinstance(d, NotDetected) else "no pose fits the detections")
+        return FoundPoints(item.name, False, f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: pick the points by hand",
+                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0)
+    final_pose, second = pose, first
+    for _ in range(0 if edge_fit.converged else 2):  # predicted from the fitted pose, the windows shrink to the pose's error
+        again = detect_all(candidates, final_pose, np.zeros(2), _SECOND_WINDOW_PX)
+        better, refit = _robust_fit(again, points, intrinsics, final_pose)
+        if better is None:
+            break
+        final_pose, fit, second = better, refit, again
+    proposals = []
+    uv_final = project_points(points, final_pose, intrinsics)
+    for i, d in second.items():
+        if isinstance(d, NotDetected):
+            missed[names[i]] = d.reason
+            continue
+        residual = float(np.linalg.norm(d.uv_px - uv_final[i]))
+        if not fit.get(i, False):
+            missed[names[i]] = f"rejected by the pose fit: {residual:.1f} px from where the other features put it"
+            continue
+        proposals.append(Proposal(names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual))
+    found = len(proposals) >= 4
+    message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
+               if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
+    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0)
+
+
+def _turned(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """``obj2cam`` with the camera turned about its centre so the image moves by ``shift_px`` (2,)."""
+    from scipy.spatial.transform import Rotation
+
+    turn = Rotation.from_rotvec([-shift_px[1] / intrinsics.fv, shift_px[0] / intrinsics.fu, 0.0]).as_matrix()
+    out = obj2cam.copy()
+    out[:3, :3] = turn @ obj2cam[:3, :3]
+    out[:3, 3] = turn @ obj2cam[:3, 3]
+    return out
+
+
+def _robust_fit(detections: dict, points: np.ndarray, intrinsics: Intrinsics, prior: np.ndarray) -> tuple[np.ndarray | None, dict[int, bool]]:
+    """The pose of the detections (robust, sampled best-confidence first) and which it keeps."""
+    found = [(i, d) for i, d in detections.items() if isinstance(d, Detection)]
+    if len(found) < 4:
+        return None, {}
+    idx = [i for i, _ in found]
+    uv = np.array([d.uv_px for _, d in found])
+    confidence = np.array([d.confidence for _, d in found])
+    try:
+        solution = solve_pose(points[idx], uv, intrinsics, prior=prior, robust=True, sigma_px=_SIGMA_PX, confidence=confidence)
+    except SolverInputError:
+        return None, {}
+    if solution.status.value == "failed":
+        return None, {}
+    return solution.obj2cam, {i: not bool(out) for i, out in zip(idx, solution.outliers)}
