@@ -78,7 +78,7 @@ def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
 
 
 def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected: np.ndarray | None = None, search_px: float = 8.0,
-                    iterations: int = 12) -> EdgeFit:
+                    iterations: int = 30) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast."""
     magnitude = gradient_magnitude(grey)
@@ -125,7 +125,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
         edges, offsets = found[ok], r[ok]
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
-        window = max(2.0, min(window, 3.0 * sigma + 1.0))
+        window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks
         if moved_px < 0.01 and it > 0:
             converged = True
             break

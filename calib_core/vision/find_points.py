@@ -28,7 +28,7 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px
-from calib_core.vision.edge_refinement import _model_shows_edge, refine_to_edges
+from calib_core.vision.edge_refinement import EdgeFit, _model_shows_edge, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude, register_patch
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
@@ -36,6 +36,7 @@ SEARCH_RADIUS_PX = 90.0
 """How far (px) the target may lie from where the model puts it: the typical robot error, twice."""
 _FIRST_WINDOW_PX = 6.0
 _EDGE_AGREEMENT_PX = 1.0
+_EDGES_SETTLED_PX = 0.5  # the edge samples' RMS offset once the pose is right (0.2-0.3 px on a sharp camera)
 _SECOND_WINDOW_PX = 2.0
 _SIGMA_PX = 0.5
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
@@ -75,6 +76,8 @@ class FoundPoints:
     offset_px: np.ndarray = field(default_factory=lambda: np.zeros(2))
     obj2cam: np.ndarray | None = None
     seconds: float = 0.0
+    edges: EdgeFit | None = None
+    """The edge refinement's result (the pose the detections were checked against), when it ran."""
 
 
 def _grey(image: np.ndarray) -> np.ndarray:
@@ -222,7 +225,19 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     # the shift as a turn of the camera about its centre, then the edges pull the pose into place
     shifted = _turned(obj2cam_model, shift, intrinsics)
     edge_fit = refine_to_edges(grey, intrinsics, item.mesh, shifted, expected=detectors.expected_image(shifted) if expected is not None else None)
-    start = edge_fit.obj2cam if edge_fit.converged else shifted
+    for _ in range(2):
+        if edge_fit.converged and edge_fit.rms_px <= _EDGES_SETTLED_PX:
+            break
+        # not settled: start again from where it got to, the model's view rendered there, a wide window again
+        again_from = edge_fit.obj2cam
+        edge_fit = refine_to_edges(grey, intrinsics, item.mesh, again_from, expected=detectors.expected_image(again_from) if expected is not None else None)
+    if not edge_fit.converged or edge_fit.rms_px > _EDGES_SETTLED_PX:
+        # The edges did not settle: detections in wide windows would lock onto neighbouring edges, and a
+        # wrong proposal costs the operator more than a pick by hand.
+        return FoundPoints(item.name, False, f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px over {edge_fit.samples} edge samples): "
+                           "pick the points by hand", missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
+                           seconds=time.perf_counter() - t0, edges=edge_fit)
+    start = edge_fit.obj2cam
     # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
     # times the edges' scatter keeps a detector off the neighbouring edge (a boss's base beside its rim)
     first = detect_all(candidates, start, np.zeros(2), _FIRST_WINDOW_PX if not edge_fit.converged else float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0)))
@@ -261,7 +276,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     found = len(proposals) >= 4
     message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
                if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
-    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0)
+    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit)
 
 
 def _turned(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
