@@ -111,3 +111,22 @@ class SetTaskApproach(Command):
 
     def undo(self) -> None:
         self._set(self.old)
+
+
+class AddPairs(Command):
+    """Add complete pairs in one step (Find points' proposals accepted): one undo removes them all.
+    ``pairs_spec``: ``(component, feature, point_world_mm (3,), pixel (2,))`` each, all on ``view``."""
+
+    def __init__(self, pairs: CorrespondenceSet, pairs_spec, view=None):
+        self.pairs = pairs
+        self.added = [Correspondence(pairs.new_number(), component, feature, tuple(float(v) for v in point), (float(pixel[0]), float(pixel[1])), True, view)
+                      for component, feature, point, pixel in pairs_spec]
+        self.label = f"Accept {len(self.added)} found point{'s' if len(self.added) != 1 else ''}"
+
+    def do(self) -> None:
+        for pair in self.added:
+            self.pairs._insert(len(self.pairs), pair)
+
+    def undo(self) -> None:
+        for pair in reversed(self.added):
+            self.pairs._remove(pair.number)

@@ -35,13 +35,14 @@ from calib_core.operator.move_preview import joint_path
 from calib_core.operator.observations import Observations
 from calib_core.operator.moves import Moves
 from calib_core.operator.picking import Picking
+from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
 from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles, Picking, Moves):
+class OperatorCore(SessionFiles, Picking, Moves, PointFinding):
     """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
@@ -68,6 +69,7 @@ class OperatorCore(SessionFiles, Picking, Moves):
     still_changed = Signal(object)
     motion_changed = Signal(object)
     move_previewed = Signal(object)
+    points_found = Signal(object)
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell

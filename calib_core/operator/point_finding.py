@@ -1,0 +1,87 @@
+"""*Find points*: the target's features located in the held frame and proposed as pairs, accepted
+in one undoable step. A mixin of :class:`~calib_core.operator.core.OperatorCore`.
+
+The frame is held as for a pick (refused while the robot moves), so the proposals carry its
+:class:`~calib_core.calibration.view_stamp.ViewStamp`; the modelled camera pose is the robot model's
+at the frame's joints. Nothing here moves the robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from calib_core.calibration.commands import AddPairs
+from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.view_stamp import ViewStamp
+from calib_core.errors import OperatorError
+from calib_core.frames import apply
+
+
+@dataclass(frozen=True)
+class FoundOnFrame:
+    """A Find points result and the frame it was found on."""
+
+    result: "FoundPoints"  # noqa: F821 (calib_core.vision.find_points, imported when first used)
+    view: ViewStamp
+
+
+class PointFinding:
+    found: FoundOnFrame | None = None
+    _model_view = None
+
+    def find_points(self) -> FoundOnFrame:
+        """Locate the target's features in the held frame (holding the newest one first). Emits
+        ``points_found``; the proposals wait for :meth:`accept_found_points`."""
+        target = self.session.target
+        if target is None:
+            raise CalibrationError("choose the target object first")
+        held = self.observations.still or self.hold_frame()
+        q = np.asarray(held.stamp.joints_deg, dtype=float)
+        item = self.workcell.component(target)
+        obj2cam_model = np.linalg.inv(self.robot.fk(q, "camera")) @ item.item2world
+        if self._model_view is None or self._model_view.intrinsics != self.intrinsics:
+            from calib_core.render.model_view import ModelView  # VTK loads on the first Find points, not at start-up
+
+            if self._model_view is not None:
+                self._model_view.close()
+            self._model_view = ModelView(self.intrinsics)
+        items = list(self.workcell.components) + self.cell.model_visuals().scene_items(q) + list(self.scene_extras)
+        from calib_core.vision.find_points import find_points
+
+        result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self._model_view.of(items, item.item2world))
+        self.found = FoundOnFrame(result, held.stamp)
+        self.record_event("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
+                          missed={m.feature: m.reason for m in result.missed}, seconds=round(result.seconds, 3))
+        self.points_found.emit(self.found)
+        self.message.emit(result.message)
+        return self.found
+
+    def accept_found_points(self, features: list[str] | None = None) -> list[int]:
+        """Add the proposals (``features``: those named; default all) as pairs, in one undoable step.
+        Features already paired are left out. Returns the new pairs' numbers."""
+        found = self.found
+        if found is None or not found.result.proposals:
+            raise OperatorError("nothing found to accept: Find points (F6) first")
+        session = self.session
+        pending = session.pairs.pending()
+        if pending is not None:
+            raise OperatorError(f"pair {pending.number} still waits for its point on the camera image: click it there, or delete it, then accept")
+        chosen = [p for p in found.result.proposals if features is None or p.feature in features]
+        unknown = set(features or ()) - {p.feature for p in found.result.proposals}
+        if unknown:
+            raise OperatorError(f"not among the proposals: {', '.join(sorted(unknown))}")
+        paired = {p.feature for p in session.pairs if p.component == found.result.component and p.feature}
+        fresh = [p for p in chosen if p.feature not in paired]
+        if not fresh:
+            raise OperatorError(f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})")
+        self.check_same_state([p for p in session.pairs if p.complete], found.view)
+        item = self.workcell.component(found.result.component)
+        spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]
+        command = AddPairs(session.pairs, spec, found.view)
+        session.undo.push(command)
+        numbers = [pair.number for pair in command.added]
+        self.record_event("found_points_accepted", numbers=numbers, features=[p.feature for p in fresh])
+        self.found = None
+        return numbers
