@@ -23,6 +23,7 @@ RESIDUAL_COLOR = QColor(255, 70, 70)
 RESIDUAL_SCALE = 10.0
 GHOST_COLOR = QColor(255, 60, 220)
 BOARD_COLOR = QColor(60, 230, 90)
+PROPOSAL_COLOR = QColor(80, 200, 255)
 STALE_COLOR = QColor(120, 120, 120)
 
 
@@ -165,6 +166,13 @@ class CameraPane(QWidget):
         self._board_text = text
         self.refresh_overlay()
 
+    def set_proposals(self, proposals, joints_deg=None) -> None:
+        """Show Find points' proposals ``[(u, v, label), ...]`` px over the image (``None`` hides them),
+        found on a frame at ``joints_deg``: hidden when the image shows another robot state."""
+        self._proposals = None if not proposals else list(proposals)
+        self._proposal_joints = None if joints_deg is None else np.asarray(joints_deg, dtype=float)
+        self.refresh_overlay()
+
     def set_edges_image(self, rgba: np.ndarray | None) -> None:
         self._edges_image = rgba
         self.refresh_overlay()
@@ -219,6 +227,13 @@ class CameraPane(QWidget):
                 banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
+        if getattr(self, "_proposals", None):
+            if self._same_state(self._proposal_joints):
+                for u, v, label in self._proposals:
+                    overlay.points.append((u, v, label, PROPOSAL_COLOR))
+                overlay.text = "blue: points found (Find points); accept them in the list"
+            else:
+                banner.append("the points found were found at another robot pose: not drawn")
         if self._board_corners is not None:
             if board_current:
                 for u, v in self._board_corners:

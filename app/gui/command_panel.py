@@ -97,6 +97,8 @@ class CommandPanel(QTabWidget):
         self.hint = QLabel("Point: click a feature in the virtual camera, then the same point on the camera image.")
         self.hint.setWordWrap(True)
         sl2.addWidget(self.hint)
+        self.find_points = _button("Find points (F6)", "find_points", "Find the target's features on the camera image and propose them as pairs")
+        sl2.addWidget(self.find_points)
         self.accept = _button("Accept pair", "accept", "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then")
         self.delete = _button("Delete pair", "delete")
         self.clear = _button("Clear all", "clear")

@@ -21,6 +21,7 @@ from app.gui.pairs_table import PairsTable
 from app.gui.replay_bar import ReplayBar
 from app.gui.results_panel import ResultsPanel
 from app.gui.file_menu import FileMenu
+from app.gui.found_points import FindPoints
 from app.gui.solved_edges import SolvedEdges
 from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
@@ -126,7 +127,7 @@ class MainWindow(QMainWindow):
         self.accept_action = QAction("&Accept pair", self, shortcut=QKeySequence("Ctrl+Return"), triggered=self._accept)
         for a in (self.undo_action, self.redo_action, self.delete_action, self.accept_action):
             edit.addAction(a)
-        cal = self.menuBar().addMenu("&Calibration")
+        cal = self.calibration_menu = self.menuBar().addMenu("&Calibration")
         self.calibrate_action = QAction("&Calibrate", self, shortcut=QKeySequence("F5"), triggered=self._calibrate)
         cal.addAction(self.calibrate_action)
         cal.addAction(QAction("&Store correction", self, triggered=self._store))
@@ -189,6 +190,7 @@ class MainWindow(QMainWindow):
         wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
         wb.session.corrections.changed.connect(lambda task: self._update_corrections())
         wb.session.changed.connect(self._after_solve)
+        self.finder = FindPoints(self)
         self._update_actions()
 
     def _move_finished(self, what: str, error: str) -> None:

@@ -1,0 +1,105 @@
+"""*Find points* in the window (F6): the core finds the target's features on the held frame; a list
+shows each proposal (feature, kind, confidence, distance from the fitted pose) with a check box and
+each feature not found with the reason; *Accept checked* adds the checked ones as pairs, one undo
+step. The camera pane draws the proposals while the list is open."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QApplication, QDialog, QDialogButtonBox, QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout
+
+from app.gui.error_boundary import attempt
+
+
+class FoundPointsDialog(QDialog):
+    """The proposals of one Find points, to accept all or some."""
+
+    def __init__(self, found, accept, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle("Points found")
+        self.found = found
+        self._accept_features = accept
+        result = found.result
+        layout = QVBoxLayout(self)
+        self.message = QLabel(result.message)
+        self.message.setTextFormat(Qt.TextFormat.PlainText)
+        self.message.setWordWrap(True)
+        layout.addWidget(self.message)
+        self.table = QTableWidget(len(result.proposals), 4, self)
+        self.table.setHorizontalHeaderLabels(["feature", "kind", "confidence", "off the fit (px)"])
+        for row, p in enumerate(result.proposals):
+            name = QTableWidgetItem(p.feature)
+            name.setFlags(Qt.ItemFlag.ItemIsUserCheckable | Qt.ItemFlag.ItemIsEnabled)
+            name.setCheckState(Qt.CheckState.Checked)
+            self.table.setItem(row, 0, name)
+            for col, text in ((1, p.kind), (2, f"{p.confidence:.2f}"), (3, f"{p.residual_px:.2f}")):
+                item = QTableWidgetItem(text)
+                item.setFlags(Qt.ItemFlag.ItemIsEnabled)
+                self.table.setItem(row, col, item)
+        self.table.resizeColumnsToContents()
+        layout.addWidget(self.table)
+        self.missed = QLabel("\n".join(f"{m.feature}: {m.reason}" for m in result.missed) or "every feature was found")
+        self.missed.setTextFormat(Qt.TextFormat.PlainText)
+        self.missed.setWordWrap(True)
+        layout.addWidget(self.missed)
+        buttons = QDialogButtonBox(self)
+        self.accept_button = QPushButton("Accept checked")
+        self.accept_button.setDefault(True)
+        self.accept_button.setEnabled(bool(result.proposals))
+        buttons.addButton(self.accept_button, QDialogButtonBox.ButtonRole.AcceptRole)
+        buttons.addButton(QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self._accept_checked)
+        buttons.rejected.connect(self.reject)
+        layout.addWidget(buttons)
+        self.resize(520, 420)
+
+    def checked_features(self) -> list[str]:
+        return [self.table.item(r, 0).text() for r in range(self.table.rowCount()) if self.table.item(r, 0).checkState() == Qt.CheckState.Checked]
+
+    def _accept_checked(self) -> None:
+        if self._accept_features(self.checked_features()):
+            self.accept()
+
+
+class FindPoints:
+    """The F6 action and the Find points button of a main window."""
+
+    def __init__(self, window):
+        self.window = window
+        self.dialog: FoundPointsDialog | None = None
+        self.action = QAction("&Find points", window, shortcut=QKeySequence("F6"), triggered=self.run)
+        self.action.setToolTip("Find the target's features on the camera image and propose them as pairs (F6)")
+        window.calibration_menu.addAction(self.action)
+        window.commands.find_points.clicked.connect(self.run)
+
+    def run(self) -> None:
+        window, wb = self.window, self.window.workbench
+        window.statusBar().showMessage("finding points ...")
+        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)  # rendering and fitting take a second
+        try:
+            found = {}
+            if not attempt(window.show_error, lambda: found.setdefault("found", wb.find_points())):
+                return
+        finally:
+            QApplication.restoreOverrideCursor()
+        self.show(found["found"])
+
+    def show(self, found) -> None:
+        window = self.window
+        window.camera.set_proposals([(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg)
+        if self.dialog is not None:
+            self.dialog.close()
+        self.dialog = FoundPointsDialog(found, self._accept, window)
+        self.dialog.finished.connect(lambda _: window.camera.set_proposals(None))
+        self.dialog.show()
+
+    def _accept(self, features: list[str]) -> bool:
+        if not features:
+            self.window.show_error("check at least one point to accept, or Cancel")
+            return False
+        numbers = {}
+        ok = attempt(self.window.show_error, lambda: numbers.setdefault("n", self.window.workbench.accept_found_points(features)))
+        if ok:
+            self.window.statusBar().showMessage(f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000)
+        return ok

@@ -1,0 +1,47 @@
+"""Find points through the real window: F6 on the held frame at the task location, the list of
+proposals, one unchecked, Accept checked: pairs in one undo step, drawn, solved."""
+
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import Qt
+
+from tests.app.test_calibration_in_window import _go_to_task
+
+OUTPUT = Path(__file__).resolve().parents[1] / "output"
+
+
+def test_f6_proposes_points_and_accept_checked_adds_them_in_one_undo_step(qtbot, window):
+    win = window
+    wb = win.workbench
+    _go_to_task(qtbot, win)
+    qtbot.keyClick(win, Qt.Key.Key_F6)
+    qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
+    dialog = win.finder.dialog
+    result = dialog.found.result
+    assert result.found, result.message
+    assert dialog.table.rowCount() == len(result.proposals) >= 4
+    assert any(p[3].name() == "#50c8ff" for p in win.camera.view.overlay.points)  # the proposals are drawn
+    OUTPUT.mkdir(exist_ok=True)
+    win.grab().save(str(OUTPUT / "window_find_points.png"))
+    dialog.grab().save(str(OUTPUT / "find_points_dialog.png"))
+    dialog.table.item(0, 0).setCheckState(Qt.CheckState.Unchecked)  # the operator rejects one
+    kept = dialog.checked_features()
+    qtbot.mouseClick(dialog.accept_button, Qt.MouseButton.LeftButton)
+    assert not dialog.isVisible() and [p.feature for p in wb.session.pairs] == kept
+    assert win.table.rowCount() == len(kept)
+    assert not any(p[3].name() == "#50c8ff" for p in win.camera.view.overlay.points)  # gone with the list
+    # The truth scores: every accepted pixel within a pixel and a half of where the feature really is.
+    bed = wb.site.bed
+    item = wb.workcell.component(result.component)
+    true_obj2cam = np.linalg.inv(bed.true_cam2world(wb.joints_deg)) @ item.item2world
+    from calib_core.camera.projection import project_points
+
+    for pair in wb.session.pairs:
+        truth = project_points(item.features[pair.feature][None], true_obj2cam, wb.intrinsics)[0]
+        assert np.linalg.norm(np.array(pair.pixel) - truth) < 1.5, pair.feature
+    qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert len(wb.session.pairs) == 0  # one undo step
+    qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    assert wb.session.result is not None and wb.session.result.solution.status.value == "ok", win.results.status.text()
