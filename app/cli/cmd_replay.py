@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     results = replay(args.recording)
     if args.json:
         json.dump({"recording": str(args.recording), "complete": contents.complete, "solves": [
-            {"id": r.id, "agree": r.agree, "equivalent": r.equivalent, "recorded_status": r.recorded["status"], "recomputed_status": r.recomputed["status"],
+            {"id": r.id, "agree": r.agree, "equivalent": r.equivalent, "skipped": r.skipped, "recorded_status": r.recorded["status"], "recomputed_status": r.recomputed["status"],
              "translation_diff_mm": r.translation_diff_mm, "rotation_diff": r.rotation_diff, "rms_diff_px": r.rms_diff_px,
              "recorded": {"t_obj2cam_mm": r.recorded["t_obj2cam_mm"], "rms_px": r.recorded["rms_px"]},
              "recomputed": {"t_obj2cam_mm": r.recomputed["t_obj2cam_mm"], "rms_px": r.recomputed["rms_px"]}} for r in results]}, sys.stdout, indent=2)
@@ -37,7 +37,9 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"{args.recording}: {len(results)} solves")
         for r in results:
-            if r.agree:
+            if r.skipped:
+                verdict = f"skipped ({r.skipped})"
+            elif r.agree:
                 verdict = "agrees"
             elif r.equivalent:
                 verdict = f"agrees to round-off ({r.translation_diff_mm:.1g} mm: not bit for bit, another solver version)"

@@ -15,11 +15,12 @@ from app.gui.error_boundary import attempt
 class FoundPointsDialog(QDialog):
     """The proposals of one Find points, to accept all or some."""
 
-    def __init__(self, found, accept, parent=None):
+    def __init__(self, found, accept, calibrate_on_edges=None, parent=None):
         super().__init__(parent)
         self.setWindowTitle("Points found")
         self.found = found
         self._accept_features = accept
+        self._on_edges = calibrate_on_edges
         result = found.result
         layout = QVBoxLayout(self)
         self.message = QLabel(result.message)
@@ -48,6 +49,12 @@ class FoundPointsDialog(QDialog):
         self.accept_button.setDefault(True)
         self.accept_button.setEnabled(bool(result.proposals))
         buttons.addButton(self.accept_button, QDialogButtonBox.ButtonRole.AcceptRole)
+        self.edges_button = QPushButton("Calibrate on edges")
+        self.edges_button.setToolTip("Solve from the target's edges on this frame (hundreds of samples, no pairs): usually the most accurate")
+        edges = result.edges
+        self.edges_button.setEnabled(edges is not None and edges.converged)
+        buttons.addButton(self.edges_button, QDialogButtonBox.ButtonRole.ActionRole)
+        self.edges_button.clicked.connect(self._calibrate_on_edges)
         buttons.addButton(QDialogButtonBox.StandardButton.Cancel)
         buttons.accepted.connect(self._accept_checked)
         buttons.rejected.connect(self.reject)
@@ -56,6 +63,10 @@ class FoundPointsDialog(QDialog):
 
     def checked_features(self) -> list[str]:
         return [self.table.item(r, 0).text() for r in range(self.table.rowCount()) if self.table.item(r, 0).checkState() == Qt.CheckState.Checked]
+
+    def _calibrate_on_edges(self) -> None:
+        if self._on_edges is not None and self._on_edges():
+            self.accept()
 
     def _accept_checked(self) -> None:
         if self._accept_features(self.checked_features()):
@@ -90,9 +101,12 @@ class FindPoints:
         window.camera.set_proposals([(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg)
         if self.dialog is not None:
             self.dialog.close()
-        self.dialog = FoundPointsDialog(found, self._accept, window)
+        self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, window)
         self.dialog.finished.connect(lambda _: window.camera.set_proposals(None))
         self.dialog.show()
+
+    def _calibrate_on_edges(self) -> bool:
+        return attempt(self.window.show_error, self.window.workbench.calibrate_on_edges)
 
     def _accept(self, features: list[str]) -> bool:
         if not features:

@@ -152,7 +152,8 @@ class ResultsPanel(QWidget):
             f"<tr><td>rotation (base axes)</td><td>rx {rv[0]:+.3f}</td><td>ry {rv[1]:+.3f}</td><td>rz {rv[2]:+.3f} deg</td><td>{np.linalg.norm(rv):.3f} deg</td></tr>"
             f"<tr><td>1-sigma</td><td>{sr[0]:.3f}</td><td>{sr[1]:.3f}</td><td>{sr[2]:.3f} deg</td><td></td></tr>"
             f"<tr><td>camera (base frame)</td><td>{cam[0]:.1f}</td><td>{cam[1]:.1f}</td><td>{cam[2]:.1f} mm</td><td></td></tr>"
-            f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} pairs</td><td>{sol.iterations} iterations</td><td></td></tr>"
+            f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} {'edge samples' if sol.method == 'edges' else 'pairs'}</td>"
+            f"<td>{'on the edges' if sol.method == 'edges' else f'{sol.iterations} iterations'}</td><td></td></tr>"
             "</table>"
         )
         numbers = session.solved_numbers

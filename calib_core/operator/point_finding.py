@@ -58,6 +58,28 @@ class PointFinding:
         self.message.emit(result.message)
         return self.found
 
+    def calibrate_on_edges(self):
+        """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's
+        edges on the held frame, hundreds of samples) as this session's result, with no pairs. Emits
+        ``solved`` like Calibrate; the solve's inputs are recorded with ``method`` ``edges``."""
+        found = self.found
+        if found is None or found.result.edges is None:
+            raise OperatorError("Find points (F6) first: the edges are fitted on its frame")
+        from calib_core.recording.replay import solve_inputs
+        from calib_core.vision.edge_solution import edge_solution
+
+        solution = edge_solution(found.result.edges, self.intrinsics)
+        item = self.workcell.component(found.result.component)
+        q = np.asarray(found.view.joints_deg, dtype=float)
+        cam2world_model = self.robot.fk(q, "camera")
+        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.intrinsics, prior=np.linalg.inv(cam2world_model) @ item.item2world)
+        inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
+        self.session.last_solve_inputs = inputs
+        self.current_pair = None
+        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [])
+        self.solved.emit()
+        return estimate
+
     def accept_found_points(self, features: list[str] | None = None) -> list[int]:
         """Add the proposals (``features``: those named; default all) as pairs, in one undoable step.
         Features already paired are left out. Returns the new pairs' numbers."""

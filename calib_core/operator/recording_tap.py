@@ -113,9 +113,12 @@ class RecordingTap:
         }
         inputs = core.session.last_solve_inputs
         self.recorder.record_solve(inputs, result.solution.to_dict(), context=context)
-        numbers = list(core.session.pairs.arrays()[2])
-        reprojected = np.asarray(inputs["points_2d"], float) - result.solution.residuals_px
-        self._reprojected = list(zip(numbers, reprojected.tolist())) if len(numbers) == len(reprojected) else None
+        if result.solution.method == "edges":  # no pairs to draw reprojections of
+            self._reprojected = None
+        else:
+            numbers = list(core.session.pairs.arrays()[2])
+            reprojected = np.asarray(inputs["points_2d"], float) - result.solution.residuals_px
+            self._reprojected = list(zip(numbers, reprojected.tolist())) if len(numbers) == len(reprojected) else None
         self._annotate()
 
     def _correction(self, c) -> None:

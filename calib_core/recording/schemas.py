@@ -116,6 +116,7 @@ SOLVE_RESULT = {
         "std": _STD, "condition_number": _NULLABLE_NUMBER,
         "candidates": {"type": "array", "items": {"type": "object"}, "description": "poses that fit about as well, best first"},
         "warnings": _vector(None, items={"type": "string"}),
+        "method": {"type": "string", "enum": ["points", "edges"], "description": "points: from the pairs; edges: from the target's edges on the image (residuals: one per edge sample)"},
     },
     "required": ["status", "R_obj2cam", "t_obj2cam_mm", "rms_px"],
 }
@@ -129,6 +130,9 @@ SOLVE_INPUTS = {
         "points_2d": {"type": "array", "items": _vector(2), "description": "picked pixels"},
         "estimate_focal": {"type": "boolean"}, "model": {"type": "string"}, "sigma_px": _NULLABLE_NUMBER, "robust": {"type": "boolean"},
         "prior": {"type": "object", "properties": {"R_obj2cam": _matrix(3, 3, "prior rotation"), "t_obj2cam_mm": _vector(3)}},
+        "method": {"type": "string", "enum": ["points", "edges"], "description": "edges: solved on the frame's image (no pairs: points_3d and points_2d are empty)"},
+        "component": {"type": "string", "description": "with method edges: the target whose edges were used"},
+        "frame_index": {"type": "integer", "description": "with method edges: the camera frame solved on"},
     },
     "required": ["intrinsics", "points_3d", "points_2d"],
 }

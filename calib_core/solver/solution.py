@@ -71,6 +71,9 @@ class PoseSolution:
     candidates: tuple[PoseCandidate, ...] = ()
     reason: str | None = None
     warnings: tuple[str, ...] = field(default_factory=tuple)
+    method: str = "points"
+    """``points``: solved from point pairs; ``edges``: from the target's edges on the image (the
+    residuals are then the edge samples' offsets, one per sample)."""
 
     @property
     def ok(self) -> bool:
@@ -137,6 +140,7 @@ class PoseSolution:
             "condition_number": None if u is None or not np.isfinite(u.condition_number) else u.condition_number,
             "candidates": [c.to_dict() for c in self.candidates],
             "warnings": list(self.warnings),
+            "method": self.method,
         }
 
 

@@ -31,8 +31,9 @@ class EdgeFit:
     """``obj2cam`` (4, 4) the refined pose (mm); ``rms_px`` the weighted RMS of the samples' normal
     offsets; ``sigma_px`` their robust scale; ``samples`` used in the last step; ``covariance`` (6, 6)
     of (rotation vector rad, translation mm) from the last step's normal equations and ``sigma_px``;
-    ``converged``; ``edges_px`` (m, 2) and ``offsets_px`` (m,) the samples and their residuals (for
-    drawing)."""
+    ``converged``; ``edges_px`` (m, 2) the image edge points found, ``offsets_px`` (m,) their offsets
+    along the normals and ``residuals_px`` (m, 2) as vectors (image edge minus the model's edge, at the
+    pose before the last step), for drawing and for the solution's residuals."""
 
     obj2cam: np.ndarray
     rms_px: float
@@ -42,6 +43,7 @@ class EdgeFit:
     converged: bool
     edges_px: np.ndarray
     offsets_px: np.ndarray
+    residuals_px: np.ndarray = None  # type: ignore[assignment]
 
 
 def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
@@ -90,7 +92,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False
     H = np.eye(6)
-    edges, offsets = np.zeros((0, 2)), np.zeros(0)
+    edges, offsets, vectors = np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2))
     for it in range(iterations):
         if len(pts) < 12:
             break
@@ -123,7 +125,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
             break
         pose = _perturbed(pose, xi)
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
-        edges, offsets = found[ok], r[ok]
+        edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
         window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks
         if moved_px < 0.01 and it > 0:
@@ -133,4 +135,4 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         covariance = sigma**2 * np.linalg.inv(H)
     except np.linalg.LinAlgError:
         covariance = np.full((6, 6), np.nan)
-    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets)
+    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors)

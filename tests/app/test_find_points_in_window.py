@@ -45,3 +45,23 @@ def test_f6_proposes_points_and_accept_checked_adds_them_in_one_undo_step(qtbot,
     qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
     assert wb.session.result is not None and wb.session.result.solution.status.value == "ok", win.results.status.text()
+
+
+def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot, window, tmp_path):
+    import subprocess
+    import sys
+
+    win = window
+    wb = win.workbench
+    _go_to_task(qtbot, win)
+    wb.start_recording(tmp_path / "edges.mcap")
+    qtbot.keyClick(win, Qt.Key.Key_F6)
+    qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
+    assert win.finder.dialog.edges_button.isEnabled()
+    qtbot.mouseClick(win.finder.dialog.edges_button, Qt.MouseButton.LeftButton)
+    result = wb.session.result
+    assert result is not None and result.solution.method == "edges" and "OK" in win.results.verdict.text()
+    assert "edge samples" in win.results.details.text()
+    wb.stop_recording()
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(tmp_path / "edges.mcap")], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0 and "skipped (solved on the image's edges" in run.stdout, run.stdout + run.stderr
