@@ -44,6 +44,14 @@ class EdgeFit:
     edges_px: np.ndarray
     offsets_px: np.ndarray
     residuals_px: np.ndarray = None  # type: ignore[assignment]
+    inlier_share: float = 0.0
+    """The share of the model's edge samples that found their image edge in the last step (weight > 0):
+    a fit that settled on a few samples (a wrong minimum) has a low one."""
+
+    @property
+    def settled(self) -> bool:
+        """Converged, the samples within 0.5 px RMS, and at least half of them on their edges."""
+        return self.converged and self.rms_px <= 0.5 and self.inlier_share >= 0.5
 
 
 def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
@@ -93,6 +101,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     sigma, rms, converged = 1.0, np.inf, False
     H = np.eye(6)
     edges, offsets, vectors = np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2))
+    share = 0.0
     for it in range(iterations):
         if len(pts) < 12:
             break
@@ -126,6 +135,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         pose = _perturbed(pose, xi)
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
+        share = float(np.mean(wts > 0))
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
         window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks
         if moved_px < 0.01 and it > 0:
@@ -135,4 +145,4 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         covariance = sigma**2 * np.linalg.inv(H)
     except np.linalg.LinAlgError:
         covariance = np.full((6, 6), np.nan)
-    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors)
+    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share)

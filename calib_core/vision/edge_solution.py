@@ -10,8 +10,6 @@ from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import uncertainty_from
 from calib_core.vision.edge_refinement import EdgeFit
 
-SETTLED_PX = 0.5
-
 
 def _to_solver_covariance(covariance: np.ndarray, t_mm: np.ndarray) -> np.ndarray:
     """(rotation vector, translation) of the edge fit's left perturbation to the solver's (dt, phi):
@@ -26,7 +24,7 @@ def _to_solver_covariance(covariance: np.ndarray, t_mm: np.ndarray) -> np.ndarra
 
 
 def edge_solution(fit: EdgeFit, intrinsics: Intrinsics) -> PoseSolution:
-    """``fit`` as a solution: ``ok`` when it converged and its samples settled within 0.5 px RMS."""
+    """``fit`` as a solution: ``ok`` when it settled (:attr:`EdgeFit.settled`)."""
     t = fit.obj2cam[:3, 3]
     R = fit.obj2cam[:3, :3]
     cov = _to_solver_covariance(fit.covariance, t)
@@ -38,8 +36,9 @@ def edge_solution(fit: EdgeFit, intrinsics: Intrinsics) -> PoseSolution:
     condition = float(np.linalg.cond(fit.covariance)) if np.all(np.isfinite(fit.covariance)) else float("inf")
     uncertainty = uncertainty_from(cov, cov_centre, fit.sigma_px, 1, condition)
     m = len(fit.residuals_px)
-    settled = fit.converged and fit.rms_px <= SETTLED_PX
-    reason = None if settled else (f"the edges did not settle: RMS {fit.rms_px:.2f} px over {fit.samples} samples" if fit.converged else "the edge refinement did not converge")
+    settled = fit.settled
+    reason = None if settled else (f"the edges did not settle: RMS {fit.rms_px:.2f} px, {100 * fit.inlier_share:.0f} % of {fit.samples} samples on their edges"
+                                   if fit.converged else "the edge refinement did not converge")
     return PoseSolution(
         status=SolveStatus.OK if settled else SolveStatus.FAILED, obj2cam=fit.obj2cam.copy(), fu=intrinsics.fu, fv=intrinsics.fv, model="pinhole",
         iterations=0, residuals_px=np.asarray(fit.residuals_px, dtype=float).reshape(-1, 2), uncertainty=uncertainty,

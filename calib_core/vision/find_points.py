@@ -36,7 +36,6 @@ SEARCH_RADIUS_PX = 90.0
 """How far (px) the target may lie from where the model puts it: the typical robot error, twice."""
 _FIRST_WINDOW_PX = 6.0
 _EDGE_AGREEMENT_PX = 1.0
-_EDGES_SETTLED_PX = 0.5  # the edge samples' RMS offset once the pose is right (0.2-0.3 px on a sharp camera)
 _SECOND_WINDOW_PX = 2.0
 _SIGMA_PX = 0.5
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
@@ -226,15 +225,16 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     shifted = _turned(obj2cam_model, shift, intrinsics)
     edge_fit = refine_to_edges(grey, intrinsics, item.mesh, shifted, expected=detectors.expected_image(shifted) if expected is not None else None)
     for _ in range(2):
-        if edge_fit.converged and edge_fit.rms_px <= _EDGES_SETTLED_PX:
+        if edge_fit.settled:
             break
         # not settled: start again from where it got to, the model's view rendered there, a wide window again
         again_from = edge_fit.obj2cam
         edge_fit = refine_to_edges(grey, intrinsics, item.mesh, again_from, expected=detectors.expected_image(again_from) if expected is not None else None)
-    if not edge_fit.converged or edge_fit.rms_px > _EDGES_SETTLED_PX:
+    if not edge_fit.settled:
         # The edges did not settle: detections in wide windows would lock onto neighbouring edges, and a
         # wrong proposal costs the operator more than a pick by hand.
-        return FoundPoints(item.name, False, f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px over {edge_fit.samples} edge samples): "
+        return FoundPoints(item.name, False, f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
+                           f"{edge_fit.samples} edge samples on their edges): "
                            "pick the points by hand", missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
                            seconds=time.perf_counter() - t0, edges=edge_fit)
     start = edge_fit.obj2cam
