@@ -153,9 +153,11 @@ class CalibrationSession:
         points_world, pixels, numbers = self.pairs.arrays()
         points_obj = apply(invert(obj2world), points_world)
         prior = invert(cam2world_model) @ obj2world
+        from calib_core.solver.errors import named_points
         from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on the first solve
 
-        solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
+        with named_points("pair", numbers):  # messages name pairs by the numbers the table shows
+            solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers)
 

@@ -5,22 +5,46 @@ Non-convergence is not an error: it is a ``failed`` status with a reason on the 
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import contextlib
+import contextvars
+from collections.abc import Iterable, Iterator, Sequence
 
 from calib_core.errors import VideocalError
 
+_NAMES: contextvars.ContextVar[tuple[str, tuple[int, ...]] | None] = contextvars.ContextVar("point_names", default=None)
+
+
+@contextlib.contextmanager
+def named_points(word: str, numbers: Sequence[int]) -> Iterator[None]:
+    """Within this block, messages name point ``i`` as ``f"{word} {numbers[i]}"``: the window's solves
+    say ``pair 12`` for the pair the table shows as 12, whatever its place in the solve."""
+    token = _NAMES.set((word, tuple(int(n) for n in numbers)))
+    try:
+        yield
+    finally:
+        _NAMES.reset(token)
+
+
+def _number(index: int) -> tuple[str, str]:
+    names = _NAMES.get()
+    if names is not None and 0 <= index < len(names[1]):
+        return names[0], str(names[1][index])
+    return "point", str(index + 1)
+
 
 def point_label(index: int) -> str:
-    """``'point 3'`` for index 2: the window and messages number points from 1."""
-    return f"point {index + 1}"
+    """``'point 3'`` for index 2 (numbered from 1), or the caller's name for it (:func:`named_points`)."""
+    word, number = _number(int(index))
+    return f"{word} {number}"
 
 
 def points_label(indices: Iterable[int]) -> str:
-    """``'points 1, 4'`` for indices (0, 3)."""
+    """``'points 1, 4'`` for indices (0, 3) (or ``'pairs 9, 12'`` inside :func:`named_points`)."""
     idx = [int(i) for i in indices]
     if len(idx) == 1:
         return point_label(idx[0])
-    return "points " + ", ".join(str(i + 1) for i in idx)
+    labels = [_number(i) for i in idx]
+    return f"{labels[0][0]}s " + ", ".join(n for _, n in labels)
 
 
 class SolverInputError(VideocalError, ValueError):
