@@ -37,6 +37,9 @@ class EdgeAlignment:
     samples: int
     distinct: float
     matched_share: float = 0.0
+    alternatives: tuple = ()
+    """The next best shifts (2,) px, each at least 8 px from the better ones: where to start again when
+    the best one leads nowhere (a parallel edge taken for the target's)."""
 
 
 def crease_segments(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
@@ -135,4 +138,13 @@ def align_edges(samples_px: np.ndarray, distance: np.ndarray, radius_px: float) 
     second = float(costs[far].min()) if far.any() else TRUNCATE_PX
     best_cost = float(fine_costs[k])
     matched = float(np.mean(_distances(samples_px, distance, fine[k]) <= 2.0))
-    return EdgeAlignment(offset, best_cost, len(samples_px), best_cost / max(second, 1e-9), matched)
+    alternatives = []
+    taken = [best]
+    for i in np.argsort(costs):
+        if len(alternatives) == 3:
+            break
+        candidate = offsets[i]
+        if all(np.linalg.norm(candidate - t) >= 8.0 for t in taken):
+            taken.append(candidate)
+            alternatives.append(candidate.astype(float))
+    return EdgeAlignment(offset, best_cost, len(samples_px), best_cost / max(second, 1e-9), matched, tuple(alternatives))

@@ -221,15 +221,20 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, shift_px, radius) for i in indices}
 
     candidates = [i for i in range(len(names)) if visible[i]]
-    # the shift as a turn of the camera about its centre, then the edges pull the pose into place
-    shifted = _turned(obj2cam_model, shift, intrinsics)
-    edge_fit = refine_to_edges(grey, intrinsics, item.mesh, shifted, expected=detectors.expected_image(shifted) if expected is not None else None)
-    for _ in range(2):
+    # the shift as a turn of the camera about its centre, then the edges pull the pose into place; when
+    # they do not settle, again from where they got to, then from the chamfer's next best shifts
+    edge_fit = None
+    for k, offset in enumerate((shift, *alignment.alternatives)):
+        start_pose = _turned(obj2cam_model, offset, intrinsics)
+        for _ in range(2 if k == 0 else 1):  # the best shift gets a restart, the others one try each
+            fit = refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected=detectors.expected_image(start_pose) if expected is not None else None)
+            if edge_fit is None or (fit.settled, fit.inlier_share * fit.samples) > (edge_fit.settled, edge_fit.inlier_share * edge_fit.samples):
+                edge_fit = fit
+            if fit.settled:
+                break
+            start_pose = fit.obj2cam
         if edge_fit.settled:
             break
-        # not settled: start again from where it got to, the model's view rendered there, a wide window again
-        again_from = edge_fit.obj2cam
-        edge_fit = refine_to_edges(grey, intrinsics, item.mesh, again_from, expected=detectors.expected_image(again_from) if expected is not None else None)
     if not edge_fit.settled:
         # The edges did not settle: detections in wide windows would lock onto neighbouring edges, and a
         # wrong proposal costs the operator more than a pick by hand.
