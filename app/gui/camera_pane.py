@@ -24,6 +24,7 @@ RESIDUAL_SCALE = 10.0
 GHOST_COLOR = QColor(255, 60, 220)
 BOARD_COLOR = QColor(60, 230, 90)
 PROPOSAL_COLOR = QColor(80, 200, 255)
+EXPECTED_COLOR = QColor(255, 255, 255)
 STALE_COLOR = QColor(120, 120, 120)
 
 
@@ -227,6 +228,11 @@ class CameraPane(QWidget):
                 banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
+            expected = self.workbench.expected_pixel()
+            if expected is not None:
+                (u, v), basis = expected
+                overlay.points.append((u, v, "expected", EXPECTED_COLOR))
+                overlay.text += f"; it should lie near the white mark ({basis})"
         if getattr(self, "_proposals", None):
             if self._same_state(self._proposal_joints):
                 for u, v, label in self._proposals:

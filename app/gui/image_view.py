@@ -240,6 +240,24 @@ class ImageView(QWidget):
         p.drawLine(QPointF(x, 0), QPointF(x, y - 6))
         p.drawLine(QPointF(x, y + 6), QPointF(x, self.height()))
 
+    def _stretched_patch(self, cu: int, cv_: int, radius_px: int) -> np.ndarray | None:
+        """The (2r+1)^2 pixels around (cu, cv) with their 2nd to 98th percentile stretched over 0-255,
+        black outside the image; ``None`` without an image array or where the patch is flat."""
+        a = self._array
+        if a is None or a.ndim != 3:
+            return None
+        h, w = a.shape[:2]
+        out = np.zeros((2 * radius_px + 1, 2 * radius_px + 1, 3), np.uint8)
+        y0, y1, x0, x1 = max(cv_ - radius_px, 0), min(cv_ + radius_px + 1, h), max(cu - radius_px, 0), min(cu + radius_px + 1, w)
+        if y0 >= y1 or x0 >= x1:
+            return out
+        crop = a[y0:y1, x0:x1, :3].astype(np.float32)
+        lo, hi = np.percentile(crop, 2), np.percentile(crop, 98)
+        if hi - lo < 4:
+            return None
+        out[y0 - (cv_ - radius_px):y1 - (cv_ - radius_px), x0 - (cu - radius_px):x1 - (cu - radius_px)] = np.clip((crop - lo) * (255.0 / (hi - lo)), 0, 255).astype(np.uint8)
+        return out
+
     def _paint_loupe(self, p: QPainter, radius_px: int = 10, size: int = 150) -> None:
         """A magnified inset of the pixels around the cursor, in the corner away from it."""
         u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())
@@ -249,14 +267,18 @@ class ImageView(QWidget):
         target = QRectF(x, self.height() - size - 8, size, size)
         p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
         p.fillRect(target, QColor(0, 0, 0))
-        p.drawImage(target, self._image, src)
+        patch = self._stretched_patch(cu, cv_, radius_px)
+        if patch is not None:  # contrast stretched: a faint boss's rim shows in the loupe
+            p.drawImage(target, qimage_from_array(patch), QRectF(0, 0, patch.shape[1], patch.shape[0]))
+        else:
+            p.drawImage(target, self._image, src)
         p.setPen(QPen(QColor(255, 255, 0), 1.0))
         cx, cy = target.center().x(), target.center().y()
         cell = size / (2 * radius_px + 1)
         p.drawRect(QRectF(cx - cell / 2, cy - cell / 2, cell, cell))
         p.setPen(QPen(QColor(200, 200, 200), 1.0))
         p.drawRect(target)
-        p.drawText(QRectF(target.x() + 4, target.y() + 2, size, 16), Qt.AlignmentFlag.AlignLeft, f"({cu}, {cv_}) x{cell:.0f}")
+        p.drawText(QRectF(target.x() + 4, target.y() + 2, size, 16), Qt.AlignmentFlag.AlignLeft, f"({cu}, {cv_}) x{cell:.0f}, contrast stretched")
 
     # --- interaction ------------------------------------------------------------------------
     def wheelEvent(self, event: QWheelEvent) -> None:

@@ -47,6 +47,40 @@ class Picking:
             self.current_pair = session.pick_2d(pixel, view)
         return self.current_pair
 
+    def expected_pixel(self):
+        """Where the pair waiting for its image point should lie on the frame being picked on: ``(uv (2,)
+        px, basis)``, from the pose of the complete pairs on that frame when there are three or more,
+        else from the model's camera; ``None`` when no pair waits."""
+        import numpy as np
+
+        from calib_core.camera.projection import project_points
+        from calib_core.frames import apply, invert
+
+        pending = self.session.pairs.pending()
+        target = self.session.target
+        if pending is None or target is None:
+            return None
+        held = self.observations.still
+        joints = np.asarray(held.stamp.joints_deg if held is not None else self.joints_deg, dtype=float)
+        obj2world = self.workcell.component(target).item2world
+        obj2cam = invert(self.robot.fk(joints, "camera")) @ obj2world
+        basis = "from the model"
+        done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
+        if len(done) >= 3:
+            from calib_core.solver import solve_pose
+            from calib_core.solver.errors import SolverInputError
+
+            points = apply(invert(obj2world), np.array([p.point_world_mm for p in done]))
+            try:
+                solution = solve_pose(points, np.array([p.pixel for p in done]), self.intrinsics, prior=obj2cam)
+            except SolverInputError:
+                solution = None
+            if solution is not None and solution.status.value != "failed":
+                obj2cam = solution.obj2cam
+                basis = f"from pairs {', '.join(str(p.number) for p in done)}"
+        uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.intrinsics)[0]
+        return (uv, basis) if np.all(np.isfinite(uv)) else None
+
     def _view_for_pick(self, number: int) -> ViewStamp:
         held = self.observations.still
         if held is None:
