@@ -54,11 +54,18 @@ class CameraPane(QWidget):
 
     picked = Signal(float, float)
     pick_rejected = Signal(str)  # a click that picks nothing, and why
+    pair_selected = Signal(int)  # a click on a pair's point
+    pair_moved = Signal(int, float, float)  # a pair's point dragged to (u, v) px
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
         self.workbench = workbench
         self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
+        self.view.grabber = self._grab
+        self.view.dragged.connect(self._dragging)
+        self.view.drag_finished.connect(self._dropped)
+        self._grabbed: int | None = None
+        self._drag_at: tuple[float, float] | None = None
         self.freeze = QCheckBox("Hold")
         self.freeze.setToolTip("Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner")
         self.subpixel = QCheckBox("Sub-pixel")
@@ -159,6 +166,33 @@ class CameraPane(QWidget):
             u, v = refine_subpixel(self.last_frame.image, u, v)
         self.picked.emit(u, v)
 
+    # --- a picked point dragged (after Accept too), or clicked to select its pair ------------------------
+    def _grab(self, u: float, v: float, radius_px: float) -> bool:
+        """Take hold of the complete pair whose point lies within ``radius_px`` of (u, v) on the image
+        shown (picked at the robot state it shows). Not while a pair waits for its point: the click is its."""
+        if self.workbench.session.pairs.pending() is not None:
+            return False
+        near = [(np.hypot(p.pixel[0] - u, p.pixel[1] - v), p.number) for p in self.workbench.session.pairs
+                if p.pixel is not None and (p.view is None or self._same_state(p.view.joints_deg))]
+        near = [n for n in near if n[0] <= radius_px]
+        self._grabbed = min(near)[1] if near else None
+        return self._grabbed is not None
+
+    def _dragging(self, u: float, v: float) -> None:
+        self._drag_at = (u, v)
+        self.refresh_overlay()
+
+    def _dropped(self, u: float, v: float, moved: bool) -> None:
+        number, self._grabbed, self._drag_at = self._grabbed, None, None
+        if number is None:
+            return
+        self.pair_selected.emit(number)
+        if moved:
+            if self.subpixel.isChecked() and self.last_frame is not None:
+                u, v = refine_subpixel(self.last_frame.image, u, v)
+            self.pair_moved.emit(number, u, v)
+        self.refresh_overlay()
+
     def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
         """Show a board detection (n, 2) px over the image (``None`` hides it); it belongs to the
         robot state it was detected at and is hidden when the robot moves."""
@@ -215,7 +249,8 @@ class CameraPane(QWidget):
         picked = [p for p in session.pairs if p.pixel is not None]
         for pair, current in zip(picked, pairs_current):
             color = (PICK_COLOR if pair.enabled else QColor(130, 130, 130)) if current else STALE_COLOR
-            overlay.points.append((pair.pixel[0], pair.pixel[1], str(pair.number) if current else f"{pair.number}?", color))
+            u, v = self._drag_at if pair.number == self._grabbed and self._drag_at is not None else pair.pixel
+            overlay.points.append((u, v, str(pair.number) if current else f"{pair.number}?", color))
         if not all(pairs_current):
             banner.append(f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)")
         result = session.result

@@ -61,6 +61,10 @@ class ImageView(QWidget):
 
     clicked = Signal(float, float)
     hovered = Signal(float, float)
+    dragged = Signal(float, float)
+    """While a grabbed point is dragged: where it is now (image px)."""
+    drag_finished = Signal(float, float, bool)
+    """A grabbed point let go: where (image px), and whether it moved at all (no: a click on it)."""
 
     def __init__(self, parent=None, *, placeholder: str = "no image", loupe: bool = False):
         super().__init__(parent)
@@ -72,6 +76,9 @@ class ImageView(QWidget):
         self._qimage: QImage | None = None  # the full-size image, made when first needed
         self._shrunk = _Shrunk()
         self._array: np.ndarray | None = None
+        self.grabber = None
+        """``grabber(u, v, radius_px) -> bool``: a left press there takes hold of a point (a drag) instead of a click."""
+        self._grab_from: QPointF | None = None
         self._overlay_image: QImage | None = None
         self._overlay_shrunk = _Shrunk()
         self.overlay = Overlay()
@@ -300,10 +307,15 @@ class ImageView(QWidget):
             self._drag_from = event.position()
         elif event.button() == Qt.MouseButton.LeftButton and self._image is not None:
             u, v = self.widget_to_image(event.position().x(), event.position().y())
+            if self.grabber is not None and self.grabber(u, v, 8.0 / self._scale()):
+                self._grab_from = event.position()
+                return
             self.clicked.emit(u, v)
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         self._mouse = event.position()
+        if self._grab_from is not None and self._image is not None:
+            self.dragged.emit(*self.widget_to_image(self._mouse.x(), self._mouse.y()))
         if self._drag_from is not None and self._image is not None:
             delta = event.position() - self._drag_from
             s = self._scale()
@@ -316,6 +328,10 @@ class ImageView(QWidget):
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         self._drag_from = None
+        if self._grab_from is not None and event.button() == Qt.MouseButton.LeftButton:
+            moved = (event.position() - self._grab_from).manhattanLength() > 2
+            self._grab_from = None
+            self.drag_finished.emit(*self.widget_to_image(event.position().x(), event.position().y()), moved)
 
     def leaveEvent(self, event) -> None:
         self._mouse = None

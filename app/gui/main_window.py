@@ -154,6 +154,8 @@ class MainWindow(QMainWindow):
         self.virtual.picked.connect(self.report(self._on_pick_3d))
         self.camera.picked.connect(self.report(self._on_pick_2d))
         self.camera.pick_rejected.connect(self.show_error)
+        self.camera.pair_moved.connect(self.report(lambda number, u, v: wb.move_pair_pixel(number, (u, v))))
+        self.camera.pair_selected.connect(self.table.select_number)
         c.accept.clicked.connect(self._accept)
         c.delete.clicked.connect(self._delete)
         c.clear.clicked.connect(self.report(lambda: wb.session.clear()))

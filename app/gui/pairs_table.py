@@ -34,6 +34,14 @@ class PairsTable(QTableWidget):
         item = self.item(rows[0].row(), 0)
         return int(item.text()) if item is not None else None
 
+    def select_number(self, number: int) -> None:
+        """Select the row of pair ``number`` (a click on its point in a pane)."""
+        for row in range(self.rowCount()):
+            item = self.item(row, 0)
+            if item is not None and item.text() == str(number):
+                self.selectRow(row)
+                return
+
     def _residuals(self) -> dict[int, float]:
         result = self.workbench.session.result
         if result is None:

@@ -47,6 +47,19 @@ class Picking:
             self.current_pair = session.pick_2d(pixel, view)
         return self.current_pair
 
+    def move_pair_pixel(self, number: int, pixel) -> None:
+        """Move pair ``number``'s image point to ``pixel`` (u, v) px, after Accept too (undoable). The
+        point stays on the frame it was picked on: the robot must be shown in that state."""
+        pair = self.session.pairs.get(number)
+        if pair.pixel is None:
+            raise OperatorError(f"pair {number} has no image point yet: click it on the camera image")
+        view = pair.view
+        held = self.observations.still
+        if view is not None and held is not None and not held.stamp.same_state(view):
+            raise CalibrationError(f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move its point")
+        self.session.move_2d(number, pixel, view)
+        self.record_event("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
+
     def expected_pixel(self):
         """Where the pair waiting for its image point should lie on the frame being picked on: ``(uv (2,)
         px, basis)``, from the pose of the complete pairs on that frame when there are three or more,

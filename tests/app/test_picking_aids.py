@@ -51,3 +51,38 @@ def test_the_loupe_stretches_a_faint_patch_over_the_grey_levels(qtbot, window):
     flat = np.full((100, 120, 3), 40, np.uint8)
     view.set_image(flat)
     assert view._stretched_patch(60, 50, 10) is None  # nothing to stretch: the plain loupe
+
+
+def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pair(qtbot, window):
+    from PySide6.QtCore import QPoint, Qt
+
+    win, wb = window, window.workbench
+    _go_to_task(qtbot, win)
+    bed = wb.site.bed
+    fixture = wb.workcell.component("oru_1_fixture")
+    model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
+    win.camera.subpixel.setChecked(False)
+    for name in FEATURES[:3]:
+        p_world = apply(fixture.item2world, fixture.features[name])
+        _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+        _click_image(qtbot, win.camera.view, *project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0])
+        wb.accept_pair()
+    view = win.camera.view
+    before = np.array(wb.session.pairs.get(2).pixel)
+    x, y = view.image_to_widget(*before)
+    target = before + (6.0, -4.0)
+    tx, ty = view.image_to_widget(*target)
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+    qtbot.mouseMove(view, QPoint(int(round(tx)), int(round(ty))))
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(tx)), int(round(ty))))
+    after = np.array(wb.session.pairs.get(2).pixel)
+    step = 1.0 / view._scale()  # a widget pixel, in image pixels
+    assert np.linalg.norm(after - target) <= 1.5 * step + 0.5 and len(wb.session.pairs) == 3  # moved, not a new pick
+    assert win.table.selected_number() == 2
+    qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert np.allclose(wb.session.pairs.get(2).pixel, before)
+    # a click on pair 3's point (no drag) selects it in the table and moves nothing
+    p3 = np.array(wb.session.pairs.get(3).pixel)
+    x3, y3 = view.image_to_widget(*p3)
+    qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x3)), int(round(y3))))
+    assert win.table.selected_number() == 3 and np.allclose(wb.session.pairs.get(3).pixel, p3) and len(wb.session.pairs) == 3
