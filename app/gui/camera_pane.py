@@ -70,7 +70,7 @@ class CameraPane(QWidget):
         self.freeze.setToolTip("Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner")
         self.subpixel = QCheckBox("Sub-pixel")
         self.subpixel.setChecked(True)
-        self.subpixel.setToolTip("Refine each pick to the nearest corner (cv2.cornerSubPix)")
+        self.subpixel.setToolTip("Refine each pick: a round feature to the centre of its rim, anything else to the nearest corner (cv2.cornerSubPix)")
         self.edges = QCheckBox("CAD edges")
         self.edges.setToolTip("After a solve, draw the model's edges from the measured camera pose")
         self.edges.setChecked(True)
@@ -163,7 +163,10 @@ class CameraPane(QWidget):
                 self.pick_rejected.emit(f"nothing picked: {exc}")
                 return
         if self.subpixel.isChecked():
-            u, v = refine_subpixel(self.last_frame.image, u, v)
+            # a round feature to its rim's centre; anything else to the nearest corner
+            image = self.held.frame.image if self.held is not None else self.last_frame.image
+            centre = self.workbench.refine_circle_pick(image, (u, v))
+            u, v = (float(centre[0]), float(centre[1])) if centre is not None else refine_subpixel(self.last_frame.image, u, v)
         self.picked.emit(u, v)
 
     # --- a picked point dragged (after Accept too), or clicked to select its pair ------------------------

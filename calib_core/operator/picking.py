@@ -60,24 +60,17 @@ class Picking:
         self.session.move_2d(number, pixel, view)
         self.record_event("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
 
-    def expected_pixel(self):
-        """Where the pair waiting for its image point should lie on the frame being picked on: ``(uv (2,)
-        px, basis)``, from the pose of the complete pairs on that frame when there are three or more,
-        else from the model's camera; ``None`` when no pair waits."""
+    def _pick_pose(self):
+        """The target's pose in the camera for the frame being picked on: ``(obj2cam (4, 4), basis)``, from
+        the complete pairs on that frame when there are three or more, else from the model's camera."""
         import numpy as np
 
-        from calib_core.camera.projection import project_points
         from calib_core.frames import apply, invert
 
-        pending = self.session.pairs.pending()
-        target = self.session.target
-        if pending is None or target is None:
-            return None
         held = self.observations.still
         joints = np.asarray(held.stamp.joints_deg if held is not None else self.joints_deg, dtype=float)
-        obj2world = self.workcell.component(target).item2world
+        obj2world = self.workcell.component(self.session.target).item2world
         obj2cam = invert(self.robot.fk(joints, "camera")) @ obj2world
-        basis = "from the model"
         done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
         if len(done) >= 3:
             from calib_core.solver import solve_pose
@@ -89,10 +82,49 @@ class Picking:
             except SolverInputError:
                 solution = None
             if solution is not None and solution.status.value != "failed":
-                obj2cam = solution.obj2cam
-                basis = f"from pairs {', '.join(str(p.number) for p in done)}"
+                return solution.obj2cam, f"from pairs {', '.join(str(p.number) for p in done)}"
+        return obj2cam, "from the model"
+
+    def expected_pixel(self):
+        """Where the pair waiting for its image point should lie on the frame being picked on: ``(uv (2,)
+        px, basis)`` (see :meth:`_pick_pose`); ``None`` when no pair waits."""
+        import numpy as np
+
+        from calib_core.camera.projection import project_points
+        from calib_core.frames import apply, invert
+
+        pending = self.session.pairs.pending()
+        if pending is None or self.session.target is None:
+            return None
+        obj2cam, basis = self._pick_pose()
+        obj2world = self.workcell.component(self.session.target).item2world
         uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.intrinsics)[0]
         return (uv, basis) if np.all(np.isfinite(uv)) else None
+
+    def refine_circle_pick(self, image, pixel):
+        """A click on a round feature (the waiting pair's feature is a circle in the workcell) moved to the
+        rim's centre: the rim the model predicts, placed at the click, fitted to the image's edges within
+        4 px, corrected for perspective. ``None`` when the feature is no circle or no rim was found."""
+        import numpy as np
+
+        from calib_core.camera.projection import project_points
+        from calib_core.vision.feature_detectors import Detection, detect_circle
+        from calib_core.vision.find_points import _circle_rim, _grey
+
+        pending = self.session.pairs.pending()
+        target = self.session.target
+        if pending is None or target is None or pending.feature is None:
+            return None
+        item = self.workcell.component(target)
+        kind = item.feature_kinds.get(pending.feature)
+        if kind is None or kind.kind != "circle":
+            return None
+        obj2cam, _ = self._pick_pose()
+        point = np.asarray(item.features[pending.feature], dtype=float)
+        rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
+        centre = project_points(point[None], obj2cam, self.intrinsics)[0]
+        found = detect_circle(_grey(image), rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
+        return found.uv_px if isinstance(found, Detection) else None
 
     def _view_for_pick(self, number: int) -> ViewStamp:
         held = self.observations.still
