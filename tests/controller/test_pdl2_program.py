@@ -15,16 +15,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import serial
 
-from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.driver import ControllerLink
 from calib_core.link.joint_motion import TrapezoidMove
 from calib_core.link.link_types import MoveError
-from calib_core.link.protocol import PROTOCOL_VERSION, ErrorReply, encode, parse_body
+from calib_core.link.protocol import PROTOCOL_VERSION
 from calib_core.link.workstation_auth import AuthState
 
 from tests.controller.pdl2_subset import load
+from tests.core.link.raw_link import first_error_reply
 
 PROGRAM = Path(__file__).resolve().parents[2] / "resources" / "controller" / "videocal_link.pdl"
 KEY = bytes(range(100, 132))
@@ -158,15 +157,6 @@ def test_the_driver_opens_a_session_and_moves_the_arm(program):
 def test_it_refuses_a_wrong_key_and_an_unsealed_move(program):
     with ControllerLink(program.path, rate_hz=20, key=bytes(32)).start(wait_open=True) as intruder:
         assert intruder.auth_state is AuthState.FAILED and "does not hold" in intruder.auth_failure
-    port = serial.serial_for_url(program.path, timeout=0.05)
-    assembler, replies = SentenceAssembler(), []
-    try:
-        port.write(encode("MVJ,x1,10,0,0,0,0,0"))
-        deadline = time.monotonic() + 5
-        while not any(isinstance(r, ErrorReply) for r in replies) and time.monotonic() < deadline:
-            replies += [parse_body(b) for b in assembler.feed(port.read(256))]
-    finally:
-        port.close()
-    (err,) = [r for r in replies if isinstance(r, ErrorReply)]
+    err = first_error_reply(program.path, "MVJ,x1,10,0,0,0,0,0")
     assert err.code == "AUTH" and err.text == "move x1: not obeyed: no authenticated session (send HEL and AUT first)"
     assert program.move is None

@@ -10,17 +10,16 @@ import threading
 import time
 
 import pytest
-import serial
 
 from calib_core.link import auth
-from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_key import LinkKeyError, default_key_path, read_key, user_key, write_new_key
 from calib_core.link.link_types import MoveError
-from calib_core.link.protocol import Ack, ErrorReply, HelloReply, encode, parse_body
+from calib_core.link.protocol import Ack, HelloReply, encode
 from calib_core.link.workstation_auth import AuthState
 
+from tests.core.link.raw_link import first_error_reply
 from tests.core.link.sim_process import SimProcess
 
 KEY = bytes(range(32))
@@ -119,16 +118,7 @@ def sim(tmp_path):
 
 def test_the_simulator_refuses_and_logs_a_raw_unauthenticated_move(sim):
     s = sim("--pty")
-    port = serial.serial_for_url(s.url, timeout=0.05)
-    assembler, replies = SentenceAssembler(), []
-    try:
-        port.write(encode("MVJ,x1,10,0,0,0,0,0"))
-        deadline = time.monotonic() + 5
-        while not any(isinstance(r, ErrorReply) for r in replies) and time.monotonic() < deadline:
-            replies += [parse_body(b) for b in assembler.feed(port.read(256))]
-    finally:
-        port.close()
-    (err,) = [r for r in replies if isinstance(r, ErrorReply)]
+    err = first_error_reply(s.url, "MVJ,x1,10,0,0,0,0,0")
     assert err.code == "AUTH" and err.text.startswith("move x1: not obeyed")
     s.proc.terminate()
     assert "refused: move x1: not obeyed: no authenticated session" in s.proc.stderr.read()
