@@ -141,3 +141,16 @@ def initial_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.n
     if problem.n_points <= SMALL_PROBLEM_POINTS:
         seeds += subset_p3p_seeds(problem, fu, fv)
     return seeds
+
+
+def distinct_seeds(seeds: list[tuple[np.ndarray, np.ndarray]], angle_deg: float = 2.0, rel_translation: float = 0.02) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The seeds with near-copies left out (within ``angle_deg`` and ``rel_translation`` of the distance
+    of one kept before): P3P over overlapping triplets gives the same pose several times, and each copy
+    would be refined to the same minimum. Order kept."""
+    kept: list[tuple[np.ndarray, np.ndarray]] = []
+    cos_limit = np.cos(np.radians(angle_deg))
+    for R, t in seeds:
+        scale = max(float(np.linalg.norm(t)), 1.0)
+        if not any((np.sum(R * Rk) - 1.0) / 2.0 >= cos_limit and np.linalg.norm(t - tk) <= rel_translation * scale for Rk, tk in kept):
+            kept.append((R, t))
+    return kept

@@ -14,7 +14,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import distinct_poses, refine_seed
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
-from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, initial_seeds, subset_p3p_seeds
+from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.problem import PoseProblem, check_in_front, make_problem
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
@@ -94,7 +94,7 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
-    refined = [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in seeds) if r is not None]
+    refined = [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in distinct_seeds(seeds)) if r is not None]
     best_rms = min((r.rms_px for r in refined), default=np.inf)
     if problem.n_points > SMALL_PROBLEM_POINTS and sampled is None and (best_rms > limit or robust):
         # A mis-click spoils the all-points seeds; triplets that avoid it still find the pose.
