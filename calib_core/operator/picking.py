@@ -123,8 +123,14 @@ class Picking:
         point = np.asarray(item.features[pending.feature], dtype=float)
         rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
         centre = project_points(point[None], obj2cam, self.intrinsics)[0]
-        found = detect_circle(_grey(image), rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
-        return found.uv_px if isinstance(found, Detection) else None
+        grey = _grey(image)
+        found = detect_circle(grey, rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
+        if not isinstance(found, Detection):
+            return None
+        # again from there in a tight window: the rim nearest, not the strongest edge within reach (a faint
+        # boss's base beside its rim)
+        again = detect_circle(grey, rim + (found.uv_px - centre), offset, search_px=1.5)
+        return again.uv_px if isinstance(again, Detection) else found.uv_px
 
     def _view_for_pick(self, number: int) -> ViewStamp:
         held = self.observations.still

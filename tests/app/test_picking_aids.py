@@ -103,6 +103,6 @@ def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
         _click_image(qtbot, win.camera.view, *(uv_true + (2.5, -2.0)), zoom=4.0)  # a hand 3 px off
         errors.append(float(np.linalg.norm(np.array(wb.session.pairs.get(wb.current_pair).pixel) - uv_true)))
         wb.accept_pair()
-    # the hand was 3.2 px off: the knob's rim puts it within 1 px, the faint boss's partial rim within 2
-    # (the boss's base beside its rim pulls the fit; Find points uses a tighter window from a better pose)
-    assert errors[0] < 1.0 and errors[1] < 2.0, errors
+    # the hand was 3.2 px off: the rims put it within about 0.5 (the boss) and 0.9 px (the knob, whose
+    # silhouette lies close to its end face's rim); 1.5 px leaves room for the frame's noise
+    assert max(errors) < 1.5, errors
