@@ -24,8 +24,8 @@ from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.link_key import default_key_path, user_key
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.move_book import MoveBook
+from calib_core.link.sample_order import SampleOrder
 from calib_core.link.protocol import (
-    SEQ_MODULUS,
     Ack,
     Done,
     ErrorReply,
@@ -48,8 +48,6 @@ from calib_core.link.protocol import (
 from calib_core.link.workstation_auth import AuthState, WorkstationAuth
 
 _READ_TIMEOUT_S = 0.01
-_RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted ...
-_FRESH_CLOCK_MS = 500  # ... as has one that went back to its first half second
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
 MODES = ("poll", "stream")
 
@@ -92,7 +90,7 @@ class ControllerLink:
         self._write_lock = threading.Lock()
         self._queue: deque[TimedSample] = deque(maxlen=queue_size)
         self._latest: TimedSample | None = None
-        self._last_seq: int | None = None
+        self._order = SampleOrder(self.stats)
         self._sample_callbacks: list[Callable[[TimedSample], None]] = []
         self._state_callbacks: list[Callable[[LinkState, str], None]] = []
         self._moves = MoveBook()
@@ -417,26 +415,9 @@ class ControllerLink:
         return False
 
     def _deliver(self, sample: TimedSample) -> None:
-        seq = sample.sample.seq
         with self._lock:
-            last_t = self._latest.sample.t_ms if self._latest is not None else None
-            if self._last_seq is not None and last_t is not None:
-                back = (self._last_seq - seq) % SEQ_MODULUS
-                if 0 < back < SEQ_MODULUS // 2 or (back == 0) or sample.sample.t_ms < last_t:
-                    if last_t - sample.sample.t_ms > _RESTART_BACK_MS or sample.sample.t_ms < _FRESH_CLOCK_MS:
-                        self.stats.controller_restarts += 1  # its clock and count start again: fresh
-                        self._last_seq = None
-                    else:
-                        self.stats.backwards_samples += 1  # a repeat or an old sample: not the robot now
-                        return
-            if self._last_seq is not None:
-                expected = (self._last_seq + 1) % SEQ_MODULUS
-                if seq != expected:
-                    self.stats.seq_gaps += 1
-                    skipped = (seq - expected) % SEQ_MODULUS
-                    if skipped < SEQ_MODULUS // 2:  # otherwise the controller restarted its count
-                        self.stats.missing_samples += skipped
-            self._last_seq = seq
+            if not self._order.admit(sample.sample):
+                return
             self._latest = sample
             self._queue.append(sample)
             self.stats.samples += 1
