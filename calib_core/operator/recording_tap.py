@@ -16,7 +16,7 @@ import numpy as np
 from calib_core.calibration.correspondences import pair_to_dict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.recording import foxglove_messages as fm
-from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC
+from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, FOUND_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC
 
 
 TF_CHANGE_DEG = 1e-3
@@ -48,6 +48,7 @@ class RecordingTap:
             (core.solved, self._solved),
             (core.correction_stored, self._correction),
             (core.session.pairs.changed, self._pairs),
+            (core.points_found, self._found),
         ]
         for signal, slot in self._connections:
             signal.connect(slot)
@@ -138,6 +139,12 @@ class RecordingTap:
         self.recorder.record_event(f"pair_{event}", **detail)
         self._reprojected = None  # the last solve's reprojections no longer match the pairs
         self._annotate()
+
+    def _found(self, found) -> None:
+        """Find points' proposals and its edge fit's edge points, on the frame they were found on."""
+        t_ns = self.recorder.unix_ns(found.view.t_capture_s)
+        edges = found.result.edges.edges_px if found.result.edges is not None and found.result.edges.settled else None
+        self.recorder.record_message(FOUND_TOPIC, fm.found_points_annotations([(p.feature, p.uv_px) for p in found.result.proposals], t_ns, edges))
 
     def _annotate(self) -> None:
         """The picks (numbered as in the window's table) and the last solve's reprojections, on the

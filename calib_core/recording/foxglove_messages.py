@@ -14,7 +14,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC, VIDEO_TOPIC
+from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, FOUND_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC, VIDEO_TOPIC
 
 WORLD_FRAME = "world"
 """The root of the recorded frame tree: the cell's world (the robot's base frame)."""
@@ -27,7 +27,8 @@ def _classes() -> dict:
     from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
     from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 
-    return {VIDEO_TOPIC: CompressedVideo, CALIBRATION_TOPIC: CameraCalibration, TRANSFORMS_TOPIC: FrameTransforms, ANNOTATIONS_TOPIC: ImageAnnotations, SCENE_TOPIC: SceneUpdate}
+    return {VIDEO_TOPIC: CompressedVideo, CALIBRATION_TOPIC: CameraCalibration, TRANSFORMS_TOPIC: FrameTransforms, ANNOTATIONS_TOPIC: ImageAnnotations, FOUND_TOPIC: ImageAnnotations,
+            SCENE_TOPIC: SceneUpdate}
 
 
 def protobuf_schema(topic: str) -> tuple[str, bytes]:
@@ -143,6 +144,39 @@ def image_annotations(picks, t_ns: int, reprojected=None, stale_numbers=()):
                 for (x, y) in (picked[number], (u, v)):
                     p = residuals.points.add()
                     p.x, p.y = x, y
+    return message
+
+
+_FOUND = (0.31, 0.78, 1.0, 1.0)
+_EDGE = (1.0, 0.85, 0.2, 0.8)
+
+
+def found_points_annotations(proposals, t_ns: int, edges_px=None):
+    """``foxglove.ImageAnnotations`` of a Find points: ``proposals`` ``[(feature, (u, v) px)]`` as blue
+    circles named after their features, and ``edges_px`` (m, 2) the image edge points its edge fit
+    settled on, as small dots (OpenCV pixels, shifted to Foxglove's corner origin)."""
+    from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
+    from foxglove_schemas_protobuf.PointsAnnotation_pb2 import PointsAnnotation
+
+    message = ImageAnnotations()
+    for feature, uv in proposals:
+        u, v = _corner_origin(uv)
+        circle = message.circles.add(diameter=12.0, thickness=2.0)
+        _stamp(circle, t_ns)
+        circle.position.x, circle.position.y = u, v
+        _color(circle.outline_color, _FOUND)
+        text = message.texts.add(text=str(feature), font_size=12.0)
+        _stamp(text, t_ns)
+        text.position.x, text.position.y = u + 8.0, v - 8.0
+        _color(text.text_color, _FOUND)
+        _color(text.background_color, (0, 0, 0, 0.6))
+    if edges_px is not None and len(edges_px):
+        dots = message.points.add(type=PointsAnnotation.Type.POINTS, thickness=2.0)
+        _stamp(dots, t_ns)
+        _color(dots.outline_color, _EDGE)
+        for uv in np.asarray(edges_px, dtype=float):
+            p = dots.points.add()
+            p.x, p.y = _corner_origin(uv)
     return message
 
 

@@ -19,6 +19,8 @@ JPEG frames (``foxglove.CompressedImage``, JSON) when a recording is made with `
 a recording has only the one of the two it uses."""
 CALIBRATION_TOPIC = "/camera/calibration"
 ANNOTATIONS_TOPIC = "/camera/annotations"
+FOUND_TOPIC = "/camera/found_points"
+"""Find points' proposals and the edge samples its fit used (``foxglove.ImageAnnotations``), on the frame found on."""
 TRANSFORMS_TOPIC = "/tf"
 SCENE_TOPIC = "/videocal/scene"
 JOINTS_TOPIC = "/robot/joints"
@@ -204,6 +206,6 @@ TOPICS = {
 def schema_bytes(topic: str) -> bytes:
     return json.dumps({"$schema": "https://json-schema.org/draft/2020-12/schema", **TOPICS[topic]}).encode()
 
-PROTOBUF_TOPICS = (VIDEO_TOPIC, CALIBRATION_TOPIC, ANNOTATIONS_TOPIC, TRANSFORMS_TOPIC, SCENE_TOPIC)
+PROTOBUF_TOPICS = (VIDEO_TOPIC, CALIBRATION_TOPIC, ANNOTATIONS_TOPIC, FOUND_TOPIC, TRANSFORMS_TOPIC, SCENE_TOPIC)
 """Topics in Foxglove's protobuf schemas (see ``foxglove_messages``)."""
 KNOWN_TOPICS = frozenset(TOPICS) | frozenset(PROTOBUF_TOPICS)

@@ -62,6 +62,15 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
     result = wb.session.result
     assert result is not None and result.solution.method == "edges" and "OK" in win.results.verdict.text()
     assert "edge samples" in win.results.details.text()
+    found = win.finder.dialog.found
     wb.stop_recording()
+    from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
+
+    from calib_core.recording.reader import read_recording
+    from calib_core.recording.schemas import FOUND_TOPIC
+
+    (message,) = read_recording(tmp_path / "edges.mcap").topic(FOUND_TOPIC)  # Foxglove shows them on the frame found on
+    annotations = ImageAnnotations.FromString(message.raw)
+    assert len(annotations.circles) == len(found.result.proposals) and len(annotations.points[0].points) > 100
     run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(tmp_path / "edges.mcap")], capture_output=True, text=True, timeout=120)
     assert run.returncode == 0 and "skipped (solved on the image's edges" in run.stdout, run.stdout + run.stderr

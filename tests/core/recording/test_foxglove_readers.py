@@ -67,6 +67,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     for k in range(3):
         frame_now(core, k, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 60 + 40 * k, np.uint8))
     _pick_all(core, site.bed, q)
+    assert not core.find_points().result.found  # a flat grey frame: recorded all the same
     core.calibrate()
     core.store_correction(confirmation="test")
     core.stop_recording()
@@ -75,6 +76,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     assert result["schemas"]["/camera/video"] == "foxglove.CompressedVideo" and result["schemas"]["/tf"] == "foxglove.FrameTransforms"
     assert result["schemas"]["/camera/calibration"] == "foxglove.CameraCalibration" and result["schemas"]["/camera/annotations"] == "foxglove.ImageAnnotations"
     assert result["schemas"]["/videocal/scene"] == "foxglove.SceneUpdate" and "/camera/image/compressed" not in result["schemas"]
+    assert result["schemas"]["/camera/found_points"] == "foxglove.ImageAnnotations"
     assert [a["name"] for a in result["attachments"]] == ["robot.urdf"]
 
 
