@@ -18,6 +18,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scale", type=bounded_float(0.1, 2.0), default=1.0, help="camera resolution relative to the camera file's")
     parser.add_argument("--workcell", type=Path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
+    parser.add_argument("--method", choices=("picks", "find-points", "edges"), default="picks",
+                        help="how each look is made: the operator's picks (default), Find points and Accept all, or Find points and Calibrate on edges")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -29,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location)
+    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method)
     print(json.dumps({k: report[k] for k in ("status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
     print(f"screenshots and report.json in {args.out}")
     return 0

@@ -22,6 +22,7 @@ from PySide6.QtCore import QEventLoop, QPointF, QSettings, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
+from calib_core.errors import OperatorError
 from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
@@ -83,7 +84,10 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
     _click(view, *view.image_to_widget(u, v))
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None) -> dict:
+METHODS = ("picks", "find-points", "edges")
+
+
+def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "picks") -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
     from calib_core.workcell import load_workcell
@@ -153,8 +157,37 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             if wb.motion.motion.value not in ("moving", "arrived"):
                 raise RuntimeError(f"demo: the move was not sent: {win.results.status.text()}")
 
+        def find_and_calibrate(round_name: str) -> None:
+            """One calibration with Find points (F6): Accept all and Calibrate, or Calibrate on edges."""
+            win.camera.freeze.setChecked(True)
+            if len(wb.session.pairs):
+                _click(win.commands.clear, 10, 10)
+            _click(win.commands.find_points, 10, 10)
+            _wait(app, lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), 30, "the points found")
+            dialog = win.finder.dialog
+            shot(f"{round_name}_points_found")
+            if method == "edges":
+                if not dialog.edges_button.isEnabled():
+                    raise OperatorError(f"demo ({round_name} look): Find points found no settled edge fit: {dialog.found.result.message}")
+                _click(dialog.edges_button, 10, 10)
+            else:
+                if not dialog.accept_button.isEnabled():
+                    raise OperatorError(f"demo ({round_name} look): Find points found nothing to accept: {dialog.found.result.message}")
+                _click(dialog.accept_button, 10, 10)
+                _click(win.commands.calibrate, 10, 10)
+            _wait(app, lambda: wb.session.result is not None, 30, "the solve")
+            shot(f"{round_name}_calibrated")
+            stored_before = len(wb.session.corrections.history(task.name))
+            _click(win.commands.store, 10, 10)
+            if len(wb.session.corrections.history(task.name)) != stored_before + 1:
+                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
+            win.camera.freeze.setChecked(False)
+
         def pick_and_calibrate(round_name: str) -> None:
             """One calibration where the robot stands: every feature picked in both panes, solved, stored."""
+            if method != "picks":
+                find_and_calibrate(round_name)
+                return
             win.camera.freeze.setChecked(True)
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
@@ -233,12 +266,14 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "workcell": str(Path(workcell).resolve()),
             "robot_joints": n_joints,
             "task_location": task.name,
+            "method": method,
             "target": wb.session.target,
             "features_skipped": skipped,
             "subpixel_refinement_refused": refined_away,
             "moves_confirmed": confirmed,
             "status": r.solution.status.value,
-            "pairs": len(wb.session.pairs.usable()),
+            "pairs": len(wb.session.pairs.usable()) if r.solution.method == "points" else 0,
+            "edge_samples": len(r.solution.residuals_px) if r.solution.method == "edges" else 0,
             "rms_px": r.solution.rms_px,
             "estimated_displacement": {"d_mm": r.displacement_mm.tolist(), "rotation_deg": r.rotation_deg.tolist()},
             "std": {"d_mm": r.std_displacement_mm.tolist(), "rotation_deg": r.std_rotation_deg.tolist()},

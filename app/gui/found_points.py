@@ -52,7 +52,7 @@ class FoundPointsDialog(QDialog):
         self.edges_button = QPushButton("Calibrate on edges")
         self.edges_button.setToolTip("Solve from the target's edges on this frame (hundreds of samples, no pairs): usually the most accurate")
         edges = result.edges
-        self.edges_button.setEnabled(edges is not None and edges.converged)
+        self.edges_button.setEnabled(edges is not None and edges.settled)
         buttons.addButton(self.edges_button, QDialogButtonBox.ButtonRole.ActionRole)
         self.edges_button.clicked.connect(self._calibrate_on_edges)
         buttons.addButton(QDialogButtonBox.StandardButton.Cancel)

@@ -258,8 +258,9 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     if pose is None:
         for i, d in first.items():
             missed.setdefault(names[i], d.reason if isinstance(d, NotDetected) else "no pose fits the detections")
-        return FoundPoints(item.name, False, f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: pick the points by hand",
-                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0)
+        return FoundPoints(item.name, False, f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: "
+                           "pick the points by hand, or Calibrate on edges (its edges settled)",
+                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0, edges=edge_fit)
     final_pose, second = pose, first
     for _ in range(0 if edge_fit.converged else 2):  # predicted from the fitted pose, the windows shrink to the pose's error
         again = detect_all(candidates, final_pose, np.zeros(2), _SECOND_WINDOW_PX)
