@@ -54,12 +54,26 @@ class EdgeFit:
         return self.converged and self.rms_px <= 0.5 and self.inlier_share >= 0.5
 
 
+def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:
+    """The occluding contour seen from ``centre_mm`` (3,) (mesh frame): edges between a face turned to the
+    camera and one turned away, whatever their angle (a pin's round side has no crease). (E, 2, 3) mm."""
+    pairs = mesh.face_adjacency
+    normals = mesh.face_normals[pairs]  # (E, 2, 3)
+    mid = mesh.vertices[mesh.face_adjacency_edges].mean(axis=1)
+    toward = np.einsum("eij,ej->ei", normals, centre_mm - mid) > 0
+    contour = toward[:, 0] != toward[:, 1]
+    return mesh.vertices[mesh.face_adjacency_edges[contour]]
+
+
 def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
-    """3D samples (m, 3) on the visible crease edges and their edges' far ends (m, 3), every ~4 px."""
+    """3D samples (m, 3) on the visible crease and silhouette edges and their edges' far ends (m, 3), every ~4 px."""
     seg, normals = crease_segments(mesh)
     centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
     facing = np.einsum("eij,ej->ei", normals, centre - seg.mean(axis=1)) > 0
     seg = seg[facing.any(axis=1)]
+    silhouette = silhouette_segments(mesh, centre)
+    if len(silhouette):
+        seg = np.concatenate([seg, silhouette]) if len(seg) else silhouette
     if len(seg) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3))
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
