@@ -157,6 +157,14 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             if wb.motion.motion.value not in ("moving", "arrived"):
                 raise RuntimeError(f"demo: the move was not sent: {win.results.status.text()}")
 
+        def store() -> None:
+            """Store correction, checked: one more entry in the task location's history."""
+            stored_before = len(wb.session.corrections.history(task.name))
+            _click(win.commands.store, 10, 10)
+            if len(wb.session.corrections.history(task.name)) != stored_before + 1:
+                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
+            win.camera.freeze.setChecked(False)
+
         def find_and_calibrate(round_name: str) -> None:
             """One calibration with Find points (F6): Accept all and Calibrate, or Calibrate on edges."""
             win.camera.freeze.setChecked(True)
@@ -177,11 +185,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
             shot(f"{round_name}_calibrated")
-            stored_before = len(wb.session.corrections.history(task.name))
-            _click(win.commands.store, 10, 10)
-            if len(wb.session.corrections.history(task.name)) != stored_before + 1:
-                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
-            win.camera.freeze.setChecked(False)
+            store()
 
         def pick_and_calibrate(round_name: str) -> None:
             """One calibration where the robot stands: every feature picked in both panes, solved, stored."""
@@ -231,11 +235,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
             shot(f"{round_name}_calibrated")
-            stored_before = len(wb.session.corrections.history(task.name))
-            _click(win.commands.store, 10, 10)
-            if len(wb.session.corrections.history(task.name)) != stored_before + 1:
-                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
-            win.camera.freeze.setChecked(False)
+            store()
 
         # As in the paper, the camera looks at the object from the task location itself: the correction is
         # measured where it is used. Moving by the correction changes the robot's error a little (its joints

@@ -39,6 +39,7 @@ class FoundPointsDialog(QDialog):
                 item.setFlags(Qt.ItemFlag.ItemIsEnabled)
                 self.table.setItem(row, col, item)
         self.table.resizeColumnsToContents()
+        self.table.horizontalHeader().setStretchLastSection(True)
         layout.addWidget(self.table)
         self.missed = QLabel("\n".join(f"{m.feature}: {m.reason}" for m in result.missed) or "every feature was found")
         self.missed.setTextFormat(Qt.TextFormat.PlainText)
