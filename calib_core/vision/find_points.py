@@ -4,11 +4,12 @@
    by the target itself (a ray from the camera reaches the feature first).
 2. Find where the target really is: its crease edges slid over the image's edges
    (:mod:`calib_core.vision.edge_alignment`). The robot's error is mostly this shift.
-3. Detect each feature by its kind (:mod:`calib_core.vision.feature_detectors`) a few pixels around
-   its shifted prediction.
-4. A robust pose fit (sampled by confidence, PROSAC) rejects wrong detections; the features are
-   predicted again from the fitted pose and detected once more in a tight window; a last robust fit
-   decides. What survives is proposed with its confidence; what does not is listed with the reason.
+3. Refine the pose on the image's gradients (:mod:`calib_core.vision.edge_refinement`); nothing is
+   proposed unless it settles.
+4. Detect each feature by its kind (:mod:`calib_core.vision.feature_detectors`) in a window of three
+   times the edges' scatter around its projection; drop detections more than 1 px from where the
+   edges put them; a robust pose fit (sampled by confidence, PROSAC) rejects the remaining wrong ones.
+   What survives is proposed with its confidence; what does not is listed with the reason.
 
 The result never moves anything: the operator accepts, rejects or drags the proposals.
 """
@@ -29,14 +30,12 @@ from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px
 from calib_core.vision.edge_refinement import EdgeFit, _model_shows_edge, refine_to_edges
-from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude, register_patch
+from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
 SEARCH_RADIUS_PX = 90.0
 """How far (px) the target may lie from where the model puts it: the typical robot error, twice."""
-_FIRST_WINDOW_PX = 6.0
 _EDGE_AGREEMENT_PX = 1.0
-_SECOND_WINDOW_PX = 2.0
 _SIGMA_PX = 0.5
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
@@ -131,7 +130,6 @@ class _Detectors:
         self.grey = grey
         self.expected = expected
         self._rendered: tuple[np.ndarray, np.ndarray] | None = None  # (obj2cam, grey image)
-        self.use_templates = False
         self.magnitude = gradient_magnitude(grey)
         self.intrinsics = intrinsics
         self.segments, self.normals = crease_segments(item.mesh)
@@ -162,28 +160,23 @@ class _Detectors:
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
         return bool(len(s) >= 2 and _model_shows_edge(_grey(self.expected_image(obj2cam)), corner + s[:, None] * d / length).mean() >= 0.6)
 
-    def detect(self, kind: FeatureKind, point, obj2cam, shift, radius) -> Detection | NotDetected:
-        uv = project_points(point[None], obj2cam, self.intrinsics)[0] + shift
-        if self.expected is not None and self.use_templates:
-            half = 20
-            if kind.kind == "circle":  # the whole rim and a margin: a boss's shading is faint
-                rim, _ = _circle_rim(point, kind, obj2cam, self.intrinsics)
-                half = int(np.clip(np.ptp(rim, axis=0).max() / 2 + 8, 20, 60))
-            return register_patch(self.grey, self.expected_image(obj2cam), uv - shift, uv, radius, half_px=half)
+    def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
+        """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
+        uv = project_points(point[None], obj2cam, self.intrinsics)[0]
         if kind.kind == "corner":
             ends = self.arms(point, obj2cam)
             if ends:
                 far = project_points(np.array(ends), obj2cam, self.intrinsics)
-                if self.expected is not None and not shift.any():  # only the arms along which the model shows an edge
+                if self.expected is not None:  # only the arms along which the model shows an edge
                     far = far[[self._arm_shows_edge(uv, f, obj2cam) for f in far]]
-                found = detect_corner_from_edges(self.grey, uv, list(far + shift), search_px=radius, magnitude=self.magnitude)
+                found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude)
                 if isinstance(found, Detection) or self.expected is not None:
                     return found
             return detect_corner(self.grey, uv, radius)
         if kind.kind == "circle":
             rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
-            shows = _model_shows_edge(_grey(self.expected_image(obj2cam)), rim) if self.expected is not None and not shift.any() else None
-            return detect_circle(self.grey, rim + shift, offset, search_px=radius, magnitude=self.magnitude, rim_has_contrast=shows)
+            shows = _model_shows_edge(_grey(self.expected_image(obj2cam)), rim) if self.expected is not None else None
+            return detect_circle(self.grey, rim, offset, search_px=radius, magnitude=self.magnitude, rim_has_contrast=shows)
         return detect_blob(self.grey, uv, max(radius, 6.0))
 
 
@@ -217,8 +210,8 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
 
     detectors = _Detectors(grey, item, intrinsics, expected)
 
-    def detect_all(indices, pose, shift_px, radius):
-        return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, shift_px, radius) for i in indices}
+    def detect_all(indices, pose, radius):
+        return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, radius) for i in indices}
 
     candidates = [i for i in range(len(names)) if visible[i]]
     # the shift as a turn of the camera about its centre, then the edges pull the pose into place; when
@@ -245,7 +238,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     start = edge_fit.obj2cam
     # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
     # times the edges' scatter keeps a detector off the neighbouring edge (a boss's base beside its rim)
-    first = detect_all(candidates, start, np.zeros(2), _FIRST_WINDOW_PX if not edge_fit.converged else float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0)))
+    first = detect_all(candidates, start, float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0)))
     if edge_fit.converged:
         # The edges (hundreds of samples) know the pose better than any one detection: a detection far
         # from where they put its feature found something else (a silhouette in front of a corner).
@@ -262,12 +255,6 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
                            "pick the points by hand, or Calibrate on edges (its edges settled)",
                            missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0, edges=edge_fit)
     final_pose, second = pose, first
-    for _ in range(0 if edge_fit.converged else 2):  # predicted from the fitted pose, the windows shrink to the pose's error
-        again = detect_all(candidates, final_pose, np.zeros(2), _SECOND_WINDOW_PX)
-        better, refit = _robust_fit(again, points, intrinsics, final_pose)
-        if better is None:
-            break
-        final_pose, fit, second = better, refit, again
     proposals = []
     uv_final = project_points(points, final_pose, intrinsics)
     for i, d in second.items():
