@@ -21,6 +21,7 @@ from calib_core.robot import solve_ik
 from calib_core.robot.errors import UnreachableTargetError
 from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
+from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "find_points.md"
@@ -95,13 +96,7 @@ def _run(factor: float, rng) -> dict:
             cam_true = camera.last_truth.cam2world
             err = float(np.linalg.norm(cam_fit[:3, 3] - cam_true[:3, 3]))
             # the bound implied by its own noise estimate: the camera centre's 1-sigma, as a length
-            R, t = fit.obj2cam[:3, :3], fit.obj2cam[:3, 3]
-            from calib_core.vision.edge_solution import _to_solver_covariance
-
-            cov = _to_solver_covariance(fit.covariance, t)
-            tx, ty, tz = t
-            B = np.hstack([-R.T, -R.T @ np.array([[0.0, -tz, ty], [tz, 0.0, -tx], [-ty, tx, 0.0]])])
-            bound = float(np.sqrt(np.trace(B @ cov @ B.T)))
+            bound = float(np.linalg.norm(edge_solution(fit, bed.intrinsics).uncertainty.std_camera_position_mm))
             stats["edge_err_mm"].append(err)
             stats["edge_ratio"].append(err / bound)
     view.close()

@@ -65,6 +65,8 @@ class CameraPane(QWidget):
         self.view.dragged.connect(self._dragging)
         self.view.drag_finished.connect(self._dropped)
         self._grabbed: int | None = None
+        self._proposals: list | None = None
+        self._proposal_joints: np.ndarray | None = None
         self._drag_at: tuple[float, float] | None = None
         self.freeze = QCheckBox("Hold")
         self.freeze.setToolTip("Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner")
@@ -271,7 +273,7 @@ class CameraPane(QWidget):
                 (u, v), basis = expected
                 overlay.points.append((u, v, "expected", EXPECTED_COLOR))
                 overlay.text += f"; it should lie near the white mark ({basis})"
-        if getattr(self, "_proposals", None):
+        if self._proposals:
             if self._same_state(self._proposal_joints):
                 for u, v, label in self._proposals:
                     overlay.points.append((u, v, label, PROPOSAL_COLOR))

@@ -109,7 +109,7 @@ class Picking:
 
         from calib_core.camera.projection import project_points
         from calib_core.vision.feature_detectors import Detection, detect_circle
-        from calib_core.vision.find_points import _circle_rim, _grey
+        from calib_core.vision.find_points import circle_rim, as_grey
 
         pending = self.session.pairs.pending()
         target = self.session.target
@@ -121,9 +121,9 @@ class Picking:
             return None
         obj2cam, _ = self._pick_pose()
         point = np.asarray(item.features[pending.feature], dtype=float)
-        rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
+        rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
         centre = project_points(point[None], obj2cam, self.intrinsics)[0]
-        grey = _grey(image)
+        grey = as_grey(image)
         found = detect_circle(grey, rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
         if not isinstance(found, Detection):
             return None

@@ -9,6 +9,7 @@ at the frame's joints. Nothing here moves the robot.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -18,12 +19,15 @@ from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply
 
+if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
+    from calib_core.vision.find_points import FoundPoints
+
 
 @dataclass(frozen=True)
 class FoundOnFrame:
     """A Find points result and the frame it was found on."""
 
-    result: "FoundPoints"  # noqa: F821 (calib_core.vision.find_points, imported when first used)
+    result: FoundPoints
     view: ViewStamp
 
 

@@ -43,8 +43,8 @@ class EdgeFit:
     converged: bool
     edges_px: np.ndarray
     offsets_px: np.ndarray
-    residuals_px: np.ndarray = None  # type: ignore[assignment]
-    inlier_share: float = 0.0
+    residuals_px: np.ndarray
+    inlier_share: float
     """The share of the model's edge samples that found their image edge in the last step (weight > 0):
     a fit that settled on a few samples (a wrong minimum) has a low one."""
 
@@ -84,7 +84,7 @@ def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.
     return pts, seg[which, 1]
 
 
-def _model_shows_edge(expected: np.ndarray, uv: np.ndarray) -> np.ndarray:
+def model_shows_edge(expected: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """Which pixels (m, 2) of the model's view (h, w) lie on a gradient of at least 12 grey levels a pixel."""
     magnitude = gradient_magnitude(expected)
     h, w = magnitude.shape
@@ -109,7 +109,8 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     pts, far = _edge_points(mesh, obj2cam, intrinsics)
     if expected is not None and len(pts):
         # where the model's view shows no gradient (two faces of one shade meeting) there is no edge to find
-        pts, far = pts[_model_shows_edge(expected, project_points(pts, obj2cam, intrinsics))], far[_model_shows_edge(expected, project_points(pts, obj2cam, intrinsics))]
+        shows = model_shows_edge(expected, project_points(pts, obj2cam, intrinsics))
+        pts, far = pts[shows], far[shows]
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 import trimesh
+from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
@@ -29,7 +30,7 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px
-from calib_core.vision.edge_refinement import EdgeFit, _model_shows_edge, refine_to_edges
+from calib_core.vision.edge_refinement import EdgeFit, model_shows_edge, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
@@ -78,7 +79,7 @@ class FoundPoints:
     """The edge refinement's result (the pose the detections were checked against), when it ran."""
 
 
-def _grey(image: np.ndarray) -> np.ndarray:
+def as_grey(image: np.ndarray) -> np.ndarray:
     return image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
 
 
@@ -108,7 +109,7 @@ def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> 
     return out
 
 
-def _circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+def circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
     """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
     n = np.asarray(kind.normal)
     a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
@@ -149,7 +150,7 @@ class _Detectors:
 
     def expected_image(self, obj2cam: np.ndarray) -> np.ndarray:
         if self._rendered is None or not np.array_equal(self._rendered[0], obj2cam):
-            self._rendered = (obj2cam.copy(), _grey(self.expected(obj2cam)))
+            self._rendered = (obj2cam.copy(), as_grey(self.expected(obj2cam)))
         return self._rendered[1]
 
     def _arm_shows_edge(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> bool:
@@ -158,7 +159,7 @@ class _Detectors:
         if length < 8.0:
             return False
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
-        return bool(len(s) >= 2 and _model_shows_edge(_grey(self.expected_image(obj2cam)), corner + s[:, None] * d / length).mean() >= 0.6)
+        return bool(len(s) >= 2 and model_shows_edge(as_grey(self.expected_image(obj2cam)), corner + s[:, None] * d / length).mean() >= 0.6)
 
     def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
         """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
@@ -174,8 +175,8 @@ class _Detectors:
                     return found
             return detect_corner(self.grey, uv, radius)
         if kind.kind == "circle":
-            rim, offset = _circle_rim(point, kind, obj2cam, self.intrinsics)
-            shows = _model_shows_edge(_grey(self.expected_image(obj2cam)), rim) if self.expected is not None else None
+            rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
+            shows = model_shows_edge(as_grey(self.expected_image(obj2cam)), rim) if self.expected is not None else None
             return detect_circle(self.grey, rim, offset, search_px=radius, magnitude=self.magnitude, rim_has_contrast=shows)
         return detect_blob(self.grey, uv, max(radius, 6.0))
 
@@ -193,7 +194,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     names = list(item.features)
     if not names:
         return FoundPoints(item.name, False, f"component {item.name!r} has no features to find")
-    grey = _grey(image)
+    grey = as_grey(image)
     points = np.array([item.features[n] for n in names], dtype=float)
     uv_model = project_points(points, obj2cam_model, intrinsics)
     z = points @ obj2cam_model[2, :3] + obj2cam_model[2, 3]
@@ -274,8 +275,6 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
 
 def _turned(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
     """``obj2cam`` with the camera turned about its centre so the image moves by ``shift_px`` (2,)."""
-    from scipy.spatial.transform import Rotation
-
     turn = Rotation.from_rotvec([-shift_px[1] / intrinsics.fv, shift_px[0] / intrinsics.fu, 0.0]).as_matrix()
     out = obj2cam.copy()
     out[:3, :3] = turn @ obj2cam[:3, :3]

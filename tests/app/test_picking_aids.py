@@ -10,6 +10,11 @@ from tests.app.test_calibration_in_window import _click_image, _go_to_task
 FEATURES = ["plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left"]
 
 
+def _pick_on_model(qtbot, win, model_cam, p_world) -> None:
+    """The operator clicks the feature at ``p_world`` (3,) mm in the virtual camera."""
+    _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+
+
 def _expected_mark(win):
     marks = [(u, v) for u, v, label, _ in win.camera.view.overlay.points if label == "expected"]
     return np.array(marks[0]) if marks else None
@@ -25,7 +30,7 @@ def test_the_expected_position_is_drawn_and_sharpens_after_three_pairs(qtbot, wi
     misses, texts = [], []
     for name in FEATURES:
         p_world = apply(fixture.item2world, fixture.features[name])
-        _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+        _pick_on_model(qtbot, win, model_cam, p_world)
         assert wb.session.pairs.pending() is not None
         mark = _expected_mark(win)
         uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
@@ -64,7 +69,7 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
     win.camera.subpixel.setChecked(False)
     for name in FEATURES[:3]:
         p_world = apply(fixture.item2world, fixture.features[name])
-        _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+        _pick_on_model(qtbot, win, model_cam, p_world)
         _click_image(qtbot, win.camera.view, *project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0])
         wb.accept_pair()
     view = win.camera.view
@@ -98,7 +103,7 @@ def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
     errors = []
     for name in ("pin_tip", "boss_bottom_left"):
         p_world = apply(fixture.item2world, fixture.features[name])
-        _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+        _pick_on_model(qtbot, win, model_cam, p_world)
         uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
         _click_image(qtbot, win.camera.view, *(uv_true + (2.5, -2.0)), zoom=4.0)  # a hand 3 px off
         errors.append(float(np.linalg.norm(np.array(wb.session.pairs.get(wb.current_pair).pixel) - uv_true)))
