@@ -1,40 +1,127 @@
-"""``videocal calibrate-hand-eye sim --out FILE``: the camera's mounting on the flange (``cam2flange``)
-from robot poses looking at a ChArUco board, here on the simulated test bed (its truth printed beside)."""
+"""``videocal calibrate-hand-eye SOURCE --out FILE``: the camera's mounting from robot poses and board views.
+
+SOURCE is ``sim`` (the simulated test bed, its truth printed beside the result), a ROS-Industrial
+``cal_data.yaml`` (or its folder), or a CSV of images with flange poses or joints
+(docs/calibration.md). A camera on the robot gives ``cam2flange``; a static camera
+(``--static-camera``, or the data file's ``static_camera``) gives ``cam2base``.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from calib_core.errors import VideocalError
-from app.cli.options import bounded_int
+from app.cli.options import bounded_float, bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", choices=("sim",), help="'sim': the simulated test bed (a real robot and camera need the window's capture mode, not built yet)")
-    parser.add_argument("--workcell", type=Path, help="the cell whose robot and camera are simulated (default: the bundled one); the board stands where its hand_eye_board says, or in front of the robot")
-    parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100")
-    parser.add_argument("--poses", type=bounded_int(3, 200), default=10, help="robot poses to view the board from (3 to 200)")
-    parser.add_argument("--out", type=Path, required=True, help="YAML file for cam2flange (xyz mm, rpy deg) and its 1-sigma")
-    parser.add_argument("--robot-errors", action="store_true", help="give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
+    parser.add_argument("source", help="'sim', a cal_data.yaml (or its folder), or a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>")
+    parser.add_argument("--workcell", type=Path, help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)")
+    parser.add_argument("--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)")
+    parser.add_argument("--intrinsics", type=Path, help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics")
+    parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
+    mount = parser.add_mutually_exclusive_group()
+    mount.add_argument("--static-camera", dest="static", action="store_const", const=True, help="the camera stands in the cell and the robot holds the board")
+    mount.add_argument("--camera-on-robot", dest="static", action="store_const", const=False, help="the camera is on the robot's flange (the default)")
+    parser.add_argument("--pose-sigma-mm", type=bounded_float(0.001, 100.0), default=1.0, help="how well the robot's poses are known, 1-sigma mm (sets when views are said to disagree)")
+    parser.add_argument("--poses", type=bounded_int(3, 200), default=10, help="with 'sim': robot poses to view the board from (3 to 200)")
+    parser.add_argument("--out", type=Path, required=True, help="YAML file for the mounting (xyz mm, rpy deg) and its 1-sigma")
+    parser.add_argument("--robot-errors", action="store_true", help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
+    parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.frames import pose_difference, xyz_rpy_from_transform
-    from calib_core.testbed.test_bed import TestBed
-    from calib_core.testbed.true_robot import RobotErrors
-    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.hand_eye_io import hand_eye_document, save_hand_eye
+
+    if args.source == "sim":
+        result, truth = _simulated(args)
+    else:
+        result, truth = _from_files(args), None
+    save_hand_eye(args.out, result)
+    doc = hand_eye_document(result)
+    if truth is not None:
+        doc["error_against_truth"] = truth
+    if args.json:
+        json.dump(doc, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+        return 0
+    camera = "cam2base" if result.static_camera else "cam2flange"
+    print(f"{result.views} poses, RMS {result.rms_px:.3f} px (the corners' own noise {result.noise_px:.3f} px)")
+    print(f"{camera} xyz {', '.join(f'{v:.3f}' for v in result.camera2mount[:3, 3])} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})")
+    if truth is not None:
+        print(f"error against the test bed's truth: {truth['mm']:.3f} mm, {truth['deg']:.4f} deg")
+    for w in result.warnings:
+        print(f"warning: {w}")
+    print(f"wrote {args.out}")
+    return 0
+
+
+def _detector(args, spec):
+    from calib_core.vision.target_detection import load_detector_settings
+
+    return spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
+
+
+def _from_files(args):
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.vision.board import DEFAULT_SPEC, parse_board
     from calib_core.vision.hand_eye import calibrate_hand_eye
-    from calib_core.vision.hand_eye_io import save_hand_eye
-    from calib_core.vision.board_placement import board_in_cell
-    from calib_core.vision.hand_eye_sim import hand_eye_poses, simulated_hand_eye_images
-    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+    from calib_core.vision.hand_eye_data import load_posed_images
     from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 
-    spec = BoardSpec.parse(args.board)
+    source = Path(args.source)
+    if not source.exists():
+        raise VideocalError(f"{source}: no such file or folder (or use 'sim')")
+    data = load_posed_images(source)
+    spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
+    static = args.static if args.static is not None else bool(data.static_camera)
+    robot = None
+    if data.joint_columns is not None:
+        from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+        robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
+        order = data.joint_order(robot.joint_names)
+    detect = _detector(args, spec)
+    views, flanges, size = [], [], None
+    for posed in data.views:
+        image = data.read_image(posed)
+        if size is None:
+            size = (image.shape[1], image.shape[0])
+        elif (image.shape[1], image.shape[0]) != size:
+            raise VideocalError(f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+        v = detect_view(posed.name, image, spec, detect)
+        if not isinstance(v, BoardView):
+            print(f"rejected {posed.name}: {v.reason}", file=sys.stderr)
+            continue
+        views.append(v)
+        flanges.append(posed.flange2base if posed.flange2base is not None else robot.fk(posed.joints_deg[order], "flange"))
+    if args.intrinsics is not None:
+        intrinsics = load_intrinsics(args.intrinsics, image_size=size)
+    elif data.pinhole is not None:
+        intrinsics = Intrinsics(*data.pinhole, size[0], size[1], (0.0,) * 5)
+    else:
+        raise VideocalError(f"{data.source}: the data file gives no intrinsics: pass --intrinsics FILE")
+    return calibrate_hand_eye(views, flanges, spec, intrinsics, static_camera=static, pose_sigma_mm=args.pose_sigma_mm)
+
+
+def _simulated(args):
+    from calib_core.frames import pose_difference
+    from calib_core.testbed.test_bed import TestBed
+    from calib_core.testbed.true_robot import RobotErrors
+    from calib_core.vision.board import DEFAULT_SPEC, parse_board
+    from calib_core.vision.board_placement import board_in_cell
+    from calib_core.vision.hand_eye import calibrate_hand_eye
+    from calib_core.vision.hand_eye_sim import hand_eye_poses, simulated_hand_eye_images
+    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    spec = parse_board(args.board or DEFAULT_SPEC)
     cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
     typical = RobotErrors.typical(0, n_joints=cell.load_robot().n_joints)
     errors = typical if args.robot_errors else RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
@@ -44,23 +131,16 @@ def run(args: argparse.Namespace) -> int:
     if len(joints) < 3:
         raise VideocalError(f"only {len(joints)} reachable poses see the board")
     print(f"rendering {len(joints)} poses...", file=sys.stderr)
+    detect = _detector(args, spec)
     views, flanges = [], []
     for name, image, q in simulated_hand_eye_images(bed, spec, joints, board2base):
-        v = detect_view(name, image, spec)
+        v = detect_view(name, image, spec, detect)
         if isinstance(v, BoardView):
             views.append(v)
             flanges.append(bed.model_robot.fk(q, "flange"))
         else:
             print(f"rejected {name}: {v.reason}", file=sys.stderr)
-    result = calibrate_hand_eye(views, flanges, spec, bed.intrinsics)
-    save_hand_eye(args.out, result)
-    xyz, _ = xyz_rpy_from_transform(result.cam2flange)
+    result = calibrate_hand_eye(views, flanges, spec, bed.intrinsics, pose_sigma_mm=args.pose_sigma_mm)
     true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
     d, r = pose_difference(result.cam2flange, true)
-    print(f"{result.views} poses, RMS {result.rms_px:.3f} px")
-    print(f"cam2flange xyz {', '.join(f'{v:.3f}' for v in xyz)} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})")
-    print(f"error against the test bed's truth: {np.linalg.norm(d):.3f} mm, {np.linalg.norm(r):.4f} deg")
-    for w in result.warnings:
-        print(f"warning: {w}")
-    print(f"wrote {args.out}")
-    return 0
+    return result, {"mm": float(np.linalg.norm(d)), "deg": float(np.linalg.norm(r))}

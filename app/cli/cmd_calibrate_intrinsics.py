@@ -1,4 +1,5 @@
-"""``videocal calibrate-intrinsics SOURCE --out FILE``: the camera's intrinsics from ChArUco board views.
+"""``videocal calibrate-intrinsics SOURCE --out FILE``: the camera's intrinsics from calibration board views
+(ChArUco, chessboard, circle grid or ArUco grid: ``--board``).
 
 SOURCE is a folder of images, a video file (every ``--every``-th frame), or ``sim`` (views of the
 board rendered by the simulated camera, whose truth is then printed beside the result).
@@ -17,7 +18,8 @@ from app.cli.options import bounded_int
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", help="a folder of images, a video file, or 'sim'")
-    parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100", help="charuco:<columns>x<rows>:<square mm>:<marker mm>:<dictionary>")
+    parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100", help="charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM (inner corners), circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
+    parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="intrinsics file to write (YAML)")
     parser.add_argument("--format", choices=("opencv", "ros"), default="opencv")
     parser.add_argument("--no-distortion", action="store_true", help="fit the pinhole only (as the paper's tool did)")
@@ -28,11 +30,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from calib_core.camera.intrinsics_io import load_intrinsics, save_intrinsics
-    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.board import parse_board
+    from calib_core.vision.target_detection import load_detector_settings
     from calib_core.vision.image_sources import folder_images, video_frames
     from calib_core.vision.intrinsics_calibration import calibrate_intrinsics, detect_views
 
-    spec = BoardSpec.parse(args.board)
+    spec = parse_board(args.board)
+    settings = load_detector_settings(args.detector_params) if args.detector_params else None
     truth = None
     if args.source == "sim":
         from calib_core.vision.sim_views import simulated_board_images
@@ -49,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
             images = video_frames(source, args.every)
         else:
             raise VideocalError(f"{source}: no such folder or video file (or use 'sim')")
-    views, rejected = detect_views(images, spec)
+    views, rejected = detect_views(images, spec, settings)
     for r in rejected:
         print(f"rejected {r.name}: {r.reason}", file=sys.stderr)
     result = calibrate_intrinsics(views, spec, distortion=not args.no_distortion, rejected=rejected)

@@ -18,7 +18,7 @@ from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.camera.intrinsics_io import save_intrinsics
 from calib_core.frames import pose_difference
-from calib_core.vision.board import DEFAULT_SPEC, BoardSpec
+from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.hand_eye import HandEyeCalibration
 from calib_core.vision.hand_eye_io import save_hand_eye
@@ -58,7 +58,7 @@ class VisionPanel(QWidget):
         board = QGroupBox("Board")
         bl = QVBoxLayout(board)
         self.spec = QLineEdit(DEFAULT_SPEC)
-        self.spec.setToolTip("charuco:<columns>x<rows>:<square mm>:<marker mm>:<ArUco dictionary>")
+        self.spec.setToolTip("charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM, circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
         self.spec.editingFinished.connect(guard(self._spec_changed))
         bl.addWidget(self.spec)
         self.show_board = QCheckBox("Board in the simulated cell")
@@ -123,7 +123,7 @@ class VisionPanel(QWidget):
     # --- board ---------------------------------------------------------------------------------
     def _spec_changed(self) -> None:
         try:
-            spec = BoardSpec.parse(self.spec.text().strip())
+            spec = parse_board(self.spec.text().strip())
         except ValueError:
             self.spec.setStyleSheet("color: #ff6060")
             raise

@@ -21,17 +21,21 @@ from calib_core.errors import FileFormatError
 FORMATS = ("opencv", "ros")
 
 
-def load_intrinsics(path: str | Path) -> Intrinsics:
-    """Read intrinsics from an OpenCV FileStorage YAML or a ROS camera_info YAML file."""
+def load_intrinsics(path: str | Path, image_size: tuple[int, int] | None = None) -> Intrinsics:
+    """Read intrinsics from an OpenCV FileStorage YAML or a ROS camera_info YAML file.
+
+    ``image_size`` (width, height) px: the size of the images they are used with, known from the
+    images themselves. A file without ``image_width``/``image_height`` (many OpenCV tools write none)
+    takes this size; a file with a size that differs is refused (it is another camera mode)."""
     path = Path(path)
     if path.exists() and not path.is_file():
         raise FileFormatError(path, "not a regular file")
     text = read_text(path, "intrinsics file", max_bytes=1024 * 1024)
     if text.lstrip().startswith("%YAML") or "!!opencv-matrix" in text:
-        return _load_opencv(path)
+        return _load_opencv(path, image_size)
     data = parse_yaml(text, path)
     if isinstance(data, dict) and "camera_matrix" in data and isinstance(data["camera_matrix"], dict):
-        return _load_ros(path, data)
+        return _load_ros(path, data, image_size)
     raise FileFormatError(path, "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
                           "!!opencv-matrix) or ROS camera_info YAML (camera_matrix: {rows, cols, data})")
 
@@ -58,7 +62,7 @@ def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv
         atomic_write_text(path, yaml.safe_dump(_ros_dict(intrinsics, camera_name), sort_keys=False))
 
 
-def _load_opencv(path: Path) -> Intrinsics:
+def _load_opencv(path: Path, image_size: tuple[int, int] | None = None) -> Intrinsics:
     try:
         fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
     except (cv2.error, SystemError) as exc:  # the binding wraps parse errors in SystemError
@@ -73,8 +77,8 @@ def _load_opencv(path: Path) -> Intrinsics:
             dist = np.zeros(5)
         else:
             dist = _fs_matrix(fs, path, "distortion_coefficients", None).ravel()
-        width = _fs_int(fs, path, "image_width")
-        height = _fs_int(fs, path, "image_height")
+        width = _fs_int(fs, path, "image_width", image_size[0] if image_size else None)
+        height = _fs_int(fs, path, "image_height", image_size[1] if image_size else None)
     except cv2.error as exc:  # a node of another shape than the file's kind says (OpenCV asserts)
         raise FileFormatError(path, f"not an OpenCV intrinsics file ({_first_line(exc).split('error: ')[-1]})") from None
     finally:
@@ -98,32 +102,42 @@ def _fs_matrix(fs: cv2.FileStorage, path: Path, key: str, shape: tuple[int, int]
     return m
 
 
-def _fs_int(fs: cv2.FileStorage, path: Path, key: str) -> int:
+def _image_side(path: Path, key: str, value, from_images: int | None) -> int:
+    """The file's ``value`` for an image side (``None``: absent), checked against the images' side."""
+    if value is None:
+        if from_images is None:
+            raise FileFormatError(path, "missing (the image size is needed; give the images it is used with, whose size then counts)", key)
+        return int(from_images)
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 < value <= MAX_IMAGE_SIDE_PX:
+        raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}, got {value!r}", key)
+    if from_images is not None and value != from_images:
+        raise FileFormatError(path, f"says {value} px, the images are {from_images} px: the file is for another camera mode", key)
+    return value
+
+
+def _fs_int(fs: cv2.FileStorage, path: Path, key: str, from_images: int | None = None) -> int:
     node = fs.getNode(key)
     if node.empty() or node.isNone():
-        raise FileFormatError(path, "missing", key)
+        return _image_side(path, key, None, from_images)
     if not node.isInt() or not 0 < node.real() <= MAX_IMAGE_SIDE_PX:
         raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}", key)
-    return int(node.real())
+    return _image_side(path, key, int(node.real()), from_images)
 
 
-def _load_ros(path: Path, data: dict) -> Intrinsics:
+def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
     known = {"image_width", "image_height", "camera_name", "camera_matrix", "distortion_model",
              "distortion_coefficients", "rectification_matrix", "projection_matrix"}
     unknown = sorted(set(data) - known)
     if unknown:
         raise FileFormatError(path, f"unknown key(s) for a ROS camera_info file: {', '.join(unknown)}")
-    for key in ("image_width", "image_height"):
-        if key not in data:
-            raise FileFormatError(path, "missing", key)
-        if isinstance(data[key], bool) or not isinstance(data[key], int) or not 0 < data[key] <= MAX_IMAGE_SIDE_PX:
-            raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}, got {data[key]!r}", key)
+    width = _image_side(path, "image_width", data.get("image_width"), image_size[0] if image_size else None)
+    height = _image_side(path, "image_height", data.get("image_height"), image_size[1] if image_size else None)
     model = data.get("distortion_model", "plumb_bob")
     if model not in ("plumb_bob", "rational_polynomial"):
         raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
     K = _ros_matrix(path, data, "camera_matrix", 9).reshape(3, 3)
     dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(5)
-    return _build(path, K, dist, data["image_width"], data["image_height"], "camera_matrix", "distortion_coefficients")
+    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")
 
 
 def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarray:

@@ -7,12 +7,10 @@ joints, the camera's mounting on the flange.
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.robot.model import RobotModel
-from calib_core.vision.board import BoardSpec
 from calib_core.vision.hand_eye import HandEyeCalibration, calibrate_hand_eye
 from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError, IntrinsicsCalibration, RejectedView, calibrate_intrinsics, coverage, detect_view
 
@@ -21,12 +19,12 @@ class BoardCapture:
     """Views of one board. ``views`` (accepted, in order) with ``joints_deg`` (the commanded joints
     (6,) deg at each, or ``None`` for a view without a robot pose); ``rejected`` with their reasons."""
 
-    def __init__(self, spec: BoardSpec):
+    def __init__(self, spec):
         self.spec = spec
         self.views: list[BoardView] = []
         self.joints_deg: list[np.ndarray | None] = []
         self.rejected: list[RejectedView] = []
-        self._detector = cv2.aruco.CharucoDetector(spec.board())
+        self._detector = spec.detector()
         self._count = 0
 
     def add(self, image_rgb: np.ndarray, joints_deg=None) -> BoardView | RejectedView:

@@ -1,10 +1,17 @@
-"""The camera's mounting on the flange (``cam2flange``) from robot poses looking at a ChArUco board.
+"""The camera's mounting from robot poses and views of a calibration board.
 
-OpenCV's ``calibrateHandEye`` (Tsai, Park, Daniilidis...) gives a start from the per-view board poses;
-then the reprojection error of every corner in every view is minimised over ``cam2flange`` and the
-board's placement together (``scipy.optimize.least_squares``), with the robot's forward kinematics
-taken as exact. Uncertainty comes from the Jacobian at the optimum. Poor pose sets (too little
-rotation, rotations about parallel axes) are reported.
+Camera on the robot (the usual case here): the result is ``cam2flange`` and where the board stands,
+``board2base``. Camera fixed in the cell, board held by the robot (``static_camera=True``,
+ROS-Industrial's ``static_camera``): ``cam2base`` and ``board2flange``. Both are one problem: with
+``A`` the flange's pose, the board is seen at ``X^-1 A^-1 Y`` (camera on the robot) or ``X^-1 A Y``
+(camera fixed), so the second is the first with ``A`` inverted (what OpenCV's documentation says
+for ``calibrateHandEye`` too).
+
+OpenCV's ``calibrateHandEye`` (Park) gives a start from the per-view board poses; then the
+reprojection error of every corner in every view is minimised over ``X`` and ``Y`` together
+(``scipy.optimize.least_squares``), with the robot's forward kinematics taken as exact. Uncertainty
+comes from the Jacobian at the optimum. Poor pose sets (too little rotation, rotations about parallel
+axes) are reported, and so are views that disagree beyond what the corners' own noise explains.
 """
 
 from __future__ import annotations
@@ -19,36 +26,76 @@ from scipy.spatial.transform import Rotation
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, make_transform
-from calib_core.vision.board import BoardSpec
 from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError
 
 MIN_POSES = 3
 _MIN_ROTATION_DEG = 10.0
+POSE_SIGMA_MM = 1.0
+"""How well an uncalibrated industrial robot's poses are known, 1-sigma per axis, mm (its absolute
+accuracy is 1-3 mm; poses close together agree better)."""
 
 
 @dataclass(frozen=True)
 class HandEyeCalibration:
-    """``cam2flange`` (4, 4) mm with 1-sigma ``std_xyz_mm`` (3,) and ``std_rotation_deg`` (3,);
-    ``board2base`` (4, 4) mm; ``rms_px`` of all corners; ``start`` the closed-form estimate;
-    ``warnings`` about the pose set."""
+    """``camera2mount`` (4, 4) mm, the camera in what holds it (the flange, or the robot's base for a
+    static camera), with 1-sigma ``std_xyz_mm`` (3,) and ``std_rotation_deg`` (3,); ``board2mount``
+    (4, 4) mm the board in what holds it (the base, or the flange); ``rms_px`` of all corners;
+    ``noise_px`` the corners' own noise (the RMS of each view's board pose fitted alone); ``start``
+    the closed-form estimate; ``warnings`` about the pose set and the fit."""
 
-    cam2flange: np.ndarray
+    camera2mount: np.ndarray
     std_xyz_mm: np.ndarray
     std_rotation_deg: np.ndarray
-    board2base: np.ndarray
+    board2mount: np.ndarray
     rms_px: float
     start: np.ndarray
     views: int
     warnings: list[str] = field(default_factory=list)
+    static_camera: bool = False
+    noise_px: float = float("nan")
+    per_view_rms_px: tuple[float, ...] = ()
+
+    def _mobile(self, name: str, value: np.ndarray) -> np.ndarray:
+        if self.static_camera:
+            raise ValueError(f"{name}: this result is for a static camera (cam2base and board2flange)")
+        return value
+
+    def _static(self, name: str, value: np.ndarray) -> np.ndarray:
+        if not self.static_camera:
+            raise ValueError(f"{name}: this result is for a camera on the robot (cam2flange and board2base)")
+        return value
+
+    @property
+    def cam2flange(self) -> np.ndarray:
+        return self._mobile("cam2flange", self.camera2mount)
+
+    @property
+    def board2base(self) -> np.ndarray:
+        return self._mobile("board2base", self.board2mount)
+
+    @property
+    def cam2base(self) -> np.ndarray:
+        return self._static("cam2base", self.camera2mount)
+
+    @property
+    def board2flange(self) -> np.ndarray:
+        return self._static("board2flange", self.board2mount)
 
 
-def board_pose(view: BoardView, spec: BoardSpec, intrinsics: Intrinsics) -> np.ndarray:
+def board_pose(view: BoardView, spec, intrinsics: Intrinsics) -> np.ndarray:
     """``board2cam`` (4, 4) mm of one view (OpenCV's PnP on the detected corners)."""
+    return board_pose_fit(view, spec, intrinsics)[0]
+
+
+def board_pose_fit(view: BoardView, spec, intrinsics: Intrinsics) -> tuple[np.ndarray, float]:
+    """``board2cam`` (4, 4) mm of one view and the RMS distance (px) of its corners from their reprojection."""
     obj = spec.corners_mm()[view.ids]
     ok, rvec, tvec = cv2.solvePnP(obj, view.corners_px, intrinsics.K, intrinsics.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
     if not ok:
         raise CalibrationInputError(f"view {view.name}: the board's pose could not be found")
-    return make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())
+    pose = make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())
+    r = project(apply(pose, obj), intrinsics) - view.corners_px
+    return pose, float(np.sqrt(2.0 * np.mean(r**2)))
 
 
 def pose_set_warnings(flange2base: list[np.ndarray]) -> list[str]:
@@ -73,21 +120,38 @@ def pose_set_warnings(flange2base: list[np.ndarray]) -> list[str]:
     return out
 
 
-def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], spec: BoardSpec, intrinsics: Intrinsics, *, method: int = cv2.CALIB_HAND_EYE_PARK) -> HandEyeCalibration:
-    """``views[i]`` seen with the flange at ``flange2base[i]`` (4, 4, mm, from forward kinematics)."""
+def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], spec, intrinsics: Intrinsics, *, static_camera: bool = False,
+                       pose_sigma_mm: float = POSE_SIGMA_MM, method: int = cv2.CALIB_HAND_EYE_PARK) -> HandEyeCalibration:
+    """``views[i]`` seen with the flange at ``flange2base[i]`` (4, 4, mm, from forward kinematics or
+    the controller). ``static_camera``: the camera stands in the cell and the robot holds the board.
+    ``pose_sigma_mm``: how well the robot's poses are known (1-sigma per axis), which with the corners'
+    measured noise sets when the views are said to disagree."""
     if len(views) != len(flange2base):
         raise CalibrationInputError(f"{len(views)} views but {len(flange2base)} robot poses: every view needs the pose it was taken at")
     if len(views) < MIN_POSES:
         raise CalibrationInputError(f"{len(views)} poses, at least {MIN_POSES} needed (10 or more recommended)")
+    if not spec.unambiguous:
+        raise CalibrationInputError(f"a {spec.kind} target looks the same turned half a turn, so a view does not say which corner is the first: use a ChArUco or ArUco board for the camera's mounting")
     warnings = pose_set_warnings(flange2base)
-    board2cam = [board_pose(v, spec, intrinsics) for v in views]
-    R_cam2flange, t_cam2flange = cv2.calibrateHandEye(
-        [T[:3, :3] for T in flange2base], [T[:3, 3] for T in flange2base],
-        [T[:3, :3] for T in board2cam], [T[:3, 3] for T in board2cam], method=method,
-    )
+    # The camera on the robot sees the board at X^-1 A^-1 Y; a static camera at X^-1 A Y.
+    moving = [invert(T) for T in flange2base] if static_camera else [np.asarray(T, dtype=float) for T in flange2base]
+    fits = [board_pose_fit(v, spec, intrinsics) for v in views]
+    board2cam = [pose for pose, _ in fits]
+    noise = float(np.sqrt(np.mean([e**2 for _, e in fits])))
+    try:
+        R_cam2flange, t_cam2flange = cv2.calibrateHandEye(
+            [T[:3, :3] for T in moving], [T[:3, 3] for T in moving],
+            [T[:3, :3] for T in board2cam], [T[:3, 3] for T in board2cam], method=method,
+        )
+    except cv2.error:
+        raise CalibrationInputError(f"the robot poses and the board views fit no {'static camera' if static_camera else 'camera on the robot'}: "
+                                    f"{'is the camera on the robot?' if static_camera else 'is it a static camera (the robot holding the board)?'} "
+                                    "Are the poses the flange's in the base, in the views' order?") from None
+    if not np.all(np.isfinite(R_cam2flange)) or abs(np.linalg.det(R_cam2flange) - 1.0) > 1e-3:
+        raise CalibrationInputError("the robot poses and the board views give no rotation for the camera's mounting: are the poses the flange's in the base, in the views' order?")
     start = make_transform(R_cam2flange, np.asarray(t_cam2flange).ravel())
     # The board's placement from the start: average over views of flange2base . cam2flange . board2cam.
-    placements = [F @ start @ B for F, B in zip(flange2base, board2cam)]
+    placements = [F @ start @ B for F, B in zip(moving, board2cam)]
     board2base0 = make_transform(Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix(), np.mean([P[:3, 3] for P in placements], axis=0))
     corners = spec.corners_mm()
 
@@ -97,7 +161,7 @@ def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], sp
     def residuals(x):
         cam2flange, board2base = unpack(x)
         out = []
-        for v, F in zip(views, flange2base):
+        for v, F in zip(views, moving):
             board2cam_i = invert(cam2flange) @ invert(F) @ board2base
             out.append((project(apply(board2cam_i, corners[v.ids]), intrinsics) - v.corners_px).ravel())
         return np.concatenate(out)
@@ -115,7 +179,25 @@ def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], sp
         cov = np.full((12, 12), np.inf)
         warnings.append("the pose set does not determine the mounting (singular normal equations)")
     std = np.sqrt(np.clip(np.diag(cov), 0, None))
-    rms = float(np.sqrt(np.mean(r**2) * 2))
-    if rms > 1.0:
-        warnings.append(f"the views do not agree on one mounting (RMS {rms:.1f} px): hand-eye calibration takes the robot's forward kinematics as exact, and this robot's is not accurate enough; calibrate the robot first, or use poses close together")
-    return HandEyeCalibration(cam2flange, std[3:6], np.degrees(std[:3]), board2base, rms, start, len(views), warnings)
+    rms = float(np.sqrt(2.0 * np.mean(r**2)))  # a distance per corner, px
+    bounds = np.cumsum([0] + [2 * len(v.ids) for v in views])
+    per_view = tuple(float(np.sqrt(2.0 * np.mean(r[a:b] ** 2))) for a, b in zip(bounds[:-1], bounds[1:]))
+    distance_mm = float(np.median([np.linalg.norm(B[:3, 3]) for B in board2cam]))
+    pose_px = 0.5 * (intrinsics.fu + intrinsics.fv) * pose_sigma_mm / max(distance_mm, 1.0)
+    limit = disagreement_limit_px(noise, pose_px)
+    if rms > limit:
+        warnings.append(f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
+                        f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
+                        "calibrate the robot first, or use poses close together")
+    typical = float(np.median(per_view))
+    for v, e in zip(views, per_view):
+        if e > max(3.0 * typical, limit):
+            warnings.append(f"view {v.name} disagrees with the others (RMS {e:.2f} px against a typical {typical:.2f} px): a wrong robot pose for it, or the board moved")
+    return HandEyeCalibration(cam2flange, std[3:6], np.degrees(std[:3]), board2base, rms, start, len(views), warnings, static_camera, noise, per_view)
+
+
+def disagreement_limit_px(noise_px: float, pose_px: float) -> float:
+    """The RMS distance (px) above which views are said to disagree on one mounting: three sigma of
+    the corners' noise ``noise_px`` (a distance) and of the robot's pose error seen in the image,
+    ``pose_px`` per axis (so sqrt(2) of it as a distance). Both scale with the camera's resolution."""
+    return 3.0 * float(np.hypot(noise_px, np.sqrt(2.0) * pose_px))

@@ -18,12 +18,18 @@ from calib_core.vision.hand_eye import HandEyeCalibration
 
 
 def hand_eye_document(result: HandEyeCalibration) -> dict:
-    xyz, rpy = xyz_rpy_from_transform(result.cam2flange)
+    """``cam2flange`` (a camera on the robot) or ``cam2base`` (a static camera) with the board's
+    placement, ``board2base`` or ``board2flange``, all as xyz (mm) and rpy (deg)."""
+    xyz, rpy = xyz_rpy_from_transform(result.camera2mount)
+    bxyz, brpy = xyz_rpy_from_transform(result.board2mount)
+    camera, board = ("cam2base", "board2flange") if result.static_camera else ("cam2flange", "board2base")
     return {
-        "cam2flange": {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
+        camera: {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
+        board: {"xyz": [round(float(v), 4) for v in bxyz], "rpy": [round(float(v), 5) for v in brpy]},
         "std": {"xyz_mm": [round(float(v), 4) for v in result.std_xyz_mm], "rotation_deg": [round(float(v), 5) for v in result.std_rotation_deg]},
         "units": {"length": "mm", "angle": "deg"},
         "rms_px": round(result.rms_px, 4),
+        "corner_noise_px": round(float(result.noise_px), 4),
         "poses": result.views,
         "warnings": list(result.warnings),
     }
@@ -42,6 +48,8 @@ def load_cam2flange(path: str | Path) -> np.ndarray:
     times too close)."""
     path = Path(path)
     doc = read_yaml(path, "hand-eye file", max_bytes=1024 * 1024)
+    if isinstance(doc, dict) and "cam2base" in doc and "cam2flange" not in doc:
+        raise FileFormatError(path, "this is a static camera's calibration (cam2base): the camera is not on the robot's flange", "cam2base")
     if not isinstance(doc, dict) or not isinstance(doc.get("cam2flange"), dict):
         raise FileFormatError(path, "not a hand-eye file: expected a cam2flange section with xyz (mm) and rpy (deg)", "cam2flange")
     units = doc.get("units")

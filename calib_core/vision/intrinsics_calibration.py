@@ -1,6 +1,7 @@
-"""Camera intrinsics (fu, fv, cx, cy and k1 k2 p1 p2 k3) from views of a ChArUco board, with
-OpenCV's ``CharucoDetector`` and ``calibrateCameraExtended``: per-view errors, the standard
-deviation of every parameter, coverage of the image, and advice on what views to add."""
+"""Camera intrinsics (fu, fv, cx, cy and k1 k2 p1 p2 k3) from views of a calibration target
+(ChArUco, chessboard, circle grid, ArUco grid: :func:`calib_core.vision.board.parse_board`), with
+OpenCV's detectors and ``calibrateCameraExtended``: per-view errors, the standard deviation of every
+parameter, coverage of the image, and advice on what views to add."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import cv2
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.vision.board import BoardSpec
+from calib_core.vision.target_detection import DetectorSettings
 from calib_core.errors import VideocalError
 
 MIN_CORNERS = 8
@@ -55,22 +56,23 @@ class IntrinsicsCalibration:
     advice: list[str] = field(default_factory=list)
 
 
-def detect_view(name: str, image: np.ndarray, spec: BoardSpec, detector=None) -> BoardView | RejectedView:
-    """Find the board's corners in one image (RGB or grey)."""
+def detect_view(name: str, image: np.ndarray, spec, detector=None) -> BoardView | RejectedView:
+    """Find the target's points in one image (RGB or grey); ``detector`` from ``spec.detector(settings)``
+    (made once for many images), else one with the default settings."""
     grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
-    detector = detector or cv2.aruco.CharucoDetector(spec.board())
-    corners, ids, marker_corners, _ = detector.detectBoard(grey)
+    found = (detector or spec.detector())(grey)
     size = (grey.shape[1], grey.shape[0])
-    if ids is None or len(ids) == 0:
-        seen = 0 if marker_corners is None else len(marker_corners)
-        return RejectedView(name, "no board found" if seen == 0 else f"{seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred")
-    if len(ids) < MIN_CORNERS:
-        return RejectedView(name, f"only {len(ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden")
-    return BoardView(name, corners.reshape(-1, 2).astype(np.float64), ids.ravel().astype(int), size)
+    if len(found.ids) == 0:
+        if found.markers_seen == 0 or spec.kind != "charuco":
+            return RejectedView(name, "no board found")
+        return RejectedView(name, f"{found.markers_seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred")
+    if len(found.ids) < MIN_CORNERS:
+        return RejectedView(name, f"only {len(found.ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden")
+    return BoardView(name, found.corners_px, found.ids, size)
 
 
-def detect_views(images: Iterable[tuple[str, np.ndarray]], spec: BoardSpec) -> tuple[list[BoardView], list[RejectedView]]:
-    detector = cv2.aruco.CharucoDetector(spec.board())
+def detect_views(images: Iterable[tuple[str, np.ndarray]], spec, settings: DetectorSettings | None = None) -> tuple[list[BoardView], list[RejectedView]]:
+    detector = spec.detector(settings)
     views, rejected = [], []
     size = None
     for name, image in images:
@@ -98,7 +100,7 @@ def coverage(views: list[BoardView], image_size: tuple[int, int], grid: tuple[in
     return float(hit.mean())
 
 
-def calibrate_intrinsics(views: list[BoardView], spec: BoardSpec, *, distortion: bool = True, rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
+def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = True, rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
     """Calibrate from detected views; ``distortion=False`` fits the pinhole only (what the paper's tool had)."""
     rejected = list(rejected or [])
     if len(views) < MIN_VIEWS:

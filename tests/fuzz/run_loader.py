@@ -120,8 +120,10 @@ def _cell_folder() -> Path:
 def loaders(folder: Path) -> dict:
     from app.cli.cmd_solve import read_solve_inputs
     from calib_core.camera.intrinsics_io import load_intrinsics
-    from calib_core.vision.board import BoardSpec
+    from calib_core.vision.board import parse_board
+    from calib_core.vision.hand_eye_data import load_posed_images
     from calib_core.vision.hand_eye_io import load_cam2flange
+    from calib_core.vision.target_detection import load_detector_settings
     from calib_core.workcell import load_workcell
     from calib_core.workspace.workspace import load_workspace
 
@@ -132,6 +134,13 @@ def loaders(folder: Path) -> dict:
     solve_doc = json.loads((ROOT / "resources" / "examples" / "pairs.json").read_text())
     workspace_doc = _workspace_doc(folder)
     out = folder / "workcell"
+    settings_doc = {"refine_markers": True, "aruco": {"adaptiveThreshWinSizeMax": 35, "cornerRefinementMethod": 1, "adaptiveThreshConstant": 7.0}, "circle_blobs": {"minArea": 25.0, "filterByConvexity": True}}
+    (out / "poses").mkdir(exist_ok=True)
+    (out / "poses" / "0.yaml").write_text("x: 0.11\ny: 0.59\nz: 0.65\nqx: -0.5186\nqy: 0.8156\nqz: 0.0932\nqw: 0.2390\n")
+    cal_data_doc = {"data": [{"image": "images/0.png", "pose": "poses/0.yaml"}, {"image": "images/1.png", "pose": "poses/0.yaml"}],
+                    "target_finder": {"type": "CharucoGridTargetFinder", "rows": 7, "cols": 5, "chessboard_dim": 0.036195, "aruco_marker_dim": 0.018256, "dictionary": 10},
+                    "intrinsics": {"fx": 1352.0, "fy": 1356.1, "cx": 789.7, "cy": 627.3}, "static_camera": True}
+    csv_text = "image,x_mm,y_mm,z_mm,qx,qy,qz,qw\nimages/0.png,110.0,590.0,650.0,-0.5186,0.8156,0.0932,0.2390\nimages/1.png,120,600,640,0,0,0,1\n"
 
     def yaml_file(name: str, doc=None, text: str | None = None) -> Path:
         path = out / name
@@ -153,7 +162,13 @@ def loaders(folder: Path) -> dict:
                      lambda v: load_cam2flange(yaml_file("he.yaml", v[1]) if v[0] == "doc" else yaml_file("he.yaml", text=v[1]))),
         "workspace": (mutated(workspace_doc), lambda d: load_workspace(json_file("ws.json", d))),
         "solve_inputs": (mutated(solve_doc), lambda d: read_solve_inputs(json_file("solve.json", d))),
-        "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"charuco:-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}", fullmatch=True)), BoardSpec.parse),
+        "detector_settings": (st.one_of(mutated(settings_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(settings_doc)).map(lambda t: ("text", t))),
+                              lambda v: load_detector_settings(yaml_file("detector.yaml", v[1]) if v[0] == "doc" else yaml_file("detector.yaml", text=v[1]))),
+        "cal_data": (st.one_of(mutated(cal_data_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(cal_data_doc)).map(lambda t: ("text", t))),
+                     lambda v: load_posed_images(yaml_file("cal_data.yaml", v[1]) if v[0] == "doc" else yaml_file("cal_data.yaml", text=v[1]))),
+        "pose_csv": (mutated_text(csv_text), lambda t: load_posed_images(yaml_file("views.csv", text=t))),
+        "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"(charuco|aruco):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}(:legacy)?", fullmatch=True),
+                        st.from_regex(r"(chessboard|circles):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}(:asymmetric)?", fullmatch=True)), parse_board),
     }
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from tests.fuzz.run_loader import ROOT
 
-LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec"]
+LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec", "detector_settings", "cal_data", "pose_csv"]
 EXAMPLES = int(os.environ.get("VIDEOCAL_FUZZ_EXAMPLES", "150"))
 
 
