@@ -138,6 +138,47 @@ def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], sp
     fits = [board_pose_fit(v, spec, intrinsics) for v in views]
     board2cam = [pose for pose, _ in fits]
     noise = float(np.sqrt(np.mean([e**2 for _, e in fits])))
+    cam2flange, board2base, start, r, J = _fit(views, moving, board2cam, spec, intrinsics, static_camera, method)
+    dof = max(len(r) - 12, 1)
+    sigma2 = float(r @ r) / dof
+    try:
+        cov = sigma2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.full((12, 12), np.inf)
+        warnings.append("the pose set does not determine the mounting (singular normal equations)")
+    std = np.sqrt(np.clip(np.diag(cov), 0, None))
+    rms, per_view = _rms(r, views)
+    distance_mm = float(np.median([np.linalg.norm(B[:3, 3]) for B in board2cam]))
+    pose_px = 0.5 * (intrinsics.fu + intrinsics.fv) * pose_sigma_mm / max(distance_mm, 1.0)
+    limit = disagreement_limit_px(noise, pose_px)
+    if rms > limit:
+        warnings.append(f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
+                        f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
+                        "calibrate the robot first, or use poses close together")
+        # One bad pose pulls every view: name it when leaving it out makes the rest agree.
+        if len(views) > MIN_POSES + 1:
+            worst = int(np.argmax(per_view))
+            keep = [k for k in range(len(views)) if k != worst]
+            try:
+                *_, r_rest, _ = _fit([views[k] for k in keep], [moving[k] for k in keep], [board2cam[k] for k in keep], spec, intrinsics, static_camera, method)
+            except CalibrationInputError:
+                r_rest = None
+            if r_rest is not None and _rms(r_rest, [views[k] for k in keep])[0] <= limit:
+                warnings.append(f"view {views[worst].name} disagrees with the others: without it the RMS is {_rms(r_rest, [views[k] for k in keep])[0]:.2f} px; "
+                                "a wrong robot pose for it, or the board moved: remove it")
+    return HandEyeCalibration(cam2flange, std[3:6], np.degrees(std[:3]), board2base, rms, start, len(views), warnings, static_camera, noise, per_view)
+
+
+def _rms(r: np.ndarray, views: list[BoardView]) -> tuple[float, tuple[float, ...]]:
+    """RMS distance (px) of all corners and of each view's, from the residual vector ``r``."""
+    bounds = np.cumsum([0] + [2 * len(v.ids) for v in views])
+    per_view = tuple(float(np.sqrt(2.0 * np.mean(r[a:b] ** 2))) for a, b in zip(bounds[:-1], bounds[1:]))
+    return float(np.sqrt(2.0 * np.mean(r**2))), per_view
+
+
+def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
+    """``X`` (camera in its mount), ``Y`` (board in its mount), the closed-form start, the residuals
+    (px) and their Jacobian at the optimum."""
     try:
         R_cam2flange, t_cam2flange = cv2.calibrateHandEye(
             [T[:3, :3] for T in moving], [T[:3, 3] for T in moving],
@@ -169,31 +210,7 @@ def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], sp
     x0 = np.concatenate([Rotation.from_matrix(start[:3, :3]).as_rotvec(), start[:3, 3], Rotation.from_matrix(board2base0[:3, :3]).as_rotvec(), board2base0[:3, 3]])
     fit = least_squares(residuals, x0, method="lm", x_scale=np.r_[[0.01] * 3, [1.0] * 3, [0.01] * 3, [1.0] * 3])
     cam2flange, board2base = unpack(fit.x)
-    r = fit.fun
-    dof = max(len(r) - 12, 1)
-    sigma2 = float(r @ r) / dof
-    J = fit.jac
-    try:
-        cov = sigma2 * np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = np.full((12, 12), np.inf)
-        warnings.append("the pose set does not determine the mounting (singular normal equations)")
-    std = np.sqrt(np.clip(np.diag(cov), 0, None))
-    rms = float(np.sqrt(2.0 * np.mean(r**2)))  # a distance per corner, px
-    bounds = np.cumsum([0] + [2 * len(v.ids) for v in views])
-    per_view = tuple(float(np.sqrt(2.0 * np.mean(r[a:b] ** 2))) for a, b in zip(bounds[:-1], bounds[1:]))
-    distance_mm = float(np.median([np.linalg.norm(B[:3, 3]) for B in board2cam]))
-    pose_px = 0.5 * (intrinsics.fu + intrinsics.fv) * pose_sigma_mm / max(distance_mm, 1.0)
-    limit = disagreement_limit_px(noise, pose_px)
-    if rms > limit:
-        warnings.append(f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
-                        f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
-                        "calibrate the robot first, or use poses close together")
-    typical = float(np.median(per_view))
-    for v, e in zip(views, per_view):
-        if e > max(3.0 * typical, limit):
-            warnings.append(f"view {v.name} disagrees with the others (RMS {e:.2f} px against a typical {typical:.2f} px): a wrong robot pose for it, or the board moved")
-    return HandEyeCalibration(cam2flange, std[3:6], np.degrees(std[:3]), board2base, rms, start, len(views), warnings, static_camera, noise, per_view)
+    return cam2flange, board2base, start, fit.fun, fit.jac
 
 
 def disagreement_limit_px(noise_px: float, pose_px: float) -> float:
