@@ -37,7 +37,8 @@ _register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recor
 _register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")
 _register("export", "app.cli.cmd_export", "export a workspace's corrections as JSON, CSV or a PDL2 listing")
 _register("calibrate-intrinsics", "app.cli.cmd_calibrate_intrinsics", "calibrate the camera's intrinsics from ChArUco board views (folder, video or 'sim')")
-_register("calibrate-hand-eye", "app.cli.cmd_calibrate_hand_eye", "calibrate the camera's mounting on the flange from robot poses viewing a board")
+_register("calibrate-hand-eye", "app.cli.cmd_calibrate_hand_eye", "calibrate the camera's mounting from robot poses viewing a board (sim, cal_data.yaml, CSV)")
+_register("calibrate-robot", "app.cli.cmd_calibrate_robot", "identify the robot's geometric parameters and camera mounting from board views at many poses")
 _register("new-cell", "app.cli.cmd_new_cell", "write a starting cell for a robot description (URDF or xacro): loads and renders at once")
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 

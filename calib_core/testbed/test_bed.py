@@ -34,6 +34,9 @@ class TestBed:
     joints_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
     extra_items: list[SceneItem] = field(default_factory=list)
     """Things put into the real cell for a while (a calibration board): the camera sees them, the CAD does not."""
+    true_components: list[SceneItem] | None = None
+    """Where the cell's components really are (``None``: where the workcell file says; the cold cell
+    moves each by its survey error)."""
     _model_visuals: RobotVisuals | None = field(default=None, repr=False)
 
     __test__ = False  # not a pytest test class despite its name
@@ -56,7 +59,8 @@ class TestBed:
         links = self.visuals.scene_items(q_true)
         for item in links:
             item.item2world = base @ item.item2world
-        return list(self.workcell.components) + links + list(self.extra_items)
+        components = self.workcell.components if self.true_components is None else self.true_components
+        return list(components) + links + list(self.extra_items)
 
     def visuals_for_model(self) -> RobotVisuals:
         """The modelled robot's visuals (the CAD view draws the model, not the truth)."""

@@ -1,0 +1,172 @@
+"""Identification of the robot's geometric parameters from what its camera saw at many poses.
+
+Views of a board (placed anywhere: its placement is found too) and of surveyed cell features (in the
+base frame, which ties the robot to the cell) at known commanded joints. The residual is every
+point's reprojection error (px) through the corrected robot's camera pose. The Jacobian is taken by
+forward differences (each parameter's effect on every pixel); QR with column pivoting on it
+chooses the identifiable subset (:mod:`~calib_core.robot_calibration.observability`); Levenberg-
+Marquardt (``scipy.optimize.least_squares``) fits that subset and the board's placement; the
+covariance is the noise measured by the residuals times the inverse normal matrix.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project
+from calib_core.errors import VideocalError
+from calib_core.frames import apply, invert, make_transform
+from calib_core.robot.model import RobotModel
+from calib_core.robot_calibration.observability import Observability, analyse
+from calib_core.robot_calibration.observations import BOARD, PoseView
+from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
+
+FD_STEP = 1e-4
+"""Forward-difference step, in parameter units (mm, mrad, px, thousandths)."""
+MIN_VIEWS = 6
+
+
+class RobotCalibrationError(VideocalError, ValueError):
+    """Views that cannot calibrate the robot (too few, no board pose, nothing identifiable)."""
+
+
+@dataclass(frozen=True)
+class RobotCalibration:
+    """``names`` of the parameters, ``values`` (p,) and 1-sigma ``sigmas`` (p,) in their units
+    (NaN sigma: not identified, left at 0); ``observability``; ``board2base`` (4, 4) mm or ``None``;
+    ``rms_px`` over all points and ``per_view_rms_px``; ``noise_px`` the residuals' sigma per
+    coordinate; ``robot`` the calibrated model and ``intrinsics`` the camera (calibrated when asked)."""
+
+    names: list[str]
+    values: np.ndarray
+    sigmas: np.ndarray
+    observability: Observability
+    board2base: np.ndarray | None
+    rms_px: float
+    per_view_rms_px: dict[str, float]
+    noise_px: float
+    robot: RobotModel
+    intrinsics: Intrinsics
+    seconds: float
+    start_rms_px: float
+    warnings: list[str] = field(default_factory=list)
+
+    def parameter(self, name: str) -> tuple[float, float]:
+        k = self.names.index(name)
+        return float(self.values[k]), float(self.sigmas[k])
+
+    @property
+    def identified_names(self) -> list[str]:
+        return [self.names[k] for k in self.observability.identified]
+
+
+class _Problem:
+    def __init__(self, robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str, with_intrinsics: bool):
+        self.corrected = CorrectedRobot(robot, camera_frame, with_intrinsics)
+        self.nominal_intrinsics = intrinsics
+        self.views = views
+        self.has_board = any(v.target == BOARD for v in views)
+        self.board0 = np.eye(4)
+        self.size = self.corrected.layout.size
+
+    def residuals(self, p: np.ndarray, board: np.ndarray) -> np.ndarray:
+        self.corrected.set(p)
+        intr = self.corrected.intrinsics(self.nominal_intrinsics)
+        board2base = delta_transform(board) @ self.board0
+        out = []
+        for v in self.views:
+            base2cam = invert(self.corrected.cam2base(v.joints_deg))
+            obj2cam = base2cam @ board2base if v.target == BOARD else base2cam
+            out.append((project(apply(obj2cam, v.points_mm), intr) - v.pixels).ravel())
+        return np.concatenate(out)
+
+    def jacobian(self, p: np.ndarray, board: np.ndarray, columns: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """(J of the chosen parameter columns, J of the 6 board parameters) by forward differences."""
+        r0 = self.residuals(p, board)
+        J = np.empty((r0.size, len(columns)))
+        for c, k in enumerate(columns):
+            dp = p.copy()
+            dp[k] += FD_STEP
+            J[:, c] = (self.residuals(dp, board) - r0) / FD_STEP
+        Jb = np.empty((r0.size, 6 if self.has_board else 0))
+        for c in range(Jb.shape[1]):
+            db = board.copy()
+            db[c] += FD_STEP
+            Jb[:, c] = (self.residuals(p, db) - r0) / FD_STEP
+        return J, Jb
+
+
+def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str) -> np.ndarray:
+    """The board's placement (4, 4) mm from each board view's PnP through the nominal robot, averaged."""
+    placements = []
+    for v in views:
+        if v.target != BOARD or len(v.points_mm) < 4:
+            continue
+        ok, rvec, tvec = cv2.solvePnP(v.points_mm, v.pixels, intrinsics.K, intrinsics.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
+        if ok:
+            placements.append(robot.fk(v.joints_deg, camera_frame) @ make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()))
+    if not placements:
+        raise RobotCalibrationError("no board view gives the board's pose: every board view needs 4 points or more")
+    R = Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix()
+    return make_transform(R, np.median([P[:3, 3] for P in placements], axis=0))
+
+
+def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *, camera_frame: str = "camera", with_intrinsics: bool = False, max_iterations: int = 50) -> RobotCalibration:
+    """Calibrate ``robot`` (its nominal model) from ``views``; see the module's docstring."""
+    started = time.perf_counter()
+    if len(views) < MIN_VIEWS:
+        raise RobotCalibrationError(f"{len(views)} views, at least {MIN_VIEWS} needed (30-40 recommended)")
+    problem = _Problem(robot, intrinsics, views, camera_frame, with_intrinsics)
+    if problem.has_board:
+        problem.board0 = initial_board2base(robot, intrinsics, views, camera_frame)
+    p0, b0 = np.zeros(problem.size), np.zeros(6)
+    start_r = problem.residuals(p0, b0)
+    if not np.all(np.isfinite(start_r)):
+        raise RobotCalibrationError("some points project behind the camera with the nominal model: a view's joints or points are wrong")
+    names = problem.corrected.layout.names
+    J_all, Jb = problem.jacobian(p0, b0, list(range(problem.size)))
+    obs = analyse(J_all, names, problem.corrected.layout.scale, Jb if Jb.size else None)
+    chosen = obs.identified
+    if not chosen:
+        raise RobotCalibrationError("the views determine no parameter: spread the poses (turn every joint, tilt the camera about two axes)")
+    k = len(chosen)
+
+    def unpack(x):
+        p = np.zeros(problem.size)
+        p[chosen] = x[:k]
+        return p, (x[k:] if problem.has_board else b0)
+
+    def fun(x):
+        return problem.residuals(*unpack(x))
+
+    def jac(x):
+        J, Jb_ = problem.jacobian(*unpack(x), chosen)
+        return np.hstack([J, Jb_])
+
+    x0 = np.zeros(k + (6 if problem.has_board else 0))
+    fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
+    p, board = unpack(fit.x)
+    r = fit.fun
+    dof = max(r.size - x0.size, 1)
+    noise = float(np.sqrt(r @ r / dof))
+    J = fit.jac
+    cov = noise**2 * np.linalg.pinv(J.T @ J)
+    sig = np.full(problem.size, np.nan)
+    sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
+    problem.corrected.set(p)
+    bounds = np.cumsum([0] + [2 * len(v.points_mm) for v in views])
+    per_view = {v.name: float(np.sqrt(2.0 * np.mean(r[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
+    warnings = []
+    if not fit.success:
+        warnings.append(f"the fit stopped before converging ({fit.message})")
+    board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
+    return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r**2))), per_view, noise,
+                            problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
+                            float(np.sqrt(2.0 * np.mean(start_r**2))), warnings)

@@ -1,0 +1,131 @@
+"""The robot calibration's files and its score on the simulated test bed.
+
+``robot_calibration.yaml``: every parameter with its value and 1-sigma (identified or left at zero),
+the observability, the residuals per view, the camera. ``<robot>_calibrated.urdf``: the robot's own
+description (xacro expanded) with the corrected joint origins, the same structure otherwise.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from calib_core.atomic_file import atomic_write_text
+from calib_core.frames import invert, pose_difference, transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.robot.model import RobotModel, _to_mm
+from calib_core.robot_calibration.identification import RobotCalibration
+
+
+def _origin_mm(joint: ET.Element) -> np.ndarray:
+    origin = joint.find("origin")
+    xyz = [float(v) * 1000.0 for v in (origin.get("xyz", "0 0 0") if origin is not None else "0 0 0").split()]
+    rpy = [np.degrees(float(v)) for v in (origin.get("rpy", "0 0 0") if origin is not None else "0 0 0").split()]
+    return transform_from_xyz_rpy(xyz, rpy)
+
+
+def _set_origin(joint: ET.Element, T_mm: np.ndarray) -> None:
+    origin = joint.find("origin")
+    if origin is None:
+        origin = ET.SubElement(joint, "origin")
+    xyz, rpy = xyz_rpy_from_transform(T_mm)
+    origin.set("xyz", " ".join(f"{v / 1000.0:.9g}" for v in xyz))
+    origin.set("rpy", " ".join(f"{np.radians(v):.9g}" for v in rpy))
+
+
+def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: str = "camera") -> tuple[str, list[str]]:
+    """The nominal URDF text with each driven joint's origin (and the camera's fixed joint, when the
+    camera is a URDF link) replaced by the calibrated one; and what could not be written there."""
+    root = ET.fromstring(nominal.urdf_xml)
+    joints = {j.get("name"): j for j in root.iter("joint")}
+    by_child = {j.find("child").get("link"): j for j in root.iter("joint") if j.find("child") is not None}
+    left = []
+    for k in range(1, nominal.model.njoints):
+        name = nominal.model.names[k]
+        element = joints.get(name)
+        if element is None:
+            left.append(f"joint {name}: not in the URDF")
+            continue
+        before, after = _to_mm(nominal.model.jointPlacements[k]), _to_mm(calibrated.model.jointPlacements[k])
+        # Pinocchio folds fixed joints before this one into its placement: keep them, change this origin.
+        folded = before @ invert(_origin_mm(element))
+        _set_origin(element, invert(folded) @ after)
+    camera = nominal.roles.get(camera_frame, camera_frame)
+    element = by_child.get(camera)
+    before, after = nominal.frame_placement(camera_frame), calibrated.frame_placement(camera_frame)
+    if element is not None and element.get("type") == "fixed":
+        folded = before @ invert(_origin_mm(element))
+        _set_origin(element, invert(folded) @ after)
+    elif not np.allclose(before, after):
+        left.append(f"the camera frame {camera!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml (camera_on_parent)")
+    return ET.tostring(root, encoding="unicode"), left
+
+
+def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera") -> dict:
+    identified = set(result.observability.identified)
+    xyz, rpy = xyz_rpy_from_transform(result.robot.frame_placement(camera_frame))
+    i = result.intrinsics
+    return {
+        "units": {"length": "mm", "angle": "mrad for corrections, deg for rpy", "pixels": "px"},
+        "model": "each joint's placement in its parent, and the camera's on its joint, corrected by a small transform applied before it, in the parent's frame",
+        "parameters": {name: {"value": round(float(v), 5), "sigma": (round(float(s), 5) if k in identified else None), "identified": k in identified}
+                       for k, (name, v, s) in enumerate(zip(result.names, result.values, result.sigmas))},
+        "observability": {
+            "identified": len(result.observability.identified), "of": len(result.names), "rank": result.observability.rank,
+            "condition_number": round(result.observability.condition, 2),
+            "unidentifiable_directions": [[f"{w:+.2f} {n}" for n, w in d] for d in result.observability.directions],
+            "correlations_over_0_9": [[a, b, r] for a, b, r in result.observability.correlations],
+        },
+        "camera_on_parent": {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
+        "intrinsics": {"fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion)},
+        "board2base": None if result.board2base is None else {"xyz": [round(float(v), 4) for v in xyz_rpy_from_transform(result.board2base)[0]],
+                                                                "rpy": [round(float(v), 5) for v in xyz_rpy_from_transform(result.board2base)[1]]},
+        "rms_px": round(result.rms_px, 4), "start_rms_px": round(result.start_rms_px, 4), "noise_px": round(result.noise_px, 4),
+        "per_view_rms_px": {k: round(v, 4) for k, v in result.per_view_rms_px.items()},
+        "warnings": list(result.warnings),
+    }
+
+
+def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera") -> tuple[Path, Path]:
+    """Write ``robot_calibration.yaml`` and ``<urdf stem>_calibrated.urdf`` into ``folder``, atomically."""
+    folder = Path(folder)
+    doc = calibration_document(result, nominal, camera_frame)
+    urdf, left = calibrated_urdf(nominal, result.robot, camera_frame)
+    doc["warnings"] += left
+    yaml_path = folder / "robot_calibration.yaml"
+    urdf_path = folder / f"{Path(nominal.urdf_path).stem}_calibrated.urdf"
+    atomic_write_text(urdf_path, urdf)
+    atomic_write_text(yaml_path, yaml.safe_dump(doc, sort_keys=False))
+    return yaml_path, urdf_path
+
+
+def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray) -> dict:
+    """How far the calibrated model is from the test bed's truth at ``held_out`` poses: the camera and
+    the TCP relative to the board (what board views determine) and in the base frame, RMS mm and deg;
+    the intrinsics' differences. Only for scoring."""
+
+    def rms(pairs):
+        a = np.array(pairs)
+        return [round(float(np.sqrt(np.mean(a[:, 0] ** 2))), 4), round(float(np.sqrt(np.mean(a[:, 1] ** 2))), 5)]
+
+    out = {}
+    if held_out and result.board2base is not None:
+        for frame in ("camera", "tcp"):
+            rel, base, nominal = [], [], []
+            for q in held_out:
+                est, tru = result.robot.fk(q, frame), bed.true_robot.fk(q, frame)
+                d, r = pose_difference(invert(result.board2base) @ est, invert(board2base_true) @ tru)
+                rel.append((np.linalg.norm(d), np.linalg.norm(r)))
+                d, r = pose_difference(est, tru)
+                base.append((np.linalg.norm(d), np.linalg.norm(r)))
+                d, r = pose_difference(bed.model_robot.fk(q, frame), tru)
+                nominal.append((np.linalg.norm(d), np.linalg.norm(r)))
+            out[f"{frame}_in_board_frame_mm_deg"] = rms(rel)
+            out[f"{frame}_in_base_frame_mm_deg"] = rms(base)
+            out[f"{frame}_nominal_model_mm_deg"] = rms(nominal)
+        out["held_out_poses"] = len(held_out)
+    t, i = truth.intrinsics, result.intrinsics
+    out["intrinsics_error_px"] = {"fu": round(i.fu - t.fu, 3), "fv": round(i.fv - t.fv, 3), "cx": round(i.cx - t.cx, 3), "cy": round(i.cy - t.cy, 3)}
+    return out

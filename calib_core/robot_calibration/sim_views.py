@@ -1,0 +1,39 @@
+"""Board views for a robot calibration from the simulated test bed: the board put up in the cell
+where the plan says, the robot stepped through the planned poses, each frame rendered by the true
+camera and detected as a real one would be. The truth places the board and renders; what comes
+out is only the detected corners and the commanded joints."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calib_core.robot_calibration.observations import PoseView
+from calib_core.testbed.sim_camera import SimulatedCamera
+from calib_core.testbed.test_bed import TestBed
+from calib_core.vision.board import board_item
+from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+
+
+def simulated_pose_views(bed: TestBed, spec, board2base: np.ndarray, joints: list[np.ndarray], seed: int = 0, progress=None) -> tuple[list[BoardView], list[PoseView], list[str]]:
+    """(board views, pose views, rejections) at ``joints`` (commanded, deg) with the board at ``board2base``."""
+    bed.extra_items = [board_item(spec, board2base)]
+    camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed)
+    detect = spec.detector()
+    corners = spec.corners_mm()
+    board_views, pose_views, rejected = [], [], []
+    try:
+        for k, q in enumerate(joints):
+            bed.joints_deg = np.asarray(q, dtype=float)
+            name = f"pose_{k + 1:02d}"
+            view = detect_view(name, camera.read().image, spec, detect)
+            if isinstance(view, BoardView):
+                board_views.append(view)
+                pose_views.append(PoseView(name, bed.joints_deg.copy(), corners[view.ids], view.corners_px))
+            else:
+                rejected.append(f"{name}: {view.reason}")
+            if progress is not None:
+                progress(k + 1, len(joints))
+    finally:
+        camera.close()
+        bed.extra_items = []
+    return board_views, pose_views, rejected
