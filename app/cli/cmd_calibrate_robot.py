@@ -17,6 +17,9 @@ import numpy as np
 
 from app.cli.options import bounded_int
 
+HELD_OUT = 20
+"""Planned poses not used for the calibration: the truth is compared there."""
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", choices=("sim",), help="'sim': the cold cell of the simulated test bed")
@@ -43,7 +46,8 @@ def run(args: argparse.Namespace) -> int:
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
     print(f"planning {args.views} poses...", file=sys.stderr)
-    plan = plan_poses(bed.model_robot, nominal, spec, board2base, args.views + 20, start_deg=bed.workcell.home_joints_deg, seed=args.seed)
+    wanted = args.views + HELD_OUT
+    plan = plan_poses(bed.model_robot, nominal, spec, board2base, wanted, start_deg=bed.workcell.home_joints_deg, candidates=min(160, 3 * wanted), seed=args.seed)
     calibration_q, held_out = plan.joints_deg[: args.views], plan.joints_deg[args.views:]
 
     def progress(k, n):

@@ -12,7 +12,7 @@ covariance is the noise measured by the residuals times the inverse normal matri
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import cv2
 import numpy as np
@@ -118,8 +118,11 @@ def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[Po
     return make_transform(R, np.median([P[:3, 3] for P in placements], axis=0))
 
 
-def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *, camera_frame: str = "camera", with_intrinsics: bool = False, max_iterations: int = 50) -> RobotCalibration:
-    """Calibrate ``robot`` (its nominal model) from ``views``; see the module's docstring."""
+def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *, camera_frame: str = "camera", with_intrinsics: bool = False,
+             parameters: list[str] | None = None, max_iterations: int = 50) -> RobotCalibration:
+    """Calibrate ``robot`` (its nominal model) from ``views``; see the module's docstring.
+    ``parameters``: fit exactly these (names as in the result), instead of the subset QR pivoting
+    chooses (the observability is reported either way)."""
     started = time.perf_counter()
     if len(views) < MIN_VIEWS:
         raise RobotCalibrationError(f"{len(views)} views, at least {MIN_VIEWS} needed (30-40 recommended)")
@@ -133,6 +136,12 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     names = problem.corrected.layout.names
     J_all, Jb = problem.jacobian(p0, b0, list(range(problem.size)))
     obs = analyse(J_all, names, problem.corrected.layout.scale, Jb if Jb.size else None)
+    if parameters is not None:
+        unknown = [n for n in parameters if n not in names]
+        if unknown:
+            raise RobotCalibrationError(f"no parameter {unknown[0]!r}; parameters are named like {names[0]} or camera.rz_mrad")
+        chosen = sorted(names.index(n) for n in parameters)
+        obs = replace(obs, identified=chosen, unidentified=[k for k in range(len(names)) if k not in chosen])
     chosen = obs.identified
     if not chosen:
         raise RobotCalibrationError("the views determine no parameter: spread the poses (turn every joint, tilt the camera about two axes)")

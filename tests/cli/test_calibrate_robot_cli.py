@@ -1,0 +1,48 @@
+"""``videocal calibrate-robot sim`` on the cold cell, as a user runs it: the poses planned, the views
+rendered and detected, the intrinsics calibrated from them, the robot identified; the files it
+writes load; the cold cell differs from its files as it says."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import yaml
+
+from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.robot.model import load_robot
+from calib_core.testbed.cold_cell import SURVEY_MM, cold_test_bed
+
+
+def test_the_cold_cell_is_wrong_where_a_real_one_is():
+    bed, truth = cold_test_bed(seed=0)
+    nominal = load_intrinsics(bed.workcell.intrinsics_path)
+    assert bed.intrinsics == truth.intrinsics  # the simulated camera renders with the truth
+    assert 0.01 <= abs(truth.intrinsics.fu / nominal.fu - 1) <= 0.031
+    assert 5 <= abs(truth.intrinsics.cx - nominal.cx) <= 20 and 5 <= abs(truth.intrinsics.cy - nominal.cy) <= 20
+    assert truth.intrinsics.distortion[0] != nominal.distortion[0]
+    assert all(np.linalg.norm(d) <= SURVEY_MM + 1e-12 for d in truth.survey_error_mm.values()) and len(truth.survey_error_mm) >= 10
+    moved = {c.name: c.item2world for c in bed.true_components}
+    for c in bed.workcell.components:
+        if c.name in truth.survey_error_mm:
+            assert np.allclose(moved[c.name][:3, 3] - c.item2world[:3, 3], truth.survey_error_mm[c.name])
+    assert np.abs(truth.errors.hand_eye_xyz_mm).min() >= 0.5
+
+
+def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-robot", "sim", "--views", "12", "--out", str(tmp_path), "--json"],
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    summary = json.loads(run.stdout)
+    assert summary["views"] == 12 and summary["start_rms_px"] > 2.0 and summary["rms_px"] < 0.2
+    score = summary["score"]
+    # What board views determine: the camera relative to the board, at 20 poses not used.
+    assert score["camera_in_board_frame_mm_deg"][0] < 0.2 and score["camera_in_board_frame_mm_deg"][1] < 0.05  # 12 views; 40 in the bench
+    assert score["camera_nominal_model_mm_deg"][0] > 2.0
+    assert abs(score["intrinsics_error_px"]["cx"]) < 2.0
+    doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
+    identified = [n for n, p in doc["parameters"].items() if p["identified"]]
+    assert identified and all(doc["parameters"][n]["sigma"] > 0 for n in identified)
+    assert doc["observability"]["unidentifiable_directions"]
+    robot = load_robot(tmp_path / "videocal_arm_calibrated.urdf")
+    assert robot.n_joints == 6
