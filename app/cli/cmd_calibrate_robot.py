@@ -16,9 +16,6 @@ from pathlib import Path
 
 from app.cli.options import bounded_int
 
-HELD_OUT = 20
-"""Planned poses not used for the calibration: the truth is compared there."""
-
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", choices=("sim",), help="'sim': the cold cell of the simulated test bed")
@@ -30,46 +27,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.camera.intrinsics_io import load_intrinsics
-    from calib_core.robot_calibration.identification import identify
-    from calib_core.robot_calibration.pose_planner import plan_poses
-    from calib_core.robot_calibration.report import save_robot_calibration, score_against_truth
-    from calib_core.robot_calibration.sim_views import simulated_pose_views
-    from calib_core.testbed.cold_cell import cold_test_bed
-    from calib_core.vision.board import DEFAULT_SPEC, parse_board
-    from calib_core.vision.board_placement import board_in_cell
-    from calib_core.vision.intrinsics_calibration import calibrate_intrinsics
-
-    bed, truth = cold_test_bed(seed=args.seed)
-    nominal = load_intrinsics(bed.workcell.intrinsics_path)
-    spec = parse_board(DEFAULT_SPEC)
-    board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
-    print(f"planning {args.views} poses...", file=sys.stderr)
-    wanted = args.views + HELD_OUT
-    plan = plan_poses(bed.model_robot, nominal, spec, board2base, wanted, start_deg=bed.workcell.home_joints_deg, candidates=min(160, 3 * wanted), seed=args.seed)
-    calibration_q, held_out = plan.joints_deg[: args.views], plan.joints_deg[args.views:]
+    from calib_core.robot_calibration.cold_run import calibrate_cold_cell
+    from calib_core.robot_calibration.report import save_robot_calibration
 
     def progress(k, n):
         print(f"\rview {k} of {n}", end="" if k < n else "\n", file=sys.stderr)
 
-    board_views, views, rejected = simulated_pose_views(bed, spec, board2base, calibration_q, seed=args.seed, progress=progress)
-    for r in rejected:
+    run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=args.with_intrinsics, progress=progress, say=lambda text: print(text, file=sys.stderr))
+    for r in run_.rejected:
         print(f"rejected {r}", file=sys.stderr)
-    intrinsics = calibrate_intrinsics(board_views, spec)
-    print(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views; identifying...", file=sys.stderr)
-    result = identify(bed.model_robot, intrinsics.intrinsics, views, with_intrinsics=args.with_intrinsics)
+    result = run_.result
     args.out.mkdir(parents=True, exist_ok=True)
-    save_robot_calibration(args.out, result, bed.model_robot)
-    score = score_against_truth(result, bed, truth, held_out, board2base)
-    summary = {"views": len(views), "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
+    save_robot_calibration(args.out, result, run_.nominal_robot)
+    summary = {"views": len(result.per_view_rms_px), "rejected": run_.rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
                "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
-               "intrinsics_rms_px": intrinsics.rms_px, "score": score, "out": str(args.out)}
+               "intrinsics_rms_px": run_.intrinsics.rms_px, "score": run_.score, "out": str(args.out)}
     if args.json:
         json.dump(summary, sys.stdout, indent=2, default=float)
         sys.stdout.write("\n")
         return 0
-    print(f"{len(views)} views; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {len(result.observability.identified)} of {len(result.names)} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
-    for key, value in score.items():
+    print(f"{summary['views']} views; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
+    for key, value in run_.score.items():
         print(f"  {key}: {value}")
     print(f"wrote {args.out}")
     return 0
