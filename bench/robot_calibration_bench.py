@@ -49,8 +49,10 @@ def main() -> str:
         "",
         "- the camera's pose relative to the board at held-out poses is what board views determine, and it meets the TCP target's figures;",
         "- the TCP does not yet: a camera sees camera poses, so a translation of the last joint along its axis and the rotation about it are taken "
-        "by the mounting (the joint-6 and camera corrections the report lists as correlated or unidentifiable); the camera-to-tool measurement "
-        "(the gripper closed on a surveyed fixture pin while the camera views the cell) is the step that fixes it, not built yet;",
+        "by the mounting (the joint-6 and camera corrections the report lists as correlated or unidentifiable). Which of two such equivalent "
+        "corrections the pivoting keeps is decided by round-off, so the TCP column changes from run to run (seed 0 gave 0.084 deg in one run "
+        "and 0.174 deg in another, with the camera figures identical): it is not determined by camera views at all. The camera-to-tool "
+        "measurement (the gripper closed on a surveyed fixture pin while the camera views the cell) is the step that fixes it, not built yet;",
         "- the base frame needs views of surveyed cell features (`PoseView(target=\"cell\")`, tested in tests/core/robot_calibration on exact views); "
         "detecting them in the rendered frames for the run above is not built yet;",
         "- identification time is the `identification` column (target 10 s).",
