@@ -8,7 +8,7 @@ import platform
 import time
 from pathlib import Path
 
-from calib_core.robot_calibration.cold_run import calibrate_cold_cell
+from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "robot_calibration.md"
 SEEDS = (0, 1, 2)

@@ -27,7 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.robot_calibration.cold_run import calibrate_cold_cell
+    from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
     from calib_core.robot_calibration.report import save_robot_calibration
 
     def progress(k, n):

@@ -1,4 +1,4 @@
-"""The robot calibration's files and its score on the simulated test bed.
+"""The robot calibration's files.
 
 ``robot_calibration.yaml``: every parameter with its value and 1-sigma (identified or left at zero),
 the observability, the residuals per view, the camera. ``<robot>_calibrated.urdf``: the robot's own
@@ -14,7 +14,7 @@ import numpy as np
 import yaml
 
 from calib_core.atomic_file import atomic_write_text
-from calib_core.frames import invert, pose_difference, transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.frames import invert, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.robot.model import RobotModel, _to_mm
 from calib_core.robot_calibration.identification import RobotCalibration
 
@@ -99,33 +99,3 @@ def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal
     atomic_write_text(urdf_path, urdf)
     atomic_write_text(yaml_path, yaml.safe_dump(doc, sort_keys=False))
     return yaml_path, urdf_path
-
-
-def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray) -> dict:
-    """How far the calibrated model is from the test bed's truth at ``held_out`` poses: the camera and
-    the TCP relative to the board (what board views determine) and in the base frame, RMS mm and deg;
-    the intrinsics' differences. Only for scoring."""
-
-    def rms(pairs):
-        a = np.array(pairs)
-        return [round(float(np.sqrt(np.mean(a[:, 0] ** 2))), 4), round(float(np.sqrt(np.mean(a[:, 1] ** 2))), 5)]
-
-    out = {}
-    if held_out and result.board2base is not None:
-        for frame in ("camera", "tcp"):
-            rel, base, nominal = [], [], []
-            for q in held_out:
-                est, tru = result.robot.fk(q, frame), bed.true_robot.fk(q, frame)
-                d, r = pose_difference(invert(result.board2base) @ est, invert(board2base_true) @ tru)
-                rel.append((np.linalg.norm(d), np.linalg.norm(r)))
-                d, r = pose_difference(est, tru)
-                base.append((np.linalg.norm(d), np.linalg.norm(r)))
-                d, r = pose_difference(bed.model_robot.fk(q, frame), tru)
-                nominal.append((np.linalg.norm(d), np.linalg.norm(r)))
-            out[f"{frame}_in_board_frame_mm_deg"] = rms(rel)
-            out[f"{frame}_in_base_frame_mm_deg"] = rms(base)
-            out[f"{frame}_nominal_model_mm_deg"] = rms(nominal)
-        out["held_out_poses"] = len(held_out)
-    t, i = truth.intrinsics, result.intrinsics
-    out["intrinsics_error_px"] = {"fu": round(i.fu - t.fu, 3), "fv": round(i.fv - t.fv, 3), "cx": round(i.cx - t.cx, 3), "cy": round(i.cy - t.cy, 3)}
-    return out
