@@ -58,8 +58,14 @@ class ArucoGridSpec:
 
     def detector(self, settings: DetectorSettings | None = None):
         settings = settings or DetectorSettings()
+        params = settings.aruco
+        if settings.source is None:
+            # An ArUco grid's points are the marker corners themselves: refine them to sub-pixel unless
+            # a settings file says otherwise (a ChArUco board refines its chessboard corners instead).
+            params = cv2.aruco.DetectorParameters()
+            params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
         board = self.board()
-        detector = cv2.aruco.ArucoDetector(board.getDictionary(), settings.aruco, cv2.aruco.RefineParameters())
+        detector = cv2.aruco.ArucoDetector(board.getDictionary(), params, cv2.aruco.RefineParameters())
         first_id = int(np.min(board.getIds()))
 
         def detect(grey: np.ndarray) -> TargetDetection:

@@ -42,10 +42,7 @@ class TargetDetection:
 
 
 def _aruco_defaults() -> cv2.aruco.DetectorParameters:
-    params = cv2.aruco.DetectorParameters()
-    # Marker corners to a tenth of a pixel: an ArUco grid's points are these corners.
-    params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
-    return params
+    return cv2.aruco.DetectorParameters()
 
 
 def _blob_defaults() -> cv2.SimpleBlobDetector_Params:

@@ -140,7 +140,10 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     win.files.start_recording(tmp_path / "board.mcap")
     for k in range(4):
         _visit_board_pose(qtbot, win, k)
-        qtbot.wait(300)  # a few frames at rest into the recording
+        # Frames at rest into the recording: 0.3 s of camera time past the first still frame (the
+        # replay below seeks 0.15 s past the settle time), however slow the machine runs.
+        still = win.camera.last_frame.t_host_s
+        qtbot.waitUntil(lambda: win.camera.last_frame.t_host_s >= still + 0.3, timeout=10_000)
     win.files.stop_recording()
     plan = vision._plan[:4]
     playback = RecordingPlayback(read_recording(tmp_path / "board.mcap"))
@@ -148,9 +151,10 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     assert wb.replaying
     messages = []
     for q in plan:
-        # the moment the recorded joints reached this pose, plus a little: frame and joints at rest
-        at = next(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
-        win.replay.seek(at + wb.workcell.safety.settle_time_s + 0.15)
+        # just before the robot left this pose: frames and joints at rest for 0.3 s and more by then,
+        # however sparse the frames a loaded machine recorded
+        last = max(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
+        win.replay.seek(last - 0.05)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         messages.append(win.results.status.text())
     assert len(vision.capture.views) == 4, ([vision.views.item(i).text() for i in range(vision.views.count())], messages)
