@@ -1,9 +1,12 @@
-"""``videocal calibrate-robot sim --out DIR``: the robot's geometric parameters and its camera
+"""``videocal calibrate-robot sim|FILE --out DIR``: the robot's geometric parameters and its camera
 mounting from views of a board at many poses (docs/calibration.md).
 
 ``sim`` runs it on the cold cell (calib_core/testbed/cold_cell.py): the poses planned, the robot
-driven through them, each view rendered by the true camera and detected; the camera's intrinsics
-calibrated from the same views first; the result scored against the truth, which nothing else reads.
+driven through them, each view rendered by the true camera and detected, the camera's intrinsics
+calibrated from the same views first, surveyed features located at each task location, the gripper
+closed on each task's fixture for the tool; the result scored against the truth, which nothing else
+reads. ``FILE`` is a CSV of images and joints (``image,<joint names | j1..jn>``, docs/calibration.md)
+of the cell's robot (``--workcell``) viewing a board.
 """
 
 from __future__ import annotations
@@ -13,41 +16,103 @@ import json
 import sys
 from pathlib import Path
 
-
 from app.cli.options import bounded_int
+from calib_core.errors import VideocalError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", choices=("sim",), help="'sim': the cold cell of the simulated test bed")
-    parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="poses to view the board from (8 to 200)")
-    parser.add_argument("--with-intrinsics", action="store_true", help="refine the camera's intrinsics with the robot (they are calibrated from the same views first either way)")
-    parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="which cold cell (its errors are drawn from this)")
+    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), or a CSV of image,<joints> views of a board")
+    parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)")
+    parser.add_argument("--with-intrinsics", action="store_true", help="refine the camera's intrinsics with the robot (they are calibrated from the same views first unless --intrinsics is given)")
+    parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="with 'sim': which cold cell (its errors are drawn from this)")
+    parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
+    parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
+    parser.add_argument("--intrinsics", type=Path, help="with a CSV: the camera's intrinsics file (default: calibrated from the same views)")
+    parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
+def _progress(k, n):
+    print(f"\rview {k} of {n}", end="" if k < n else "\n", file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
-    from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
     from calib_core.robot_calibration.report import save_robot_calibration
 
-    def progress(k, n):
-        print(f"\rview {k} of {n}", end="" if k < n else "\n", file=sys.stderr)
+    if args.source == "sim":
+        from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
 
-    run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=args.with_intrinsics, progress=progress, say=lambda text: print(text, file=sys.stderr))
-    for r in run_.rejected:
+        run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=args.with_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
+        result, robot, nominal, tool, rejected, score = run_.result, run_.robot, run_.nominal_robot, run_.tool, run_.rejected, run_.score
+        intrinsics_rms = run_.intrinsics.rms_px
+    else:
+        result, nominal, rejected, intrinsics_rms = _from_files(args)
+        robot, tool, score = result.robot, None, None
+    for r in rejected:
         print(f"rejected {r}", file=sys.stderr)
-    result = run_.result
     args.out.mkdir(parents=True, exist_ok=True)
-    save_robot_calibration(args.out, result, run_.nominal_robot)
-    summary = {"views": len(result.per_view_rms_px), "rejected": run_.rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
+    save_robot_calibration(args.out, result, nominal, robot=robot, tool=tool)
+    summary = {"views": len(result.per_view_rms_px), "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
                "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
-               "intrinsics_rms_px": run_.intrinsics.rms_px, "score": run_.score, "out": str(args.out)}
+               "intrinsics_rms_px": intrinsics_rms, "out": str(args.out)}
+    if tool is not None:
+        summary["tool"] = {"grasps": len(tool.per_grasp), "spread_mm": tool.spread_mm, "spread_deg": tool.spread_deg}
+    if score is not None:
+        summary["score"] = score
     if args.json:
         json.dump(summary, sys.stdout, indent=2, default=float)
         sys.stdout.write("\n")
         return 0
     print(f"{summary['views']} views; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
-    for key, value in run_.score.items():
+    for w in result.warnings:
+        print(f"warning: {w}")
+    for key, value in (score or {}).items():
         print(f"  {key}: {value}")
     print(f"wrote {args.out}")
     return 0
+
+
+def _from_files(args):
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.robot_calibration.identification import identify
+    from calib_core.robot_calibration.observations import PoseView
+    from calib_core.vision.board import DEFAULT_SPEC, parse_board
+    from calib_core.vision.hand_eye_data import load_posed_images
+    from calib_core.vision.intrinsics_calibration import BoardView, calibrate_intrinsics, detect_view
+    from calib_core.vision.target_detection import load_detector_settings
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    source = Path(args.source)
+    if not source.exists():
+        raise VideocalError(f"{source}: no such file (or use 'sim')")
+    data = load_posed_images(source)
+    if data.joint_columns is None:
+        raise VideocalError(f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses")
+    robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
+    order = data.joint_order(robot.joint_names)
+    spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
+    if not spec.unambiguous:
+        raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+    detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
+    corners = spec.corners_mm()
+    board_views, views, rejected, size = [], [], [], None
+    for k, posed in enumerate(data.views):
+        image = data.read_image(posed)
+        if size is None:
+            size = (image.shape[1], image.shape[0])
+        elif (image.shape[1], image.shape[0]) != size:
+            raise VideocalError(f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+        v = detect_view(posed.name, image, spec, detect)
+        if isinstance(v, BoardView):
+            board_views.append(v)
+            views.append(PoseView(posed.name, posed.joints_deg[order], corners[v.ids], v.corners_px))
+        else:
+            rejected.append(f"{posed.name}: {v.reason}")
+        _progress(k + 1, len(data.views))
+    if args.intrinsics is not None:
+        intrinsics, rms = load_intrinsics(args.intrinsics, image_size=size), None
+    else:
+        calibrated = calibrate_intrinsics(board_views, spec, rejected=[])
+        intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
+    return identify(robot, intrinsics, views, with_intrinsics=args.with_intrinsics), robot, rejected, rms

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QApplication, QDialog, QDialogButtonBox, QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout
+from PySide6.QtWidgets import QDialog, QDialogButtonBox, QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout
 
+from app.gui.busy import busy
 from app.gui.error_boundary import attempt
 
 
@@ -87,14 +88,10 @@ class FindPoints:
 
     def run(self) -> None:
         window, wb = self.window, self.window.workbench
-        window.statusBar().showMessage("finding points ...")
-        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)  # rendering and fitting take a second
-        try:
-            found = {}
+        found = {}
+        with busy(window, "finding points ..."):  # rendering and fitting take a second
             if not attempt(window.show_error, lambda: found.setdefault("found", wb.find_points())):
                 return
-        finally:
-            QApplication.restoreOverrideCursor()
         self.show(found["found"])
 
     def show(self, found) -> None:

@@ -25,6 +25,7 @@ from app.gui.found_points import FindPoints
 from app.gui.solved_edges import SolvedEdges
 from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
+from app.gui.robot_panel import RobotPanel
 from app.gui.vision_panel import VisionPanel
 from app.gui.workbench import Workbench
 from app.gui.confirm import ask, ask_save
@@ -56,6 +57,11 @@ class MainWindow(QMainWindow):
         vision_scroll.setWidgetResizable(True)
         vision_scroll.setWidget(self.vision)
         self.commands.addTab(vision_scroll, "Vision")
+        self.robot_calibration = RobotPanel(workbench, self.show_error)
+        robot_scroll = QScrollArea()
+        robot_scroll.setWidgetResizable(True)
+        robot_scroll.setWidget(self.robot_calibration)
+        self.commands.addTab(robot_scroll, "Robot")
         self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
         cell_scroll = QScrollArea()
         cell_scroll.setWidgetResizable(True)

@@ -36,13 +36,14 @@ from calib_core.operator.observations import Observations
 from calib_core.operator.moves import Moves
 from calib_core.operator.picking import Picking
 from calib_core.operator.point_finding import PointFinding
+from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
 from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles, Picking, Moves, PointFinding):
+class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating):
     """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,

@@ -25,7 +25,7 @@ from calib_core.errors import VideocalError
 from calib_core.frames import apply, invert, make_transform
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observability import Observability, analyse
-from calib_core.robot_calibration.observations import BOARD, PoseView
+from calib_core.robot_calibration.observations import BOARD, CELL, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
 
 FD_STEP = 1e-4
@@ -57,6 +57,14 @@ class RobotCalibration:
     seconds: float
     start_rms_px: float
     warnings: list[str] = field(default_factory=list)
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    """(k, k) of the identified parameters, in the order of ``observability.identified``."""
+    nominal: RobotModel | None = None
+    """A copy of the robot the identification started from (applying the result changes the robot)."""
+    camera_frame: str = "camera"
+    noise_by_target_px: dict[str, float] = field(default_factory=dict)
+    """The residuals' sigma (px per coordinate) of the board views and of the surveyed-feature views,
+    each group weighted by its own."""
 
     def parameter(self, name: str) -> tuple[float, float]:
         k = self.names.index(name)
@@ -152,21 +160,37 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
         p[chosen] = x[:k]
         return p, (x[k:] if problem.has_board else b0)
 
+    # Board corners and surveyed features have their own noise (a tenth of a pixel against the edges'
+    # pose and the survey's tenth of a millimetre): each group weighted by its own measured sigma.
+    group_of = np.concatenate([np.full(2 * len(v.points_mm), 0 if v.target == BOARD else 1) for v in views])
+    weights = np.ones(group_of.size)
+
     def fun(x):
-        return problem.residuals(*unpack(x))
+        return weights * problem.residuals(*unpack(x))
 
     def jac(x):
         J, Jb_ = problem.jacobian(*unpack(x), chosen)
-        return np.hstack([J, Jb_])
+        return weights[:, None] * np.hstack([J, Jb_])
 
     x0 = np.zeros(k + (6 if problem.has_board else 0))
+    group_sigma = {}
+    for _ in range(2 if len(set(group_of.tolist())) > 1 else 1):
+        fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
+        r_px = fit.fun / weights
+        for g in set(group_of.tolist()):
+            sel = group_of == g
+            group_sigma[g] = max(float(np.sqrt(np.mean(r_px[sel] ** 2))), 1e-6)
+            weights[sel] = 1.0 / group_sigma[g]
+        x0 = fit.x
     fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
     p, board = unpack(fit.x)
-    r = fit.fun
+    r = fit.fun / weights
     dof = max(r.size - x0.size, 1)
     noise = float(np.sqrt(r @ r / dof))
     J = fit.jac
-    cov = noise**2 * np.linalg.pinv(J.T @ J)
+    # The weighted residuals have unit variance when the groups' sigmas are right: scale by what they have.
+    scale2 = float(fit.fun @ fit.fun / dof)
+    cov = scale2 * np.linalg.pinv(J.T @ J)
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)
@@ -178,4 +202,23 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
     return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r**2))), per_view, noise,
                             problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
-                            float(np.sqrt(2.0 * np.mean(start_r**2))), warnings)
+                            float(np.sqrt(2.0 * np.mean(start_r**2))), warnings, cov[:k, :k], robot.copy(), camera_frame,
+                            {(BOARD if g == 0 else CELL): v for g, v in group_sigma.items()})
+
+
+def pose_covariance(result: RobotCalibration, q_deg, frame: str = "camera") -> np.ndarray:
+    """The covariance (6, 6) of ``frame``'s pose at joints ``q_deg`` from the identified parameters'
+    covariance: translation (mm) then rotation vector (mrad), both in the base frame."""
+    corrected = CorrectedRobot(result.nominal, result.camera_frame, len(result.values) > 6 * (result.nominal.n_joints + 1))
+    corrected.set(result.values)
+    T0 = corrected.robot.fk(q_deg, frame)
+    ids = result.observability.identified
+    J = np.empty((6, len(ids)))
+    for c, k in enumerate(ids):
+        p = result.values.copy()
+        p[k] += FD_STEP
+        corrected.set(p)
+        T = corrected.robot.fk(q_deg, frame)
+        J[:3, c] = (T[:3, 3] - T0[:3, 3]) / FD_STEP
+        J[3:, c] = 1000.0 * Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec() / FD_STEP
+    return J @ result.covariance @ J.T

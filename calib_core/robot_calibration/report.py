@@ -36,8 +36,8 @@ def _set_origin(joint: ET.Element, T_mm: np.ndarray) -> None:
 
 
 def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: str = "camera") -> tuple[str, list[str]]:
-    """The nominal URDF text with each driven joint's origin (and the camera's fixed joint, when the
-    camera is a URDF link) replaced by the calibrated one; and what could not be written there."""
+    """The nominal URDF text with each driven joint's origin (and the camera's and the TCP's fixed
+    joints, when they are URDF links) replaced by the calibrated one; and what could not be written there."""
     root = ET.fromstring(nominal.urdf_xml)
     joints = {j.get("name"): j for j in root.iter("joint")}
     by_child = {j.find("child").get("link"): j for j in root.iter("joint") if j.find("child") is not None}
@@ -52,14 +52,17 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
         # Pinocchio folds fixed joints before this one into its placement: keep them, change this origin.
         folded = before @ invert(_origin_mm(element))
         _set_origin(element, invert(folded) @ after)
-    camera = nominal.roles.get(camera_frame, camera_frame)
-    element = by_child.get(camera)
-    before, after = nominal.frame_placement(camera_frame), calibrated.frame_placement(camera_frame)
-    if element is not None and element.get("type") == "fixed":
-        folded = before @ invert(_origin_mm(element))
-        _set_origin(element, invert(folded) @ after)
-    elif not np.allclose(before, after):
-        left.append(f"the camera frame {camera!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml (camera_on_parent)")
+    for role in (camera_frame, "tcp"):
+        frame = nominal.roles.get(role, role)
+        element = by_child.get(frame)
+        before, after = nominal.frame_placement(role), calibrated.frame_placement(role)
+        if np.allclose(before, after, atol=1e-9):
+            continue
+        if element is not None and element.get("type") == "fixed":
+            folded = before @ invert(_origin_mm(element))
+            _set_origin(element, invert(folded) @ after)
+        else:
+            left.append(f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})")
     return ET.tostring(root, encoding="unicode"), left
 
 
@@ -83,16 +86,28 @@ def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_f
         "board2base": None if result.board2base is None else {"xyz": [round(float(v), 4) for v in xyz_rpy_from_transform(result.board2base)[0]],
                                                                 "rpy": [round(float(v), 5) for v in xyz_rpy_from_transform(result.board2base)[1]]},
         "rms_px": round(result.rms_px, 4), "start_rms_px": round(result.start_rms_px, 4), "noise_px": round(result.noise_px, 4),
+        "noise_by_target_px": {k: round(v, 4) for k, v in result.noise_by_target_px.items()},
         "per_view_rms_px": {k: round(v, 4) for k, v in result.per_view_rms_px.items()},
         "warnings": list(result.warnings),
     }
 
 
-def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera") -> tuple[Path, Path]:
-    """Write ``robot_calibration.yaml`` and ``<urdf stem>_calibrated.urdf`` into ``folder``, atomically."""
+def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera", *, robot: RobotModel | None = None, tool=None) -> tuple[Path, Path]:
+    """Write ``robot_calibration.yaml`` and ``<urdf stem>_calibrated.urdf`` into ``folder``, atomically.
+    ``robot``: the robot to write (default the identification's; with the TCP from the grasps, say);
+    ``tool``: the :class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool` it came from."""
     folder = Path(folder)
+    robot = robot or result.robot
     doc = calibration_document(result, nominal, camera_frame)
-    urdf, left = calibrated_urdf(nominal, result.robot, camera_frame)
+    if tool is not None:
+        xyz, rpy = xyz_rpy_from_transform(tool.tcp2cam)
+        doc["tcp2cam"] = {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy], "grasps": len(tool.per_grasp),
+                          "spread_mm": round(tool.spread_mm, 4), "spread_deg": round(tool.spread_deg, 5),
+                          "measured": "the TCP in the camera frame, from the gripper closed on surveyed fixtures"}
+    doc["measured"] = ["the intrinsics (from the board views)", "the joints' placements the observability report lists as identified", "the camera's placement",
+                       "the board's placement"] + (["the TCP from the camera (grasps)"] if tool is not None else [])
+    doc["from_the_model"] = ["every parameter listed as not identified (left at the nominal value)"] + ([] if tool is not None else ["the TCP's placement on the flange"])
+    urdf, left = calibrated_urdf(nominal, robot, camera_frame)
     doc["warnings"] += left
     yaml_path = folder / "robot_calibration.yaml"
     urdf_path = folder / f"{Path(nominal.urdf_path).stem}_calibrated.urdf"

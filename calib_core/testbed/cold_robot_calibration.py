@@ -8,12 +8,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import invert, pose_difference
 from calib_core.robot_calibration.identification import RobotCalibration, identify
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
-from calib_core.robot_calibration.sim_views import simulated_pose_views
+from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
+from calib_core.robot_calibration.cell_views import cell_view_joints
+from calib_core.testbed.compliant_grasp import grasp_joints
+from calib_core.robot_calibration.sim_views import simulated_cell_views, simulated_pose_views
 from calib_core.testbed.cold_cell import cold_test_bed
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
@@ -25,15 +29,23 @@ HELD_OUT = 20
 
 @dataclass(frozen=True)
 class ColdRun:
+    """``result`` the identification; ``robot`` the calibrated robot with its TCP from the grasps
+    (``tool``; the identification's robot when there were none); ``score`` against the truth."""
+
     result: RobotCalibration
     intrinsics: IntrinsicsCalibration
     plan: PosePlan
     rejected: list[str]
     score: dict
     nominal_robot: object
+    tool: CameraToTool | None = None
+    robot: object = None
 
 
-def calibrate_cold_cell(views: int = 40, seed: int = 0, *, with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
+def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
+    """``views`` board views and ``cell_views_per_task`` views of each task location's component
+    (surveyed features: they tie the robot to the cell; 0 leaves the base unidentified); with
+    ``grasps``, the gripper closed on each task location's fixture gives the TCP from the camera."""
     bed, truth = cold_test_bed(seed=seed)
     nominal = load_intrinsics(bed.workcell.intrinsics_path)
     spec = parse_board(DEFAULT_SPEC)
@@ -44,16 +56,31 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, with_intrinsics: bool
     calibration_q, held_out = plan.joints_deg[:views], plan.joints_deg[views:]
     board_views, pose_views, rejected = simulated_pose_views(bed, spec, board2base, calibration_q, seed=seed, progress=progress)
     intrinsics = calibrate_intrinsics(board_views, spec)
-    say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views; identifying...")
+    say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views")
+    if cell_views_per_task:
+        targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed)
+        say(f"locating surveyed features in {len(targets)} views...")
+        cell_views, cell_rejected = simulated_cell_views(bed, intrinsics.intrinsics, targets, seed=seed)
+        pose_views += cell_views
+        rejected += cell_rejected
+    say("identifying...")
     result = identify(bed.model_robot, intrinsics.intrinsics, pose_views, with_intrinsics=with_intrinsics)
-    score = score_against_truth(result, bed, truth, held_out, board2base)
-    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot)
+    robot, tool = result.robot, None
+    if grasps:
+        done = [Grasp(t.name, grasp_joints(bed, t.tcp2base, seed + k), t.tcp2base) for k, t in enumerate(bed.workcell.task_locations.values())]
+        tool = camera_to_tool(result.robot, done)
+        robot = with_tool(result.robot, tool.tcp2cam)
+        say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
+    score = score_against_truth(result, bed, truth, held_out, board2base, robot)
+    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot)
 
 
-def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray) -> dict:
+def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray, robot=None) -> dict:
     """How far the calibrated model is from the test bed's truth at ``held_out`` poses: the camera and
     the TCP relative to the board (what board views determine) and in the base frame, RMS mm and deg;
-    the intrinsics' differences. Only for scoring."""
+    the intrinsics' differences. ``robot``: the calibrated robot to score (default the
+    identification's). Only for scoring."""
+    robot = robot or result.robot
 
     def rms(pairs):
         a = np.array(pairs)
@@ -64,7 +91,7 @@ def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.
         for frame in ("camera", "tcp"):
             rel, base, nominal = [], [], []
             for q in held_out:
-                est, tru = result.robot.fk(q, frame), bed.true_robot.fk(q, frame)
+                est, tru = robot.fk(q, frame), bed.true_robot.fk(q, frame)
                 d, r = pose_difference(invert(result.board2base) @ est, invert(board2base_true) @ tru)
                 rel.append((np.linalg.norm(d), np.linalg.norm(r)))
                 d, r = pose_difference(est, tru)
@@ -72,9 +99,28 @@ def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.
                 d, r = pose_difference(bed.model_robot.fk(q, frame), tru)
                 nominal.append((np.linalg.norm(d), np.linalg.norm(r)))
             out[f"{frame}_in_board_frame_mm_deg"] = rms(rel)
+            if frame == "camera":
+                out["camera_in_base_frame_within_3_sigma"] = _within_3_sigma(result, bed, held_out)
             out[f"{frame}_in_base_frame_mm_deg"] = rms(base)
             out[f"{frame}_nominal_model_mm_deg"] = rms(nominal)
         out["held_out_poses"] = len(held_out)
     t, i = truth.intrinsics, result.intrinsics
     out["intrinsics_error_px"] = {"fu": round(i.fu - t.fu, 3), "fv": round(i.fv - t.fv, 3), "cx": round(i.cx - t.cx, 3), "cy": round(i.cy - t.cy, 3)}
     return out
+
+
+def _within_3_sigma(result: RobotCalibration, bed, held_out: list[np.ndarray]) -> float:
+    """The share of held-out poses whose camera pose error (base frame) lies within the 3-sigma
+    ellipsoid of its propagated covariance (chi-square with 6 degrees of freedom at 99.73 %)."""
+    from scipy.stats import chi2
+
+    from calib_core.robot_calibration.identification import pose_covariance
+
+    limit = chi2.ppf(0.9973, 6)
+    inside = 0
+    for q in held_out:
+        est, tru = result.robot.fk(q, "camera"), bed.true_robot.fk(q, "camera")
+        d = np.r_[tru[:3, 3] - est[:3, 3], 1000.0 * Rotation.from_matrix(tru[:3, :3] @ est[:3, :3].T).as_rotvec()]
+        cov = pose_covariance(result, q)
+        inside += float(d @ np.linalg.pinv(cov) @ d) <= limit
+    return round(inside / max(len(held_out), 1), 3)

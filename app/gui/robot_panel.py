@@ -1,0 +1,195 @@
+"""The Robot mode: calibrate the robot's geometry and its camera mounting from board views at many
+poses. Plan the poses (reachable, collision-free paths, the whole board in view, chosen for what they
+determine), preview the plan, run it (each move awaited, each view taken once the robot settled),
+review the identification (what the views determine and what not), apply it to the cell's robot or
+take it back, save it (YAML of the parameters, the calibrated URDF)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QPushButton, QSpinBox, QVBoxLayout, QWidget
+
+from app.gui.busy import busy
+from app.gui.confirm import ask
+from app.gui.error_boundary import guarded
+from calib_core.errors import OperatorError
+from calib_core.vision.board import DEFAULT_SPEC, parse_board
+
+
+def _button(text: str, name: str, tip: str) -> QPushButton:
+    b = QPushButton(text)
+    b.setObjectName(name)
+    b.setToolTip(tip)
+    return b
+
+
+class RobotPanel(QWidget):
+    """``show_error`` puts a failed step's reason in the window; progress goes to the workbench's
+    messages (the status bar) and to the panel's own line."""
+
+    def __init__(self, workbench, show_error: Callable[[str], None], parent=None):
+        super().__init__(parent)
+        self.workbench = workbench
+        guard = guarded(show_error)
+        self.plan = None
+        self.run = None
+        self.result = None
+
+        plan = QGroupBox("Plan")
+        pl = QVBoxLayout(plan)
+        self.spec = QLineEdit(DEFAULT_SPEC)
+        self.spec.setToolTip("a ChArUco or ArUco board: charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
+        pl.addWidget(self.spec)
+        self.show_board = QCheckBox("Board in the simulated cell")
+        self.show_board.setToolTip("Put the board up where the cell's hand_eye_board says (the simulated camera sees it)")
+        self.show_board.toggled.connect(guard(lambda on: self.workbench.show_calibration_board(self._spec(), on)))
+        pl.addWidget(self.show_board)
+        row = QHBoxLayout()
+        row.addWidget(QLabel("Poses"))
+        self.poses = QSpinBox()
+        self.poses.setRange(8, 200)
+        self.poses.setValue(40)
+        self.poses.setToolTip("How many poses to view the board from (30-40 determine a 6-axis robot well)")
+        row.addWidget(self.poses)
+        self.plan_button = _button("Plan poses", "robot_plan", "Choose reachable, collision-free poses that see the whole board and determine the parameters best")
+        self.plan_button.clicked.connect(guard(self.make_plan))
+        row.addWidget(self.plan_button, 1)
+        pl.addLayout(row)
+        self.plan_text = QLabel("No plan yet.")
+        self.plan_text.setWordWrap(True)
+        pl.addWidget(self.plan_text)
+
+        run = QGroupBox("Run")
+        rl = QVBoxLayout(run)
+        row = QHBoxLayout()
+        self.run_button = _button("Run plan", "robot_run", "Drive the robot through the planned poses (MVJ), capturing a board view at each once the robot settled")
+        self.run_button.clicked.connect(guard(self.start_run))
+        self.stop_button = _button("Stop", "robot_stop", "Stop after the current move; the views taken so far are kept")
+        self.stop_button.clicked.connect(guard(lambda: self.run.stop() if self.run is not None else None))
+        row.addWidget(self.run_button, 2)
+        row.addWidget(self.stop_button, 1)
+        rl.addLayout(row)
+        self.progress = QProgressBar()
+        self.progress.setRange(0, 1)
+        self.progress.setValue(0)
+        rl.addWidget(self.progress)
+        self.run_text = QLabel("")
+        self.run_text.setWordWrap(True)
+        rl.addWidget(self.run_text)
+
+        review = QGroupBox("Identify")
+        vl = QVBoxLayout(review)
+        self.identify_button = _button("Identify", "robot_identify", "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)")
+        self.identify_button.clicked.connect(guard(self.identify))
+        vl.addWidget(self.identify_button)
+        self.result_text = QLabel("")
+        self.result_text.setWordWrap(True)
+        self.result_text.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        vl.addWidget(self.result_text)
+        row = QHBoxLayout()
+        self.apply_button = _button("Apply", "robot_apply", "Use the calibrated robot for the views, the solver's prior and every move from now on")
+        self.apply_button.clicked.connect(guard(self.apply))
+        self.revert_button = _button("Revert", "robot_revert", "Use the robot's model as loaded again")
+        self.revert_button.clicked.connect(guard(self.revert))
+        self.save_button = _button("Save...", "robot_save", "Save robot_calibration.yaml and the calibrated URDF into a folder")
+        self.save_button.clicked.connect(guard(self._save_dialog))
+        for b in (self.apply_button, self.revert_button, self.save_button):
+            row.addWidget(b)
+        vl.addLayout(row)
+
+        layout = QVBoxLayout(self)
+        layout.addWidget(plan)
+        layout.addWidget(run)
+        layout.addWidget(review)
+        layout.addStretch(1)
+        self._refresh()
+
+    def _spec(self):
+        spec = parse_board(self.spec.text().strip())
+        if not spec.unambiguous:
+            raise OperatorError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+        return spec
+
+    def _refresh(self) -> None:
+        running = self.run is not None and self.run.phase in ("moving", "settling")
+        views = len(self.run.capture.views) if self.run is not None else 0
+        self.plan_button.setEnabled(not running)
+        self.run_button.setEnabled(self.plan is not None and bool(self.plan.joints_deg) and not running)
+        self.stop_button.setEnabled(running)
+        self.identify_button.setEnabled(views >= 6 and not running)
+        self.apply_button.setEnabled(self.result is not None)
+        self.save_button.setEnabled(self.result is not None)
+        self.revert_button.setEnabled(getattr(self.workbench, "_robot_before_calibration", None) is not None)
+
+    # --- plan and run --------------------------------------------------------------------------
+    def make_plan(self) -> None:
+        with busy(self, "planning the calibration poses ..."):
+            self.plan = self.workbench.plan_robot_calibration(self._spec(), self.poses.value())
+        n = len(self.plan.joints_deg)
+        why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
+        self.plan_text.setText(f"{n} poses planned from {self.plan.candidates} candidates" + (f" (left out: {why})" if why else "")
+                               + ". Every pose sees the whole board with the model, and every move from the one before is free of collisions.")
+        self.workbench.message.emit(f"robot calibration: {n} poses planned")
+        self._refresh()
+
+    def start_run(self) -> None:
+        if self.plan is None or not self.plan.joints_deg:
+            raise OperatorError("plan the poses first")
+        n = len(self.plan.joints_deg)
+        if not ask(self, "Drive the robot through the calibration poses?", f"The robot will move through {n} poses, one after the other, stopping at each "
+                   "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
+                   "Stop ends the run after the current move.", "Run"):
+            return
+        self.run = self.workbench.robot_calibration_run(self._spec(), self.plan.joints_deg)
+        self.progress.setRange(0, n)
+        self.progress.setValue(0)
+        self.run.progress.connect(self._on_progress)
+        self.run.finished.connect(lambda text: self._refresh())
+        self.run.start()
+        self._refresh()
+
+    def _on_progress(self, p) -> None:
+        self.progress.setValue(min(p.index, p.total))
+        self.run_text.setText(p.text)
+        self._refresh()
+
+    # --- identify, apply, save -----------------------------------------------------------------
+    def identify(self) -> None:
+        if self.run is None:
+            raise OperatorError("run the plan first: the identification needs the views it takes")
+        with busy(self, "identifying the robot ..."):
+            r = self.result = self.workbench.calibrate_robot(self.run.capture)
+        obs = r.observability
+        lines = [
+            f"<b>Robot</b> from {len(r.per_view_rms_px)} views: RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
+            f"{len(obs.identified)} of {len(r.names)} parameters identified (condition {obs.condition:.0f}); {len(obs.directions)} combinations the views do not determine"
+            + (f", e.g. {', '.join(f'{w:+.2f} {n}' for n, w in obs.directions[0][:3])}" if obs.directions else ""),
+            f"{len(obs.correlations)} pairs correlated above 0.9" if obs.correlations else "no two parameters correlated above 0.9",
+        ]
+        worst = max(r.per_view_rms_px.items(), key=lambda kv: kv[1])
+        lines.append(f"worst view {worst[0]}: {worst[1]:.3f} px")
+        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in r.warnings]
+        self.result_text.setText("<br>".join(lines))
+        self._refresh()
+
+    def apply(self) -> None:
+        if self.result is None:
+            raise OperatorError("identify first")
+        self.workbench.apply_robot_calibration(self.result)
+        self._refresh()
+
+    def revert(self) -> None:
+        self.workbench.revert_robot_calibration()
+        self._refresh()
+
+    def save(self, folder) -> None:
+        if self.result is None:
+            raise OperatorError("identify first")
+        self.workbench.save_robot_calibration(folder, self.result)
+
+    def _save_dialog(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self, "Save the robot calibration into")
+        if folder:
+            self.save(folder)

@@ -1,0 +1,32 @@
+"""The gripper closed on a fixture pin in the simulated cell: compliance puts the true TCP on the pin.
+
+What the physical cell does by itself (the fingers centre on the pin, the controller in compliance lets
+the joints follow) is done here by inverse kinematics on the true robot: the commanded joints whose
+true TCP is the pin's grasp, within the compliance's own error. Only the simulation uses the truth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from calib_core.frames import invert, make_transform
+from calib_core.robot import solve_ik
+from calib_core.testbed.test_bed import TestBed
+
+COMPLIANCE_MM = 0.02
+"""How far from the pin's axis the fingers leave the TCP (a centring gripper on a ground pin)."""
+
+
+def grasp_joints(bed: TestBed, tcp2base: np.ndarray, seed: int = 0) -> np.ndarray:
+    """The commanded joints (deg) the controller reports with the gripper closed on the pin whose
+    grasp is ``tcp2base`` (4, 4) mm: the true TCP there, to within :data:`COMPLIANCE_MM`."""
+    rng = np.random.default_rng(seed)
+    off = rng.normal(0.0, 1.0, 3)
+    off *= COMPLIANCE_MM * rng.uniform() / max(np.linalg.norm(off), 1e-9)
+    target = make_transform(np.eye(3), off) @ np.asarray(tcp2base, dtype=float)
+    true = bed.true_robot
+    # TrueRobot.fk(q) = base_true2base_model . robot.fk(q + offsets): solve on its robot, then undo the offsets.
+    start = np.asarray(bed.workcell.home_joints_deg, dtype=float)
+    seed_q = solve_ik(bed.model_robot, tcp2base, start).q_deg
+    q_true = solve_ik(true.robot, invert(true.base_true2base_model) @ target, seed_q + true.joint_offsets).q_deg
+    return q_true - true.joint_offsets
