@@ -46,14 +46,16 @@ def run(args: argparse.Namespace) -> int:
         run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=args.with_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
         result, robot, nominal, tool, rejected, score = run_.result, run_.robot, run_.nominal_robot, run_.tool, run_.rejected, run_.score
         intrinsics_rms = run_.intrinsics.rms_px
+        counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}
     else:
         result, nominal, rejected, intrinsics_rms = _from_files(args)
         robot, tool, score = result.robot, None, None
+        counts = {"board_views": len(result.per_view_rms_px), "cell_views": 0}
     for r in rejected:
         print(f"rejected {r}", file=sys.stderr)
     args.out.mkdir(parents=True, exist_ok=True)
     save_robot_calibration(args.out, result, nominal, robot=robot, tool=tool)
-    summary = {"views": len(result.per_view_rms_px), "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
+    summary = {"views": len(result.per_view_rms_px), **counts, "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
                "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
                "intrinsics_rms_px": intrinsics_rms, "out": str(args.out)}
     if tool is not None:
@@ -64,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         json.dump(summary, sys.stdout, indent=2, default=float)
         sys.stdout.write("\n")
         return 0
-    print(f"{summary['views']} views; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
+    print(f"{counts['board_views']} board views, {counts['cell_views']} views of surveyed components; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
     for w in result.warnings:
         print(f"warning: {w}")
     for key, value in (score or {}).items():

@@ -3,11 +3,11 @@
 A board at an unknown pose cannot say where the robot's base is; the cell's components can, since
 their placements are surveyed in the base frame. At a few poses around each task location's approach
 the camera looks at its component, and :func:`~calib_core.vision.find_points.find_points` locates the
-component's features in the frame (through the given intrinsics, never the truth). The component's
-pose comes from its edges (the model-based refinement, ~0.1 px over hundreds of samples); each
-feature's pixel is then where that pose puts it, which carries the edges' accuracy rather than a
-single detector's bias (0.2-0.8 px on corners and bosses, docs/benchmarks/find_points.md). A view
-whose edge fit does not settle is left out, with the reason.
+component in the frame (through the given intrinsics, never the truth). The observation is the
+component's pose from its edges (the model-based refinement over hundreds of samples) with that
+fit's covariance, not single features: the edges carry less bias than any one detector (0.2-0.8 px on
+corners and bosses, docs/benchmarks/find_points.md), and the covariance says how far to trust them.
+A view whose edge fit does not settle is left out, with the reason.
 """
 
 from __future__ import annotations
@@ -17,11 +17,11 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
-from calib_core.frames import apply, invert
+from calib_core.frames import invert
 from calib_core.robot import solve_ik
 from calib_core.robot.errors import UnreachableTargetError
 from calib_core.robot.model import RobotModel
-from calib_core.robot_calibration.observations import CELL, PoseView
+from calib_core.robot_calibration.observations import ObjectPoseView
 
 SPREAD_MM, SPREAD_DEG = 60.0, 8.0
 
@@ -61,9 +61,10 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
     return out
 
 
-def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, component: str, robot: RobotModel, intrinsics: Intrinsics, expected=None) -> PoseView | str:
-    """The features of ``component`` in ``image`` taken at ``joints_deg``, as a :class:`PoseView` of
-    surveyed points (base frame); or the reason there is none. ``robot`` places the modelled camera
+def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, component: str, robot: RobotModel, intrinsics: Intrinsics, expected=None) -> ObjectPoseView | str:
+    """``component`` located in ``image`` taken at ``joints_deg``: its pose from the edges with their
+    covariance, as an :class:`ObjectPoseView` (the component surveyed in the base frame); or the
+    reason there is none. ``robot`` places the modelled camera
     (the nominal robot, or one calibrated on a board already, which starts the search closer)."""
     from calib_core.vision.find_points import find_points
 
@@ -72,9 +73,6 @@ def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, co
     result = find_points(image, intrinsics, item, obj2cam_model, expected=expected)
     if result.edges is None or not result.edges.settled:
         return f"{name}: {component} not located ({result.message})"
-    local = np.array(list(item.features.values()), dtype=float)
-    pixels = project_points(local, result.edges.obj2cam, intrinsics)
-    inside = intrinsics.contains(pixels, margin_px=5)
-    if inside.sum() < 4:
-        return f"{name}: fewer than 4 of {component}'s features in the image"
-    return PoseView(name, np.asarray(joints_deg, dtype=float), apply(item.item2world, local[inside]), pixels[inside], target=CELL)
+    if not np.all(np.isfinite(result.edges.covariance)):
+        return f"{name}: {component}'s edge fit gives no covariance"
+    return ObjectPoseView(name, np.asarray(joints_deg, dtype=float), result.edges.obj2cam, result.edges.covariance, item.item2world)

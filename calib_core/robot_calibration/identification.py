@@ -25,9 +25,11 @@ from calib_core.errors import VideocalError
 from calib_core.frames import apply, invert, make_transform
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observability import Observability, analyse
-from calib_core.robot_calibration.observations import BOARD, CELL, PoseView
+from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
 
+SURVEY_SIGMA_MM = 0.05
+"""A theodolite survey's 1-sigma per axis (its points good to about 0.1 mm)."""
 FD_STEP = 1e-4
 """Forward-difference step, in parameter units (mm, mrad, px, thousandths)."""
 MIN_VIEWS = 6
@@ -75,22 +77,41 @@ class RobotCalibration:
         return [self.names[k] for k in self.observability.identified]
 
 
+def residual_count(view) -> int:
+    return 6 if view.target == OBJECT else 2 * len(view.points_mm)
+
+
+def pose_residual(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """The left perturbation (rotation vector rad, translation mm) taking ``predicted`` to ``measured``."""
+    R = measured[:3, :3] @ predicted[:3, :3].T
+    return np.r_[Rotation.from_matrix(R).as_rotvec(), measured[:3, 3] - R @ predicted[:3, 3]]
+
+
 class _Problem:
-    def __init__(self, robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str, with_intrinsics: bool):
+    def __init__(self, robot: RobotModel, intrinsics: Intrinsics, views: list, camera_frame: str, with_intrinsics: bool, survey_sigma_mm: float = 0.0):
         self.corrected = CorrectedRobot(robot, camera_frame, with_intrinsics)
         self.nominal_intrinsics = intrinsics
         self.views = views
         self.has_board = any(v.target == BOARD for v in views)
         self.board0 = np.eye(4)
         self.size = self.corrected.layout.size
+        # An object's measured pose whitened by its covariance, the survey's sigma added to the translation.
+        self.whiten = {}
+        for k, v in enumerate(views):
+            if v.target == OBJECT:
+                cov = np.asarray(v.covariance, dtype=float) + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3)
+                self.whiten[k] = np.linalg.inv(np.linalg.cholesky(cov + 1e-15 * np.eye(6)))
 
     def residuals(self, p: np.ndarray, board: np.ndarray) -> np.ndarray:
         self.corrected.set(p)
         intr = self.corrected.intrinsics(self.nominal_intrinsics)
         board2base = delta_transform(board) @ self.board0
         out = []
-        for v in self.views:
+        for k, v in enumerate(self.views):
             base2cam = invert(self.corrected.cam2base(v.joints_deg))
+            if v.target == OBJECT:
+                out.append(self.whiten[k] @ pose_residual(base2cam @ v.obj2base, v.obj2cam))
+                continue
             obj2cam = base2cam @ board2base if v.target == BOARD else base2cam
             out.append((project(apply(obj2cam, v.points_mm), intr) - v.pixels).ravel())
         return np.concatenate(out)
@@ -127,18 +148,21 @@ def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[Po
 
 
 def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *, camera_frame: str = "camera", with_intrinsics: bool = False,
-             parameters: list[str] | None = None, max_iterations: int = 50) -> RobotCalibration:
+             parameters: list[str] | None = None, survey_sigma_mm: float = SURVEY_SIGMA_MM, max_iterations: int = 50) -> RobotCalibration:
     """Calibrate ``robot`` (its nominal model) from ``views``; see the module's docstring.
+    ``survey_sigma_mm``: how well the surveyed points are known (1-sigma per axis), added to the
+    surveyed views' measured noise as the pixels it makes at each point's distance.
     ``parameters``: fit exactly these (names as in the result), instead of the subset QR pivoting
     chooses (the observability is reported either way)."""
     started = time.perf_counter()
     if len(views) < MIN_VIEWS:
         raise RobotCalibrationError(f"{len(views)} views, at least {MIN_VIEWS} needed (30-40 recommended)")
-    problem = _Problem(robot, intrinsics, views, camera_frame, with_intrinsics)
+    problem = _Problem(robot, intrinsics, views, camera_frame, with_intrinsics, survey_sigma_mm)
     if problem.has_board:
         problem.board0 = initial_board2base(robot, intrinsics, views, camera_frame)
     p0, b0 = np.zeros(problem.size), np.zeros(6)
     start_r = problem.residuals(p0, b0)
+    pixel_rows = np.concatenate([np.full(residual_count(v), v.target != OBJECT) for v in views])
     if not np.all(np.isfinite(start_r)):
         raise RobotCalibrationError("some points project behind the camera with the nominal model: a view's joints or points are wrong")
     names = problem.corrected.layout.names
@@ -162,8 +186,13 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
 
     # Board corners and surveyed features have their own noise (a tenth of a pixel against the edges'
     # pose and the survey's tenth of a millimetre): each group weighted by its own measured sigma.
-    group_of = np.concatenate([np.full(2 * len(v.points_mm), 0 if v.target == BOARD else 1) for v in views])
+    groups = (BOARD, CELL, OBJECT)
+    group_of = np.concatenate([np.full(residual_count(v), groups.index(v.target)) for v in views])
     weights = np.ones(group_of.size)
+    # A surveyed point off by survey_sigma_mm moves its pixel by f * sigma / depth: a floor under the
+    # surveyed points' noise that their few residuals cannot show (each view's points share one pose).
+    survey_px = np.concatenate([np.repeat(0.5 * (intrinsics.fu + intrinsics.fv) * survey_sigma_mm / np.maximum(apply(invert(robot.fk(v.joints_deg, camera_frame)), v.points_mm)[:, 2], 1.0), 2)
+                                if v.target == CELL else np.zeros(residual_count(v)) for v in views])
 
     def fun(x):
         return weights * problem.residuals(*unpack(x))
@@ -180,13 +209,17 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
         for g in set(group_of.tolist()):
             sel = group_of == g
             group_sigma[g] = max(float(np.sqrt(np.mean(r_px[sel] ** 2))), 1e-6)
-            weights[sel] = 1.0 / group_sigma[g]
+            # Object poses come whitened: their scale is at least the covariance's own (a few views
+            # cannot show a covariance too large, and the edge fits' is known to be too small).
+            sigma = max(group_sigma[g], 1.0) if groups[g] == OBJECT else group_sigma[g]
+            weights[sel] = 1.0 / np.sqrt(sigma**2 + survey_px[sel] ** 2)
         x0 = fit.x
     fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
     p, board = unpack(fit.x)
     r = fit.fun / weights
     dof = max(r.size - x0.size, 1)
-    noise = float(np.sqrt(r @ r / dof))
+    rp = r[pixel_rows]
+    noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float('nan')
     J = fit.jac
     # The weighted residuals have unit variance when the groups' sigmas are right: scale by what they have.
     scale2 = float(fit.fun @ fit.fun / dof)
@@ -194,16 +227,16 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)
-    bounds = np.cumsum([0] + [2 * len(v.points_mm) for v in views])
-    per_view = {v.name: float(np.sqrt(2.0 * np.mean(r[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
+    bounds = np.cumsum([0] + [residual_count(v) for v in views])
+    per_view = {v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
     warnings = []
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
     board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
-    return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r**2))), per_view, noise,
+    return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))), per_view, noise,
                             problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
-                            float(np.sqrt(2.0 * np.mean(start_r**2))), warnings, cov[:k, :k], robot.copy(), camera_frame,
-                            {(BOARD if g == 0 else CELL): v for g, v in group_sigma.items()})
+                            float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame,
+                            {groups[g]: v for g, v in group_sigma.items()})
 
 
 def pose_covariance(result: RobotCalibration, q_deg, frame: str = "camera") -> np.ndarray:

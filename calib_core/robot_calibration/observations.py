@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-BOARD, CELL = "board", "cell"
+BOARD, CELL, OBJECT = "board", "cell", "object"
 
 
 @dataclass(frozen=True)
@@ -26,3 +26,24 @@ class PoseView:
             raise ValueError(f"view {self.name}: target must be {BOARD!r} or {CELL!r}, got {self.target!r}")
         if self.points_mm.shape[0] != self.pixels.shape[0]:
             raise ValueError(f"view {self.name}: {len(self.points_mm)} points but {len(self.pixels)} pixels")
+
+
+@dataclass(frozen=True)
+class ObjectPoseView:
+    """At commanded joints ``joints_deg`` (n,), a surveyed object measured at ``obj2cam`` (4, 4) mm
+    with ``covariance`` (6, 6) of a left perturbation (rotation vector rad, then translation mm, in the
+    camera frame: the model-based edge refinement's); the object stands at ``obj2base`` (4, 4) mm as
+    surveyed. Its residual is the 6-vector that takes the predicted pose to the measured one,
+    whitened by the covariance (the survey's own sigma added to the translation)."""
+
+    name: str
+    joints_deg: np.ndarray
+    obj2cam: np.ndarray
+    covariance: np.ndarray
+    obj2base: np.ndarray
+    target: str = "object"
+
+    def __post_init__(self):
+        c = np.asarray(self.covariance, dtype=float)
+        if c.shape != (6, 6) or not np.all(np.isfinite(c)):
+            raise ValueError(f"view {self.name}: the pose covariance must be a finite 6 x 6 matrix")

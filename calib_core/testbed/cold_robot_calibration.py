@@ -40,6 +40,8 @@ class ColdRun:
     nominal_robot: object
     tool: CameraToTool | None = None
     robot: object = None
+    board_views: int = 0
+    cell_views: int = 0
 
 
 def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
@@ -57,6 +59,7 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     board_views, pose_views, rejected = simulated_pose_views(bed, spec, board2base, calibration_q, seed=seed, progress=progress)
     intrinsics = calibrate_intrinsics(board_views, spec)
     say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views")
+    board_count, cell_views = len(pose_views), []
     if cell_views_per_task:
         targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed)
         say(f"locating surveyed features in {len(targets)} views...")
@@ -72,7 +75,7 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
         robot = with_tool(result.robot, tool.tcp2cam)
         say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
-    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot)
+    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, board_count, len(cell_views))
 
 
 def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray, robot=None) -> dict:

@@ -34,11 +34,14 @@ def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-2000:]
     summary = json.loads(run.stdout)
-    assert summary["views"] == 12 and summary["start_rms_px"] > 2.0 and summary["rms_px"] < 0.2
+    assert summary["board_views"] == 12 and summary["cell_views"] >= 3 and summary["start_rms_px"] > 2.0 and summary["rms_px"] < 0.2
     score = summary["score"]
     # What board views determine: the camera relative to the board, at 20 poses not used.
     assert score["camera_in_board_frame_mm_deg"][0] < 0.2 and score["camera_in_board_frame_mm_deg"][1] < 0.05  # 12 views; 40 in the bench
     assert score["camera_nominal_model_mm_deg"][0] > 2.0
+    # Tied to the cell by its surveyed components, with the tool from the grasps: the TCP in the base frame.
+    assert score["tcp_in_base_frame_mm_deg"][0] < 0.2 * score["tcp_nominal_model_mm_deg"][0]
+    assert summary["tool"]["grasps"] == 2
     assert abs(score["intrinsics_error_px"]["cx"]) < 2.0
     doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
     identified = [n for n, p in doc["parameters"].items() if p["identified"]]
