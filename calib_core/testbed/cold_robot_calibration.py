@@ -44,10 +44,12 @@ class ColdRun:
     cell_views: int = 0
 
 
-def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
+def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, grasp_tasks: list[str] | None = None,
+                        with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
     """``views`` board views and ``cell_views_per_task`` views of each task location's component
     (surveyed features: they tie the robot to the cell; 0 leaves the base unidentified); with
-    ``grasps``, the gripper closed on each task location's fixture gives the TCP from the camera."""
+    ``grasps``, the gripper closed on each task location's fixture (``grasp_tasks``: only these) gives
+    the TCP from the camera."""
     bed, truth = cold_test_bed(seed=seed)
     nominal = load_intrinsics(bed.workcell.intrinsics_path)
     spec = parse_board(DEFAULT_SPEC)
@@ -70,7 +72,8 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     result = identify(bed.model_robot, intrinsics.intrinsics, pose_views, with_intrinsics=with_intrinsics)
     robot, tool = result.robot, None
     if grasps:
-        done = [Grasp(t.name, grasp_joints(bed, t.tcp2base, seed + k), t.tcp2base) for k, t in enumerate(bed.workcell.task_locations.values())]
+        tasks = [t for t in bed.workcell.task_locations.values() if grasp_tasks is None or t.name in grasp_tasks]
+        done = [Grasp(t.name, grasp_joints(bed, t.tcp2base, seed + k), t.tcp2base) for k, t in enumerate(tasks)]
         tool = camera_to_tool(result.robot, done)
         robot = with_tool(result.robot, tool.tcp2cam)
         say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")

@@ -49,3 +49,21 @@ def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
     assert doc["observability"]["unidentifiable_directions"]
     robot = load_robot(tmp_path / "videocal_arm_calibrated.urdf")
     assert robot.n_joints == 6
+
+
+def test_demo_cold_reports_each_step_beside_the_truth(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--cold", "--out", str(tmp_path)], capture_output=True, text=True, timeout=900)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads((tmp_path / "report.json").read_text())
+    steps = report["steps"]
+    assert set(steps) == {"1_intrinsics", "2_robot_and_mounting", "3_camera_to_tool", "4_task_location"}
+    assert abs(steps["1_intrinsics"]["error_against_truth_px"]["cx"]) < 1.0
+    robot = steps["2_robot_and_mounting"]
+    assert robot["camera_in_base_frame_mm_deg"][0] < 0.2 * robot["camera_nominal_model_mm_deg"][0]
+    tool = steps["3_camera_to_tool"]
+    assert tool["grasps"] == ["oru_2_grasp"]  # not the looked-at task: that one is a check of its own
+    assert tool["tcp_in_base_frame_mm_deg"][0] < 0.2 * tool["tcp_nominal_model_mm_deg"][0]
+    look = steps["4_task_location"]
+    assert look["task"] == "oru_1_grasp" and look["calibrated_model_only_mm_deg"][0] < 0.5
+    assert (tmp_path / "robot_calibration.yaml").is_file() and (tmp_path / "videocal_arm_calibrated.urdf").is_file()
+    assert "tcp2cam" in yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
