@@ -100,7 +100,11 @@ class CalibrationRun:
     def _on_frame(self, frame) -> None:
         if self.phase != SETTLING or not self.core.observations.stillness(frame).settled:
             return
-        view = self.capture.add(frame.image, np.array(self.core.stamp_frame(frame).joints_deg))
+        try:
+            joints = np.array(self.core.stamp_frame(frame).joints_deg)
+        except VideocalError:  # settled, but its joints not known yet (a sample late): the next frame
+            return
+        view = self.capture.add(frame.image, joints)
         if isinstance(view, RejectedView):
             self._tries += 1
             if self._tries < MAX_FRAMES_PER_POSE:
