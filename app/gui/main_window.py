@@ -53,20 +53,13 @@ class MainWindow(QMainWindow):
         self.commands = CommandPanel(workbench)
         self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error, lambda send: self.move(send))
-        vision_scroll = QScrollArea()
-        vision_scroll.setWidgetResizable(True)
-        vision_scroll.setWidget(self.vision)
-        self.commands.addTab(vision_scroll, "Vision")
         self.robot_calibration = RobotPanel(workbench, self.show_error)
-        robot_scroll = QScrollArea()
-        robot_scroll.setWidgetResizable(True)
-        robot_scroll.setWidget(self.robot_calibration)
-        self.commands.addTab(robot_scroll, "Robot")
         self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
-        cell_scroll = QScrollArea()
-        cell_scroll.setWidgetResizable(True)
-        cell_scroll.setWidget(self.cell_panel)
-        self.commands.addTab(cell_scroll, "Cell")
+        for panel, title in ((self.vision, "Vision"), (self.robot_calibration, "Robot"), (self.cell_panel, "Cell")):
+            scroll = QScrollArea()  # the panels are taller than a small screen
+            scroll.setWidgetResizable(True)
+            scroll.setWidget(panel)
+            self.commands.addTab(scroll, title)
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0
         self.solved_edges = SolvedEdges(workbench.intrinsics)
