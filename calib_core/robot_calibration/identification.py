@@ -64,6 +64,8 @@ class RobotCalibration:
     nominal: RobotModel | None = None
     """A copy of the robot the identification started from (applying the result changes the robot)."""
     camera_frame: str = "camera"
+    residual_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """The weight of every residual in the final fit (1 / its group's sigma)."""
     noise_by_target_px: dict[str, float] = field(default_factory=dict)
     """The residuals' sigma (px per coordinate) of the board views and of the surveyed-feature views,
     each group weighted by its own."""
@@ -235,7 +237,7 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
     return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))), per_view, noise,
                             problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
-                            float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame,
+                            float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame, weights.copy(),
                             {groups[g]: v for g, v in group_sigma.items()})
 
 

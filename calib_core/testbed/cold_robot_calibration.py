@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
@@ -78,6 +79,7 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
         robot = with_tool(result.robot, tool.tcp2cam)
         say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
+    score["parameters_against_truth"] = parameters_against_truth(result, bed, pose_views, intrinsics.intrinsics)
     return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, board_count, len(cell_views))
 
 
@@ -130,3 +132,48 @@ def _within_3_sigma(result: RobotCalibration, bed, held_out: list[np.ndarray]) -
         cov = pose_covariance(result, q)
         inside += float(d @ np.linalg.pinv(cov) @ d) <= limit
     return round(inside / max(len(held_out), 1), 3)
+
+
+def truth_in_model_parameters(bed) -> np.ndarray:
+    """The test bed's true robot in the error model's own parameters (mm, mrad): each joint's true
+    placement with its zero offset folded in, the base's error on the first joint, the camera's."""
+    from calib_core.robot.model import _to_mm
+    from calib_core.robot_calibration.parameters import CorrectedRobot, delta_of
+
+    nominal, true = bed.model_robot, bed.true_robot
+    layout = CorrectedRobot(nominal).layout
+    p = np.zeros(layout.size)
+    root2base = np.linalg.inv(nominal.base2root)
+    # Each joint's zero offset is its motion at q = offset after the placement: liMi at the offsets.
+    data = nominal.model.createData()
+    pin.forwardKinematics(nominal.model, data, nominal.configuration(true.joint_offsets))
+    for j in range(1, nominal.model.njoints):
+        P = _to_mm(nominal.model.jointPlacements[j])
+        T = _to_mm(true.robot.model.jointPlacements[j]) @ np.linalg.inv(P) @ _to_mm(data.liMi[j])
+        if j == 1:  # the base's error is the first joint's: the survey is in the base frame
+            T = np.linalg.inv(root2base) @ true.base_true2base_model @ root2base @ T
+        p[layout.joint_block(j - 1)] = delta_of(T @ np.linalg.inv(P))
+    Pc, Tc = nominal.frame_placement("camera"), true.robot.frame_placement("camera")
+    p[layout.camera_block] = delta_of(Tc @ np.linalg.inv(Pc))
+    return p
+
+
+def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -> dict:
+    """The identified parameters against the truth mapped into the identified subset: with redundant
+    parameters the fit puts the unidentified ones' share into the identified (to first order
+    ``p_id + (J_id^+ J_unid) p_unid``, the board's placement a nuisance). ``within_3_sigma`` is the share
+    of identified parameters within 3 of their sigmas of it."""
+    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, _Problem
+
+    truth = truth_in_model_parameters(bed)
+    problem = _Problem(result.nominal, intrinsics, views, result.camera_frame, False, SURVEY_SIGMA_MM)
+    problem.board0 = result.board2base if result.board2base is not None else np.eye(4)
+    ids, unid = result.observability.identified, result.observability.unidentified
+    J, Jb = problem.jacobian(result.values, np.zeros(6), list(range(problem.size)))
+    W = result.residual_weights[:, None]
+    A = W * np.hstack([J[:, ids], Jb])
+    absorbed = np.linalg.lstsq(A, W * J[:, unid], rcond=None)[0][: len(ids)] @ truth[unid]
+    expected = truth[ids] + absorbed
+    z = (result.values[ids] - expected) / result.sigmas[ids]
+    return {"within_3_sigma": round(float(np.mean(np.abs(z) < 3.0)), 3), "rms_error_over_sigma": round(float(np.sqrt(np.mean(z**2))), 2),
+            "worst": result.names[ids[int(np.argmax(np.abs(z)))]]}

@@ -42,6 +42,8 @@ def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
     # Tied to the cell by its surveyed components, with the tool from the grasps: the TCP in the base frame.
     assert score["tcp_in_base_frame_mm_deg"][0] < 0.2 * score["tcp_nominal_model_mm_deg"][0]
     assert summary["tool"]["grasps"] == 2
+    # The identified parameters against the truth in the model's own parameters (their share within 3 sigma).
+    assert score["parameters_against_truth"]["within_3_sigma"] >= 0.8, score["parameters_against_truth"]
     assert abs(score["intrinsics_error_px"]["cx"]) < 2.0
     doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
     identified = [n for n, p in doc["parameters"].items() if p["identified"]]
