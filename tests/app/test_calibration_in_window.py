@@ -223,9 +223,12 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win._on_pick_2d(100.0, 120.0)
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
     qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
-    qtbot.wait(1100)
-    win._update_status()
-    assert "REC" in win.record_label.text()
+
+    def recording_shown() -> bool:  # the status line the window's timer refreshes
+        win._update_status()
+        return "REC" in win.record_label.text()
+
+    qtbot.waitUntil(recording_shown, timeout=10_000)
     win.files.save_workspace(tmp_path / "w.json")
     win.files.stop_recording()
     contents = read_recording(tmp_path / "session.mcap")
