@@ -10,21 +10,14 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QLabel,
     QListWidget,
-    QPushButton,
     QTabWidget,
     QVBoxLayout,
     QWidget,
 )
 
+from app.gui.buttons import button
 from app.gui.workbench import Workbench
 
-
-def _button(text: str, name: str, tip: str = "") -> QPushButton:
-    b = QPushButton(text)
-    b.setObjectName(name)
-    if tip:
-        b.setToolTip(tip)
-    return b
 
 
 class CommandPanel(QTabWidget):
@@ -60,9 +53,9 @@ class CommandPanel(QTabWidget):
         self.approach.setToolTip("How far back along the tool's z axis the robot stops before the task pose")
         approach_row.addRow("Approach", self.approach)
         pl.addLayout(approach_row)
-        self.go_approach = _button("Go to approach", "go_approach", "IK to the approach pose, then move the robot (MVJ)")
-        self.go_task = _button("Go to task", "go_task", "IK to the task pose itself, without correction")
-        self.add_location = _button("Add location from current pose", "add_location")
+        self.go_approach = button("Go to approach", "go_approach", "IK to the approach pose, then move the robot (MVJ)")
+        self.go_task = button("Go to task", "go_task", "IK to the task pose itself, without correction")
+        self.add_location = button("Add location from current pose", "add_location")
         for b in (self.go_approach, self.go_task, self.add_location):
             pl.addWidget(b)
         self.addTab(prog, "Program")
@@ -71,7 +64,7 @@ class CommandPanel(QTabWidget):
         sim = QWidget()
         sl = QVBoxLayout(sim)
         sl.addWidget(QLabel("Animate the planned motion in CAD (the robot does not move)."))
-        self.animate = _button("Animate to selected task", "animate")
+        self.animate = button("Animate to selected task", "animate")
         sl.addWidget(self.animate)
         self.sim_status = QLabel("")
         self.sim_status.setWordWrap(True)
@@ -97,13 +90,13 @@ class CommandPanel(QTabWidget):
         self.hint = QLabel("Point: click a feature in the virtual camera, then the same point on the camera image.")
         self.hint.setWordWrap(True)
         sl2.addWidget(self.hint)
-        self.find_points = _button("Find points (F6)", "find_points", "Find the target's features on the camera image and propose them as pairs")
+        self.find_points = button("Find points (F6)", "find_points", "Find the target's features on the camera image and propose them as pairs")
         sl2.addWidget(self.find_points)
-        self.accept = _button("Accept pair", "accept", "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then")
-        self.delete = _button("Delete pair", "delete")
-        self.clear = _button("Clear all", "clear")
-        self.undo = _button("Undo", "undo")
-        self.redo = _button("Redo", "redo")
+        self.accept = button("Accept pair", "accept", "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then")
+        self.delete = button("Delete pair", "delete")
+        self.clear = button("Clear all", "clear")
+        self.undo = button("Undo", "undo")
+        self.redo = button("Redo", "redo")
         for b in (self.accept, self.delete, self.clear, self.undo, self.redo):
             sl2.addWidget(b)
         cl.addWidget(steps)
@@ -111,9 +104,9 @@ class CommandPanel(QTabWidget):
         self.robust = QCheckBox("Robust (flag mis-clicks)")
         cl.addWidget(self.estimate_focal)
         cl.addWidget(self.robust)
-        self.calibrate = _button("Calibrate", "calibrate", "Solve the camera pose (F5)")
+        self.calibrate = button("Calibrate", "calibrate", "Solve the camera pose (F5)")
         self.calibrate.setStyleSheet("font-weight: bold; padding: 6px;")
-        self.store = _button("Store correction", "store", "Store the displacement for the current task location")
+        self.store = button("Store correction", "store", "Store the displacement for the current task location")
         cl.addWidget(self.calibrate)
         cl.addWidget(self.store)
         cl.addStretch(1)
@@ -128,11 +121,11 @@ class CommandPanel(QTabWidget):
         self.live.setChecked(True)
         el.addWidget(self.monitoring)
         el.addWidget(self.live)
-        self.go_corrected = _button("Go to task, corrected", "go_corrected", "Move to the task location with its stored correction")
-        self.go_uncorrected = _button("Go to task, uncorrected", "go_uncorrected")
+        self.go_corrected = button("Go to task, corrected", "go_corrected", "Move to the task location with its stored correction")
+        self.go_uncorrected = button("Go to task, uncorrected", "go_uncorrected")
         el.addWidget(self.go_corrected)
         el.addWidget(self.go_uncorrected)
-        self.verify = _button("Verify: look again", "verify", "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree")
+        self.verify = button("Verify: look again", "verify", "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree")
         el.addWidget(self.verify)
         self.corrections = QLabel("No corrections stored.")
         self.corrections.setWordWrap(True)

@@ -9,20 +9,15 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QPushButton, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QSpinBox, QVBoxLayout, QWidget
 
+from app.gui.buttons import button
 from app.gui.busy import busy
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.errors import OperatorError
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 
-
-def _button(text: str, name: str, tip: str) -> QPushButton:
-    b = QPushButton(text)
-    b.setObjectName(name)
-    b.setToolTip(tip)
-    return b
 
 
 class RobotPanel(QWidget):
@@ -53,7 +48,7 @@ class RobotPanel(QWidget):
         self.poses.setValue(40)
         self.poses.setToolTip("How many poses to view the board from (30-40 determine a 6-axis robot well)")
         row.addWidget(self.poses)
-        self.plan_button = _button("Plan poses", "robot_plan", "Choose reachable, collision-free poses that see the whole board and determine the parameters best")
+        self.plan_button = button("Plan poses", "robot_plan", "Choose reachable, collision-free poses that see the whole board and determine the parameters best")
         self.plan_button.clicked.connect(guard(self.make_plan))
         row.addWidget(self.plan_button, 1)
         pl.addLayout(row)
@@ -64,9 +59,9 @@ class RobotPanel(QWidget):
         run = QGroupBox("Run")
         rl = QVBoxLayout(run)
         row = QHBoxLayout()
-        self.run_button = _button("Run plan", "robot_run", "Drive the robot through the planned poses (MVJ), capturing a board view at each once the robot settled")
+        self.run_button = button("Run plan", "robot_run", "Drive the robot through the planned poses (MVJ), capturing a board view at each once the robot settled")
         self.run_button.clicked.connect(guard(self.start_run))
-        self.stop_button = _button("Stop", "robot_stop", "Stop after the current move; the views taken so far are kept")
+        self.stop_button = button("Stop", "robot_stop", "Stop after the current move; the views taken so far are kept")
         self.stop_button.clicked.connect(guard(lambda: self.run.stop() if self.run is not None else None))
         row.addWidget(self.run_button, 2)
         row.addWidget(self.stop_button, 1)
@@ -81,7 +76,7 @@ class RobotPanel(QWidget):
 
         review = QGroupBox("Identify")
         vl = QVBoxLayout(review)
-        self.identify_button = _button("Identify", "robot_identify", "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)")
+        self.identify_button = button("Identify", "robot_identify", "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)")
         self.identify_button.clicked.connect(guard(self.identify))
         vl.addWidget(self.identify_button)
         self.result_text = QLabel("")
@@ -89,11 +84,11 @@ class RobotPanel(QWidget):
         self.result_text.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         vl.addWidget(self.result_text)
         row = QHBoxLayout()
-        self.apply_button = _button("Apply", "robot_apply", "Use the calibrated robot for the views, the solver's prior and every move from now on")
+        self.apply_button = button("Apply", "robot_apply", "Use the calibrated robot for the views, the solver's prior and every move from now on")
         self.apply_button.clicked.connect(guard(self.apply))
-        self.revert_button = _button("Revert", "robot_revert", "Use the robot's model as loaded again")
+        self.revert_button = button("Revert", "robot_revert", "Use the robot's model as loaded again")
         self.revert_button.clicked.connect(guard(self.revert))
-        self.save_button = _button("Save...", "robot_save", "Save robot_calibration.yaml and the calibrated URDF into a folder")
+        self.save_button = button("Save...", "robot_save", "Save robot_calibration.yaml and the calibrated URDF into a folder")
         self.save_button.clicked.connect(guard(self._save_dialog))
         for b in (self.apply_button, self.revert_button, self.save_button):
             row.addWidget(b)

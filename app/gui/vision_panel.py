@@ -12,8 +12,9 @@ from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QPushButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QVBoxLayout, QWidget
 
+from app.gui.buttons import button
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.camera.intrinsics_io import save_intrinsics
@@ -25,12 +26,6 @@ from calib_core.vision.hand_eye_io import save_hand_eye
 from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
 from calib_core.vision.result_checks import hand_eye_problems, intrinsics_problems, views_with_lost_corners
 from calib_core.errors import OperatorError
-
-def _button(text: str, name: str, tip: str) -> QPushButton:
-    b = QPushButton(text)
-    b.setObjectName(name)
-    b.setToolTip(tip)
-    return b
 
 
 class VisionPanel(QWidget):
@@ -65,9 +60,9 @@ class VisionPanel(QWidget):
         self.show_board.setToolTip("Put the board up in front of the robot in the simulated cell (the simulated camera sees it)")
         self.show_board.toggled.connect(guard(self._show_board_toggled))
         bl.addWidget(self.show_board)
-        self.next_pose = _button("Next board pose", "vision_next_pose", "Move the robot (MVJ) to the next planned pose that sees the board")
+        self.next_pose = button("Next board pose", "vision_next_pose", "Move the robot (MVJ) to the next planned pose that sees the board")
         self.next_pose.clicked.connect(guard(self._next_pose))
-        self.capture_button = _button("Capture view", "vision_capture", "Detect the board in the camera's current frame and keep the view with the robot's joints")
+        self.capture_button = button("Capture view", "vision_capture", "Detect the board in the camera's current frame and keep the view with the robot's joints")
         self.capture_button.clicked.connect(guard(self.capture_view))
         row = QHBoxLayout()
         row.addWidget(self.next_pose)
@@ -79,7 +74,7 @@ class VisionPanel(QWidget):
         self.views = QListWidget()
         self.views.setMinimumHeight(90)
         vl.addWidget(self.views)
-        self.remove_button = _button("Remove view", "vision_remove", "Drop the selected view (blurred or mis-detected)")
+        self.remove_button = button("Remove view", "vision_remove", "Drop the selected view (blurred or mis-detected)")
         self.remove_button.clicked.connect(guard(self._remove_selected))
         vl.addWidget(self.remove_button)
         self.coverage = QLabel("No views yet.")
@@ -88,9 +83,9 @@ class VisionPanel(QWidget):
 
         cal = QGroupBox("Calibrate")
         cl = QVBoxLayout(cal)
-        self.calibrate_intrinsics_button = _button("Calibrate intrinsics", "vision_intrinsics", "fu, fv, cx, cy and k1 k2 p1 p2 k3 from the views (3 or more)")
+        self.calibrate_intrinsics_button = button("Calibrate intrinsics", "vision_intrinsics", "fu, fv, cx, cy and k1 k2 p1 p2 k3 from the views (3 or more)")
         self.calibrate_intrinsics_button.clicked.connect(guard(self.calibrate_intrinsics))
-        self.calibrate_hand_eye_button = _button("Calibrate hand-eye", "vision_hand_eye", "The camera's mounting on the flange from the views and their robot poses (3 or more, 10 recommended)")
+        self.calibrate_hand_eye_button = button("Calibrate hand-eye", "vision_hand_eye", "The camera's mounting on the flange from the views and their robot poses (3 or more, 10 recommended)")
         self.calibrate_hand_eye_button.clicked.connect(guard(self.calibrate_hand_eye))
         row = QHBoxLayout()
         row.addWidget(self.calibrate_intrinsics_button)
@@ -100,13 +95,13 @@ class VisionPanel(QWidget):
         self.result.setWordWrap(True)
         self.result.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         cl.addWidget(self.result)
-        self.apply_intrinsics_button = _button("Apply intrinsics", "vision_apply_intrinsics", "Use the calibrated intrinsics for picking, solving and the virtual camera")
+        self.apply_intrinsics_button = button("Apply intrinsics", "vision_apply_intrinsics", "Use the calibrated intrinsics for picking, solving and the virtual camera")
         self.apply_intrinsics_button.clicked.connect(guard(self.apply_intrinsics))
-        self.save_intrinsics_button = _button("Save...", "vision_save_intrinsics", "Save the intrinsics as OpenCV YAML or ROS camera_info")
+        self.save_intrinsics_button = button("Save...", "vision_save_intrinsics", "Save the intrinsics as OpenCV YAML or ROS camera_info")
         self.save_intrinsics_button.clicked.connect(guard(self._save_intrinsics_dialog))
-        self.apply_hand_eye_button = _button("Apply mounting", "vision_apply_hand_eye", "Use the measured camera mounting for the virtual camera, the solver's prior and the displacement")
+        self.apply_hand_eye_button = button("Apply mounting", "vision_apply_hand_eye", "Use the measured camera mounting for the virtual camera, the solver's prior and the displacement")
         self.apply_hand_eye_button.clicked.connect(guard(self.apply_hand_eye))
-        self.save_hand_eye_button = _button("Save...", "vision_save_hand_eye", "Save cam2flange (xyz mm, rpy deg) with its 1-sigma as YAML")
+        self.save_hand_eye_button = button("Save...", "vision_save_hand_eye", "Save cam2flange (xyz mm, rpy deg) with its 1-sigma as YAML")
         self.save_hand_eye_button.clicked.connect(guard(self._save_hand_eye_dialog))
         for pair in ((self.apply_intrinsics_button, self.save_intrinsics_button), (self.apply_hand_eye_button, self.save_hand_eye_button)):
             row = QHBoxLayout()

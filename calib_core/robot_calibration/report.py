@@ -66,9 +66,13 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
     return ET.tostring(root, encoding="unicode"), left
 
 
+def _xyz_rpy(T_mm: np.ndarray) -> dict:
+    xyz, rpy = xyz_rpy_from_transform(T_mm)
+    return {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]}
+
+
 def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera") -> dict:
     identified = set(result.observability.identified)
-    xyz, rpy = xyz_rpy_from_transform(result.robot.frame_placement(camera_frame))
     i = result.intrinsics
     return {
         "units": {"length": "mm", "angle": "mrad for corrections, deg for rpy", "pixels": "px"},
@@ -81,10 +85,9 @@ def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_f
             "unidentifiable_directions": [[f"{w:+.2f} {n}" for n, w in d] for d in result.observability.directions],
             "correlations_over_0_9": [[a, b, r] for a, b, r in result.observability.correlations],
         },
-        "camera_on_parent": {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
+        "camera_on_parent": _xyz_rpy(result.robot.frame_placement(camera_frame)),
         "intrinsics": {"fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion)},
-        "board2base": None if result.board2base is None else {"xyz": [round(float(v), 4) for v in xyz_rpy_from_transform(result.board2base)[0]],
-                                                                "rpy": [round(float(v), 5) for v in xyz_rpy_from_transform(result.board2base)[1]]},
+        "board2base": None if result.board2base is None else _xyz_rpy(result.board2base),
         "rms_px": round(result.rms_px, 4), "start_rms_px": round(result.start_rms_px, 4), "noise_px": round(result.noise_px, 4),
         "noise_by_target_px": {k: round(v, 4) for k, v in result.noise_by_target_px.items()},
         "per_view_rms_px": {k: round(v, 4) for k, v in result.per_view_rms_px.items()},
@@ -100,8 +103,7 @@ def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal
     robot = robot or result.robot
     doc = calibration_document(result, nominal, camera_frame)
     if tool is not None:
-        xyz, rpy = xyz_rpy_from_transform(tool.tcp2cam)
-        doc["tcp2cam"] = {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy], "grasps": len(tool.per_grasp),
+        doc["tcp2cam"] = {**_xyz_rpy(tool.tcp2cam), "grasps": len(tool.per_grasp),
                           "spread_mm": round(tool.spread_mm, 4), "spread_deg": round(tool.spread_deg, 5),
                           "measured": "the TCP in the camera frame, from the gripper closed on surveyed fixtures"}
     doc["measured"] = ["the intrinsics (from the board views)", "the joints' placements the observability report lists as identified", "the camera's placement",

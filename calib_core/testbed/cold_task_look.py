@@ -15,6 +15,7 @@ from calib_core.calibration.end_effector import end_effector_from_solution
 from calib_core.frames import invert, pose_difference
 from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
+from calib_core.robot.visuals import RobotVisuals
 from calib_core.testbed.sim_camera import SimulatedCamera
 from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
@@ -36,7 +37,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         image = camera.read().image
         cam2world_model = robot.fk(q_approach, "camera")
         obj2cam_model = invert(cam2world_model) @ item.item2world
-        expected = view.of(list(cell.components) + [s for s in _model_robot_items(robot, q_approach)], item.item2world)
+        expected = view.of(list(cell.components) + RobotVisuals.from_robot(robot).scene_items(q_approach), item.item2world)
         found = find_points(image, intrinsics, item, obj2cam_model, expected=expected)
     finally:
         camera.close()
@@ -60,9 +61,3 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         "within_3_sigma": bool(np.linalg.norm(d) <= 3 * sigma_mm and np.linalg.norm(r) <= 3 * sigma_deg),
     })
     return out
-
-
-def _model_robot_items(robot, q):
-    from calib_core.robot.visuals import RobotVisuals
-
-    return RobotVisuals.from_robot(robot).scene_items(q)
