@@ -23,6 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, help="intrinsics file to write (YAML)")
     parser.add_argument("--format", choices=("opencv", "ros"), default="opencv")
     parser.add_argument("--no-distortion", action="store_true", help="fit the pinhole only (as the paper's tool did)")
+    parser.add_argument("--k-coefficients", type=int, choices=(2, 3), default=2, help="radial distortion terms: 2 (k1 k2, k3 held at 0; the default, as ROS's camera_calibration) or 3 (wide lenses, with views reaching the image's corners)")
     parser.add_argument("--every", type=bounded_int(1, 100_000), default=15, help="with a video: use every n-th frame")
     parser.add_argument("--views", type=bounded_int(3, 500), default=15, help="with 'sim': how many views to render")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -56,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     views, rejected = detect_views(images, spec, settings)
     for r in rejected:
         print(f"rejected {r.name}: {r.reason}", file=sys.stderr)
-    result = calibrate_intrinsics(views, spec, distortion=not args.no_distortion, rejected=rejected)
+    result = calibrate_intrinsics(views, spec, distortion=not args.no_distortion, radial_terms=args.k_coefficients, rejected=rejected)
     save_intrinsics(args.out, result.intrinsics, args.format)
     i = result.intrinsics
     summary = {

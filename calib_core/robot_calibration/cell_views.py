@@ -24,39 +24,93 @@ from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observations import ObjectPoseView
 
 SPREAD_MM, SPREAD_DEG = 60.0, 8.0
+LOOK_DISTANCE_MM = 350.0
+"""How far the camera stands from a component that has no task location (about a task's approach)."""
+DISTINCT_MM = 50.0
+"""Components closer than this to one already chosen add no new geometry (a fixture on its ORU)."""
+MIN_FEATURES = 4
+
+
+def surveyed_targets(robot: RobotModel, workcell) -> list[tuple[str, np.ndarray]]:
+    """(component, camera2base (4, 4) mm of a central view) for every surveyed component the tie can
+    use: each task location's component seen from its approach, then the other components with
+    :data:`MIN_FEATURES` features or more, seen from :data:`LOOK_DISTANCE_MM` on the side facing the
+    robot, leaving out one within :data:`DISTINCT_MM` of a chosen one. Two components alone leave the
+    base's turn about the line through them to their edge fits' orientations; a third off that line
+    fixes it by positions, which the edges measure far better."""
+    chosen: list[tuple[str, np.ndarray]] = []
+    where: list[np.ndarray] = []
+
+    def take(name: str, camera2base: np.ndarray) -> None:
+        centre = _centroid(workcell.component(name))
+        if all(np.linalg.norm(centre - c) > DISTINCT_MM for c in where):
+            chosen.append((name, camera2base))
+            where.append(centre)
+
+    for task in workcell.task_locations.values():
+        if task.component is not None and len(workcell.component(task.component).features) >= MIN_FEATURES:
+            take(task.component, _approach_camera(robot, task))
+    for item in workcell.components:
+        if len(item.features) >= MIN_FEATURES and item.name not in [n for n, _ in chosen]:
+            take(item.name, _look_at(_centroid(item), LOOK_DISTANCE_MM))
+    return chosen
+
+
+def _centroid(item) -> np.ndarray:
+    """The mean of the component's features (its own frame) in the base frame, mm."""
+    points = np.array(list(item.features.values()), dtype=float)
+    return item.item2world[:3, :3] @ points.mean(axis=0) + item.item2world[:3, 3]
+
+
+def _approach_camera(robot: RobotModel, task) -> np.ndarray:
+    """The modelled camera's pose (4, 4) mm when the TCP is at the task's approach."""
+    tcp2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("tcp")
+    cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
+    return task.approach2base @ np.linalg.inv(tcp2flange) @ cam2flange
+
+
+def _look_at(target_mm: np.ndarray, distance_mm: float) -> np.ndarray:
+    """A camera pose (4, 4) mm looking horizontally at ``target_mm`` from ``distance_mm`` on the
+    side of the robot's base axis, image up pointing up."""
+    out = np.array([target_mm[0], target_mm[1], 0.0])
+    z = out / max(np.linalg.norm(out), 1e-9)
+    x = np.cross([0.0, 0.0, -1.0], z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([x, y, z])
+    T[:3, 3] = target_mm - distance_mm * z
+    return T
 
 
 def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_target: int = 3, seed: int = 0) -> list[tuple[str, np.ndarray]]:
-    """(component, joints deg) for ``per_target`` poses around each task location's approach from
-    which the modelled camera sees every feature of the task's component."""
+    """(component, joints deg) for ``per_target`` poses around each of :func:`surveyed_targets`'
+    views, from which the modelled camera sees every feature of the component."""
     rng = np.random.default_rng(seed)
     home = np.asarray(workcell.home_joints_deg, dtype=float)
+    cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
     out = []
-    for task in workcell.task_locations.values():
-        if task.component is None:
-            continue
-        item = workcell.component(task.component)
+    for component, camera2base in surveyed_targets(robot, workcell):
+        item = workcell.component(component)
         points = np.array(list(item.features.values()), dtype=float)
-        if len(points) < 4:
-            continue
         try:
-            q0 = solve_ik(robot, task.approach2base, home).q_deg
+            q0 = solve_ik(robot, camera2base @ np.linalg.inv(cam2flange), home, frame="flange").q_deg
         except UnreachableTargetError:
             continue
         found, attempts = 0, 0
         while found < per_target and attempts < 30 * per_target:
             attempts += 1
-            T = task.approach2base.copy()
+            T = camera2base.copy()
             if found or attempts > 1:
                 T[:3, :3] = Rotation.from_rotvec(np.radians(SPREAD_DEG) * rng.normal(size=3) / np.sqrt(3)).as_matrix() @ T[:3, :3]
                 T[:3, 3] += rng.normal(0.0, SPREAD_MM / np.sqrt(3), 3)
             try:
-                q = solve_ik(robot, T, q0).q_deg
+                q = solve_ik(robot, T @ np.linalg.inv(cam2flange), q0, frame="flange").q_deg
             except UnreachableTargetError:
                 continue
             uv = project_points(points, invert(robot.fk(q, "camera")) @ item.item2world, intrinsics)
-            if intrinsics.contains(uv, margin_px=40).all():
-                out.append((task.component, q))
+            if intrinsics.contains(uv, margin_px=40).all() and np.all(robot.within_limits(q, 1.0)):
+                out.append((component, q))
                 found += 1
     return out
 

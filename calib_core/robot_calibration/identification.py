@@ -28,6 +28,9 @@ from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
 
+OUTLIER_RATIO = 4.0
+"""A surveyed component's view whose residual is this many times the median of those views' (and
+over 3 of its own sigmas) is left out: one edge fit on the wrong edges pulled the tie 0.17 mm."""
 SURVEY_SIGMA_MM = 0.05
 """A theodolite survey's 1-sigma per axis (its points good to about 0.1 mm)."""
 FD_STEP = 1e-4
@@ -69,6 +72,9 @@ class RobotCalibration:
     noise_by_target_px: dict[str, float] = field(default_factory=dict)
     """The residuals' sigma (px per coordinate) of the board views and of the surveyed-feature views,
     each group weighted by its own."""
+    left_out: dict[str, str] = field(default_factory=dict)
+    """Views given no weight in the final fit (view name -> why): a component's pose that disagrees
+    with the rest (an edge fit settled on the wrong edges)."""
 
     def parameter(self, name: str) -> tuple[float, float]:
         k = self.names.index(name)
@@ -204,22 +210,27 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
         return weights[:, None] * np.hstack([J, Jb_])
 
     x0 = np.zeros(k + (6 if problem.has_board else 0))
+    bounds = np.cumsum([0] + [residual_count(v) for v in views])
+    kept = np.ones(group_of.size, dtype=bool)
+    left_out: dict[str, str] = {}
     group_sigma = {}
     for _ in range(2 if len(set(group_of.tolist())) > 1 else 1):
         fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
-        r_px = fit.fun / weights
+        r_px = problem.residuals(*unpack(fit.x))
+        left_out.update(_disagreeing_objects(views, bounds, r_px, kept))
         for g in set(group_of.tolist()):
-            sel = group_of == g
-            group_sigma[g] = max(float(np.sqrt(np.mean(r_px[sel] ** 2))), 1e-6)
+            sel = (group_of == g) & kept
+            group_sigma[g] = max(float(np.sqrt(np.mean(r_px[sel] ** 2))), 1e-6) if sel.any() else 1.0
             # Object poses come whitened: their scale is at least the covariance's own (a few views
             # cannot show a covariance too large, and the edge fits' is known to be too small).
             sigma = max(group_sigma[g], 1.0) if groups[g] == OBJECT else group_sigma[g]
             weights[sel] = 1.0 / np.sqrt(sigma**2 + survey_px[sel] ** 2)
+        weights[~kept] = 0.0
         x0 = fit.x
     fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
     p, board = unpack(fit.x)
-    r = fit.fun / weights
-    dof = max(r.size - x0.size, 1)
+    r = np.where(kept, problem.residuals(p, board), 0.0)
+    dof = max(int(kept.sum()) - x0.size, 1)
     rp = r[pixel_rows]
     noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float('nan')
     J = fit.jac
@@ -229,16 +240,33 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)
-    bounds = np.cumsum([0] + [residual_count(v) for v in views])
-    per_view = {v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
-    warnings = []
+    r_all = problem.residuals(p, board)
+    per_view = {v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r_all[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
+    warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
     board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
     return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))), per_view, noise,
                             problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
                             float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame, weights.copy(),
-                            {groups[g]: v for g, v in group_sigma.items()})
+                            {groups[g]: v for g, v in group_sigma.items()}, left_out)
+
+
+def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray, kept: np.ndarray) -> dict[str, str]:
+    """The surveyed components' views (whitened residuals) that disagree with the others, by
+    :data:`OUTLIER_RATIO`; ``kept`` (residuals,) is cleared for them. One at a time, the worst first,
+    since one bad view raises the others' residuals too."""
+    out = {}
+    while True:
+        rms = {k: float(np.sqrt(np.mean(residuals[bounds[k]:bounds[k + 1]] ** 2))) for k, v in enumerate(views) if v.target == OBJECT and kept[bounds[k]]}
+        if len(rms) < 4:
+            return out
+        median = float(np.median(list(rms.values())))
+        worst = max(rms, key=rms.get)
+        if rms[worst] <= max(OUTLIER_RATIO * median, 3.0):
+            return out
+        kept[bounds[worst]:bounds[worst + 1]] = False
+        out[views[worst].name] = f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} (median)"
 
 
 def pose_covariance(result: RobotCalibration, q_deg, frame: str = "camera") -> np.ndarray:

@@ -2,11 +2,15 @@
 determine the parameters best.
 
 Candidates come from :func:`~calib_core.vision.board_placement.board_view_joints` (the camera aimed
-at the board from directions within 30 deg of its normal, rolled about its axis, 420-600 mm away),
+at the board from directions within 30 deg of its normal, rolled about its axis, 420-600 mm away,
+and turned up to 15 deg off it so the board reaches the image's corners),
 each checked against the joint limits, the cell's collision bodies and the image's edges with the
 nominal model. Of those, poses are chosen greedily to maximise the determinant of the
 identification's information matrix (D-optimal design, with the board's placement as a nuisance):
-the pose that adds most to what the set determines comes next.
+the pose that adds most to what the set determines comes next. The information includes the
+intrinsics and the lens distortion, since the same views calibrate the camera: a set whose corners
+stay in the image's middle leaves the distortion at its edges a guess, and a component seen there
+later is measured through that guess.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from calib_core.robot_calibration.observations import PoseView
 from calib_core.vision.board_placement import board_view_joints
 
 EDGE_MARGIN_PX = 30.0
+OFF_CENTRE_DEG = 15.0
 
 
 @dataclass(frozen=True)
@@ -49,7 +54,7 @@ def plan_poses(robot: RobotModel, intrinsics: Intrinsics, spec, board2base: np.n
     :class:`~calib_core.robot.collision.CollisionWorld` (``None``: not checked)."""
     start = np.zeros(robot.n_joints) if start_deg is None else np.asarray(start_deg, dtype=float)
     corners = spec.corners_mm()
-    pool = board_view_joints(robot, start, spec, board2base, candidates, seed)
+    pool = board_view_joints(robot, start, spec, board2base, candidates, seed, off_centre_deg=OFF_CENTRE_DEG)
     rejected: dict[str, int] = {}
     kept = []
     for q in pool:
@@ -65,7 +70,7 @@ def plan_poses(robot: RobotModel, intrinsics: Intrinsics, spec, board2base: np.n
         return PosePlan([], len(pool), rejected, float("-inf"))
     # Each candidate's block of the identification Jacobian at the nominal model, board as nuisance.
     views = [PoseView(f"c{k}", q, corners, project(apply(invert(robot.fk(q, "camera")) @ board2base, corners), intrinsics)) for k, q in enumerate(kept)]
-    problem = _Problem(robot, intrinsics, views, "camera", False)
+    problem = _Problem(robot, intrinsics, views, "camera", True)
     problem.board0 = board2base
     J, Jb = problem.jacobian(np.zeros(problem.size), np.zeros(6), list(range(problem.size)))
     rows = 2 * len(corners)

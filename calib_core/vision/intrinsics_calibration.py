@@ -100,9 +100,21 @@ def coverage(views: list[BoardView], image_size: tuple[int, int], grid: tuple[in
     return float(hit.mean())
 
 
-def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = True, rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
-    """Calibrate from detected views; ``distortion=False`` fits the pinhole only (what the paper's tool had)."""
+RADIAL_TERMS = 2
+"""k1 and k2 by default, k3 held at zero (as ROS's camera_calibration does): with views that do not
+reach the image's corners a third radial term is free to bend the model where no corner was seen
+(on the cold cell's planned views it made k2 0.37 against a true 0.08 and put a component seen near
+the image's top 0.5-2 mm off in depth)."""
+
+
+def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = True, radial_terms: int = RADIAL_TERMS,
+                         rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
+    """Calibrate from detected views; ``distortion=False`` fits the pinhole only (what the paper's
+    tool had); ``radial_terms`` 2 (k1, k2) or 3 (k1, k2, k3; for wide lenses, with views covering the
+    image's corners). Tangential terms p1, p2 are fitted with any distortion."""
     rejected = list(rejected or [])
+    if radial_terms not in (2, 3):
+        raise CalibrationInputError(f"radial_terms must be 2 (k1 k2) or 3 (k1 k2 k3), got {radial_terms}")
     if len(views) < MIN_VIEWS:
         why = "; ".join(f"{r.name}: {r.reason}" for r in rejected[:5])
         raise CalibrationInputError(f"{len(views)} usable board views, at least {MIN_VIEWS} needed" + (f" (rejected: {why})" if why else ""))
@@ -113,6 +125,8 @@ def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = Tru
     flags = 0
     if not distortion:
         flags |= cv2.CALIB_FIX_K1 | cv2.CALIB_FIX_K2 | cv2.CALIB_FIX_K3 | cv2.CALIB_ZERO_TANGENT_DIST
+    elif radial_terms == 2:
+        flags |= cv2.CALIB_FIX_K3
     rms, K, dist, _, _, std_intr, _, per_view = cv2.calibrateCameraExtended(object_points, image_points, size, None, None, flags=flags)
     dist = np.asarray(dist, dtype=float).ravel()[:5]
     intr = Intrinsics(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), size[0], size[1], tuple(np.pad(dist, (0, 5 - len(dist)))))
