@@ -23,7 +23,7 @@ from calib_core.errors import VideocalError
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), or a CSV of image,<joints> views of a board")
     parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)")
-    parser.add_argument("--with-intrinsics", action="store_true", help="refine the camera's intrinsics with the robot (they are calibrated from the same views first unless --intrinsics is given)")
+    parser.add_argument("--fixed-intrinsics", action="store_true", help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot")
     parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="with 'sim': which cold cell (its errors are drawn from this)")
     parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
     parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     if args.source == "sim":
         from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
 
-        run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=args.with_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
+        run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=not args.fixed_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
         result, robot, nominal, tool, rejected, score = run_.result, run_.robot, run_.nominal_robot, run_.tool, run_.rejected, run_.score
         intrinsics_rms = run_.intrinsics.rms_px
         counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}
@@ -117,4 +117,4 @@ def _from_files(args):
     else:
         calibrated = calibrate_intrinsics(board_views, spec, rejected=[])
         intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
-    return identify(robot, intrinsics, views, with_intrinsics=args.with_intrinsics), robot, rejected, rms
+    return identify(robot, intrinsics, views, with_intrinsics=not args.fixed_intrinsics), robot, rejected, rms

@@ -129,4 +129,5 @@ def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, co
         return f"{name}: {component} not located ({result.message})"
     if not np.all(np.isfinite(result.edges.covariance)):
         return f"{name}: {component}'s edge fit gives no covariance"
-    return ObjectPoseView(name, np.asarray(joints_deg, dtype=float), result.edges.obj2cam, result.edges.covariance, item.item2world)
+    points = np.array(list(item.features.values()), dtype=float)
+    return ObjectPoseView(name, np.asarray(joints_deg, dtype=float), result.edges.obj2cam, result.edges.covariance, item.item2world, points_mm=points)

@@ -109,6 +109,12 @@ class _Problem:
             if v.target == OBJECT:
                 cov = np.asarray(v.covariance, dtype=float) + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3)
                 self.whiten[k] = np.linalg.inv(np.linalg.cholesky(cov + 1e-15 * np.eye(6)))
+        # With the intrinsics fitted, an object's pose measured through the starting ones moves with them.
+        self.moves_with_intrinsics = {}
+        if with_intrinsics:
+            for k, v in enumerate(views):
+                if v.target == OBJECT and v.points_mm is not None and len(v.points_mm) >= 4:
+                    self.moves_with_intrinsics[k] = pose_sensitivity_to_intrinsics(v.obj2cam, v.points_mm, intrinsics)
 
     def residuals(self, p: np.ndarray, board: np.ndarray) -> np.ndarray:
         self.corrected.set(p)
@@ -118,7 +124,10 @@ class _Problem:
         for k, v in enumerate(self.views):
             base2cam = invert(self.corrected.cam2base(v.joints_deg))
             if v.target == OBJECT:
-                out.append(self.whiten[k] @ pose_residual(base2cam @ v.obj2base, v.obj2cam))
+                r = pose_residual(base2cam @ v.obj2base, v.obj2cam)
+                if k in self.moves_with_intrinsics:
+                    r = r + self.moves_with_intrinsics[k] @ p[self.corrected.layout.intrinsics_block]
+                out.append(self.whiten[k] @ r)
                 continue
             obj2cam = base2cam @ board2base if v.target == BOARD else base2cam
             out.append((project(apply(obj2cam, v.points_mm), intr) - v.pixels).ravel())
@@ -138,6 +147,32 @@ class _Problem:
             db[c] += FD_STEP
             Jb[:, c] = (self.residuals(p, db) - r0) / FD_STEP
         return J, Jb
+
+
+def pose_sensitivity_to_intrinsics(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Intrinsics, step: float = 0.1) -> np.ndarray:
+    """(6, 8): how an object's pose measured at ``obj2cam`` (4, 4) mm through ``intrinsics`` moves
+    (left perturbation: rotation vector rad, translation mm) per unit of each correction in
+    :data:`~calib_core.robot_calibration.parameters.INTRINSICS`: the pose that puts ``points_mm``
+    (m, 3, the object's frame) on the same pixels through the corrected intrinsics, by central
+    differences of OpenCV's PnP refinement. First order is enough: the corrections are tenths of a
+    pixel and thousandths."""
+    from calib_core.robot_calibration.parameters import INTRINSICS, corrected_intrinsics
+
+    pts = np.asarray(points_mm, dtype=np.float64)
+    rvec0 = cv2.Rodrigues(obj2cam[:3, :3])[0]
+    tvec0 = obj2cam[:3, 3].reshape(3, 1).astype(np.float64)
+    pixels = cv2.projectPoints(pts, rvec0, tvec0, intrinsics.K, intrinsics.dist_coeffs)[0]
+    S = np.zeros((6, len(INTRINSICS)))
+    for j in range(len(INTRINSICS)):
+        poses = []
+        for sign in (1.0, -1.0):
+            d = np.zeros(len(INTRINSICS))
+            d[j] = sign * step
+            moved = corrected_intrinsics(intrinsics, d)
+            _, rvec, tvec = cv2.solvePnP(pts, pixels, moved.K, moved.dist_coeffs, rvec0.copy(), tvec0.copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
+            poses.append(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()))
+        S[:, j] = (pose_residual(obj2cam, poses[0]) - pose_residual(obj2cam, poses[1])) / (2.0 * step)
+    return S
 
 
 def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str) -> np.ndarray:

@@ -34,7 +34,9 @@ class ObjectPoseView:
     with ``covariance`` (6, 6) of a left perturbation (rotation vector rad, then translation mm, in the
     camera frame: the model-based edge refinement's); the object stands at ``obj2base`` (4, 4) mm as
     surveyed. Its residual is the 6-vector that takes the predicted pose to the measured one,
-    whitened by the covariance (the survey's own sigma added to the translation)."""
+    whitened by the covariance (the survey's own sigma added to the translation). ``points_mm``
+    (m, 3), the object's own frame: points spread over it (its features), with which the pose is
+    carried over to corrected intrinsics when the identification fits them (``None``: it is not)."""
 
     name: str
     joints_deg: np.ndarray
@@ -42,6 +44,7 @@ class ObjectPoseView:
     covariance: np.ndarray
     obj2base: np.ndarray
     target: str = "object"
+    points_mm: np.ndarray | None = None
 
     def __post_init__(self):
         c = np.asarray(self.covariance, dtype=float)

@@ -34,6 +34,13 @@ def delta_transform(v: np.ndarray) -> np.ndarray:
     return T
 
 
+def corrected_intrinsics(nominal: Intrinsics, d: np.ndarray) -> Intrinsics:
+    """``nominal`` with the corrections ``d`` (8,) in the units of :data:`INTRINSICS` applied."""
+    dist = np.asarray(nominal.distortion, dtype=float).copy()
+    dist[:4] += np.asarray(d[4:8], dtype=float) / 1000.0
+    return Intrinsics(nominal.fu + d[0], nominal.fv + d[1], nominal.cx + d[2], nominal.cy + d[3], nominal.width, nominal.height, tuple(dist))
+
+
 def delta_of(T: np.ndarray) -> np.ndarray:
     """The inverse of :func:`delta_transform`: (x, y, z mm, rx, ry, rz mrad) of a (4, 4) mm."""
     return np.r_[T[:3, 3], 1000.0 * Rotation.from_matrix(T[:3, :3]).as_rotvec()]
@@ -105,10 +112,7 @@ class CorrectedRobot:
         """``nominal`` with the intrinsics corrections applied (itself without them)."""
         if not self.layout.with_intrinsics:
             return nominal
-        d = self.parameters[self.layout.intrinsics_block]
-        dist = np.asarray(nominal.distortion, dtype=float).copy()
-        dist[:4] += d[4:8] / 1000.0
-        return Intrinsics(nominal.fu + d[0], nominal.fv + d[1], nominal.cx + d[2], nominal.cy + d[3], nominal.width, nominal.height, tuple(dist))
+        return corrected_intrinsics(nominal, self.parameters[self.layout.intrinsics_block])
 
     def calibrated_model(self) -> RobotModel:
         """A copy of the robot with the current corrections: the calibrated robot."""

@@ -46,7 +46,7 @@ class ColdRun:
 
 
 def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, grasp_tasks: list[str] | None = None,
-                        with_intrinsics: bool = False, progress=None, say=lambda text: None) -> ColdRun:
+                        with_intrinsics: bool = True, progress=None, say=lambda text: None) -> ColdRun:
     """``views`` board views and ``cell_views_per_task`` views of each task location's component
     (surveyed features: they tie the robot to the cell; 0 leaves the base unidentified); with
     ``grasps``, the gripper closed on each task location's fixture (``grasp_tasks``: only these) gives
@@ -166,7 +166,12 @@ def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -
     from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, _Problem
 
     truth = truth_in_model_parameters(bed)
-    problem = _Problem(result.nominal, intrinsics, views, result.camera_frame, False, SURVEY_SIGMA_MM)
+    with_intrinsics = len(result.names) > truth.size
+    if with_intrinsics:  # the true camera as the corrections to the intrinsics the fit started from
+        t = bed.intrinsics
+        truth = np.r_[truth, t.fu - intrinsics.fu, t.fv - intrinsics.fv, t.cx - intrinsics.cx, t.cy - intrinsics.cy,
+                      1000.0 * (np.asarray(t.distortion[:4]) - np.asarray(intrinsics.distortion[:4]))]
+    problem = _Problem(result.nominal, intrinsics, views, result.camera_frame, with_intrinsics, SURVEY_SIGMA_MM)
     problem.board0 = result.board2base if result.board2base is not None else np.eye(4)
     ids, unid = result.observability.identified, result.observability.unidentified
     J, Jb = problem.jacobian(result.values, np.zeros(6), list(range(problem.size)))

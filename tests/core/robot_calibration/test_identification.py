@@ -143,3 +143,42 @@ def test_the_planned_poses_see_the_board_and_inform_more_than_arbitrary_ones(set
     # The D-optimal set determines the parameters better: smaller sigmas on what both identify.
     common = sorted(set(first12.observability.identified) & set(chosen.observability.identified))
     assert np.median(chosen.sigmas[common] / first12.sigmas[common]) < 1.0
+
+
+def test_the_plan_reaches_the_image_corners(setup, monkeypatch):
+    """The same views calibrate the lens: turned off the board's centre, the planned views put
+    corners in most of the image's cells (where the distortion is learnt), far more than views
+    aimed at the board's centre."""
+    from calib_core.robot_calibration import pose_planner
+    from calib_core.vision.intrinsics_calibration import BoardView, coverage
+
+    bed, board2base, joints = setup
+    size = (bed.intrinsics.width, bed.intrinsics.height)
+
+    def covered():
+        plan = plan_poses(bed.model_robot, bed.intrinsics, SPEC, board2base, 20, start_deg=np.zeros(6), candidates=60)
+        views = [BoardView(str(k), project(apply(invert(bed.model_robot.fk(q, "camera")) @ board2base, SPEC.corners_mm()), bed.intrinsics), np.arange(len(SPEC.corners_mm())), size) for k, q in enumerate(plan.joints_deg)]
+        return coverage(views, size)
+
+    turned = covered()
+    monkeypatch.setattr(pose_planner, "OFF_CENTRE_DEG", 0.0)
+    centred = covered()
+    assert turned > 0.85 and turned > centred + 0.15, (turned, centred)
+
+
+def test_the_tie_sees_components_off_the_line_of_the_tasks():
+    """The bundled cell's two task fixtures stand one above the other: the base's turn about that
+    line would rest on edge-fit orientations alone. The tie's targets add a component off it."""
+    from calib_core.robot_calibration.cell_views import _centroid, surveyed_targets
+
+    cell = load_workcell()
+    robot = cell.load_robot()
+    targets = surveyed_targets(robot, cell)
+    names = [n for n, _ in targets]
+    assert names[:2] == ["oru_1_fixture", "oru_2_fixture"] and len(names) >= 3
+    c = np.array([_centroid(cell.component(n)) for n in names])
+    line = (c[1] - c[0]) / np.linalg.norm(c[1] - c[0])
+    off = [np.linalg.norm(np.cross(p - c[0], line)) for p in c[2:]]
+    assert max(off) > 500.0
+    for _, camera2base in targets:  # each camera looks at its component
+        assert np.isclose(np.linalg.det(camera2base[:3, :3]), 1.0)

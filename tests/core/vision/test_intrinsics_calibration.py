@@ -41,6 +41,19 @@ def test_recovers_the_truth(images):
     assert abs(pinhole.intrinsics.fu / TRUTH.fu - 1) > abs(i.fu / TRUTH.fu - 1)
 
 
+def test_k3_is_held_at_zero_unless_asked_for(images):
+    """Two radial terms by default (ROS's camera_calibration does the same): a third bends the model
+    where the views have no corner. Asked for, it is fitted and reported with its sigma."""
+    views, _ = detect_views(images, SPEC)
+    two = calibrate_intrinsics(views, SPEC)
+    three = calibrate_intrinsics(views, SPEC, radial_terms=3)
+    assert two.intrinsics.distortion[4] == 0.0 and two.std["k3"] == 0.0
+    assert three.intrinsics.distortion[4] != 0.0 and three.std["k3"] > 0.0
+    assert abs(two.intrinsics.fu / TRUTH.fu - 1) < 0.002
+    with pytest.raises(CalibrationInputError, match="radial_terms must be 2 .k1 k2. or 3"):
+        calibrate_intrinsics(views, SPEC, radial_terms=4)
+
+
 def test_bad_views_are_rejected_with_reasons(images):
     blank = np.full((480, 640, 3), 90, np.uint8)
     name, board = images[0]
