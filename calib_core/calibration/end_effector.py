@@ -34,6 +34,8 @@ class EndEffectorEstimate:
     rotation_deg: np.ndarray
     std_displacement_mm: np.ndarray
     std_rotation_deg: np.ndarray
+    covariance: np.ndarray | None = None
+    """(6, 6) of (displacement mm, rotation deg); ``None`` when the solve gave no uncertainty."""
 
     @property
     def delta_base(self) -> np.ndarray:
@@ -54,6 +56,7 @@ def end_effector_from_solution(solution: PoseSolution, obj2world: np.ndarray, ca
     d, rv = pose_difference(tcp_meas, tcp2base_model)
     std_d = np.full(3, np.nan)
     std_r = np.full(3, np.nan)
+    cov = None
     u = solution.uncertainty
     if u is not None and np.all(np.isfinite(u.covariance[:6, :6])):
         # Jacobian of (d, rotvec) with respect to the solver's (dt mm, phi rad) on obj2cam.
@@ -72,4 +75,4 @@ def end_effector_from_solution(solution: PoseSolution, obj2world: np.ndarray, ca
         cov = J @ u.covariance[:6, :6] @ J.T
         std = np.sqrt(np.clip(np.diag(cov), 0, None))
         std_d, std_r = std[:3], std[3:]
-    return EndEffectorEstimate(solution, obj2world, cam2world_model, obj2world @ invert(obj2cam), tcp2base_model, tcp_meas, d, rv, std_d, std_r)
+    return EndEffectorEstimate(solution, obj2world, cam2world_model, obj2world @ invert(obj2cam), tcp2base_model, tcp_meas, d, rv, std_d, std_r, cov)

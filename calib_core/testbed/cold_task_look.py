@@ -21,10 +21,12 @@ from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 
 
-def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0) -> dict:
+def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0, model_covariance=None) -> dict:
     """Figures of one look at ``task_name`` (default: the cell's first task) with the calibrated
     ``robot`` and ``intrinsics``: the TCP's true error at the task commanded through the calibrated
-    model without the look and with it, the look's own 1-sigma, and whether the error is within 3 sigma."""
+    model without the look and with it, the look's own 1-sigma, and whether the error is within 3 sigma.
+    ``model_covariance(q_deg)``: the calibrated model's TCP covariance (6, 6: mm, deg) at joints; with
+    it the look is also fused with the model (:mod:`calib_core.calibration.look_fusion`) and scored."""
     cell = bed.workcell
     task = cell.task(task_name) if task_name else next(iter(cell.task_locations.values()))
     item = cell.component(task.component)
@@ -60,4 +62,18 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         "look_displacement_mm": [round(float(v), 4) for v in estimate.displacement_mm],
         "within_3_sigma": bool(np.linalg.norm(d) <= 3 * sigma_mm and np.linalg.norm(r) <= 3 * sigma_deg),
     })
+    if model_covariance is not None and estimate.covariance is not None:
+        from calib_core.calibration.look_fusion import fuse_look
+
+        fused = fuse_look(estimate, model_covariance(q_approach))
+        q_fused = solve_ik(robot, invert(fused.delta_base) @ task.tcp2base, q_approach).q_deg
+        d, r = pose_difference(bed.true_robot.fk(q_fused, "tcp"), task.tcp2base)
+        s = np.sqrt(np.diag(fused.covariance))
+        out["fused"] = {
+            "after_mm_deg": [round(float(np.linalg.norm(d)), 4), round(float(np.linalg.norm(r)), 5)],
+            "sigma_mm_deg": [round(float(np.linalg.norm(s[:3])), 4), round(float(np.linalg.norm(s[3:])), 5)],
+            "look_weight_position_rotation": [round(float(np.mean(fused.look_weight[:3])), 3), round(float(np.mean(fused.look_weight[3:])), 3)],
+            "agree": fused.agree, "message": fused.message,
+            "within_3_sigma": bool(np.linalg.norm(d) <= 3 * np.linalg.norm(s[:3]) and np.linalg.norm(r) <= 3 * np.linalg.norm(s[3:])),
+        }
     return out
