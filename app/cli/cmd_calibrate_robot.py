@@ -28,6 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
     parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
     parser.add_argument("--intrinsics", type=Path, help="with a CSV: the camera's intrinsics file (default: calibrated from the same views)")
+    parser.add_argument("--grasps", type=Path, help="with a CSV: a CSV of task,<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera")
     parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -48,8 +49,20 @@ def run(args: argparse.Namespace) -> int:
         intrinsics_rms = run_.intrinsics.rms_px
         counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}
     else:
+        grasps = None
+        if args.grasps is not None:  # read first: a mistake in it is found before the identification's work
+            from calib_core.robot_calibration.grasp_file import load_grasps
+            from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+            cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+            grasps = load_grasps(args.grasps, cell.load_robot().joint_names, cell)
         result, nominal, rejected, intrinsics_rms = _from_files(args)
         robot, tool, score = result.robot, None, None
+        if grasps is not None:
+            from calib_core.robot_calibration.camera_to_tool import camera_to_tool, with_tool
+
+            tool = camera_to_tool(result.robot, grasps)
+            robot = with_tool(result.robot, tool.tcp2cam)
         counts = {"board_views": len(result.per_view_rms_px), "cell_views": 0}
     for r in rejected:
         print(f"rejected {r}", file=sys.stderr)

@@ -1,0 +1,77 @@
+"""``videocal calibrate-robot VIEWS.csv --grasps GRASPS.csv`` as a user runs it on files: board images
+with their joints written from the cold cell, and the joints the controller reported with the gripper
+closed on each task location's pin. The calibrated URDF at those joints puts its TCP on the pins; a
+mistake in the grasps file is named before any work is done."""
+
+import re
+import subprocess
+import sys
+
+import cv2
+import numpy as np
+import pytest
+
+from calib_core.camera.intrinsics_io import load_intrinsics
+from calib_core.frames import pose_difference
+from calib_core.robot.model import load_robot
+from calib_core.robot_calibration.pose_planner import plan_poses
+from calib_core.testbed.cold_cell import cold_test_bed
+from calib_core.testbed.compliant_grasp import grasp_joints
+from calib_core.vision.board import DEFAULT_SPEC, parse_board
+from calib_core.vision.board_placement import board_in_cell
+from calib_core.vision.hand_eye_sim import simulated_hand_eye_images
+
+
+def _videocal(*args, timeout=600):
+    return subprocess.run([sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("robot_views")
+    bed, _ = cold_test_bed(seed=1)
+    spec = parse_board(DEFAULT_SPEC)
+    board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
+    plan = plan_poses(bed.model_robot, load_intrinsics(bed.workcell.intrinsics_path), spec, board2base, 16, start_deg=bed.workcell.home_joints_deg, candidates=48)
+    rows = ["image," + ",".join(bed.model_robot.joint_names)]
+    for name, image, q in simulated_hand_eye_images(bed, spec, plan.joints_deg, board2base):
+        cv2.imwrite(str(folder / f"{name}.png"), image[:, :, ::-1])
+        rows.append(f"{name}.png," + ",".join(f"{v:.6f}" for v in q))
+    (folder / "views.csv").write_text("\n".join(rows) + "\n")
+    grasps = {t.name: grasp_joints(bed, t.tcp2base, k) for k, t in enumerate(bed.workcell.task_locations.values())}
+    (folder / "grasps.csv").write_text("task," + ",".join(f"j{k + 1}" for k in range(6)) + "\n" + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items()))
+    return folder, bed, grasps
+
+
+def test_the_grasps_give_the_tool_and_the_urdf_carries_it(files, tmp_path):
+    folder, bed, grasps = files
+    run = _videocal("calibrate-robot", folder / "views.csv", "--grasps", folder / "grasps.csv", "--out", tmp_path)
+    assert run.returncode == 0, run.stderr[-2000:]
+    robot = load_robot(tmp_path / "videocal_arm_calibrated.urdf")
+    # Board views alone leave the base untied (no surveyed component in these files), so the two grasps'
+    # tools differ by a few tenths of a millimetre; their mean puts each pin within that.
+    for name, q in grasps.items():
+        pin = bed.workcell.task(name).tcp2base
+        d, r = pose_difference(robot.fk(q, "tcp"), pin)
+        nominal = np.linalg.norm(pose_difference(bed.model_robot.fk(q, "tcp"), pin)[0])
+        assert np.linalg.norm(d) < 0.5 and np.linalg.norm(d) < nominal / 4 and np.linalg.norm(r) < 0.02, (name, d, r, nominal)
+    assert "tcp2cam" in (tmp_path / "robot_calibration.yaml").read_text()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("task,j1,j2,j3,j4,j5,j6\nno_such_task,1,2,3,4,5,6\n", "row 2, task.*no task location 'no_such_task'.*oru_1_grasp"),
+    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,x,4,5,6\n", "row 2, j3.*not a number: 'x'"),
+    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,3,4,5\n", "row 2.*6 values, the header has 7"),
+    ("task,a,b,c,d,e,f\noru_1_grasp,1,2,3,4,5,6\n", "header.*not the robot's joints"),
+    ("joints,j1,j2,j3,j4,j5,j6\n", "the first column must be 'task'"),
+    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,nan,4,5,6\n", "row 2, j3.*finite"),
+])
+def test_a_wrong_grasps_file_is_named_before_any_work(files, tmp_path, text, message):
+    folder, _, _ = files
+    bad = tmp_path / "grasps.csv"
+    bad.write_text(text)
+    run = _videocal("calibrate-robot", folder / "views.csv", "--grasps", bad, "--out", tmp_path / "out", timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "grasps.csv" in run.stderr
+    assert re.search(message, run.stderr), run.stderr
+    assert not (tmp_path / "out").exists()
