@@ -15,7 +15,9 @@ from app.gui.buttons import button
 from app.gui.busy import busy
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
+from app.gui.tool_group import ToolGroup
 from calib_core.errors import OperatorError
+from calib_core.operator.calibration_run import VIA
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 
 
@@ -94,10 +96,12 @@ class RobotPanel(QWidget):
             row.addWidget(b)
         vl.addLayout(row)
 
+        self.tool = ToolGroup(workbench, show_error, self._refresh)
         layout = QVBoxLayout(self)
         layout.addWidget(plan)
         layout.addWidget(run)
         layout.addWidget(review)
+        layout.addWidget(self.tool)
         layout.addStretch(1)
         self._refresh()
 
@@ -124,20 +128,23 @@ class RobotPanel(QWidget):
             self.plan = self.workbench.plan_robot_calibration(self._spec(), self.poses.value())
         n = len(self.plan.joints_deg)
         why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
-        self.plan_text.setText(f"{n} poses planned from {self.plan.candidates} candidates" + (f" (left out: {why})" if why else "")
-                               + ". Every pose sees the whole board with the model, and every move from the one before is free of collisions.")
+        seen = [c for c, _ in self.plan.cell_views if c != VIA]
+        self.plan_text.setText(f"{n} board poses planned from {self.plan.candidates} candidates, then {len(seen)} views of the surveyed components "
+                               f"({', '.join(sorted(set(seen))) or 'none reachable'}: they tie the robot to the cell)"
+                               + (f" (left out: {why})" if why else "")
+                               + ". Every pose sees its target with the model, and every move from the one before is free of collisions.")
         self.workbench.message.emit(f"robot calibration: {n} poses planned")
         self._refresh()
 
     def start_run(self) -> None:
         if self.plan is None or not self.plan.joints_deg:
             raise OperatorError("plan the poses first")
-        n = len(self.plan.joints_deg)
+        n = len(self.plan.joints_deg) + len(self.plan.cell_views)
         if not ask(self, "Drive the robot through the calibration poses?", f"The robot will move through {n} poses, one after the other, stopping at each "
                    "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
                    "Stop ends the run after the current move.", "Run"):
             return
-        self.run = self.workbench.robot_calibration_run(self._spec(), self.plan.joints_deg)
+        self.run = self.workbench.robot_calibration_run(self._spec(), self.plan.joints_deg, self.plan.cell_views)
         self.progress.setRange(0, n)
         self.progress.setValue(0)
         self.run.progress.connect(self._on_progress)
@@ -155,10 +162,10 @@ class RobotPanel(QWidget):
         if self.run is None:
             raise OperatorError("run the plan first: the identification needs the views it takes")
         with busy(self, "identifying the robot ..."):
-            r = self.result = self.workbench.calibrate_robot(self.run.capture)
+            r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames)
         obs = r.observability
         lines = [
-            f"<b>Robot</b> from {len(r.per_view_rms_px)} views: RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
+            f"<b>Robot</b> from {len(r.per_view_rms_px)} views ({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
             f"{len(obs.identified)} of {len(r.names)} parameters identified (condition {obs.condition:.0f}); {len(obs.directions)} combinations the views do not determine"
             + (f", e.g. {', '.join(f'{w:+.2f} {n}' for n, w in obs.directions[0][:3])}" if obs.directions else ""),
             f"{len(obs.correlations)} pairs correlated above 0.9" if obs.correlations else "no two parameters correlated above 0.9",
@@ -177,12 +184,13 @@ class RobotPanel(QWidget):
 
     def revert(self) -> None:
         self.workbench.revert_robot_calibration()
+        self.tool.tool = None
         self._refresh()
 
     def save(self, folder) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.workbench.save_robot_calibration(folder, self.result)
+        self.workbench.save_robot_calibration(folder, self.result, self.tool.tool)
 
     def _save_dialog(self) -> None:
         folder = QFileDialog.getExistingDirectory(self, "Save the robot calibration into")

@@ -1,4 +1,5 @@
-"""A robot calibration run: the robot driven through planned poses, one board view captured at each.
+"""A robot calibration run: the robot driven through planned poses, one board view captured at each,
+then the poses that view the surveyed components, one settled frame kept at each.
 
 Each move is awaited (the core's ``motion_changed`` says it arrived, or why not), then a frame taken
 after the robot settled (the same stillness rule every pick and capture follows) is detected and kept
@@ -20,8 +21,20 @@ from calib_core.vision.capture import BoardCapture
 from calib_core.vision.intrinsics_calibration import RejectedView
 
 IDLE, MOVING, SETTLING, DONE, STOPPED = "idle", "moving", "settling", "done", "stopped"
+VIA = "via"
+"""In a plan's ``cell_views``: a pose passed through on the way to the next (home, round an obstacle), nothing captured."""
 MAX_FRAMES_PER_POSE = 60
 """Settled frames tried at a pose before it is given up (the board not found in any)."""
+
+
+@dataclass(frozen=True)
+class CellFrame:
+    """A settled frame ``image`` at ``joints_deg`` viewing surveyed ``component``: located later,
+    by the identification (Find points' edges take a second or two, too long between moves)."""
+
+    component: str
+    joints_deg: np.ndarray
+    image: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -40,10 +53,12 @@ class CalibrationRun:
     progress = Signal(object)
     finished = Signal(str)
 
-    def __init__(self, core, spec, plan: list[np.ndarray]):
+    def __init__(self, core, spec, plan: list[np.ndarray], cell_views=()):
         self.core = core
         self.capture = BoardCapture(spec)
-        self.plan = [np.asarray(q, dtype=float) for q in plan]
+        self.components = [None] * len(plan) + [c for c, _ in cell_views]
+        self.plan = [np.asarray(q, dtype=float) for q in plan] + [np.asarray(q, dtype=float) for _, q in cell_views]
+        self.cell_frames: list[CellFrame] = []
         self.index = 0
         self.phase = IDLE
         self.skipped: list[str] = []
@@ -51,7 +66,8 @@ class CalibrationRun:
 
     @property
     def what(self) -> str:
-        return f"calibration pose {self.index + 1} of {len(self.plan)}"
+        component = self.components[self.index] if self.index < len(self.plan) else None
+        return f"calibration pose {self.index + 1} of {len(self.plan)}" + (" (on the way, through home)" if component == VIA else f" ({component})" if component else "")
 
     def start(self) -> None:
         if not self.plan:
@@ -78,7 +94,7 @@ class CalibrationRun:
 
     def _visit(self) -> None:
         if self.index >= len(self.plan):
-            self._end(DONE, f"calibration run done: {len(self.capture.views)} views of {len(self.plan)} poses" + (f" ({len(self.skipped)} skipped)" if self.skipped else ""))
+            self._end(DONE, f"calibration run done: {len(self.capture.views)} board views and {len(self.cell_frames)} of the surveyed components from {len(self.plan)} poses" + (f" ({len(self.skipped)} skipped)" if self.skipped else ""))
             return
         self.phase, self._tries = MOVING, 0
         try:
@@ -91,7 +107,10 @@ class CalibrationRun:
     def _on_motion(self, state) -> None:
         if self.phase != MOVING or state.what != self.what:
             return
-        if state.motion is Motion.ARRIVED:
+        if state.motion is Motion.ARRIVED and self.components[self.index] == VIA:
+            self.index += 1
+            self._visit()
+        elif state.motion is Motion.ARRIVED:
             self.phase = SETTLING
             self._say(f"{self.what}: arrived, waiting for the robot to settle")
         elif state.motion is not Motion.MOVING:
@@ -103,6 +122,11 @@ class CalibrationRun:
         try:
             joints = np.array(self.core.stamp_frame(frame).joints_deg)
         except VideocalError:  # settled, but its joints not known yet (a sample late): the next frame
+            return
+        if self.components[self.index] is not None:
+            self.cell_frames.append(CellFrame(self.components[self.index], joints, frame.image.copy()))
+            self.index += 1
+            self._visit()
             return
         view = self.capture.add(frame.image, joints)
         if isinstance(view, RejectedView):

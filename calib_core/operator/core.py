@@ -39,11 +39,12 @@ from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
+from calib_core.operator.tool_measuring import ToolMeasuring
 from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating):
+class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring):
     """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,

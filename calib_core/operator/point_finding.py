@@ -45,22 +45,27 @@ class PointFinding:
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.workcell.component(target)
         obj2cam_model = np.linalg.inv(self.robot.fk(q, "camera")) @ item.item2world
-        if self._model_view is None or self._model_view.intrinsics != self.intrinsics:
-            from calib_core.render.model_view import ModelView  # VTK loads on the first Find points, not at start-up
-
-            if self._model_view is not None:
-                self._model_view.close()
-            self._model_view = ModelView(self.intrinsics)
-        items = list(self.workcell.components) + self.cell.model_visuals().scene_items(q) + list(self.scene_extras)
         from calib_core.vision.find_points import find_points
 
-        result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self._model_view.of(items, item.item2world))
+        result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))
         self.found = FoundOnFrame(result, held.stamp)
         self.record_event("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
                           missed={m.feature: m.reason for m in result.missed}, seconds=round(result.seconds, 3))
         self.points_found.emit(self.found)
         self.message.emit(result.message)
         return self.found
+
+    def modelled_view(self, q_deg, item):
+        """What the modelled camera at joints ``q_deg`` sees of ``item`` (the modelled cell, the robot
+        and what is put up in it), for Find points' checks against the image."""
+        if self._model_view is None or self._model_view.intrinsics != self.intrinsics:
+            from calib_core.render.model_view import ModelView  # VTK loads on the first Find points, not at start-up
+
+            if self._model_view is not None:
+                self._model_view.close()
+            self._model_view = ModelView(self.intrinsics)
+        items = list(self.workcell.components) + self.cell.model_visuals().scene_items(q_deg) + list(self.scene_extras)
+        return self._model_view.of(items, item.item2world)
 
     def calibrate_on_edges(self):
         """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's

@@ -8,17 +8,20 @@ from pathlib import Path
 import numpy as np
 
 from calib_core.errors import OperatorError
+from calib_core.operator.calibration_run import VIA
 from calib_core.robot.model import _to_mm, _to_se3
 
 
 class RobotCalibrating:
     """Mixed into :class:`~calib_core.operator.core.OperatorCore`."""
 
-    def plan_robot_calibration(self, spec, n: int = 40):
+    def plan_robot_calibration(self, spec, n: int = 40, *, cell_views_per_target: int = 3):
         """A :class:`~calib_core.robot_calibration.pose_planner.PosePlan` of ``n`` poses seeing the
-        board where the cell puts it, each free of collisions, in an order whose every move from the
-        current joints is free of collisions too."""
+        board where the cell puts it, then ``cell_views_per_target`` poses seeing each surveyed
+        component the tie to the cell uses; each free of collisions, in an order whose every move
+        from the current joints is free of collisions too."""
         from calib_core.operator.move_preview import joint_path
+        from calib_core.robot_calibration.cell_views import cell_view_joints
         from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 
         world = self.collision_world()
@@ -31,17 +34,38 @@ class RobotCalibrating:
         rejected = dict(plan.rejected)
         if len(kept) < len(plan.joints_deg):
             rejected["no collision-free path from the pose before"] = len(plan.joints_deg) - len(kept)
-        return PosePlan(kept, plan.candidates, rejected, plan.log_det)
+        cell, home = [], np.asarray(self.cell.home_joints, dtype=float)
 
-    def robot_calibration_run(self, spec, plan: list[np.ndarray]):
-        """A :class:`~calib_core.operator.calibration_run.CalibrationRun` over ``plan`` (not started)."""
+        def free(a, b):
+            return not any(world.check(p) for p in joint_path(a, b))
+
+        for component, goal in cell_view_joints(self.robot, self.workcell, self.intrinsics, cell_views_per_target, collisions=world) if cell_views_per_target else []:
+            if free(q, goal):
+                cell.append((component, goal))
+            elif free(q, home) and free(home, goal):  # round the cell's obstacles through home
+                cell += [(VIA, home), (component, goal)]
+            else:
+                rejected["a component's view with no collision-free path"] = rejected.get("a component's view with no collision-free path", 0) + 1
+                continue
+            q = goal
+        return PosePlan(kept, plan.candidates, rejected, plan.log_det, cell)
+
+    def robot_calibration_run(self, spec, plan: list[np.ndarray], cell_views=()):
+        """A :class:`~calib_core.operator.calibration_run.CalibrationRun` over ``plan`` then the
+        components' ``cell_views`` ((component, joints deg)), not started."""
         from calib_core.operator.calibration_run import CalibrationRun
 
-        return CalibrationRun(self, spec, plan)
+        return CalibrationRun(self, spec, plan, cell_views)
 
-    def calibrate_robot(self, capture, *, with_intrinsics: bool = False):
+    def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False):
         """Identify the robot from a :class:`~calib_core.vision.capture.BoardCapture`'s views with
-        joints; the robot as it is now (nominal, or calibrated before) is the start."""
+        joints and the run's ``cell_frames`` (:class:`~calib_core.operator.calibration_run.CellFrame`:
+        each component located by Find points' edges, through the intrinsics in use); the robot as it
+        is now (nominal, or calibrated before) is the start. A component not located is named in the
+        result's warnings."""
+        from dataclasses import replace
+
+        from calib_core.robot_calibration.cell_views import cell_view
         from calib_core.robot_calibration.identification import identify
         from calib_core.robot_calibration.observations import PoseView
 
@@ -50,15 +74,21 @@ class RobotCalibrating:
             raise OperatorError(f"{len(posed)} views with a robot pose, at least 6 needed (run the calibration plan)")
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
-        result = identify(self.robot, self.intrinsics, views, with_intrinsics=with_intrinsics)
-        self.record_event("robot_calibrated", views=len(views), rms_px=result.rms_px, identified=len(result.observability.identified))
+        objects, missed = [], []
+        for k, f in enumerate(cell_frames):
+            item = self.workcell.component(f.component)
+            found = cell_view(f"cell_{k + 1:02d}_{f.component}", f.image, f.joints_deg, self.workcell, f.component, self.robot, self.intrinsics, self.modelled_view(f.joints_deg, item))
+            (missed if isinstance(found, str) else objects).append(found)
+        result = identify(self.robot, self.intrinsics, views + objects, with_intrinsics=with_intrinsics)
+        if missed:
+            result = replace(result, warnings=list(result.warnings) + missed)
+        self.record_event("robot_calibrated", views=len(views), component_views=len(objects), rms_px=result.rms_px, identified=len(result.observability.identified))
         return result
 
     def apply_robot_calibration(self, result) -> None:
         """Use the calibrated joint and camera placements for everything from now on (the robot
         object stays the same, so every view follows); :meth:`revert_robot_calibration` takes it back."""
-        if getattr(self, "_robot_before_calibration", None) is None:
-            self._robot_before_calibration = ([_to_mm(p) for p in self.robot.model.jointPlacements], self.robot.frame_placement("camera"), self.robot.frame_placement("tcp"))
+        self.keep_robot_before_calibration()
         for j in range(1, self.robot.model.njoints):
             self.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
         self.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
@@ -67,6 +97,11 @@ class RobotCalibrating:
         self.camera_model_changed.emit()
         self.scene_changed.emit()
         self.message.emit(f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)")
+
+    def keep_robot_before_calibration(self) -> None:
+        """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
+        if getattr(self, "_robot_before_calibration", None) is None:
+            self._robot_before_calibration = ([_to_mm(p) for p in self.robot.model.jointPlacements], self.robot.frame_placement("camera"), self.robot.frame_placement("tcp"))
 
     def revert_robot_calibration(self) -> None:
         before = getattr(self, "_robot_before_calibration", None)
@@ -83,11 +118,14 @@ class RobotCalibrating:
         self.scene_changed.emit()
         self.message.emit("the robot's model as loaded is in use again")
 
-    def save_robot_calibration(self, folder, result) -> tuple[Path, Path]:
-        """``robot_calibration.yaml`` and the calibrated URDF into ``folder``."""
+    def save_robot_calibration(self, folder, result, tool=None) -> tuple[Path, Path]:
+        """``robot_calibration.yaml`` and the calibrated URDF into ``folder``; with ``tool`` (from
+        :meth:`measure_tool`) the URDF's TCP joint carries it and the YAML says it was measured."""
+        from calib_core.robot_calibration.camera_to_tool import with_tool
         from calib_core.robot_calibration.report import save_robot_calibration
 
         Path(folder).mkdir(parents=True, exist_ok=True)
-        paths = save_robot_calibration(folder, result, result.nominal)
+        robot = with_tool(result.robot, tool.tcp2cam) if tool is not None else None
+        paths = save_robot_calibration(folder, result, result.nominal, robot=robot, tool=tool)
         self.message.emit(f"robot calibration saved to {paths[0]} and {paths[1]}")
         return paths

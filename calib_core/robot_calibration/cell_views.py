@@ -50,9 +50,10 @@ def surveyed_targets(robot: RobotModel, workcell) -> list[tuple[str, np.ndarray]
     for task in workcell.task_locations.values():
         if task.component is not None and len(workcell.component(task.component).features) >= MIN_FEATURES:
             take(task.component, _approach_camera(robot, task))
+    eye = robot.fk(np.asarray(workcell.home_joints_deg, dtype=float), "camera")[:3, 3]
     for item in workcell.components:
         if len(item.features) >= MIN_FEATURES and item.name not in [n for n, _ in chosen]:
-            take(item.name, _look_at(_centroid(item), LOOK_DISTANCE_MM))
+            take(item.name, _look_at(_centroid(item), LOOK_DISTANCE_MM, eye[2]))
     return chosen
 
 
@@ -69,10 +70,11 @@ def _approach_camera(robot: RobotModel, task) -> np.ndarray:
     return task.approach2base @ np.linalg.inv(tcp2flange) @ cam2flange
 
 
-def _look_at(target_mm: np.ndarray, distance_mm: float) -> np.ndarray:
-    """A camera pose (4, 4) mm looking horizontally at ``target_mm`` from ``distance_mm`` on the
-    side of the robot's base axis, image up pointing up."""
-    out = np.array([target_mm[0], target_mm[1], 0.0])
+def _look_at(target_mm: np.ndarray, distance_mm: float, eye_height_mm: float) -> np.ndarray:
+    """A camera pose (4, 4) mm looking at ``target_mm`` from ``distance_mm`` along the line from the
+    robot's base axis at ``eye_height_mm`` (the camera's height at home) to it, image up pointing
+    up: the arm reaches out and down (or up) to it without folding its wrist."""
+    out = np.array([target_mm[0], target_mm[1], target_mm[2] - eye_height_mm])
     z = out / max(np.linalg.norm(out), 1e-9)
     x = np.cross([0.0, 0.0, -1.0], z)
     x /= np.linalg.norm(x)
@@ -83,9 +85,10 @@ def _look_at(target_mm: np.ndarray, distance_mm: float) -> np.ndarray:
     return T
 
 
-def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_target: int = 3, seed: int = 0) -> list[tuple[str, np.ndarray]]:
+def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_target: int = 3, seed: int = 0, collisions=None) -> list[tuple[str, np.ndarray]]:
     """(component, joints deg) for ``per_target`` poses around each of :func:`surveyed_targets`'
-    views, from which the modelled camera sees every feature of the component."""
+    views, from which the modelled camera sees every feature of the component; with ``collisions``
+    (a :class:`~calib_core.robot.collision.CollisionWorld`) only poses free of contacts."""
     rng = np.random.default_rng(seed)
     home = np.asarray(workcell.home_joints_deg, dtype=float)
     cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
@@ -109,7 +112,7 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
             except UnreachableTargetError:
                 continue
             uv = project_points(points, invert(robot.fk(q, "camera")) @ item.item2world, intrinsics)
-            if intrinsics.contains(uv, margin_px=40).all() and np.all(robot.within_limits(q, 1.0)):
+            if intrinsics.contains(uv, margin_px=40).all() and np.all(robot.within_limits(q, 1.0)) and (collisions is None or not collisions.check(q)):
                 out.append((component, q))
                 found += 1
     return out

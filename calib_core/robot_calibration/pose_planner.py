@@ -15,7 +15,7 @@ later is measured through that guess.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -35,12 +35,15 @@ OFF_CENTRE_DEG = 15.0
 class PosePlan:
     """``joints_deg``: the chosen poses in the order to visit them; ``candidates`` how many were
     generated, ``rejected`` why the others were left (reason -> count); ``log_det`` the chosen set's
-    information (higher is better)."""
+    information (higher is better); ``cell_views`` (component, joints deg) poses that view the
+    surveyed components (:func:`~calib_core.robot_calibration.cell_views.cell_view_joints`), visited
+    after the board's, which tie the robot to the cell."""
 
     joints_deg: list[np.ndarray]
     candidates: int
     rejected: dict[str, int]
     log_det: float
+    cell_views: list[tuple[str, np.ndarray]] = field(default_factory=list)
 
 
 def _sees_board(robot: RobotModel, intrinsics: Intrinsics, q, board2base, corners) -> bool:

@@ -64,7 +64,10 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views")
     board_count, cell_views = len(pose_views), []
     if cell_views_per_task:
-        targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed)
+        from calib_core.robot.collision import CollisionWorld
+
+        world = CollisionWorld(bed.model_robot, list(bed.workcell.components), bed.workcell.home_joints_deg)
+        targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed, collisions=world)
         say(f"locating surveyed features in {len(targets)} views...")
         cell_views, cell_rejected = simulated_cell_views(bed, intrinsics.intrinsics, targets, seed=seed)
         pose_views += cell_views

@@ -7,7 +7,9 @@ import yaml
 from PySide6.QtCore import Qt
 
 from calib_core.frames import invert, pose_difference
+from calib_core.robot import solve_ik
 from calib_core.robot.model import load_robot
+from calib_core.testbed.compliant_grasp import grasp_joints
 from calib_core.testbed.true_robot import RobotErrors
 from tests.app.windows import answer_next_question
 
@@ -37,7 +39,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     qtbot.waitUntil(lambda: panel.run.phase in ("done", "stopped"), timeout=240_000)
     assert panel.run.phase == "done", panel.run_text.text()
     n = len(panel.plan.joints_deg)
-    assert len(panel.run.capture.views) == n and panel.progress.value() == n
+    assert len(panel.run.capture.views) == n and panel.progress.value() == n + len(panel.plan.cell_views)
     # every view keeps the joints it was taken at: the planned ones, the robot at rest
     for q, planned in zip(panel.run.capture.joints_deg, panel.plan.joints_deg):
         assert np.max(np.abs(q - planned)) < 1e-3
@@ -54,6 +56,13 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     d, rot = pose_difference(invert(r.board2base) @ r.robot.fk(q, "camera"), invert(board2base) @ bed.true_cam2world(q))
     d0, rot0 = pose_difference(wb.robot.fk(q, "camera"), bed.true_cam2world(q))
     assert np.linalg.norm(d) < 0.3 * np.linalg.norm(d0) and np.linalg.norm(rot) < 0.3 * np.linalg.norm(rot0)
+    # The run's views of the surveyed components tie the robot to the cell: the camera in the base frame itself.
+    seen = [c for c, _ in panel.plan.cell_views if c != "via"]
+    assert len(set(seen)) >= 3 and len(panel.run.cell_frames) == len(seen)
+    located = [k for k in r.per_view_rms_px if k.startswith("cell_")]
+    assert len(located) >= 3 and "of surveyed components" in panel.result_text.text()
+    d_base, rot_base = pose_difference(r.robot.fk(q, "camera"), bed.true_cam2world(q))
+    assert np.linalg.norm(d_base) < 0.1 * np.linalg.norm(d0) and np.linalg.norm(rot_base) < 0.2 * np.linalg.norm(rot0), (d_base, d0)
 
     renders = win.virtual.renders
     before = wb.robot.fk(q, "camera")
@@ -61,11 +70,45 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert np.allclose(wb.robot.fk(q, "camera"), r.robot.fk(q, "camera")) and win.virtual.renders > renders
     assert panel.revert_button.isEnabled()
 
+    # Camera to tool: the gripper closed on each task location's pin in compliance. The simulated
+    # physical world plays the compliance (the joints where the true TCP is on the pin); the window
+    # only reads the joints the controller then reports.
+    tool = panel.tool
+    assert not tool.measure_button.isEnabled()
+    panel.show_board.setChecked(False)  # the board taken down before the gripper works at the fixtures
+    pins = {}
+
+    def move(q, what, allowed=frozenset()):  # awaited until the reported joints are there: the next preview starts from them
+        handle = wb.move_joints(q, what, confirmed=True, allowed_contacts=allowed)
+        qtbot.waitUntil(lambda: handle.finished and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=60_000)
+
+    home = np.asarray(wb.cell.home_joints, dtype=float)
+    for task in list(wb.workcell.task_locations.values())[:2]:
+        wb.set_task(task.name)
+        q_approach = solve_ik(wb.robot, task.approach2base, home).q_deg
+        q_pin = grasp_joints(bed, task.tcp2base, seed=len(pins))
+        move(home, "home")
+        move(q_approach, f"{task.name} approach")
+        move(q_pin, f"{task.name} grasp (the compliance)", frozenset({task.component}))
+        qtbot.waitUntil(lambda: wb.motion.motion.value not in ("moving", "unknown"), timeout=10_000)
+        qtbot.mouseClick(tool.record_button, Qt.MouseButton.LeftButton)
+        pins[task.name] = (q_pin, task.tcp2base)
+        move(q_approach, f"{task.name} approach", frozenset({task.component}))  # back out of the fixture
+    assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text()
+    before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
+    qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
+    assert tool.tool is not None and "TCP from 2 grasps" in tool.text.text()
+    for name, (q_pin, pin) in pins.items():
+        miss = np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0])
+        assert miss <= 1.2 * tool.tool.spread_mm + 0.01 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])
+
     panel.save(tmp_path)
     doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
+    assert doc["tcp2cam"]["grasps"] == 2
     assert doc["observability"]["identified"] == len(r.observability.identified)
     again = load_robot(tmp_path / "videocal_arm_calibrated.urdf")
     assert np.linalg.norm(pose_difference(again.fk(q, "camera"), r.robot.fk(q, "camera"))[0]) < 1e-3
 
     qtbot.mouseClick(panel.revert_button, Qt.MouseButton.LeftButton)
     assert np.allclose(wb.robot.fk(q, "camera"), before)
+    assert np.allclose(wb.robot.fk(q, "tcp"), wb.workcell.load_robot().fk(q, "tcp"), atol=1e-6)  # the tool taken back too

@@ -1,0 +1,63 @@
+"""The Robot tab's camera-to-tool group: record a grasp at the current task location (the gripper
+closed on its fixture pin in compliance, by the teach pendant), then measure the TCP from the grasps."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtWidgets import QGroupBox, QHBoxLayout, QLabel, QVBoxLayout
+
+from app.gui.buttons import button
+from app.gui.error_boundary import guarded
+
+
+class ToolGroup(QGroupBox):
+    """``changed`` is called after the robot's TCP changed (the panel's buttons follow)."""
+
+    def __init__(self, workbench, show_error: Callable[[str], None], changed: Callable[[], None], parent=None):
+        super().__init__("Camera to tool", parent)
+        self.workbench = workbench
+        self.changed = changed
+        self.tool = None
+        guard = guarded(show_error)
+        layout = QVBoxLayout(self)
+        how = QLabel("Close the gripper on the task location's fixture pin with the controller in compliance (teach pendant), "
+                     "then record the grasp. Two or more task locations give the spread.")
+        how.setWordWrap(True)
+        layout.addWidget(how)
+        row = QHBoxLayout()
+        self.record_button = button("Record grasp", "tool_record", "Keep the joints the controller reports now, the TCP on the current task location's pin")
+        self.record_button.clicked.connect(guard(self.record))
+        self.measure_button = button("Measure tool", "tool_measure", "The TCP in the camera frame from the grasps, through the robot as it is now (calibrate it first); Revert takes it back")
+        self.measure_button.clicked.connect(guard(self.measure))
+        self.clear_button = button("Clear", "tool_clear", "Forget the recorded grasps")
+        self.clear_button.clicked.connect(guard(self.clear))
+        for b in (self.record_button, self.measure_button, self.clear_button):
+            row.addWidget(b)
+        layout.addLayout(row)
+        self.text = QLabel("No grasp recorded.")
+        self.text.setWordWrap(True)
+        layout.addWidget(self.text)
+        self.refresh()
+
+    def refresh(self) -> None:
+        n = len(self.workbench.grasps)
+        self.measure_button.setEnabled(n > 0)
+        self.clear_button.setEnabled(n > 0)
+
+    def record(self) -> None:
+        g = self.workbench.record_grasp()
+        self.text.setText(f"{len(self.workbench.grasps)} grasps; last {g.name} at joints " + " ".join(f"{v:.2f}" for v in g.joints_deg) + " deg")
+        self.refresh()
+
+    def measure(self) -> None:
+        t = self.tool = self.workbench.measure_tool()
+        self.text.setText(f"TCP from {len(t.per_grasp)} grasps: {t.tcp2cam[0, 3]:.2f} {t.tcp2cam[1, 3]:.2f} {t.tcp2cam[2, 3]:.2f} mm in the camera frame; "
+                          f"spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg. In use now (Revert takes it back); saved with the robot calibration.")
+        self.refresh()
+        self.changed()
+
+    def clear(self) -> None:
+        self.workbench.clear_grasps()
+        self.text.setText("No grasp recorded.")
+        self.refresh()
