@@ -31,6 +31,11 @@ from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transf
 OUTLIER_RATIO = 4.0
 """A surveyed component's view whose residual is this many times the median of those views' (and
 over 3 of its own sigmas) is left out: one edge fit on the wrong edges pulled the tie 0.17 mm."""
+OBJECT_TURN_SIGMA_MRAD = 1.0
+"""A component's own orientation from its edges is biased by a few tenths of a milliradian, the
+same way across views (on the cold cell 0.1-0.5 mrad about the camera's x axis, 2-17 of the fit's
+sigmas), while its position is right to 0.03 mm: its covariance gets a turn about its own origin of
+this size, so the tie rests on where the components are (three off one line fix the base)."""
 SURVEY_SIGMA_MM = 0.05
 """A theodolite survey's 1-sigma per axis (its points good to about 0.1 mm)."""
 FD_STEP = 1e-4
@@ -107,7 +112,7 @@ class _Problem:
         self.whiten = {}
         for k, v in enumerate(views):
             if v.target == OBJECT:
-                cov = np.asarray(v.covariance, dtype=float) + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3)
+                cov = np.asarray(v.covariance, dtype=float) + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3) + turn_about_object(v.obj2cam, OBJECT_TURN_SIGMA_MRAD)
                 self.whiten[k] = np.linalg.inv(np.linalg.cholesky(cov + 1e-15 * np.eye(6)))
         # With the intrinsics fitted, an object's pose measured through the starting ones moves with them.
         self.moves_with_intrinsics = {}
@@ -147,6 +152,15 @@ class _Problem:
             db[c] += FD_STEP
             Jb[:, c] = (self.residuals(p, db) - r0) / FD_STEP
         return J, Jb
+
+
+def turn_about_object(obj2cam: np.ndarray, sigma_mrad: float) -> np.ndarray:
+    """(6, 6) covariance, in the left perturbation of ``obj2cam`` (rotation vector rad, translation
+    mm, camera frame), of the object turned about its own origin by ``sigma_mrad`` (1-sigma per
+    axis): a turn ``w`` about the origin at ``t`` is the left rotation ``w`` with translation ``t x w``."""
+    t = obj2cam[:3, 3]
+    G = np.vstack([np.eye(3), np.array([[0.0, -t[2], t[1]], [t[2], 0.0, -t[0]], [-t[1], t[0], 0.0]])])
+    return (sigma_mrad / 1000.0) ** 2 * G @ G.T
 
 
 def pose_sensitivity_to_intrinsics(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Intrinsics, step: float = 0.1) -> np.ndarray:
