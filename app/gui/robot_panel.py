@@ -81,6 +81,10 @@ class RobotPanel(QWidget):
         self.identify_button = button("Identify", "robot_identify", "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)")
         self.identify_button.clicked.connect(guard(self.identify))
         vl.addWidget(self.identify_button)
+        self.fit_intrinsics = QCheckBox("Refine the camera's intrinsics with the robot")
+        self.fit_intrinsics.setChecked(True)
+        self.fit_intrinsics.setToolTip("The board views correct fu, fv, cx, cy, k1, k2, p1, p2 together with the robot; Apply uses them too, Revert takes them back")
+        vl.addWidget(self.fit_intrinsics)
         self.result_text = QLabel("")
         self.result_text.setWordWrap(True)
         self.result_text.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
@@ -129,10 +133,10 @@ class RobotPanel(QWidget):
         n = len(self.plan.joints_deg)
         why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
         seen = [c for c, _ in self.plan.cell_views if c != VIA]
-        self.plan_text.setText(f"{n} board poses planned from {self.plan.candidates} candidates, then {len(seen)} views of the surveyed components "
-                               f"({', '.join(sorted(set(seen))) or 'none reachable'}: they tie the robot to the cell)"
-                               + (f" (left out: {why})" if why else "")
-                               + ". Every pose sees its target with the model, and every move from the one before is free of collisions.")
+        self.plan_text.setText(f"{n} board poses (of {self.plan.candidates} candidates) and {len(seen)} views of surveyed components "
+                               f"({', '.join(sorted(set(seen))) or 'none reachable'}), which tie the robot to the cell.")
+        self.plan_text.setToolTip("Every pose sees its target with the model, and every move from the one before is free of collisions."
+                                  + (f" Left out: {why}." if why else ""))
         self.workbench.message.emit(f"robot calibration: {n} poses planned")
         self._refresh()
 
@@ -162,7 +166,7 @@ class RobotPanel(QWidget):
         if self.run is None:
             raise OperatorError("run the plan first: the identification needs the views it takes")
         with busy(self, "identifying the robot ..."):
-            r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames)
+            r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked())
         obs = r.observability
         lines = [
             f"<b>Robot</b> from {len(r.per_view_rms_px)} views ({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",

@@ -21,8 +21,7 @@ class ToolGroup(QGroupBox):
         self.tool = None
         guard = guarded(show_error)
         layout = QVBoxLayout(self)
-        how = QLabel("Close the gripper on the task location's fixture pin with the controller in compliance (teach pendant), "
-                     "then record the grasp. Two or more task locations give the spread.")
+        how = QLabel("Gripper closed on the task's pin in compliance (pendant), then Record grasp; two tasks give the spread.")
         how.setWordWrap(True)
         layout.addWidget(how)
         row = QHBoxLayout()
@@ -37,6 +36,8 @@ class ToolGroup(QGroupBox):
         layout.addLayout(row)
         self.text = QLabel("No grasp recorded.")
         self.text.setWordWrap(True)
+        # Room for two lines from the start: a wrapped label that grows later is not given the height in a scroll area.
+        self.text.setMinimumHeight(2 * self.text.fontMetrics().lineSpacing() + 4)
         layout.addWidget(self.text)
         self.refresh()
 
@@ -47,13 +48,14 @@ class ToolGroup(QGroupBox):
 
     def record(self) -> None:
         g = self.workbench.record_grasp()
-        self.text.setText(f"{len(self.workbench.grasps)} grasps; last {g.name} at joints " + " ".join(f"{v:.2f}" for v in g.joints_deg) + " deg")
+        self.text.setText(f"{len(self.workbench.grasps)} grasps (last: {g.name})")
+        self.text.setToolTip("joints " + " ".join(f"{v:.3f}" for v in g.joints_deg) + " deg")
         self.refresh()
 
     def measure(self) -> None:
         t = self.tool = self.workbench.measure_tool()
-        self.text.setText(f"TCP from {len(t.per_grasp)} grasps: {t.tcp2cam[0, 3]:.2f} {t.tcp2cam[1, 3]:.2f} {t.tcp2cam[2, 3]:.2f} mm in the camera frame; "
-                          f"spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg. In use now (Revert takes it back); saved with the robot calibration.")
+        self.text.setText(f"TCP from {len(t.per_grasp)} grasps, spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: in use (Revert takes it back)")
+        self.text.setToolTip(f"TCP in the camera frame: {t.tcp2cam[0, 3]:.3f} {t.tcp2cam[1, 3]:.3f} {t.tcp2cam[2, 3]:.3f} mm; saved with the robot calibration")
         self.refresh()
         self.changed()
 

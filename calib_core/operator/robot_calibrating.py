@@ -86,13 +86,18 @@ class RobotCalibrating:
         return result
 
     def apply_robot_calibration(self, result) -> None:
-        """Use the calibrated joint and camera placements for everything from now on (the robot
-        object stays the same, so every view follows); :meth:`revert_robot_calibration` takes it back."""
+        """Use the calibrated joint and camera placements (and the intrinsics, when the identification
+        refined them) for everything from now on (the robot object stays the same, so every view
+        follows); :meth:`revert_robot_calibration` takes it back."""
         self.keep_robot_before_calibration()
         for j in range(1, self.robot.model.njoints):
             self.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
         self.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
         self.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
+        if result.intrinsics != self.intrinsics:  # refined with the robot: the camera as the same fit saw it
+            if getattr(self, "_intrinsics_before_calibration", None) is None:
+                self._intrinsics_before_calibration = self.intrinsics
+            self.use_intrinsics(result.intrinsics)
         self.record_event("robot_calibration_applied", rms_px=result.rms_px)
         self.camera_model_changed.emit()
         self.scene_changed.emit()
@@ -113,6 +118,9 @@ class RobotCalibrating:
         self.robot.set_frame_placement("camera", camera)
         self.robot.set_frame_placement("tcp", tcp)
         self._robot_before_calibration = None
+        if getattr(self, "_intrinsics_before_calibration", None) is not None:
+            self.use_intrinsics(self._intrinsics_before_calibration)
+            self._intrinsics_before_calibration = None
         self.record_event("robot_calibration_reverted")
         self.camera_model_changed.emit()
         self.scene_changed.emit()

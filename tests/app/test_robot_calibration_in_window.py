@@ -25,7 +25,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     panel.show_board.setChecked(True)
     panel.poses.setValue(10)
     qtbot.mouseClick(panel.plan_button, Qt.MouseButton.LeftButton)
-    assert len(panel.plan.joints_deg) >= 8 and "poses planned" in panel.plan_text.text()
+    assert len(panel.plan.joints_deg) >= 8 and "board poses (of" in panel.plan_text.text() and "views of surveyed components" in panel.plan_text.text()
     assert panel.run_button.isEnabled()
 
     # Cancel at the question: nothing moves.
@@ -65,9 +65,12 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert np.linalg.norm(d_base) < 0.1 * np.linalg.norm(d0) and np.linalg.norm(rot_base) < 0.2 * np.linalg.norm(rot0), (d_base, d0)
 
     renders = win.virtual.renders
-    before = wb.robot.fk(q, "camera")
+    before, intrinsics_before = wb.robot.fk(q, "camera"), wb.intrinsics
+    assert panel.fit_intrinsics.isChecked() and r.intrinsics != intrinsics_before  # refined with the robot by default
+    assert abs(r.intrinsics.fu - bed.intrinsics.fu) < 2.0 and abs(r.intrinsics.cx - bed.intrinsics.cx) < 2.0
     qtbot.mouseClick(panel.apply_button, Qt.MouseButton.LeftButton)
     assert np.allclose(wb.robot.fk(q, "camera"), r.robot.fk(q, "camera")) and win.virtual.renders > renders
+    assert wb.intrinsics == r.intrinsics
     assert panel.revert_button.isEnabled()
 
     # Camera to tool: the gripper closed on each task location's pin in compliance. The simulated
@@ -97,11 +100,12 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text()
     before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
-    assert tool.tool is not None and "TCP from 2 grasps" in tool.text.text()
+    assert tool.tool is not None and "TCP from 2 grasps, spread" in tool.text.text()
     for name, (q_pin, pin) in pins.items():
         miss = np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0])
         assert miss <= 1.2 * tool.tool.spread_mm + 0.01 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])
 
+    win.grab().save(str(OUTPUT / "window_robot_tool.png"))
     panel.save(tmp_path)
     doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
     assert doc["tcp2cam"]["grasps"] == 2
@@ -112,3 +116,4 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     qtbot.mouseClick(panel.revert_button, Qt.MouseButton.LeftButton)
     assert np.allclose(wb.robot.fk(q, "camera"), before)
     assert np.allclose(wb.robot.fk(q, "tcp"), wb.workcell.load_robot().fk(q, "tcp"), atol=1e-6)  # the tool taken back too
+    assert wb.intrinsics == intrinsics_before
