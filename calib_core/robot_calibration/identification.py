@@ -278,7 +278,8 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
         x0 = fit.x
     fit = least_squares(fun, x0, jac=jac, method="lm", max_nfev=max_iterations * 2)
     p, board = unpack(fit.x)
-    r = np.where(kept, problem.residuals(p, board), 0.0)
+    r_all = problem.residuals(p, board)  # the left-out views' too: their residuals are reported
+    r = np.where(kept, r_all, 0.0)
     dof = max(int(kept.sum()) - x0.size, 1)
     rp = r[pixel_rows]
     noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float('nan')
@@ -289,7 +290,6 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)
-    r_all = problem.residuals(p, board)
     per_view = {v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r_all[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
     warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
     if not fit.success:
