@@ -69,12 +69,12 @@ def _cold(args: argparse.Namespace) -> int:
 
     bed, _ = cold_test_bed(seed=0)
     from calib_core.calibration.look_fusion import tcp_covariance_from_camera
-    from calib_core.robot_calibration.identification import pose_covariance
+    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
     def model_covariance(q):
         return tcp_covariance_from_camera(pose_covariance(run.result, q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
 
-    look = look_at_task(bed, run.robot, run.result.intrinsics, look_task, model_covariance=model_covariance)
+    look = look_at_task(bed, run.robot, run.result.intrinsics, look_task, model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM)
     i = run.intrinsics
     report = {
         "cell": "cold (calib_core/testbed/cold_cell.py, seed 0)",

@@ -252,7 +252,10 @@ class ReplayBar(QWidget):
         solution = solve_from_inputs(solve.inputs)  # deterministic: the same answer as recorded
         numbers = [p.number for p in self.workbench.session.pairs.usable()]
         obj2world, cam_model, tcp_model = (np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model"))
-        self.workbench.session.show_result(solution, obj2world, cam_model, tcp_model, c.get("joints_deg"), numbers)
+        from calib_core.camera.intrinsics import Intrinsics
+
+        self.workbench.session.show_result(solution, obj2world, cam_model, tcp_model, c.get("joints_deg"), numbers,
+                                           points_obj_mm=solve.inputs.get("points_3d"), intrinsics=Intrinsics.from_dict(solve.inputs["intrinsics"]))
 
     # --- branching -----------------------------------------------------------------------------
     def _on_edit(self) -> None:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from PySide6.QtCore import Qt
-from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtCore import QEventLoop, Qt
+from PySide6.QtWidgets import QApplication, QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QSpinBox, QVBoxLayout, QWidget
 
 from app.gui.buttons import button
 from app.gui.busy import busy
@@ -165,8 +165,22 @@ class RobotPanel(QWidget):
     def identify(self) -> None:
         if self.run is None:
             raise OperatorError("run the plan first: the identification needs the views it takes")
-        with busy(self, "identifying the robot ..."):
-            r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked())
+        def step(done: int, total: int, text: str) -> None:
+            self.progress.setRange(0, total)
+            self.progress.setValue(done)
+            self.run_text.setText(text)
+            QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)  # drawn, not clicked twice
+
+        before = (self.progress.maximum(), self.progress.value(), self.run_text.text())
+        self.identify_button.setEnabled(False)
+        try:
+            with busy(self, "identifying the robot ..."):
+                r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked(), progress=step)
+        finally:  # the run's own progress back (the panel says what the run did)
+            self.progress.setRange(0, before[0])
+            self.progress.setValue(before[1])
+            self.run_text.setText(before[2])
+            self._refresh()
         obs = r.observability
         lines = [
             f"<b>Robot</b> from {len(r.per_view_rms_px)} views ({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",

@@ -56,13 +56,17 @@ def tcp_covariance_from_camera(camera_cov: np.ndarray, cam2base: np.ndarray, tcp
     return A @ camera_cov @ A.T
 
 
-def fuse_look(look: EndEffectorEstimate, model_covariance: np.ndarray) -> FusedCorrection:
+def fuse_look(look: EndEffectorEstimate, model_covariance: np.ndarray, placement_sigma_mm: float = 0.0) -> FusedCorrection:
     """The look's displacement fused with the model's prior (zero, ``model_covariance`` (6, 6) mm
-    and deg of the TCP at the look's joints). Raises ``ValueError`` for a look without covariance."""
+    and deg of the TCP at the look's joints). The look sees the component where it stands, the model
+    aims where the workcell file places it: ``placement_sigma_mm`` (1-sigma per axis, the survey's)
+    widens the model's prior in position by that much. Raises ``ValueError`` for a look without
+    covariance."""
     if look.covariance is None or not np.all(np.isfinite(look.covariance)):
         raise ValueError("the look has no covariance: it cannot be weighed against the model")
     x = np.r_[look.displacement_mm, look.rotation_deg]
-    C_look, C_model = np.asarray(look.covariance, dtype=float), np.asarray(model_covariance, dtype=float)
+    C_look = np.asarray(look.covariance, dtype=float)
+    C_model = np.asarray(model_covariance, dtype=float) + np.diag([placement_sigma_mm**2] * 3 + [0.0] * 3)
     S = C_model + C_look
     m2 = float(x @ np.linalg.solve(S, x))
     agree = m2 <= chi2.ppf(AGREEMENT, 6)

@@ -15,7 +15,7 @@ import numpy as np
 from calib_core.calibration.commands import AddPoint3D, ClearPairs, DeletePair, SetEnabled, SetPixel
 from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.calibration.correspondences import CorrespondenceSet
-from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution
+from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution, shared_shift_covariance
 from calib_core.calibration.undo import Command, UndoStack
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
@@ -53,6 +53,9 @@ class SolveContext:
     joints_deg: np.ndarray | None
     numbers: tuple[int, ...]
     pairs: dict
+    points_obj_mm: np.ndarray | None = None
+    """The solve's 3D points (m, 3) in the target's frame, for the image points' shared error."""
+    intrinsics: Intrinsics | None = None
 
 
 class ChooseCandidate(Command):
@@ -159,17 +162,29 @@ class CalibrationSession:
         with named_points("pair", numbers):  # messages name pairs by the numbers the table shows
             solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
-        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers)
+        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics)
 
-    def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int]) -> EndEffectorEstimate:
-        """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here."""
+    def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int], *,
+                    points_obj_mm=None, intrinsics: Intrinsics | None = None) -> EndEffectorEstimate:
+        """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here.
+        With the solve's ``points_obj_mm`` (m, 3, the target's frame) and ``intrinsics`` the result's
+        covariance carries the image points' shared error
+        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`)."""
         used = [p for p in self.pairs if p.number in set(numbers)]
-        self._context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used))
-        self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model)
+        points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
+        self._context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
+                                     points, intrinsics)
+        self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=self._shared(solution.obj2cam))
         self.chosen_candidate = 0
         self.verdict = self._judge(self.result)
         self._changed()
         return self.result
+
+    def _shared(self, obj2cam):
+        c = self._context
+        if c is None or c.points_obj_mm is None or c.intrinsics is None:
+            return None
+        return shared_shift_covariance(obj2cam, c.points_obj_mm, c.intrinsics)
 
     def _judge(self, estimate) -> ResultVerdict:
         return (self.judge or judge)(estimate)
@@ -229,7 +244,8 @@ class CalibrationSession:
             raise CalibrationError(f"there is no solution {index + 1}")
         c = self._context
         obj2cam = candidates[index].obj2cam if candidates else None
-        self.result = end_effector_from_solution(self.result.solution, c.obj2world, c.cam2world_model, c.tcp2base_model, obj2cam)
+        self.result = end_effector_from_solution(self.result.solution, c.obj2world, c.cam2world_model, c.tcp2base_model, obj2cam,
+                                                 shared_covariance=self._shared(self.result.solution.obj2cam if obj2cam is None else obj2cam))
         self.chosen_candidate = index
         self.verdict = self._judge(self.result)
         self._changed()
@@ -237,10 +253,13 @@ class CalibrationSession:
     def choose_candidate(self, index: int) -> None:
         self.undo.push(ChooseCandidate(self, index))
 
-    def store_correction(self, task: str, source: str = "", *, confirmation: str = "") -> Correction:
+    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None) -> Correction:
         """``Store correction`` for a task location from the last solve. A result that is not ``ok``
         (implausible, uncertain, ambiguous) raises :class:`ConfirmationNeeded` unless
-        ``confirmation`` says who accepted it and why; that text is stored with the correction."""
+        ``confirmation`` says who accepted it and why; that text is stored with the correction.
+        ``fused``: the look weighed against a calibrated robot
+        (:class:`~calib_core.calibration.look_fusion.FusedCorrection`): stored in the look's place
+        when they agree; when they do not, storing the look alone needs the same confirmation."""
         r = self.result
         if r is None:
             raise CalibrationError("calibrate first")
@@ -252,12 +271,22 @@ class CalibrationSession:
         verdict = self.verdict or self._judge(r)
         if not verdict.ok and not confirmation.strip():
             raise ConfirmationNeeded(f"the result is {verdict.verdict.value}: {'; '.join(verdict.reasons)}. Storing it needs your confirmation", verdict.reasons)
+        if fused is not None and not fused.agree and not confirmation.strip():
+            raise ConfirmationNeeded(f"{fused.message}. Storing the look alone needs your confirmation", (fused.message,))
         c = self._context
         joints, numbers = c.joints_deg, c.numbers
+        source = source or (f"pairs {', '.join(map(str, numbers))}" if numbers else "edges")
+        measured, d, rv, std_d, std_r = r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
+        if fused is not None and fused.agree:
+            std = np.sqrt(np.clip(np.diag(fused.covariance), 0.0, None))
+            measured, d, rv, std_d, std_r = fused.delta_base @ r.tcp2base_model, fused.displacement_mm, fused.rotation_deg, std[:3], std[3:]
+            source += f"; {fused.message}"
+        elif fused is not None:
+            source += f"; the look alone ({fused.message})"
         correction = Correction(
-            task, r.tcp2base_model, r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg,
-            np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source or f"pairs {', '.join(map(str, numbers))}",
-            verdict=verdict.verdict.value, confirmation="" if verdict.ok else confirmation.strip(),
+            task, r.tcp2base_model, measured, d, rv, std_d, std_r,
+            np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source,
+            verdict=verdict.verdict.value, confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation.strip(),
         )
         self.undo.push(_StoreCorrection(self.corrections, correction))
         return correction

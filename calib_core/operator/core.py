@@ -263,10 +263,11 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
 
     def store_correction(self, *, confirmation: str = ""):
         """Store the last result for the task location. One that is not ``ok`` needs ``confirmation``
-        (who accepted it and why: kept with the correction and recorded)."""
+        (who accepted it and why: kept with the correction and recorded). With a robot calibration
+        applied, the look is stored fused with the calibrated model (:meth:`look_fused_with_robot`)."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        c = self.session.store_correction(self.task.name, confirmation=confirmation)
+        c = self.session.store_correction(self.task.name, confirmation=confirmation, fused=self.look_fused_with_robot(self.session.result))
         if c.confirmation:
             self.record_event("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)

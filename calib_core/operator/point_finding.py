@@ -87,7 +87,8 @@ class PointFinding:
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.session.last_solve_inputs = inputs
         self.current_pair = None
-        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [])
+        features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
+        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.intrinsics)
         self.solved.emit()
         return estimate
 

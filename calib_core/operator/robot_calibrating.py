@@ -57,12 +57,13 @@ class RobotCalibrating:
 
         return CalibrationRun(self, spec, plan, cell_views)
 
-    def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False):
+    def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False, progress=None):
         """Identify the robot from a :class:`~calib_core.vision.capture.BoardCapture`'s views with
         joints and the run's ``cell_frames`` (:class:`~calib_core.operator.calibration_run.CellFrame`:
         each component located by Find points' edges, through the intrinsics in use); the robot as it
         is now (nominal, or calibrated before) is the start. A component not located is named in the
-        result's warnings."""
+        result's warnings. ``progress(done, total, text)`` is told before each component's location
+        (1-2 s each) and before the identification."""
         from dataclasses import replace
 
         from calib_core.robot_calibration.cell_views import cell_view
@@ -75,10 +76,15 @@ class RobotCalibrating:
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
         objects, missed = [], []
+        total = len(cell_frames) + 1
         for k, f in enumerate(cell_frames):
+            if progress is not None:
+                progress(k, total, f"locating {f.component} in view {k + 1} of {len(cell_frames)} ...")
             item = self.workcell.component(f.component)
             found = cell_view(f"cell_{k + 1:02d}_{f.component}", f.image, f.joints_deg, self.workcell, f.component, self.robot, self.intrinsics, self.modelled_view(f.joints_deg, item))
             (missed if isinstance(found, str) else objects).append(found)
+        if progress is not None:
+            progress(total - 1, total, f"identifying the robot from {len(views)} board and {len(objects)} component views ...")
         result = identify(self.robot, self.intrinsics, views + objects, with_intrinsics=with_intrinsics)
         if missed:
             result = replace(result, warnings=list(result.warnings) + missed)
@@ -90,6 +96,7 @@ class RobotCalibrating:
         refined them) for everything from now on (the robot object stays the same, so every view
         follows); :meth:`revert_robot_calibration` takes it back."""
         self.keep_robot_before_calibration()
+        self.applied_robot_calibration = result
         for j in range(1, self.robot.model.njoints):
             self.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
         self.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
@@ -102,6 +109,25 @@ class RobotCalibrating:
         self.camera_model_changed.emit()
         self.scene_changed.emit()
         self.message.emit(f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)")
+
+    def look_fused_with_robot(self, look):
+        """The look (an :class:`~calib_core.calibration.end_effector.EndEffectorEstimate` at its
+        solve's joints) weighed against the calibrated robot in use
+        (:func:`~calib_core.calibration.look_fusion.fuse_look`: the model's TCP covariance there, the
+        component placed to the survey's sigma); ``None`` without an applied robot calibration or a
+        look without covariance."""
+        result = getattr(self, "applied_robot_calibration", None)
+        context = self.session.context
+        if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
+            return None
+        from calib_core.calibration.look_fusion import fuse_look, tcp_covariance_from_camera
+        from calib_core.frames import invert
+        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+
+        q = context.joints_deg
+        cam2base = self.robot.fk(q, "camera")
+        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, invert(cam2base) @ self.robot.fk(q, "tcp"))
+        return fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
 
     def keep_robot_before_calibration(self) -> None:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
@@ -118,6 +144,7 @@ class RobotCalibrating:
         self.robot.set_frame_placement("camera", camera)
         self.robot.set_frame_placement("tcp", tcp)
         self._robot_before_calibration = None
+        self.applied_robot_calibration = None
         if getattr(self, "_intrinsics_before_calibration", None) is not None:
             self.use_intrinsics(self._intrinsics_before_calibration)
             self._intrinsics_before_calibration = None

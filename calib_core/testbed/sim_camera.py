@@ -35,6 +35,12 @@ class CameraLook:
     light_direction: tuple[float, float, float] = (-0.5, 0.4, 0.8)
     light_intensity: float = 0.8
     background: tuple[float, float, float] = (0.30, 0.31, 0.33)
+    supersample: int | None = None
+    """Samples per pixel side (``None``: enough for a render at least :data:`FINE_WIDTH_PX` wide, at
+    most 8). A sensor integrates the light over each pixel, a renderer samples the pixel's centre:
+    point samples give stair-stepped edges whose offset is shared along an edge, and they tilted edge
+    fits by 0.4-1.2 mrad at 1280 px and up to 3 mrad at 640 px, the same way in every view. Measured
+    at 1280 px: 2 samples leave 0.1-0.17 mrad, 4 leave 0.05; at 640 px 2 leave 3.2 mrad, 4 leave 0.5."""
 
 
 @dataclass(frozen=True)
@@ -45,6 +51,29 @@ class CameraTruth:
     cam2world: np.ndarray
     q_commanded_deg: np.ndarray
     intrinsics: Intrinsics
+
+
+FINE_WIDTH_PX = 2560
+"""The width the automatic supersampling renders at, whatever the camera's resolution: the edges'
+residual steps are then the same size in the scene (0.1 mrad on the cold cell's fixtures)."""
+
+
+def samples_per_pixel(look: CameraLook, width_px: int) -> int:
+    """The supersampling ``look`` asks for at an image ``width_px`` wide."""
+    if look.supersample is not None:
+        return max(1, int(look.supersample))
+    return int(min(8, max(1, -(-FINE_WIDTH_PX // max(int(width_px), 1)))))
+
+
+def supersampled(intrinsics: Intrinsics, samples: int) -> Intrinsics:
+    """``intrinsics`` (no distortion) of a canvas with ``samples`` x ``samples`` pixels for each of
+    ``intrinsics``' (pixel centres at integers: the coarse pixel ``u`` covers the fine ones
+    ``samples * u + 0 .. samples - 1``, whose mean centre is ``samples * u + (samples - 1) / 2``)."""
+    if samples == 1:
+        return intrinsics
+    shift = (samples - 1) / 2.0
+    return Intrinsics(intrinsics.fu * samples, intrinsics.fv * samples, intrinsics.cx * samples + shift, intrinsics.cy * samples + shift,
+                      intrinsics.width * samples, intrinsics.height * samples)
 
 
 class SimulatedCamera(FrameSource):
@@ -66,6 +95,7 @@ class SimulatedCamera(FrameSource):
         self._renderer: SceneRenderer | None = None
         self._index = 0
         self._vignette = self._vignette_mask()
+        self._last_ideal: tuple | None = None
         self.last_truth: CameraTruth | None = None
 
     @property
@@ -80,13 +110,10 @@ class SimulatedCamera(FrameSource):
 
     def render(self, q_commanded_deg: np.ndarray) -> tuple[np.ndarray, CameraTruth]:
         """One image (h, w, 3) uint8 RGB at the given commanded joints, with its truth."""
-        if self._renderer is None:
-            self._renderer = SceneRenderer(self._map.ideal.width, self._map.ideal.height)
-            self._renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
         q = np.asarray(q_commanded_deg, dtype=float)
-        self._renderer.set_items(self._scene_at(q))
+        items = self._scene_at(q)
         cam2world = self._cam2world_at(q)
-        ideal = self._renderer.render_view(self._map.ideal, cam2world, RenderOptions(background=self.look.background, show_edges=False))
+        ideal = self._ideal_render(items, cam2world)
         image = self._map.apply(ideal).astype(np.float32) * self._vignette
         if self.look.blur_sigma_px > 0:
             image = cv2.GaussianBlur(image, (0, 0), self.look.blur_sigma_px)
@@ -94,6 +121,26 @@ class SimulatedCamera(FrameSource):
             image += self._rng.normal(0.0, self.look.noise_sigma, image.shape).astype(np.float32)
         image = np.clip(image, 0, 255).astype(np.uint8)
         return image, CameraTruth(cam2world, q, self.intrinsics)
+
+    def _ideal_render(self, items: list[SceneItem], cam2world: np.ndarray) -> np.ndarray:
+        """The scene through the ideal (undistorted) lens, each pixel the mean of its samples; the
+        last one again while neither the scene nor the camera moved (a robot at rest costs no render:
+        only the noise is new)."""
+        key = (cam2world.tobytes(), tuple((i.name, id(i.mesh), np.asarray(i.item2world).tobytes(), tuple(map(float, i.color)), float(i.opacity), id(i.texture)) for i in items))
+        if self._last_ideal is not None and self._last_ideal[0] == key:
+            return self._last_ideal[1]
+        ideal_intrinsics = self._map.ideal
+        samples = samples_per_pixel(self.look, ideal_intrinsics.width)
+        fine = supersampled(ideal_intrinsics, samples)
+        if self._renderer is None:
+            self._renderer = SceneRenderer(fine.width, fine.height)
+            self._renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
+        self._renderer.set_items(items)
+        ideal = self._renderer.render_view(fine, cam2world, RenderOptions(background=self.look.background, show_edges=False))
+        if samples > 1:  # an exact box filter for an integer factor
+            ideal = cv2.resize(ideal, (ideal_intrinsics.width, ideal_intrinsics.height), interpolation=cv2.INTER_AREA)
+        self._last_ideal = (key, ideal)
+        return ideal
 
     def read(self) -> Frame | None:
         # The exposure is the moment the robot's pose is taken; the render after it is the camera's
@@ -109,3 +156,4 @@ class SimulatedCamera(FrameSource):
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+        self._last_ideal = None

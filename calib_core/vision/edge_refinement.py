@@ -152,8 +152,11 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
         share = float(np.mean(wts > 0))
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
+        at_finest = window <= 2.0
         window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks
-        if moved_px < 0.01 and it > 0:
+        # Settled when the samples stop moving; at the finest window a step under a tenth of the
+        # noise is samples trading places at the window's rim (a cycle, not a descent).
+        if it > 0 and (moved_px < 0.01 or (at_finest and moved_px < 0.1 * sigma)):
             converged = True
             break
     try:

@@ -11,7 +11,7 @@ from calib_core.robot import solve_ik
 from calib_core.robot.model import load_robot
 from calib_core.testbed.compliant_grasp import grasp_joints
 from calib_core.testbed.true_robot import RobotErrors
-from tests.app.windows import answer_next_question
+from tests.app.windows import answer_next_question, wait_for_settled_frame
 
 OUTPUT = __import__("pathlib").Path(__file__).resolve().parents[1] / "output"
 
@@ -46,8 +46,13 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     OUTPUT.mkdir(exist_ok=True)
     win.grab().save(str(OUTPUT / "window_robot.png"))
 
+    steps = []  # the identification's progress: each component's location, then the fit
+    panel.progress.valueChanged.connect(lambda v: steps.append((v, panel.progress.maximum())))
     qtbot.mouseClick(panel.identify_button, Qt.MouseButton.LeftButton)
     r = panel.result
+    located_steps = {v for v, top in steps if top == len(panel.run.cell_frames) + 1}
+    assert located_steps >= set(range(len(panel.run.cell_frames) + 1)), steps
+    assert panel.progress.value() == n + len(panel.plan.cell_views)  # the run's own progress back
     assert r.start_rms_px > 1.0 and r.rms_px < 0.3 and "parameters identified" in panel.result_text.text()
     # The camera relative to the board at a pose of the plan, against the test bed's truth.
     bed = wb.site.bed
@@ -106,6 +111,34 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
         assert miss <= 1.2 * tool.tool.spread_mm + 0.01 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])
 
     win.grab().save(str(OUTPUT / "window_robot_tool.png"))
+
+    # One look at a task location on the calibrated model: Find points' edges at the approach,
+    # stored weighed against the calibrated robot (its covariance there), scored by the truth.
+    task = wb.workcell.task("oru_1_grasp")
+    wb.set_task(task.name)
+    q_look = solve_ik(wb.robot, task.approach2base, home).q_deg
+    move(home, "home")
+    move(q_look, f"{task.name} approach")
+    wait_for_settled_frame(qtbot, win)
+    found = wb.find_points()
+    edges = found.result.edges
+    assert edges is not None and edges.settled, (edges.converged, edges.rms_px, edges.inlier_share) if edges else "no edges"
+    look = wb.calibrate_on_edges()
+    fused = wb.look_fused_with_robot(look)
+    assert wb.session.verdict.ok and fused is not None and fused.agree, (wb.session.verdict, fused and fused.message)
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    stored = wb.session.corrections.latest(task.name)
+    assert stored is not None, win.statusBar().currentMessage()
+    assert "look and model agree" in stored.source, stored.source
+    assert np.linalg.norm(stored.std_displacement_mm) < np.linalg.norm(look.std_displacement_mm)
+    assert np.linalg.norm(stored.std_rotation_deg) < np.linalg.norm(look.std_rotation_deg)
+
+    def miss_mm(delta):
+        q_task = solve_ik(wb.robot, invert(delta) @ task.tcp2base, q_look).q_deg
+        return np.linalg.norm(pose_difference(bed.true_robot.fk(q_task, "tcp"), task.tcp2base)[0])
+
+    assert miss_mm(stored.delta_base) <= max(miss_mm(look.delta_base), miss_mm(np.eye(4))) + 0.01
+    assert miss_mm(stored.delta_base) <= 3 * np.linalg.norm(stored.std_displacement_mm) + 0.02
     panel.save(tmp_path)
     doc = yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())
     assert doc["tcp2cam"]["grasps"] == 2

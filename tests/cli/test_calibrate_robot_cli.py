@@ -68,9 +68,12 @@ def test_demo_cold_reports_each_step_beside_the_truth(tmp_path):
     look = steps["4_task_location"]
     assert look["task"] == "oru_1_grasp" and look["calibrated_model_only_mm_deg"][0] < 0.15
     assert tool["tcp_in_base_frame_mm_deg"][0] < 0.15  # 0.11 mm measured; the target is 0.1 mm RMS over held-out poses
-    # The look weighed against the model: never a worse TCP than the model alone, and honest about it.
+    # The target for one look on the calibrated model (scored at the task on the part as it
+    # truly stands): 0.041 mm and 0.006 deg measured.
+    assert look["after_look_mm_deg"][0] <= 0.05 and look["after_look_mm_deg"][1] <= 0.05 and look["within_3_sigma"]
+    # The look weighed against the model: agreeing with it, never worse than either, and honest about it.
     fused = look["fused"]
-    assert fused["after_mm_deg"][0] <= look["calibrated_model_only_mm_deg"][0] + 0.02 and fused["within_3_sigma"]
-    assert fused["message"]
+    assert fused["agree"] and fused["within_3_sigma"], fused["message"]
+    assert fused["after_mm_deg"][0] <= max(look["after_look_mm_deg"][0], look["calibrated_model_only_mm_deg"][0]) + 0.005
     assert (tmp_path / "robot_calibration.yaml").is_file() and (tmp_path / "videocal_arm_calibrated.urdf").is_file()
     assert "tcp2cam" in yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())

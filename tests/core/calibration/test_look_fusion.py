@@ -68,3 +68,17 @@ def test_the_lever_arm_matches_composed_transforms():
         C = tcp_covariance_from_camera(np.outer(step, step), cam, tcp2cam)
         mapped = np.r_[d, r]
         assert np.allclose(C, np.outer(mapped, mapped), atol=1e-9 * max(1.0, np.abs(C).max()))
+
+
+def test_the_placement_of_the_component_widens_the_models_prior_in_position_only():
+    """The look sees the part where it stands, the model aims where the survey put it: with the
+    survey's sigma added to the model's, a look 0.12 mm off a 0.01 mm model agrees and weighs more,
+    and the rotation's weight is unchanged (the known answer of the scalar update per axis)."""
+    look = _look([0.12, 0.0, 0.0], [0.002, 0.0, 0.0], 0.02, 0.005)
+    assert not fuse_look(look, _model(0.01, 0.005)).agree
+    fused = fuse_look(look, _model(0.01, 0.005), placement_sigma_mm=0.05)
+    assert fused.agree
+    prior = 0.01**2 + 0.05**2
+    assert fused.look_weight[0] == pytest.approx(prior / (prior + 0.02**2))
+    assert fused.look_weight[3] == pytest.approx(0.5)
+    assert fused.displacement_mm[0] == pytest.approx(0.12 * prior / (prior + 0.02**2))

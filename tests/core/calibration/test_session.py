@@ -115,3 +115,32 @@ def test_listeners_hear_every_change():
     s.undo.undo()
     s.undo.undo()
     assert events == [("added", 1), ("changed", 1), ("changed", 1), ("removed", 1)]
+
+
+def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed):
+    """With a calibrated model's prior: a look that agrees is stored fused (its displacement pulled
+    toward the model's, sigmas smaller); one that disagrees needs a confirmation, then is stored alone
+    with the reason kept."""
+    from calib_core.calibration.look_fusion import fuse_look
+    from calib_core.calibration.session import ConfirmationNeeded
+
+    task = bed.workcell.task("oru_1_grasp")
+    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q_app, noise_px=0.2)
+    look = _calibrate(s, bed, q_app)
+    sigma = np.sqrt(np.diag(look.covariance))
+    agreeing = fuse_look(look, np.diag(np.r_[look.displacement_mm, look.rotation_deg] ** 2 + sigma**2))
+    assert agreeing.agree
+    c = s.store_correction(task.name, fused=agreeing)
+    assert np.allclose(c.displacement_mm, agreeing.displacement_mm) and np.allclose(c.delta_base, agreeing.delta_base)
+    assert np.all(c.std_displacement_mm < look.std_displacement_mm) and "look and model agree" in c.source and not c.confirmation
+    s.corrections.remove_last(task.name)
+    tight = fuse_look(look, np.diag([1e-6] * 3 + [1e-8] * 3))  # a model "certain" the TCP is where it says: millimetres away
+    assert not tight.agree
+    with pytest.raises(ConfirmationNeeded, match="sigma from the calibrated model"):
+        s.store_correction(task.name, fused=tight)
+    assert s.corrections.latest(task.name) is None  # nothing stored
+    c = s.store_correction(task.name, fused=tight, confirmation="the operator checked the image")
+    assert np.allclose(c.displacement_mm, look.displacement_mm) and "the look alone" in c.source and c.confirmation

@@ -13,7 +13,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import invert, make_transform, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.scene import SceneItem
-from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
+from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera, samples_per_pixel
 from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
 
@@ -86,3 +86,32 @@ def test_frames_are_deterministic_for_a_seed_and_report_truth(bed):
     cv2.imwrite(str(OUTPUT / "sim_camera_oru_1_approach.png"), fa.image[:, :, ::-1])
     for cam in (a, b, c):
         cam.close()
+
+
+def _edge_column_px(supersample: int, edge_u: float) -> float:
+    """Where a bright card's left edge lies in the image of a pinhole camera (column, px), from the
+    row's light: each pixel's share of the card is its brightness over the card's."""
+    lens = Intrinsics(280.0, 280.0, 160.0, 120.0, 320, 240)
+    depth = 400.0
+    x_left = (edge_u - lens.cx) * depth / lens.fu
+    card = trimesh.creation.box(extents=[200.0, 100.0, 1.0])
+    item = SceneItem("card", card, make_transform(np.eye(3), [x_left + 100.0, 0.0, depth]), color=(1, 1, 1))
+    look = CameraLook(noise_sigma=0.0, vignetting=0.0, gain=1.0, background=(0, 0, 0), supersample=supersample)
+    cam = SimulatedCamera(lens, lambda q: [item], lambda q: np.eye(4), lambda: np.zeros(6), look=look)
+    row = cam.read().image[120, :, 1].astype(float)
+    cam.close()
+    bright = float(np.mean(row[112:130]))
+    covered = row[90:112] / bright  # pixels 90..111: the card covers those past the edge, whole from 112
+    return 112 - 0.5 - float(covered.sum())
+
+
+def test_pixels_integrate_the_light_over_their_area():
+    """A sensor's pixel sums the light over its area, so an edge's sub-pixel place shows in the
+    pixel it crosses; a renderer's point sample per pixel moves the edge in whole pixels (the steps
+    that tilted edge fits by up to 1.2 mrad)."""
+    offsets = [0.1, 0.3, 0.45, 0.6, 0.85]
+    assert samples_per_pixel(CameraLook(), 640) == 4 and samples_per_pixel(CameraLook(), 1280) == 2 and samples_per_pixel(CameraLook(supersample=1), 640) == 1
+    point_sampled = [abs(_edge_column_px(1, 100.0 + f) - (100.0 + f)) for f in offsets]
+    integrated = [abs(_edge_column_px(4, 100.0 + f) - (100.0 + f)) for f in offsets]
+    assert max(point_sampled) > 0.25  # whole-pixel steps
+    assert max(integrated) <= 0.125 + 0.03  # quarter-pixel steps: the box filter of 4 x 4 samples
