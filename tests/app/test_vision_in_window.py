@@ -153,8 +153,10 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     for q in plan:
         # just before the robot left this pose: frames and joints at rest for 0.3 s and more by then,
         # however sparse the frames a loaded machine recorded
-        last = max(t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3)
-        win.replay.seek(last - 0.05)
+        # (the joints are recorded sparsely at rest: the first sample away from the pose is the departure)
+        at = [t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3]
+        left = [t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if t > max(at) and np.max(np.abs(rq - q)) >= 1e-3]
+        win.replay.seek((min(left) if left else max(at)) - 0.05)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         messages.append(win.results.status.text())
     assert len(vision.capture.views) == 4, ([vision.views.item(i).text() for i in range(vision.views.count())], messages)
