@@ -83,7 +83,8 @@ class SimulatedCamera(FrameSource):
 
     description = "simulated camera"
 
-    def __init__(self, intrinsics: Intrinsics, scene_at: Callable[[np.ndarray], list[SceneItem]], cam2world_at: Callable[[np.ndarray], np.ndarray], joints: Callable[[], np.ndarray], *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0):
+    def __init__(self, intrinsics: Intrinsics, scene_at: Callable[[np.ndarray], list[SceneItem]], cam2world_at: Callable[[np.ndarray], np.ndarray], joints: Callable[[], np.ndarray], *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0,
+                 coarse_while_moving: bool = False):
         self.intrinsics = intrinsics
         self._scene_at = scene_at
         self._cam2world_at = cam2world_at
@@ -92,10 +93,14 @@ class SimulatedCamera(FrameSource):
         self.look = look or CameraLook()
         self._rng = np.random.default_rng(seed)
         self._map = distortion_map(intrinsics)
-        self._renderer: SceneRenderer | None = None
+        self._renderers: dict[int, SceneRenderer] = {}
         self._index = 0
         self._vignette = self._vignette_mask()
         self._last_ideal: tuple | None = None
+        self.coarse_while_moving = coarse_while_moving
+        """Live video: a frame of a scene that changed since the last one (the robot moving) is point
+        sampled, the next one of the same scene integrated. Frames of a moving robot are never measured
+        on (a pick or a view needs it settled), and 16 samples a pixel at 15 fps take a core."""
         self.last_truth: CameraTruth | None = None
 
     @property
@@ -127,19 +132,23 @@ class SimulatedCamera(FrameSource):
         last one again while neither the scene nor the camera moved (a robot at rest costs no render:
         only the noise is new)."""
         key = (cam2world.tobytes(), tuple((i.name, id(i.mesh), np.asarray(i.item2world).tobytes(), tuple(map(float, i.color)), float(i.opacity), id(i.texture)) for i in items))
-        if self._last_ideal is not None and self._last_ideal[0] == key:
-            return self._last_ideal[1]
+        same_scene = self._last_ideal is not None and self._last_ideal[0] == key
         ideal_intrinsics = self._map.ideal
         samples = samples_per_pixel(self.look, ideal_intrinsics.width)
+        if self.coarse_while_moving and not same_scene:
+            samples = 1
+        if same_scene and self._last_ideal[2] >= samples:
+            return self._last_ideal[1]
         fine = supersampled(ideal_intrinsics, samples)
-        if self._renderer is None:
-            self._renderer = SceneRenderer(fine.width, fine.height)
-            self._renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
-        self._renderer.set_items(items)
-        ideal = self._renderer.render_view(fine, cam2world, RenderOptions(background=self.look.background, show_edges=False))
+        renderer = self._renderers.get(samples)
+        if renderer is None:  # one per sample count: a coarse and a fine one while live
+            renderer = self._renderers[samples] = SceneRenderer(fine.width, fine.height)
+            renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
+        renderer.set_items(items)
+        ideal = renderer.render_view(fine, cam2world, RenderOptions(background=self.look.background, show_edges=False))
         if samples > 1:  # an exact box filter for an integer factor
             ideal = cv2.resize(ideal, (ideal_intrinsics.width, ideal_intrinsics.height), interpolation=cv2.INTER_AREA)
-        self._last_ideal = (key, ideal)
+        self._last_ideal = (key, ideal, samples)
         return ideal
 
     def read(self) -> Frame | None:
@@ -153,7 +162,7 @@ class SimulatedCamera(FrameSource):
         return frame
 
     def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        for renderer in self._renderers.values():
+            renderer.close()
+        self._renderers = {}
         self._last_ideal = None

@@ -39,7 +39,7 @@ class SimulatedSite:
         return self.process.wait_ready()
 
     def camera_factory(self, fps: float | None = None) -> Callable:
-        return lambda: self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed)
+        return lambda: self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True)
 
     def attach(self, link) -> None:
         link.on_sample(self._follow)
