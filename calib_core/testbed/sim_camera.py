@@ -99,7 +99,8 @@ class SimulatedCamera(FrameSource):
         self._last_ideal: tuple | None = None
         self.coarse_while_moving = coarse_while_moving
         """Live video: a frame of a scene that changed since the last one (the robot moving) is point
-        sampled, the next one of the same scene integrated. Frames of a moving robot are never measured
+        sampled, unless the joints did not change during that render; the next one of the same scene
+        integrated. Frames of a moving robot are never measured
         on (a pick or a view needs it settled), and 16 samples a pixel at 15 fps take a core."""
         self.last_truth: CameraTruth | None = None
 
@@ -119,6 +120,11 @@ class SimulatedCamera(FrameSource):
         items = self._scene_at(q)
         cam2world = self._cam2world_at(q)
         ideal = self._ideal_render(items, cam2world)
+        if self._last_ideal[2] < samples_per_pixel(self.look, self._map.ideal.width) and np.array_equal(np.asarray(self._joints(), dtype=float), q):
+            # Point-sampled because the scene changed, yet the robot did not move during that render:
+            # it may have come to rest, and the first frame at rest must be integrated too (a slow
+            # machine can deliver it after the robot has been still long enough to be measured on).
+            ideal = self._ideal_render(items, cam2world, integrate=True)
         image = self._map.apply(ideal).astype(np.float32) * self._vignette
         if self.look.blur_sigma_px > 0:
             image = cv2.GaussianBlur(image, (0, 0), self.look.blur_sigma_px)
@@ -127,7 +133,7 @@ class SimulatedCamera(FrameSource):
         image = np.clip(image, 0, 255).astype(np.uint8)
         return image, CameraTruth(cam2world, q, self.intrinsics)
 
-    def _ideal_render(self, items: list[SceneItem], cam2world: np.ndarray) -> np.ndarray:
+    def _ideal_render(self, items: list[SceneItem], cam2world: np.ndarray, *, integrate: bool = False) -> np.ndarray:
         """The scene through the ideal (undistorted) lens, each pixel the mean of its samples; the
         last one again while neither the scene nor the camera moved (a robot at rest costs no render:
         only the noise is new)."""
@@ -135,7 +141,7 @@ class SimulatedCamera(FrameSource):
         same_scene = self._last_ideal is not None and self._last_ideal[0] == key
         ideal_intrinsics = self._map.ideal
         samples = samples_per_pixel(self.look, ideal_intrinsics.width)
-        if self.coarse_while_moving and not same_scene:
+        if self.coarse_while_moving and not same_scene and not integrate:
             samples = 1
         if same_scene and self._last_ideal[2] >= samples:
             return self._last_ideal[1]

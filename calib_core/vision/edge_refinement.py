@@ -117,6 +117,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     H = np.eye(6)
     edges, offsets, vectors = np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2))
     share = 0.0
+    previous_xi, damping = None, 1.0
     for it in range(iterations):
         if len(pts) < 12:
             break
@@ -147,6 +148,13 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
             xi = np.linalg.solve(H + 1e-9 * np.eye(6) * np.trace(H), g)
         except np.linalg.LinAlgError:
             break
+        if previous_xi is not None and xi @ H @ previous_xi < -0.5 * (xi @ H @ xi):
+            # The step turned back on the last one: samples jumping between two pixels (an aliased or
+            # quantised edge) make a two-cycle that plain Gauss-Newton never leaves. Halve the steps
+            # from here on, and the pose settles between the two.
+            damping *= 0.5
+        previous_xi = xi
+        xi = damping * xi
         pose = _perturbed(pose, xi)
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]

@@ -9,6 +9,7 @@ import pytest
 from calib_core.camera.projection import project_points
 from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
+from calib_core.testbed.sim_camera import CameraLook
 from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
 from calib_core.vision.edge_alignment import align_edges, edge_distance_map, edge_samples_px
@@ -85,3 +86,27 @@ def test_a_frame_without_the_target_says_so():
         blank = np.full_like(image, 90)
         result = find_points(blank, intrinsics, item, model, expected=expected)
         assert not result.found and "pick the points by hand" in result.message and not result.proposals
+
+
+def test_the_edge_fit_settles_on_an_aliased_frame():
+    """A point-sampled frame (no pixel integration: what a sharp lens on a sensor with a small fill
+    factor gives) quantises the edges; plain Gauss-Newton then steps back and forth between two poses
+    for ever. These errors made that two-cycle: the fit must settle between them, on the part."""
+    bed = TestBed.create(errors=RobotErrors.typical(2, n_joints=6))
+    cell = bed.workcell
+    q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").approach2base, np.array(cell.home_joints_deg, float)).q_deg
+    bed.joints_deg = q
+    camera = bed.camera(look=CameraLook(supersample=1))
+    image = camera.read().image
+    truth = np.linalg.inv(camera.last_truth.cam2world) @ cell.component(TARGET).item2world
+    camera.close()
+    item = cell.component(TARGET)
+    model = np.linalg.inv(bed.model_cam2world(q)) @ item.item2world
+    view = ModelView(bed.intrinsics)
+    try:
+        expected = view.of(list(cell.components) + bed.visuals_for_model().scene_items(q), item.item2world)
+        result = find_points(image, bed.intrinsics, item, model, expected=expected)
+    finally:
+        view.close()
+    assert result.edges is not None and result.edges.converged and result.edges.settled, result.message
+    assert _pixel_errors(item, result.edges.obj2cam, truth, bed.intrinsics).max() < 0.5
