@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, QPointF, QSettings, Qt
+from PySide6.QtWidgets import QApplication
 
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
@@ -277,10 +278,12 @@ def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):
     view = win.camera.view
     image = np.zeros((480, 640, 3), np.uint8)
     image[240, 320] = (255, 0, 0)  # one red pixel to find in the loupe
-    # No camera frame may replace this image before the grab: the worker stops, and frames it had already
-    # queued to the GUI thread are held off by Freeze.
+    # No camera frame may replace this image before the grab: the worker stops (its thread joined) and
+    # the frames it had already queued to the GUI thread are delivered first. (Freeze cannot hold them
+    # off: it holds only a frame taken after the robot settled, which a young window may not have.)
     win.worker.stop()
-    win.camera.freeze.setChecked(True)
+    assert win.worker.isFinished()
+    QApplication.processEvents()
     view.set_image(image)
     x, y = view.image_to_widget(320, 240)
     qtbot.mouseMove(view, QPoint(int(round(x)), int(round(y))))
