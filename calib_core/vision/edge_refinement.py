@@ -23,6 +23,7 @@ from calib_core.vision.feature_detectors import gradient_magnitude, search_norma
 
 _SAMPLE_STEP_PX = 4.0
 _MIN_STRENGTH = 12.0
+_CROWDED_PX = 3.0
 _TUKEY = 4.685
 
 
@@ -65,23 +66,82 @@ def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:
     return mesh.vertices[mesh.face_adjacency_edges[contour]]
 
 
-def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
-    """3D samples (m, 3) on the visible crease and silhouette edges and their edges' far ends (m, 3), every ~4 px."""
+def _segment_keys(seg: np.ndarray) -> list[bytes]:
+    """One key per segment (E, 2, 3), the same for both directions (to 1 um)."""
+    ends = np.round(seg * 1000.0).astype(np.int64)
+    flip = [tuple(a) > tuple(b) for a, b in zip(ends[:, 0], ends[:, 1])]
+    return [(e[::-1] if f else e).tobytes() for e, f in zip(ends, flip)]
+
+
+def visible_segments(mesh, obj2cam: np.ndarray) -> np.ndarray:
+    """The crease edges with a face turned to the camera and the silhouette, each once: (E, 2, 3) mm
+    (a crease on the occluding contour is both; sampled twice, its samples would count double)."""
     seg, normals = crease_segments(mesh)
     centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
     facing = np.einsum("eij,ej->ei", normals, centre - seg.mean(axis=1)) > 0
     seg = seg[facing.any(axis=1)]
     silhouette = silhouette_segments(mesh, centre)
     if len(silhouette):
-        seg = np.concatenate([seg, silhouette]) if len(seg) else silhouette
+        known = set(_segment_keys(seg)) if len(seg) else set()
+        new = np.array([k not in known for k in _segment_keys(silhouette)], dtype=bool)
+        seg = np.concatenate([seg, silhouette[new]]) if len(seg) else silhouette
+    return seg
+
+
+def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3) and
+    their clearance (m,) px, every ~4 px. With ``expected`` (h, w, the cell rendered at ``obj2cam``)
+    only where it shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
+    (:func:`_clearance`)."""
+    seg = visible_segments(mesh, obj2cam)
     if len(seg) == 0:
-        return np.zeros((0, 3)), np.zeros((0, 3))
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
     counts = np.clip(np.floor(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / _SAMPLE_STEP_PX).astype(int) - 1, 0, 500)
     which = np.repeat(np.arange(len(seg)), counts)
     s = np.concatenate([(np.arange(1, c + 1)) / (c + 1) for c in counts]) if counts.sum() else np.zeros(0)
     pts = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]
-    return pts, seg[which, 1]
+    far = seg[which, 1]
+    if expected is None or len(pts) == 0:
+        return pts, far, np.full(len(pts), np.inf)
+    uv = project_points(pts, obj2cam, intrinsics)
+    # where the model's view shows no gradient (two faces of one shade meeting, an edge hidden behind a
+    # face) there is no edge to find, and a search there would lock onto the nearest one
+    shows = model_shows_edge(expected, uv)
+    # the edges that can crowd a sample: those the model's view shows (a rim's facets, too short to
+    # hold a sample, by their midpoints)
+    sampled = np.bincount(which, minlength=len(seg))
+    shown = np.where(sampled > 0, np.bincount(which[shows], minlength=len(seg)) >= 0.5 * sampled,
+                     model_shows_edge(expected, project_points(seg.mean(axis=1), obj2cam, intrinsics)))
+    clearance = _clearance(uv, ends[shown], np.searchsorted(np.flatnonzero(shown), which), shown[which])
+    keep = shows & (clearance > _CROWDED_PX)
+    return pts[keep], far[keep], clearance[keep]
+
+
+def _clearance(uv: np.ndarray, ends_px: np.ndarray, own: np.ndarray, own_listed: np.ndarray) -> np.ndarray:
+    """How far (m,) px along its normal each sample (m, 2) px is from another projected edge
+    (``ends_px`` (E, 2, 2); ``own`` (m,) each sample's own among them where ``own_listed``); inf where
+    none crosses its normal. A search wider than that cannot tell the two apart: a plate's front and
+    back top edges 3 px apart seen at a grazing angle lock both onto the stronger one (found 2 px and
+    1.2 px off, all along them); a boss's rim 4 px inside its base circle, onto the base."""
+    if len(ends_px) == 0:
+        return np.full(len(uv), np.inf)
+    a, b = ends_px[:, 0], ends_px[:, 1]  # (E, 2)
+    own = np.clip(own, 0, len(ends_px) - 1)
+    d = ends_px[own, 1] - ends_px[own, 0]
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
+    n = np.column_stack([-d[:, 1], d[:, 0]])  # (m, 2)
+    # the line uv + t n meets the segment a + s (b - a): solve [n, a - b] (t, s) = a - uv
+    e = b - a  # (E, 2)
+    det = n[:, None, 0] * (-e[None, :, 1]) - n[:, None, 1] * (-e[None, :, 0])  # (m, E)
+    rhs = a[None] - uv[:, None]  # (m, E, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (rhs[..., 0] * (-e[None, :, 1]) - rhs[..., 1] * (-e[None, :, 0])) / det
+        s = (n[:, None, 0] * rhs[..., 1] - n[:, None, 1] * rhs[..., 0]) / det
+    meets = np.isfinite(t) & (np.abs(det) > 1e-9) & (s >= 0) & (s <= 1)
+    rows = np.flatnonzero(own_listed)
+    meets[rows, own[rows]] = False
+    return np.where(meets, np.abs(t), np.inf).min(axis=1)
 
 
 def model_shows_edge(expected: np.ndarray, uv: np.ndarray) -> np.ndarray:
@@ -106,11 +166,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast."""
     magnitude = gradient_magnitude(grey)
-    pts, far = _edge_points(mesh, obj2cam, intrinsics)
-    if expected is not None and len(pts):
-        # where the model's view shows no gradient (two faces of one shade meeting) there is no edge to find
-        shows = model_shows_edge(expected, project_points(pts, obj2cam, intrinsics))
-        pts, far = pts[shows], far[shows]
+    pts, far, clearance = _edge_points(mesh, obj2cam, intrinsics, expected)
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False
@@ -127,6 +183,10 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         normals = np.column_stack([-d[:, 1], d[:, 0]])
         found, strength, inside = search_normals(magnitude, uv, normals, window)
         ok = inside & (strength >= _MIN_STRENGTH)
+        # while the window is wide, only the samples with no other edge inside it (a few, far apart,
+        # bring the pose near; the crowded ones join as it shrinks)
+        clear = ok & (clearance > window)
+        ok = clear if clear.sum() >= max(12, 0.2 * ok.sum()) else ok
         if ok.sum() < 12:
             break
         r = np.einsum("ij,ij->i", found - uv, normals)
