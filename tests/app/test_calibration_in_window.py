@@ -220,6 +220,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     wb = win.workbench
     win.files.start_recording(tmp_path / "session.mcap")
     assert win.files.record_action.isChecked()
+    wait_for_settled_frame(qtbot, win)  # a pick holds the newest frame: one taken with the robot settled
     win._on_pick_3d(type("Hit", (), {"component": "oru_1_fixture", "feature": "pin_tip", "point_world_mm": (1.0, 2.0, 3.0)})())
     win._on_pick_2d(100.0, 120.0)
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
