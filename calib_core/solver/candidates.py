@@ -16,8 +16,8 @@ from calib_core.solver.refine import NewtonResult, run_newton
 from calib_core.solver.solution import pose_matrix
 
 # Two refined poses closer than this are the same minimum reached from different seeds.
-_SAME_POSE_DEG = 1e-4
-_SAME_POSE_REL = 1e-6
+SAME_POSE_DEG = 1e-4
+SAME_POSE_REL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -52,11 +52,11 @@ def refine_seed(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float
 def same_pose(a: np.ndarray, b: np.ndarray) -> bool:
     """Whether two ``obj2cam`` poses are the same minimum (to round-off of the solver)."""
     scale = max(float(np.linalg.norm(a[:3, 3])), 1.0)
-    if np.linalg.norm(a[:3, 3] - b[:3, 3]) > _SAME_POSE_REL * scale * 1e3:
+    if np.linalg.norm(a[:3, 3] - b[:3, 3]) > SAME_POSE_REL * scale * 1e3:
         return False
     # cos of the relative angle from the trace: scipy's conversion costs more than the solve at small N
     cos_angle = (float(np.sum(a[:3, :3] * b[:3, :3])) - 1.0) / 2.0
-    return cos_angle >= np.cos(np.radians(_SAME_POSE_DEG))
+    return cos_angle >= np.cos(np.radians(SAME_POSE_DEG))
 
 
 def distinct_poses(refined: list[RefinedPose]) -> list[RefinedPose]:

@@ -1,29 +1,41 @@
-"""The common case in one compiled call: six or more non-coplanar pairs, known focal
-lengths, pinhole model, no robust loss. Returns ``None`` whenever the full search is needed
-(no DLT seed, no convergence, or a fit worse than the limit)."""
+"""The common cases in one compiled call: four or more non-coplanar pairs, known focal lengths,
+pinhole model, no robust loss (six and more seeded by a DLT, four and five by P3P over every
+triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit
+worse than the limit, or, for a few pairs, a second pose that fits about as well)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from calib_core.solver.finish import noise_px, operator_warnings
-from calib_core.solver.kernels.fast_path import dlt_newton_summary
+from calib_core.solver.candidates import SAME_POSE_DEG, SAME_POSE_REL
+from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
 from calib_core.solver.problem import PoseProblem
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 
 _MAX_ITERATIONS = 100
+SEEDED_BY_DLT = 6
 
 
 def applies(problem: PoseProblem, robust: bool) -> bool:
-    return problem.n_points >= 6 and not problem.coplanar and not problem.estimate_focal and problem.model == "pinhole" and not robust
+    return problem.n_points >= 4 and not problem.coplanar and not problem.estimate_focal and problem.model == "pinhole" and not robust
 
 
-def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float) -> PoseSolution | None:
-    """Solve ``problem`` through the compiled fast path, or ``None`` to fall back."""
+def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float, ambiguity_chi2: float = 9.0) -> PoseSolution | None:
+    """Solve ``problem`` through the compiled fast path, or ``None`` to fall back. With fewer than
+    six pairs, a second minimum costing within ``ambiguity_chi2`` noise variances of the best is an
+    ambiguity the full search reports (the same rule)."""
     intr = problem.intrinsics
-    out = dlt_newton_summary(problem.points_3d, problem.points_2d, intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, -1.0 if sigma_px is None else float(sigma_px), DEFAULT_SIGMA_PX)
+    sigma = -1.0 if sigma_px is None else float(sigma_px)
+    if problem.n_points >= SEEDED_BY_DLT:
+        out = dlt_newton_summary(problem.points_3d, problem.points_2d, intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX)
+    else:
+        # A P3P root that puts all the pairs more than ten times the limit off is refuted by them;
+        # every minimum that fits them has a root of each triplet near it.
+        out = p3p_newton_summary(problem.points_3d, problem.points_2d, intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX,
+                                 10.0 * limit_px, ambiguity_chi2 * noise_px(sigma_px) ** 2, np.cos(np.radians(SAME_POSE_DEG)), SAME_POSE_REL * 1e3)
     if out is None:
         return None
     R, t, r, cov, cov_c, loo, scalars = out

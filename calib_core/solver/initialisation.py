@@ -8,6 +8,7 @@ each is refined afterwards by the Newton solver. Seeds are object-to-camera pose
 
 from __future__ import annotations
 
+from functools import lru_cache
 from itertools import combinations
 
 import cv2
@@ -30,13 +31,12 @@ def _camera(intrinsics: Intrinsics, fu: float, fv: float) -> tuple[np.ndarray, n
 
 
 def _as_seeds(rvecs, tvecs) -> list[tuple[np.ndarray, np.ndarray]]:
-    seeds = []
-    for rvec, tvec in zip(rvecs, tvecs):
-        rvec = np.asarray(rvec, dtype=float).reshape(3)
-        tvec = np.asarray(tvec, dtype=float).reshape(3)
-        if np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec)):
-            seeds.append((cv2.Rodrigues(rvec)[0], tvec))
-    return seeds
+    if len(rvecs) == 0:
+        return []
+    rv = np.asarray(rvecs, dtype=float).reshape(-1, 3)
+    tv = np.asarray(tvecs, dtype=float).reshape(-1, 3)
+    finite = np.isfinite(rv).all(axis=1) & np.isfinite(tv).all(axis=1)
+    return [(cv2.Rodrigues(rv[k])[0], tv[k].copy()) for k in np.flatnonzero(finite)]
 
 
 def normalized_coordinates(points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> np.ndarray:
@@ -94,6 +94,11 @@ _ENUMERATE_UP_TO = 12  # C(12, 3) = 220 triplets: below this, every one is looke
 _SAMPLED_TRIPLETS = 200
 
 
+@lru_cache(maxsize=_ENUMERATE_UP_TO + 1)
+def _all_triplets(n: int) -> np.ndarray:
+    return np.array(list(combinations(range(n), 3)))
+
+
 def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tuple[int, int, int]]:
     """Up to ``limit`` triplets of point indices, the largest triangles first (best conditioned P3P).
 
@@ -105,7 +110,9 @@ def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tup
     if n < 3:
         return []
     if n <= _ENUMERATE_UP_TO:
-        triplets = np.array(list(combinations(range(n), 3)))
+        triplets = _all_triplets(n)
+        if len(triplets) <= limit:  # all of them: no ranking needed
+            return [tuple(int(v) for v in tri) for tri in triplets]
     else:
         rng = np.random.default_rng(n)
         drawn = np.sort(np.stack([rng.choice(n, 3, replace=False) for _ in range(_SAMPLED_TRIPLETS)]), axis=1)
@@ -129,9 +136,11 @@ def subset_p3p_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[n
     return seeds
 
 
-def initial_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def initial_seeds(problem: PoseProblem, fu: float, fv: float, gate_px: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Seeds for a problem without a guess: P3P roots for 3 pairs; DLT (6 or more pairs off a
-    plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs."""
+    plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs. With ``gate_px``
+    (known focal lengths only) the triplets' roots that put all the pairs more than that off (RMS)
+    are left out, unless none is within it."""
     P, uv, intr = problem.points_3d, problem.points_2d, problem.intrinsics
     if problem.n_points == 3:
         return p3p_seeds(P, uv, intr, fu, fv)
@@ -139,18 +148,48 @@ def initial_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.n
     if problem.coplanar:
         seeds += ippe_seeds(P, uv, intr, fu, fv)
     if problem.n_points <= SMALL_PROBLEM_POINTS:
-        seeds += subset_p3p_seeds(problem, fu, fv)
+        roots = subset_p3p_seeds(problem, fu, fv)
+        if gate_px is not None and roots:
+            # Each triplet's roots: the true pose and up to three others that the remaining pairs
+            # refute by tens to hundreds of pixels. Every minimum that fits all the pairs has a root
+            # of each triplet near it, so the refuted ones would only be refined to be dropped.
+            rms = seed_rms_px(problem, roots, fu, fv)
+            near = rms <= gate_px
+            roots = [r for r, keep in zip(roots, near) if keep] if near.any() else roots
+        seeds += roots
     return seeds
+
+
+def seed_rms_px(problem: PoseProblem, seeds: list[tuple[np.ndarray, np.ndarray]], fu: float, fv: float) -> np.ndarray:
+    """RMS reprojection error (k,) px of each seed over all the pairs, pinhole in undistorted
+    coordinates (a gate, not a fit); inf where a point is behind the camera."""
+    R = np.stack([r for r, _ in seeds])
+    t = np.stack([t for _, t in seeds])
+    X = np.einsum("kij,nj->kni", R, problem.points_3d) + t[:, None, :]
+    z = X[..., 2]
+    xy = normalized_coordinates(problem.points_2d, problem.intrinsics, fu, fv)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d = X[..., :2] / z[..., None] - xy[None]
+    e2 = (d[..., 0] * fu) ** 2 + (d[..., 1] * fv) ** 2
+    rms = np.sqrt(np.mean(e2, axis=1))
+    return np.where((z > 0).all(axis=1) & np.isfinite(rms), rms, np.inf)
 
 
 def distinct_seeds(seeds: list[tuple[np.ndarray, np.ndarray]], angle_deg: float = 2.0, rel_translation: float = 0.02) -> list[tuple[np.ndarray, np.ndarray]]:
     """The seeds with near-copies left out (within ``angle_deg`` and ``rel_translation`` of the distance
     of one kept before): P3P over overlapping triplets gives the same pose several times, and each copy
     would be refined to the same minimum. Order kept."""
-    kept: list[tuple[np.ndarray, np.ndarray]] = []
+    if len(seeds) < 2:
+        return list(seeds)
+    R = np.stack([r for r, _ in seeds])
+    t = np.stack([v for _, v in seeds])
     cos_limit = np.cos(np.radians(angle_deg))
-    for R, t in seeds:
-        scale = max(float(np.linalg.norm(t)), 1.0)
-        if not any((np.sum(R * Rk) - 1.0) / 2.0 >= cos_limit and np.linalg.norm(t - tk) <= rel_translation * scale for Rk, tk in kept):
-            kept.append((R, t))
-    return kept
+    # all pairs at once: same turn (cos of the relative angle from the trace) and same place
+    cos = (np.einsum("aij,bij->ab", R, R) - 1.0) / 2.0
+    scale = np.maximum(np.linalg.norm(t, axis=1), 1.0)
+    near = (cos >= cos_limit) & (np.linalg.norm(t[:, None] - t[None], axis=2) <= rel_translation * scale[:, None])
+    kept: list[int] = []
+    for i in range(len(seeds)):
+        if not near[i, kept].any():
+            kept.append(i)
+    return [seeds[i] for i in kept]

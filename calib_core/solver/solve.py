@@ -76,8 +76,9 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     fu0, fv0 = intrinsics.fu, intrinsics.fv
 
     if fast_path_applies(problem, robust):
-        # Many points: a DLT seed refined to a good fit is the answer; the other seeds cost more than the whole solve.
-        solution = fast_solve(problem, sigma_px, limit)
+        # A DLT seed (many points) or P3P's roots (a few) refined to one good fit is the answer; the
+        # other seeds cost more than the whole solve.
+        solution = fast_solve(problem, sigma_px, limit, _AMBIGUITY_CHI2)
         if solution is not None:
             return solution
     order = None
@@ -89,7 +90,8 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust and problem.n_points > SMALL_PROBLEM_POINTS else None
     # With a sampled seed the all-points seeds add nothing: outliers spoil them, and on a clean set the
     # sampler's seed is theirs.
-    seeds = [] if sampled is not None else initial_seeds(problem, fu0, fv0)
+    gate = 10.0 * limit if not problem.estimate_focal and problem.model == "pinhole" else None
+    seeds = [] if sampled is not None else initial_seeds(problem, fu0, fv0, gate)
     if sampled is not None:
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:

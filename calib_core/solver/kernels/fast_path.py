@@ -1,4 +1,5 @@
-"""The whole solve for many points in one compiled call: DLT seed, Newton, fit summary.
+"""The whole solve in one compiled call: for many points a DLT seed, for a few P3P over every
+triplet; Newton; the fit summary.
 
 Most operator solves have six or more well-spread points; for them one call replaces a
 dozen interpreter round trips (the solve then costs less than OpenCV's own refinement).
@@ -13,7 +14,8 @@ from numba import njit
 from calib_core.solver.kernels.camera_models import PINHOLE
 from calib_core.solver.kernels.diagnostics import fit_summary
 from calib_core.solver.kernels.dlt import dlt_pose
-from calib_core.solver.kernels.newton import newton
+from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, newton
+from calib_core.solver.kernels.p3p import p3p
 
 # Fixed-point undistortion sweeps for the seed: the Newton iterations absorb what is left.
 _SEED_UNDISTORT_SWEEPS = 8
@@ -60,4 +62,109 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     lengths = np.empty(n)
     rms, sigma, source, condition = fit_summary(J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
     scalars = np.array([iterations, outcome, rms, sigma, source, condition], dtype=np.float64)
+    return R, t, r, cov, cov_centre, loo, scalars
+
+
+@njit(cache=True)
+def _same_pose(Ra, ta, Rb, tb, cos_limit, rel_translation):
+    scale = max(np.sqrt(np.sum(ta * ta)), 1.0)
+    if np.sqrt(np.sum((ta - tb) ** 2)) > rel_translation * scale:
+        return False
+    return (np.sum(Ra * Rb) - 1.0) / 2.0 >= cos_limit
+
+
+@njit(cache=True)
+def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, gate_px, margin_cost, same_cos, same_rel):
+    """The whole solve for a few points (4 or 5, off a plane): P3P over every triplet, the roots
+    that put all the points within ``gate_px`` (RMS) refined, summarised as
+    :func:`dlt_newton_summary`. ``None`` when no root is near or no refinement converges, or when a
+    second distinct minimum (``same_cos``/``same_rel``: the cosine and relative distance under which
+    two poses are one) costs within ``margin_cost`` px^2 of the best: an ambiguity, for the full
+    search to report with its candidates."""
+    n = P.shape[0]
+    xy = seed_coordinates(uv, fu, fv, cx, cy, dist)
+    bearings = np.empty((n, 3))
+    for i in range(n):
+        norm = np.sqrt(xy[i, 0] ** 2 + xy[i, 1] ** 2 + 1.0)
+        bearings[i, 0] = xy[i, 0] / norm
+        bearings[i, 1] = xy[i, 1] / norm
+        bearings[i, 2] = 1.0 / norm
+    m_max = 4 * (n * (n - 1) * (n - 2) // 6)
+    Rs = np.empty((m_max, 3, 3))
+    ts = np.empty((m_max, 3))
+    seed_rms = np.empty(m_max)
+    m = 0
+    Rk = np.empty((4, 3, 3))
+    tk = np.empty((4, 3))
+    tri_P = np.empty((3, 3))
+    tri_b = np.empty((3, 3))
+    seed_cos = np.cos(np.radians(2.0))
+    for a in range(n):
+        for b in range(a + 1, n):
+            for c in range(b + 1, n):
+                tri_P[0], tri_P[1], tri_P[2] = P[a], P[b], P[c]
+                tri_b[0], tri_b[1], tri_b[2] = bearings[a], bearings[b], bearings[c]
+                for k in range(p3p(tri_P, tri_b, Rk, tk)):
+                    # all the points within the gate, in front of the camera
+                    e2 = 0.0
+                    front = True
+                    for i in range(n):
+                        X = Rk[k] @ P[i] + tk[k]
+                        if X[2] <= 0.0:
+                            front = False
+                            break
+                        e2 += ((X[0] / X[2] - xy[i, 0]) * fu) ** 2 + ((X[1] / X[2] - xy[i, 1]) * fv) ** 2
+                    if not front or not np.sqrt(e2 / n) <= gate_px:
+                        continue
+                    copy = False
+                    for j in range(m):
+                        if _same_pose(Rs[j], ts[j], Rk[k], tk[k], seed_cos, 0.02):
+                            copy = True
+                            break
+                    if not copy:
+                        Rs[m] = Rk[k]
+                        ts[m] = tk[k]
+                        seed_rms[m] = np.sqrt(e2 / n)
+                        m += 1
+    if m == 0:
+        return None
+    order = np.argsort(seed_rms[:m])
+    rs = np.empty((m, n, 2))
+    Js = np.empty((m, n, 2, 6))
+    costs = np.full(m, np.inf)
+    its = np.zeros(m, dtype=np.int64)
+    outcomes = np.zeros(m, dtype=np.int64)
+    f = np.empty(2)
+    best = -1
+    basin_cos = np.cos(np.radians(5.0))
+    for j in order:
+        # best seeds first; one within a few degrees of a pose already found would only find it again
+        # (the true pose's roots from each triplet, apart by the noise)
+        again = False
+        for i in range(m):
+            if costs[i] < np.inf and _same_pose(Rs[i], ts[i], Rs[j], ts[j], basin_cos, 0.05):
+                again = True
+                break
+        if again:
+            continue
+        f[0], f[1] = fu, fv
+        its[j], outcomes[j] = newton(PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, max_iterations, True, rs[j], Js[j])
+        if outcomes[j] == CONVERGED or outcomes[j] == EXACT_FIT:
+            costs[j] = np.sum(rs[j] ** 2)
+            if best < 0 or costs[j] < costs[best]:
+                best = j
+    if best < 0:
+        return None
+    for j in range(m):
+        if j != best and costs[j] <= costs[best] + margin_cost and not _same_pose(Rs[best], ts[best], Rs[j], ts[j], same_cos, same_rel):
+            return None
+    R = Rs[best].copy()
+    t = ts[best].copy()
+    r = rs[best].copy()
+    cov = np.empty((6, 6))
+    cov_centre = np.empty((3, 3))
+    loo = np.empty(n)
+    lengths = np.empty(n)
+    rms, sigma, source, condition = fit_summary(Js[best], r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
+    scalars = np.array([its[best], outcomes[best], rms, sigma, source, condition], dtype=np.float64)
     return R, t, r, cov, cov_centre, loo, scalars
