@@ -1,13 +1,14 @@
 """The window's memory of files: the recent list (a menu) and the minute-by-minute autosave.
 
 The recent lists live in the window's ``QSettings`` (``files/recent`` and ``files/recent_cells``, newest
-first). Each window autosaves to its own ``<user data>/recovery/autosave-<pid>-<start>.json``
+first). Each window autosaves to its own ``<user data>/recovery/autosave-<pid>-<start>.<window>.json``
 (``files/autosave_dir`` overrides the folder), only when the session changed; a session that ended without
 saving leaves its file, and the next window offers it.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import time
 from collections.abc import Callable
@@ -19,6 +20,8 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu
 
 from calib_core.errors import VideocalError
+
+_WINDOWS = itertools.count(1)
 
 RECENT_MAX = 8
 AUTOSAVE_INTERVAL_MS = 60_000
@@ -56,7 +59,7 @@ class Autosave:
 
     ``revision()`` counts the session's changes (the core's ``revision``); ``save(path)`` writes it;
     ``report(text)`` tells the operator when a write fails. The file is
-    ``<recovery folder>/autosave-<pid>-<start time>.json``: two windows never share one, and a new window
+    ``<recovery folder>/autosave-<pid>-<start time>.<window>.json``: two windows never share one, and a new window
     never writes over the autosave of a session that ended without saving, which :meth:`orphans` finds.
     """
 
@@ -66,7 +69,8 @@ class Autosave:
         self._save = save
         self._report = report
         self.folder = Path(settings.value("files/autosave_dir") or platformdirs.user_data_dir("videocal")) / "recovery"
-        self.path = self.folder / f"autosave-{os.getpid()}-{int(time.time())}.json"
+        # the start time and the window's number in this process: two windows opened in one second differ
+        self.path = self.folder / f"autosave-{os.getpid()}-{int(time.time())}.{next(_WINDOWS)}.json"
         self._written = revision()  # the revision last written to a file (autosave or deliberate save)
         self._saved = revision()  # the revision last saved by the operator
         self.timer = QTimer(parent)

@@ -113,7 +113,9 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
 
     from calib_core.video.frame import Frame
 
+    wait_for_settled_frame(qtbot, win)  # Hold holds only a frame taken with the robot settled
     win.camera.freeze.setChecked(True)  # the operator froze this (black) frame to pick on
+    assert wb.observations.still is not None
     win.camera.show_frame(Frame(np.zeros((480, 640, 3), np.uint8), 0, time.monotonic()))
     _click_image(qtbot, win.camera.view, 100, 100)
     assert "pick the point on the model" in win.results.status.text()
