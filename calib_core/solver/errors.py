@@ -25,6 +25,17 @@ def named_points(word: str, numbers: Sequence[int]) -> Iterator[None]:
         _NAMES.reset(token)
 
 
+@contextlib.contextmanager
+def named_points_as_given(rows: Sequence[int]) -> Iterator[None]:
+    """Within this block point ``i`` of a solve on a subset is named as the pair ``rows[i]`` it came
+    from (in the caller's names, when there are any)."""
+    outer = _NAMES.get()
+    word = outer[0] if outer is not None else "point"
+    numbers = [int(outer[1][r]) if outer is not None and r < len(outer[1]) else int(r) + 1 for r in rows]
+    with named_points(word, numbers):
+        yield
+
+
 def _number(index: int) -> tuple[str, str]:
     names = _NAMES.get()
     if names is not None and 0 <= index < len(names[1]):

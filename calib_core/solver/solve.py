@@ -7,6 +7,8 @@ closeness to the prior (the modelled camera pose) when there is one.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -17,6 +19,7 @@ from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solv
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.problem import PoseProblem, check_in_front, make_problem
+from calib_core.solver.errors import named_points_as_given, point_label
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
 from calib_core.solver.finish import finish_solution, noise_px
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
@@ -66,9 +69,16 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     accepted as a fit (default five times the noise); ``confidence`` (n,) in [0, 1], a detector's
     confidence in each pair: the robust sampler draws from the most confident first (PROSAC).
 
+    A pair given more than once (the same 3D point at the same pixel: a detector's keypoints at two
+    scales) is counted once, with a warning; the per-pair arrays still have one row per pair given.
+
     Raises a :class:`~calib_core.solver.errors.SolverInputError` subclass for bad input.
     Non-convergence and poor fits are a ``failed`` status with a reason.
     """
+    first = _first_of_each_pair(points_3d, points_2d)
+    if first is not None:
+        return _solve_distinct(first, points_3d, points_2d, intrinsics, prior=prior, estimate_focal=estimate_focal, model=model, sigma_px=sigma_px,
+                               robust=robust, max_rms_px=max_rms_px, confidence=confidence)
     problem, prior2 = _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px)
     noise = noise_px(sigma_px)
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
@@ -146,3 +156,39 @@ def _no_pose(problem: PoseProblem, reason: str) -> PoseSolution:
 
 
 __all__ = ["solve_pose", "refine_pose", "DEFAULT_SIGMA_PX", "pose_matrix"]
+
+
+def _first_of_each_pair(points_3d, points_2d) -> np.ndarray | None:
+    """For each pair (n,) the index of its first occurrence when some pair is given again (bit for bit
+    the same 3D point and pixel), else ``None`` (malformed input is left to the checks)."""
+    try:
+        p3 = np.asarray(points_3d, dtype=float)
+        p2 = np.asarray(points_2d, dtype=float)
+    except (TypeError, ValueError):
+        return None
+    if p3.ndim != 2 or p2.ndim != 2 or p3.shape[1] != 3 or p2.shape[1] != 2 or len(p3) != len(p2) or len(p3) < 2:
+        return None
+    rows = np.ascontiguousarray(np.hstack([p3, p2]))
+    _, first, inverse = np.unique(rows.view(np.dtype((np.void, rows.dtype.itemsize * 5))).ravel(), return_index=True, return_inverse=True)
+    if len(first) == len(rows):
+        return None
+    return first[inverse.ravel()]
+
+
+def _solve_distinct(first: np.ndarray, points_3d, points_2d, intrinsics, **options) -> PoseSolution:
+    """Solve on each distinct pair once; report on every pair given (a repeat shares its first's
+    residual, leave-one-out and outlier flag), the messages numbering the pairs as given."""
+    keep = np.flatnonzero(first == np.arange(len(first)))
+    place = np.searchsorted(keep, first)  # each pair's row in the distinct set
+    confidence = options.pop("confidence")
+    if confidence is not None:
+        confidence = np.asarray(confidence, dtype=float).reshape(-1)
+        if confidence.shape == first.shape:
+            confidence = confidence[keep]
+    with named_points_as_given(keep):
+        solution = solve_pose(np.asarray(points_3d, float)[keep], np.asarray(points_2d, float)[keep], intrinsics, confidence=confidence, **options)
+    repeats = np.flatnonzero(first != np.arange(len(first)))
+    shown = ", ".join(f"{point_label(int(r))} = {point_label(int(first[r]))}" for r in repeats[:5]) + (f" and {len(repeats) - 5} more" if len(repeats) > 5 else "")
+    note = f"{len(repeats)} pair{'s' if len(repeats) > 1 else ''} given again (the same 3D point at the same pixel), each counted once: {shown}"
+    return replace(solution, residuals_px=solution.residuals_px[place], leave_one_out_px=solution.leave_one_out_px[place], outliers=solution.outliers[place],
+                   warnings=(note, *solution.warnings))

@@ -18,6 +18,7 @@ from calib_core.solver import (
     solve_pose_batch,
 )
 
+from calib_core.solver.errors import named_points
 from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, random_pose
 
 RNG = np.random.default_rng(0)
@@ -61,8 +62,20 @@ def test_one_3d_point_at_two_pixels_is_allowed_and_a_disagreement_is_named():
     UV2[-1] = UV[1] + [6.0, 0.0]
     off = solve_pose(P2, UV2, GRIPPER_CAMERA)
     assert any(f"point 2 and point {len(P) + 1} are the same 3D point picked 6.0 px apart" in w for w in off.warnings)
-    with pytest.raises(DuplicatePointsError, match="point 2 and point 5 are the same pair"):
-        solve_pose(np.vstack([P[:4], P[1]]), np.vstack([UV[:4], UV[1]]), GRIPPER_CAMERA)
+    # one pair given twice is counted once, the repeat named and reported like its first
+    twice = solve_pose(np.vstack([P[:4], P[1]]), np.vstack([UV[:4], UV[1]]), GRIPPER_CAMERA)
+    once = solve_pose(P[:4], UV[:4], GRIPPER_CAMERA)
+    assert twice.status is once.status and np.allclose(twice.obj2cam, once.obj2cam)
+    assert "1 pair given again (the same 3D point at the same pixel), each counted once: point 5 = point 2" in twice.warnings
+    assert twice.residuals_px.shape == (5, 2) and np.array_equal(twice.residuals_px[4], twice.residuals_px[1])
+    # in the window's numbers, and so is every message of the solve on the distinct pairs
+    P8 = random_points(np.random.default_rng(8), 8)
+    uv = pixels(P8, TRUTH)
+    uv[2] += [40.0, 0.0]  # a mis-click on the third pair
+    with named_points("pair", [9, 10, 11, 12, 13, 14, 15, 16, 17]):
+        named = solve_pose(np.vstack([P8, P8[1]]), np.vstack([uv, uv[1]]), GRIPPER_CAMERA)
+    assert "each counted once: pair 17 = pair 10" in named.warnings[0]
+    assert named.status is SolveStatus.FAILED and "pair 11 fits worst" in named.reason, named.reason
 
 
 def test_two_points_at_one_pixel_name_both():
