@@ -155,6 +155,7 @@ class MainWindow(QMainWindow):
         self.camera.pick_rejected.connect(self.show_error)
         self.camera.pair_moved.connect(self.report(lambda number, u, v: wb.move_pair_pixel(number, (u, v))))
         self.camera.pair_selected.connect(self.table.select_number)
+        self.virtual.pair_selected.connect(self.table.select_number)
         c.accept.clicked.connect(self._accept)
         c.delete.clicked.connect(self._delete)
         c.clear.clicked.connect(self.report(lambda: wb.session.clear()))

@@ -19,10 +19,15 @@ FEATURE_COLOR = QColor(90, 190, 255)
 RENDER_SCALE = 0.5  # the pane shows a half-size render: plenty to pick features, half the cost
 
 
+SELECT_RADIUS_PX = 6.0  # a click this close to a pair's mark (pane pixels) selects the pair
+
+
 class VirtualPane(QWidget):
-    """``picked(PickResult)`` when the operator picks on the target object."""
+    """``picked(PickResult)`` when the operator picks on the target object; ``pair_selected(number)``
+    when they click a pair's mark while no pair waits for its 3D point."""
 
     picked = Signal(object)
+    pair_selected = Signal(int)
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
@@ -95,7 +100,26 @@ class VirtualPane(QWidget):
         if not self.is_current(tolerance_deg):
             self.refresh()
 
+    def _pair_at(self, u: float, v: float) -> int | None:
+        """The pair whose 3D point is drawn within :data:`SELECT_RADIUS_PX` of (u, v), nearest first."""
+        world2cam = invert(self.workbench.model_cam2world())
+        near = []
+        for p in self.workbench.session.pairs:
+            uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
+            if np.all(np.isfinite(uv)):
+                near.append((float(np.hypot(uv[0] - u, uv[1] - v)), p.number))
+        near = [n for n in near if n[0] <= SELECT_RADIUS_PX]
+        return min(near)[1] if near else None
+
     def _on_click(self, u: float, v: float) -> None:
+        # A click on a pair's mark selects it, as in the camera pane; while a pair waits for its image
+        # point a click here picks its 3D point again, and naming features only picks.
+        if self.feature_component is None and self.workbench.session.pairs.pending() is None:
+            number = self._pair_at(u, v)
+            if number is not None:
+                self.info.setText(f"pair {number} selected")
+                self.pair_selected.emit(number)
+                return
         target = self.feature_component or self.workbench.session.target
         snap = 0.0 if self.feature_component else 10.0  # naming a feature: the core snaps it to the mesh
         hit: PickResult | None = self.renderer.pick(u, v, snap_radius_px=snap, components=None if target is None else {target})

@@ -91,6 +91,16 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
     x3, y3 = view.image_to_widget(*p3)
     qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x3)), int(round(y3))))
     assert win.table.selected_number() == 3 and np.allclose(wb.session.pairs.get(3).pixel, p3) and len(wb.session.pairs) == 3
+    # and in the virtual camera: a click on pair 1's mark selects it and starts no new pair
+    _pick_on_model(qtbot, win, model_cam, np.array(wb.session.pairs.get(1).point_world_mm))
+    assert win.table.selected_number() == 1 and len(wb.session.pairs) == 3 and wb.session.pairs.pending() is None
+    assert "pair 1 selected" in win.virtual.info.text()
+    # while a pair waits for its image point, a click on a mark is a pick: the waiting pair's 3D point
+    fourth = apply(fixture.item2world, fixture.features[FEATURES[3]])
+    _pick_on_model(qtbot, win, model_cam, fourth)
+    assert wb.session.pairs.pending().feature == FEATURES[3] and len(wb.session.pairs) == 4
+    _pick_on_model(qtbot, win, model_cam, np.array(wb.session.pairs.get(1).point_world_mm))
+    assert wb.session.pairs.pending().feature == wb.session.pairs.get(1).feature and len(wb.session.pairs) == 4
 
 
 def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
