@@ -82,6 +82,10 @@ class DuplicatePointsError(SolverInputError):
     """Two pairs share the same 3D point or the same pixel."""
 
 
+class RepeatedPairError(DuplicatePointsError):
+    """One pair given twice (the same 3D point at the same pixel); ``solve_pose`` counts it once."""
+
+
 class DegenerateGeometryError(SolverInputError):
     """The 3D points are collinear (or coincide): no pose can be recovered from them."""
 

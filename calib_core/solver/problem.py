@@ -18,6 +18,7 @@ from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, 
 from calib_core.solver.errors import (
     DegenerateGeometryError,
     DuplicatePointsError,
+    RepeatedPairError,
     InvalidIntrinsicsError,
     MismatchedPointsError,
     NonFiniteInputError,
@@ -120,10 +121,26 @@ def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tu
     same_px = _close_pairs(p2, _DUPLICATE_PX)
     if same_px:
         i, j = same_px[0]
-        if np.linalg.norm(p3[i] - p3[j]) <= tol3_mm:
-            raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)", (i, j))
-        raise DuplicatePointsError(f"{point_label(i)} and {point_label(j)} have the same pixel", (i, j))
+        same = [(a, b) for a, b in same_px if np.linalg.norm(p3[a] - p3[b]) <= tol3_mm]
+        other = [(a, b) for a, b in same_px if (a, b) not in set(same)]
+        if other:
+            a, b = other[0]
+            raise DuplicatePointsError(f"{point_label(a)} and {point_label(b)} have the same pixel", (a, b))
+        raise RepeatedPairError(f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)", sorted({k for pair in same for k in pair}))
     return tuple(_close_pairs(p3, tol3_mm))
+
+
+def first_of_each_pair(points_3d: np.ndarray, points_2d: np.ndarray) -> np.ndarray:
+    """For each pair (n,) the index of the first pair that is the same (the same 3D point at the same
+    pixel, to the tolerances the checks use): itself when it is the first."""
+    p3 = np.asarray(points_3d, dtype=float)
+    p2 = np.asarray(points_2d, dtype=float)
+    spread = float(np.ptp(p3, axis=0).max()) if len(p3) else 0.0
+    first = np.arange(len(p3))
+    for i, j in _close_pairs(p2, _DUPLICATE_PX):
+        if np.linalg.norm(p3[i] - p3[j]) <= _DUPLICATE_REL_3D * max(spread, 1.0):
+            first[j] = min(first[j], first[i])
+    return first
 
 
 def _close_pairs(points: np.ndarray, tol: float) -> list[tuple[int, int]]:

@@ -18,8 +18,8 @@ from calib_core.solver.candidates import distinct_poses, refine_seed
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
 from calib_core.solver.sampler import robust_seed
-from calib_core.solver.problem import PoseProblem, check_in_front, make_problem
-from calib_core.solver.errors import named_points_as_given, point_label
+from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
+from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
 from calib_core.solver.finish import finish_solution, noise_px
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
@@ -75,11 +75,15 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     Raises a :class:`~calib_core.solver.errors.SolverInputError` subclass for bad input.
     Non-convergence and poor fits are a ``failed`` status with a reason.
     """
-    first = _first_of_each_pair(points_3d, points_2d)
-    if first is not None:
-        return _solve_distinct(first, points_3d, points_2d, intrinsics, prior=prior, estimate_focal=estimate_focal, model=model, sigma_px=sigma_px,
-                               robust=robust, max_rms_px=max_rms_px, confidence=confidence)
-    problem, prior2 = _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px)
+    try:
+        problem, prior2 = _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px)
+    except RepeatedPairError:
+        # (found by the checks every solve makes: the common case pays nothing for this)
+        first = first_of_each_pair(points_3d, points_2d)
+        if np.all(first == np.arange(len(first))):
+            raise
+        return _solve_distinct(first, points_3d, points_2d, intrinsics, prior=prior, estimate_focal=estimate_focal, model=model,
+                               sigma_px=sigma_px, robust=robust, max_rms_px=max_rms_px, confidence=confidence)
     noise = noise_px(sigma_px)
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
     huber = 2.0 * noise if robust else None
@@ -156,23 +160,6 @@ def _no_pose(problem: PoseProblem, reason: str) -> PoseSolution:
 
 
 __all__ = ["solve_pose", "refine_pose", "DEFAULT_SIGMA_PX", "pose_matrix"]
-
-
-def _first_of_each_pair(points_3d, points_2d) -> np.ndarray | None:
-    """For each pair (n,) the index of its first occurrence when some pair is given again (bit for bit
-    the same 3D point and pixel), else ``None`` (malformed input is left to the checks)."""
-    try:
-        p3 = np.asarray(points_3d, dtype=float)
-        p2 = np.asarray(points_2d, dtype=float)
-    except (TypeError, ValueError):
-        return None
-    if p3.ndim != 2 or p2.ndim != 2 or p3.shape[1] != 3 or p2.shape[1] != 2 or len(p3) != len(p2) or len(p3) < 2:
-        return None
-    rows = np.ascontiguousarray(np.hstack([p3, p2]))
-    _, first, inverse = np.unique(rows.view(np.dtype((np.void, rows.dtype.itemsize * 5))).ravel(), return_index=True, return_inverse=True)
-    if len(first) == len(rows):
-        return None
-    return first[inverse.ravel()]
 
 
 def _solve_distinct(first: np.ndarray, points_3d, points_2d, intrinsics, **options) -> PoseSolution:
