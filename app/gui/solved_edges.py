@@ -24,12 +24,14 @@ class SolvedEdges:
 
     def set_intrinsics(self, intrinsics: Intrinsics) -> None:
         self.intrinsics = intrinsics
-        self._half = distortion_map(intrinsics.scaled(0.5))
+        self._half = None  # the lens's map, made on the first solve too (0.1 s of start-up otherwise)
 
     def render(self, items: list[SceneItem], cam2world: np.ndarray, highlight: str | None) -> np.ndarray:
         """The edges of ``items`` seen from ``cam2world`` (4, 4) mm, the camera that took the image."""
         if self._renderer is None:
             self._renderer = SceneRenderer()
+        if self._half is None:
+            self._half = distortion_map(self.intrinsics.scaled(0.5))
         self._renderer.set_items(items)
         rgba = self._renderer.render_view(self._half.ideal, cam2world, RenderOptions(style="edges", transparent_background=True, highlight=highlight))
         return cv2.resize(self._half.apply(rgba), (self.intrinsics.width, self.intrinsics.height), interpolation=cv2.INTER_LINEAR)
