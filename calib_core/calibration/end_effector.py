@@ -15,6 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.frames import concat, invert, make_transform, pose_difference
 from calib_core.solver.solution import PoseSolution
+from calib_core.vision.pnp_sensitivity import pose_derivatives
 
 
 @dataclass(frozen=True)
@@ -58,24 +59,20 @@ def shared_shift_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intr
     image axis): how the pose that puts the points on the shifted pixels moves, by central
     differences of OpenCV's PnP refinement from ``obj2cam`` (a common shift is a principal point
     moved the other way). Zeros when fewer than 4 points."""
-    import cv2
-
     pts = np.asarray(points_obj_mm, dtype=np.float64).reshape(-1, 3)
     if len(pts) < 4 or bias_px <= 0:
         return np.zeros((6, 6))
-    rvec0 = cv2.Rodrigues(obj2cam[:3, :3])[0]
-    tvec0 = obj2cam[:3, 3].reshape(3, 1).astype(np.float64)
-    pixels = cv2.projectPoints(pts, rvec0, tvec0, intrinsics.K, intrinsics.dist_coeffs)[0].reshape(-1, 2)
-    S = np.zeros((6, 2))
-    for axis in range(2):
-        moved = []
-        for sign in (1.0, -1.0):
-            shifted = pixels.copy()
-            shifted[:, axis] += sign * step_px
-            ok, rvec, tvec = cv2.solvePnP(pts, shifted, intrinsics.K, intrinsics.dist_coeffs, rvec0.copy(), tvec0.copy(), True, cv2.SOLVEPNP_ITERATIVE)
-            R = cv2.Rodrigues(rvec)[0]
-            moved.append(np.r_[tvec.ravel() - obj2cam[:3, 3], Rotation.from_matrix(R @ obj2cam[:3, :3].T).as_rotvec()])
-        S[:, axis] = (moved[0] - moved[1]) / (2 * step_px)
+
+    def shift(axis):
+        def change(d, pixels):
+            pixels[:, axis] += d
+            return pixels, intrinsics
+        return change
+
+    def difference(start, moved):  # the solver's (dt mm, phi rad)
+        return np.r_[moved[:3, 3] - start[:3, 3], Rotation.from_matrix(moved[:3, :3] @ start[:3, :3].T).as_rotvec()]
+
+    S = pose_derivatives(obj2cam, pts, intrinsics, [shift(0), shift(1)], difference, step_px)
     return bias_px**2 * S @ S.T
 
 

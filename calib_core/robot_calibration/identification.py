@@ -27,6 +27,7 @@ from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
+from calib_core.vision.pnp_sensitivity import pose_derivatives
 
 OUTLIER_RATIO = 4.0
 """A surveyed component's view whose residual is this many times the median of those views' (and
@@ -174,21 +175,14 @@ def pose_sensitivity_to_intrinsics(obj2cam: np.ndarray, points_mm: np.ndarray, i
     pixel and thousandths."""
     from calib_core.robot_calibration.parameters import INTRINSICS, corrected_intrinsics
 
-    pts = np.asarray(points_mm, dtype=np.float64)
-    rvec0 = cv2.Rodrigues(obj2cam[:3, :3])[0]
-    tvec0 = obj2cam[:3, 3].reshape(3, 1).astype(np.float64)
-    pixels = cv2.projectPoints(pts, rvec0, tvec0, intrinsics.K, intrinsics.dist_coeffs)[0]
-    S = np.zeros((6, len(INTRINSICS)))
-    for j in range(len(INTRINSICS)):
-        poses = []
-        for sign in (1.0, -1.0):
-            d = np.zeros(len(INTRINSICS))
-            d[j] = sign * step
-            moved = corrected_intrinsics(intrinsics, d)
-            _, rvec, tvec = cv2.solvePnP(pts, pixels, moved.K, moved.dist_coeffs, rvec0.copy(), tvec0.copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
-            poses.append(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()))
-        S[:, j] = (pose_residual(obj2cam, poses[0]) - pose_residual(obj2cam, poses[1])) / (2.0 * step)
-    return S
+    def correct(j):
+        def change(d, pixels):
+            delta = np.zeros(len(INTRINSICS))
+            delta[j] = d
+            return pixels, corrected_intrinsics(intrinsics, delta)
+        return change
+
+    return pose_derivatives(obj2cam, points_mm, intrinsics, [correct(j) for j in range(len(INTRINSICS))], pose_residual, step)
 
 
 def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str) -> np.ndarray:
