@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -135,6 +137,21 @@ class CommandPanel(QTabWidget):
         self.setCurrentIndex(2)
         workbench.task_changed.connect(self._sync_tasks)
         workbench.scene_changed.connect(self._sync_targets)
+
+    def show_corrections(self, table) -> None:
+        """The stored corrections (a :class:`~calib_core.calibration.corrections.CorrectionTable`), one
+        line per task location: the latest, how many were stored, its last verification."""
+        lines = []
+        for task in table.tasks():
+            c = table.latest(task)
+            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored"
+            line += f", {c.verdict} confirmed)" if c.confirmation else ")"
+            looks = table.verifications(task)
+            if looks:
+                v = looks[-1]
+                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), looks {'agree' if v.agree else 'DISAGREE'}"
+            lines.append(line)
+        self.corrections.setText("\n".join(lines) or "No corrections stored.")
 
     def _sync_tasks(self, name: str = "") -> None:
         """The task list follows the cell (a location added or undone)."""

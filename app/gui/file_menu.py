@@ -11,7 +11,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QFileDialog, QMenu
 
-from app.gui.confirm import ask
+from app.gui.confirm import ask, ask_save
 from app.gui.error_boundary import attempt
 from app.gui.session_files import Autosave, RecentFiles
 from calib_core.errors import OperatorError
@@ -216,4 +216,24 @@ class FileMenu:
         if action is not None:
             self.menu.removeAction(action)
         self.restore_action = next(iter(self.restore_actions.values()), None)
+        return True
+
+    def may_close(self) -> bool:
+        """Unsaved work: ask to save it, discard it (it stays in the recovery file) or stay. A quit by a
+        signal (SIGTERM, Ctrl+C in the terminal) or with ``window/ask_unsaved`` off asks nothing."""
+        from PySide6.QtWidgets import QApplication
+
+        w = self.window
+        if self.autosave is None or not self.autosave.unsaved or QApplication.instance().property("videocal_quit_by_signal"):
+            return True
+        if str(w.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
+            return True
+        s = w.workbench.session
+        what = f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored corrections"
+        choice = ask_save(w, "Unsaved work", f"The session has changes that are not saved in a workspace file ({what}). Save them before closing?\n"
+                          "Discard closes the window; the changes stay in the recovery file, offered at the next start.")
+        if choice == "cancel":
+            return False
+        if choice == "save":
+            return self.save_workspace_dialog()
         return True

@@ -27,8 +27,9 @@ from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
 from app.gui.robot_panel import RobotPanel
 from app.gui.vision_panel import VisionPanel
+from app.gui.window_layout import restore_layout, save_layout
 from app.gui.workbench import Workbench
-from app.gui.confirm import ask, ask_save
+from app.gui.confirm import ask
 from calib_core.calibration.session import ConfirmationNeeded
 from calib_core.operator.move_preview import MoveNeedsConfirmation
 from calib_core.robot import solve_ik
@@ -69,7 +70,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_status()
         self._connect()
-        self._restore()
+        restore_layout(self, self.settings)
         self._redraw = QTimer(self)
         self._redraw.setInterval(50)  # overview and virtual camera at up to 20 fps, only when something changed
         self._redraw.timeout.connect(self._redraw_views)
@@ -190,7 +191,7 @@ class MainWindow(QMainWindow):
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.changed.connect(self._update_actions)
         wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
-        wb.session.corrections.changed.connect(lambda task: self._update_corrections())
+        wb.session.corrections.changed.connect(lambda task: self.commands.show_corrections(wb.session.corrections))
         wb.session.changed.connect(self._after_solve)
         self.finder = FindPoints(self)
         self._update_actions()
@@ -376,20 +377,6 @@ class MainWindow(QMainWindow):
         self.commands.calibrate.setEnabled(self.workbench.session.can_calibrate)
         self.status_line.show_pairs(len(self.workbench.session.pairs.usable()), self.workbench.session.required_pairs)
 
-    def _update_corrections(self) -> None:
-        table = self.workbench.session.corrections
-        lines = []
-        for task in table.tasks():
-            c = table.latest(task)
-            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored"
-            line += f", {c.verdict} confirmed)" if c.confirmation else ")"
-            looks = table.verifications(task)
-            if looks:
-                v = looks[-1]
-                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), looks {'agree' if v.agree else 'DISAGREE'}"
-            lines.append(line)
-        self.commands.corrections.setText("\n".join(lines) or "No corrections stored.")
-
     def _update_status(self) -> None:
         self.status_line.update()
 
@@ -397,48 +384,11 @@ class MainWindow(QMainWindow):
         return self.camera.last_frame_received, self.worker, self.replay.playback is not None
 
     # --- life cycle ------------------------------------------------------------------------
-    def _may_close(self) -> bool:
-        """Unsaved work: ask to save it, discard it (it stays in the recovery file) or stay. A quit by a
-        signal (SIGTERM, Ctrl+C in the terminal) or with ``window/ask_unsaved`` off asks nothing."""
-        from PySide6.QtWidgets import QApplication
-
-        autosave = getattr(self.files, "autosave", None)
-        if autosave is None or not autosave.unsaved or QApplication.instance().property("videocal_quit_by_signal"):
-            return True
-        if str(self.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
-            return True
-        s = self.workbench.session
-        what = f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored corrections"
-        choice = ask_save(self, "Unsaved work", f"The session has changes that are not saved in a workspace file ({what}). Save them before closing?\n"
-                          "Discard closes the window; the changes stay in the recovery file, offered at the next start.")
-        if choice == "cancel":
-            return False
-        if choice == "save":
-            return self.files.save_workspace_dialog()
-        return True
-
-
-    def _restore(self) -> None:
-        geometry = self.settings.value("window/geometry")
-        if geometry is not None:
-            self.restoreGeometry(geometry)
-        state = self.settings.value("window/state")
-        if state is not None:
-            self.restoreState(state)
-        for key, splitter in (("window/split_main", self.splitter), ("window/split_top", self.top_splitter), ("window/split_bottom", self.bottom_splitter)):
-            value = self.settings.value(key)
-            if value is not None:
-                splitter.restoreState(value)
-
     def closeEvent(self, event) -> None:
-        if not self._may_close():
+        if not self.files.may_close():
             event.ignore()
             return
-        self.settings.setValue("window/geometry", self.saveGeometry())
-        self.settings.setValue("window/state", self.saveState())
-        self.settings.setValue("window/split_main", self.splitter.saveState())
-        self.settings.setValue("window/split_top", self.top_splitter.saveState())
-        self.settings.setValue("window/split_bottom", self.bottom_splitter.saveState())
+        save_layout(self, self.settings)
         self._redraw.stop()
         self.files.autosave.finish()  # unsaved work stays recoverable; a closed window writes nothing more
         self.status_line.timer.stop()
