@@ -82,11 +82,11 @@ def edge_samples_px(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intr
     return uv[intrinsics.contains(uv, margin_px=2)]
 
 
-def edge_distance_map(grey: np.ndarray) -> np.ndarray:
-    """Distance (px, float32, truncated) from every pixel to the nearest image edge (Canny)."""
+def edge_distance_map(grey: np.ndarray, truncate_px: float = TRUNCATE_PX) -> np.ndarray:
+    """Distance (px, float32, truncated at ``truncate_px``) from every pixel to the nearest image edge (Canny)."""
     edges = cv2.Canny(cv2.GaussianBlur(grey, (5, 5), 1.0), 20, 60)
     dist = cv2.distanceTransform((edges == 0).astype(np.uint8), cv2.DIST_L2, 3)
-    return np.minimum(dist, TRUNCATE_PX).astype(np.float32)
+    return np.minimum(dist, truncate_px).astype(np.float32)
 
 
 def _distances(samples: np.ndarray, distance: np.ndarray, offset: np.ndarray) -> np.ndarray:
@@ -95,6 +95,13 @@ def _distances(samples: np.ndarray, distance: np.ndarray, offset: np.ndarray) ->
     v = np.rint(samples[:, 1] + offset[1]).astype(np.int64)
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
     return np.where(inside, distance[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)], TRUNCATE_PX)
+
+
+def matched_share(samples_px: np.ndarray, distance: np.ndarray, within_px: float = 2.0) -> float:
+    """The share of edge samples (m, 2) px within ``within_px`` of an image edge (``distance`` (h, w))."""
+    if len(samples_px) == 0:
+        return 0.0
+    return float(np.mean(_distances(samples_px, distance, np.zeros(2)) <= within_px))
 
 
 def _costs(samples: np.ndarray, distance: np.ndarray, offsets: np.ndarray) -> np.ndarray:
@@ -137,7 +144,7 @@ def align_edges(samples_px: np.ndarray, distance: np.ndarray, radius_px: float) 
                 offset[axis] += 0.5 * (left - right) / denom
     second = float(costs[far].min()) if far.any() else TRUNCATE_PX
     best_cost = float(fine_costs[k])
-    matched = float(np.mean(_distances(samples_px, distance, fine[k]) <= 2.0))
+    matched = matched_share(samples_px + fine[k], distance)
     alternatives = []
     taken = [best]
     for i in np.argsort(costs):

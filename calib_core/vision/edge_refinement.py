@@ -88,7 +88,7 @@ def visible_segments(mesh, obj2cam: np.ndarray) -> np.ndarray:
     return seg
 
 
-def _edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3) and
     their clearance (m,) px, every ~4 px. With ``expected`` (h, w, the cell rendered at ``obj2cam``)
     only where it shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
@@ -166,7 +166,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast."""
     magnitude = gradient_magnitude(grey)
-    pts, far, clearance = _edge_points(mesh, obj2cam, intrinsics, expected)
+    pts, far, clearance = edge_points(mesh, obj2cam, intrinsics, expected)
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False

@@ -29,15 +29,19 @@ from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
-from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px
-from calib_core.vision.edge_refinement import EdgeFit, model_shows_edge, refine_to_edges
+from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px, matched_share
+from calib_core.vision.edge_refinement import EdgeFit, edge_points, model_shows_edge, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude
+from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
-SEARCH_RADIUS_PX = 90.0
-"""How far (px) the target may lie from where the model puts it: the typical robot error, twice."""
+REACH_MM = 20.0
+"""How far the camera's centre may be from where the model puts it: a typical robot's error (8 mm), twice, and some."""
+REACH_DEG = 1.5
+"""How far the camera may be turned from where the model puts it: a typical robot's error (0.7 deg), twice."""
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
+_CLEAR_SHARE = 0.75  # a settled fit with this share of its samples on their edges ends the search (a wrong minimum found 53 %, the right one 90 %)
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
 
@@ -181,14 +185,25 @@ class _Detectors:
         return detect_blob(self.grey, uv, max(radius, 6.0))
 
 
+def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG) -> float:
+    """How far (px) the target may lie from where a camera at ``obj2cam`` sees it, when the camera may be
+    ``reach_mm`` and ``reach_deg`` off: a move across the line of sight shifts a point at depth z by
+    f reach / z (the target's nearer half counts), a turn by f reach in radians."""
+    z = points_mm @ obj2cam[2, :3] + obj2cam[2, 3]
+    z = z[z > 1.0]
+    f = max(intrinsics.fu, intrinsics.fv)
+    near = float(np.percentile(z, 25)) if len(z) else 1e9
+    return f * (reach_mm / near + np.radians(reach_deg))
+
+
 def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2cam_model: np.ndarray, *, kinds: dict[str, FeatureKind] | None = None,
-                search_radius_px: float = SEARCH_RADIUS_PX, expected=None) -> FoundPoints:
+                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None) -> FoundPoints:
     """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
     ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
     the item's own, corner when absent). ``expected(obj2cam) -> image``: the cell rendered as this
-    camera would see it with the item at ``obj2cam`` (lens distortion included); with it each feature is
-    found by registering its rendered neighbourhood, which knows silhouettes and shading, and the kinds'
-    detectors are the fallback without a renderer."""
+    camera would see it with the item at ``obj2cam`` (lens distortion included): edges it shows no
+    contrast on are not searched for. ``reach_mm`` and ``reach_deg``: how far the true camera may be
+    from the modelled one (the robot's error), which bounds the search."""
     t0 = time.perf_counter()
     kinds = item.feature_kinds if kinds is None else kinds
     names = list(item.features)
@@ -197,16 +212,13 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     grey = as_grey(image)
     points = np.array([item.features[n] for n in names], dtype=float)
     uv_model = project_points(points, obj2cam_model, intrinsics)
+    radius_px = search_radius_px(item.mesh.vertices, obj2cam_model, intrinsics, reach_mm, reach_deg)
     z = points @ obj2cam_model[2, :3] + obj2cam_model[2, 3]
-    visible = (z > 0) & intrinsics.contains(uv_model, margin_px=-search_radius_px) & _visible(item.mesh, points, obj2cam_model)
+    visible = (z > 0) & intrinsics.contains(uv_model, margin_px=-radius_px) & _visible(item.mesh, points, obj2cam_model)
     missed = {n: "hidden or outside the image at the modelled pose" for n, v in zip(names, visible) if not v}
 
     distance = edge_distance_map(grey)
-    alignment = align_edges(edge_samples_px(item.mesh, obj2cam_model, intrinsics), distance, search_radius_px)
-    if alignment.matched_share < _MATCHED_SHARE:
-        return FoundPoints(item.name, False, f"{item.name} was not found near where the model puts it (only {100 * alignment.matched_share:.0f} % of its edges "
-                           f"meet an edge of the image): pick the points by hand", missed=tuple(Missed(n, "the target was not found") for n in names),
-                           offset_px=alignment.offset_px, seconds=time.perf_counter() - t0)
+    alignment = align_edges(edge_samples_px(item.mesh, obj2cam_model, intrinsics), distance, radius_px)
     shift = alignment.offset_px
 
     detectors = _Detectors(grey, item, intrinsics, expected)
@@ -215,20 +227,30 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, radius) for i in indices}
 
     candidates = [i for i in range(len(names)) if visible[i]]
-    # The shift as a turn of the camera about its centre, then the edges pull the pose into place, then
-    # again from where they got to: the model's view and the edges' samples taken afresh there (from the
-    # shifted start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px,
-    # which the second pass leaves for the right pose at 0.13 px). When they do not settle, the
-    # chamfer's next best shifts.
+    # The shift as a turn of the camera about its centre; then poses around it with the camera's centre
+    # moved too (close up, a robot's error moves near and far edges differently), ranked by their
+    # edges' chamfer distance; from the best few the edges pull the pose into place, each fit run again
+    # from where it got to, with the model's view and the samples taken afresh there (from the shifted
+    # start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px, which the
+    # second pass leaves for the right pose at 0.13 px). The fit with the most samples on their edges
+    # wins; when none settles, the chamfer's next best shifts are tried.
+    wide = edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX)
+    shifted = _turned(obj2cam_model, shift, intrinsics)
+    samples, _, _ = edge_points(item.mesh, shifted, intrinsics, detectors.expected_image(shifted) if expected is not None else None)
+    ranked = rank_starts(wide, intrinsics, samples, shifted, reach_mm)
+    # Not there at all: too few of its edges meet an image edge even at the best start (the edge fit
+    # decides the rest)
+    share = matched_share(edge_samples_px(item.mesh, ranked[0], intrinsics), distance)
+    if share < _MATCHED_SHARE:
+        return FoundPoints(item.name, False, f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges "
+                           f"meet an edge of the image): pick the points by hand", missed=tuple(Missed(n, "the target was not found") for n in names),
+                           offset_px=shift, seconds=time.perf_counter() - t0)
     edge_fit = None
-    for k, offset in enumerate((shift, *alignment.alternatives)):
-        start_pose = _turned(obj2cam_model, offset, intrinsics)
-        for attempt in range(2 if k == 0 else 1):  # the best shift gets the second pass, the others one try each
-            fit = refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected=detectors.expected_image(start_pose) if expected is not None else None)
-            if attempt > 0 and fit.settled or edge_fit is None or (fit.settled, fit.inlier_share * fit.samples) > (edge_fit.settled, edge_fit.inlier_share * edge_fit.samples):
-                edge_fit = fit
-            start_pose = fit.obj2cam
-        if edge_fit.settled:
+    for start_pose in (*ranked, *(_turned(obj2cam_model, offset, intrinsics) for offset in alignment.alternatives)):
+        fit = _refined_twice(grey, intrinsics, item.mesh, start_pose, detectors.expected_image if expected is not None else None)
+        if edge_fit is None or _fit_rank(fit) > _fit_rank(edge_fit):
+            edge_fit = fit
+        if edge_fit.settled and edge_fit.inlier_share >= _CLEAR_SHARE:
             break
     if not edge_fit.settled:
         # The edges did not settle: detections in wide windows would lock onto neighbouring edges, and a
@@ -272,6 +294,19 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
                if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
     return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit)
+
+
+def _refined_twice(grey: np.ndarray, intrinsics: Intrinsics, mesh, start: np.ndarray, expected_image) -> EdgeFit:
+    """The edge refinement from ``start``, then again from where it got to (the second one kept when it
+    settles); ``expected_image(obj2cam)`` the model's view there, or ``None``."""
+    first = refine_to_edges(grey, intrinsics, mesh, start, expected=expected_image(start) if expected_image else None)
+    second = refine_to_edges(grey, intrinsics, mesh, first.obj2cam, expected=expected_image(first.obj2cam) if expected_image else None)
+    return second if second.settled or _fit_rank(second) > _fit_rank(first) else first
+
+
+def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
+    """Settled first, then the most samples on their edges."""
+    return fit.settled, fit.inlier_share * fit.samples
 
 
 def _turned(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
