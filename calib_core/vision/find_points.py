@@ -2,10 +2,10 @@
 
 1. Predict every feature's pixel from the modelled camera pose; keep those in the image and not hidden
    by the target itself (a ray from the camera reaches the feature first).
-2. Find where the target really is: its crease edges slid over the image's edges
-   (:mod:`calib_core.vision.edge_alignment`). The robot's error is mostly this shift.
-3. Refine the pose on the image's gradients (:mod:`calib_core.vision.edge_refinement`); nothing is
-   proposed unless it settles.
+2. Find roughly where the target is: camera poses within the robot's error of the modelled one,
+   ranked by how well the target's edges lie on the image's (:mod:`calib_core.vision.pose_hypotheses`).
+3. Refine the pose on the image's gradients from the best few (:mod:`calib_core.vision.edge_refinement`);
+   the fit with the most samples on their edges is kept, and nothing is proposed unless it settles.
 4. Detect each feature by its kind (:mod:`calib_core.vision.feature_detectors`) in a window of three
    times the edges' scatter around its projection; drop detections more than 1 px from where the
    edges put them; a robust pose fit (sampled by confidence, PROSAC) rejects the remaining wrong ones.
@@ -22,14 +22,13 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 import trimesh
-from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
-from calib_core.vision.edge_alignment import align_edges, crease_segments, edge_distance_map, edge_samples_px, matched_share
+from calib_core.vision.edge_alignment import crease_segments, edge_distance_map, edge_samples_px, matched_share
 from calib_core.vision.edge_refinement import EdgeFit, edge_points, model_shows_edge, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_corner, detect_corner_from_edges, gradient_magnitude
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -218,46 +217,40 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     missed = {n: "hidden or outside the image at the modelled pose" for n, v in zip(names, visible) if not v}
 
     distance = edge_distance_map(grey)
-    alignment = align_edges(edge_samples_px(item.mesh, obj2cam_model, intrinsics), distance, radius_px)
-    shift = alignment.offset_px
-
     detectors = _Detectors(grey, item, intrinsics, expected)
 
     def detect_all(indices, pose, radius):
         return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, radius) for i in indices}
 
     candidates = [i for i in range(len(names)) if visible[i]]
-    # The shift as a turn of the camera about its centre; then poses around it with the camera's centre
-    # moved too (close up, a robot's error moves near and far edges differently), ranked by their
-    # edges' chamfer distance; from the best few the edges pull the pose into place, each fit run again
-    # from where it got to, with the model's view and the samples taken afresh there (from the shifted
-    # start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px, which the
-    # second pass leaves for the right pose at 0.13 px). The fit with the most samples on their edges
-    # wins; when none settles, the chamfer's next best shifts are tried.
-    wide = edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX)
-    shifted = _turned(obj2cam_model, shift, intrinsics)
-    samples, _, _ = edge_points(item.mesh, shifted, intrinsics, detectors.expected_image(shifted) if expected is not None else None)
-    ranked = rank_starts(wide, intrinsics, samples, shifted, reach_mm)
-    # Not there at all: too few of its edges meet an image edge even at the best start (the edge fit
-    # decides the rest)
-    share = matched_share(edge_samples_px(item.mesh, ranked[0], intrinsics), distance)
-    if share < _MATCHED_SHARE:
-        return FoundPoints(item.name, False, f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges "
-                           f"meet an edge of the image): pick the points by hand", missed=tuple(Missed(n, "the target was not found") for n in names),
-                           offset_px=shift, seconds=time.perf_counter() - t0)
+    # Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error
+    # moves near and far edges differently: no 2D shift lays them all on the image); from the best few
+    # the edges pull the pose into place, each fit run again from where it got to, with the model's
+    # view and the samples taken afresh there (from a turned start a pin seen end-on can lock its rims
+    # onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right pose at
+    # 0.13 px). The fit with the most samples on their edges wins.
+    samples, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_image(obj2cam_model) if expected is not None else None)
+    ranked = rank_starts(edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg)
+    centre = item.mesh.vertices.mean(axis=0)[None]
+    shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     edge_fit = None
-    for start_pose in (*ranked, *(_turned(obj2cam_model, offset, intrinsics) for offset in alignment.alternatives)):
+    for start_pose in ranked:
         fit = _refined_twice(grey, intrinsics, item.mesh, start_pose, detectors.expected_image if expected is not None else None)
         if edge_fit is None or _fit_rank(fit) > _fit_rank(edge_fit):
             edge_fit = fit
         if edge_fit.settled and edge_fit.inlier_share >= _CLEAR_SHARE:
             break
     if not edge_fit.settled:
-        # The edges did not settle: detections in wide windows would lock onto neighbouring edges, and a
-        # wrong proposal costs the operator more than a pick by hand.
-        return FoundPoints(item.name, False, f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
-                           f"{edge_fit.samples} edge samples on their edges): "
-                           "pick the points by hand", missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
+        # Not there, or the edges did not settle: detections in wide windows would lock onto neighbouring
+        # edges, and a wrong proposal costs the operator more than a pick by hand.
+        share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
+        if share < _MATCHED_SHARE:
+            message = (f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an edge of the image): "
+                       "pick the points by hand")
+        else:
+            message = (f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
+                       f"{edge_fit.samples} edge samples on their edges): pick the points by hand")
+        return FoundPoints(item.name, False, message, missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
                            seconds=time.perf_counter() - t0, edges=edge_fit)
     start = edge_fit.obj2cam
     # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
@@ -307,15 +300,6 @@ def _refined_twice(grey: np.ndarray, intrinsics: Intrinsics, mesh, start: np.nda
 def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
     """Settled first, then the most samples on their edges."""
     return fit.settled, fit.inlier_share * fit.samples
-
-
-def _turned(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
-    """``obj2cam`` with the camera turned about its centre so the image moves by ``shift_px`` (2,)."""
-    turn = Rotation.from_rotvec([-shift_px[1] / intrinsics.fv, shift_px[0] / intrinsics.fu, 0.0]).as_matrix()
-    out = obj2cam.copy()
-    out[:3, :3] = turn @ obj2cam[:3, :3]
-    out[:3, 3] = turn @ obj2cam[:3, 3]
-    return out
 
 
 def _robust_fit(detections: dict, points: np.ndarray, intrinsics: Intrinsics, prior: np.ndarray) -> tuple[np.ndarray | None, dict[int, bool]]:

@@ -1,15 +1,19 @@
-"""Where to start the edge refinement: poses around the shifted model pose, ranked by how well the
-target's edges lie on the image's (truncated chamfer distance).
+"""Where to start the edge refinement: camera poses within the robot's error of the modelled one,
+ranked by how well the target's edges lie on the image's (truncated chamfer distance).
 
-The 2D shift of :mod:`calib_core.vision.edge_alignment` is a turn of the camera about its centre. A
-robot's error also moves the camera's centre, and close to the target that moves its near and far
-edges by different amounts (parallax): at the paper's task location, 177 mm from the fixture, the pin
-stands 15 px away from where the shift puts it while the plate's outline fits, and the edge refinement
-settles with half its samples on the plate, 2.4 mm from the true pose. So the camera's centre is
-searched too: moved across and along the line of sight by up to ``reach_mm``, turned back so the
-target's middle stays where the shift put it, and rolled about that line. Each pose is scored by the mean distance of its edge samples from the
-image's edges (Canny, truncated at :data:`TRUNCATE_PX`), all poses in one vectorised projection; the
-best few, a grid step apart, are where the refinement starts.
+A robot's error moves the camera's centre (up to ``reach_mm``) and turns it (up to ``reach_deg``).
+Far from the target both look alike, a shift of the image; close to it the move also shifts near and
+far edges by different amounts (parallax): at the paper's task location, 177 mm from the fixture, a
+shift that lays the plate's outline on the image leaves the pin 15 px off, and the edge refinement
+settled from there with half its samples on the plate, 2.4 mm from the true pose. A 2D shift found
+first also locks onto the wrong edges once the error reaches 100 px (twice the typical robot error,
+that close), and a search around it inherits that. So the search is over the camera itself: its centre
+on a grid over the reach (across and along the line of sight), a roll about the line of sight, and the
+turn of its line of sight, which is nearly a shift of the image, scored as one (a grid of pixel
+offsets over ``reach_deg``, added to each centre's projection). Every candidate is scored by the mean
+distance of the target's edge samples from the image's edges (Canny, truncated at
+:data:`TRUNCATE_PX`); the best few that differ in the image by more than a few pixels are where the
+refinement starts.
 """
 
 from __future__ import annotations
@@ -20,83 +24,81 @@ from scipy.spatial.transform import Rotation
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
 
-TRUNCATE_PX = 20.0
-"""The distance map's cap: wide enough to rank poses 10-20 px apart, one far edge costs no more than this."""
+TRUNCATE_PX = 40.0
+"""The distance map's cap (px): wide enough that a pose 30 px from the target still sees its way down
+(at 20 px the landscape was flat between the grid's points, 5 mm apart at 155 mm), and one far edge
+costs no more than this."""
 ROLL_DEG = 2.0
 """The largest roll about the line of sight searched: about three times a typical robot's orientation error."""
 _LATERAL_STEPS = 9
 _DEPTH_STEPS = 5
 _ROLL_STEPS = 5
-_MAX_SAMPLES = 400
+_TURN_STEPS = 7
+_MAX_SAMPLES = 150
+_DISTINCT_PX = 6.0
 
 
-def moved_cameras(obj2cam: np.ndarray, centre_mm: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndarray) -> np.ndarray:
-    """``obj2cam`` (4, 4) with the camera's centre moved by each of ``shifts_mm`` (H, 3) (camera axes),
-    turned so the point ``centre_mm`` (3,) (camera frame) stays on its line of sight, then rolled by
-    ``rolls_deg`` (H,) about that line: (H, 4, 4)."""
-    a = centre_mm / np.linalg.norm(centre_mm)
-    b = centre_mm[None] - shifts_mm
-    b /= np.linalg.norm(b, axis=1, keepdims=True)
-    axis = np.cross(b, a)
-    angle = np.arctan2(np.linalg.norm(axis, axis=1), b @ a)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        unit = np.where(np.linalg.norm(axis, axis=1, keepdims=True) > 1e-15, axis / np.linalg.norm(axis, axis=1, keepdims=True), 0.0)
-    turn = Rotation.from_rotvec(np.radians(rolls_deg)[:, None] * a[None]) * Rotation.from_rotvec(unit * angle[:, None])
+def turned_camera(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """``obj2cam`` (4, 4) with the camera turned about its centre so the image moves by ``shift_px`` (2,)
+    (to first order: exact at the image's centre)."""
+    turn = Rotation.from_rotvec([-shift_px[1] / intrinsics.fv, shift_px[0] / intrinsics.fu, 0.0]).as_matrix()
+    out = obj2cam.copy()
+    out[:3, :3] = turn @ obj2cam[:3, :3]
+    out[:3, 3] = turn @ obj2cam[:3, 3]
+    return out
+
+
+def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndarray) -> np.ndarray:
+    """``obj2cam`` (4, 4) with the camera's centre moved by each of ``shifts_mm`` (H, 3) (camera axes)
+    and the camera rolled by ``rolls_deg`` (H,) about its optical axis: (H, 4, 4)."""
     moved = np.tile(np.eye(4), (len(shifts_mm), 1, 1))
-    moved[:, :3, :3] = turn.as_matrix()
+    moved[:, :3, :3] = Rotation.from_rotvec(np.radians(rolls_deg)[:, None] * np.array([0.0, 0.0, 1.0])).as_matrix()
     moved[:, :3, 3] = -np.einsum("hij,hj->hi", moved[:, :3, :3], shifts_mm)
     return moved @ obj2cam
 
 
-def _costs(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """The mean truncated distance (H,) of the samples (m, 3) seen from each pose (H, 4, 4)."""
-    pts = np.einsum("hij,nj->hni", poses[:, :3, :3], samples_mm) + poses[:, None, :3, 3]
-    uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(poses), -1, 2)
+def _scores(distance: np.ndarray, uv: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Mean truncated distance (H, S) of the pixels ``uv`` (H, m, 2) moved by each of ``offsets`` (S, 2)."""
     h, w = distance.shape
-    u = np.rint(np.nan_to_num(uv[..., 0], nan=-1.0)).astype(np.int64)
-    v = np.rint(np.nan_to_num(uv[..., 1], nan=-1.0)).astype(np.int64)
+    u = np.rint(np.nan_to_num(uv[:, None, :, 0], nan=-1e6) + offsets[None, :, None, 0]).astype(np.int64)
+    v = np.rint(np.nan_to_num(uv[:, None, :, 1], nan=-1e6) + offsets[None, :, None, 1]).astype(np.int64)
     inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
-    return np.where(inside, distance[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)], TRUNCATE_PX).mean(axis=1)
+    return np.where(inside, distance[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)], TRUNCATE_PX).mean(axis=2)
 
 
-def _grid(reach_mm: float, roll_deg: float, steps: tuple[int, int, int]) -> np.ndarray:
-    lateral = np.linspace(-reach_mm, reach_mm, steps[0])
-    depth = np.linspace(-reach_mm, reach_mm, steps[1])
-    rolls = np.linspace(-roll_deg, roll_deg, steps[2])
-    return np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
-
-
-def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, obj2cam: np.ndarray, reach_mm: float, keep: int = 3) -> list[np.ndarray]:
+def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, obj2cam: np.ndarray, reach_mm: float, reach_deg: float,
+                keep: int = 3) -> list[np.ndarray]:
     """The ``keep`` best poses (4, 4) to start an edge refinement from, best first, near ``obj2cam``.
 
     ``distance`` (h, w): each pixel's distance to the nearest image edge, truncated at
     :data:`TRUNCATE_PX` (:func:`calib_core.vision.edge_alignment.edge_distance_map`);
     ``samples_mm`` (m, 3): points on the target's edges that the camera sees (object frame);
-    ``reach_mm``: how far the camera's centre may be from ``obj2cam``'s. A grid over that reach, then
-    a grid of half its steps around each of the best; candidates closer than a step to a better one
-    are left out. The unmoved pose wins a tie: it is what the shift found.
+    ``reach_mm``, ``reach_deg``: how far the camera's centre and its line of sight may be from
+    ``obj2cam``'s. Candidates whose edges lie within a few pixels of a better one's are left out.
     """
     if len(samples_mm) < 10:
         return [obj2cam]
     if len(samples_mm) > _MAX_SAMPLES:
         samples_mm = samples_mm[np.random.default_rng(0).choice(len(samples_mm), _MAX_SAMPLES, replace=False)]
-    centre = np.median(samples_mm @ obj2cam[:3, :3].T + obj2cam[:3, 3], axis=0)
-
-    def poses_at(grid: np.ndarray) -> np.ndarray:
-        return moved_cameras(obj2cam, centre, grid[:, :3], grid[:, 3])
-
-    coarse = _grid(reach_mm, ROLL_DEG, (_LATERAL_STEPS, _DEPTH_STEPS, _ROLL_STEPS))
-    cost = _costs(distance, intrinsics, samples_mm, poses_at(coarse))
-    cost[np.flatnonzero((np.abs(coarse) < 1e-12).all(axis=1))] -= 1e-6
-    steps = np.array([2 * reach_mm / (_LATERAL_STEPS - 1)] * 2 + [2 * reach_mm / (_DEPTH_STEPS - 1), 2 * ROLL_DEG / (_ROLL_STEPS - 1)])
-    fine_offsets = _grid(1.0, 1.0, (3, 3, 3)) * 0.5 * steps
-    best = coarse[np.argsort(cost, kind="stable")[:keep]]
-    grid = np.concatenate([coarse, (best[:, None, :] + fine_offsets[None]).reshape(-1, 4)])
-    cost = np.concatenate([cost, _costs(distance, intrinsics, samples_mm, poses_at(grid[len(coarse):]))])
-    chosen: list[int] = []
-    for i in np.argsort(cost, kind="stable"):
-        if all(np.max(np.abs(grid[i] - grid[j]) / steps) >= 0.99 for j in chosen):
-            chosen.append(int(i))
+    lateral = np.linspace(-reach_mm, reach_mm, _LATERAL_STEPS)
+    depth = np.linspace(-reach_mm, reach_mm, _DEPTH_STEPS)
+    rolls = np.linspace(-ROLL_DEG, ROLL_DEG, _ROLL_STEPS)
+    grid = np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
+    poses = moved_cameras(obj2cam, grid[:, :3], grid[:, 3])
+    pts = np.einsum("hij,nj->hni", poses[:, :3, :3], samples_mm) + poses[:, None, :3, 3]
+    uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
+    turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
+    t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
+    offsets = np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2)
+    cost = np.concatenate([_scores(distance, chunk, offsets) for chunk in np.array_split(uv, max(1, len(uv) // 128))])  # (H, S)
+    # the unmoved pose wins a tie
+    cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
+    chosen: list[tuple[int, int]] = []
+    flat = np.argsort(cost, axis=None, kind="stable")
+    for i, s in zip(*np.unravel_index(flat[: 50 * keep], cost.shape)):
+        seen = uv[i] + offsets[s]
+        if all(np.nanmean(np.linalg.norm(seen - (uv[j] + offsets[k]), axis=1)) > _DISTINCT_PX for j, k in chosen):
+            chosen.append((int(i), int(s)))
         if len(chosen) == keep:
             break
-    return list(poses_at(grid[chosen]))
+    return [turned_camera(poses[i], offsets[s], intrinsics) for i, s in chosen]
