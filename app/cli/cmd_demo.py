@@ -19,8 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=Path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
-    parser.add_argument("--method", choices=("picks", "find-points", "edges"), default="picks",
-                        help="how each look is made: the operator's picks (default), Find points and Accept all, or Find points and Calibrate on edges")
+    parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
+                        help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,12 +1,14 @@
 """``videocal demo``: drive the real window through a whole calibration at a task location of any cell
 (by default the bundled cell and the paper's task location).
 
-The simulated operator clicks the panes' widgets like a person would: at the task location it picks each
-feature in the virtual camera, zooms the camera image around the same feature and clicks it (sub-pixel
-refinement on corners, clicked again without it when the refined cross-hair leaves the corner), accepts, calibrates and stores the correction; the features are those of the task's
-component that the camera sees; then it moves to the corrected
-location, looks again the same way, stores the refined correction and moves there. Where the
-features are in the camera image it learns from the test bed's truth, as a person learns it by looking.
+The simulated operator clicks the panes' widgets like a person would. At the task location it presses
+Find points (F6), Accept all and Calibrate (``method="find-points"``, the default), or Calibrate on
+edges (``"edges"``), or picks each feature by hand (``"picks"``): in the virtual camera, then the same
+feature in the zoomed camera image (sub-pixel refinement on corners, clicked again without it when the
+refined cross-hair leaves the corner), accepts and calibrates; where the features are in the camera
+image the hand learns from the test bed's truth, as a person learns it by looking. Either way it stores
+the correction, moves to the corrected location, looks again the same way, stores the refined
+correction and moves there.
 A PNG of the window is written after each step, ``report.json`` with the figures and ``workspace.json`` with the
 pairs and the corrections (for ``videocal export``).
 """
@@ -84,10 +86,10 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
     _click(view, *view.image_to_widget(u, v))
 
 
-METHODS = ("picks", "find-points", "edges")
+METHODS = ("find-points", "picks", "edges")
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "picks") -> dict:
+def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points") -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
     from calib_core.workcell import load_workcell

@@ -5,13 +5,17 @@ import subprocess
 import sys
 
 import cv2
+import pytest
 
 
-def test_demo_writes_screenshots_and_a_report(tmp_path):
+@pytest.mark.parametrize("method", [None, "picks"], ids=["find points (the default)", "picks by hand"])
+def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--out", str(out), "--scale", "0.5"], capture_output=True, text=True, timeout=300)
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--out", str(out), "--scale", "0.5", *(["--method", method] if method else [])],
+                         capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
+    assert report["method"] == (method or "find-points")
     assert report["status"] == "ok" and report["pairs"] >= 6
     for key in ("estimated_displacement", "std", "true_displacement", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "rms_px"):
         assert key in report
