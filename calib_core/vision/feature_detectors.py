@@ -6,9 +6,12 @@ reason an operator can act on. Pixels are (u, v) with (0, 0) the centre of the t
 - corners: Harris corners in the window (``cv2.goodFeaturesToTrack``), the one nearest the prediction,
   refined by ``cv2.cornerSubPix``; when the refinement walks more than 1.5 px (three faces meeting),
   the Harris position is kept with a lower confidence;
-- circles: the strongest gradient along the normals of the predicted ellipse (the projected circle,
-  shifted), an ellipse fitted to those edge points, and its centre moved by the perspective offset
-  (the image of the circle's centre minus the centre of the imaged ellipse, from the model);
+- circles, with the model's view at the pose the edges found: the rim's edges found along its normals in
+  the image and in the model's view, the rim moved as a whole by their differences
+  (:func:`detect_circle_against_model`); without a model's view, the strongest gradient along the
+  normals of the predicted ellipse (the projected circle, shifted), an ellipse fitted to those edge
+  points, and its centre moved by the perspective offset (the image of the circle's centre minus the
+  centre of the imaged ellipse, from the model);
 - points: the centroid of the blob at the prediction, darker or brighter than its surroundings.
 """
 
@@ -143,6 +146,50 @@ def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.nda
     rms = float(np.sqrt(np.mean(residual**2)))
     predicted_centre = np.array(cv2.fitEllipse(rim_px.astype(np.float32))[0]) + centre_offset_px
     return Detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)))
+
+
+def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.ndarray, rim_px: np.ndarray, centre_px: np.ndarray, search_px: float = 2.0) -> Detection | NotDetected:
+    """The image of a circle's centre, measured against the model's view of it.
+
+    ``rim_px`` (m, 2): the rim projected at the pose the edges found (a closed polygon, in order);
+    ``centre_px`` (2,): the circle's centre projected at that pose (perspective included);
+    ``magnitude`` and ``expected_magnitude`` (h, w): the gradient magnitude of the camera's image and of
+    the model's view rendered at that pose. Along each rim point's normal the strongest edge is found in
+    both, and the offsets are taken as differences, the image's edge less the model's: where the model's
+    own strongest edge is not exactly the rim (a boss's base circle or its side's outline within the
+    window) both are measured on the same edge (an ellipse fitted to the image's edges alone came out
+    0.5-0.9 px off, outward, on every boss). The differences move the rim as a whole (two unknowns, least
+    squares on the normal offsets, outliers dropped), and the centre with it: the perspective is the
+    model's, the place the image's. A point whose model edge lies more than 1.5 px from the rim is left
+    out (its two searches can lock onto different edges: beside the gripper's fingers a boss came out
+    up to 2.5 px off)."""
+    tangent = np.roll(rim_px, -1, axis=0) - np.roll(rim_px, 1, axis=0)
+    normals = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-9)
+    found, strength, inside = search_normals(magnitude, rim_px, normals, search_px)
+    modelled, model_strength, _ = search_normals(expected_magnitude, rim_px, normals, search_px)
+    model_offset = np.einsum("ij,ij->i", modelled - rim_px, normals)
+    usable = inside & (model_strength >= 12.0) & (np.abs(model_offset) <= 1.5)
+    if usable.sum() < 6:
+        return NotDetected(f"its rim is outside the image or stands beside another edge in the model's view ({int(usable.sum())} of {len(rim_px)} rim points clear)")
+    floor = max(8.0, 0.35 * float(np.median(strength[usable])))
+    strong = usable & (strength >= floor)
+    if strong.sum() < 6:
+        return NotDetected(f"its rim has too little contrast ({int(strong.sum())} of {len(rim_px)} edge points)")
+    n = normals[strong]
+    r = np.einsum("ij,ij->i", found[strong] - rim_px[strong], n) - model_offset[strong]
+    for _ in range(3):
+        A = n.T @ n
+        if np.linalg.eigvalsh(A)[0] < 0.05 * len(n):
+            return NotDetected("too short an arc of its rim shows")
+        delta = np.linalg.solve(A, n.T @ r)
+        residual = r - n @ delta
+        keep = np.abs(residual) < max(0.3, 3.0 * 1.4826 * float(np.median(np.abs(residual))))
+        if keep.all() or keep.sum() < 6:
+            break
+        n, r = n[keep], r[keep]
+    rms = float(np.sqrt(np.mean(residual**2)))
+    coverage = len(n) / len(rim_px)
+    return Detection(centre_px + delta, float(np.clip(coverage / 0.5, 0, 1) * np.exp(-rms / 0.5)))
 
 
 def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: list[np.ndarray], search_px: float = 3.0, magnitude: np.ndarray | None = None) -> Detection | NotDetected:
