@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QFont, QImage, QMouseEvent, QPainter, QPen, QWheelEvent
+from PySide6.QtGui import QColor, QFont, QFontMetricsF, QImage, QMouseEvent, QPainter, QPen, QWheelEvent
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 
@@ -199,6 +199,8 @@ class ImageView(QWidget):
         font.setPointSizeF(9.0)
         font.setBold(True)
         p.setFont(font)
+        metrics = QFontMetricsF(font)
+        taken: list[QRectF] = []  # labels already placed: a crowded corner of the image keeps them readable
         for u, v, label, color in self.overlay.points:
             x, y = self.image_to_widget(u, v)
             p.setPen(QPen(QColor(0, 0, 0, 160), 3.0))
@@ -207,11 +209,13 @@ class ImageView(QWidget):
             p.drawEllipse(QPointF(x, y), 5.0, 5.0)
             p.drawLine(QPointF(x - 8, y), QPointF(x - 3, y))
             p.drawLine(QPointF(x + 3, y), QPointF(x + 8, y))
-            if label:
+            box = _free_label_box(metrics, x, y, label, taken) if label else None
+            if box is not None:
+                taken.append(box)
                 p.setPen(QColor(0, 0, 0))
-                p.drawText(QPointF(x + 8, y - 7), label)
+                p.drawText(box.bottomLeft() + QPointF(1, -metrics.descent() + 1), label)
                 p.setPen(color)
-                p.drawText(QPointF(x + 7, y - 8), label)
+                p.drawText(box.bottomLeft() + QPointF(0, -metrics.descent()), label)
         if self._mouse is not None and self.underMouse():
             self._paint_crosshair(p)
             if self.loupe:
@@ -336,3 +340,15 @@ class ImageView(QWidget):
     def leaveEvent(self, event) -> None:
         self._mouse = None
         self.update()
+
+
+def _free_label_box(metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF]) -> QRectF | None:
+    """Where a mark's label at widget (x, y) px goes: above right, below right, above left or below left
+    of the mark, the first place no placed label overlaps; ``None`` when all are taken (the mark is drawn
+    without it, its name is in the pairs table and the Find points list)."""
+    w, h = metrics.horizontalAdvance(label) + 2, metrics.height()
+    for dx, dy in ((7, -8 - h), (7, 8), (-7 - w, -8 - h), (-7 - w, 8)):
+        box = QRectF(x + dx, y + dy, w, h)
+        if not any(box.intersects(other) for other in taken):
+            return box
+    return None
