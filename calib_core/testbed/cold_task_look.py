@@ -1,7 +1,7 @@
 """The last step of the cold cell's chain: one look at a task location on the calibrated model.
 
-The calibrated robot (its joints, camera and tool) goes to the task's approach; Find points' edge
-refinement measures the task's component through the calibrated intrinsics (Calibrate on edges); the
+The calibrated robot (its joints, camera and tool) goes to the task location (or its approach); Find
+points' edge refinement measures the task's component through the calibrated intrinsics (Calibrate on edges); the
 end effector's displacement there is the correction (``Δ``, :mod:`calib_core.calibration.end_effector`);
 the robot is commanded to ``Δ^-1 . target`` through the calibrated model. The truth places the robot
 and renders the frame, and scores where the true TCP ends up: nothing else reads it.
@@ -26,9 +26,11 @@ from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 
 
-def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0, model_covariance=None, placement_sigma_mm: float = 0.0) -> dict:
+def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0, model_covariance=None, placement_sigma_mm: float = 0.0,
+                 from_where: str = "task") -> dict:
     """Figures of one look at ``task_name`` (default: the cell's first task) with the calibrated
-    ``robot`` and ``intrinsics``: the TCP's true error at the task commanded through the calibrated
+    ``robot`` and ``intrinsics``, made from the task location itself (``from_where="task"``, as the
+    paper and ``videocal demo`` do) or from its approach (``"approach"``): the TCP's true error at the task commanded through the calibrated
     model without the look and with it, the look's own 1-sigma, and whether the error is within 3 sigma.
     ``model_covariance(q_deg)``: the calibrated model's TCP covariance (6, 6: mm, deg) at joints; with
     it the look is also fused with the model (:mod:`calib_core.calibration.look_fusion`), the
@@ -37,7 +39,11 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     task = cell.task(task_name) if task_name else next(iter(cell.task_locations.values()))
     item = cell.component(task.component)
     home = np.asarray(cell.home_joints_deg, dtype=float)
+    if from_where not in ("task", "approach"):
+        raise ValueError(f"look_at_task: from_where must be 'task' or 'approach', not {from_where!r}")
     q_approach = solve_ik(robot, task.approach2base, home).q_deg
+    if from_where == "task":
+        q_approach = solve_ik(robot, task.tcp2base, q_approach).q_deg
     bed.joints_deg = q_approach
     camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 7)
     view = ModelView(intrinsics)
@@ -50,7 +56,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     finally:
         camera.close()
         view.close()
-    out = {"task": task.name, "found": bool(found.edges is not None and found.edges.settled), "message": found.message}
+    out = {"task": task.name, "looked_from": from_where, "found": bool(found.edges is not None and found.edges.settled), "message": found.message}
     true_item = next((c for c in bed.true_components or () if c.name == item.name), item)
     task_true = true_item.item2world @ invert(item.item2world) @ task.tcp2base
 
