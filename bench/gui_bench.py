@@ -159,6 +159,14 @@ def main() -> str:
         lat.append(time.monotonic() - t_arrive)
     # 4. A pick to the solved overlays on screen: the last 2D pick of a complete set, then Calibrate.
     _spin(app, 3.0)  # the robot arrives at the approach pose
+    # the first pick holds the newest frame: wait, as the core does, until that frame's joints are known and still
+    deadline = time.monotonic() + 10.0
+    while time.monotonic() < deadline:
+        frame = win.camera.last_frame_received
+        if frame is not None and wb.observations.stillness(frame).settled:
+            break
+        app.processEvents()
+        time.sleep(0.005)
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     pick_ms, edges_ms = [], []

@@ -41,6 +41,8 @@ class Stillness:
     still_for_s: float
     speed_deg_s: float = 0.0
     joint: int | None = None
+    pending: bool = False
+    """Not judged yet: the samples around the time have not arrived (a frame newer than the newest sample)."""
 
 
 @dataclass(frozen=True)
@@ -162,7 +164,7 @@ class JointHistory:
             return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
         if times[-1] < t_s:
             # Judged before the samples around the capture have arrived, a frame would be judged on older ones.
-            return Stillness(False, f"waiting for the joint samples of the frame's time (the newest is {t_s - times[-1]:.2f} s older)", 0.0)
+            return Stillness(False, f"waiting for the joint samples of the frame's time (the newest is {t_s - times[-1]:.2f} s older)", 0.0, pending=True)
         end = bisect.bisect_right(self._t, t_s)  # samples at or before the capture
         stop = min(end + 1, len(times))  # and the one after it: the motion across the capture counts
         q = np.array([self._q[k] for k in range(stop)])

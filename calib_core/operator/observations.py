@@ -40,10 +40,11 @@ class Observations:
         self.history = history
         self.source = source
         self.latest: Frame | None = None
+        self.previous: Frame | None = None
         self.still: HeldFrame | None = None
 
     def observe(self, frame: Frame) -> None:
-        self.latest = frame
+        self.previous, self.latest = self.latest, frame
 
     def stillness(self, frame: Frame) -> Stillness:
         return self.history.stillness(frame.t_host_s)
@@ -65,8 +66,13 @@ class Observations:
         return ViewStamp(int(frame.index), float(frame.t_host_s), tuple(float(v) for v in at.joints_deg), float(at.stamp_gap_s), captured_at, self.source)
 
     def hold(self, frame: Frame | None = None) -> HeldFrame:
-        """Hold ``frame`` (default: the newest) for picking."""
-        frame = frame if frame is not None else self.latest
+        """Hold ``frame`` for picking. By default the newest; when its joint samples have not arrived
+        yet (the joint stream lags a frame by up to a sample period, 20 ms at 50 Hz), the one before
+        it: a click on the image must not be refused for that."""
+        if frame is None:
+            frame = self.latest
+            if frame is not None and self.previous is not None and self.stillness(frame).pending:
+                frame = self.previous
         if frame is None:
             raise OperatorError("no camera image yet: start the camera (Execute > Live) or open a recording")
         self.still = HeldFrame(frame, self.stamp(frame))

@@ -161,3 +161,33 @@ def test_pairs_without_a_robot_pose_are_not_solved(cell_and_site):
         core.session.pick_2d((10.0 * k, 5.0))  # a script's picks, outside the core's frames
     with pytest.raises(CalibrationError, match="pairs 1, 2, 3, 4 carry no robot pose"):
         core.calibrate()
+
+
+def test_a_pick_on_a_frame_newer_than_the_joint_stream_holds_the_frame_before_it(cell_and_site):
+    """The joint stream lags the camera by up to a sample period: a click that lands when the newest
+    frame is 10 ms newer than the newest sample is made on the frame before it, not refused. A frame
+    of a moving robot is refused all the same."""
+    cell, site = cell_and_site
+    core = OperatorCore(cell, site)
+    q = _task_joints(core)
+    t_last = still_for(core, joints_deg=q)
+    before = frame_now(core, index=1, t_s=t_last - 0.005)
+    frame_now(core, index=2, t_s=t_last + 0.010)  # its joint samples are still on the way
+    fixture = core.workcell.component(core.task.component)
+    p = apply(fixture.item2world, fixture.features["pin_tip"])
+    core.pick_model_point(fixture.name, "pin_tip", p)
+    core.pick_image_point((320.0, 240.0))
+    assert core.observations.still.frame is before
+    assert np.allclose(core.session.pairs.get(core.current_pair).view.joints_deg, q, atol=1e-6)
+    core.close()
+    # moving: the newest frame is judged (the robot moved before it), and refused with the reason
+    core = OperatorCore(cell, site)
+    t0 = still_for(core, joints_deg=q)
+    for k in range(1, 20):
+        sample(core, q + 0.5 * k, t0 + 0.02 * k)
+    frame_now(core, index=1, t_s=t0 + 0.30)
+    frame_now(core, index=2, t_s=t0 + 0.38)
+    core.pick_model_point(fixture.name, "pin_tip", p)
+    with pytest.raises(NotSettledError, match="frame 2"):
+        core.pick_image_point((320.0, 240.0))
+    core.close()
