@@ -183,13 +183,14 @@ class _Detectors:
                 far = project_points(np.array(ends), obj2cam, self.intrinsics)
                 if self.expected is not None:  # only the arms along which the model shows an edge
                     far = far[[self._arm_shows_edge(uv, f, obj2cam) for f in far]]
-                found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude)
+                found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
                 if self.expected is not None and isinstance(found, Detection):
                     # The same lines in the model's view at this pose: where its own arms meet well off
                     # the corner (a neighbouring edge within the window: a plate's back top edge 3 px
                     # behind its front one), the image's do alike, and that much is taken off. Nearer
                     # than _MODEL_BIAS_PX it is the rendering's own aliasing, which would only add noise.
-                    modelled = detect_corner_from_edges(self.expected_image(obj2cam), uv, list(far), search_px=radius, magnitude=self.expected_magnitude(obj2cam))
+                    modelled = detect_corner_from_edges(self.expected_image(obj2cam), uv, list(far), search_px=radius, magnitude=self.expected_magnitude(obj2cam),
+                                                        lens=self.intrinsics)
                     if isinstance(modelled, Detection) and np.linalg.norm(modelled.uv_px - uv) > _MODEL_BIAS_PX:
                         return Detection(found.uv_px - (modelled.uv_px - uv), min(found.confidence, modelled.confidence))
                 if isinstance(found, Detection) or self.expected is not None:
