@@ -209,7 +209,7 @@ class ImageView(QWidget):
             p.drawEllipse(QPointF(x, y), 5.0, 5.0)
             p.drawLine(QPointF(x - 8, y), QPointF(x - 3, y))
             p.drawLine(QPointF(x + 3, y), QPointF(x + 8, y))
-            box = _free_label_box(metrics, x, y, label, taken) if label else None
+            box = _free_label_box(metrics, x, y, label, taken, QRectF(self.rect())) if label else None
             if box is not None:
                 taken.append(box)
                 p.setPen(QColor(0, 0, 0))
@@ -342,13 +342,13 @@ class ImageView(QWidget):
         self.update()
 
 
-def _free_label_box(metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF]) -> QRectF | None:
+def _free_label_box(metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF], bounds: QRectF | None = None) -> QRectF | None:
     """Where a mark's label at widget (x, y) px goes: above right, below right, above left or below left
-    of the mark, the first place no placed label overlaps; ``None`` when all are taken (the mark is drawn
-    without it, its name is in the pairs table and the Find points list)."""
+    of the mark, the first place no placed label overlaps, inside ``bounds`` (the widget) where one is;
+    ``None`` when all are taken (the mark is drawn without it, its name is in the pairs table and the
+    Find points list)."""
     w, h = metrics.horizontalAdvance(label) + 2, metrics.height()
-    for dx, dy in ((7, -8 - h), (7, 8), (-7 - w, -8 - h), (-7 - w, 8)):
-        box = QRectF(x + dx, y + dy, w, h)
-        if not any(box.intersects(other) for other in taken):
-            return box
-    return None
+    free = [box for box in (QRectF(x + dx, y + dy, w, h) for dx, dy in ((7, -8 - h), (7, 8), (-7 - w, -8 - h), (-7 - w, 8)))
+            if not any(box.intersects(other) for other in taken)]
+    inside = [box for box in free if bounds is None or bounds.contains(box)]
+    return (inside or free or [None])[0]

@@ -2,6 +2,7 @@
 the pin's tip and a plate corner within 30 px at the task location), no label hides another."""
 
 import numpy as np
+from PySide6.QtCore import QRectF
 from PySide6.QtGui import QColor, QFont, QFontMetricsF, QImage
 
 from app.gui.image_view import ImageView, Overlay, _free_label_box
@@ -19,6 +20,10 @@ def test_labels_of_crowded_marks_take_free_places_and_never_overlap(qapp):
     # a lone mark's label sits above right of it, where it always was
     lone = _free_label_box(metrics, 300, 300, "pin_tip", [])
     assert lone.left() > 300 and lone.bottom() < 300
+    # at the widget's right edge it goes to the left of the mark rather than be cut off
+    bounds = QRectF(0, 0, 320, 240)
+    at_edge = _free_label_box(metrics, 310, 100, "plate_top_right", [], bounds)
+    assert bounds.contains(at_edge) and at_edge.right() < 310
 
 
 def test_a_view_with_crowded_labels_draws_every_mark(qtbot):

@@ -12,10 +12,10 @@ from calib_core.robot import solve_ik
 from calib_core.testbed.sim_camera import CameraLook
 from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
-from calib_core.vision.edge_alignment import align_edges, edge_distance_map, edge_samples_px
-from calib_core.vision.edge_refinement import refine_to_edges
+from calib_core.vision.edge_alignment import edge_distance_map
+from calib_core.vision.edge_refinement import edge_points, refine_to_edges
 from calib_core.vision.find_points import find_points
-from calib_core.vision.pose_hypotheses import turned_camera
+from calib_core.vision.pose_hypotheses import TRUNCATE_PX, rank_starts
 
 TARGET = "oru_1_fixture"
 
@@ -60,8 +60,8 @@ def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
     image, intrinsics, item, model, truth, expected = look
     assert _pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
     grey = image.mean(axis=2).astype(np.uint8)
-    shift = align_edges(edge_samples_px(item.mesh, model, intrinsics), edge_distance_map(grey), 90.0)
-    start = turned_camera(model, shift.offset_px, intrinsics)
+    samples, _, _ = edge_points(item.mesh, model, intrinsics, expected(model).mean(axis=2).astype(np.uint8))
+    start = rank_starts(edge_distance_map(grey, TRUNCATE_PX), intrinsics, samples, model, reach_mm=20.0, reach_deg=1.5)[0]
     fit = refine_to_edges(grey, intrinsics, item.mesh, start, expected=expected(start).mean(axis=2).astype(np.uint8))
     assert fit.converged and fit.samples > 300
     errors = _pixel_errors(item, fit.obj2cam, truth, intrinsics)
