@@ -135,18 +135,10 @@ def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.nda
         rms = float(np.sqrt(np.mean(_ellipse_residual(pts, ellipse) ** 2)))
         return Detection(np.array(ellipse[0]) + centre_offset_px, float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)))
     # a partial rim: the predicted ellipse moved as a whole onto the edge points (two unknowns)
-    n, r = normals[strong], np.einsum("ij,ij->i", points[strong] - rim_px[strong], normals[strong])
-    for _ in range(3):
-        A = n.T @ n
-        if np.linalg.eigvalsh(A)[0] < 0.05 * len(n):
-            return NotDetected("too short an arc of its rim shows")
-        delta = np.linalg.solve(A, n.T @ r)
-        residual = r - n @ delta
-        keep = np.abs(residual) < max(0.5, 3.0 * 1.4826 * float(np.median(np.abs(residual))))
-        if keep.all() or keep.sum() < 6:
-            break
-        n, r = n[keep], r[keep]
-    rms = float(np.sqrt(np.mean(residual**2)))
+    shift = _rim_shift(normals[strong], np.einsum("ij,ij->i", points[strong] - rim_px[strong], normals[strong]), 0.5)
+    if isinstance(shift, NotDetected):
+        return shift
+    delta, rms, _ = shift
     predicted_centre = np.array(cv2.fitEllipse(rim_px.astype(np.float32))[0]) + centre_offset_px
     return Detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)))
 
@@ -178,21 +170,29 @@ def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     strong = usable & (strength >= floor)
     if strong.sum() < 6:
         return NotDetected(f"its rim has too little contrast ({int(strong.sum())} of {len(rim_px)} edge points)")
-    n = normals[strong]
-    r = np.einsum("ij,ij->i", found[strong] - rim_px[strong], n) - model_offset[strong]
+    shift = _rim_shift(normals[strong], np.einsum("ij,ij->i", found[strong] - rim_px[strong], normals[strong]) - model_offset[strong], 0.3)
+    if isinstance(shift, NotDetected):
+        return shift
+    delta, rms, kept = shift
+    return Detection(centre_px + delta, float(np.clip(kept / len(rim_px) / 0.5, 0, 1) * np.exp(-rms / 0.5)))
+
+
+def _rim_shift(normals: np.ndarray, offsets_px: np.ndarray, floor_px: float) -> tuple[np.ndarray, float, int] | NotDetected:
+    """The shift (2,) px that moves rim points along their unit ``normals`` (m, 2) by ``offsets_px``
+    (m,), least squares with points off by more than 3 robust sigmas (at least ``floor_px``) dropped
+    twice at most; with its RMS residual and how many points it kept."""
+    n, r = normals, offsets_px
     for _ in range(3):
         A = n.T @ n
         if np.linalg.eigvalsh(A)[0] < 0.05 * len(n):
             return NotDetected("too short an arc of its rim shows")
         delta = np.linalg.solve(A, n.T @ r)
         residual = r - n @ delta
-        keep = np.abs(residual) < max(0.3, 3.0 * 1.4826 * float(np.median(np.abs(residual))))
+        keep = np.abs(residual) < max(floor_px, 3.0 * 1.4826 * float(np.median(np.abs(residual))))
         if keep.all() or keep.sum() < 6:
             break
         n, r = n[keep], r[keep]
-    rms = float(np.sqrt(np.mean(residual**2)))
-    coverage = len(n) / len(rim_px)
-    return Detection(centre_px + delta, float(np.clip(coverage / 0.5, 0, 1) * np.exp(-rms / 0.5)))
+    return delta, float(np.sqrt(np.mean(residual**2))), len(n)
 
 
 def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: list[np.ndarray], search_px: float = 3.0, magnitude: np.ndarray | None = None,
