@@ -244,22 +244,28 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
 
     candidates = [i for i in range(len(names)) if visible[i]]
     # Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error
-    # moves near and far edges differently: no 2D shift lays them all on the image); from the best few
-    # the edges pull the pose into place, each fit run again from where it got to, with the model's
-    # view and the samples taken afresh there (from a turned start a pin seen end-on can lock its rims
-    # onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right pose at
-    # 0.13 px). The fit with the most samples on their edges wins.
+    # moves near and far edges differently: no 2D shift lays them all on the image); from the best few,
+    # in turn until one settles with most of its samples on their edges, the edges pull the pose into
+    # place. The fit with the most samples on their edges runs again from where it got to, with the
+    # model's view and the samples taken afresh there (from a turned start a pin seen end-on can lock
+    # its rims onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right
+    # pose at 0.13 px).
     samples, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_image(obj2cam_model) if expected is not None else None)
     ranked = rank_starts(edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg)
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
-    edge_fit = None
+    def refined(start_pose: np.ndarray) -> EdgeFit:
+        return refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected=detectors.expected_image(start_pose) if expected is not None else None)
+
+    best = None
     for start_pose in ranked:
-        fit = _refined_twice(grey, intrinsics, item.mesh, start_pose, detectors.expected_image if expected is not None else None)
-        if edge_fit is None or _fit_rank(fit) > _fit_rank(edge_fit):
-            edge_fit = fit
-        if edge_fit.settled and edge_fit.inlier_share >= _CLEAR_SHARE:
+        fit = refined(start_pose)
+        if best is None or _fit_rank(fit) > _fit_rank(best):
+            best = fit
+        if best.settled and best.inlier_share >= _CLEAR_SHARE:
             break
+    again = refined(best.obj2cam)  # the second pass, for the best start only
+    edge_fit = again if again.settled or _fit_rank(again) > _fit_rank(best) else best
     if not edge_fit.settled:
         # Not there, or the edges did not settle: detections in wide windows would lock onto neighbouring
         # edges, and a wrong proposal costs the operator more than a pick by hand.
@@ -307,14 +313,6 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
                if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
     return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit)
-
-
-def _refined_twice(grey: np.ndarray, intrinsics: Intrinsics, mesh, start: np.ndarray, expected_image) -> EdgeFit:
-    """The edge refinement from ``start``, then again from where it got to (the second one kept when it
-    settles); ``expected_image(obj2cam)`` the model's view there, or ``None``."""
-    first = refine_to_edges(grey, intrinsics, mesh, start, expected=expected_image(start) if expected_image else None)
-    second = refine_to_edges(grey, intrinsics, mesh, first.obj2cam, expected=expected_image(first.obj2cam) if expected_image else None)
-    return second if second.settled or _fit_rank(second) > _fit_rank(first) else first
 
 
 def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
