@@ -32,7 +32,8 @@ def _look_rows(seed: int) -> list[str]:
 
     rows = []
     for where in ("task", "approach"):
-        look = look_at_task(bed, run.robot, run.result.intrinsics, tasks[0], model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM, from_where=where)
+        look = look_at_task(bed, run.robot, run.result.intrinsics, tasks[0], model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM, from_where=where,
+                            tool=run.tool)
         model = look["calibrated_model_only_mm_deg"]
         if "after_look_mm_deg" not in look:
             rows.append(f"| {seed} | {where} | {model[0]:.3f} mm, {model[1]:.4f} deg | not found: {look['message']} | | | |")

@@ -74,7 +74,8 @@ def _cold(args: argparse.Namespace) -> int:
     def model_covariance(q):
         return tcp_covariance_from_camera(pose_covariance(run.result, q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
 
-    look = look_at_task(bed, run.robot, run.result.intrinsics, look_task, model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM, from_where="task")
+    look = look_at_task(bed, run.robot, run.result.intrinsics, look_task, model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM, from_where="task",
+                        tool=run.tool)
     i = run.intrinsics
     report = {
         "cell": "cold (calib_core/testbed/cold_cell.py, seed 0)",

@@ -3,6 +3,8 @@ identify, apply the result to the cell's robot (and take it back), save it."""
 
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 
 import numpy as np
@@ -127,7 +129,13 @@ class RobotCalibrating:
         q = context.joints_deg
         cam2base = self.robot.fk(q, "camera")
         model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, invert(cam2base) @ self.robot.fk(q, "tcp"))
-        return fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
+        fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
+        tool = getattr(self, "measured_tool", None)
+        tool_covariance = tool.covariance_in_base(cam2base) if tool is not None else None
+        if tool_covariance is None:
+            return fused
+        # look and model share the tool's error (the grasped fixtures' survey): added after the fusion
+        return dataclasses.replace(fused, covariance=fused.covariance + tool_covariance)
 
     def keep_robot_before_calibration(self) -> None:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
@@ -145,6 +153,7 @@ class RobotCalibrating:
         self.robot.set_frame_placement("tcp", tcp)
         self._robot_before_calibration = None
         self.applied_robot_calibration = None
+        self.measured_tool = None
         if getattr(self, "_intrinsics_before_calibration", None) is not None:
             self.use_intrinsics(self._intrinsics_before_calibration)
             self._intrinsics_before_calibration = None

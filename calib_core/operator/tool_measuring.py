@@ -55,7 +55,12 @@ class ToolMeasuring:
 
         if not self.grasps:
             raise OperatorError("record a grasp first: close the gripper on a task location's pin in compliance, then Record grasp")
-        tool = camera_to_tool(self.robot, self.grasps)
+        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+
+        calibration = getattr(self, "applied_robot_calibration", None)
+        tool = camera_to_tool(self.robot, self.grasps, placement_sigma_mm=SURVEY_SIGMA_MM,
+                              camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None)
+        self.measured_tool = tool
         placed = with_tool(self.robot, tool.tcp2cam)
         self.keep_robot_before_calibration()
         self.robot.set_frame_placement("tcp", placed.frame_placement("tcp"))

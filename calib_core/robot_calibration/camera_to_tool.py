@@ -43,23 +43,53 @@ class Grasp:
 @dataclass(frozen=True)
 class CameraToTool:
     """``tcp2cam`` (4, 4) mm, the mean of ``per_grasp``; ``spread_mm``/``spread_deg`` the largest
-    distance of a grasp's estimate from the mean (0 for one grasp: no check of its own)."""
+    distance of a grasp's estimate from the mean (0 for one grasp: no check of its own);
+    ``covariance`` (6, 6: the TCP's position mm and rotation deg, camera axes) when the grasps' own
+    uncertainty was given, else ``None``."""
 
     tcp2cam: np.ndarray
     per_grasp: dict[str, np.ndarray]
     spread_mm: float
     spread_deg: float
+    covariance: np.ndarray | None = None
+
+    def covariance_in_base(self, cam2base: np.ndarray) -> np.ndarray | None:
+        """The tool's covariance (6, 6: mm, deg) in the base frame's axes with the camera at ``cam2base``."""
+        if self.covariance is None:
+            return None
+        R = np.kron(np.eye(2), cam2base[:3, :3])
+        return R @ self.covariance @ R.T
 
 
-def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "camera") -> CameraToTool:
-    """``tcp2cam`` from ``grasps`` with ``robot`` (calibrated) placing the camera."""
+def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "camera", *, placement_sigma_mm: float | None = None,
+                   camera_covariance=None) -> CameraToTool:
+    """``tcp2cam`` from ``grasps`` with ``robot`` (calibrated) placing the camera.
+
+    With ``placement_sigma_mm`` (the survey's 1-sigma per axis of each grasped fixture) the tool gets a
+    covariance: the fixture's survey error goes whole into its grasp's estimate (the gripper centres the
+    TCP on the fixture as it truly stands, the estimate takes it where the workcell file places it), and
+    ``camera_covariance(joints_deg)`` (6, 6: mm, mrad, base axes; the calibrated model's camera) adds the
+    camera's at each grasp. Grasps of different fixtures are independent: their mean has 1/n of it."""
     if not grasps:
         raise CameraToToolError("no grasp: close the gripper on a surveyed fixture pin at least once")
-    per = {g.name: invert(robot.fk(g.joints_deg, camera_frame)) @ np.asarray(g.tcp2base, dtype=float) for g in grasps}
+    cams = {g.name: robot.fk(g.joints_deg, camera_frame) for g in grasps}
+    per = {g.name: invert(cams[g.name]) @ np.asarray(g.tcp2base, dtype=float) for g in grasps}
     Ts = list(per.values())
     mean = make_transform(Rotation.from_matrix([T[:3, :3] for T in Ts]).mean().as_matrix(), np.mean([T[:3, 3] for T in Ts], axis=0))
     spreads = [pose_difference(T, mean) for T in Ts]
-    return CameraToTool(mean, per, max(float(np.linalg.norm(d)) for d, _ in spreads), max(float(np.linalg.norm(r)) for _, r in spreads))
+    covariance = None
+    if placement_sigma_mm is not None:
+        from calib_core.calibration.look_fusion import tcp_covariance_from_camera
+
+        total = np.zeros((6, 6))
+        for g in grasps:
+            in_base = np.diag([placement_sigma_mm**2] * 3 + [0.0] * 3)
+            if camera_covariance is not None:
+                in_base = in_base + tcp_covariance_from_camera(camera_covariance(g.joints_deg), cams[g.name], per[g.name])
+            R = np.kron(np.eye(2), cams[g.name][:3, :3].T)
+            total += R @ in_base @ R.T
+        covariance = total / len(grasps) ** 2
+    return CameraToTool(mean, per, max(float(np.linalg.norm(d)) for d, _ in spreads), max(float(np.linalg.norm(r)) for _, r in spreads), covariance)
 
 
 def with_tool(robot: RobotModel, tcp2cam: np.ndarray, tcp_frame: str = "tcp", camera_frame: str = "camera") -> RobotModel:

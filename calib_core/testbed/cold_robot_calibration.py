@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import invert, pose_difference
-from calib_core.robot_calibration.identification import RobotCalibration, identify
+from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCalibration, identify, pose_covariance
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
 from calib_core.robot_calibration.cell_views import cell_view_joints
@@ -78,7 +78,7 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     if grasps:
         tasks = [t for t in bed.workcell.task_locations.values() if grasp_tasks is None or t.name in grasp_tasks]
         done = [Grasp(t.name, grasp_joints(bed, t.tcp2base, seed + k), t.tcp2base) for k, t in enumerate(tasks)]
-        tool = camera_to_tool(result.robot, done)
+        tool = camera_to_tool(result.robot, done, placement_sigma_mm=SURVEY_SIGMA_MM, camera_covariance=lambda q: pose_covariance(result, q))
         robot = with_tool(result.robot, tool.tcp2cam)
         say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)

@@ -27,14 +27,17 @@ from calib_core.vision.find_points import find_points
 
 
 def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0, model_covariance=None, placement_sigma_mm: float = 0.0,
-                 from_where: str = "task") -> dict:
+                 from_where: str = "task", tool=None) -> dict:
     """Figures of one look at ``task_name`` (default: the cell's first task) with the calibrated
     ``robot`` and ``intrinsics``, made from the task location itself (``from_where="task"``, as the
     paper and ``videocal demo`` do) or from its approach (``"approach"``): the TCP's true error at the task commanded through the calibrated
     model without the look and with it, the look's own 1-sigma, and whether the error is within 3 sigma.
     ``model_covariance(q_deg)``: the calibrated model's TCP covariance (6, 6: mm, deg) at joints; with
     it the look is also fused with the model (:mod:`calib_core.calibration.look_fusion`), the
-    component's placement known to ``placement_sigma_mm`` (1-sigma per axis), and scored."""
+    component's placement known to ``placement_sigma_mm`` (1-sigma per axis), and scored. ``tool``: the
+    :class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool` the robot's TCP came from; its
+    covariance is added to the look's and to the fused one (look and model share the tool's error, so it
+    is added after the fusion, not weighed in it)."""
     cell = bed.workcell
     task = cell.task(task_name) if task_name else next(iter(cell.task_locations.values()))
     item = cell.component(task.component)
@@ -75,8 +78,10 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
                                           shared_covariance=shared_shift_covariance(solution.obj2cam, features, intrinsics))
     q_task = solve_ik(robot, invert(estimate.delta_base) @ task.tcp2base, q_approach).q_deg
     d, r, after = error(q_task)
-    sigma_mm = float(np.linalg.norm(estimate.std_displacement_mm))
-    sigma_deg = float(np.linalg.norm(estimate.std_rotation_deg))
+    tool_covariance = tool.covariance_in_base(cam2world_model) if tool is not None else None
+    look_std = np.sqrt(np.diag(estimate.covariance + tool_covariance)) if tool_covariance is not None and estimate.covariance is not None else None
+    sigma_mm = float(np.linalg.norm(estimate.std_displacement_mm if look_std is None else look_std[:3]))
+    sigma_deg = float(np.linalg.norm(estimate.std_rotation_deg if look_std is None else look_std[3:]))
     out.update({
         "after_look_mm_deg": after,
         "look_sigma_mm_deg": [round(sigma_mm, 4), round(sigma_deg, 5)],
@@ -89,7 +94,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         fused = fuse_look(estimate, model_covariance(q_approach), placement_sigma_mm=placement_sigma_mm)
         q_fused = solve_ik(robot, invert(fused.delta_base) @ task.tcp2base, q_approach).q_deg
         d, r, after = error(q_fused)
-        s = np.sqrt(np.diag(fused.covariance))
+        s = np.sqrt(np.diag(fused.covariance if tool_covariance is None else fused.covariance + tool_covariance))
         out["fused"] = {
             "after_mm_deg": after,
             "sigma_mm_deg": [round(float(np.linalg.norm(s[:3])), 4), round(float(np.linalg.norm(s[3:])), 5)],

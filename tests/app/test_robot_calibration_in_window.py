@@ -106,6 +106,8 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
     assert tool.tool is not None and "TCP from 2 grasps, spread" in tool.text.text()
+    # the tool knows its own uncertainty (the grasped fixtures' survey, the camera's there): a stored look adds it
+    assert np.all(np.diag(tool.tool.covariance)[:3] >= 0.05**2 / 2 - 1e-12)
     for name, (q_pin, pin) in pins.items():
         miss = np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0])
         assert miss <= 1.2 * tool.tool.spread_mm + 0.01 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])

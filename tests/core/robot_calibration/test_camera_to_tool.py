@@ -59,3 +59,39 @@ def test_the_simulated_compliance_puts_the_true_tcp_on_the_pin():
         assert np.linalg.norm(d) <= COMPLIANCE_MM + 1e-3 and np.linalg.norm(r) < 1e-4
         d_model, _ = pose_difference(bed.model_robot.fk(q, "tcp"), task.tcp2base)
         assert np.linalg.norm(d_model) > 1.0  # the model says the TCP is elsewhere: the robot's error
+
+
+def test_the_tool_s_covariance_holds_each_grasped_fixture_s_survey_and_the_camera_s():
+    """Known answers: one grasp with the survey's 0.05 mm per axis gives that much in position in any
+    axes; two grasps of different fixtures half of it; a camera covariance adds the lever arm's share;
+    and the Monte Carlo of fixtures moved within their survey matches the covariance."""
+    cell = load_workcell()
+    robot = cell.load_robot()
+    home = np.array(cell.home_joints_deg, float)
+    tasks = list(cell.task_locations.values())[:2]
+    grasps = [Grasp(t.name, solve_ik(robot, t.tcp2base, home).q_deg, t.tcp2base) for t in tasks]
+    assert camera_to_tool(robot, grasps).covariance is None
+    one = camera_to_tool(robot, grasps[:1], placement_sigma_mm=0.05)
+    cam2base = robot.fk(grasps[0].joints_deg, "camera")
+    assert np.allclose(one.covariance_in_base(cam2base)[:3, :3], 0.05**2 * np.eye(3), atol=1e-12)
+    assert np.allclose(one.covariance[3:, 3:], 0.0)
+    two = camera_to_tool(robot, grasps, placement_sigma_mm=0.05)
+    assert np.isclose(np.trace(two.covariance[:3, :3]), 3 * 0.05**2 / 2)
+    turn = np.diag([0.0, 0.0, 0.0, 0.2, 0.2, 0.2]) ** 2  # the camera turned 0.2 mrad per axis: the TCP swings
+    with_camera = camera_to_tool(robot, grasps[:1], placement_sigma_mm=0.05, camera_covariance=lambda q: turn)
+    assert np.trace(with_camera.covariance[:3, :3]) > np.trace(one.covariance[:3, :3])
+    assert np.allclose(np.sqrt(np.diag(with_camera.covariance[3:, 3:])), np.degrees(0.2e-3), rtol=1e-9)
+    # Monte Carlo: the fixtures truly stand within the survey, the grasps put the TCP there, and the
+    # tool computed from the surveyed places is off by what the covariance says
+    rng = np.random.default_rng(0)
+    surveyed = two.tcp2cam[:3, 3]
+    errors = []
+    for _ in range(2000):
+        true_grasps = []
+        for g in grasps:
+            moved = g.tcp2base.copy()
+            moved[:3, 3] += rng.normal(0, 0.05, 3)
+            true_grasps.append(Grasp(g.name, g.joints_deg, moved))
+        errors.append(surveyed - camera_to_tool(robot, true_grasps).tcp2cam[:3, 3])
+    empirical = np.cov(np.array(errors).T)
+    assert np.allclose(empirical, two.covariance[:3, :3], atol=0.1 * 0.05**2)
