@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from calib_core.calibration.look_fusion import tcp_covariance_from_camera
 from calib_core.errors import VideocalError
 from calib_core.frames import invert, make_transform, pose_difference
 from calib_core.robot.model import RobotModel
@@ -79,8 +80,6 @@ def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "
     spreads = [pose_difference(T, mean) for T in Ts]
     covariance = None
     if placement_sigma_mm is not None:
-        from calib_core.calibration.look_fusion import tcp_covariance_from_camera
-
         total = np.zeros((6, 6))
         for g in grasps:
             in_base = np.diag([placement_sigma_mm**2] * 3 + [0.0] * 3)

@@ -26,16 +26,36 @@ def test_labels_of_crowded_marks_take_free_places_and_never_overlap(qapp):
     assert bounds.contains(at_edge) and at_edge.right() < 310
 
 
-def test_a_view_with_crowded_labels_draws_every_mark(qtbot):
+def _blue_pixels(qtbot, labelled: bool) -> int:
     view = ImageView()
     qtbot.addWidget(view)
     view.resize(640, 480)
     view.set_image(np.full((480, 640, 3), 40, np.uint8))
     blue = QColor("#50c8ff")
-    view.set_overlay(Overlay(points=[(320 + 3 * k, 240 + 2 * k, f"feature_{k}", blue) for k in range(6)]))
+    view.set_overlay(Overlay(points=[(320 + 3 * k, 240 + 2 * k, f"feature_{k}" if labelled else "", blue) for k in range(6)]))
     view.show()
     qtbot.waitExposed(view)
     image = view.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
     pixels = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()].reshape(image.height(), image.width(), 3)
-    bluish = (pixels[..., 2] > 200) & (pixels[..., 0] < 150)
-    assert bluish.sum() > 200  # the marks and the labels that found a place are drawn
+    return int(((pixels[..., 2] > 200) & (pixels[..., 0] < 150)).sum())
+
+
+def test_a_view_with_crowded_marks_draws_four_labels_round_them(qtbot):
+    """Six marks within 15 px: four labels find a free place (the other two are left out), so the
+    labels' ink is about four times one label's (later marks cover a little of it), not six times and
+    not one (drawn on top of each other, as before the placement)."""
+    marks_only = _blue_pixels(qtbot, labelled=False)
+    with_labels = _blue_pixels(qtbot, labelled=True)
+    view = ImageView()
+    qtbot.addWidget(view)
+    view.resize(640, 480)
+    view.set_image(np.full((480, 640, 3), 40, np.uint8))
+    view.set_overlay(Overlay(points=[(100, 100, "feature_0", QColor("#50c8ff"))]))
+    view.show()
+    qtbot.waitExposed(view)
+    image = view.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
+    pixels = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()].reshape(image.height(), image.width(), 3)
+    one_mark_and_label = int(((pixels[..., 2] > 200) & (pixels[..., 0] < 150)).sum())
+    one_label = one_mark_and_label - marks_only / 6
+    ink = with_labels - marks_only
+    assert 2.5 * one_label < ink < 4.8 * one_label, (ink, one_label)
