@@ -17,7 +17,8 @@ from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCa
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
 from calib_core.robot_calibration.cell_views import cell_view_joints
-from calib_core.testbed.compliant_grasp import grasp_joints
+from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp
+from calib_core.testbed.compliant_grasp import grasp_frame, grasp_joints
 from calib_core.robot_calibration.sim_views import simulated_cell_views, simulated_pose_views
 from calib_core.testbed.cold_cell import cold_test_bed
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
@@ -46,11 +47,12 @@ class ColdRun:
 
 
 def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, grasp_tasks: list[str] | None = None,
-                        with_intrinsics: bool = True, progress=None, say=lambda text: None) -> ColdRun:
+                        with_intrinsics: bool = True, seen_grasps: bool = True, progress=None, say=lambda text: None) -> ColdRun:
     """``views`` board views and ``cell_views_per_task`` views of each task location's component
     (surveyed features: they tie the robot to the cell; 0 leaves the base unidentified); with
     ``grasps``, the gripper closed on each task location's fixture (``grasp_tasks``: only these) gives
-    the TCP from the camera."""
+    the TCP from the camera; ``seen_grasps``: the camera's frame at each grasp measures it
+    (:mod:`calib_core.robot_calibration.grasp_view`), else the survey through the calibrated robot."""
     bed, truth = cold_test_bed(seed=seed)
     nominal = load_intrinsics(bed.workcell.intrinsics_path)
     spec = parse_board(DEFAULT_SPEC)
@@ -77,10 +79,19 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     robot, tool = result.robot, None
     if grasps:
         tasks = [t for t in bed.workcell.task_locations.values() if grasp_tasks is None or t.name in grasp_tasks]
-        done = [Grasp(t.name, grasp_joints(bed, t.tcp2base, seed + k), t.tcp2base) for k, t in enumerate(tasks)]
+        done = []
+        for k, t in enumerate(tasks):
+            q = grasp_joints(bed, t.tcp2base, seed + k, t.component)
+            seen = None
+            if seen_grasps:
+                try:
+                    seen = see_grasp(grasp_frame(bed, q, seed + k), result.intrinsics, result.robot, bed.workcell, t, q)
+                except GraspNotSeenError as e:
+                    say(f"{e}: that grasp is taken through the calibrated robot and the survey")
+            done.append(Grasp(t.name, q, t.tcp2base, seen))
         tool = camera_to_tool(result.robot, done, placement_sigma_mm=SURVEY_SIGMA_MM, camera_covariance=lambda q: pose_covariance(result, q))
         robot = with_tool(result.robot, tool.tcp2cam)
-        say(f"camera to tool from {len(done)} grasps (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
+        say(f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
     score["parameters_against_truth"] = parameters_against_truth(result, bed, pose_views, intrinsics.intrinsics)
     return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, board_count, len(cell_views))

@@ -113,15 +113,20 @@ def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> 
     return out
 
 
-def circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
-    """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
+def rim_points_mm(point: np.ndarray, kind: FeatureKind, count: int = 48) -> np.ndarray:
+    """``count`` points (count, 3) mm evenly round the rim of a circle feature centred at ``point``
+    (3,) mm, in the component's frame."""
     n = np.asarray(kind.normal)
     a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
     a /= np.linalg.norm(a)
     b = np.cross(n, a)
-    angles = np.linspace(0, 2 * np.pi, 48, endpoint=False)
-    rim_3d = point + kind.radius_mm * (np.cos(angles)[:, None] * a + np.sin(angles)[:, None] * b)
-    rim = project_points(rim_3d, obj2cam, intrinsics)
+    angles = np.linspace(0, 2 * np.pi, count, endpoint=False)
+    return point + kind.radius_mm * (np.cos(angles)[:, None] * a + np.sin(angles)[:, None] * b)
+
+
+def circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+    """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
+    rim = project_points(rim_points_mm(point, kind), obj2cam, intrinsics)
     (cx, cy), _, _ = cv2.fitEllipse(rim.astype(np.float32))
     centre = project_points(point[None], obj2cam, intrinsics)[0]
     return rim, centre - (cx, cy)

@@ -94,23 +94,29 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     for task in list(wb.workcell.task_locations.values())[:2]:
         wb.set_task(task.name)
         q_approach = solve_ik(wb.robot, task.approach2base, home).q_deg
-        q_pin = grasp_joints(bed, task.tcp2base, seed=len(pins))
+        q_pin = grasp_joints(bed, task.tcp2base, seed=len(pins), component=task.component)
         move(home, "home")
         move(q_approach, f"{task.name} approach")
         move(q_pin, f"{task.name} grasp (the compliance)", frozenset({task.component}))
-        qtbot.waitUntil(lambda: wb.motion.motion.value not in ("moving", "unknown"), timeout=10_000)
+        wait_for_settled_frame(qtbot, win)  # the grasp is seen on a frame of the robot at rest
         qtbot.mouseClick(tool.record_button, Qt.MouseButton.LeftButton)
         pins[task.name] = (q_pin, task.tcp2base)
         move(q_approach, f"{task.name} approach", frozenset({task.component}))  # back out of the fixture
-    assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text()
+    assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text(), win.statusBar().currentMessage()
     before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
     assert tool.tool is not None and "TCP from 2 grasps, spread" in tool.text.text()
-    # the tool knows its own uncertainty (the grasped fixtures' survey, the camera's there): a stored look adds it
-    assert np.all(np.diag(tool.tool.covariance)[:3] >= 0.05**2 / 2 - 1e-12)
+    # each grasp was seen on the camera's frame (the held fixture's edges): the tool knows its own
+    # uncertainty from those views, better than the survey's 0.05 mm per axis; a stored look adds it
+    assert tool.tool.seen_grasps == 2, win.statusBar().currentMessage()
+    assert np.all(np.diag(tool.tool.covariance)[:3] < 0.05**2 / 2) and np.all(np.diag(tool.tool.covariance) > 0)
+    # scored by the truth: the model with the seen tool puts the TCP on each pin to within the
+    # calibrated camera's error there (a short calibration at 640 x 480: its principal point 0.26 px
+    # off turns the camera frame by 0.5 mrad, and the seen tool with it, 0.09 mm at the TCP's lever
+    # arm; the task's look below, made through the same camera, takes that out), far better than before
     for name, (q_pin, pin) in pins.items():
         miss = np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0])
-        assert miss <= 1.2 * tool.tool.spread_mm + 0.01 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])
+        assert miss < 0.15 and miss < 0.2 * before_tool[name], (name, miss, before_tool[name])
 
     win.grab().save(str(OUTPUT / "window_robot_tool.png"))
 

@@ -38,7 +38,7 @@ def files(tmp_path_factory):
         cv2.imwrite(str(folder / f"{name}.png"), image[:, :, ::-1])
         rows.append(f"{name}.png," + ",".join(f"{v:.6f}" for v in q))
     (folder / "views.csv").write_text("\n".join(rows) + "\n")
-    grasps = {t.name: grasp_joints(bed, t.tcp2base, k) for k, t in enumerate(bed.workcell.task_locations.values())}
+    grasps = {t.name: grasp_joints(bed, t.tcp2base, k, t.component) for k, t in enumerate(bed.workcell.task_locations.values())}
     (folder / "grasps.csv").write_text("task," + ",".join(f"j{k + 1}" for k in range(6)) + "\n" + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items()))
     return folder, bed, grasps
 
