@@ -107,12 +107,13 @@ def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.
     uv = project_points(pts, obj2cam, intrinsics)
     # where the model's view shows no gradient (two faces of one shade meeting, an edge hidden behind a
     # face) there is no edge to find, and a search there would lock onto the nearest one
-    shows = model_shows_edge(expected, uv)
+    expected_magnitude = gradient_magnitude(expected)
+    shows = model_shows_edge(None, uv, expected_magnitude)
     # the edges that can crowd a sample: those the model's view shows (a rim's facets, too short to
     # hold a sample, by their midpoints)
     sampled = np.bincount(which, minlength=len(seg))
     shown = np.where(sampled > 0, np.bincount(which[shows], minlength=len(seg)) >= 0.5 * sampled,
-                     model_shows_edge(expected, project_points(seg.mean(axis=1), obj2cam, intrinsics)))
+                     model_shows_edge(None, project_points(seg.mean(axis=1), obj2cam, intrinsics), expected_magnitude))
     clearance = _clearance(uv, ends[shown], np.searchsorted(np.flatnonzero(shown), which), shown[which])
     keep = shows & (clearance > _CROWDED_PX)
     return pts[keep], far[keep], clearance[keep]
@@ -144,9 +145,10 @@ def _clearance(uv: np.ndarray, ends_px: np.ndarray, own: np.ndarray, own_listed:
     return np.where(meets, np.abs(t), np.inf).min(axis=1)
 
 
-def model_shows_edge(expected: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """Which pixels (m, 2) of the model's view (h, w) lie on a gradient of at least 12 grey levels a pixel."""
-    magnitude = gradient_magnitude(expected)
+def model_shows_edge(expected: np.ndarray | None, uv: np.ndarray, magnitude: np.ndarray | None = None) -> np.ndarray:
+    """Which pixels (m, 2) of the model's view (h, w) lie on a gradient of at least 12 grey levels a pixel
+    (``magnitude``: the view's :func:`gradient_magnitude`, when it is at hand)."""
+    magnitude = gradient_magnitude(expected) if magnitude is None else magnitude
     h, w = magnitude.shape
     inside = (uv[:, 0] >= 0) & (uv[:, 0] < w - 1) & (uv[:, 1] >= 0) & (uv[:, 1] < h - 1)
     u = np.clip(np.rint(uv[:, 0]).astype(int), 0, w - 1)
@@ -162,10 +164,11 @@ def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
 
 
 def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected: np.ndarray | None = None, search_px: float = 8.0,
-                    iterations: int = 30) -> EdgeFit:
+                    iterations: int = 30, magnitude: np.ndarray | None = None) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
-    image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast."""
-    magnitude = gradient_magnitude(grey)
+    image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast;
+    ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
+    magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
     pts, far, clearance = edge_points(mesh, obj2cam, intrinsics, expected)
     pose = obj2cam.copy()
     window = search_px

@@ -177,7 +177,7 @@ class _Detectors:
         if length < 8.0:
             return False
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
-        return bool(len(s) >= 2 and model_shows_edge(as_grey(self.expected_image(obj2cam)), corner + s[:, None] * d / length).mean() >= 0.6)
+        return bool(len(s) >= 2 and model_shows_edge(None, corner + s[:, None] * d / length, self.expected_magnitude(obj2cam)).mean() >= 0.6)
 
     def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
         """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
@@ -260,7 +260,8 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     def refined(start_pose: np.ndarray) -> EdgeFit:
-        return refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected=detectors.expected_image(start_pose) if expected is not None else None)
+        return refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected=detectors.expected_image(start_pose) if expected is not None else None,
+                               magnitude=detectors.magnitude)
 
     best = None
     for start_pose in ranked:

@@ -57,13 +57,14 @@ def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndar
     return moved @ obj2cam
 
 
-def _scores(distance: np.ndarray, uv: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """Mean truncated distance (H, S) of the pixels ``uv`` (H, m, 2) moved by each of ``offsets`` (S, 2)."""
-    h, w = distance.shape
-    u = np.rint(np.nan_to_num(uv[:, None, :, 0], nan=-1e6) + offsets[None, :, None, 0]).astype(np.int64)
-    v = np.rint(np.nan_to_num(uv[:, None, :, 1], nan=-1e6) + offsets[None, :, None, 1]).astype(np.int64)
-    inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
-    return np.where(inside, distance[np.clip(v, 0, h - 1), np.clip(u, 0, w - 1)], TRUNCATE_PX).mean(axis=2)
+def _scores(padded: np.ndarray, uv_px: np.ndarray, offsets_px: np.ndarray) -> np.ndarray:
+    """Mean truncated distance (H, S) of the whole pixels ``uv_px`` (H, m, 2) int moved by each of the
+    whole-pixel ``offsets_px`` (S, 2) int, looked up in ``padded`` (the distance map with a one-pixel
+    border of :data:`TRUNCATE_PX`: anything outside the image lands there)."""
+    h, w = padded.shape[0] - 2, padded.shape[1] - 2
+    u = np.clip(uv_px[:, None, :, 0] + offsets_px[None, :, None, 0], -1, w) + 1
+    v = np.clip(uv_px[:, None, :, 1] + offsets_px[None, :, None, 1], -1, h) + 1
+    return padded.ravel()[v * (w + 2) + u].mean(axis=2)
 
 
 def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, obj2cam: np.ndarray, reach_mm: float, reach_deg: float,
@@ -89,8 +90,11 @@ def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.nda
     uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
-    offsets = np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2)
-    cost = np.concatenate([_scores(distance, chunk, offsets) for chunk in np.array_split(uv, max(1, len(uv) // 128))])  # (H, S)
+    offsets = np.rint(np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2))  # whole pixels: a chamfer ranking needs no finer
+    padded = np.pad(np.asarray(distance, dtype=np.float32), 1, constant_values=TRUNCATE_PX)
+    # whole pixels, and far outside the image (or behind the camera: NaN) clipped to its border
+    uv_px = np.rint(np.clip(np.nan_to_num(uv, nan=-1e6), -2.0, max(distance.shape) + 2.0)).astype(np.int32)
+    cost = np.concatenate([_scores(padded, chunk, offsets.astype(np.int32)) for chunk in np.array_split(uv_px, max(1, len(uv_px) // 128))])  # (H, S)
     # the unmoved pose wins a tie
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []
