@@ -116,7 +116,7 @@ def _run(factor: float, rng, place: str) -> dict:
         frame = camera.read()
         model = np.linalg.inv(bed.model_cam2world(q)) @ item.item2world
         truth = np.linalg.inv(camera.last_truth.cam2world) @ item.item2world
-        expected = view.of(list(cell.components) + bed.visuals_for_model().scene_items(q), item.item2world)
+        expected = view.of_cell(cell.components, bed.visuals_for_model(), q, item.item2world)
         t0 = time.perf_counter()
         result = find_points(frame.image, bed.intrinsics, item, model, expected=expected)
         stats["times"].append(time.perf_counter() - t0)

@@ -64,8 +64,7 @@ class PointFinding:
             if self._model_view is not None:
                 self._model_view.close()
             self._model_view = ModelView(self.intrinsics)
-        items = list(self.workcell.components) + self.cell.model_visuals().scene_items(q_deg) + list(self.scene_extras)
-        return self._model_view.of(items, item.item2world)
+        return self._model_view.of_cell(self.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.scene_extras))
 
     def calibrate_on_edges(self):
         """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's

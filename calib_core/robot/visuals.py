@@ -122,6 +122,12 @@ class RobotVisuals:
         root2base = np.linalg.inv(self.robot.base2root)
         return [root2base @ _to_mm(p) for p in data.oMg]
 
+    def riding_with(self, frame: str) -> frozenset[str]:
+        """The names of the scene items (:meth:`scene_items`) on the joint that carries ``frame`` (the
+        gripper and its fingers with a camera on the flange): they move with that frame."""
+        joint = self.robot.model.frames[self.robot.frame_id(frame)].parentJoint
+        return frozenset(f"robot/{g.name}" for g in self.geometry_model.geometryObjects if g.parentJoint == joint)
+
     def scene_items(self, q_deg: ArrayLike) -> list[SceneItem]:
         """One :class:`SceneItem` per visual, named ``robot/<link>_<index>``, kind ``robot``."""
         items = []

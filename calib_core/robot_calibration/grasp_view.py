@@ -75,7 +75,7 @@ def see_grasp(image: np.ndarray, intrinsics: Intrinsics, robot: RobotModel, work
     view = ModelView(intrinsics) if expected is None else None
     try:
         if view is not None:
-            expected = view.of(list(workcell.components) + RobotVisuals.from_robot(robot).scene_items(q), item.item2world)
+            expected = view.of_cell(workcell.components, RobotVisuals.from_robot(robot), q, item.item2world, camera_frame)
         found = find_points(image, intrinsics, item, invert(cam2base) @ item.item2world, expected=expected)
     finally:
         if view is not None:

@@ -55,7 +55,7 @@ def simulated_cell_views(bed: TestBed, intrinsics, targets: list[tuple[str, np.n
         for k, (component, q) in enumerate(targets):
             bed.joints_deg = np.asarray(q, dtype=float)
             item = bed.workcell.component(component)
-            expected = view.of(list(bed.workcell.components) + visuals.scene_items(bed.joints_deg), item.item2world)
+            expected = view.of_cell(bed.workcell.components, visuals, bed.joints_deg, item.item2world)
             found = cell_view(f"cell_{k + 1:02d}_{component}", camera.read().image, bed.joints_deg.copy(), bed.workcell, component, robot, intrinsics, expected)
             (rejected if isinstance(found, str) else views).append(found)
             if progress is not None:

@@ -54,7 +54,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         image = camera.read().image
         cam2world_model = robot.fk(q_approach, "camera")
         obj2cam_model = invert(cam2world_model) @ item.item2world
-        expected = view.of(list(cell.components) + RobotVisuals.from_robot(robot).scene_items(q_approach), item.item2world)
+        expected = view.of_cell(cell.components, RobotVisuals.from_robot(robot), q_approach, item.item2world)
         found = find_points(image, intrinsics, item, obj2cam_model, expected=expected)
     finally:
         camera.close()

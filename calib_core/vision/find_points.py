@@ -171,13 +171,25 @@ class _Detectors:
             self._expected_magnitude = gradient_magnitude(image)
         return self._expected_magnitude
 
-    def _arm_shows_edge(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> bool:
+    def _visible_arm(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> np.ndarray | None:
+        """The pixel (2,) the arm from ``corner`` to ``far`` (px) may be searched to, by the model's view
+        at ``obj2cam``: ``far`` when it shows an edge along most of the arm's first 40 px; the end of the
+        stretch it shows from the corner when something stands in front of the rest (a gripper's finger
+        across a plate's edge: the first 12 px or more are enough for a line); ``None`` when no edge shows."""
         d = far - corner
         length = float(np.linalg.norm(d))
         if length < 8.0:
-            return False
+            return None
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
-        return bool(len(s) >= 2 and model_shows_edge(None, corner + s[:, None] * d / length, self.expected_magnitude(obj2cam)).mean() >= 0.6)
+        if len(s) < 2:
+            return None
+        shows = model_shows_edge(None, corner + s[:, None] * d / length, self.expected_magnitude(obj2cam))
+        if shows.mean() >= 0.6:
+            return far
+        run = int(np.argmin(shows)) if not shows.all() else len(shows)
+        if run >= 5:  # shown from 4 px to 12 px or more: the search stops where it stops showing
+            return corner + (s[run - 1] / 0.8) * d / length
+        return None
 
     def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
         """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
@@ -186,8 +198,9 @@ class _Detectors:
             ends = self.arms(point, obj2cam)
             if ends:
                 far = project_points(np.array(ends), obj2cam, self.intrinsics)
-                if self.expected is not None:  # only the arms along which the model shows an edge
-                    far = far[[self._arm_shows_edge(uv, f, obj2cam) for f in far]]
+                if self.expected is not None:  # only the arms, or their stretches, along which the model shows an edge
+                    shown = [self._visible_arm(uv, f, obj2cam) for f in far]
+                    far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
                 found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
                 if self.expected is not None and isinstance(found, Detection):
                     # The same lines in the model's view at this pose: where its own arms meet well off

@@ -40,7 +40,7 @@ def _look(factor: float, place: str = "approach"):
     obj2cam_model = np.linalg.inv(bed.model_cam2world(q)) @ item.item2world
     obj2cam_true = np.linalg.inv(camera.last_truth.cam2world) @ item.item2world
     view = ModelView(bed.intrinsics)
-    expected = view.of(list(cell.components) + bed.visuals_for_model().scene_items(q), item.item2world)
+    expected = view.of_cell(cell.components, bed.visuals_for_model(), q, item.item2world)
     yield frame.image, bed.intrinsics, item, obj2cam_model, obj2cam_true, expected
     view.close()
     camera.close()
@@ -124,7 +124,7 @@ def test_the_edge_fit_settles_on_an_aliased_frame():
     model = np.linalg.inv(bed.model_cam2world(q)) @ item.item2world
     view = ModelView(bed.intrinsics)
     try:
-        expected = view.of(list(cell.components) + bed.visuals_for_model().scene_items(q), item.item2world)
+        expected = view.of_cell(cell.components, bed.visuals_for_model(), q, item.item2world)
         result = find_points(image, bed.intrinsics, item, model, expected=expected)
     finally:
         view.close()
