@@ -144,3 +144,17 @@ def _size(n_bytes: int) -> str:
 
 def _first_line(exc: Exception) -> str:
     return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+
+
+def csv_numbers(cells: list[str], columns: list[str], path: str | Path, where: str) -> list[float]:
+    """The CSV ``cells`` of one row as finite floats, one per name in ``columns``; a
+    ``FileFormatError`` naming the row (``where``) and the column of the first that is not."""
+    values = []
+    for column, cell in zip(columns, cells):
+        try:
+            number = float(cell.strip())
+        except ValueError:
+            raise FileFormatError(path, f"not a number: {cell.strip()!r}", f"{where}, {column}") from None
+        values.append(finite_number(number, path, f"{where}, {column}"))
+    return values
+

@@ -90,6 +90,9 @@ def _from_files(args):
     detect = _detector(args, spec)
     views, flanges, size = [], [], None
     for posed in data.views:
+        if posed.component is not None:
+            print(f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; calibrate-robot uses both)", file=sys.stderr)
+            continue
         image = data.read_image(posed)
         if size is None:
             size = (image.shape[1], image.shape[0])

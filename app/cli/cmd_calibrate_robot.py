@@ -5,8 +5,10 @@ mounting from views of a board at many poses (docs/calibration.md).
 driven through them, each view rendered by the true camera and detected, the camera's intrinsics
 calibrated from the same views first, surveyed features located at each task location, the gripper
 closed on each task's fixture for the tool; the result scored against the truth, which nothing else
-reads. ``FILE`` is a CSV of images and joints (``image,<joint names | j1..jn>``, docs/calibration.md)
-of the cell's robot (``--workcell``) viewing a board.
+reads. ``FILE`` is a CSV of images and joints (``image[,component],<joint names | j1..jn>``,
+docs/calibration.md) of the cell's robot (``--workcell``) viewing a board, or with ``component`` one of
+the cell's surveyed components (their edges tie the robot's base to the cell); ``--grasps`` a CSV of
+``task[,image],<joints>``: the gripper closed on each task's pin, seen when its frame is given.
 """
 
 from __future__ import annotations
@@ -56,14 +58,13 @@ def run(args: argparse.Namespace) -> int:
 
             cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
             grasps = load_grasps(args.grasps, cell.load_robot().joint_names, cell)
-        result, nominal, rejected, intrinsics_rms = _from_files(args)
+        result, nominal, rejected, intrinsics_rms, counts = _from_files(args)
         robot, tool, score = result.robot, None, None
         if grasps is not None:
             from calib_core.robot_calibration.camera_to_tool import camera_to_tool, with_tool
 
-            tool = camera_to_tool(result.robot, grasps)
+            tool = camera_to_tool(result.robot, _seen_grasps(grasps, result, cell))
             robot = with_tool(result.robot, tool.tcp2cam)
-        counts = {"board_views": len(result.per_view_rms_px), "cell_views": 0}
     for r in rejected:
         print(f"rejected {r}", file=sys.stderr)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -72,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
                "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
                "intrinsics_rms_px": intrinsics_rms, "out": str(args.out)}
     if tool is not None:
-        summary["tool"] = {"grasps": len(tool.per_grasp), "spread_mm": tool.spread_mm, "spread_deg": tool.spread_deg}
+        summary["tool"] = {"grasps": len(tool.per_grasp), "seen": tool.seen_grasps, "spread_mm": tool.spread_mm, "spread_deg": tool.spread_deg}
     if score is not None:
         summary["score"] = score
     if args.json:
@@ -104,20 +105,29 @@ def _from_files(args):
     data = load_posed_images(source)
     if data.joint_columns is None:
         raise VideocalError(f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses")
-    robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
+    cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+    robot = cell.load_robot()
     order = data.joint_order(robot.joint_names)
+    components = {c.name for c in cell.components if c.features}
+    for posed in data.views:  # before any work: a view of a component the cell does not survey
+        if posed.component is not None and posed.component not in components:
+            raise VideocalError(f"{data.source}: view {posed.name}: no surveyed component {posed.component!r} in {cell.path.name} (components with features: "
+                                f"{', '.join(sorted(components)) or 'none'})")
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     if not spec.unambiguous:
         raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
-    board_views, views, rejected, size = [], [], [], None
+    board_views, views, rejected, size, of_components = [], [], [], None, []
     for k, posed in enumerate(data.views):
         image = data.read_image(posed)
         if size is None:
             size = (image.shape[1], image.shape[0])
         elif (image.shape[1], image.shape[0]) != size:
             raise VideocalError(f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+        if posed.component is not None:
+            of_components.append(posed)  # located once the intrinsics are known
+            continue
         v = detect_view(posed.name, image, spec, detect)
         if isinstance(v, BoardView):
             board_views.append(v)
@@ -130,4 +140,46 @@ def _from_files(args):
     else:
         calibrated = calibrate_intrinsics(board_views, spec, rejected=[])
         intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
-    return identify(robot, intrinsics, views, with_intrinsics=not args.fixed_intrinsics), robot, rejected, rms
+    board_count = len(views)
+    if of_components:
+        from calib_core.render.model_view import ModelView
+        from calib_core.robot.visuals import RobotVisuals
+        from calib_core.robot_calibration.cell_views import cell_view
+
+        visuals, view = RobotVisuals.from_robot(robot), ModelView(intrinsics)
+        try:
+            for posed in of_components:
+                q = posed.joints_deg[order]
+                item = cell.component(posed.component)
+                found = cell_view(posed.name, data.read_image(posed), q, cell, posed.component, robot, intrinsics, view.of_cell(cell.components, visuals, q, item.item2world))
+                (rejected.append(found) if isinstance(found, str) else views.append(found))
+        finally:
+            view.close()
+    counts = {"board_views": board_count, "cell_views": len(views) - board_count}
+    return identify(robot, intrinsics, views, with_intrinsics=not args.fixed_intrinsics), robot, rejected, rms, counts
+
+
+def _seen_grasps(rows, result, cell) -> list:
+    """The grasps of the file, each seen on its frame when one is given (the held fixture's edges
+    give the tool); one not seen is kept through the robot and the survey, and said so."""
+    import cv2
+
+    from calib_core.errors import FileFormatError
+    from calib_core.robot_calibration.camera_to_tool import Grasp
+    from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp
+
+    grasps = []
+    for row in rows:
+        g = row.grasp
+        if row.image_path is None:
+            grasps.append(g)
+            continue
+        image = cv2.imread(str(row.image_path), cv2.IMREAD_GRAYSCALE) if row.image_path.is_file() else None
+        if image is None:
+            raise FileFormatError(row.image_path, "not an image OpenCV can read" if row.image_path.is_file() else "no such image", g.name)
+        try:
+            grasps.append(Grasp(g.name, g.joints_deg, g.tcp2base, see_grasp(image, result.intrinsics, result.robot, cell, cell.task(row.task), g.joints_deg)))
+        except GraspNotSeenError as e:
+            print(f"grasp {g.name}: {e}: taken through the robot and the survey", file=sys.stderr)
+            grasps.append(g)
+    return grasps

@@ -8,6 +8,11 @@ one column per joint named as the robot's joints or ``j1..jn`` (deg; mm for a pr
     task,j1,j2,j3,j4,j5,j6
     oru_1_grasp,12.5,-33.0,81.2,0.4,41.8,12.9
 
+An optional ``image`` column after ``task`` names the camera's frame taken while the gripper held the
+pin (relative to the file): the grasp is then *seen*
+(:mod:`calib_core.robot_calibration.grasp_view`), the tool measured from the held fixture's edges
+instead of through the robot and the fixture's survey. The images are read when the tool is measured.
+
 Every mistake is a :class:`~calib_core.errors.FileFormatError` naming the file, the row and the field.
 """
 
@@ -15,18 +20,28 @@ from __future__ import annotations
 
 import csv
 import io
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from calib_core.documents import finite_number, read_text
+from calib_core.documents import csv_numbers, read_text
 from calib_core.errors import FileFormatError
 from calib_core.robot_calibration.camera_to_tool import Grasp
 
 MAX_GRASPS = 200
 
 
-def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Grasp]:
+@dataclass(frozen=True)
+class GraspRow:
+    """One grasp of the file, and the frame taken while it held (``None``: not given)."""
+
+    grasp: Grasp
+    image_path: Path | None
+    task: str
+
+
+def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[GraspRow]:
     """The grasps in ``path`` for a robot with ``joint_names``; each task location's ``tcp2base``
     from ``workcell`` is where its grasp puts the TCP."""
     path = Path(path)
@@ -40,7 +55,8 @@ def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Gras
     header = [c.strip() for c in rows[0]]
     if header[0] != "task":
         raise FileFormatError(path, f"the first column must be 'task', got {header[0]!r}", "header")
-    columns = header[1:]
+    with_images = len(header) > 1 and header[1] == "image"
+    columns = header[2:] if with_images else header[1:]
     generic = [f"j{k + 1}" for k in range(len(joint_names))]
     if columns == generic:
         order = list(range(len(columns)))
@@ -58,13 +74,9 @@ def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Gras
         task = row[0].strip()
         if task not in workcell.task_locations:
             raise FileFormatError(path, f"no task location {task!r} in the workcell; task locations: {', '.join(workcell.task_locations)}", f"{where}, task")
-        values = []
-        for c, v in zip(columns, row[1:]):
-            try:
-                number = float(v.strip())
-            except ValueError:
-                raise FileFormatError(path, f"not a number: {v.strip()!r}", f"{where}, {c}") from None
-            values.append(finite_number(number, path, f"{where}, {c}"))
-        q = np.array(values, dtype=float)[order]
-        grasps.append(Grasp(f"{task} (row {n})", q, workcell.task(task).tcp2base))
+        image = row[1].strip() if with_images else ""
+        if image and not (path.parent / image).is_file():
+            raise FileFormatError(path, f"no such image {path.parent / image}", f"{where}, image")
+        q = np.array(csv_numbers(row[2:] if with_images else row[1:], columns, path, where), dtype=float)[order]
+        grasps.append(GraspRow(Grasp(f"{task} (row {n})", q, workcell.task(task).tcp2base), path.parent / image if image else None, task))
     return grasps

@@ -8,7 +8,9 @@ Two layouts are read:
   ``intrinsics`` (``fx fy cx cy``, no distortion, no image size), ``static_camera``.
 - **A CSV** with a header: ``image`` and either ``x_mm,y_mm,z_mm,qx,qy,qz,qw`` (the flange in the
   base) or one column per joint, named as the robot's joints or ``j1..jn`` (deg, mm for a prismatic
-  joint), each row one view.
+  joint), each row one view. With joints, an optional ``component`` column after ``image`` names the
+  workcell's surveyed component a view shows instead of the board (empty: a board view), for the
+  robot calibration's tie to the cell.
 
 Every problem is a :class:`~calib_core.errors.FileFormatError` naming the file, the row or entry
 and the field; nothing is read from an image until it is used.
@@ -25,7 +27,7 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from calib_core.documents import finite_number, read_text, read_yaml
+from calib_core.documents import csv_numbers, finite_number, read_text, read_yaml
 from calib_core.errors import FileFormatError
 from calib_core.frames import make_transform
 
@@ -42,6 +44,8 @@ class PosedImage:
     image_path: Path
     flange2base: np.ndarray | None = None
     joints_deg: np.ndarray | None = None
+    component: str | None = None
+    """The surveyed component the view shows instead of the board (a CSV's ``component`` column)."""
 
 
 @dataclass(frozen=True)
@@ -175,9 +179,16 @@ def _load_csv(path: Path) -> PosedImages:
     columns = header[1:]
     if len(set(columns)) != len(columns):
         raise FileFormatError(path, "a column name appears twice", "header")
+    named = bool(columns) and columns[0] == "component"
+    if named:
+        columns = columns[1:]
+    elif "component" in columns:
+        raise FileFormatError(path, "the component column must come right after image", "header")
     posed = set(columns) == set(POSE_COLUMNS)
     if not posed and (not columns or set(columns) & set(POSE_COLUMNS)):
         raise FileFormatError(path, f"expected the columns {', '.join(POSE_COLUMNS)} or one column per joint", "header")
+    if posed and named:
+        raise FileFormatError(path, "a component column goes with joint columns (a robot calibration), not with flange poses", "header")
     if len(rows) - 1 > MAX_VIEWS or len(rows) < 2:
         raise FileFormatError(path, f"expected 1 to {MAX_VIEWS} rows of views, got {len(rows) - 1}")
     views = []
@@ -186,16 +197,12 @@ def _load_csv(path: Path) -> PosedImages:
         if len(row) != len(header):
             raise FileFormatError(path, f"{len(row)} values, the header has {len(header)}", where)
         image = row[0].strip()
-        values = {c: row[i + 1].strip() for i, c in enumerate(columns)}
-        numbers = {}
-        for c, v in values.items():
-            try:
-                numbers[c] = float(v)
-            except ValueError:
-                raise FileFormatError(path, f"not a number: {v!r}", f"{where}, {c}") from None
+        component = row[1].strip() or None if named else None
+        cells = row[2:] if named else row[1:]
         if posed:
+            numbers = dict(zip(columns, csv_numbers(cells, columns, path, where)))
             views.append(PosedImage(Path(image).stem, path.parent / image, flange2base=_quaternion_pose(numbers, path, where, 1.0, POSE_COLUMNS)))
         else:
-            q = np.array([finite_number(numbers[c], path, f"{where}, {c}") for c in columns])
-            views.append(PosedImage(Path(image).stem, path.parent / image, joints_deg=q))
+            q = np.array(csv_numbers(cells, columns, path, where))
+            views.append(PosedImage(Path(image).stem, path.parent / image, joints_deg=q, component=component))
     return PosedImages(path, views, joint_columns=None if posed else tuple(columns))
