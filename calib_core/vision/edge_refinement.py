@@ -31,7 +31,9 @@ _TUKEY = 4.685
 class EdgeFit:
     """``obj2cam`` (4, 4) the refined pose (mm); ``rms_px`` the weighted RMS of the samples' normal
     offsets; ``sigma_px`` their robust scale; ``samples`` used in the last step; ``covariance`` (6, 6)
-    of (rotation vector rad, translation mm) from the last step's normal equations and ``sigma_px``;
+    of (rotation vector rad, translation mm) from the last step's normal equations, the samples of each
+    edge chain taken as one measurement (their offsets share the edge's error) and never less than
+    ``sigma_px`` over independent samples gives (``covariance_independent``);
     ``converged``; ``edges_px`` (m, 2) the image edge points found, ``offsets_px`` (m,) their offsets
     along the normals and ``residuals_px`` (m, 2) as vectors (image edge minus the model's edge, at the
     pose before the last step), for drawing and for the solution's residuals."""
@@ -48,6 +50,9 @@ class EdgeFit:
     inlier_share: float
     """The share of the model's edge samples that found their image edge in the last step (weight > 0):
     a fit that settled on a few samples (a wrong minimum) has a low one."""
+    covariance_independent: np.ndarray | None = None
+    """(6, 6) as ``covariance`` with every sample taken as independent (``sigma_px^2 H^-1``):
+    ``covariance`` takes each edge chain's samples as one measurement as well, and is never less."""
 
     @property
     def settled(self) -> bool:
@@ -88,22 +93,57 @@ def visible_segments(mesh, obj2cam: np.ndarray) -> np.ndarray:
     return seg
 
 
-def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+_CHAIN_TURN_DEG = 35.0
+
+
+def edge_chains(seg: np.ndarray) -> np.ndarray:
+    """One chain number (E,) per segment (E, 2, 3): segments joined end to end where exactly two meet
+    and turn by less than 35 deg (a rim's facets make one chain; a plate's edges meet at corners and
+    stay apart). A chain's samples share what the image does to that edge (its lighting, its bevel), so
+    their offsets are not independent."""
+    n = len(seg)
+    parent = np.arange(n)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    ends = np.round(seg * 1000.0).astype(np.int64)  # to 1 um
+    at: dict[bytes, list[tuple[int, int]]] = {}
+    for e in range(n):
+        for k in range(2):
+            at.setdefault(ends[e, k].tobytes(), []).append((e, k))
+    for meeting in at.values():
+        if len(meeting) != 2:
+            continue
+        (a, ka), (b, kb) = meeting
+        da = seg[a, 1 - ka] - seg[a, ka]  # both pointing away from the shared end
+        db = seg[b, 1 - kb] - seg[b, kb]
+        cos = -float(da @ db) / max(float(np.linalg.norm(da) * np.linalg.norm(db)), 1e-12)
+        if cos > np.cos(np.radians(_CHAIN_TURN_DEG)):
+            parent[root(a)] = root(b)
+    return np.array([root(i) for i in range(n)])
+
+
+def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None, *, chains: bool = False):
     """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3) and
-    their clearance (m,) px, every ~4 px. With ``expected`` (h, w, the cell rendered at ``obj2cam``)
-    only where it shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
-    (:func:`_clearance`)."""
+    their clearance (m,) px, every ~4 px; with ``chains`` also each sample's :func:`edge_chains` number
+    (m,). With ``expected`` (h, w, the cell rendered at ``obj2cam``) only where it shows an edge and no
+    other edge it shows passes within :data:`_CROWDED_PX` (:func:`_clearance`)."""
     seg = visible_segments(mesh, obj2cam)
     if len(seg) == 0:
-        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)
+        return (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)) + ((np.zeros(0, dtype=int),) if chains else ())
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
     counts = np.clip(np.floor(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / _SAMPLE_STEP_PX).astype(int) - 1, 0, 500)
     which = np.repeat(np.arange(len(seg)), counts)
     s = np.concatenate([(np.arange(1, c + 1)) / (c + 1) for c in counts]) if counts.sum() else np.zeros(0)
     pts = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]
     far = seg[which, 1]
+    chain = edge_chains(seg)[which] if chains else None
     if expected is None or len(pts) == 0:
-        return pts, far, np.full(len(pts), np.inf)
+        return (pts, far, np.full(len(pts), np.inf)) + ((chain,) if chains else ())
     uv = project_points(pts, obj2cam, intrinsics)
     # where the model's view shows no gradient (two faces of one shade meeting, an edge hidden behind a
     # face) there is no edge to find, and a search there would lock onto the nearest one
@@ -116,7 +156,7 @@ def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.
                      model_shows_edge(None, project_points(seg.mean(axis=1), obj2cam, intrinsics), expected_magnitude))
     clearance = _clearance(uv, ends[shown], np.searchsorted(np.flatnonzero(shown), which), shown[which])
     keep = shows & (clearance > _CROWDED_PX)
-    return pts[keep], far[keep], clearance[keep]
+    return (pts[keep], far[keep], clearance[keep]) + ((chain[keep],) if chains else ())
 
 
 def _clearance(uv: np.ndarray, ends_px: np.ndarray, own: np.ndarray, own_listed: np.ndarray) -> np.ndarray:
@@ -169,7 +209,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast;
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    pts, far, clearance = edge_points(mesh, obj2cam, intrinsics, expected)
+    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected, chains=True)
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False
@@ -231,7 +271,23 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
             converged = True
             break
     try:
-        covariance = sigma**2 * np.linalg.inv(H)
+        H_inv = np.linalg.inv(H)
+        independent = sigma**2 * H_inv
+        covariance = independent if len(offsets) == 0 else H_inv @ _chain_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
     except np.linalg.LinAlgError:
-        covariance = np.full((6, 6), np.nan)
-    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share)
+        independent = covariance = np.full((6, 6), np.nan)
+    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent)
+
+
+def _chain_scatter(J: np.ndarray, weighted_residuals: np.ndarray, chain: np.ndarray, independent: np.ndarray) -> np.ndarray:
+    """The normal equations' scatter (6, 6) with the samples of one chain (:func:`edge_chains`) taken
+    as one measurement (a cluster-robust "sandwich": their offsets share the edge's own error), scaled
+    by G / (G - 1) for G chains; never less than ``independent`` (sigma^2 H, the samples as
+    independent) in any direction: with few chains the clustered scatter alone can come out small."""
+    used = weighted_residuals != 0
+    sums = np.zeros((int(chain.max()) + 1 if len(chain) else 1, 6))
+    np.add.at(sums, chain[used], J[used] * weighted_residuals[used, None])
+    groups = int(np.count_nonzero(np.any(sums != 0, axis=1)))
+    clustered = sums.T @ sums * (groups / max(groups - 1, 1))
+    excess, vectors = np.linalg.eigh(clustered - independent)
+    return independent + (vectors * np.clip(excess, 0, None)) @ vectors.T
