@@ -253,13 +253,15 @@ class CalibrationSession:
     def choose_candidate(self, index: int) -> None:
         self.undo.push(ChooseCandidate(self, index))
 
-    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None) -> Correction:
+    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None, tool_covariance: np.ndarray | None = None) -> Correction:
         """``Store correction`` for a task location from the last solve. A result that is not ``ok``
         (implausible, uncertain, ambiguous) raises :class:`ConfirmationNeeded` unless
         ``confirmation`` says who accepted it and why; that text is stored with the correction.
         ``fused``: the look weighed against a calibrated robot
         (:class:`~calib_core.calibration.look_fusion.FusedCorrection`): stored in the look's place
-        when they agree; when they do not, storing the look alone needs the same confirmation."""
+        when they agree; when they do not, storing the look alone needs the same confirmation.
+        ``tool_covariance`` (6, 6: mm, deg, base axes): a measured tool's, which the look reaches the
+        TCP through; added to a look stored alone (a fused one holds it already)."""
         r = self.result
         if r is None:
             raise CalibrationError("calibrate first")
@@ -281,8 +283,13 @@ class CalibrationSession:
             std = np.sqrt(np.clip(np.diag(fused.covariance), 0.0, None))
             measured, d, rv, std_d, std_r = fused.delta_base @ r.tcp2base_model, fused.displacement_mm, fused.rotation_deg, std[:3], std[3:]
             source += f"; {fused.message}"
-        elif fused is not None:
-            source += f"; the look alone ({fused.message})"
+        else:
+            if fused is not None:
+                source += f"; the look alone ({fused.message})"
+            if tool_covariance is not None and r.covariance is not None:
+                std = np.sqrt(np.clip(np.diag(r.covariance + tool_covariance), 0.0, None))
+                std_d, std_r = std[:3], std[3:]
+                source += "; with the measured tool's uncertainty"
         correction = Correction(
             task, r.tcp2base_model, measured, d, rv, std_d, std_r,
             np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source,

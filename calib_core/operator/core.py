@@ -264,10 +264,16 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     def store_correction(self, *, confirmation: str = ""):
         """Store the last result for the task location. One that is not ``ok`` needs ``confirmation``
         (who accepted it and why: kept with the correction and recorded). With a robot calibration
-        applied, the look is stored fused with the calibrated model (:meth:`look_fused_with_robot`)."""
+        applied, the look is stored fused with the calibrated model (:meth:`look_fused_with_robot`); with a
+        measured tool (:meth:`measure_tool`) its covariance is in the stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        c = self.session.store_correction(self.task.name, confirmation=confirmation, fused=self.look_fused_with_robot(self.session.result))
+        tool, context = getattr(self, "measured_tool", None), self.session.context
+        tool_covariance = None
+        if tool is not None and context is not None and context.joints_deg is not None:
+            tool_covariance = tool.covariance_in_base(self.robot.fk(context.joints_deg, "camera"))
+        c = self.session.store_correction(self.task.name, confirmation=confirmation, fused=self.look_fused_with_robot(self.session.result),
+                                          tool_covariance=tool_covariance)
         if c.confirmation:
             self.record_event("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)

@@ -144,3 +144,20 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     assert s.corrections.latest(task.name) is None  # nothing stored
     c = s.store_correction(task.name, fused=tight, confirmation="the operator checked the image")
     assert np.allclose(c.displacement_mm, look.displacement_mm) and "the look alone" in c.source and c.confirmation
+
+
+def test_a_look_stored_alone_carries_the_measured_tool_s_uncertainty(bed):
+    """A look reaches the TCP through the measured tool: its covariance (here 0.05 mm and 0.01 deg per
+    axis) is in the stored 1-sigma when no calibrated model is weighed against the look."""
+    task = bed.workcell.task("oru_1_grasp")
+    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q_app, noise_px=0.2)
+    look = _calibrate(s, bed, q_app)
+    tool = np.diag([0.05**2] * 3 + [0.01**2] * 3)
+    c = s.store_correction(task.name, tool_covariance=tool)
+    assert np.allclose(c.std_displacement_mm, np.sqrt(look.std_displacement_mm**2 + 0.05**2))
+    assert np.allclose(c.std_rotation_deg, np.sqrt(look.std_rotation_deg**2 + 0.01**2))
+    assert "measured tool" in c.source and np.allclose(c.displacement_mm, look.displacement_mm)
+
