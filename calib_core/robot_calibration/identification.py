@@ -6,7 +6,8 @@ point's reprojection error (px) through the corrected robot's camera pose. The J
 forward differences (each parameter's effect on every pixel); QR with column pivoting on it
 chooses the identifiable subset (:mod:`~calib_core.robot_calibration.observability`); Levenberg-
 Marquardt (``scipy.optimize.least_squares``) fits that subset and the board's placement; the
-covariance is the noise measured by the residuals times the inverse normal matrix.
+covariance is the noise measured by the residuals times the inverse normal matrix, with each view's
+residuals taken as one measurement where they share an error (:mod:`calib_core.solver.clustered_covariance`).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
+from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.pnp_sensitivity import pose_derivatives
 
 OUTLIER_RATIO = 4.0
@@ -281,8 +283,13 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float('nan')
     J = fit.jac
     # The weighted residuals have unit variance when the groups' sigmas are right: scale by what they have.
+    # A view's residuals share its error (a board view's blur and the board's flatness there, an object
+    # pose's edge fit): each view's score is one measurement (clustered_covariance), never less than
+    # the independent residuals' covariance.
     scale2 = float(fit.fun @ fit.fun / dof)
-    cov = scale2 * np.linalg.pinv(J.T @ J)
+    H_inv = np.linalg.pinv(J.T @ J)
+    view_of = np.repeat(np.arange(len(views)), np.diff(bounds))
+    cov = H_inv @ clustered_scatter(J, fit.fun, view_of, scale2 * (J.T @ J)) @ H_inv
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)

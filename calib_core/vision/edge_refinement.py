@@ -18,6 +18,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
+from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
 
@@ -273,21 +274,8 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     try:
         H_inv = np.linalg.inv(H)
         independent = sigma**2 * H_inv
-        covariance = independent if len(offsets) == 0 else H_inv @ _chain_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
+        covariance = independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
     except np.linalg.LinAlgError:
         independent = covariance = np.full((6, 6), np.nan)
     return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent)
 
-
-def _chain_scatter(J: np.ndarray, weighted_residuals: np.ndarray, chain: np.ndarray, independent: np.ndarray) -> np.ndarray:
-    """The normal equations' scatter (6, 6) with the samples of one chain (:func:`edge_chains`) taken
-    as one measurement (a cluster-robust "sandwich": their offsets share the edge's own error), scaled
-    by G / (G - 1) for G chains; never less than ``independent`` (sigma^2 H, the samples as
-    independent) in any direction: with few chains the clustered scatter alone can come out small."""
-    used = weighted_residuals != 0
-    sums = np.zeros((int(chain.max()) + 1 if len(chain) else 1, 6))
-    np.add.at(sums, chain[used], J[used] * weighted_residuals[used, None])
-    groups = int(np.count_nonzero(np.any(sums != 0, axis=1)))
-    clustered = sums.T @ sums * (groups / max(groups - 1, 1))
-    excess, vectors = np.linalg.eigh(clustered - independent)
-    return independent + (vectors * np.clip(excess, 0, None)) @ vectors.T

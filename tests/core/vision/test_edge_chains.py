@@ -4,7 +4,8 @@ import numpy as np
 import trimesh
 
 from calib_core.vision.edge_alignment import crease_segments
-from calib_core.vision.edge_refinement import _chain_scatter, edge_chains
+from calib_core.solver.clustered_covariance import clustered_scatter
+from calib_core.vision.edge_refinement import edge_chains
 
 
 def test_a_box_has_twelve_chains_and_a_cylinder_s_rims_one_each():
@@ -27,10 +28,10 @@ def test_the_chained_scatter_grows_with_a_shared_error_and_never_falls_below_the
     H = J.T @ J
     independent = sigma**2 * H
     # independent offsets, each sample its own chain: the scatter is sigma^2 H (the sandwich is consistent)
-    alone = _chain_scatter(J, rng.normal(0, sigma, m), np.arange(m), independent)
+    alone = clustered_scatter(J, rng.normal(0, sigma, m), np.arange(m), independent)
     assert np.allclose(alone, independent, rtol=0.25, atol=0.25 * sigma**2 * np.abs(H).max())
     # the same noise plus an offset shared by each chain's samples: the scatter grows, in every direction no less
     shared = rng.normal(0, sigma, m) + np.repeat(rng.normal(0, sigma, 20), m // 20)
-    grown = _chain_scatter(J, shared, chain, independent)
+    grown = clustered_scatter(J, shared, chain, independent)
     assert np.trace(grown) > 5 * np.trace(independent)
     assert np.linalg.eigvalsh(grown - independent).min() > -1e-9 * np.trace(grown)
