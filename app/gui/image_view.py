@@ -231,8 +231,8 @@ class ImageView(QWidget):
             p.setPen(QColor(255, 235, 200))
             p.drawText(box.adjusted(8, 0, -8, 0), flags, self.overlay.banner)
         if self._inset is not None:
-            w, h = self._inset.width(), self._inset.height()
-            box = QRectF(self.width() - w - 8, self.height() - h - 34, w, h)
+            marks = [QPointF(*self.image_to_widget(u, v)) for u, v, _, _ in self.overlay.points]
+            box = _inset_box(QRectF(self.rect()), self._inset.width(), self._inset.height(), marks)
             # The inset steps aside while the cursor is over it: a pick under it stays possible.
             if self._mouse is None or not box.contains(self._mouse) or not self.underMouse():
                 p.setOpacity(0.9)
@@ -340,6 +340,17 @@ class ImageView(QWidget):
     def leaveEvent(self, event) -> None:
         self._mouse = None
         self.update()
+
+
+def _inset_box(bounds: QRectF, w: float, h: float, marks: list[QPointF]) -> QRectF:
+    """Where the live inset (``w`` x ``h`` px) goes over the held frame: the bottom-right corner, else
+    the first of bottom-left, top-right and top-left with no mark under it (a proposal or a pick must
+    not hide behind the live video), else the corner with the fewest."""
+    right, left = bounds.right() - w - 8, bounds.left() + 8
+    bottom, top = bounds.bottom() - h - 34, bounds.top() + 48  # clear of the status banner and the overlay's text
+    corners = [QRectF(x, y, w, h) for x, y in ((right, bottom), (left, bottom), (right, top), (left, top))]
+    under = [sum(box.adjusted(-10, -10, 10, 10).contains(m) for m in marks) for box in corners]
+    return corners[under.index(min(under))]
 
 
 def _free_label_box(metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF], bounds: QRectF | None = None) -> QRectF | None:

@@ -5,7 +5,7 @@ import numpy as np
 from PySide6.QtCore import QRectF
 from PySide6.QtGui import QColor, QFont, QFontMetricsF, QImage
 
-from app.gui.image_view import ImageView, Overlay, _free_label_box
+from app.gui.image_view import ImageView, Overlay, _free_label_box, _inset_box
 
 
 def test_labels_of_crowded_marks_take_free_places_and_never_overlap(qapp):
@@ -24,6 +24,22 @@ def test_labels_of_crowded_marks_take_free_places_and_never_overlap(qapp):
     bounds = QRectF(0, 0, 320, 240)
     at_edge = _free_label_box(metrics, 310, 100, "plate_top_right", [], bounds)
     assert bounds.contains(at_edge) and at_edge.right() < 310
+
+
+def test_the_live_inset_leaves_the_corner_where_marks_are(qapp):
+    """Over a held frame the live inset sits bottom right; with proposals there it takes the next free
+    corner, and with marks everywhere the corner with the fewest."""
+    from PySide6.QtCore import QPointF
+
+    bounds = QRectF(0, 0, 800, 600)
+    alone = _inset_box(bounds, 180, 135, [])
+    assert alone.right() > 700 and alone.bottom() > 500
+    marks = [QPointF(740, 500), QPointF(700, 480)]
+    moved = _inset_box(bounds, 180, 135, marks)
+    assert moved.left() < 100 and moved.bottom() > 500 and not any(moved.contains(m) for m in marks)
+    everywhere = [QPointF(x, y) for x in (50, 100, 700, 750) for y in (100, 500)] + [QPointF(60, 110)]
+    fewest = _inset_box(bounds, 180, 135, everywhere)
+    assert sum(fewest.adjusted(-10, -10, 10, 10).contains(m) for m in everywhere) == 2
 
 
 def _blue_pixels(qtbot, labelled: bool) -> int:
