@@ -23,14 +23,14 @@ from calib_core.errors import VideocalError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), or a CSV of image,<joints> views of a board")
+    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, or a folder holding views.csv (and grasps.csv)")
     parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)")
     parser.add_argument("--fixed-intrinsics", action="store_true", help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot")
     parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="with 'sim': which cold cell (its errors are drawn from this)")
     parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
     parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
     parser.add_argument("--intrinsics", type=Path, help="with a CSV: the camera's intrinsics file (default: calibrated from the same views)")
-    parser.add_argument("--grasps", type=Path, help="with a CSV: a CSV of task,<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera")
+    parser.add_argument("--grasps", type=Path, help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)")
     parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -52,6 +52,10 @@ def run(args: argparse.Namespace) -> int:
         counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}
     else:
         grasps = None
+        folder = Path(args.source)
+        if args.grasps is None and folder.is_dir() and (folder / "grasps.csv").is_file():
+            args.grasps = folder / "grasps.csv"
+            print(f"grasps from {args.grasps}", file=sys.stderr)
         if args.grasps is not None:  # read first: a mistake in it is found before the identification's work
             from calib_core.robot_calibration.grasp_file import load_grasps
             from calib_core.workcell import DEFAULT_WORKCELL, load_workcell

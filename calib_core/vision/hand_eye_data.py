@@ -83,10 +83,14 @@ class PosedImages:
 
 
 def load_posed_images(path: str | Path) -> PosedImages:
-    """A ``cal_data.yaml`` (or a folder holding one) or a ``.csv``: see the module's docstring."""
+    """A ``cal_data.yaml`` or a ``.csv``, or a folder holding one (``cal_data.yaml``, else
+    ``views.csv``): see the module's docstring."""
     path = Path(path)
     if path.is_dir():
-        path = path / "cal_data.yaml"
+        found = [path / name for name in ("cal_data.yaml", "views.csv") if (path / name).is_file()]
+        if not found:
+            raise FileFormatError(path, "a folder of views holds cal_data.yaml (ROS-Industrial's layout) or views.csv (image[,component],<joints>)")
+        path = found[0]
     if path.suffix.lower() == ".csv":
         return _load_csv(path)
     return _load_cal_data(path)

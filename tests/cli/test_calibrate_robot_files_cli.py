@@ -123,3 +123,16 @@ def test_a_view_of_a_component_the_cell_does_not_survey_is_named_before_any_work
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert re.search(r"views_bad_component.csv: view cell_\d+: no surveyed component 'no_such_part'.*oru_1_fixture", run.stderr), run.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_holds_the_views_and_the_grasps(files, tmp_path):
+    """``calibrate-robot FOLDER``: its views.csv, and its grasps.csv without --grasps (said so)."""
+    folder, _, grasps, _ = files
+    run = _videocal("calibrate-robot", folder, "--out", tmp_path, "--json")
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "grasps from" in run.stderr and json.loads(run.stdout)["tool"]["grasps"] == len(grasps)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    run = _videocal("calibrate-robot", empty, "--out", tmp_path / "out", timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr and "cal_data.yaml" in run.stderr and "views.csv" in run.stderr
+
