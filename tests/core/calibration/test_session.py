@@ -34,6 +34,16 @@ def _pick_all(session, bed, q, names=FEATURES, noise_px=0.2, seed=0):
         session.pick_2d(pixel)
 
 
+def _look_at_the_approach(bed):
+    """The paper's task location, a session whose picks at its approach (0.2 px noise) are solved, and the look."""
+    task = bed.workcell.task("oru_1_grasp")
+    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q_app, noise_px=0.2)
+    return task, s, _calibrate(s, bed, q_app)
+
+
 def _calibrate(session, bed, q):
     fx = bed.workcell.component("oru_1_fixture")
     return session.calibrate(bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q, "tcp"), q)
@@ -124,12 +134,7 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     from calib_core.calibration.look_fusion import fuse_look
     from calib_core.calibration.session import ConfirmationNeeded
 
-    task = bed.workcell.task("oru_1_grasp")
-    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
-    s = CalibrationSession()
-    s.set_target("oru_1_fixture")
-    _pick_all(s, bed, q_app, noise_px=0.2)
-    look = _calibrate(s, bed, q_app)
+    task, s, look = _look_at_the_approach(bed)
     sigma = np.sqrt(np.diag(look.covariance))
     agreeing = fuse_look(look, np.diag(np.r_[look.displacement_mm, look.rotation_deg] ** 2 + sigma**2))
     assert agreeing.agree
@@ -149,12 +154,7 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
 def test_a_look_stored_alone_carries_the_measured_tool_s_uncertainty(bed):
     """A look reaches the TCP through the measured tool: its covariance (here 0.05 mm and 0.01 deg per
     axis) is in the stored 1-sigma when no calibrated model is weighed against the look."""
-    task = bed.workcell.task("oru_1_grasp")
-    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
-    s = CalibrationSession()
-    s.set_target("oru_1_fixture")
-    _pick_all(s, bed, q_app, noise_px=0.2)
-    look = _calibrate(s, bed, q_app)
+    task, s, look = _look_at_the_approach(bed)
     tool = np.diag([0.05**2] * 3 + [0.01**2] * 3)
     c = s.store_correction(task.name, tool_covariance=tool)
     assert np.allclose(c.std_displacement_mm, np.sqrt(look.std_displacement_mm**2 + 0.05**2))
