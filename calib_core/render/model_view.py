@@ -49,11 +49,11 @@ class ModelView:
             return lambda obj2cam: self.render(items, item2world @ np.linalg.inv(obj2cam))
         own = {i.name: np.array(i.item2world, dtype=float) for i in items if i.name in riding}
         scene = [replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items]  # the caller's items keep their poses
-        model2world = np.linalg.inv(cam2world_model)
+        world2cam_model = np.linalg.inv(cam2world_model)
 
         def expected(obj2cam: np.ndarray) -> np.ndarray:
             cam2world = item2world @ np.linalg.inv(obj2cam)
-            carry = cam2world @ model2world
+            carry = cam2world @ world2cam_model  # the modelled camera onto the one placed here
             return self.render(scene, cam2world, {name: carry @ pose for name, pose in own.items()})
 
         return expected
