@@ -118,10 +118,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     win.show()
     shots = []
 
-    def shot(name: str) -> None:
+    def shot(name: str, widget=None) -> None:
+        """The window (or ``widget``: a dialog of its own) as the operator sees it now, saved as a PNG."""
         _pause(app, 0.3)
         path = out_dir / f"{len(shots) + 1:02d}_{name}.png"
-        win.grab().save(str(path))
+        (widget or win).grab().save(str(path))
         shots.append(path.name)
 
     skipped: list[str] = []
@@ -176,6 +177,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             _wait(app, lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), 30, "the points found")
             dialog = win.finder.dialog
             shot(f"{round_name}_points_found")
+            shot(f"{round_name}_points_found_list", dialog)  # the proposals and what was missed, with the reasons
             if method == "edges":
                 if not dialog.edges_button.isEnabled():
                     raise OperatorError(f"demo ({round_name} look): Find points found no settled edge fit: {dialog.found.result.message}")
