@@ -231,8 +231,9 @@ class ImageView(QWidget):
             p.setPen(QColor(255, 235, 200))
             p.drawText(box.adjusted(8, 0, -8, 0), flags, self.overlay.banner)
         if self._inset is not None:
-            marks = [QPointF(*self.image_to_widget(u, v)) for u, v, _, _ in self.overlay.points]
-            box = _inset_box(QRectF(self.rect()), self._inset.width(), self._inset.height(), marks)
+            marks = [QRectF(x - 10, y - 10, 20, 20) for x, y in (self.image_to_widget(u, v) for u, v, _, _ in self.overlay.points)]
+            w = min(float(self._inset.width()), 0.22 * self.width())  # a small pane keeps most of its frame
+            box = _inset_box(QRectF(self.rect()), w, w * self._inset.height() / self._inset.width(), marks + taken)
             # The inset steps aside while the cursor is over it: a pick under it stays possible.
             if self._mouse is None or not box.contains(self._mouse) or not self.underMouse():
                 p.setOpacity(0.9)
@@ -342,14 +343,17 @@ class ImageView(QWidget):
         self.update()
 
 
-def _inset_box(bounds: QRectF, w: float, h: float, marks: list[QPointF]) -> QRectF:
+def _inset_box(bounds: QRectF, w: float, h: float, obstacles: list[QRectF]) -> QRectF:
     """Where the live inset (``w`` x ``h`` px) goes over the held frame: the bottom-right corner, else
-    the first of bottom-left, top-right and top-left with no mark under it (a proposal or a pick must
-    not hide behind the live video), else the corner with the fewest."""
+    the first of the other corners and the middles of the edges that covers none of ``obstacles`` (the
+    marks and their labels: a proposal or a pick must not hide behind the live video), else the place
+    covering fewest."""
     right, left = bounds.right() - w - 8, bounds.left() + 8
     bottom, top = bounds.bottom() - h - 34, bounds.top() + 48  # clear of the status banner and the overlay's text
-    corners = [QRectF(x, y, w, h) for x, y in ((right, bottom), (left, bottom), (right, top), (left, top))]
-    under = [sum(box.adjusted(-10, -10, 10, 10).contains(m) for m in marks) for box in corners]
+    middle_x, middle_y = (left + right) / 2, (top + bottom) / 2
+    corners = [QRectF(x, y, w, h) for x, y in ((right, bottom), (left, bottom), (right, top), (left, top),
+                                                (right, middle_y), (left, middle_y), (middle_x, bottom), (middle_x, top))]
+    under = [sum(box.intersects(o) for o in obstacles) for box in corners]
     return corners[under.index(min(under))]
 
 

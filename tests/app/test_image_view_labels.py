@@ -27,19 +27,21 @@ def test_labels_of_crowded_marks_take_free_places_and_never_overlap(qapp):
 
 
 def test_the_live_inset_leaves_the_corner_where_marks_are(qapp):
-    """Over a held frame the live inset sits bottom right; with proposals there it takes the next free
-    corner, and with marks everywhere the corner with the fewest."""
-    from PySide6.QtCore import QPointF
-
+    """Over a held frame the live inset sits bottom right; with proposals (their marks or labels) there it
+    takes the next free corner, and with them everywhere the corner covering the fewest."""
     bounds = QRectF(0, 0, 800, 600)
     alone = _inset_box(bounds, 180, 135, [])
     assert alone.right() > 700 and alone.bottom() > 500
-    marks = [QPointF(740, 500), QPointF(700, 480)]
+    marks = [QRectF(730, 490, 20, 20), QRectF(560, 470, 130, 14)]  # a mark, and a label reaching into the corner
     moved = _inset_box(bounds, 180, 135, marks)
-    assert moved.left() < 100 and moved.bottom() > 500 and not any(moved.contains(m) for m in marks)
-    everywhere = [QPointF(x, y) for x in (50, 100, 700, 750) for y in (100, 500)] + [QPointF(60, 110)]
+    assert moved.left() < 100 and moved.bottom() > 500 and not any(moved.intersects(m) for m in marks)
+    corners = [QRectF(x, y, 20, 20) for x in (50, 100, 700, 750) for y in (100, 500)]
+    between = _inset_box(bounds, 180, 135, corners)  # every corner taken: the middle of an edge
+    assert not any(between.intersects(m) for m in corners) and 150 < between.center().y() < 450
+    everywhere = [QRectF(x, y, 20, 20) for x in range(0, 800, 60) for y in range(0, 600, 60)] + [QRectF(700, 500, 20, 20)]
     fewest = _inset_box(bounds, 180, 135, everywhere)
-    assert sum(fewest.adjusted(-10, -10, 10, 10).contains(m) for m in everywhere) == 2
+    right_bottom = QRectF(bounds.right() - 188, bounds.bottom() - 169, 180, 135)
+    assert sum(fewest.intersects(m) for m in everywhere) < sum(right_bottom.intersects(m) for m in everywhere)
 
 
 def _blue_pixels(qtbot, labelled: bool) -> int:
