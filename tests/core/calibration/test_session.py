@@ -34,13 +34,13 @@ def _pick_all(session, bed, q, names=FEATURES, noise_px=0.2, seed=0):
         session.pick_2d(pixel)
 
 
-def _look_at_the_approach(bed):
-    """The paper's task location, a session whose picks at its approach (0.2 px noise) are solved, and the look."""
+def _look_at_the_approach(bed, noise_px=0.2):
+    """The paper's task location, a session whose picks at its approach (``noise_px`` of noise) are solved, and the look."""
     task = bed.workcell.task("oru_1_grasp")
     q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
     s = CalibrationSession()
     s.set_target("oru_1_fixture")
-    _pick_all(s, bed, q_app, noise_px=0.2)
+    _pick_all(s, bed, q_app, noise_px=noise_px)
     return task, s, _calibrate(s, bed, q_app)
 
 
@@ -65,12 +65,8 @@ def test_estimated_displacement_matches_the_truth(bed):
 
 
 def test_stored_correction_brings_the_real_tool_to_the_target(bed):
-    task = bed.workcell.task("oru_1_grasp")
-    q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
-    s = CalibrationSession()
-    s.set_target("oru_1_fixture")
-    _pick_all(s, bed, q_app, noise_px=0.0)
-    _calibrate(s, bed, q_app)
+    task, s, _ = _look_at_the_approach(bed, noise_px=0.0)
+    q_app = s.context.joints_deg
     s.store_correction(task.name)
     # Uncorrected: the real tool misses the grasp by millimetres; corrected: by far less.
     q_plain = solve_ik(bed.model_robot, task.tcp2base, q_app).q_deg
