@@ -21,7 +21,8 @@ class ToolGroup(QGroupBox):
         self.tool = None
         guard = guarded(show_error)
         layout = QVBoxLayout(self)
-        how = QLabel("Gripper closed on the task's pin in compliance (pendant), then Record grasp; two tasks give the spread.")
+        how = QLabel("Gripper closed on the task's pin in compliance (pendant), the camera seeing its fixture, then Record grasp; "
+                     "two tasks give the spread.")
         how.setWordWrap(True)
         layout.addWidget(how)
         row = QHBoxLayout()
@@ -54,7 +55,8 @@ class ToolGroup(QGroupBox):
 
     def measure(self) -> None:
         t = self.tool = self.workbench.measure_tool()
-        self.text.setText(f"TCP from {len(t.per_grasp)} grasps, spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: in use (Revert takes it back)")
+        self.text.setText(f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: "
+                          "in use (Revert takes it back)")
         self.text.setToolTip(f"TCP in the camera frame: {t.tcp2cam[0, 3]:.3f} {t.tcp2cam[1, 3]:.3f} {t.tcp2cam[2, 3]:.3f} mm; saved with the robot calibration")
         self.refresh()
         self.changed()

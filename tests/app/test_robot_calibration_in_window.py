@@ -105,7 +105,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text(), win.statusBar().currentMessage()
     before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
-    assert tool.tool is not None and "TCP from 2 grasps, spread" in tool.text.text()
+    assert tool.tool is not None and "TCP from 2 grasps (2 seen by the camera), spread" in tool.text.text()
     # each grasp was seen on the camera's frame (the held fixture's edges): the tool knows its own
     # uncertainty from those views, better than the survey's 0.05 mm per axis; a stored look adds it
     assert tool.tool.seen_grasps == 2, win.statusBar().currentMessage()
