@@ -128,36 +128,36 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
     return np.array([root(i) for i in range(n)])
 
 
-def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None, *, chains: bool = False):
-    """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3) and
-    their clearance (m,) px, every ~4 px; with ``chains`` also each sample's :func:`edge_chains` number
-    (m,). With ``expected`` (h, w, the cell rendered at ``obj2cam``) only where it shows an edge and no
+def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3),
+    their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With ``expected`` (h, w, the cell rendered at ``obj2cam``) only where it shows an edge and no
     other edge it shows passes within :data:`_CROWDED_PX` (:func:`_clearance`)."""
     seg = visible_segments(mesh, obj2cam)
     if len(seg) == 0:
-        return (np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)) + ((np.zeros(0, dtype=int),) if chains else ())
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
     counts = np.clip(np.floor(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / _SAMPLE_STEP_PX).astype(int) - 1, 0, 500)
     which = np.repeat(np.arange(len(seg)), counts)
     s = np.concatenate([(np.arange(1, c + 1)) / (c + 1) for c in counts]) if counts.sum() else np.zeros(0)
     pts = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]
     far = seg[which, 1]
-    chain = edge_chains(seg)[which] if chains else None
+    chain = edge_chains(seg)[which]
     if expected is None or len(pts) == 0:
-        return (pts, far, np.full(len(pts), np.inf)) + ((chain,) if chains else ())
+        return pts, far, np.full(len(pts), np.inf), chain
     uv = project_points(pts, obj2cam, intrinsics)
     # where the model's view shows no gradient (two faces of one shade meeting, an edge hidden behind a
     # face) there is no edge to find, and a search there would lock onto the nearest one
     expected_magnitude = gradient_magnitude(expected)
-    shows = model_shows_edge(None, uv, expected_magnitude)
+    shows = model_shows_edge(expected_magnitude, uv)
     # the edges that can crowd a sample: those the model's view shows (a rim's facets, too short to
     # hold a sample, by their midpoints)
     sampled = np.bincount(which, minlength=len(seg))
     shown = np.where(sampled > 0, np.bincount(which[shows], minlength=len(seg)) >= 0.5 * sampled,
-                     model_shows_edge(None, project_points(seg.mean(axis=1), obj2cam, intrinsics), expected_magnitude))
+                     model_shows_edge(expected_magnitude, project_points(seg.mean(axis=1), obj2cam, intrinsics)))
     clearance = _clearance(uv, ends[shown], np.searchsorted(np.flatnonzero(shown), which), shown[which])
     keep = shows & (clearance > _CROWDED_PX)
-    return (pts[keep], far[keep], clearance[keep]) + ((chain[keep],) if chains else ())
+    return pts[keep], far[keep], clearance[keep], chain[keep]
 
 
 def _clearance(uv: np.ndarray, ends_px: np.ndarray, own: np.ndarray, own_listed: np.ndarray) -> np.ndarray:
@@ -186,10 +186,9 @@ def _clearance(uv: np.ndarray, ends_px: np.ndarray, own: np.ndarray, own_listed:
     return np.where(meets, np.abs(t), np.inf).min(axis=1)
 
 
-def model_shows_edge(expected: np.ndarray | None, uv: np.ndarray, magnitude: np.ndarray | None = None) -> np.ndarray:
-    """Which pixels (m, 2) of the model's view (h, w) lie on a gradient of at least 12 grey levels a pixel
-    (``magnitude``: the view's :func:`gradient_magnitude`, when it is at hand)."""
-    magnitude = gradient_magnitude(expected) if magnitude is None else magnitude
+def model_shows_edge(magnitude: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Which pixels (m, 2) of the model's view lie on a gradient of at least 12 grey levels a pixel
+    (``magnitude`` (h, w): the view's :func:`gradient_magnitude`, computed once per render)."""
     h, w = magnitude.shape
     inside = (uv[:, 0] >= 0) & (uv[:, 0] < w - 1) & (uv[:, 1] >= 0) & (uv[:, 1] < h - 1)
     u = np.clip(np.rint(uv[:, 0]).astype(int), 0, w - 1)
@@ -210,7 +209,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast;
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected, chains=True)
+    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected)
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False

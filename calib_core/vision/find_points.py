@@ -183,7 +183,7 @@ class _Detectors:
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
         if len(s) < 2:
             return None
-        shows = model_shows_edge(None, corner + s[:, None] * d / length, self.expected_magnitude(obj2cam))
+        shows = model_shows_edge(self.expected_magnitude(obj2cam), corner + s[:, None] * d / length)
         if shows.mean() >= 0.6:
             return far
         run = int(np.argmin(shows)) if not shows.all() else len(shows)
@@ -268,7 +268,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     # model's view and the samples taken afresh there (from a turned start a pin seen end-on can lock
     # its rims onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right
     # pose at 0.13 px).
-    samples, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_image(obj2cam_model) if expected is not None else None)
+    samples, _, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_image(obj2cam_model) if expected is not None else None)
     ranked = rank_starts(edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg)
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]

@@ -60,7 +60,7 @@ def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
     image, intrinsics, item, model, truth, expected = look
     assert _pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
     grey = image.mean(axis=2).astype(np.uint8)
-    samples, _, _ = edge_points(item.mesh, model, intrinsics, expected(model).mean(axis=2).astype(np.uint8))
+    samples, _, _, _ = edge_points(item.mesh, model, intrinsics, expected(model).mean(axis=2).astype(np.uint8))
     start = rank_starts(edge_distance_map(grey, TRUNCATE_PX), intrinsics, samples, model, reach_mm=20.0, reach_deg=1.5)[0]
     fit = refine_to_edges(grey, intrinsics, item.mesh, start, expected=expected(start).mean(axis=2).astype(np.uint8))
     assert fit.converged and fit.samples > 300
