@@ -128,11 +128,13 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
     return np.array([root(i) for i in range(n)])
 
 
-def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.ndarray | None = None
+def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3),
-    their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With ``expected`` (h, w, the cell rendered at ``obj2cam``) only where it shows an edge and no
-    other edge it shows passes within :data:`_CROWDED_PX` (:func:`_clearance`)."""
+    their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With
+    ``expected_magnitude`` (h, w: the :func:`gradient_magnitude` of the cell rendered at ``obj2cam``)
+    only where that view shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
+    (:func:`_clearance`)."""
     seg = visible_segments(mesh, obj2cam)
     if len(seg) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
@@ -143,12 +145,11 @@ def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected: np.
     pts = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]
     far = seg[which, 1]
     chain = edge_chains(seg)[which]
-    if expected is None or len(pts) == 0:
+    if expected_magnitude is None or len(pts) == 0:
         return pts, far, np.full(len(pts), np.inf), chain
     uv = project_points(pts, obj2cam, intrinsics)
     # where the model's view shows no gradient (two faces of one shade meeting, an edge hidden behind a
     # face) there is no edge to find, and a search there would lock onto the nearest one
-    expected_magnitude = gradient_magnitude(expected)
     shows = model_shows_edge(expected_magnitude, uv)
     # the edges that can crowd a sample: those the model's view shows (a rim's facets, too short to
     # hold a sample, by their midpoints)
@@ -203,13 +204,14 @@ def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return out
 
 
-def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected: np.ndarray | None = None, search_px: float = 8.0,
+def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected_magnitude: np.ndarray | None = None, search_px: float = 8.0,
                     iterations: int = 30, magnitude: np.ndarray | None = None) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
-    image's; ``expected`` (h, w) the cell rendered at ``obj2cam``, to leave out edges without contrast;
+    image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
+    ``obj2cam``, to leave out edges without contrast;
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected)
+    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected_magnitude)
     pose = obj2cam.copy()
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False

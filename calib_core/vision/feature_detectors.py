@@ -6,8 +6,8 @@ reason an operator can act on. Pixels are (u, v) with (0, 0) the centre of the t
 - corners: Harris corners in the window (``cv2.goodFeaturesToTrack``), the one nearest the prediction,
   refined by ``cv2.cornerSubPix``; when the refinement walks more than 1.5 px (three faces meeting),
   the Harris position is kept with a lower confidence;
-- circles, with the model's view at the pose the edges found: the rim's edges found along its normals in
-  the image and in the model's view, the rim moved as a whole by their differences
+- circles, with the model's view at the pose the edges found: along the rim's normals the image's
+  gradient profile matched against the model's, the rim moved as a whole by the offsets
   (:func:`detect_circle_against_model`); without a model's view, the strongest gradient along the
   normals of the predicted ellipse (the projected circle, shifted), an ellipse fitted to those edge
   points, and its centre moved by the perspective offset (the image of the circle's centre minus the
@@ -24,6 +24,9 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project, undistort_pixels, unproject
+from calib_core.vision.profile_matching import match_profiles
+
+_ALIKE = 0.5  # the least correlation of a rim point's gradient profile with the model's to measure it by
 
 
 @dataclass(frozen=True)
@@ -149,28 +152,31 @@ def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     ``rim_px`` (m, 2): the rim projected at the pose the edges found (a closed polygon, in order);
     ``centre_px`` (2,): the circle's centre projected at that pose (perspective included);
     ``magnitude`` and ``expected_magnitude`` (h, w): the gradient magnitude of the camera's image and of
-    the model's view rendered at that pose. Along each rim point's normal the strongest edge is found in
-    both, and the offsets are taken as differences, the image's edge less the model's: where the model's
-    own strongest edge is not exactly the rim (a boss's base circle or its side's outline within the
-    window) both are measured on the same edge (an ellipse fitted to the image's edges alone came out
-    0.5-0.9 px off, outward, on every boss). The differences move the rim as a whole (two unknowns, least
-    squares on the normal offsets, outliers dropped), and the centre with it: the perspective is the
-    model's, the place the image's. A point whose model edge lies more than 1.5 px from the rim is left
-    out (its two searches can lock onto different edges: beside the gripper's fingers a boss came out
-    up to 2.5 px off)."""
+    the model's view rendered at that pose. Along each rim point's normal the image's gradient profile
+    is matched against the model's (:func:`~calib_core.vision.profile_matching.match_profiles`): the
+    offset is the image's edge less the model's, wherever the model's own edge lies (a boss's base
+    circle or its side's outline within the window: an ellipse fitted to the image's edges alone came
+    out 0.5-0.9 px off, outward, on every boss), and a side seen edge-on, a thin line with two peaks,
+    is matched as the pair (the strongest of the two picked differently in image and model put a rim
+    1-1.8 px off). The offsets move the rim as a whole (two unknowns, least squares on the normal
+    offsets, outliers dropped), and the centre with it: the perspective is the model's, the place the
+    image's. A point whose model edge lies more than 1.5 px from the rim, or whose profiles are
+    unlike (correlation under 0.5), is left out (beside the gripper's fingers a boss came out up to
+    2.5 px off)."""
     tangent = np.roll(rim_px, -1, axis=0) - np.roll(rim_px, 1, axis=0)
     normals = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-9)
-    found, strength, inside = search_normals(magnitude, rim_px, normals, search_px)
-    modelled, model_strength, _ = search_normals(expected_magnitude, rim_px, normals, search_px)
+    _, strength, inside = search_normals(magnitude, rim_px, normals, search_px)
+    modelled, model_strength, _ = search_normals(expected_magnitude, rim_px, normals, 1.5)
     model_offset = np.einsum("ij,ij->i", modelled - rim_px, normals)
-    usable = inside & (model_strength >= 12.0) & (np.abs(model_offset) <= 1.5)
+    offset, alike = match_profiles(magnitude, expected_magnitude, rim_px, normals, search_px)
+    usable = inside & (model_strength >= 12.0) & (np.abs(model_offset) <= 1.5) & (alike >= _ALIKE)
     if usable.sum() < 6:
-        return NotDetected(f"its rim is outside the image or stands beside another edge in the model's view ({int(usable.sum())} of {len(rim_px)} rim points clear)")
+        return NotDetected(f"its rim is outside the image, stands beside another edge in the model's view or looks unlike it ({int(usable.sum())} of {len(rim_px)} rim points clear)")
     floor = max(8.0, 0.35 * float(np.median(strength[usable])))
     strong = usable & (strength >= floor)
     if strong.sum() < 6:
         return NotDetected(f"its rim has too little contrast ({int(strong.sum())} of {len(rim_px)} edge points)")
-    shift = _rim_shift(normals[strong], np.einsum("ij,ij->i", found[strong] - rim_px[strong], normals[strong]) - model_offset[strong], 0.3)
+    shift = _rim_shift(normals[strong], offset[strong], 0.3)
     if isinstance(shift, NotDetected):
         return shift
     delta, rms, kept = shift

@@ -57,14 +57,11 @@ def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndar
     return moved @ obj2cam
 
 
-def _scores(padded: np.ndarray, uv_px: np.ndarray, offsets_px: np.ndarray) -> np.ndarray:
-    """Mean truncated distance (H, S) of the whole pixels ``uv_px`` (H, m, 2) int moved by each of the
-    whole-pixel ``offsets_px`` (S, 2) int, looked up in ``padded`` (the distance map with a one-pixel
-    border of :data:`TRUNCATE_PX`: anything outside the image lands there)."""
-    h, w = padded.shape[0] - 2, padded.shape[1] - 2
-    u = np.clip(uv_px[:, None, :, 0] + offsets_px[None, :, None, 0], -1, w) + 1
-    v = np.clip(uv_px[:, None, :, 1] + offsets_px[None, :, None, 1], -1, h) + 1
-    return padded.ravel()[v * (w + 2) + u].mean(axis=2)
+def _scores(padded_flat: np.ndarray, base: np.ndarray, offsets_flat: np.ndarray) -> np.ndarray:
+    """Mean truncated distance (H, S) of the samples at the flat indices ``base`` (H, m) of the padded
+    distance map, each moved by every flat offset ``offsets_flat`` (S,) (a move of (du, dv) whole
+    pixels is du + dv times the padded width: the padding holds every move inside the map)."""
+    return padded_flat[base[:, None, :] + offsets_flat[None, :, None]].mean(axis=2)
 
 
 def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, obj2cam: np.ndarray, reach_mm: float, reach_deg: float,
@@ -91,10 +88,18 @@ def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.nda
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
     offsets = np.rint(np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2))  # whole pixels: a chamfer ranking needs no finer
-    padded = np.pad(np.asarray(distance, dtype=np.float32), 1, constant_values=TRUNCATE_PX)
-    # whole pixels, and far outside the image (or behind the camera: NaN) clipped to its border
-    uv_px = np.rint(np.clip(np.nan_to_num(uv, nan=-1e6), -2.0, max(distance.shape) + 2.0)).astype(np.int32)
-    cost = np.concatenate([_scores(padded, chunk, offsets.astype(np.int32)) for chunk in np.array_split(uv_px, max(1, len(uv_px) // 128))])  # (H, S)
+    # whole pixels; anything outside the image (or behind the camera: NaN) clipped to just outside it,
+    # where the padding (wider than any offset) holds the cap
+    h, w = distance.shape
+    pad = int(np.abs(offsets).max()) + 2
+    padded = np.pad(np.asarray(distance, dtype=np.float32), pad, constant_values=TRUNCATE_PX)
+    uv_px = np.rint(np.nan_to_num(uv, nan=-1e6).clip(-1e6, 1e6)).astype(np.int64)
+    u = np.clip(uv_px[..., 0], -1, w) + pad
+    v = np.clip(uv_px[..., 1], -1, h) + pad
+    base = v * padded.shape[1] + u  # (H, m)
+    offsets_flat = (offsets[:, 1] * padded.shape[1] + offsets[:, 0]).astype(np.int64)
+    flat = padded.ravel()
+    cost = np.concatenate([_scores(flat, chunk, offsets_flat) for chunk in np.array_split(base, max(1, len(base) // 128))])  # (H, S)
     # the unmoved pose wins a tie
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []

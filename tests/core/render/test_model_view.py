@@ -50,3 +50,30 @@ def test_the_gripper_rides_on_the_camera_s_joint():
     riding = visuals.riding_with("camera")
     assert any(name.startswith("robot/gripper") for name in riding)
     assert not any(name.startswith("robot/link_1") for name in riding)
+
+
+def test_a_box_rendered_alone_matches_the_whole_image_there_through_a_distorting_lens():
+    """The box of a view (the target and a margin, what Find points renders) is the whole view's
+    pixels there, with the lens's distortion: the box's pinhole camera sees exactly the ideal pixels
+    the distortion map samples. Outside the box the image is black."""
+    intrinsics = Intrinsics(900.0, 900.0, 330.0, 250.0, 640, 480, distortion=(-0.25, 0.1, 0.001, -0.001, 0.0))
+    plate = SceneItem(name="plate", mesh=trimesh.creation.box((120.0, 80.0, 10.0)), item2world=make_transform(np.eye(3), [30.0, -20.0, 400.0]), color=(0.8, 0.5, 0.2))
+    boss = SceneItem(name="boss", mesh=trimesh.creation.cylinder(radius=12.0, height=20.0), item2world=make_transform(np.eye(3), [40.0, -10.0, 385.0]),
+                     color=(0.2, 0.6, 0.9))
+    view = ModelView(intrinsics)
+    try:
+        expected = view.of([plate, boss], plate.item2world)
+        obj2cam = plate.item2world.copy()
+        whole = expected(obj2cam)
+        box = (300, 150, 520, 330)  # across the plate's right edge, far from the centre (strong distortion)
+        part = expected(obj2cam, box_px=box)
+        u0, v0, u1, v1 = box
+        inside = whole[v0:v1, u0:u1].astype(int)
+        assert inside.std() > 20  # the box holds the plate's edge and the boss, not one flat face
+        assert np.abs(part[v0:v1, u0:u1].astype(int) - inside).max() <= 2
+        assert part[:v0].max() == 0 and part[:, u1:].max() == 0
+        # a box reaching past the image is clipped to it
+        clipped = expected(obj2cam, box_px=(600, -20, 700, 40))
+        assert np.abs(clipped[0:40, 600:640].astype(int) - whole[0:40, 600:640].astype(int)).max() <= 2
+    finally:
+        view.close()

@@ -14,6 +14,7 @@ from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
 from calib_core.vision.edge_alignment import edge_distance_map
 from calib_core.vision.edge_refinement import edge_points, refine_to_edges
+from calib_core.vision.feature_detectors import gradient_magnitude
 from calib_core.vision.find_points import find_points
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX, rank_starts
 
@@ -60,9 +61,9 @@ def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
     image, intrinsics, item, model, truth, expected = look
     assert _pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
     grey = image.mean(axis=2).astype(np.uint8)
-    samples, _, _, _ = edge_points(item.mesh, model, intrinsics, expected(model).mean(axis=2).astype(np.uint8))
+    samples, _, _, _ = edge_points(item.mesh, model, intrinsics, gradient_magnitude(expected(model).mean(axis=2).astype(np.uint8)))
     start = rank_starts(edge_distance_map(grey, TRUNCATE_PX), intrinsics, samples, model, reach_mm=20.0, reach_deg=1.5)[0]
-    fit = refine_to_edges(grey, intrinsics, item.mesh, start, expected=expected(start).mean(axis=2).astype(np.uint8))
+    fit = refine_to_edges(grey, intrinsics, item.mesh, start, expected_magnitude=gradient_magnitude(expected(start).mean(axis=2).astype(np.uint8)))
     assert fit.converged and fit.samples > 300
     errors = _pixel_errors(item, fit.obj2cam, truth, intrinsics)
     assert errors.max() < 0.2, errors
