@@ -31,7 +31,8 @@ def match_profiles(magnitude: np.ndarray, expected_magnitude: np.ndarray, points
     ``magnitude`` and ``expected_magnitude`` (h, w): the gradient magnitudes of the camera's image
     and of the model's view. The model's profile over +-``half_px`` is slid over the image's within
     +-``search_px``; the shift of the best normalised correlation, refined by a parabola through its
-    neighbours, is the offset (positive along the normal). A flat profile has a correlation of 0."""
+    neighbours, is the offset (positive along the normal). A flat profile, and a best match at the
+    search's end (the edge may lie beyond it), have a correlation of 0."""
     model = _profiles(expected_magnitude, points_px, normals, half_px)  # (m, w)
     image = _profiles(magnitude, points_px, normals, half_px + search_px)  # (m, w + 2 k)
     width = model.shape[1]
@@ -48,4 +49,5 @@ def match_profiles(magnitude: np.ndarray, expected_magnitude: np.ndarray, points
     denom = left - 2 * mid + right
     sub = np.where((k == kk) & (denom < 0), 0.5 * (left - right) / np.where(denom < 0, denom, -1.0), 0.0)
     offset = (k + sub) * _STEP_PX - search_px
-    return offset, correlation[rows, k]
+    # a best match at the search's end may lie beyond it: not measured
+    return offset, np.where((k > 0) & (k < shifts - 1), correlation[rows, k], 0.0)
