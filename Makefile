@@ -15,6 +15,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/python -m calib_core.solver.compile_kernels  # numba's cache: the first Calibrate does not wait 2-9 s for it
 	@touch $(STAMP)
 
 venv: $(STAMP)

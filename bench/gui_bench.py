@@ -110,6 +110,7 @@ def main() -> str:
 
     from app.gui.demo import METHODS
     from app.gui.main_window import MainWindow
+    from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
     from calib_core.camera.projection import project
     from calib_core.frames import apply, invert
@@ -136,6 +137,7 @@ def main() -> str:
     _video_file(video, seconds=20.0)  # frames until the picks at the end (a pick needs a frame newer than the settled robot)
     win.start_camera(lambda: OpenCVSource(str(video)))
     win.show()
+    warm_solver_in_background()  # as videocal gui does: the solves below do not wait for the kernels' loading
     _spin(app, 2.0)
     # 2. Camera pane fps on a 30 fps 1280 x 960 file while the overview follows a 50 Hz joint stream and the robot moves.
     shown_frames = []

@@ -91,6 +91,7 @@ METHODS = ("find-points", "picks", "edges")
 
 def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points") -> dict:
     from app.gui.main_window import MainWindow
+    from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
     from calib_core.workcell import load_workcell
 
@@ -116,6 +117,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     win.resize(1600, 1000)
     win.start_camera(site.camera_factory())
     win.show()
+    warm_solver_in_background()  # as videocal gui does
     shots = []
 
     def shot(name: str, widget=None) -> None:

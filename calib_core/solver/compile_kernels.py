@@ -1,0 +1,62 @@
+"""Compile the solver's numba kernels once, into numba's on-disk cache, so the operator's first solve
+does not wait for them.
+
+Each kernel compiles on its first call with a new type signature and is cached beside its source
+(``__pycache__``) for every later process. On a fresh install that first call is the operator's first
+Calibrate: the window froze for 2-9 s on a 2-core machine (four pairs take one compiled path, six
+another, a robust solve a third). ``make venv`` runs this after installing; ``python -m
+calib_core.solver.compile_kernels`` does it by hand and prints how long it took.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.solver import solve_pose
+from calib_core.solver.batch import solve_pose_batch
+
+
+def _scene(n: int, rng: np.random.Generator, planar: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` points (n, 3) mm of a 150 mm object and the (4, 4) pose that puts it 500 mm in front."""
+    points = rng.uniform(-75.0, 75.0, (n, 3))
+    if planar:
+        points[:, 2] = 0.0
+    obj2cam = np.eye(4)
+    obj2cam[:3, 3] = (10.0, -5.0, 500.0)
+    return points, obj2cam
+
+
+def _pixels(points: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    cam = points @ obj2cam[:3, :3].T + obj2cam[:3, 3]
+    return np.column_stack([intrinsics.fu * cam[:, 0] / cam[:, 2] + intrinsics.cx, intrinsics.fv * cam[:, 1] / cam[:, 2] + intrinsics.cy])
+
+
+def compile_kernels() -> float:
+    """Run one solve down each compiled path (pinhole and distorted, four to six pairs, coplanar,
+    focal lengths estimated, robust, a batch); returns the seconds it took."""
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(0)
+    pinhole = Intrinsics(1100.0, 1100.0, 640.0, 480.0, 1280, 960)
+    distorted = Intrinsics(1100.0, 1100.0, 640.0, 480.0, 1280, 960, distortion=(-0.1, 0.05, 0.0, 0.0, 0.0))
+    for n, planar in ((4, False), (5, False), (6, False), (12, False), (4, True), (8, True)):
+        points, obj2cam = _scene(n, rng, planar)
+        uv = _pixels(points, obj2cam, pinhole) + rng.normal(0.0, 0.2, (n, 2))
+        solve_pose(points, uv, pinhole, sigma_px=0.5)
+        solve_pose(points, uv, distorted, sigma_px=0.5)
+        solve_pose(points, uv, pinhole, prior=obj2cam, sigma_px=0.5)
+        if n >= 6:
+            solve_pose(points, uv, pinhole, estimate_focal=True)
+    points, obj2cam = _scene(40, rng)
+    uv = _pixels(points, obj2cam, pinhole) + rng.normal(0.0, 0.3, (40, 2))
+    uv[:8] = rng.uniform(0.0, 900.0, (8, 2))
+    solve_pose(points, uv, pinhole, robust=True, sigma_px=0.5)
+    scenes = [_scene(6, rng) for _ in range(4)]
+    solve_pose_batch(np.array([p for p, _ in scenes]), np.array([_pixels(p, T, pinhole) for p, T in scenes]), pinhole)
+    return time.perf_counter() - t0
+
+
+if __name__ == "__main__":
+    print(f"the solver's kernels compiled (or found in numba's cache) in {compile_kernels():.1f} s")
