@@ -57,11 +57,13 @@ def _visible_features(component, cam2world: np.ndarray, intrinsics) -> list[str]
     return names
 
 
-def _wait(app: QApplication, condition, timeout_s: float, what: str) -> None:
+def _wait(app: QApplication, condition, timeout_s: float, what: str, state=None) -> None:
+    """Process events until ``condition()``; after ``timeout_s`` a TimeoutError naming ``what`` and,
+    when given, ``state()`` (what the window and the robot say then)."""
     deadline = time.monotonic() + timeout_s
     while not condition():
         if time.monotonic() > deadline:
-            raise TimeoutError(f"demo: timed out waiting for {what}")
+            raise TimeoutError(f"demo: timed out waiting for {what}" + (f" ({state()})" if state is not None else ""))
         app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 20)
         time.sleep(0.01)
 
@@ -140,6 +142,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
 
         def at(target) -> bool:
             return np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]) < 0.01
+
+        def where(target):
+            """What a move's timeout reports: the motion's state, the distance left, the status line."""
+            return lambda: (f"motion {wb.motion.motion.value}, {np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]):.3f} mm from the target; "
+                            f"status: {win.results.status.text()!r}")
 
         def settle(what: str) -> None:
             # a frame the core accepts for picks (the robot settled before it, its own rule), captured after the
@@ -247,20 +254,21 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         # measured where it is used. Moving by the correction changes the robot's error a little (its joints
         # change), so a second look from the corrected location refines it.
         go(win.commands.go_task)
-        _wait(app, lambda: at(task.tcp2base), 60, "the robot at the task location")
+        _wait(app, lambda: at(task.tcp2base), 60, "the robot at the task location", where(task.tcp2base))
         settle("at the task location")
         shot("at_task")
         q_first = wb.joints_deg.copy()
         pick_and_calibrate("first")
         first = wb.session.result
         go(win.commands.go_corrected)
-        _wait(app, lambda: at(wb.session.corrections.corrected_target(task.name, task.tcp2base)), 60, "the robot at the corrected task location")
+        once = wb.session.corrections.corrected_target(task.name, task.tcp2base)
+        _wait(app, lambda: at(once), 60, "the robot at the corrected task location", where(once))
         settle("at the corrected task location")
         q_measured = wb.joints_deg.copy()
         pick_and_calibrate("second")
         go(win.commands.go_corrected)
         corrected = wb.session.corrections.corrected_target(task.name, task.tcp2base)
-        _wait(app, lambda: at(corrected), 60, "the robot at the twice-corrected task location")
+        _wait(app, lambda: at(corrected), 60, "the robot at the twice-corrected task location", where(corrected))
         shot("at_corrected_task")
         r = wb.session.result
         d_true, r_true = pose_difference(bed.true_robot.fk(q_measured), bed.model_robot.fk(q_measured))

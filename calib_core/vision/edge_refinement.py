@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.camera.projection import project_points
+from calib_core.camera.projection import project, project_points
 from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
@@ -204,6 +204,23 @@ def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return out
 
 
+def normal_jacobian(points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """The derivative (m, 6) of each point's (m, 3, object frame, mm) pixel along its unit normal
+    (m, 2) in the pose's six small motions (the rotation vector in rad, then the translation in mm,
+    both in the camera frame, applied as :func:`_perturbed` does). The pixel's derivative in the
+    camera-frame point (central differences through the lens, three directions) times the point's in
+    the motion (``-[X]x`` for a turn, the identity for a move)."""
+    X = points_mm @ obj2cam[:3, :3].T + obj2cam[:3, 3]
+    h = 1e-3  # mm, at 100-1000 mm: the lens's curvature is far below the pixel's
+    d_uv = np.empty((len(X), 2, 3))
+    for k in range(3):
+        step = np.zeros(3)
+        step[k] = h
+        d_uv[:, :, k] = (project(X + step, intrinsics) - project(X - step, intrinsics)) / (2 * h)
+    d_offset = np.einsum("mi,mik->mk", normals, d_uv)  # (m, 3): the normal offset per mm of the point
+    return np.column_stack([np.cross(X, d_offset), d_offset])  # n . D (w x X) = (X x (n D)) . w
+
+
 def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected_magnitude: np.ndarray | None = None, search_px: float = 8.0,
                     iterations: int = 30, magnitude: np.ndarray | None = None) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
@@ -239,14 +256,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         sigma = max(mad, 0.05)
         c = _TUKEY * sigma
         wts = np.where(ok & (np.abs(r) < c), (1 - (r / c) ** 2) ** 2, 0.0)
-        # Jacobian of each sample's normal offset in the pose's six small motions (central differences)
-        J = np.empty((len(pts), 6))
-        for k in range(6):
-            step = np.zeros(6)
-            step[k] = 1e-5 if k < 3 else 1e-3
-            plus = project_points(pts, _perturbed(pose, step), intrinsics)
-            minus = project_points(pts, _perturbed(pose, -step), intrinsics)
-            J[:, k] = np.einsum("ij,ij->i", (plus - minus) / (2 * step[k]), normals)
+        J = normal_jacobian(pts, pose, normals, intrinsics)
         H = J.T @ (wts[:, None] * J)
         g = J.T @ (wts * r)
         try:

@@ -29,6 +29,7 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import crease_segments, edge_distance_map, edge_samples_px, matched_share
+from calib_core.vision.corner_against_model import detect_corner_against_model
 from calib_core.vision.edge_refinement import EdgeFit, edge_points, model_shows_edge, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_circle_against_model, detect_corner, detect_corner_from_edges, gradient_magnitude
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -40,10 +41,12 @@ REACH_DEG = 1.5
 """How far the camera may be turned from where the model puts it: a typical robot's error (0.7 deg), twice."""
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
-_MODEL_BIAS_PX = 0.5
 _CLEAR_SHARE = 0.75  # a settled fit with this share of its samples on their edges ends the search (a wrong minimum found 53 %, the right one 90 %)
 _BOX_MARGIN_PX = 24.0  # the widest search from an edge (8 px) and the corner's arms' windows, twice
 _REUSE_PX = 0.25
+_COARSE = 0.5
+_DETAIL_SAMPLES = 2  # the test bed's camera integrates 2 x 2 (a real one its whole pixel area)
+_DETAIL_MARGIN_PX = 12.0  # a detector's search (3 px), its profile's half (3 px) and the gradient's reach
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
@@ -172,7 +175,7 @@ class _Detectors:
             lo, hi = np.floor(corners.min(axis=0)) - _BOX_MARGIN_PX, np.ceil(corners.max(axis=0)) + _BOX_MARGIN_PX
             h, w = self.grey.shape
             self._box = (max(int(lo[0]), 0), max(int(lo[1]), 0), min(int(hi[0]) + 1, w), min(int(hi[1]) + 1, h))
-            self._rendered = (obj2cam.copy(), as_grey(self.expected(obj2cam, box_px=self._box)))
+            self._rendered = (obj2cam.copy(), as_grey(self.expected(obj2cam, box_px=self._box, supersample=_COARSE)))
             self._expected_magnitude = None
         return self._rendered[1]
 
@@ -186,6 +189,21 @@ class _Detectors:
             if u1 > u0 and v1 > v0:
                 self._expected_magnitude[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
         return self._expected_magnitude
+
+    def detail_magnitude(self, obj2cam: np.ndarray, points_px: np.ndarray) -> np.ndarray:
+        """The gradient magnitude (h, w) of the model's view at ``obj2cam``, supersampled
+        (:data:`_DETAIL_SAMPLES`) in the box round ``points_px`` (m, 2) and :data:`_DETAIL_MARGIN_PX`,
+        zero elsewhere: what a feature's detector measures the image against (a camera's pixels
+        integrate over their area; the plain view's edges are staircases)."""
+        lo = np.floor(points_px.min(axis=0) - _DETAIL_MARGIN_PX).astype(int)
+        hi = np.ceil(points_px.max(axis=0) + _DETAIL_MARGIN_PX).astype(int) + 1
+        h, w = self.grey.shape
+        u0, v0, u1, v1 = max(lo[0], 0), max(lo[1], 0), min(hi[0], w), min(hi[1], h)
+        out = np.zeros((h, w), dtype=np.float32)
+        if u1 > u0 and v1 > v0:
+            image = as_grey(self.expected(obj2cam, box_px=(u0, v0, u1, v1), supersample=_DETAIL_SAMPLES))
+            out[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
+        return out
 
     def rendered_pose(self) -> np.ndarray | None:
         """The pose (4, 4) of the last model's view rendered."""
@@ -221,23 +239,19 @@ class _Detectors:
                 if self.expected is not None:  # only the arms, or their stretches, along which the model shows an edge
                     shown = [self._visible_arm(uv, f, obj2cam) for f in far]
                     far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
+                if self.expected is not None:
+                    # against the model's view: its chamfers, its plate's thickness and its silhouettes are the image's
+                    reach = [uv + min(float(np.linalg.norm(f - uv)), 40.0) * (f - uv) / max(float(np.linalg.norm(f - uv)), 1e-9) for f in far]
+                    detail = self.detail_magnitude(obj2cam, np.vstack([uv[None], *[r[None] for r in reach]]))
+                    return detect_corner_against_model(self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5))
                 found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
-                if self.expected is not None and isinstance(found, Detection):
-                    # The same lines in the model's view at this pose: where its own arms meet well off
-                    # the corner (a neighbouring edge within the window: a plate's back top edge 3 px
-                    # behind its front one), the image's do alike, and that much is taken off. Nearer
-                    # than _MODEL_BIAS_PX it is the rendering's own aliasing, which would only add noise.
-                    modelled = detect_corner_from_edges(self.expected_image(obj2cam), uv, list(far), search_px=radius, magnitude=self.expected_magnitude(obj2cam),
-                                                        lens=self.intrinsics)
-                    if isinstance(modelled, Detection) and np.linalg.norm(modelled.uv_px - uv) > _MODEL_BIAS_PX:
-                        return Detection(found.uv_px - (modelled.uv_px - uv), min(found.confidence, modelled.confidence))
-                if isinstance(found, Detection) or self.expected is not None:
+                if isinstance(found, Detection):
                     return found
             return detect_corner(self.grey, uv, radius)
         if kind.kind == "circle":
             rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
             if self.expected is not None:
-                return detect_circle_against_model(self.magnitude, self.expected_magnitude(obj2cam), rim, uv, search_px=max(radius, 1.5))
+                return detect_circle_against_model(self.magnitude, self.detail_magnitude(obj2cam, rim), rim, uv, search_px=max(radius, 1.5))
             return detect_circle(self.grey, rim, offset, search_px=radius, magnitude=self.magnitude)
         return detect_blob(self.grey, uv, max(radius, 6.0))
 
