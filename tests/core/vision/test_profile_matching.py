@@ -43,9 +43,9 @@ def test_offsets_round_trip_a_known_shift_of_a_step_edge_both_ways():
         image = gradient_magnitude(np.tile(step, (80, 1)).astype(np.uint8))
         points = np.column_stack([np.full(10, 40.0), np.arange(35.0, 45.0)])
         offset, _ = match_profiles(image, model, points, np.tile([1.0, 0.0], (10, 1)), search_px=2.5)
-        assert np.allclose(offset, shift, atol=0.15), (shift, offset)
+        assert np.allclose(offset, shift, atol=0.08), (shift, offset)  # a parabola through half-pixel samples (pixel locking): 0.04-0.07
         back, _ = match_profiles(model, image, points, np.tile([1.0, 0.0], (10, 1)), search_px=2.5)
-        assert np.allclose(back, -shift, atol=0.15), (shift, back)
+        assert np.allclose(back, -shift, atol=0.08), (shift, back)
 
 
 def test_an_edge_beyond_the_search_is_not_measured():
