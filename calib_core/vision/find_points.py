@@ -87,6 +87,9 @@ class FoundPoints:
     seconds: float = 0.0
     edges: EdgeFit | None = None
     """The edge refinement's result (the pose the detections were checked against), when it ran."""
+    edge_seconds: float = 0.0
+    """The time the edges took: the search for where to start, the refinement, its second pass and its
+    check from the features' pose (s)."""
 
 
 def as_grey(image: np.ndarray) -> np.ndarray:
@@ -303,6 +306,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     # model's view and the samples taken afresh there (from a turned start a pin seen end-on can lock
     # its rims onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right
     # pose at 0.13 px).
+    t_edges = time.perf_counter()
     samples, _, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_magnitude(obj2cam_model) if expected is not None else None)
     ranked = rank_starts(edge_distance_map(grey, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg)
     centre = item.mesh.vertices.mean(axis=0)[None]
@@ -320,6 +324,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
             break
     again = refined(best.obj2cam)  # the second pass, for the best start only
     edge_fit = again if again.settled or _fit_rank(again) > _fit_rank(best) else best
+    edge_seconds = time.perf_counter() - t_edges
     if not edge_fit.settled:
         # Not there, or the edges did not settle: detections in wide windows would lock onto neighbouring
         # edges, and a wrong proposal costs the operator more than a pick by hand.
@@ -331,7 +336,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
             message = (f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
                        f"{edge_fit.samples} edge samples on their edges): pick the points by hand")
         return FoundPoints(item.name, False, message, missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
-                           seconds=time.perf_counter() - t0, edges=edge_fit)
+                           seconds=time.perf_counter() - t0, edges=edge_fit, edge_seconds=edge_seconds)
     start = edge_fit.obj2cam
     # The detectors measure against the model's view at the pose they predict from; the second pass's
     # view serves when its fit moved the target less than _REUSE_PX from there (a render saved: a
@@ -356,16 +361,18 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         # features put them at (a plate cut by the image's border, its faint rims holding the rest:
         # 1.1 mm off with 0.1 mm sigma, 84 % on their edges; from the features' pose 96 %): the edges
         # again from there, and the fit with more samples on their edges is kept.
+        t_across = time.perf_counter()
         across = refine_to_edges(grey, intrinsics, item.mesh, pose, expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
                                  magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX)
         if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
             edge_fit = across
+        edge_seconds += time.perf_counter() - t_across
     if pose is None:
         for i, d in first.items():
             missed.setdefault(names[i], d.reason if isinstance(d, NotDetected) else "no pose fits the detections")
         return FoundPoints(item.name, False, f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: "
                            "pick the points by hand, or Calibrate on edges (its edges settled)",
-                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0, edges=edge_fit)
+                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0, edges=edge_fit, edge_seconds=edge_seconds)
     final_pose, second = pose, first
     proposals = []
     uv_final = project_points(points, final_pose, intrinsics)
@@ -381,7 +388,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     found = len(proposals) >= 4
     message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
                if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
-    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit)
+    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit, edge_seconds)
 
 
 def _moved_px(points_mm: np.ndarray, a: np.ndarray, b: np.ndarray, intrinsics: Intrinsics) -> float:

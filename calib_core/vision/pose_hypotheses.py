@@ -36,6 +36,7 @@ _ROLL_STEPS = 5
 _TURN_STEPS = 7
 _MAX_SAMPLES = 150
 _DISTINCT_PX = 6.0
+_RESCORED = 600
 
 
 def turned_camera(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
@@ -99,12 +100,19 @@ def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.nda
     base = v * padded.shape[1] + u  # (H, m)
     offsets_flat = (offsets[:, 1] * padded.shape[1] + offsets[:, 0]).astype(np.int64)
     flat = padded.ravel()
-    cost = np.concatenate([_scores(flat, chunk, offsets_flat) for chunk in np.array_split(base, max(1, len(base) // 128))])  # (H, S)
+    # every candidate on a third of the samples, the best few hundred again on all of them (the coarse
+    # score only has to keep the right one among those)
+    coarse = base[:, : max(10, base.shape[1] // 3)]
+    rough = np.concatenate([_scores(flat, chunk, offsets_flat) for chunk in np.array_split(coarse, max(1, len(coarse) // 128))])  # (H, S)
+    best = np.argpartition(rough, min(_RESCORED, rough.size) - 1, axis=None)[:_RESCORED]
+    rows, cols = np.unravel_index(best, rough.shape)
+    cost = np.full(rough.shape, np.inf, dtype=np.float32)
+    cost[rows, cols] = flat[base[rows] + offsets_flat[cols][:, None]].mean(axis=1)
     # the unmoved pose wins a tie
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []
-    flat = np.argsort(cost, axis=None, kind="stable")
-    for i, s in zip(*np.unravel_index(flat[: 50 * keep], cost.shape)):
+    order = np.argsort(cost, axis=None, kind="stable")
+    for i, s in zip(*np.unravel_index(order[: 50 * keep], cost.shape)):
         seen = uv[i] + offsets[s]
         if all(np.nanmean(np.linalg.norm(seen - (uv[j] + offsets[k]), axis=1)) > _DISTINCT_PX for j, k in chosen):
             chosen.append((int(i), int(s)))
