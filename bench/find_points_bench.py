@@ -24,7 +24,8 @@ from calib_core.robot.errors import UnreachableTargetError
 from calib_core.testbed.test_bed import TestBed
 from calib_core.testbed.true_robot import RobotErrors
 from calib_core.vision.edge_solution import edge_solution
-from calib_core.vision.find_points import find_points, rim_points_mm
+from calib_core.vision.find_points import find_points
+from calib_core.vision.target_detectors import rim_points_mm
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "find_points.md"
 TARGET = "oru_1_fixture"

@@ -109,7 +109,7 @@ class Picking:
 
         from calib_core.camera.projection import project_points
         from calib_core.vision.feature_detectors import Detection, detect_circle
-        from calib_core.vision.find_points import circle_rim, as_grey
+        from calib_core.vision.target_detectors import as_grey, circle_rim
 
         pending = self.session.pairs.pending()
         target = self.session.target

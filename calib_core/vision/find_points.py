@@ -6,10 +6,12 @@
    ranked by how well the target's edges lie on the image's (:mod:`calib_core.vision.pose_hypotheses`).
 3. Refine the pose on the image's gradients from the best few (:mod:`calib_core.vision.edge_refinement`);
    the fit with the most samples on their edges is kept, and nothing is proposed unless it settles.
-4. Detect each feature by its kind (:mod:`calib_core.vision.feature_detectors`) in a window of three
-   times the edges' scatter around its projection; drop detections more than 1 px from where the
-   edges put them; a robust pose fit (sampled by confidence, PROSAC) rejects the remaining wrong ones.
-   What survives is proposed with its confidence; what does not is listed with the reason.
+4. Detect each feature by its kind (:mod:`calib_core.vision.target_detectors`: with the model's view,
+   a corner's edges and a circle's rim measured against it) in a window of three times the edges'
+   scatter around its projection; drop detections more than 1 px from where the edges put them; a
+   robust pose fit (sampled by confidence, PROSAC) rejects the remaining wrong ones. What survives is
+   proposed with its confidence; what does not is listed with the reason. The edges run once more
+   from the features' pose, and the fit with more samples on their edges is the one reported.
 
 The result never moves anything: the operator accepts, rejects or drags the proposals.
 """
@@ -19,7 +21,6 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-import cv2
 import numpy as np
 import trimesh
 
@@ -28,10 +29,10 @@ from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
-from calib_core.vision.edge_alignment import crease_segments, edge_distance_map, edge_samples_px, matched_share
-from calib_core.vision.corner_against_model import detect_corner_against_model
-from calib_core.vision.edge_refinement import EdgeFit, edge_points, model_shows_edge, refine_to_edges
-from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_circle_against_model, detect_corner, detect_corner_from_edges, gradient_magnitude
+from calib_core.vision.edge_alignment import edge_distance_map, edge_samples_px, matched_share
+from calib_core.vision.edge_refinement import EdgeFit, edge_points, refine_to_edges
+from calib_core.vision.feature_detectors import Detection, NotDetected
+from calib_core.vision.target_detectors import TargetDetectors, as_grey
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
@@ -42,11 +43,7 @@ REACH_DEG = 1.5
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
 _CLEAR_SHARE = 0.75  # a settled fit with this share of its samples on their edges ends the search (a wrong minimum found 53 %, the right one 90 %)
-_BOX_MARGIN_PX = 24.0  # the widest search from an edge (8 px) and the corner's arms' windows, twice
 _REUSE_PX = 0.25
-_COARSE = 0.5
-_DETAIL_SAMPLES = 2  # the test bed's camera integrates 2 x 2 (a real one its whole pixel area)
-_DETAIL_MARGIN_PX = 12.0  # a detector's search (3 px), its profile's half (3 px) and the gradient's reach
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
@@ -92,10 +89,6 @@ class FoundPoints:
     check from the features' pose (s)."""
 
 
-def as_grey(image: np.ndarray) -> np.ndarray:
-    return image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
-
-
 def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> np.ndarray:
     """Which feature points (n, 3) a camera at ``obj2cam`` sees, not hidden by the mesh itself: no
     triangle crosses the segment from the camera to the point short of it (Moller-Trumbore over every
@@ -120,143 +113,6 @@ def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> 
         hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < length - 1.0)
         out[k] = not hit.any()
     return out
-
-
-def rim_points_mm(point: np.ndarray, kind: FeatureKind, count: int = 48) -> np.ndarray:
-    """``count`` points (count, 3) mm evenly round the rim of a circle feature centred at ``point``
-    (3,) mm, in the component's frame."""
-    n = np.asarray(kind.normal)
-    a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
-    a /= np.linalg.norm(a)
-    b = np.cross(n, a)
-    angles = np.linspace(0, 2 * np.pi, count, endpoint=False)
-    return point + kind.radius_mm * (np.cos(angles)[:, None] * a + np.sin(angles)[:, None] * b)
-
-
-def circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
-    """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
-    rim = project_points(rim_points_mm(point, kind), obj2cam, intrinsics)
-    (cx, cy), _, _ = cv2.fitEllipse(rim.astype(np.float32))
-    centre = project_points(point[None], obj2cam, intrinsics)[0]
-    return rim, centre - (cx, cy)
-
-
-class _Detectors:
-    """The detectors of one image and one target: the gradient computed once, the edges that end at
-    each corner found once."""
-
-    def __init__(self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None):
-        self.grey = grey
-        self.expected = expected
-        self._rendered: tuple[np.ndarray, np.ndarray] | None = None  # (obj2cam, grey image)
-        self._expected_magnitude: np.ndarray | None = None
-        self._box = (0, 0, 0, 0)
-        self.magnitude = gradient_magnitude(grey)
-        self.intrinsics = intrinsics
-        self.segments, self.normals = crease_segments(item.mesh)
-        self.box_corners = trimesh.bounds.corners(item.mesh.bounds)
-
-    def arms(self, point: np.ndarray, obj2cam: np.ndarray) -> list[np.ndarray]:
-        """The far ends (3,) of the visible crease edges that end at ``point``."""
-        if len(self.segments) == 0:
-            return []
-        centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
-        ends = []
-        for k in range(2):
-            near = np.linalg.norm(self.segments[:, k] - point, axis=1) < 0.5
-            for e in np.flatnonzero(near):
-                if (self.normals[e] @ (centre - point) > 0).any():
-                    ends.append(self.segments[e, 1 - k])
-        return ends
-
-    def expected_image(self, obj2cam: np.ndarray) -> np.ndarray:
-        """The model's view (h, w) grey with the target at ``obj2cam``: only the target's box and
-        :data:`_BOX_MARGIN_PX` round it rendered (every search stays within the target's edges and a
-        window of theirs), black elsewhere."""
-        if self._rendered is None or not np.array_equal(self._rendered[0], obj2cam):
-            corners = project_points(self.box_corners, obj2cam, self.intrinsics)
-            lo, hi = np.floor(corners.min(axis=0)) - _BOX_MARGIN_PX, np.ceil(corners.max(axis=0)) + _BOX_MARGIN_PX
-            h, w = self.grey.shape
-            self._box = (max(int(lo[0]), 0), max(int(lo[1]), 0), min(int(hi[0]) + 1, w), min(int(hi[1]) + 1, h))
-            self._rendered = (obj2cam.copy(), as_grey(self.expected(obj2cam, box_px=self._box, supersample=_COARSE)))
-            self._expected_magnitude = None
-        return self._rendered[1]
-
-    def expected_magnitude(self, obj2cam: np.ndarray) -> np.ndarray:
-        """The gradient magnitude (h, w) of the model's view at ``obj2cam``, computed once per render and
-        only in the rendered box (zero elsewhere)."""
-        image = self.expected_image(obj2cam)
-        if self._expected_magnitude is None:
-            u0, v0, u1, v1 = self._box
-            self._expected_magnitude = np.zeros(image.shape, dtype=np.float32)
-            if u1 > u0 and v1 > v0:
-                self._expected_magnitude[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
-        return self._expected_magnitude
-
-    def detail_magnitude(self, obj2cam: np.ndarray, points_px: np.ndarray) -> np.ndarray:
-        """The gradient magnitude (h, w) of the model's view at ``obj2cam``, supersampled
-        (:data:`_DETAIL_SAMPLES`) in the box round ``points_px`` (m, 2) and :data:`_DETAIL_MARGIN_PX`,
-        zero elsewhere: what a feature's detector measures the image against (a camera's pixels
-        integrate over their area; the plain view's edges are staircases)."""
-        lo = np.floor(points_px.min(axis=0) - _DETAIL_MARGIN_PX).astype(int)
-        hi = np.ceil(points_px.max(axis=0) + _DETAIL_MARGIN_PX).astype(int) + 1
-        h, w = self.grey.shape
-        u0, v0, u1, v1 = max(lo[0], 0), max(lo[1], 0), min(hi[0], w), min(hi[1], h)
-        out = np.zeros((h, w), dtype=np.float32)
-        if u1 > u0 and v1 > v0:
-            image = as_grey(self.expected(obj2cam, box_px=(u0, v0, u1, v1), supersample=_DETAIL_SAMPLES))
-            out[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
-        return out
-
-    def rendered_pose(self) -> np.ndarray | None:
-        """The pose (4, 4) of the last model's view rendered."""
-        return None if self._rendered is None else self._rendered[0]
-
-    def _visible_arm(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> np.ndarray | None:
-        """The pixel (2,) the arm from ``corner`` to ``far`` (px) may be searched to, by the model's view
-        at ``obj2cam``: ``far`` when it shows an edge along most of the arm's first 40 px; the end of the
-        stretch it shows from the corner when something stands in front of the rest (a gripper's finger
-        across a plate's edge: the first 12 px or more are enough for a line); ``None`` when no edge shows."""
-        d = far - corner
-        length = float(np.linalg.norm(d))
-        if length < 8.0:
-            return None
-        s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
-        if len(s) < 2:
-            return None
-        shows = model_shows_edge(self.expected_magnitude(obj2cam), corner + s[:, None] * d / length)
-        if shows.mean() >= 0.6:
-            return far
-        run = int(np.argmin(shows)) if not shows.all() else len(shows)
-        if run >= 5:  # shown from 4 px to 12 px or more: the search stops where it stops showing
-            return corner + (s[run - 1] / 0.8) * d / length
-        return None
-
-    def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
-        """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
-        uv = project_points(point[None], obj2cam, self.intrinsics)[0]
-        if kind.kind == "corner":
-            ends = self.arms(point, obj2cam)
-            if ends:
-                far = project_points(np.array(ends), obj2cam, self.intrinsics)
-                if self.expected is not None:  # only the arms, or their stretches, along which the model shows an edge
-                    shown = [self._visible_arm(uv, f, obj2cam) for f in far]
-                    far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
-                if self.expected is not None:
-                    # against the model's view: its chamfers, its plate's thickness and its silhouettes are the image's
-                    reach = [uv + min(float(np.linalg.norm(f - uv)), 40.0) * (f - uv) / max(float(np.linalg.norm(f - uv)), 1e-9) for f in far]
-                    detail = self.detail_magnitude(obj2cam, np.vstack([uv[None], *[r[None] for r in reach]]))
-                    return detect_corner_against_model(self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5))
-                found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
-                if isinstance(found, Detection):
-                    return found
-            return detect_corner(self.grey, uv, radius)
-        if kind.kind == "circle":
-            rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
-            if self.expected is not None:
-                return detect_circle_against_model(self.magnitude, self.detail_magnitude(obj2cam, rim), rim, uv, search_px=max(radius, 1.5))
-            return detect_circle(self.grey, rim, offset, search_px=radius, magnitude=self.magnitude)
-        return detect_blob(self.grey, uv, max(radius, 6.0))
 
 
 def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG) -> float:
@@ -293,7 +149,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     missed = {n: "hidden or outside the image at the modelled pose" for n, v in zip(names, visible) if not v}
 
     distance = edge_distance_map(grey)
-    detectors = _Detectors(grey, item, intrinsics, expected)
+    detectors = TargetDetectors(grey, item, intrinsics, expected)
 
     def detect_all(indices, pose, radius):
         return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, radius) for i in indices}
