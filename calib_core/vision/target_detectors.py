@@ -118,9 +118,10 @@ class TargetDetectors:
         """The pose (4, 4) of the last model's view rendered."""
         return None if self._rendered is None else self._rendered[0]
 
-    def _visible_arm(self, corner: np.ndarray, far: np.ndarray, obj2cam: np.ndarray) -> np.ndarray | None:
+    def _visible_arm(self, corner: np.ndarray, far: np.ndarray, magnitude: np.ndarray) -> np.ndarray | None:
         """The pixel (2,) the arm from ``corner`` to ``far`` (px) may be searched to, by the model's view
-        at ``obj2cam``: ``far`` when it shows an edge along most of the arm's first 40 px; the end of the
+        (``magnitude``: its gradient, supersampled round the corner: at half resolution a faint edge's
+        gradient falls under the threshold and the arm was lost): ``far`` when it shows an edge along most of the arm's first 40 px; the end of the
         stretch it shows from the corner when something stands in front of the rest (a gripper's finger
         across a plate's edge: the first 12 px or more are enough for a line); ``None`` when no edge shows."""
         d = far - corner
@@ -130,13 +131,26 @@ class TargetDetectors:
         s = np.arange(4.0, min(0.8 * length, 40.0), 2.0)
         if len(s) < 2:
             return None
-        shows = model_shows_edge(self.expected_magnitude(obj2cam), corner + s[:, None] * d / length)
+        shows = model_shows_edge(magnitude, corner + s[:, None] * d / length)
         if shows.mean() >= 0.6:
             return far
         run = int(np.argmin(shows)) if not shows.all() else len(shows)
         if run >= 5:  # shown from 4 px to 12 px or more: the search stops where it stops showing
             return corner + (s[run - 1] / 0.8) * d / length
         return None
+
+    def _corner_from_lines(self, uv: np.ndarray, far: np.ndarray, radius: float, detail: np.ndarray, why: NotDetected) -> Detection | NotDetected:
+        """When fewer than two arms can be measured against the model's view (a finger beside an edge,
+        shaded otherwise in the model: the Panda's plate corner), the lines the image shows along the
+        arms, intersected, less where the model's own lines meet off the corner (``detail``: the
+        model's supersampled gradient there); ``why`` when that fails too."""
+        lines = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
+        if not isinstance(lines, Detection):
+            return why
+        modelled = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=detail, lens=self.intrinsics)
+        if isinstance(modelled, Detection):
+            return Detection(lines.uv_px - (modelled.uv_px - uv), min(lines.confidence, modelled.confidence))
+        return lines
 
     def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:
         """``point`` (3,) mm of the kind ``kind``, within ``radius`` px of its projection at ``obj2cam``."""
@@ -145,14 +159,16 @@ class TargetDetectors:
             ends = self.arms(point, obj2cam)
             if ends:
                 far = project_points(np.array(ends), obj2cam, self.intrinsics)
-                if self.expected is not None:  # only the arms, or their stretches, along which the model shows an edge
-                    shown = [self._visible_arm(uv, f, obj2cam) for f in far]
-                    far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
                 if self.expected is not None:
-                    # against the model's view: its chamfers, its plate's thickness and its silhouettes are the image's
+                    # against the model's view, supersampled round the corner and along its arms' first 40 px:
+                    # its chamfers, its plate's thickness and its silhouettes are the image's
                     reach = [uv + min(float(np.linalg.norm(f - uv)), 40.0) * (f - uv) / max(float(np.linalg.norm(f - uv)), 1e-9) for f in far]
                     detail = self.detail_magnitude(obj2cam, np.vstack([uv[None], *[r[None] for r in reach]]))
-                    return detect_corner_against_model(self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5))
+                    # only the arms, or their stretches, along which the model shows an edge
+                    shown = [self._visible_arm(uv, f, detail) for f in far]
+                    far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
+                    found = detect_corner_against_model(self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5))
+                    return found if isinstance(found, Detection) else self._corner_from_lines(uv, far, radius, detail, found)
                 found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
                 if isinstance(found, Detection):
                     return found
