@@ -13,10 +13,14 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import yaml
 
 from calib_core.errors import FileFormatError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 MAX_DOCUMENT_BYTES = 16 * 1024 * 1024
 """A workcell, an intrinsics or hand-eye file, a workspace of thousands of pairs: all far below."""
@@ -158,3 +162,17 @@ def csv_numbers(cells: list[str], columns: list[str], path: str | Path, where: s
         values.append(finite_number(number, path, f"{where}, {column}"))
     return values
 
+
+
+def read_grey_image(image_path: str | Path, listed_in: str | Path, where: str) -> "np.ndarray":
+    """The image (h, w) uint8 grey that a row ``where`` of the file ``listed_in`` names. Refused with a
+    :class:`FileFormatError`: a missing image names the list and its row, an unreadable one the image."""
+    import cv2
+
+    image_path = Path(image_path)
+    if not image_path.is_file():
+        raise FileFormatError(listed_in, f"no such image {image_path}", where)
+    image = cv2.imread(str(image_path), cv2.IMREAD_GRAYSCALE)
+    if image is None:
+        raise FileFormatError(image_path, "not an image OpenCV can read", where)
+    return image

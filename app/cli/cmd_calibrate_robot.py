@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
         if grasps is not None:
             from calib_core.robot_calibration.camera_to_tool import camera_to_tool, with_tool
 
-            tool = camera_to_tool(result.robot, _seen_grasps(grasps, result, cell))
+            tool = camera_to_tool(result.robot, _seen_grasps(grasps, args.grasps, result, cell))
             robot = with_tool(result.robot, tool.tcp2cam)
     for r in rejected:
         print(f"rejected {r}", file=sys.stderr)
@@ -163,12 +163,10 @@ def _from_files(args):
     return identify(robot, intrinsics, views, with_intrinsics=not args.fixed_intrinsics), robot, rejected, rms, counts
 
 
-def _seen_grasps(rows, result, cell) -> list:
-    """The grasps of the file, each seen on its frame when one is given (the held fixture's edges
-    give the tool); one not seen is kept through the robot and the survey, and said so."""
-    import cv2
-
-    from calib_core.errors import FileFormatError
+def _seen_grasps(rows, grasps_path: Path, result, cell) -> list:
+    """The grasps of the file ``grasps_path``, each seen on its frame when one is given (the held
+    fixture's edges give the tool); one not seen is kept through the robot and the survey, and said so."""
+    from calib_core.documents import read_grey_image
     from calib_core.robot_calibration.camera_to_tool import Grasp
     from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp
 
@@ -178,9 +176,7 @@ def _seen_grasps(rows, result, cell) -> list:
         if row.image_path is None:
             grasps.append(g)
             continue
-        image = cv2.imread(str(row.image_path), cv2.IMREAD_GRAYSCALE) if row.image_path.is_file() else None
-        if image is None:
-            raise FileFormatError(row.image_path, "not an image OpenCV can read" if row.image_path.is_file() else "no such image", g.name)
+        image = read_grey_image(row.image_path, grasps_path, g.name)
         try:
             grasps.append(Grasp(g.name, g.joints_deg, g.tcp2base, see_grasp(image, result.intrinsics, result.robot, cell, cell.task(row.task), g.joints_deg)))
         except GraspNotSeenError as e:

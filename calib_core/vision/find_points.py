@@ -44,7 +44,8 @@ _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
 _CLEAR_SHARE = 0.75  # a settled fit with this share of its samples on their edges ends the search (a wrong minimum found 53 %, the right one 90 %)
 _REUSE_PX = 0.25
-_RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
+_RECHECK_SEARCH_PX = 3.0
+_AGREE_PX = 0.2  # the features' pose is within a pixel or so of the edges'
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
 
@@ -212,11 +213,12 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
                 first[i] = NotDetected(f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges put it "
                                        "(another edge in front of it?)")
     pose, fit = _robust_fit(first, points, intrinsics, start)
-    if pose is not None:
+    if pose is not None and _moved_px(points, pose, edge_fit.obj2cam, intrinsics) > _AGREE_PX:
         # The edges can settle where every feature still passes the 1 px gate and yet off the pose the
         # features put them at (a plate cut by the image's border, its faint rims holding the rest:
         # 1.1 mm off with 0.1 mm sigma, 84 % on their edges; from the features' pose 96 %): the edges
-        # again from there, and the fit with more samples on their edges is kept.
+        # again from there, and the fit with more samples on their edges is kept. Where the two poses
+        # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
         across = refine_to_edges(grey, intrinsics, item.mesh, pose, expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
                                  magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX)

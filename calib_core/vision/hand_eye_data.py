@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from calib_core.documents import csv_numbers, finite_number, read_text, read_yaml
+from calib_core.documents import csv_numbers, finite_number, read_grey_image, read_text, read_yaml
 from calib_core.errors import FileFormatError
 from calib_core.frames import make_transform
 
@@ -74,12 +74,7 @@ class PosedImages:
 
     def read_image(self, view: PosedImage) -> np.ndarray:
         """The view's image, grey; :class:`FileFormatError` names the file when it is not an image."""
-        if not view.image_path.is_file():
-            raise FileFormatError(self.source, f"no such image {view.image_path}", view.name)
-        image = cv2.imread(str(view.image_path), cv2.IMREAD_GRAYSCALE)
-        if image is None:
-            raise FileFormatError(view.image_path, "not an image OpenCV can read")
-        return image
+        return read_grey_image(view.image_path, self.source, view.name)
 
 
 def load_posed_images(path: str | Path) -> PosedImages:
