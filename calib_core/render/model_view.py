@@ -30,15 +30,16 @@ class ModelView:
         self._items: list[SceneItem] | None = None
 
     def render(self, items: list[SceneItem], cam2world: np.ndarray, moved: dict[str, np.ndarray] | None = None, box_px: tuple[int, int, int, int] | None = None,
-               supersample: int = 1) -> np.ndarray:
+               supersample: float = 1) -> np.ndarray:
         """The image (h, w, 3) uint8 the modelled camera at ``cam2world`` (4, 4, mm) would take;
         ``moved``: items (by name) put at these poses (4, 4, mm) first (the renderer writes an item's
         pose into it: pass items of your own). ``box_px`` (u0, v0, u1, v1), px of the image, ends
         excluded: only that box is rendered, the rest of the image is black (no edges).
-        ``supersample``: the box rendered at that many times the resolution and box-filtered down, as a
-        camera's pixels integrate the light over their area (without it an edge a few degrees off the
-        rows is a staircase of whole-pixel steps, and a face under a pixel wide shows or not: a corner
-        measured against such a view came out 0.9 px off)."""
+        ``supersample``: a whole number above 1 renders the box that many times finer and box-filters it
+        down, as a camera's pixels integrate the light over their area (without it an edge a few degrees
+        off the rows is a staircase of whole-pixel steps, and a face under a pixel wide shows or not: a
+        corner measured against such a view came out 0.9 px off); a fraction (0.5) renders it coarser and
+        interpolates it up, for a view that only has to say where edges are."""
         if self._renderer is None:
             self._renderer = SceneRenderer(self._map.ideal.width, self._map.ideal.height)
         if items is not self._items:
@@ -84,7 +85,7 @@ class ModelView:
         scene = [replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items]  # the caller's items keep their poses
         world2cam_model = np.linalg.inv(cam2world_model)
 
-        def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: int = 1) -> np.ndarray:
+        def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1) -> np.ndarray:
             cam2world = item2world @ np.linalg.inv(obj2cam)
             carry = cam2world @ world2cam_model  # the modelled camera onto the one placed here
             return self.render(scene, cam2world, {name: carry @ pose for name, pose in own.items()}, box_px, supersample)
