@@ -43,9 +43,9 @@ REACH_DEG = 1.5
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
 _CLEAR_SHARE = 0.75  # a settled fit with this share of its samples on their edges ends the search (a wrong minimum found 53 %, the right one 90 %)
-_REUSE_PX = 0.25
-_RECHECK_SEARCH_PX = 3.0
-_AGREE_PX = 0.2  # the features' pose is within a pixel or so of the edges'
+_REUSE_PX = 0.25  # the second pass's view serves the detectors when its fit moved the target less than this
+_RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
+_AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put a feature further apart
 _MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 
 
