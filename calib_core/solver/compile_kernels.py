@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project_points
 from calib_core.solver import solve_pose
 from calib_core.solver.batch import solve_pose_batch
 
@@ -29,11 +30,6 @@ def _scene(n: int, rng: np.random.Generator, planar: bool = False) -> tuple[np.n
     return points, obj2cam
 
 
-def _pixels(points: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
-    cam = points @ obj2cam[:3, :3].T + obj2cam[:3, 3]
-    return np.column_stack([intrinsics.fu * cam[:, 0] / cam[:, 2] + intrinsics.cx, intrinsics.fv * cam[:, 1] / cam[:, 2] + intrinsics.cy])
-
-
 def compile_kernels() -> float:
     """Run one solve down each compiled path (pinhole and distorted, four to six pairs, coplanar,
     focal lengths estimated, robust, a batch); returns the seconds it took."""
@@ -43,18 +39,18 @@ def compile_kernels() -> float:
     distorted = Intrinsics(1100.0, 1100.0, 640.0, 480.0, 1280, 960, distortion=(-0.1, 0.05, 0.0, 0.0, 0.0))
     for n, planar in ((4, False), (5, False), (6, False), (12, False), (4, True), (8, True)):
         points, obj2cam = _scene(n, rng, planar)
-        uv = _pixels(points, obj2cam, pinhole) + rng.normal(0.0, 0.2, (n, 2))
+        uv = project_points(points, obj2cam, pinhole) + rng.normal(0.0, 0.2, (n, 2))
         solve_pose(points, uv, pinhole, sigma_px=0.5)
         solve_pose(points, uv, distorted, sigma_px=0.5)
         solve_pose(points, uv, pinhole, prior=obj2cam, sigma_px=0.5)
         if n >= 6:
             solve_pose(points, uv, pinhole, estimate_focal=True)
     points, obj2cam = _scene(40, rng)
-    uv = _pixels(points, obj2cam, pinhole) + rng.normal(0.0, 0.3, (40, 2))
+    uv = project_points(points, obj2cam, pinhole) + rng.normal(0.0, 0.3, (40, 2))
     uv[:8] = rng.uniform(0.0, 900.0, (8, 2))
     solve_pose(points, uv, pinhole, robust=True, sigma_px=0.5)
     scenes = [_scene(6, rng) for _ in range(4)]
-    solve_pose_batch(np.array([p for p, _ in scenes]), np.array([_pixels(p, T, pinhole) for p, T in scenes]), pinhole)
+    solve_pose_batch(np.array([p for p, _ in scenes]), np.array([project_points(p, T, pinhole) for p, T in scenes]), pinhole)
     return time.perf_counter() - t0
 
 
