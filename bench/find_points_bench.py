@@ -21,8 +21,8 @@ from calib_core.render.model_view import ModelView
 from calib_core.render.renderer import RenderOptions, SceneRenderer
 from calib_core.robot import solve_ik
 from calib_core.robot.errors import UnreachableTargetError
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 from calib_core.vision.target_detectors import rim_points_mm

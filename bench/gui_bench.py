@@ -61,7 +61,7 @@ def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
 
     from app.gui.main_window import MainWindow
     from app.gui.workbench import Workbench
-    from calib_core.testbed.sim_site import simulated_cell
+    from videocal_sim.sim_site import simulated_cell
 
     wb = Workbench(*simulated_cell(workcell))
     wb.start_controller()
@@ -108,13 +108,13 @@ def _demo(workcell: Path | None, tmp: Path, tag: str, method: str) -> dict | Non
 def main() -> str:
     from PySide6.QtWidgets import QApplication
 
-    from app.gui.demo import METHODS
+    from videocal_sim.demo_operator import METHODS
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
     from calib_core.camera.projection import project
     from calib_core.frames import apply, invert
-    from calib_core.testbed.sim_site import simulated_cell
+    from videocal_sim.sim_site import simulated_cell
     from calib_core.video.opencv_source import OpenCVSource
 
     from calib_core.workcell.starter import write_starter_cell

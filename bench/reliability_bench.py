@@ -122,7 +122,7 @@ def link_lost_mid_move() -> float:
 
     from calib_core.operator.core import OperatorCore
     from calib_core.operator.motion import Motion
-    from calib_core.testbed.sim_site import simulated_cell
+    from videocal_sim.sim_site import simulated_cell
 
     cell, site = simulated_cell(image_scale=0.25)
     core = OperatorCore(cell, site)

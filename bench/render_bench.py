@@ -11,7 +11,7 @@ import numpy as np
 
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.robot import solve_ik
-from calib_core.testbed.test_bed import TestBed
+from videocal_sim.test_bed import TestBed
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "render.md"
 
@@ -43,7 +43,7 @@ def _memory_in_fresh_process() -> tuple[float, float]:
 
     code = (
         "import json; from bench.render_bench import _rss_mb; a = _rss_mb(); "
-        "from calib_core.testbed.test_bed import TestBed; from calib_core.render import SceneRenderer; "
+        "from videocal_sim.test_bed import TestBed; from calib_core.render import SceneRenderer; "
         "from calib_core.robot import solve_ik; bed = TestBed.create(); cell = bed.workcell; "
         "q = solve_ik(bed.model_robot, cell.task('oru_1_grasp').approach2base, cell.home_joints_deg).q_deg; "
         "r = SceneRenderer(); r.set_items(cell.components + bed.visuals_for_model().scene_items(q)); "

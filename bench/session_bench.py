@@ -15,7 +15,7 @@ from calib_core.recording.reader import read_recording
 from calib_core.recording.recorder import SessionRecorder
 from calib_core.recording.replay import replay, solve_inputs
 from calib_core.solver import solve_pose
-from calib_core.testbed.test_bed import TestBed
+from videocal_sim.test_bed import TestBed
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "session.md"
 

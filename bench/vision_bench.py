@@ -10,7 +10,7 @@ from pathlib import Path
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.vision.board import BoardSpec
 from calib_core.vision.intrinsics_calibration import calibrate_intrinsics, detect_views
-from calib_core.vision.sim_views import simulated_board_images
+from videocal_sim.board_views import simulated_board_images
 from calib_core.workcell import load_workcell
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "vision.md"
@@ -20,10 +20,10 @@ def hand_eye_rows() -> list[str]:
     import numpy as np
 
     from calib_core.frames import pose_difference
-    from calib_core.testbed.test_bed import TestBed
-    from calib_core.testbed.true_robot import RobotErrors
+    from videocal_sim.test_bed import TestBed
+    from videocal_sim.true_robot import RobotErrors
     from calib_core.vision.hand_eye import calibrate_hand_eye
-    from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
+    from videocal_sim.hand_eye_views import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
     from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 
     spec = BoardSpec()

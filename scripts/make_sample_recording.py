@@ -22,7 +22,7 @@ from calib_core.link.link_types import TimedSample
 from calib_core.link.protocol import JointSample
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from calib_core.video.frame import Frame
 
 OUT = Path(__file__).resolve().parents[1] / "resources" / "recordings" / "sample_session.mcap"

@@ -1,4 +1,4 @@
-"""The one direction of the architecture: app -> calib_core, never back; VTK only in render."""
+"""The one direction of the architecture: videocal_sim -> app -> calib_core, never back; VTK only in render."""
 
 import ast
 from pathlib import Path
@@ -22,6 +22,17 @@ def test_calib_core_never_imports_qt_or_app():
         str(p.relative_to(ROOT))
         for p in (ROOT / "calib_core").rglob("*.py")
         if _imports(p) & {"PySide6", "PyQt5", "PyQt6", "shiboken6", "app"}
+    ]
+    assert offenders == []
+
+
+def test_core_and_app_never_import_the_simulator():
+    # The simulator is a plug-in (entry points): deleting videocal_sim must leave calib_core and app whole.
+    offenders = [
+        str(p.relative_to(ROOT))
+        for package in ("calib_core", "app")
+        for p in (ROOT / package).rglob("*.py")
+        if "videocal_sim" in _imports(p)
     ]
     assert offenders == []
 

@@ -114,36 +114,10 @@ def _from_files(args):
 
 
 def _simulated(args):
-    from calib_core.frames import pose_difference
-    from calib_core.testbed.test_bed import TestBed
-    from calib_core.testbed.true_robot import RobotErrors
-    from calib_core.vision.board import DEFAULT_SPEC, parse_board
-    from calib_core.vision.board_placement import board_in_cell
-    from calib_core.vision.hand_eye import calibrate_hand_eye
-    from calib_core.vision.hand_eye_sim import hand_eye_poses, simulated_hand_eye_images
-    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
-    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+    from calib_core.plugins import SITES, load_plugin
 
-    spec = parse_board(args.board or DEFAULT_SPEC)
-    cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
-    typical = RobotErrors.typical(0, n_joints=cell.load_robot().n_joints)
-    errors = typical if args.robot_errors else RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
-    bed = TestBed.create(cell, errors=errors)
-    board2base = board_in_cell(spec, cell, bed.model_robot)
-    joints = hand_eye_poses(bed, spec, board2base, args.poses)
-    if len(joints) < 3:
-        raise VideocalError(f"only {len(joints)} reachable poses see the board")
-    print(f"rendering {len(joints)} poses...", file=sys.stderr)
-    detect = _detector(args, spec)
-    views, flanges = [], []
-    for name, image, q in simulated_hand_eye_images(bed, spec, joints, board2base):
-        v = detect_view(name, image, spec, detect)
-        if isinstance(v, BoardView):
-            views.append(v)
-            flanges.append(bed.model_robot.fk(q, "flange"))
-        else:
-            print(f"rejected {name}: {v.reason}", file=sys.stderr)
-    result = calibrate_hand_eye(views, flanges, spec, bed.intrinsics, pose_sigma_mm=args.pose_sigma_mm)
-    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
-    d, r = pose_difference(result.cam2flange, true)
-    return result, {"mm": float(np.linalg.norm(d)), "deg": float(np.linalg.norm(r))}
+    if args.intrinsics is not None:
+        raise VideocalError("--intrinsics is not used with 'sim': the simulated camera's intrinsics are the bundled cell's")
+    simulated = load_plugin(SITES, "sim")
+    return simulated.hand_eye(board=args.board, workcell=args.workcell, robot_errors=args.robot_errors, poses=args.poses,
+                              detector_params=args.detector_params, pose_sigma_mm=args.pose_sigma_mm)

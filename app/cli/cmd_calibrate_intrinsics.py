@@ -40,12 +40,10 @@ def run(args: argparse.Namespace) -> int:
     settings = load_detector_settings(args.detector_params) if args.detector_params else None
     truth = None
     if args.source == "sim":
-        from calib_core.vision.sim_views import simulated_board_images
-        from calib_core.workcell import load_workcell
+        from calib_core.plugins import SITES, load_plugin
 
-        truth = load_intrinsics(load_workcell().intrinsics_path)
         print(f"rendering {args.views} simulated views of {spec}...", file=sys.stderr)
-        images = simulated_board_images(truth, spec, args.views)
+        truth, images = load_plugin(SITES, "sim").board_images(spec, args.views)
     else:
         source = Path(args.source)
         if source.is_dir():

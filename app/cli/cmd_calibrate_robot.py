@@ -1,7 +1,7 @@
 """``videocal calibrate-robot sim|FILE --out DIR``: the robot's geometric parameters and its camera
 mounting from views of a board at many poses (docs/calibration.md).
 
-``sim`` runs it on the cold cell (calib_core/testbed/cold_cell.py): the poses planned, the robot
+``sim`` runs it on the simulator's cold cell (videocal_sim/cold_cell.py): the poses planned, the robot
 driven through them, each view rendered by the true camera and detected, the camera's intrinsics
 calibrated from the same views first, surveyed features located at each task location, the gripper
 closed on each task's fixture for the tool; the result scored against the truth, which nothing else
@@ -44,9 +44,9 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.robot_calibration.report import save_robot_calibration
 
     if args.source == "sim":
-        from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
+        from calib_core.plugins import SITES, load_plugin
 
-        run_ = calibrate_cold_cell(args.views, args.seed, with_intrinsics=not args.fixed_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
+        run_ = load_plugin(SITES, "sim").calibrate_robot(args.views, args.seed, with_intrinsics=not args.fixed_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
         result, robot, nominal, tool, rejected, score = run_.result, run_.robot, run_.nominal_robot, run_.tool, run_.rejected, run_.score
         intrinsics_rms = run_.intrinsics.rms_px
         counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}

@@ -10,36 +10,39 @@ import sys
 import time
 from pathlib import Path
 
+from app.cli.options import resolved_path
 from calib_core.workcell import DEFAULT_WORKCELL
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
+    parser.add_argument("--workcell", type=resolved_path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
     parser.add_argument("--port", help="a real controller link URL (serial port, socket://host:port, ...) instead of the simulator")
     parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file, a stream URL or a folder of images, instead of the simulated camera")
-    parser.add_argument("--hand-eye", type=Path, help="a cam2flange file from videocal calibrate-hand-eye: the measured camera mounting replaces the modelled one")
-    parser.add_argument("--recording", type=Path, help="open this MCAP recording on the replay timeline at start")
+    parser.add_argument("--hand-eye", type=resolved_path, help="a cam2flange file from videocal calibrate-hand-eye: the measured camera mounting replaces the modelled one")
+    parser.add_argument("--recording", type=resolved_path, help="open this MCAP recording on the replay timeline at start")
     parser.add_argument("--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)")
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.testbed.sim_process import SimulatorProcess
+    from calib_core.errors import VideocalError
+    from calib_core.plugins import SITES, load_plugin
 
-    simulated = not args.port
-    if args.camera and simulated:
-        from calib_core.errors import VideocalError
-
-        raise VideocalError("--camera needs --port: a real camera belongs to a real controller (the simulated cell brings its own camera)")
-    # Start the controller simulator first: its start-up then overlaps the window's imports. It dies with us.
-    simulator = SimulatorProcess(args.workcell) if simulated else None
+    if args.port is None:
+        if args.camera:
+            raise VideocalError("--camera needs --port: a real camera belongs to a real controller (the simulated cell brings its own camera)")
+        site_kind = load_plugin(SITES, "sim")
+        # Start the controller simulator first: its start-up then overlaps the window's imports. It dies with us.
+        simulator = site_kind.start_early(args.workcell)
+    else:
+        site_kind, simulator = None, None
     try:
-        return _run_window(args, simulator)
+        return _run_window(args, site_kind, simulator)
     finally:
         if simulator is not None:
             simulator.stop()
 
 
-def _run_window(args: argparse.Namespace, simulator) -> int:
+def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
     from PySide6.QtCore import Qt, QTimer
     from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
@@ -71,12 +74,7 @@ def _run_window(args: argparse.Namespace, simulator) -> int:
 
     from app.gui.cell_launcher import CellLauncher, real_site
 
-    if args.port:
-        open_site = real_site(args.port, args.camera)
-    else:
-        from calib_core.testbed.sim_site import simulated_cell
-
-        open_site = lambda workcell, process=None: simulated_cell(workcell, process=process)  # noqa: E731
+    open_site = real_site(args.port, args.camera) if site_kind is None else site_kind.open_cell
     window = CellLauncher(open_site, args.hand_eye).open(args.workcell, simulator)
     window.setGeometry(shell.geometry())
     window.show()

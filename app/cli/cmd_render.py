@@ -52,16 +52,19 @@ def run(args: argparse.Namespace) -> int:
         raise VideocalError(f"--scale must lie between 0.05 and 4, got {args.scale}")
     from calib_core.render import RenderOptions, SceneRenderer
     from calib_core.robot import solve_ik
-    from calib_core.testbed.test_bed import TestBed
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.robot.visuals import RobotVisuals
     from calib_core.workcell import load_workcell
 
     cell = load_workcell(args.workcell)
-    bed = TestBed.create(cell)
+    if cell.intrinsics_path is None:
+        raise VideocalError(f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)")
+    robot = cell.load_robot()
     highlight = args.highlight
     q = np.array(cell.home_joints_deg, dtype=float)
     if args.joints:
         try:
-            q = bed.model_robot.check_joints(_joints(args.joints))
+            q = robot.check_joints(_joints(args.joints))
         except ValueError as exc:
             raise VideocalError(f"--joints: {exc}") from None
     elif args.location:
@@ -69,25 +72,24 @@ def run(args: argparse.Namespace) -> int:
             task = cell.task(args.location)
         except KeyError as exc:
             raise VideocalError(str(exc.args[0])) from None
-        q = solve_ik(bed.model_robot, task.approach2base, q).q_deg
+        q = solve_ik(robot, task.approach2base, q).q_deg
         highlight = highlight or task.component
     if highlight is not None:
         try:
             cell.component(highlight)
         except KeyError as exc:
             raise VideocalError(str(exc.args[0])) from None
-    intr = bed.intrinsics.scaled(args.scale)
+    intr = load_intrinsics(cell.intrinsics_path).scaled(args.scale)
     options = RenderOptions(highlight=highlight, show_features=args.features, feature_names=args.features, style=args.style)
     if args.view == "true":
-        bed.joints_deg = q
-        camera = bed.camera(intrinsics=intr)
-        image = camera.read().image
-        camera.close()
+        from calib_core.plugins import SITES, load_plugin
+
+        image = load_plugin(SITES, "sim").true_view(cell, q, intr)
     else:
         renderer = SceneRenderer()
-        renderer.set_items(cell.components + bed.visuals_for_model().scene_items(q))
+        renderer.set_items(cell.components + RobotVisuals.from_robot(robot).scene_items(q))
         if args.view == "virtual":
-            image = renderer.render_view(intr.without_distortion(), bed.model_cam2world(q), options)
+            image = renderer.render_view(intr.without_distortion(), robot.fk(q, "camera"), options)
         else:
             image = renderer.render_overview(options=options)
         renderer.close()

@@ -27,7 +27,6 @@ def _register(name: str, module: str, help_text: str) -> None:
 
 
 _register("gui", "app.cli.cmd_gui", "open the operator's window (the bundled workcell with simulated robot and camera by default)")
-_register("demo", "app.cli.cmd_demo", "drive the window through a whole calibration, writing screenshots and report.json")
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
 _register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot controller on a pty or a TCP port")
@@ -43,6 +42,20 @@ _register("new-cell", "app.cli.cmd_new_cell", "write a starting cell for a robot
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 
+def _register_plugins() -> None:
+    """Subcommands that installed packages register (``videocal.commands``; the simulator's ``demo``):
+    imported only when they run, like ours; one of ours is never replaced."""
+    from calib_core.plugins import COMMANDS as GROUP
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=GROUP):
+        if ep.name not in COMMANDS:
+            COMMANDS[ep.name] = (ep.value, None)
+
+
+_register_plugins()
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2, as for every bad input
         self.print_usage(sys.stderr)
@@ -55,6 +68,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"videocal {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
+        if help_text is None:  # a plug-in's: its one line is the module's HELP
+            help_text = getattr(importlib.import_module(module), "HELP", f"(from {module})")
         sp = sub.add_parser(name, help=help_text, description=help_text)
         sp.set_defaults(_module=module)
         # Arguments are declared by the module itself, imported lazily only for this parser.

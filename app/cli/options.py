@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 
 def bounded_int(low: int, high: int):
@@ -36,3 +37,9 @@ def bounded_float(low: float, high: float, *, exclusive_low: bool = False):
         return value
 
     return parse
+
+
+def resolved_path(text: str) -> Path:
+    """An ``argparse`` type: a path made absolute where the user gave it (the current folder), so a
+    child process or a later change of folder reads the same file."""
+    return Path(text).expanduser().resolve()

@@ -2,7 +2,7 @@
 camera; the core never knows which kind of site it has.
 
 :class:`RealSite` is a controller URL and a camera spec. The simulated site
-(:class:`calib_core.testbed.sim_site.SimulatedSite`) starts a controller simulator and a
+(:class:`videocal_sim.sim_site.SimulatedSite`) starts a controller simulator and a
 simulated camera for the cell the operator opened, and is the only code that knows the truth.
 """
 

@@ -38,7 +38,7 @@ OBJECT_TURN_SIGMA_MRAD = 1.0
 """A turn about a component's own origin added to its covariance: the tie rests on where the
 components are (three off one line fix the base), less on how each is turned. First set against a
 bias of 0.4-1.2 mrad the simulated camera's point-sampled edges put into the edge fits' orientation
-(gone with the pixels integrated, :class:`~calib_core.testbed.sim_camera.CameraLook`); still the
+(gone with the pixels integrated, :class:`~videocal_sim.sim_camera.CameraLook`); still the
 better choice after: on cold cells 0-4 the TCP at held-out poses is 0.036-0.068 mm with it and
 0.042-0.093 mm with 0.2 mrad."""
 SURVEY_SIGMA_MM = 0.05

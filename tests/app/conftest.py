@@ -9,8 +9,8 @@ from app.gui.cell_launcher import CellLauncher
 from app.gui.main_window import MainWindow
 from tests.app.windows import window_settings
 from app.gui.workbench import Workbench
-from calib_core.testbed.sim_site import simulated_cell
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_site import simulated_cell
+from videocal_sim.true_robot import RobotErrors
 
 
 @pytest.fixture

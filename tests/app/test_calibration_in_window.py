@@ -13,7 +13,7 @@ from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from tests.app.windows import confirm_move_if_asked, pick_pair, wait_for_settled_frame
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"

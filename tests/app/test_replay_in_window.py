@@ -15,7 +15,7 @@ from app.gui.workbench import Workbench
 from tests.app.windows import confirm_move_if_asked
 from calib_core.recording.playback import RecordingPlayback
 from calib_core.recording.reader import read_recording
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "recordings" / "sample_session.mcap"
 OUTPUT = Path(__file__).resolve().parents[1] / "output"

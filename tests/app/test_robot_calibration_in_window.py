@@ -9,8 +9,8 @@ from PySide6.QtCore import Qt
 from calib_core.frames import invert, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.robot.model import load_robot
-from calib_core.testbed.compliant_grasp import grasp_joints
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.compliant_grasp import grasp_joints
+from videocal_sim.true_robot import RobotErrors
 from tests.app.windows import answer_next_question, wait_for_settled_frame
 
 OUTPUT = __import__("pathlib").Path(__file__).resolve().parents[1] / "output"

@@ -22,7 +22,7 @@ from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from calib_core.video.frame import Frame
 
 BASELINES = Path(__file__).resolve().parents[1] / "baselines"

@@ -11,7 +11,7 @@ from PySide6.QtCore import Qt
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.true_robot import RobotErrors
 from tests.app.windows import confirm_move_if_asked
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"

@@ -5,7 +5,7 @@ import pytest
 import yaml
 
 from app.gui.workbench import Workbench
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from calib_core.errors import FileFormatError
 from calib_core.frames import pose_difference
 

@@ -11,7 +11,7 @@ import yaml
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.robot.model import load_robot
-from calib_core.testbed.cold_cell import SURVEY_MM, cold_test_bed
+from videocal_sim.cold_cell import SURVEY_MM, cold_test_bed
 
 
 def test_the_cold_cell_is_wrong_where_a_real_one_is():

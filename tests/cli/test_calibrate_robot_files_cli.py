@@ -16,12 +16,12 @@ from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
 from calib_core.robot.model import load_robot
 from calib_core.robot_calibration.pose_planner import plan_poses
-from calib_core.testbed.cold_cell import cold_test_bed
+from videocal_sim.cold_cell import cold_test_bed
 from calib_core.robot_calibration.cell_views import cell_view_joints
-from calib_core.testbed.compliant_grasp import grasp_frame, grasp_joints
+from videocal_sim.compliant_grasp import grasp_frame, grasp_joints
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
-from calib_core.vision.hand_eye_sim import simulated_hand_eye_images
+from videocal_sim.hand_eye_views import simulated_hand_eye_images
 
 
 def _videocal(*args, timeout=600):

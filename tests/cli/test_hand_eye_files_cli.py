@@ -15,11 +15,11 @@ import yaml
 from calib_core.errors import FileFormatError
 from calib_core.frames import pose_difference, transform_from_xyz_rpy
 from calib_core.vision.hand_eye_io import load_cam2flange
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
-from calib_core.vision.hand_eye_sim import hand_eye_poses, simulated_hand_eye_images
+from videocal_sim.hand_eye_views import hand_eye_poses, simulated_hand_eye_images
 from calib_core.workcell import load_workcell
 
 ROSI = Path(__file__).resolve().parents[1] / "data" / "third_party" / "ros_industrial" / "test_set_charuco"

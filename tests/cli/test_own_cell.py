@@ -18,9 +18,9 @@ from calib_core.link.protocol import PROTOCOL_VERSION
 from calib_core.link.link_types import MoveError
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_process import SimulatorProcess
-from calib_core.testbed.sim_site import simulated_cell
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_process import SimulatorProcess
+from videocal_sim.sim_site import simulated_cell
+from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import load_workcell
 from tests.vendor_robots import PANDA, SHARE, UR5, require
 

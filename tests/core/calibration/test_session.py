@@ -9,8 +9,8 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.solver import SolveStatus
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left", "boss_top_right", "boss_bottom_left", "boss_bottom_right"]
 

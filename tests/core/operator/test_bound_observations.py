@@ -11,7 +11,7 @@ from calib_core.frames import apply, invert
 from calib_core.operator.core import OperatorCore
 from calib_core.operator.observations import NotSettledError
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, sample, still_for
 
 FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left")

@@ -8,7 +8,7 @@ from calib_core.frames import apply, invert
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
 from calib_core.solver.errors import named_points, point_label, points_label
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for
 
 FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left")

@@ -8,7 +8,7 @@ from calib_core.calibration.verdict import Verdict
 from calib_core.errors import OperatorError
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for
 
 

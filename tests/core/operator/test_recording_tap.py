@@ -21,7 +21,7 @@ from calib_core.frames import apply, invert
 from calib_core.operator.core import OperatorCore
 from calib_core.recording.reader import read_recording
 from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, JOINTS_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC, VIDEO_TOPIC
-from calib_core.testbed.sim_site import simulated_cell
+from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for
 from tests.core.operator.test_bound_observations import _pick_all, _task_joints
 

@@ -54,7 +54,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     import numpy as np
 
     from calib_core.operator.core import OperatorCore
-    from calib_core.testbed.sim_site import simulated_cell
+    from videocal_sim.sim_site import simulated_cell
     from tests.core.operator.still_robot import frame_now, still_for
     from tests.core.operator.test_bound_observations import _pick_all, _task_joints
 

@@ -8,9 +8,9 @@ from calib_core.frames import invert, pose_difference, transform_from_xyz_rpy
 from calib_core.robot import solve_ik
 from calib_core.robot_calibration.camera_to_tool import CameraToToolError, Grasp, camera_to_tool, with_tool
 from calib_core.robot_calibration.parameters import CorrectedRobot
-from calib_core.testbed.compliant_grasp import COMPLIANCE_MM, grasp_joints
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.compliant_grasp import COMPLIANCE_MM, grasp_joints
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import load_workcell
 
 

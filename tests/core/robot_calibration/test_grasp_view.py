@@ -9,9 +9,9 @@ from scipy.spatial.transform import Rotation
 from calib_core.frames import invert, make_transform, pose_difference
 from calib_core.robot_calibration.camera_to_tool import Grasp, camera_to_tool
 from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp, tcp_covariance_in_camera
-from calib_core.testbed.compliant_grasp import grasp_frame, grasp_joints
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.compliant_grasp import grasp_frame, grasp_joints
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 
 
 def test_the_tool_s_covariance_follows_the_view_s_by_its_jacobian():

@@ -13,8 +13,8 @@ from calib_core.robot_calibration.observations import CELL, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot
 from calib_core.robot_calibration.pose_planner import plan_poses
 from calib_core.robot_calibration.report import calibrated_urdf, save_robot_calibration
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell, board_view_joints
 from calib_core.workcell import load_workcell

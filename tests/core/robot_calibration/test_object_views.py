@@ -13,8 +13,8 @@ from calib_core.frames import apply, invert, make_transform, pose_difference
 from calib_core.robot_calibration.identification import identify, pose_residual, pose_sensitivity_to_intrinsics
 from calib_core.robot_calibration.observations import ObjectPoseView, PoseView
 from calib_core.robot_calibration.parameters import INTRINSICS, corrected_intrinsics
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell, board_view_joints
 from calib_core.workcell import load_workcell

@@ -5,8 +5,8 @@ import numpy as np
 
 from calib_core.frames import pose_difference
 from calib_core.robot_calibration.parameters import CorrectedRobot
-from calib_core.testbed.cold_cell import cold_test_bed
-from calib_core.testbed.cold_robot_calibration import truth_in_model_parameters
+from videocal_sim.cold_cell import cold_test_bed
+from videocal_sim.cold_robot_calibration import truth_in_model_parameters
 
 
 def test_the_truth_in_model_parameters_moves_like_the_true_robot():

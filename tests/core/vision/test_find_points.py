@@ -9,9 +9,9 @@ import pytest
 from calib_core.camera.projection import project_points
 from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_camera import CameraLook
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_camera import CameraLook
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.edge_alignment import edge_distance_map
 from calib_core.vision.edge_refinement import edge_points, refine_to_edges
 from calib_core.vision.feature_detectors import gradient_magnitude

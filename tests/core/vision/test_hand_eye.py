@@ -9,11 +9,11 @@ import pytest
 import yaml
 
 from calib_core.frames import make_transform, pose_difference
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.board import BoardSpec
 from calib_core.vision.hand_eye import calibrate_hand_eye, pose_set_warnings
-from calib_core.vision.hand_eye_sim import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
+from videocal_sim.hand_eye_views import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
 from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError, detect_view
 from scipy.spatial.transform import Rotation
 

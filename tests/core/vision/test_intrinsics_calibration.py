@@ -12,7 +12,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.vision.board import BoardSpec
 from calib_core.vision.intrinsics_calibration import CalibrationInputError, calibrate_intrinsics, detect_view, detect_views
-from calib_core.vision.sim_views import simulated_board_images
+from videocal_sim.board_views import simulated_board_images
 
 # Half the gripper camera's resolution keeps the test quick; the distortion is the real lens's.
 TRUTH = Intrinsics(560.0, 558.0, 322.35, 238.15, 640, 480, (-0.18, 0.07, 0.0006, -0.0004, -0.01))

@@ -15,7 +15,7 @@ from calib_core.camera.projection import project
 from calib_core.errors import FileFormatError
 from calib_core.frames import apply, invert
 from calib_core.robot import solve_ik
-from calib_core.testbed.test_bed import TestBed
+from videocal_sim.test_bed import TestBed
 from calib_core.workspace.exports import CSV_COLUMNS, corrections_csv, corrections_pdl2
 from calib_core.workspace.workspace import Workspace, load_workspace, save_workspace
 

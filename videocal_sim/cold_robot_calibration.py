@@ -18,9 +18,9 @@ from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
 from calib_core.robot_calibration.cell_views import cell_view_joints
 from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp
-from calib_core.testbed.compliant_grasp import grasp_frame, grasp_joints
-from calib_core.robot_calibration.sim_views import simulated_cell_views, simulated_pose_views
-from calib_core.testbed.cold_cell import cold_test_bed
+from videocal_sim.compliant_grasp import grasp_frame, grasp_joints
+from videocal_sim.robot_calibration_views import simulated_cell_views, simulated_pose_views
+from videocal_sim.cold_cell import cold_test_bed
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
 from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, calibrate_intrinsics

@@ -29,8 +29,8 @@ from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_site import simulated_cell
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_site import simulated_cell
+from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import DEFAULT_WORKCELL
 
 _MIN_FEATURES = 4

@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import make_transform
-from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
+from videocal_sim.sim_camera import CameraLook, SimulatedCamera
 from calib_core.vision.board import BoardSpec, board_item
 
 

@@ -1,5 +1,6 @@
 """``videocal demo``: the whole calibration driven through the real window, with a PNG after
-each step and ``report.json`` in the output folder."""
+each step and ``report.json`` in the output folder. Registered by the simulator's package
+(entry point ``videocal.commands``: ``demo``)."""
 
 from __future__ import annotations
 
@@ -8,15 +9,18 @@ import json
 import os
 from pathlib import Path
 
-from app.cli.options import bounded_float
+from app.cli.options import bounded_float, resolved_path
 from calib_core.errors import VideocalError
 
 
+HELP = "drive the window through a whole calibration on the simulated cell, writing screenshots and report.json"
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", type=Path, default=Path("out/demo"), help="folder for the screenshots and report.json")
+    parser.add_argument("--out", type=resolved_path, default=Path("out/demo"), help="folder for the screenshots and report.json")
     parser.add_argument("--offscreen", action="store_true", help="no display needed: Qt's offscreen platform")
     parser.add_argument("--scale", type=bounded_float(0.1, 2.0), default=1.0, help="camera resolution relative to the camera file's")
-    parser.add_argument("--workcell", type=Path, default=None, help="the cell to calibrate in (default: the bundled one)")
+    parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
@@ -30,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
         return _cold(args)
     if args.offscreen:
         os.environ["QT_QPA_PLATFORM"] = "offscreen"
-    from app.gui.demo import run_demo
+    from videocal_sim.demo_operator import run_demo
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
@@ -45,8 +49,8 @@ def _cold(args: argparse.Namespace) -> int:
 
     from calib_core.atomic_file import atomic_write_text
     from calib_core.robot_calibration.report import save_robot_calibration
-    from calib_core.testbed.cold_robot_calibration import calibrate_cold_cell
-    from calib_core.testbed.cold_task_look import look_at_task
+    from videocal_sim.cold_robot_calibration import calibrate_cold_cell
+    from videocal_sim.cold_task_look import look_at_task
 
     if args.workcell is not None:
         raise VideocalError("demo --cold runs on the bundled cell (its cold twin is built from it)")
@@ -65,7 +69,7 @@ def _cold(args: argparse.Namespace) -> int:
     run = calibrate_cold_cell(40, 0, grasp_tasks=[t for t in tasks if t != look_task] or tasks, progress=lambda k, n: print(f"\rboard view {k} of {n}", end="" if k < n else "\n", file=sys.stderr), say=say)
     save_robot_calibration(args.out, run.result, run.nominal_robot, robot=run.robot, tool=run.tool)
     say("looking at the task location with the calibrated model...")
-    from calib_core.testbed.cold_cell import cold_test_bed
+    from videocal_sim.cold_cell import cold_test_bed
 
     bed, _ = cold_test_bed(seed=0)
     from calib_core.calibration.look_fusion import tcp_covariance_from_camera
@@ -78,7 +82,7 @@ def _cold(args: argparse.Namespace) -> int:
                         tool=run.tool)
     i = run.intrinsics
     report = {
-        "cell": "cold (calib_core/testbed/cold_cell.py, seed 0)",
+        "cell": "cold (videocal_sim/cold_cell.py, seed 0)",
         "steps": {
             "1_intrinsics": {"views": len(i.used), "rms_px": round(i.rms_px, 4), "error_against_truth_px": run.score["intrinsics_error_px"]},
             "2_robot_and_mounting": {"board_views": run.board_views, "cell_views": run.cell_views, "identified": len(run.result.observability.identified),

@@ -13,9 +13,9 @@ from calib_core.camera.projection import project
 from calib_core.frames import invert, make_transform, pose_difference
 from calib_core.robot import solve_ik
 from calib_core.scene import SceneItem
-from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera, samples_per_pixel
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_camera import CameraLook, SimulatedCamera, samples_per_pixel
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 
 OUTPUT = Path(__file__).resolve().parents[2] / "output"
 SMALL_LENS = Intrinsics(280.0, 279.0, 161.3, 119.2, 320, 240, (-0.18, 0.07, 0.0006, -0.0004, -0.01))

@@ -11,8 +11,8 @@ import numpy as np
 
 from calib_core.frames import invert, make_transform
 from calib_core.robot import solve_ik
-from calib_core.testbed.sim_camera import SimulatedCamera
-from calib_core.testbed.test_bed import TestBed
+from videocal_sim.sim_camera import SimulatedCamera
+from videocal_sim.test_bed import TestBed
 
 COMPLIANCE_MM = 0.02
 """How far from the pin's axis the fingers leave the TCP (a centring gripper on a ground pin)."""

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from calib_core.robot_calibration.observations import PoseView
-from calib_core.testbed.sim_camera import SimulatedCamera
-from calib_core.testbed.test_bed import TestBed
+from videocal_sim.sim_camera import SimulatedCamera
+from videocal_sim.test_bed import TestBed
 from calib_core.vision.board import board_item
 from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 

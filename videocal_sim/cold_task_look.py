@@ -21,7 +21,7 @@ from calib_core.frames import invert, pose_difference
 from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
 from calib_core.robot.visuals import RobotVisuals
-from calib_core.testbed.sim_camera import SimulatedCamera
+from videocal_sim.sim_camera import SimulatedCamera
 from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 

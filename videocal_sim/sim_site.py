@@ -16,9 +16,9 @@ from calib_core.errors import VideocalError
 from calib_core.link.joint_map import JointMap
 from calib_core.operator.cell import Cell
 from calib_core.scene import SceneItem
-from calib_core.testbed.sim_process import SimulatorProcess
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.sim_process import SimulatorProcess
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
 class SimulatedSite:

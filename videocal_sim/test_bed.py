@@ -17,8 +17,8 @@ from calib_core.errors import VideocalError
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
 from calib_core.scene import SceneItem
-from calib_core.testbed.sim_camera import CameraLook, SimulatedCamera
-from calib_core.testbed.true_robot import RobotErrors, TrueRobot
+from videocal_sim.sim_camera import CameraLook, SimulatedCamera
+from videocal_sim.true_robot import RobotErrors, TrueRobot
 from calib_core.workcell import Workcell, load_workcell
 
 

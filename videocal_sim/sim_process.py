@@ -13,7 +13,7 @@ from pathlib import Path
 
 from calib_core.errors import VideocalError
 
-_PROJECT = Path(__file__).resolve().parents[2]
+_PROJECT = Path(__file__).resolve().parents[1]
 _PR_SET_PDEATHSIG = 1
 
 
@@ -34,6 +34,8 @@ class SimulatorProcess:
     a stable link path in a private folder. It starts at once; :meth:`wait_ready` returns the path."""
 
     def __init__(self, workcell_path: str | Path, joints_controller=None):
+        # Resolved here, where the caller's folder is known: the child runs in the project's folder.
+        workcell_path = Path(workcell_path).expanduser().resolve()
         self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-")
         folder = Path(self._folder.name)
         self.link_path = folder / "controller"

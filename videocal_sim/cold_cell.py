@@ -20,8 +20,8 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import make_transform
-from calib_core.testbed.test_bed import TestBed
-from calib_core.testbed.true_robot import RobotErrors
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import Workcell, load_workcell
 
 SURVEY_MM = 0.1

@@ -1,1 +1,0 @@
-"""The simulated test bed: a true robot that differs from the model, and a camera on it."""
