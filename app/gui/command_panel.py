@@ -144,12 +144,18 @@ class CommandPanel(QTabWidget):
         lines = []
         for task in table.tasks():
             c = table.latest(task)
-            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({len(table.history(task))} stored"
+            history = table.history(task)
+            measurements = sum(1 for h in history if h.kind == "measurement")
+            kept = f"{len(history) - measurements} stored" + (f", {measurements} measurement{'s' if measurements > 1 else ''} at other poses" if measurements else "")
+            if c is None:
+                lines.append(f"{task}: no correction ({kept})")
+                continue
+            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({kept}"
             line += f", {c.verdict} confirmed)" if c.confirmation else ")"
             looks = table.verifications(task)
             if looks:
                 v = looks[-1]
-                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), looks {'agree' if v.agree else 'DISAGREE'}"
+                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), {v.judgement}"
             lines.append(line)
         self.corrections.setText("\n".join(lines) or "No corrections stored.")
 

@@ -30,3 +30,17 @@ def ask_save(parent: QWidget, title: str, text: str) -> str:
     box.setEscapeButton(QMessageBox.StandardButton.Cancel)
     chosen = box.exec()
     return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(QMessageBox.StandardButton(chosen), "cancel")
+
+
+def ask_choice(parent: QWidget, title: str, text: str, choices: list[tuple[str, str]]) -> str:
+    """The key of the button chosen among ``choices`` (``(key, label)``), or ``cancel``; Cancel is the
+    default and Esc's answer."""
+    box = QMessageBox(QMessageBox.Icon.Warning, title, text, parent=parent)
+    box.setTextFormat(Qt.TextFormat.PlainText)
+    buttons = {box.addButton(label, QMessageBox.ButtonRole.AcceptRole): key for key, label in choices}
+    no = box.addButton("Cancel", QMessageBox.ButtonRole.RejectRole)
+    box.setDefaultButton(no)
+    box.setEscapeButton(no)
+    box.setObjectName("confirm")
+    box.exec()
+    return buttons.get(box.clickedButton(), "cancel")

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import getpass
 from collections.abc import Callable
-from datetime import datetime, timezone
 
 import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
@@ -29,8 +27,7 @@ from app.gui.robot_panel import RobotPanel
 from app.gui.vision_panel import VisionPanel
 from app.gui.window_layout import restore_layout, save_layout
 from app.gui.workbench import Workbench
-from app.gui.confirm import ask
-from calib_core.calibration.session import ConfirmationNeeded
+from app.gui.store_correction import store_with_consent
 from calib_core.operator.move_preview import MoveNeedsConfirmation
 from calib_core.robot import solve_ik
 from calib_core.errors import OperatorError
@@ -277,21 +274,13 @@ class MainWindow(QMainWindow):
 
     def _verify(self) -> None:
         v = self.workbench.verify()
-        self.results.show_message(v.text, ok=v.agree)
+        self.results.show_message(v.text, ok=v.ok)
 
     def _store(self) -> None:
         self.report(self._store_impl)()
 
     def _store_impl(self) -> None:
-        try:
-            self.workbench.store_correction()
-        except ConfirmationNeeded as exc:
-            question = "\n".join(["This result is not OK:", *[f"- {r}" for r in exc.reasons], "", "Store it as the correction for this task location anyway?",
-                                   "Your confirmation is kept with the correction."])
-            if not ask(self, "Store an implausible result?", question, "Store anyway"):
-                self.statusBar().showMessage("nothing stored", 5000)
-                return
-            self.workbench.store_correction(confirmation=f"confirmed in the window by {getpass.getuser()} at {datetime.now(timezone.utc).isoformat(timespec='seconds')}: {'; '.join(exc.reasons)}")
+        store_with_consent(self, self.workbench, lambda text: self.statusBar().showMessage(text, 5000))
 
     def _go(self, *, approach: bool, corrected: bool = False) -> None:
         self.move(lambda confirmed: self.workbench.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))

@@ -21,7 +21,9 @@ class Correction:
     ``rotation_deg`` (3,) with 1-sigma; ``rms_px`` and ``pairs`` of the solve; ``time_s``
     (Unix time); ``source``: where it came from (e.g. a recording and pick numbers); ``verdict``
     of the result (``ok``, or what the operator confirmed) and ``confirmation``: who confirmed a
-    result that was not ``ok``, when and why (empty for an ``ok`` one)."""
+    result that was not ``ok``, when and why (empty for an ``ok`` one). ``kind``: ``correction``
+    (commanded when the task is executed) or ``measurement`` (a look made at another pose or on a
+    recording, kept as what it is: never commanded)."""
 
     task: str
     tcp2base_model: np.ndarray
@@ -37,6 +39,7 @@ class Correction:
     source: str = ""
     verdict: str = "ok"
     confirmation: str = ""
+    kind: str = "correction"
 
     @property
     def delta_base(self) -> np.ndarray:
@@ -75,6 +78,7 @@ class CorrectionTable:
         self.changed.emit(correction.task)
 
     def remove_last(self, task: str) -> Correction:
+        """Take the newest entry of ``task``'s history away (undo of a store)."""
         c = self._table[task].pop()
         if not self._table[task]:
             del self._table[task]
@@ -85,8 +89,9 @@ class CorrectionTable:
         return list(self._table.get(task, []))
 
     def latest(self, task: str) -> Correction | None:
-        h = self._table.get(task)
-        return h[-1] if h else None
+        """The newest *correction* of ``task`` (measurements are never commanded); ``None`` if none."""
+        corrections = [c for c in self._table.get(task, []) if c.kind == "correction"]
+        return corrections[-1] if corrections else None
 
     def tasks(self) -> list[str]:
         return list(self._table)

@@ -56,6 +56,9 @@ class SolveContext:
     points_obj_mm: np.ndarray | None = None
     """The solve's 3D points (m, 3) in the target's frame, for the image points' shared error."""
     intrinsics: Intrinsics | None = None
+    view_sources: tuple[str, ...] = ("live",)
+    """Where the frames of the look came from: ``live``, or a recording's name (see
+    :class:`~calib_core.calibration.view_stamp.ViewStamp`)."""
 
 
 class ChooseCandidate(Command):
@@ -165,15 +168,18 @@ class CalibrationSession:
         return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics)
 
     def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int], *,
-                    points_obj_mm=None, intrinsics: Intrinsics | None = None) -> EndEffectorEstimate:
+                    points_obj_mm=None, intrinsics: Intrinsics | None = None, view_sources: tuple[str, ...] | None = None) -> EndEffectorEstimate:
         """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here.
         With the solve's ``points_obj_mm`` (m, 3, the target's frame) and ``intrinsics`` the result's
         covariance carries the image points' shared error
-        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`)."""
+        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`). ``view_sources``: where
+        the look's frames came from (default: the used pairs' stamps)."""
         used = [p for p in self.pairs if p.number in set(numbers)]
         points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
+        if view_sources is None:
+            view_sources = tuple(sorted({p.view.source for p in used if p.view is not None})) or ("live",)
         self._context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
-                                     points, intrinsics)
+                                     points, intrinsics, tuple(view_sources))
         self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=self._shared(solution.obj2cam))
         self.chosen_candidate = 0
         self.verdict = self._judge(self.result)
@@ -253,7 +259,8 @@ class CalibrationSession:
     def choose_candidate(self, index: int) -> None:
         self.undo.push(ChooseCandidate(self, index))
 
-    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None, tool_covariance: np.ndarray | None = None) -> Correction:
+    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None, tool_covariance: np.ndarray | None = None,
+                         kind: str = "correction") -> Correction:
         """``Store correction`` for a task location from the last solve. A result that is not ``ok``
         (implausible, uncertain, ambiguous) raises :class:`ConfirmationNeeded` unless
         ``confirmation`` says who accepted it and why; that text is stored with the correction.
@@ -261,7 +268,9 @@ class CalibrationSession:
         (:class:`~calib_core.calibration.look_fusion.FusedCorrection`): stored in the look's place
         when they agree; when they do not, storing the look alone needs the same confirmation.
         ``tool_covariance`` (6, 6: mm, deg, base axes): a measured tool's, which the look reaches the
-        TCP through; added to a look stored alone (a fused one holds it already)."""
+        TCP through; added to a look stored alone (a fused one holds it already). ``kind``:
+        ``measurement`` keeps the look as what it is, never commanded (no confirmation needed: it moves
+        nothing)."""
         r = self.result
         if r is None:
             raise CalibrationError("calibrate first")
@@ -271,7 +280,9 @@ class CalibrationSession:
         if stale:
             raise CalibrationError(f"the result is from an earlier state ({stale}); nothing stored")
         verdict = self.verdict or self._judge(r)
-        if not verdict.ok and not confirmation.strip():
+        if kind == "measurement":
+            fused = None  # what this pose measured, alone
+        elif not verdict.ok and not confirmation.strip():
             raise ConfirmationNeeded(f"the result is {verdict.verdict.value}: {'; '.join(verdict.reasons)}. Storing it needs your confirmation", verdict.reasons)
         if fused is not None and not fused.agree and not confirmation.strip():
             raise ConfirmationNeeded(f"{fused.message}. Storing the look alone needs your confirmation", (fused.message,))
@@ -293,7 +304,7 @@ class CalibrationSession:
         correction = Correction(
             task, r.tcp2base_model, measured, d, rv, std_d, std_r,
             np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source,
-            verdict=verdict.verdict.value, confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation.strip(),
+            verdict=verdict.verdict.value, confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation.strip(), kind=kind,
         )
         self.undo.push(_StoreCorrection(self.corrections, correction))
         return correction
@@ -303,7 +314,7 @@ class _StoreCorrection(Command):
     def __init__(self, table: CorrectionTable, correction: Correction):
         self.table = table
         self.correction = correction
-        self.label = f"Store correction for {correction.task}"
+        self.label = f"Store {correction.kind} for {correction.task}"
 
     def do(self) -> None:
         self.table.add(self.correction)

@@ -24,7 +24,9 @@ EXPORT_FORMATS = ("json", "csv") + FORMATS
 def _target(c: Correction, tasks: dict[str, TaskLocation]):
     """The pose to command so the real tool reaches the planned location, with this correction."""
     task = tasks.get(c.task)
-    return None if task is None else invert(c.delta_base) @ task.tcp2base
+    if task is None or c.kind != "correction":  # a measurement at another pose is never commanded
+        return None
+    return invert(c.delta_base) @ task.tcp2base
 
 
 def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:

@@ -61,7 +61,7 @@ def _correction_dict(c: Correction) -> dict:
         "tcp2base_model": _pose(c.tcp2base_model), "tcp2base_measured": _pose(c.tcp2base_measured),
         "displacement_mm": c.displacement_mm.tolist(), "rotation_deg": c.rotation_deg.tolist(),
         "std_displacement_mm": c.std_displacement_mm.tolist(), "std_rotation_deg": c.std_rotation_deg.tolist(),
-        "rms_px": c.rms_px, "pairs": c.pairs, "verdict": c.verdict, "confirmation": c.confirmation,
+        "rms_px": c.rms_px, "pairs": c.pairs, "verdict": c.verdict, "confirmation": c.confirmation, "kind": c.kind,
     }
 
 
@@ -85,7 +85,13 @@ def workspace_to_dict(ws: Workspace) -> dict:
 
 def _verification_dict(v: Verification) -> dict:
     return {"task": v.task, "time_s": v.time_s, "remaining_mm": v.remaining_mm.tolist(), "remaining_deg": v.remaining_deg.tolist(), "std_remaining_mm": v.std_remaining_mm.tolist(),
-            "disagreement_mm": v.disagreement_mm, "agree_within_mm": v.agree_within_mm, "rms_px": v.rms_px, "pairs": v.pairs}
+            "disagreement_mm": v.disagreement_mm, "agree_within_mm": v.agree_within_mm, "rms_px": v.rms_px, "pairs": v.pairs, "tolerance_mm": v.tolerance_mm}
+
+
+def _correction_kind(value, field: str, f) -> str:
+    if value not in ("correction", "measurement"):
+        raise f.fail(field, f"must be 'correction' or 'measurement', got {value!r}")
+    return value
 
 
 def save_workspace(path: str | Path, ws: Workspace) -> None:
@@ -210,6 +216,7 @@ def load_workspace(path: str | Path) -> Workspace:
             source=str(c.get("source", "")),
             verdict=str(c.get("verdict", "ok")),
             confirmation=str(c.get("confirmation", "")),
+            kind=_correction_kind(c.get("kind", "correction"), f"{where}.kind", f),
         ))
     verifications = data.get("verifications", []) or []
     if not isinstance(verifications, list):
@@ -220,6 +227,7 @@ def load_workspace(path: str | Path) -> Workspace:
             table.add_verification(Verification(
                 str(v["task"]), np.asarray(v["remaining_mm"], float).reshape(3), np.asarray(v["remaining_deg"], float).reshape(3),
                 np.asarray(v["std_remaining_mm"], float).reshape(3), float(v["disagreement_mm"]), float(v["agree_within_mm"]), float(v["rms_px"]), int(v["pairs"]), float(v.get("time_s", 0.0)),
+                float(v.get("tolerance_mm", DEFAULT_TOLERANCE_MM)),
             ))
         except (KeyError, TypeError, ValueError) as exc:
             raise f.fail(where, f"not a verification: {exc}") from None

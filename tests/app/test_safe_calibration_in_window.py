@@ -11,34 +11,17 @@ from PySide6.QtWidgets import QApplication
 
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
-from tests.app.windows import answer_next_question as _answer, confirm_move_if_asked, wait_for_settled_frame
+from tests.app.windows import answer_next_question as _answer, answer_questions, confirm_move_if_asked, go_and_settle, pick_features, wait_for_settled_frame
 
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
 
 
 def _go(qtbot, win, button) -> None:
-    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-    confirm_move_if_asked(qtbot, win)
-    qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
-    wait_for_settled_frame(qtbot, win)
+    go_and_settle(qtbot, win, button)
 
 
 def _pick_features(qtbot, win) -> None:
-    """Pick each feature through the panes (the truth tells the operator's eyes where it is)."""
-    wb = win.workbench
-    fixture = wb.workcell.component("oru_1_fixture")
-    true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
-    win.camera.subpixel.setChecked(False)
-    for name in FEATURES:
-        p = apply(fixture.item2world, fixture.features[name])
-        uv_model = project(apply(invert(wb.model_cam2world()), p[None]), win.virtual.intrinsics, distort=False)[0]
-        x, y = win.virtual.view.image_to_widget(*uv_model)
-        qtbot.mouseClick(win.virtual.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
-        uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0]
-        x, y = win.camera.view.image_to_widget(*uv)
-        qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
-        qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)
-    assert len(wb.session.pairs.usable()) == len(FEATURES), win.results.status.text()
+    pick_features(qtbot, win, FEATURES)
 
 
 def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale_is_drawn(qtbot, window, tmp_path):
@@ -84,13 +67,16 @@ def test_an_implausible_result_is_stored_only_with_a_confirmation(qtbot, window)
     obj2world = wb.workcell.component("oru_1_fixture").item2world
     wb.session.calibrate(wb.intrinsics, obj2world, wb.robot.fk(home, "camera"), wb.robot.fk(home, "tcp"), home)
     assert "IMPLAUSIBLE" in win.results.verdict.text() and "model error of 25 mm" in win.results.verdict.text()
-    asked = _answer(qtbot, "Cancel")
+    # Solved with the home joints, the look is not one of the task location: it is converted explicitly first.
+    convert = f"Convert into {wb.task.name}'s correction"
+    asked = answer_questions(qtbot, [convert, "Cancel"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
-    assert asked and "not OK" in asked[0] and wb.session.corrections.latest(wb.task.name) is None
-    asked = _answer(qtbot, "Store anyway")
+    assert len(asked) == 2 and "cannot be" in asked[0] and "not OK" in asked[1] and wb.session.corrections.latest(wb.task.name) is None
+    asked = answer_questions(qtbot, [convert, "Store anyway"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     stored = wb.session.corrections.latest(wb.task.name)
-    assert asked and stored is not None and stored.verdict == "implausible" and "confirmed in the window by" in stored.confirmation
+    assert len(asked) == 2 and stored is not None and stored.verdict == "implausible" and "confirmed in the window by" in stored.confirmation
+    assert "converted in the window by" in stored.source
 
 
 def test_a_click_while_the_robot_moves_picks_nothing(qtbot, window):

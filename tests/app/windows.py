@@ -60,3 +60,58 @@ def answer_next_question(qtbot, button_text: str) -> list:
 
     QTimer.singleShot(0, look)
     return answered
+
+
+def answer_questions(qtbot, button_texts: list[str]) -> list:
+    """Click ``button_texts`` in the next modal questions, one question each, in order; returns the
+    questions' texts as they were answered."""
+    answered = []
+    remaining = list(button_texts)
+
+    def look() -> None:
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox) and box.text() not in answered[-1:]:
+            for b in box.buttons():
+                if b.text().replace("&", "") == remaining[0]:
+                    answered.append(box.text())
+                    remaining.pop(0)
+                    b.click()
+                    break
+        if remaining:
+            QTimer.singleShot(20, look)
+
+    QTimer.singleShot(0, look)
+    return answered
+
+
+def go_and_settle(qtbot, win, button) -> None:
+    """Press a move button, confirm the move if the overview asks, wait until it arrived and a frame
+    captured after it has settled."""
+    qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
+    wait_for_settled_frame(qtbot, win)
+
+
+def pick_features(qtbot, win, features: list[str], component: str = "oru_1_fixture") -> None:
+    """Pick each feature through the panes: on the virtual camera, then on the camera image where the
+    truth puts it (the operator's eyes), then Ctrl+Return."""
+    from PySide6.QtCore import QPoint
+
+    from calib_core.camera.projection import project
+    from calib_core.frames import apply, invert
+
+    wb = win.workbench
+    fixture = wb.workcell.component(component)
+    true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
+    win.camera.subpixel.setChecked(False)
+    for name in features:
+        p = apply(fixture.item2world, fixture.features[name])
+        uv_model = project(apply(invert(wb.model_cam2world()), p[None]), win.virtual.intrinsics, distort=False)[0]
+        x, y = win.virtual.view.image_to_widget(*uv_model)
+        qtbot.mouseClick(win.virtual.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+        uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0]
+        x, y = win.camera.view.image_to_widget(*uv)
+        qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+        qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)
+    assert len(wb.session.pairs.usable()) == len(features), win.results.status.text()

@@ -4,6 +4,7 @@ session, picks while the robot moves, pairs from two poses, a link that drops, a
 import numpy as np
 import pytest
 
+from calib_core.calibration.look_place import LookNotAtTask
 from calib_core.calibration.session import CalibrationError, ConfirmationNeeded
 from calib_core.calibration.verdict import Verdict
 from calib_core.camera.projection import project
@@ -12,9 +13,9 @@ from calib_core.operator.core import OperatorCore
 from calib_core.operator.observations import NotSettledError
 from calib_core.robot import solve_ik
 from videocal_sim.sim_site import simulated_cell
+from tests.core.operator.perfect_operator import FEATURES, pick_all as _pick_all
 from tests.core.operator.still_robot import frame_now, sample, still_for
 
-FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left")
 
 
 @pytest.fixture
@@ -34,19 +35,6 @@ def _picked_at_task(cell, site) -> tuple[OperatorCore, np.ndarray]:
     frame_now(core)
     _pick_all(core, site.bed, q_task)
     return core, q_task
-
-
-def _pick_all(core, bed, q) -> None:
-    """Pick each feature on the model and its true image (what a perfect operator clicks)."""
-    fixture = core.workcell.component(core.task.component)
-    true_cam = bed.true_cam2world(q)
-    for name in FEATURES:
-        if name not in fixture.features:
-            continue
-        p = apply(fixture.item2world, fixture.features[name])
-        core.pick_model_point(fixture.name, name, p)
-        core.pick_image_point(project(apply(invert(true_cam), p[None]), core.intrinsics)[0])
-        core.accept_pair()
 
 
 def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_and_site, tmp_path):
@@ -91,12 +79,15 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
     assert np.linalg.norm(result.displacement_mm) > 100.0
     verdict = core.session.verdict
     assert verdict.verdict is Verdict.IMPLAUSIBLE and "beyond the cell's stated model error of 25 mm" in verdict.text
-    with pytest.raises(ConfirmationNeeded) as refused:
+    with pytest.raises(LookNotAtTask, match="from .*'s pose"):  # the home joints are not the task location's pose
         core.store_correction()
+    converted = "converted by a test: the look is the task's"
+    with pytest.raises(ConfirmationNeeded) as refused:
+        core.store_correction(convert=converted)
     assert refused.value.reasons == verdict.reasons and core.session.corrections.latest(core.task.name) is None
     events = []
     core.event.connect(lambda kind, detail: events.append((kind, detail)))
-    stored = core.store_correction(confirmation="confirmed by a test: the cell was moved")
+    stored = core.store_correction(convert=converted, confirmation="confirmed by a test: the cell was moved")
     assert stored.verdict == "implausible" and stored.confirmation == "confirmed by a test: the cell was moved"
     assert ("correction_confirmed", {"task": core.task.name, "verdict": "implausible", "confirmation": stored.confirmation}) in events
 

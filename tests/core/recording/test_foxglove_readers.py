@@ -69,7 +69,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     _pick_all(core, site.bed, q)
     assert not core.find_points().result.found  # a flat grey frame: recorded all the same
     core.calibrate()
-    core.store_correction(confirmation="test")
+    core.store_correction(convert="a test: the approach's look stands for the task", confirmation="test")
     core.stop_recording()
     (result,) = _read_indexed(path)
     _agrees_with_ours(result, path)

@@ -1,0 +1,19 @@
+"""An operator whose clicks land where the truth says: each feature picked on the model and on its true image."""
+
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert
+
+FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left")
+
+
+def pick_all(core, bed, q, features=FEATURES) -> None:
+    """Pick each of ``features`` of the task's component on the model and on its true image at commanded joints ``q``."""
+    fixture = core.workcell.component(core.task.component)
+    true_cam = bed.true_cam2world(q)
+    for name in features:
+        if name not in fixture.features:
+            continue
+        p = apply(fixture.item2world, fixture.features[name])
+        core.pick_model_point(fixture.name, name, p)
+        core.pick_image_point(project(apply(invert(true_cam), p[None]), core.intrinsics)[0])
+        core.accept_pair()
