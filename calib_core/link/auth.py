@@ -13,7 +13,9 @@ The session key is HMAC-SHA256(key, ``"videocal-session|" wn "|" cn``). A motion
 seal as its last field, ``#<counter>:<mac>``: ``counter`` 1, 2, 3 ... within the session (a replayed
 sentence reuses one and is refused), ``mac`` the first 32 hex digits of HMAC-SHA256(session key,
 ``"<counter>|<body before the seal>"``). Fresh nonces on both sides make an old session's sentences
-worthless in a new one. ``STP`` is never sealed: anyone at the link may stop the robot.
+worthless in a new one. ``STP`` is never sealed: anyone at the link may stop the robot. A new
+``HEL`` does not end the session in force: only a complete handshake (a right ``AUT``) replaces it,
+so a process without the key cannot end the workstation's session.
 """
 
 from __future__ import annotations
@@ -26,8 +28,9 @@ from dataclasses import dataclass
 
 NONCE_HEX = 16
 PROOF_HEX = 32
-SEALED = frozenset({"MVJ"})
-"""The sentence types a controller with a key obeys only when sealed: the ones that move the robot."""
+SEALED = frozenset({"MVJ", "HBT"})
+"""The sentence types a controller with a key obeys only when sealed: the ones that change what the
+robot does (a move; a heartbeat, which keeps a move running and arms or disarms the dead-man)."""
 
 _HEX = re.compile(r"[0-9a-f]+")
 _SEAL = re.compile(r"#([0-9]{1,10}):([0-9a-f]{32})")

@@ -49,7 +49,8 @@ class ControllerLogic:
     default; the test bed reports commanded joints, which is what a real controller does).
 
     ``key`` (32 bytes): the link's pre-shared key. With one, the controller speaks protocol 4 and
-    obeys a motion sentence only when it is sealed in the current session (:mod:`calib_core.link.auth`);
+    obeys a motion sentence and a heartbeat only when sealed in the current session
+    (:mod:`calib_core.link.auth`);
     every refusal is answered ``ERR,AUTH`` and kept in ``auth_refusals`` (and passed to ``on_refusal``).
     Without one it is a protocol-3 controller: any client's ``MVJ`` moves it.
     """
@@ -74,6 +75,11 @@ class ControllerLogic:
         self.on_refusal = on_refusal
         self.auth_refusals: list[str] = []
         self.end_session()
+
+    @property
+    def session_open(self) -> bool:
+        """An authenticated session is in force."""
+        return self._session is not None
 
     def end_session(self) -> None:
         """Forget the authenticated session (the workstation went away or opened a new one)."""
@@ -151,6 +157,9 @@ class ControllerLogic:
         elif isinstance(msg, Stop):
             out += self._halt(now, "STOPPED", "stopped by the workstation")
             out.append(Ack("STP", "-"))
+        elif isinstance(msg, Heartbeat) and self.key is not None and (why := self._seal_problem(inner, sealed)):
+            # only the authenticated workstation keeps a move running or disarms the dead-man
+            out.append(self._refuse(f"heartbeat: not obeyed: {why}"))
         elif isinstance(msg, Heartbeat):
             self.deadman_s = msg.timeout_ms / 1000.0
             self._last_heartbeat_t = now
@@ -171,7 +180,8 @@ class ControllerLogic:
 
     def _handshake(self, msg) -> HelloReply | Ack | ErrorReply:
         if isinstance(msg, Hello):
-            self.end_session()  # a new hello ends any earlier session
+            # The session in force stays until a new handshake completes: a hello from a process
+            # without the key (a second writer on the line) cannot end the workstation's session.
             controller_nonce = auth.new_nonce()
             self._hello = (msg.nonce, controller_nonce)
             return HelloReply(controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce))

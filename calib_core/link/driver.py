@@ -340,9 +340,10 @@ class ControllerLink:
             if self.mode == "poll" and now >= next_poll:
                 self._send(RequestJoints().body())
                 next_poll = max(next_poll + 1.0 / self.rate_hz, now)
-            if self.deadman_ms and now >= next_heartbeat:
-                # five heartbeats per dead-man time: a reader thread that waits for the CPU does not trip it
-                self._send(Heartbeat(self.deadman_ms).body())
+            if self.deadman_ms and now >= next_heartbeat and self._auth.state in (AuthState.READY, AuthState.OFF):
+                # five heartbeats per dead-man time: a reader thread that waits for the CPU does not trip it.
+                # Sealed in the session: the controller believes no one else's (none is sent without a session).
+                self._send(Heartbeat(self.deadman_ms).body(), sealed=True)
                 next_heartbeat = now + self.deadman_ms / 5000.0
             if self._state in (LinkState.UP, LinkState.CONNECTING) and now - last_sample_t > self.stale_after_s:
                 self._set_state(LinkState.STALE, f"no joint sample for {now - last_sample_t:.2f} s")
@@ -400,8 +401,8 @@ class ControllerLink:
             with self._lock:
                 self.stats.errors += 1
             self.last_error = f"controller error {msg.code}: {msg.text}"
-            if not self._auth.on_error(msg):
-                self._moves.refused(msg)
+            if not self._auth.on_error(msg) and not msg.text.startswith(("heartbeat:", "auth:")):
+                self._moves.refused(msg)  # a refused heartbeat or handshake is no move's answer
             if self._auth.lost_session(msg) and t_host >= self._next_hello_s:
                 self._hello()  # the controller restarted and forgot the session: open a new one
         elif isinstance(msg, StateReport):

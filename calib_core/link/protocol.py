@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-PROTOCOL_VERSION = 4
+PROTOCOL_VERSION = 5
 # Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences; version 4
 # adds a 45-byte seal to motion sentences (16 joints of 1e6 still fit).
 MAX_SENTENCE_BYTES = 320
@@ -103,7 +103,11 @@ class ErrorReply:
     text: str
 
     def body(self) -> str:
-        return f"ERR,{self.code},{self.text}"
+        # A refusal quotes what it refuses (a move id, a number): cut so the sentence always fits the
+        # protocol's limit, whatever it quotes.
+        head = f"ERR,{self.code},"
+        room = MAX_SENTENCE_BYTES - len("$*HH\r\n") - len(head)
+        return head + (self.text if len(self.text) <= room else self.text[: room - 3] + "...")
 
 
 # --- commands to the controller --------------------------------------------------------------
@@ -235,7 +239,13 @@ def _integer(text: str, what: str) -> int:
     return int(text)
 
 
+MAX_ID_CHARS = 32
+"""A move id's longest (the controller program keeps it in a ``STRING[32]``)."""
+
+
 def _token(text: str, what: str) -> str:
+    if len(text) > MAX_ID_CHARS:
+        raise ProtocolError("malformed", f"{what}: longer than {MAX_ID_CHARS} characters ({len(text)})")
     if not text or not all(c.isalnum() or c in "_-." for c in text):
         raise ProtocolError("malformed", f"{what}: not a valid identifier: {text!r}")
     return text

@@ -79,7 +79,12 @@ class _PtyEndpoint:
 
 
 class _TcpEndpoint:
-    def __init__(self, port: int):
+    """One workstation at a time on a TCP port. ``holds_session()``: the connected client has an
+    authenticated session (``None``: a controller without a key, where the first client keeps the
+    port). A client without a session does not lock the port: the next connection takes its place."""
+
+    def __init__(self, port: int, holds_session: Callable[[], bool] | None = None):
+        self.holds_session = holds_session
         self.server = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         self.server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         self.server.bind(("127.0.0.1", port))
@@ -106,7 +111,8 @@ class _TcpEndpoint:
         if fd is self.server:
             conn, _ = self.server.accept()
             conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            if self.client is not None and self._alive(self.client):
+            keeps_port = self.holds_session is None or self.holds_session()
+            if self.client is not None and self._alive(self.client) and keeps_port:
                 # One workstation at a time: a second client does not take the robot over.
                 with contextlib.suppress(OSError):
                     conn.sendall(encode(ErrorReply("BUSY", "another workstation is connected; this connection is closed").body()))
@@ -152,7 +158,7 @@ def serve(logic: ControllerLogic, options: SimOptions, faults: FaultInjector | N
     faults = faults or FaultInjector()
 
     def open_endpoint():
-        return _PtyEndpoint(options.link_path) if options.pty else _TcpEndpoint(options.tcp_port)
+        return _PtyEndpoint(options.link_path) if options.pty else _TcpEndpoint(options.tcp_port, None if logic.key is None else lambda: logic.session_open)
 
     endpoint = open_endpoint()
     announce(endpoint.path)

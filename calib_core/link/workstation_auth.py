@@ -79,7 +79,8 @@ class WorkstationAuth:
         """An ``ERR`` about the handshake (True: it was one)."""
         if self._key is None:
             return False
-        if msg.code == "AUTH" and msg.text.startswith("auth:"):
+        if msg.code == "AUTH" and msg.text.startswith("auth:") and self.state is AuthState.PENDING:
+            # (in a session, an "auth:" refusal answers another writer's handshake on the line, not ours)
             self._set(AuthState.FAILED, f"the controller refused {self._key_name} ({msg.text}); the robot is not moved")
             return True
         if self.state is AuthState.PENDING and not msg.text.startswith("move ") and ("HEL" in msg.text or "AUT" in msg.text):

@@ -16,10 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from calib_core.link import auth
 from calib_core.link.driver import ControllerLink
 from calib_core.link.joint_motion import TrapezoidMove
 from calib_core.link.link_types import MoveError
-from calib_core.link.protocol import PROTOCOL_VERSION
+from calib_core.link.protocol import PROTOCOL_VERSION, parse_body
 from calib_core.link.workstation_auth import AuthState
 
 from tests.controller.pdl2_subset import load
@@ -160,3 +161,67 @@ def test_it_refuses_a_wrong_key_and_an_unsealed_move(program):
     err = first_error_reply(program.path, "MVJ,x1,10,0,0,0,0,0")
     assert err.code == "AUTH" and err.text == "move x1: not obeyed: no authenticated session (send HEL and AUT first)"
     assert program.move is None
+
+
+class _ProgramBySentence:
+    """The translated program fed one sentence body at a time on a clock the test sets (no pty)."""
+
+    def __init__(self):
+        self.t_ms, self.sent, self.q, self.moving = 0, [], np.zeros(6), False
+        site = {"configure": self._configure, "link_read": lambda: -1, "link_write": self.sent.append, "now_ms": lambda: self.t_ms,
+                "boot_text": lambda: "boot 1", "arm_joint": lambda j: float(self.q[j - 1]), "arm_start": self._start,
+                "arm_moving": lambda: self.moving, "arm_stop": self._stop}
+        self.ns = load(PROGRAM.read_text(), site)
+        self.ns["startup"]()
+
+    def _configure(self):
+        self.ns["link_key_hex"] = KEY.hex()
+        self.ns["n_joints"] = 6
+        for j in range(1, 7):
+            self.ns["lower_deg"][j], self.ns["upper_deg"][j] = -170.0, 170.0
+
+    def _start(self):
+        self.moving = True
+
+    def _stop(self):
+        self.moving = False
+
+    def handle(self, body: str) -> list:
+        self.sent.clear()
+        self.ns["handle"](body)
+        return [parse_body(s[1:s.index("*")]) for s in self.sent]
+
+    def tick(self) -> list:
+        self.sent.clear()
+        self.ns["tick"]()
+        return [parse_body(s[1:s.index("*")]) for s in self.sent]
+
+
+def _session(program: _ProgramBySentence):
+    nonce = auth.new_nonce()
+    (reply,) = program.handle(f"HEL,{nonce}")
+    assert program.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}")[0].body() == "ACK,AUT,-"
+    counter = iter(range(1, 10**6))
+    return lambda body: program.handle(auth.seal(auth.session_key(KEY, nonce, reply.nonce), next(counter), body))
+
+
+def test_it_believes_only_the_workstations_sealed_heartbeat():
+    p = _ProgramBySentence()
+    sealed = _session(p)
+    assert sealed("HBT,500") == []
+    assert sealed("MVJ,a.1,160,0,0,0,0,0")[0].body() == "ACK,MVJ,a.1"
+    for _ in range(5):  # the workstation is gone: someone else's heartbeats every 0.1 s
+        p.t_ms += 100
+        (refusal,) = p.handle("HBT,60000")
+        assert refusal.code == "AUTH" and refusal.text == "heartbeat: not obeyed: the sentence carries no seal"
+    p.t_ms += 150
+    (halted,) = p.tick()
+    assert halted.code == "DEADMAN" and not p.moving
+
+
+def test_a_hello_without_the_key_leaves_the_session_in_force():
+    p = _ProgramBySentence()
+    sealed = _session(p)
+    p.handle(f"HEL,{auth.new_nonce()}")  # a second writer
+    assert p.handle("AUT," + "0" * 32)[0].text.startswith("auth: wrong proof")
+    assert sealed("MVJ,a.1,10,0,0,0,0,0")[0].body() == "ACK,MVJ,a.1"
