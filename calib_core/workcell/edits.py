@@ -13,6 +13,7 @@ import numpy as np
 import trimesh
 
 from calib_core.calibration.undo import Command
+from calib_core.names import check_typed_name
 from calib_core.errors import FileFormatError, OperatorError
 from calib_core.frames import check_transform
 from calib_core.scene import SceneItem
@@ -25,10 +26,8 @@ Notify = Callable[[str, str], None]
 
 
 def check_name(name: str, what: str) -> str:
-    name = str(name).strip()
-    if not name or any(c in name for c in "\n\r\t:#{}[],&*!|>'\"%@`"):
-        raise OperatorError(f"{what} name {name!r}: use letters, digits, '_', '-', '.' or spaces")
-    return name
+    """A name typed in the window (:func:`calib_core.names.check_typed_name`)."""
+    return check_typed_name(name, what)
 
 
 def load_component_mesh(path: str | Path, units: str = "mm") -> trimesh.Trimesh:

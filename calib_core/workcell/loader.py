@@ -15,6 +15,7 @@ import numpy as np
 import trimesh
 from calib_core.documents import read_yaml
 
+from calib_core.names import name_problem
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
 from calib_core.robot.errors import RobotSpecError
@@ -81,6 +82,13 @@ class _Reader:
             raise self.fail(field, f"must be a non-empty string, got {value!r}")
         return value
 
+    def name(self, value, field: str) -> str:
+        """A name (of a component, a feature, a task location): text without control characters."""
+        why = name_problem(value)
+        if why is not None:
+            raise self.fail(field, f"the name {str(value)[:60]!r} {why}")
+        return value
+
     def placement(self, value, field: str) -> np.ndarray:
         value = self.mapping(value, field, {"xyz", "rpy"}, {"xyz", "rpy"})
         return transform_from_xyz_rpy(self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy"))
@@ -100,7 +108,7 @@ class _Reader:
 def _component(reader: _Reader, raw, i: int) -> SceneItem:
     f = f"components[{i}]"
     raw = reader.mapping(raw, f, _COMPONENT_KEYS, {"name", "mesh", "mesh_units", "placement"})
-    name = reader.text(raw["name"], f"{f}.name")
+    name = reader.name(raw["name"], f"{f}.name")
     kind = reader.choice(raw.get("kind", "component"), f"{f}.kind", _KINDS)
     units = reader.choice(raw["mesh_units"], f"{f}.mesh_units", set(_MESH_SCALE))
     mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
@@ -122,6 +130,7 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         raise reader.fail(f"{f}.features", "must be a mapping of name: [x, y, z] (mm), or name: {at: [x, y, z], kind: ...}")
     features, kinds = {}, {}
     for k, v in features_raw.items():
+        reader.name(k, f"{f}.features.{str(k)[:40]!r}")
         features[str(k)], feature_kind = _feature(reader, v, f"{f}.features.{k}")
         if feature_kind.kind != "corner":
             kinds[str(k)] = feature_kind
@@ -168,7 +177,7 @@ def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:
     tolerance = reader.number(raw.get("tolerance_mm", DEFAULT_TOLERANCE_MM), f"{f}.tolerance_mm")
     if tolerance <= 0:
         raise reader.fail(f"{f}.tolerance_mm", f"must be > 0 mm, got {tolerance}")
-    return TaskLocation(reader.text(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component, tolerance)
+    return TaskLocation(reader.name(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component, tolerance)
 
 
 def _safety(reader: _Reader, raw) -> SafetyLimits:

@@ -17,13 +17,16 @@ Variable names are made unique within a listing after the vendor's length limit.
 
 from __future__ import annotations
 
+import re
 import time
+import warnings
 from collections.abc import Callable
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from calib_core.calibration.corrections import CorrectionTable
+from calib_core.names import InvalidNameError, check_name
 from calib_core.workcell.model import TaskLocation
 
 
@@ -44,6 +47,15 @@ def unique_identifiers(names: list[str], max_len: int, suffix: str = "_c") -> di
         used.add(ident.lower())
         out[name] = ident
     return out
+
+
+_IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
+def _remark(name: str) -> str:
+    """A checked name as it may stand in any listing's comment: characters that end a comment or a
+    line in some language (``;`` in FANUC TP, quotes) become ``_``."""
+    return "".join(c if (c.isalnum() and c.isascii()) or c in " _-." else "_" for c in name)
 
 
 def urscript_pose(T: np.ndarray) -> str:
@@ -75,7 +87,10 @@ def fanuc_position(T: np.ndarray) -> tuple[float, ...]:
 
 def pdl2_pos(T: np.ndarray) -> str:
     x, y, z = T[:3, 3]
-    e = Rotation.from_matrix(T[:3, :3]).as_euler("ZYZ", degrees=True)
+    with warnings.catch_warnings():
+        # e2 = 0 or 180 deg: e1 and e3 are not unique; scipy's choice gives the same rotation
+        warnings.simplefilter("ignore", UserWarning)
+        e = Rotation.from_matrix(T[:3, :3]).as_euler("ZYZ", degrees=True)
     return f"POS({x:.3f}, {y:.3f}, {z:.3f}, {e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f}, '')"
 
 
@@ -145,9 +160,14 @@ def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLo
     each with its measured displacement as a remark."""
     writer, max_name = LISTINGS[fmt]
     targets = corrected_targets(table, tasks)
+    for name in targets:  # never write a name that was not checked, whatever let it in
+        check_name(name, "task location")
     idents = unique_identifiers(list(targets), max_name)
+    for ident in idents.values():
+        if not _IDENTIFIER.fullmatch(ident) or len(ident) > max_name:
+            raise InvalidNameError(f"{ident!r} is not a {fmt} identifier")  # unique_identifiers' promise, kept here too
     entries = []
     for name, T in targets.items():
         c = table.latest(name)
-        entries.append((idents[name], T, f"{name}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
+        entries.append((idents[name], T, f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
     return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S")) + [""])

@@ -28,6 +28,7 @@ from calib_core.documents import read_json
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
+from calib_core.names import name_problem
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM
 
 SCHEMA_VERSION = 2
@@ -116,6 +117,14 @@ class _Fields:
             raise self.fail(f"{where}.{key}" if where else key, f"must be {getattr(kind, '__name__', kind)}, got {type(value).__name__}")
         return value
 
+    def name(self, data: dict, key: str, where: str) -> str:
+        """A name (task location, component, feature): text without control characters."""
+        value = self.get(data, key, where, str)
+        why = name_problem(value)
+        if why is not None:
+            raise self.fail(f"{where}.{key}" if where else key, f"the name {value[:60]!r} {why}")
+        return value
+
     def vector(self, value, n: int, where: str) -> np.ndarray:
         try:
             arr = np.asarray(value, dtype=float)
@@ -181,7 +190,7 @@ def load_workspace(path: str | Path) -> Workspace:
     tasks = {}
     for i, t in enumerate(f.get(data, "task_locations", "", list)):
         where = f"task_locations[{i}]"
-        name = f.get(t, "name", where, str)
+        name = f.name(t, "name", where)
         component = t.get("component")
         if component is not None and not isinstance(component, str):
             raise f.fail(f"{where}.component", f"must be the name of one component, got {component!r}")
@@ -197,12 +206,12 @@ def load_workspace(path: str | Path) -> Workspace:
                 view = ViewStamp.from_dict(p["view"])
             except (KeyError, TypeError, ValueError) as exc:
                 raise f.fail(f"{where}.view", f"not a frame stamp: {exc}") from None
-        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.get(p, "component", where, str), p.get("feature"), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True)), view))
+        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.name(p, "component", where), None if p.get("feature") is None else f.name(p, "feature", where), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True)), view))
     table = CorrectionTable()
     for i, c in enumerate(f.get(data, "corrections", "", list)):
         where = f"corrections[{i}]"
         table.add(Correction(
-            task=f.get(c, "task", where, str),
+            task=f.name(c, "task", where),
             tcp2base_model=f.pose(f.get(c, "tcp2base_model", where, dict), f"{where}.tcp2base_model"),
             tcp2base_measured=f.pose(f.get(c, "tcp2base_measured", where, dict), f"{where}.tcp2base_measured"),
             displacement_mm=f.vector(f.get(c, "displacement_mm", where), 3, f"{where}.displacement_mm"),
