@@ -49,7 +49,13 @@ def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("videocal")
     # SIGTERM and Ctrl+C close the window like Quit does (so the simulator and the link stop with it).
-    def quit_by_signal(*_):
+    # During start-up there is no event loop to quit yet (app.quit() then does nothing and the window came
+    # up regardless): the start is abandoned instead, and what it started is stopped on the way out.
+    running = False
+
+    def quit_by_signal(signum, _frame):
+        if not running:
+            raise SystemExit(128 + signum)
         app.setProperty("videocal_quit_by_signal", True)  # closing asks nothing; unsaved work stays in the autosave
         app.quit()
 
@@ -94,6 +100,7 @@ def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
             app.quit()
 
         QTimer.singleShot(4000, shoot)
+    running = True
     code = int(app.exec())
     for widget in app.topLevelWidgets():  # quit by a signal: close as Quit does (the window of a cell opened since too)
         if isinstance(widget, QMainWindow) and widget.isVisible():

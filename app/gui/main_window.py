@@ -285,7 +285,7 @@ class MainWindow(QMainWindow):
     def _go(self, *, approach: bool, corrected: bool = False) -> None:
         self.move(lambda confirmed: self.workbench.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))
 
-    def move(self, send: Callable[[bool], object]) -> None:
+    def move(self, send: Callable[[object], object]) -> None:
         """Send a move (``send(confirmed)`` calls the core). The core previews it in the overview; one
         that needs a confirmation waits there for *Move*; a refused one says why."""
         self.report(self._move_impl)(send)
@@ -294,7 +294,7 @@ class MainWindow(QMainWindow):
         try:
             send(False)
         except MoveNeedsConfirmation as exc:
-            self.overview.show_preview(exc.preview, lambda: self.report(send)(True))
+            self.overview.show_preview(exc.preview, lambda: self.report(send)(exc.confirmation))  # void after a Stop
             self.statusBar().showMessage(f"{exc}: press Move in the overview to send it", 15000)
 
     def _animate(self) -> None:

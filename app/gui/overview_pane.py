@@ -119,6 +119,7 @@ class OverviewPane(QWidget):
         workbench.session.pairs.changed.connect(lambda *_: self.mark_dirty())
         workbench.move_previewed.connect(lambda preview: self.show_preview(preview))
         workbench.motion_changed.connect(self._motion_changed)
+        workbench.prompts_withdrawn.connect(self._withdraw_prompt)
 
     # --- previewed moves ------------------------------------------------------------------------
     def show_preview(self, preview, send: Callable[[], None] | None = None) -> None:
@@ -142,6 +143,11 @@ class OverviewPane(QWidget):
             self.workbench.stop_robot()
             return
         self.show_preview(None)
+
+    def _withdraw_prompt(self) -> None:
+        """A Stop (Esc, *Stop*) voids a move still waiting for *Move*."""
+        if self._send is not None:
+            self.show_preview(None)
 
     def _confirm(self) -> None:
         send, self._send = self._send, None

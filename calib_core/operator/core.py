@@ -56,7 +56,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     :class:`~calib_core.operator.observations.HeldFrame`, or ``None`` when released),
     ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`),
     ``move_previewed(preview)`` (a :class:`~calib_core.operator.move_preview.MovePreview`, before
-    every move, sent or not)."""
+    every move, sent or not), ``prompts_withdrawn()`` (a Stop voided every move prompt still waiting)."""
 
     joints_changed = Signal(object)
     sample_received = Signal(object, object)
@@ -74,6 +74,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     motion_changed = Signal(object)
     move_previewed = Signal(object)
     points_found = Signal(object)
+    prompts_withdrawn = Signal()
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
@@ -90,6 +91,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.replaying = False
         self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
+        self.stops_sent = 0  # a prompt's confirmation carries the count it saw: a later Stop voids it
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the

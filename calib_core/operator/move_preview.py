@@ -77,12 +77,23 @@ class MoveRefused(OperatorError):
         self.preview = preview
 
 
-class MoveNeedsConfirmation(OperatorError):
-    """A move sent only once the operator confirms it (``preview.confirm_reasons``)."""
+@dataclass(frozen=True)
+class Confirmation:
+    """The operator's answer to one prompt: the move to ``what``, asked for when the core had sent
+    ``stops_seen`` stops. A Stop after the prompt voids it: the answer then moves nothing."""
 
-    def __init__(self, preview: MovePreview):
+    what: str
+    stops_seen: int
+
+
+class MoveNeedsConfirmation(OperatorError):
+    """A move sent only once the operator confirms it (``preview.confirm_reasons``); pass
+    ``confirmation`` back as ``confirmed=`` to send it."""
+
+    def __init__(self, preview: MovePreview, confirmation: Confirmation | None = None):
         super().__init__(f"the move to {preview.what} needs your confirmation: {'; '.join(preview.confirm_reasons)}")
         self.preview = preview
+        self.confirmation = confirmation or Confirmation(preview.what, 0)
 
 
 def joint_path(start_deg, goal_deg, step_deg: float = STEP_DEG) -> np.ndarray:

@@ -13,7 +13,7 @@ import numpy as np
 from calib_core.calibration.session import CalibrationError
 from calib_core.link.link_types import MoveHandle
 from calib_core.operator.motion import Motion, MotionState, ended
-from calib_core.operator.move_preview import MoveNeedsConfirmation, MovePreview, MoveRefused, preview_move
+from calib_core.operator.move_preview import Confirmation, MoveNeedsConfirmation, MovePreview, MoveRefused, preview_move
 from calib_core.robot import solve_ik
 from calib_core.robot.collision import CollisionWorld
 
@@ -25,7 +25,7 @@ class Moves:
         self.motion = state
         self.motion_changed.emit(state)
 
-    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
+    def move_to(self, target2base: np.ndarray, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool | Confirmation = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
         """IK for the TCP target (4, 4) mm in base from the current joints, then a joint move."""
         q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
         return self.move_joints(q, what, wait=wait, timeout_s=timeout_s, confirmed=confirmed, allowed_contacts=allowed_contacts)
@@ -43,11 +43,12 @@ class Moves:
         self.move_previewed.emit(preview)
         return preview
 
-    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
+    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool | Confirmation = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
         """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended.
         The move is previewed first: refused (:class:`MoveRefused`) outside the limits or into a
         collision, and sent only with ``confirmed`` when it turns a joint further than the cell's
-        ``confirm_joint_change_deg`` (:class:`MoveNeedsConfirmation`)."""
+        ``confirm_joint_change_deg`` (:class:`MoveNeedsConfirmation`). ``confirmed``: ``True`` (a
+        script's), or the prompt's :class:`Confirmation`, void once a Stop was sent after it."""
         if self.replaying:
             raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
         if self.link is None:
@@ -67,7 +68,9 @@ class Moves:
             raise MoveRefused(preview)
         if preview.needs_confirmation:
             if not confirmed:
-                raise MoveNeedsConfirmation(preview)
+                raise MoveNeedsConfirmation(preview, Confirmation(what, self.stops_sent))
+            if isinstance(confirmed, Confirmation) and (confirmed.stops_seen != self.stops_sent or confirmed.what != what):
+                raise CalibrationError(f"not moving to {what}: the robot was stopped after this move was asked for; ask for it again")
             self.record_event("move_confirmed", what=what, reasons=list(preview.confirm_reasons))
         handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
         if not handle.sent:
@@ -88,7 +91,7 @@ class Moves:
         self.move_finished.emit(what, str(error) if error else "")
         self.message.emit(f"move to {what} failed: {error}" if error else f"arrived at {what}")
 
-    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False, confirmed: bool = False) -> MoveHandle:
+    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False, confirmed: bool | Confirmation = False) -> MoveHandle:
         if self.task is None:
             raise CalibrationError("choose a task location first")
         target = self.task.approach2base if approach else self.task.tcp2base
@@ -104,6 +107,9 @@ class Moves:
     def stop_robot(self) -> bool:
         """Stop now (``$STP``): the controller halts the robot where it is; the running move ends with
         its ``STOPPED`` reason. True if the stop went out."""
+        # Every prompt still waiting is void, link or not: a Move pressed after Stop must not move the robot.
+        self.stops_sent += 1
+        self.prompts_withdrawn.emit()
         if self.link is None:
             raise CalibrationError("no controller link: nothing to stop")
         sent = self.link.stop()

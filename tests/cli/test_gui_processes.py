@@ -104,3 +104,36 @@ def test_two_windows_killed_with_sigkill_leave_no_simulator(cell_copy, tmp_path)
             if gui.poll() is None:
                 gui.kill()
             gui.communicate()
+
+
+def test_sigterm_during_start_up_ends_it_and_leaves_no_simulator(cell_copy, tmp_path):
+    """Issue 32: a SIGTERM while the cell was loading was ignored for 40 s in one run (no event loop to
+    quit yet), and left the simulator running in another."""
+    shown = tmp_path / "shown.txt"
+    gui = _gui("--workcell", str(cell_copy), env={"VIDEOCAL_REPORT_SHOWN": str(shown)})
+    try:
+        deadline = time.monotonic() + 120
+        while not shown.exists():  # the loading window is up; the cell, robot and link load behind it
+            assert gui.poll() is None, gui.stderr.read()
+            assert time.monotonic() < deadline, "the loading window did not come up"
+            time.sleep(0.05)
+        assert not shown.with_suffix(".ready").exists()
+        gui.send_signal(signal.SIGTERM)
+        gui.wait(timeout=20)
+        assert gui.returncode == 128 + signal.SIGTERM
+        assert not shown.with_suffix(".ready").exists()  # it did not come up after all
+        assert _wait_gone(cell_copy) == []
+    finally:
+        if gui.poll() is None:
+            gui.kill()
+        gui.communicate()
+
+
+def test_a_relative_workcell_path_opens_the_window(cell_copy, tmp_path):
+    """Issue 29/31: the simulator child ran in the project's folder with the path as given."""
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    done = subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--workcell", os.path.relpath(cell_copy, tmp_path), "--screenshot", "shot.png"],
+                          cwd=tmp_path, capture_output=True, text=True, env=env, timeout=180)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "shot.png").stat().st_size > 10_000
+    assert _wait_gone(cell_copy) == []
