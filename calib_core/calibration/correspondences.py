@@ -122,6 +122,9 @@ class CorrespondenceSet:
 
     def _reset(self, pairs: list[Correspondence]) -> list[Correspondence]:
         old, self._pairs = self._pairs, list(pairs)
+        # New pairs are numbered after every pair ever shown: a pick in a replay's branch once took
+        # number 1 beside recorded pair 1, and its image click moved the recorded pair.
+        self._next_number = max([self._next_number] + [p.number + 1 for p in self._pairs])
         self._emit("reset", None)
         return old
 

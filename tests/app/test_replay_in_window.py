@@ -174,3 +174,28 @@ def test_a_recording_from_another_camera_mode_replays_with_its_own_intrinsics(qt
     assert win.camera.last_frame.image.shape[:2] == (half.height, half.width)
     win.replay.close_replay()
     assert wb.intrinsics == live and win.virtual.intrinsics == live.without_distortion().scaled(RENDER_SCALE)
+
+
+def test_a_branchs_new_pair_is_numbered_after_the_recorded_ones_and_undo_stays_in_the_branch(qtbot, window, recording):
+    """Issue 32: a new pair took number 1 beside recorded pair 1; the camera click meant for it moved the
+    recorded pair, Undo twice deleted the recorded pair and Redo left two rows numbered 1."""
+    win, wb = window, window.workbench
+    win.files.open_recording(recording)
+    win.replay.seek(win.replay.playback.duration_s)
+    recorded = wb.session.pairs.pairs()
+    assert recorded and min(p.number for p in recorded) == 1
+    fixture = wb.workcell.component("oru_1_fixture")
+    number = wb.pick_model_point("oru_1_fixture", "pin_tip", tuple(fixture.item2world[:3, 3]))
+    assert win.replay.branched_at_s is not None
+    assert number == max(p.number for p in recorded) + 1
+    win.camera.subpixel.setChecked(False)
+    qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(300, 200))
+    assert wb.session.pairs.get(number).pixel is not None
+    assert [p for p in wb.session.pairs if p.number != number] == recorded  # no recorded pair moved
+    wb.undo()
+    wb.undo()
+    assert wb.session.pairs.pairs() == recorded  # undo took back the branch's edits only
+    assert wb.undo() is None and wb.session.pairs.pairs() == recorded  # and reaches no further
+    wb.redo()
+    numbers = [p.number for p in wb.session.pairs]
+    assert len(numbers) == len(set(numbers)) == len(recorded) + 1
