@@ -38,12 +38,12 @@ class SimulatedSiteKind:
         truth = load_intrinsics(load_workcell().intrinsics_path)
         return truth, simulated_board_images(truth, spec, n)
 
-    def hand_eye(self, args, detect):
-        """``(HandEyeResult, error against the truth)`` from simulated board views (see
+    def hand_eye(self, **options):
+        """``(HandEyeResult, error against the truth)`` from simulated board views (options: see
         :func:`videocal_sim.hand_eye_views.calibrate_simulated_hand_eye`)."""
         from videocal_sim.hand_eye_views import calibrate_simulated_hand_eye
 
-        return calibrate_simulated_hand_eye(args, detect)
+        return calibrate_simulated_hand_eye(**options)
 
     def calibrate_robot(self, views: int, seed: int, **options):
         """The cold cell's robot calibration (:func:`videocal_sim.cold_robot_calibration.calibrate_cold_cell`)."""

@@ -45,7 +45,10 @@ from calib_core.link.protocol import (
     parse_body,
 )
 
-from calib_core.link.workstation_auth import AuthState, WorkstationAuth
+from calib_core.link.workstation_auth import HANDSHAKE_ATTEMPTS, HANDSHAKE_TIMEOUT_S, AuthState, WorkstationAuth
+
+HANDSHAKE_WAIT_S = HANDSHAKE_TIMEOUT_S * sum(range(1, HANDSHAKE_ATTEMPTS + 1)) + 0.5
+"""How long a move waits for a handshake under way (its retries included) before it is not sent."""
 
 _READ_TIMEOUT_S = 0.01
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
@@ -200,7 +203,7 @@ class ControllerLink:
         if not all(abs(v) < 1e6 for v in q):
             raise ValueError(f"a move needs finite joint values within 1e6, got {q}")
         handle = MoveHandle(f"m{self._session}.{next(self._ids)}", q, time.monotonic() + timeout_s)
-        if self._auth.wait_settled(1.0) not in (AuthState.READY, AuthState.OFF):
+        if self._auth.wait_settled(HANDSHAKE_WAIT_S) not in (AuthState.READY, AuthState.OFF):
             handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: not sent: {self._auth.why_not}"))
             return handle
@@ -350,7 +353,8 @@ class ControllerLink:
                 if self.mode == "stream":
                     self._send(Stream(self.rate_hz).body())  # a controller that forgot the stream gets asked again
                     last_sample_t = now
-            self._auth.check_timeout(now)
+            if self._auth.check_timeout(now):
+                self._hello()  # unanswered: once more before giving up
             self._moves.expire(now)
 
     def _sync_counts(self) -> None:

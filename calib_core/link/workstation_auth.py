@@ -15,6 +15,9 @@ from calib_core.link import auth
 from calib_core.link.protocol import Authenticate, ErrorReply, Hello, HelloReply
 
 HANDSHAKE_TIMEOUT_S = 1.5
+HANDSHAKE_ATTEMPTS = 3
+"""An unanswered hello is sent again (after 1.5 s, then 3 s more) before the handshake is given up: a
+controller simulator starting on a loaded two-core machine once missed the first 1.5 s."""
 
 
 class AuthState(str, Enum):
@@ -39,6 +42,7 @@ class WorkstationAuth:
         self._session: bytes | None = None
         self._counter = 0
         self._sent_s = 0.0
+        self._attempts = 0
         self.listeners: list = []
         """``callback(state, failure)`` when the handshake ends (on the link's reader thread)."""
 
@@ -54,6 +58,8 @@ class WorkstationAuth:
         """The ``HEL`` body that opens a new session (``None`` without a key)."""
         if self._key is None:
             return None
+        retry = self.state is AuthState.PENDING and self._nonce is not None
+        self._attempts = self._attempts + 1 if retry else 1
         self._nonce, self._session, self._counter = auth.new_nonce(), None, 0
         self._sent_s = time.monotonic()
         self._set(AuthState.PENDING)
@@ -93,9 +99,16 @@ class WorkstationAuth:
         """A move refused for want of a session (the controller restarted): time for a new hello."""
         return self._key is not None and msg.code == "AUTH" and "no authenticated session" in msg.text
 
-    def check_timeout(self, now_s: float) -> None:
-        if self.state is AuthState.PENDING and now_s - self._sent_s > HANDSHAKE_TIMEOUT_S:
-            self._set(AuthState.FAILED, f"the controller did not answer the handshake within {HANDSHAKE_TIMEOUT_S:g} s (a protocol-3 controller?); the robot is not moved")
+    def check_timeout(self, now_s: float) -> bool:
+        """True when an unanswered hello is due to be sent again; after :data:`HANDSHAKE_ATTEMPTS` the
+        handshake has failed."""
+        if self.state is not AuthState.PENDING or self._nonce is None or now_s - self._sent_s <= HANDSHAKE_TIMEOUT_S * self._attempts:
+            return False
+        if self._attempts < HANDSHAKE_ATTEMPTS:
+            return True
+        waited = HANDSHAKE_TIMEOUT_S * sum(range(1, HANDSHAKE_ATTEMPTS + 1))
+        self._set(AuthState.FAILED, f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:g} s; a protocol-3 controller?); the robot is not moved")
+        return False
 
     def wait_settled(self, timeout_s: float) -> AuthState:
         """Wait while the handshake is under way (at most ``timeout_s``); the state then."""

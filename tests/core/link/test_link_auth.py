@@ -17,7 +17,7 @@ from calib_core.link.driver import ControllerLink
 from calib_core.link.link_key import LinkKeyError, default_key_path, read_key, user_key, write_new_key
 from calib_core.link.link_types import MoveError
 from calib_core.link.protocol import Ack, HelloReply, encode
-from calib_core.link.workstation_auth import AuthState
+from calib_core.link.workstation_auth import AuthState, WorkstationAuth
 
 from tests.core.link.raw_link import first_error_reply
 from tests.core.link.sim_process import SimProcess
@@ -186,3 +186,23 @@ def test_the_key_file_is_private_and_made_once(tmp_path):
 def test_the_user_key_lives_in_the_config_folder():
     assert str(default_key_path()).startswith(os.environ["XDG_CONFIG_HOME"])
     assert user_key() == read_key(default_key_path())
+
+
+def test_an_unanswered_hello_is_sent_again_before_the_handshake_fails():
+    """A controller simulator starting on a loaded machine once missed the only 1.5 s the driver gave it."""
+    ws = WorkstationAuth(KEY)
+    first = ws.hello()
+    t0 = ws._sent_s
+    assert not ws.check_timeout(t0 + 1.4) and ws.check_timeout(t0 + 1.6)
+    second = ws.hello()
+    assert second != first and ws.state is AuthState.PENDING
+    t1 = ws._sent_s
+    assert not ws.check_timeout(t1 + 2.9) and ws.check_timeout(t1 + 3.1)  # 3 s for the second
+    ws.hello()
+    t2 = ws._sent_s
+    assert not ws.check_timeout(t2 + 4.4) and ws.state is AuthState.PENDING
+    assert not ws.check_timeout(t2 + 4.6) and ws.state is AuthState.FAILED and "3 tries in 9 s" in ws.failure
+    # the reply to the latest hello is what counts; a late reply to the failed one is not believed
+    nonce = ws._nonce
+    reply = HelloReply("0123456789abcdef", auth.controller_proof(KEY, nonce, "0123456789abcdef"))
+    assert ws.on_hello_reply(reply) is None
