@@ -50,7 +50,7 @@ class MainWindow(QMainWindow):
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
         self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
-        self.vision = VisionPanel(workbench, lambda: self.camera.last_frame, self.camera.set_board_corners, self.show_error, lambda send: self.move(send))
+        self.vision = VisionPanel(workbench, self.camera.set_board_corners, self.show_error, lambda send: self.move(send))
         self.robot_calibration = RobotPanel(workbench, self.show_error)
         self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
         for panel, title in ((self.vision, "Vision"), (self.robot_calibration, "Robot"), (self.cell_panel, "Cell")):
@@ -294,7 +294,8 @@ class MainWindow(QMainWindow):
         try:
             send(False)
         except MoveNeedsConfirmation as exc:
-            self.overview.show_preview(exc.preview, lambda: self.report(send)(exc.confirmation))  # void after a Stop
+            confirmation = exc.confirmation  # the name ``exc`` is gone once the except block ends
+            self.overview.show_preview(exc.preview, lambda: self.report(send)(confirmation))  # void after a Stop
             self.statusBar().showMessage(f"{exc}: press Move in the overview to send it", 15000)
 
     def _animate(self) -> None:

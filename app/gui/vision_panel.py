@@ -29,15 +29,14 @@ from calib_core.errors import OperatorError
 
 
 class VisionPanel(QWidget):
-    """``current_frame()`` gives the camera pane's frame (a ``Frame`` or ``None``); ``show_corners``
+    """Captures take the core's newest frame (:meth:`frame_to_capture`); ``show_corners``
     draws a detection on the camera pane; ``show_error`` puts a failed step's reason in the window;
     progress goes to the workbench's messages (the status bar)."""
 
-    def __init__(self, workbench, current_frame: Callable, show_corners: Callable, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
+    def __init__(self, workbench, show_corners: Callable, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
         super().__init__(parent)
         self.workbench = workbench
         self._move = move or (lambda send: send(False))  # the window previews and confirms moves
-        self._current_frame = current_frame
         self._show_corners = show_corners
         self._report = workbench.message.emit
         guard = guarded(show_error)
@@ -150,15 +149,11 @@ class VisionPanel(QWidget):
     # --- capturing -----------------------------------------------------------------------------
     def capture_view(self) -> None:
         """Detect the board in the current frame; keep it (with the joints) or say why not."""
-        frame = self._current_frame()
-        if frame is None:
-            raise OperatorError("no camera frame yet: start the camera (Execution > Live) or open a recording")
-        # The joints at the frame's capture (live: from the link's samples; replaying: the recorded ones),
-        # and only when the robot had settled before it: a refusal says why, nothing is captured.
-        # Without a robot (no link, no replay) a view serves the intrinsics only.
-        has_robot = self.workbench.replaying or self.workbench.link is not None
-        joints = np.array(self.workbench.stamp_frame(frame).joints_deg) if has_robot else None
-        view = self.capture.add(frame.image, joints)
+        # The newest frame (not the still held for picking), taken after the last move and once the
+        # robot had settled, with the joints then: a refusal says why, nothing is captured.
+        frame, stamp = self.workbench.frame_to_capture()
+        joints = None if stamp is None else np.array(stamp.joints_deg)
+        view = self.capture.add(frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s))
         if isinstance(view, RejectedView):
             self._show_corners(None, "")
             self._report(f"{view.name} rejected: {view.reason}")

@@ -92,6 +92,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
         self.stops_sent = 0  # a prompt's confirmation carries the count it saw: a later Stop voids it
+        self.last_move_sent_s: float | None = None  # host monotonic s
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the

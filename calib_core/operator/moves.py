@@ -8,6 +8,8 @@ joints and events.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from calib_core.calibration.session import CalibrationError
@@ -75,6 +77,7 @@ class Moves:
         handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
         if not handle.sent:
             handle.wait(0)  # raises the link's reason
+        self.last_move_sent_s = time.monotonic()  # frames from before it show the old pose (board captures)
         self.message.emit(f"moving to {what}: joints {', '.join(f'{v:.1f}' for v in q)}")
         self._set_motion(MotionState(Motion.MOVING, what))
         self._pending_move = (what, handle)

@@ -65,14 +65,20 @@ class Observations:
             captured_at = f"{frame.t_host_s:.3f} s into {self.source}"
         return ViewStamp(int(frame.index), float(frame.t_host_s), tuple(float(v) for v in at.joints_deg), float(at.stamp_gap_s), captured_at, self.source)
 
+    def newest_usable(self) -> Frame | None:
+        """The newest frame; when its joint samples have not arrived yet (the joint stream lags a frame
+        by up to a sample period, 20 ms at 50 Hz), the one before it."""
+        frame = self.latest
+        if frame is not None and self.previous is not None and self.stillness(frame).pending:
+            frame = self.previous
+        return frame
+
     def hold(self, frame: Frame | None = None) -> HeldFrame:
         """Hold ``frame`` for picking. By default the newest; when its joint samples have not arrived
         yet (the joint stream lags a frame by up to a sample period, 20 ms at 50 Hz), the one before
         it: a click on the image must not be refused for that."""
         if frame is None:
-            frame = self.latest
-            if frame is not None and self.previous is not None and self.stillness(frame).pending:
-                frame = self.previous
+            frame = self.newest_usable()
         if frame is None:
             raise OperatorError("no camera image yet: start the camera (Execute > Live) or open a recording")
         self.still = HeldFrame(frame, self.stamp(frame))

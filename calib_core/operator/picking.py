@@ -15,7 +15,7 @@ from calib_core.calibration.session import CalibrationError
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory
-from calib_core.operator.observations import HeldFrame, Observations
+from calib_core.operator.observations import HeldFrame, NotSettledError, Observations
 
 
 class Picking:
@@ -162,6 +162,19 @@ class Picking:
         self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
         self.still_changed.emit(held)
         return held
+
+    def frame_to_capture(self) -> tuple:
+        """``(frame, stamp)`` for a board view: the newest frame (never a held still), by the same rule as
+        a pick (the robot had settled before it; :class:`NotSettledError` otherwise) and taken after the
+        last move was sent (a frame from before it shows the board from the pose before). ``stamp`` is
+        ``None`` without a robot (no link, no replay): such a view serves the intrinsics only."""
+        frame = self.observations.newest_usable()
+        if frame is None:
+            raise OperatorError("no camera frame yet: start the camera (Execute > Live) or open a recording")
+        if not self.replaying and self.last_move_sent_s is not None and frame.t_host_s <= self.last_move_sent_s:
+            raise NotSettledError(f"frame {frame.index} was taken before the last move ({self.motion.what}) was sent: wait for a frame from where the robot stands now")
+        has_robot = self.replaying or self.link is not None
+        return frame, (self.observations.stamp(frame) if has_robot else None)
 
     def stamp_frame(self, frame) -> ViewStamp:
         """``frame``'s stamp (its joints at capture), refused while the robot was not settled."""

@@ -26,14 +26,21 @@ class BoardCapture:
         self.rejected: list[RejectedView] = []
         self._detector = spec.detector()
         self._count = 0
+        self._captured: dict = {}  # frame key -> the view's name
 
-    def add(self, image_rgb: np.ndarray, joints_deg=None) -> BoardView | RejectedView:
-        """Detect the board in an image and keep the view when enough corners are seen."""
+    def add(self, image_rgb: np.ndarray, joints_deg=None, frame_key=None) -> BoardView | RejectedView:
+        """Detect the board in an image and keep the view when enough corners are seen. ``frame_key``
+        (hashable: the frame's source and number) refuses a frame captured already: four captures of one
+        frame are one view, not four."""
+        if frame_key is not None and frame_key in self._captured:
+            raise CalibrationInputError(f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next pose")
         if self.views and (image_rgb.shape[1], image_rgb.shape[0]) != self.views[0].image_size:
             w, h = self.views[0].image_size
             raise CalibrationInputError(f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one calibration is for one camera mode")
         self._count += 1
         result = detect_view(f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
+        if frame_key is not None:
+            self._captured[frame_key] = result.name
         if isinstance(result, RejectedView):
             self.rejected.append(result)
         else:

@@ -25,6 +25,11 @@ def test_esc_withdraws_a_waiting_move_prompt(qtbot, window):
     assert not win.overview.preview_bar.isVisible() and not win.overview.move_button.isVisible()
     qtbot.mouseClick(win.overview.move_button, Qt.MouseButton.LeftButton)  # hidden: the click goes nowhere
     assert wb.motion.motion.value != "moving" and np.max(np.abs(wb.joints_deg - before)) < 1e-6
+    # Asked again, Move sends it.
+    win.move(lambda confirmed: wb.move_joints(q, "far", confirmed=confirmed))
+    qtbot.mouseClick(win.overview.move_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
+    assert np.max(np.abs(wb.joints_deg - q)) < 1e-3
 
 
 def test_a_confirmation_given_before_a_stop_moves_nothing(qtbot, window):

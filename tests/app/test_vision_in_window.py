@@ -188,3 +188,28 @@ def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, 
     asked = _answer(qtbot, "Apply anyway")
     qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
     assert asked and not np.array_equal(wb.robot.frame_placement("camera"), before) and "vision_result_confirmed" in events
+
+
+def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
+    """Issue 32: four captures while the robot moved to the next board pose were all accepted, each a copy
+    of the frame from before the move (the still held for picking); coverage stayed while the count rose."""
+    win, wb = window, window.workbench
+    vision = win.vision
+    vision.show_board.setChecked(True)
+    _visit_board_pose(qtbot, win, 0)
+    qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    assert len(vision.capture.views) == 1
+    wb.hold_frame()  # a still held for picking, from before the move: the old code captured it again and again
+    qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    refusals = []
+    while wb.motion.motion.value == "moving":
+        qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+        refusals.append(win.results.status.text())
+        qtbot.wait(150)
+    assert len(refusals) >= 2 and len(vision.capture.views) == 1, refusals
+    assert all("before the last move" in r or "cannot be used" in r for r in refusals), refusals
+    _fresh_still_frame(qtbot, win)
+    qtbot.waitUntil(lambda: wb.observations.latest.t_host_s > wb.last_move_sent_s and wb.observations.stillness(wb.observations.newest_usable()).settled, timeout=10_000)
+    qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
+    assert len(vision.capture.views) == 2
