@@ -84,7 +84,11 @@ class FileMenu:
 
     # --- workspaces and exports ---------------------------------------------------------------------
     def save_workspace(self, path) -> bool:
-        """Save; only a save that succeeded joins the recent files and counts as saved for the autosave."""
+        """Save; only a save that succeeded joins the recent files and counts as saved for the autosave.
+        The recovery folder holds autosaves only: a save there is refused."""
+        if Path(path).resolve().parent == self.autosave.folder.resolve():
+            self.window.show_error(f"{path}: that is the recovery folder, which holds autosaves only; save the workspace somewhere else")
+            return False
         if not attempt(self.window.show_error, self.window.workbench.save_workspace, path):
             return False
         self.recent.remember(path)
@@ -92,9 +96,15 @@ class FileMenu:
         self.workspace_path = str(path)
         return True
 
-    def open_workspace(self, path) -> bool:
+    def open_workspace(self, path, *, restored: bool = False) -> bool:
+        """Open a workspace file. ``restored``: an autosave, which is no file of the operator's: it joins
+        no recent list and *Save* asks where (it once wrote into the recovery folder, offered again at
+        the next start as an unsaved autosave)."""
         if not attempt(self.window.show_error, self.window.workbench.open_workspace, path):
             return False
+        if restored:
+            self.workspace_path = None
+            return True
         self.recent.remember(path)
         self.workspace_path = str(path)
         return True
@@ -209,7 +219,7 @@ class FileMenu:
                 return False
             path = next(iter(self.restore_actions))
         path = Path(path)
-        if not self.open_workspace(path):
+        if not self.open_workspace(path, restored=True):
             return False
         self.autosave.set_aside(path)
         action = self.restore_actions.pop(str(path), None)

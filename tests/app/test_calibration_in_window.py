@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QPoint, QPointF, QSettings, Qt
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QPoint, QPointF, QSettings, Qt, QTimer
+from PySide6.QtWidgets import QApplication, QFileDialog
 
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
@@ -315,6 +315,28 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         assert "Restore" in win.files.restore_action.text()
         win.files.restore_action.trigger()
         assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
+        # Issue 32: Save after a restore wrote into the recovery folder without a dialog, and the next
+        # start offered that file again. A restored session has no file yet: Save asks where.
+        assert win.files.workspace_path is None
+        chosen = tmp_path / "mine.json"
+        asked = []
+
+        def answer():
+            dialog = QApplication.activeModalWidget()
+            if isinstance(dialog, QFileDialog):
+                asked.append(dialog.windowTitle())
+                dialog.selectFile(str(chosen))
+                dialog.accept()
+            else:
+                QTimer.singleShot(20, answer)
+
+        QTimer.singleShot(0, answer)
+        assert win.files.save_workspace_dialog()
+        assert asked == ["Save workspace"] and chosen.is_file()
+        assert sorted(p.name for p in (tmp_path / "recovery").iterdir()) == ["recovered-autosave.json"]
+        assert win.files.autosave.orphans() == []
+        assert not win.files.save_workspace(tmp_path / "recovery" / "w.json")  # the recovery folder holds autosaves only
+        assert "recovery folder" in win.results.status.text() and not (tmp_path / "recovery" / "w.json").exists()
     finally:
         win.close()
 
