@@ -154,6 +154,10 @@ def main() -> str:
         bad = bad_inputs(Path(tmp))
     closes = failed_recorder_close()
     lost_s = link_lost_mid_move()
+    from bench import link_attacks
+
+    heartbeats, hello, squatter, oversize = (link_attacks.dead_workstation_with_foreign_heartbeats(), link_attacks.second_writer_handshake(),
+                                             link_attacks.tcp_squatter(), link_attacks.oversize_fields())
     fuzzed = fuzz()
     lines = [
         "# Reliability benchmarks",
@@ -176,6 +180,17 @@ def main() -> str:
         lines.append(f"| a failed recorder's close(), {what} (`{failure}`), 60 frames queued | {1000 * seconds:.0f} ms | <= 1 s |")
     lines.append(f"| the simulator killed mid-move: the core's motion state says the pose is unknown | {1000 * lost_s:.0f} ms | <= 1 s |")
     lines += [
+        "",
+        "| link attack (issue 32, the real simulator process) | answer | time | target |",
+        "|---|---|---|---|",
+        f"| workstation SIGKILLed mid-move (dead-man 1000 ms), then `HBT,60000` unsealed every 100 ms from another process | "
+        f"{heartbeats['refused']} heartbeats refused; the robot at rest at {heartbeats['stopped_deg']:.1f} of 160 deg | {heartbeats['stopped_s']:.2f} s from the kill | "
+        "at rest within the dead-man time (+ one tick), short of the goal |",
+        f"| a keyless `HEL` and a wrong `AUT` from a second writer on the workstation's pty | the workstation's next move "
+        f"{'obeyed' if hello['obeyed'] else 'NOT obeyed: ' + hello.get('why', '')} | {hello.get('move_s', float('nan')):.2f} s for a 5 deg move | obeyed |",
+        f"| a keyless TCP client connected first and staying | the workstation's session is {squatter['state']} | {squatter['session_s']:.2f} s to connect and authenticate | ready |",
+        f"| a 250-character move id; an `MVJ` of +-1e308 | simulator {'alive' if oversize['alive'] else 'DEAD'}; longest reply {oversize['longest_reply']} bytes | - | "
+        f"alive, <= {oversize['limit']} bytes |",
         "",
         "The dead-man (the controller stops a move when the workstation's heartbeat is missing for `deadman_ms`,",
         "1000 ms by default) is checked at every tick of the controller's logic; tests/core/link/test_link_safety.py",
