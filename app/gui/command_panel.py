@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from PySide6.QtCore import QSignalBlocker
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -137,6 +138,13 @@ class CommandPanel(QTabWidget):
         self.setCurrentIndex(2)
         workbench.task_changed.connect(self._sync_tasks)
         workbench.scene_changed.connect(self._sync_targets)
+
+    def show_option(self, name: str, value: bool) -> None:
+        """A solve option changed in the session (a click, an undo): the box shows it without sending it back."""
+        box = {"estimate_focal": self.estimate_focal, "robust": self.robust}.get(name)
+        if box is not None and box.isChecked() != value:
+            with QSignalBlocker(box):
+                box.setChecked(value)
 
     def show_corrections(self, table) -> None:
         """The stored corrections (a :class:`~calib_core.calibration.corrections.CorrectionTable`), one

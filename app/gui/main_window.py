@@ -162,8 +162,9 @@ class MainWindow(QMainWindow):
         c.calibrate.clicked.connect(self._calibrate)
         c.store.clicked.connect(self._store)
         c.target.currentTextChanged.connect(self.report(lambda name: wb.session.set_target(name)))
-        c.estimate_focal.toggled.connect(lambda on: setattr(wb.session, "estimate_focal", on))
-        c.robust.toggled.connect(lambda on: setattr(wb.session, "robust", on))
+        c.estimate_focal.toggled.connect(lambda on: self.report(wb.session.set_option)("estimate_focal", on))
+        c.robust.toggled.connect(lambda on: self.report(wb.session.set_option)("robust", on))
+        wb.session.option_changed.connect(c.show_option)  # an undo sets the box back
         c.tasks.currentTextChanged.connect(self.report(self._task_selected))
         c.approach.valueChanged.connect(self.report(self._approach_edited))
         wb.task_changed.connect(self._show_task)

@@ -99,9 +99,24 @@ class CalibrationSession:
 
     changed = Signal()
     """After every solve, candidate choice, cleared result or target change."""
+    option_changed = Signal(str, object)
+    """``(name, value)`` when a solve option (``estimate_focal``, ``robust``) changed."""
+
+    SOLVE_OPTIONS = ("estimate_focal", "robust")
 
     def _changed(self) -> None:
         self.changed.emit()
+
+    def set_option(self, name: str, value: bool) -> None:
+        """Set a solve option through the undo stack (nothing happens when it already has ``value``)."""
+        if name not in self.SOLVE_OPTIONS:
+            raise CalibrationError(f"no solve option {name!r}; options: {', '.join(self.SOLVE_OPTIONS)}")
+        if getattr(self, name) != bool(value):
+            self.undo.push(_SetOption(self, name, bool(value)))
+
+    def _apply_option(self, name: str, value: bool) -> None:
+        setattr(self, name, value)
+        self.option_changed.emit(name, value)
 
     @property
     def required_pairs(self) -> int:
@@ -321,3 +336,15 @@ class _StoreCorrection(Command):
 
     def undo(self) -> None:
         self.table.remove_last(self.correction.task)
+
+
+class _SetOption(Command):
+    def __init__(self, session: CalibrationSession, name: str, value: bool):
+        self.session, self.name, self.value, self.old = session, name, value, getattr(session, name)
+        self.label = f"{'Use' if value else 'Stop using'} the {name.replace('_', ' ')} option"
+
+    def do(self) -> None:
+        self.session._apply_option(self.name, self.value)
+
+    def undo(self) -> None:
+        self.session._apply_option(self.name, self.old)

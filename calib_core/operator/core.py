@@ -192,13 +192,19 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.sample_received.emit(sample, q)
         if self.replaying:
             return  # the recorded joints drive the views while a recording is replayed
-        self.joints_deg = q
-        self.joints_changed.emit(self.joints_deg)
+        self._show_joints(q)
 
     def show_replayed_joints(self, joints_deg) -> None:
         """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
-        self.joints_deg = np.array(joints_deg, dtype=float)
-        self.joints_changed.emit(self.joints_deg)
+        self._show_joints(np.array(joints_deg, dtype=float))
+
+    def _show_joints(self, q: np.ndarray) -> None:
+        # Emitted only on a change: a still robot streams the same joints 50 times a second, and every
+        # pane would redraw (or filter the repeats itself).
+        changed = q.shape != np.shape(self.joints_deg) or not np.array_equal(q, self.joints_deg)
+        self.joints_deg = q
+        if changed:
+            self.joints_changed.emit(self.joints_deg)
 
     @property
     def link_up(self) -> bool:
