@@ -120,13 +120,15 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
 
     win.grab().save(str(OUTPUT / "window_robot_tool.png"))
 
-    # One look at a task location on the calibrated model: Find points' edges at the approach,
-    # stored weighed against the calibrated robot (its covariance there), scored by the truth.
+    # One look at a task location on the calibrated model: Find points' edges at the task location
+    # itself (a look from elsewhere is not its correction), stored weighed against the calibrated robot
+    # (its covariance there), scored by the truth.
     task = wb.workcell.task("oru_1_grasp")
     wb.set_task(task.name)
-    q_look = solve_ik(wb.robot, task.approach2base, home).q_deg
+    q_look = solve_ik(wb.robot, task.tcp2base, home).q_deg
     move(home, "home")
-    move(q_look, f"{task.name} approach")
+    move(solve_ik(wb.robot, task.approach2base, home).q_deg, f"{task.name} approach")
+    move(q_look, f"{task.name} task", frozenset({task.component}))
     wait_for_settled_frame(qtbot, win)
     found = wb.find_points()
     edges = found.result.edges
