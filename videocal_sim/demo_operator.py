@@ -172,6 +172,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         def store() -> None:
             """Store correction, checked: one more entry in the task location's history."""
             stored_before = len(wb.session.corrections.history(task.name))
+            place = wb.look_place()
+            if place is None or not place.counts:  # the window would ask; the demo's looks are made where they count
+                raise RuntimeError(f"demo: the look does not count for {task.name}: {place.text if place else 'no robot pose'}")
             _click(win.commands.store, 10, 10)
             if len(wb.session.corrections.history(task.name)) != stored_before + 1:
                 raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
