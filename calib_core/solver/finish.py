@@ -77,12 +77,20 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     to_metric = paper_to_metric_jacobian(chosen.newton.t, problem.intrinsics, chosen.fu, chosen.fv, problem.n_params) if problem.model == "paper" else None
     rms, e, loo, uncertainty = fit_uncertainty(jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma_px, to_metric)
     status, reason = SolveStatus.OK, None
+    agreeing = int(np.count_nonzero(~outliers))
     if not chosen.converged:
         status, reason = SolveStatus.FAILED, f"Newton iterations stopped: {chosen.newton.reason}"
+    elif outliers.any() and 2 * agreeing - problem.n_params < 2:
+        # The pairs left fit exactly by construction: nothing checks them, and a mis-click among them
+        # would pass unseen (5 pairs, one off: three fitted exactly, two good ones rejected, 550 mm wrong).
+        status = SolveStatus.FAILED
+        reason = (f"only {agreeing} pairs agree after rejecting {points_label(np.flatnonzero(outliers))}: too few to check one another; "
+                  "pick the rejected pairs again or add pairs")
     elif rms > limit_px:
         worst = int(np.nanargmax(np.where(np.isfinite(loo), loo, e)))
         status = SolveStatus.FAILED
-        reason = f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; {point_label(worst)} fits worst (check that pick, or use robust)"
+        advice = "check that pick" if huber_px is not None else "check that pick, or use robust"  # (robust is on already)
+        reason = f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; {point_label(worst)} fits worst ({advice})"
     elif len(candidates) > 1:
         status = SolveStatus.AMBIGUOUS
         reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"

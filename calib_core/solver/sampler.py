@@ -25,7 +25,7 @@ INLIER_SIGMAS = 3.72  # sqrt of chi-square(2 dof) at 99.9 %
 CONFIDENCE = 0.9999
 MAX_HYPOTHESES = 10_000
 MIN_HYPOTHESES = 20  # PoseLib's default of 1000 costs 2 ms even on a clean set
-MIN_POINTS = 6
+MIN_POINTS = 4
 
 
 @dataclass(frozen=True)

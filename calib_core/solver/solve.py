@@ -17,6 +17,7 @@ from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import distinct_poses, refine_seed
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
+from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px, msac_score
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
 from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label
@@ -101,26 +102,35 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         if c.shape != (problem.n_points,) or not np.all(np.isfinite(c)):
             raise ValueError(f"confidence: one finite number per pair ({problem.n_points}), got {c.shape[0]}")
         order = np.argsort(-c, kind="stable")
-    sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust and problem.n_points > SMALL_PROBLEM_POINTS else None
+    sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust else None
     # With a sampled seed the all-points seeds add nothing: outliers spoil them, and on a clean set the
     # sampler's seed is theirs.
-    gate = 10.0 * limit if not problem.estimate_focal and problem.model == "pinhole" else None
-    seeds = [] if sampled is not None else initial_seeds(problem, fu0, fv0, gate)
+    # (no gate when robust: it ranks the triplets' roots by all the pairs' RMS, outliers included, and
+    # could keep a wrong root that spreads an outlier's error over good pairs and drop the right one)
+    gate = 10.0 * limit if not problem.estimate_focal and problem.model == "pinhole" and not robust else None
+    # (a few pairs: every triplet's roots as well, so that a second pose fitting another subset as well is
+    # found and the answer called ambiguous rather than ok)
+    seeds = [] if sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS else initial_seeds(problem, fu0, fv0, gate)
     if sampled is not None:
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
-    refined = [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in distinct_seeds(seeds)) if r is not None]
+    refine = _refiner(problem, fu0, fv0, huber, noise)
+    refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
     best_rms = min((r.rms_px for r in refined), default=np.inf)
     if problem.n_points > SMALL_PROBLEM_POINTS and sampled is None and (best_rms > limit or robust):
         # A mis-click spoils the all-points seeds; triplets that avoid it still find the pose.
-        refined += [r for r in (refine_seed(problem, R, t, fu0, fv0, huber) for R, t in subset_p3p_seeds(problem, fu0, fv0)) if r is not None]
+        refined += [r for r in (refine(R, t) for R, t in subset_p3p_seeds(problem, fu0, fv0)) if r is not None]
     if not refined:
         return _no_pose(problem, "no starting pose could be found for these picks (P3P/SQPnP found no pose in front of the camera)")
 
     poses = distinct_poses(refined)
+    score = (lambda p: p.cost)
+    if robust:  # judged by what they explain: two poses that each fit a different four of five pairs are ambiguous
+        poses = by_consensus(poses, inlier_threshold_px(noise))
+        score = (lambda p: msac_score(p.newton.residuals, inlier_threshold_px(noise)))
     best = poses[0]
-    close = [p for p in poses if p.converged and p.cost - best.cost <= _AMBIGUITY_CHI2 * noise**2]
+    close = [p for p in poses if p.converged and score(p) - score(best) <= _AMBIGUITY_CHI2 * noise**2]
     if not close:
         close = [best]
     distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
@@ -128,6 +138,14 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     ranked = [close[i] for i in order]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, order))
     return finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+
+
+def _refiner(problem: PoseProblem, fu: float, fv: float, huber: float | None, noise: float):
+    """How each seed is refined: least squares, or when robust, on the pairs it agrees with (pinhole; the
+    paper's model keeps Huber's loss)."""
+    if huber is not None and problem.model == "pinhole":
+        return lambda R, t: consensus_refine(problem, R, t, fu, fv, inlier_threshold_px(noise))
+    return lambda R, t: refine_seed(problem, R, t, fu, fv, huber)
 
 
 def refine_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, start_obj2cam: ArrayLike, *, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None, damped: bool = True, max_iterations: int = 100) -> PoseSolution:

@@ -1,0 +1,67 @@
+"""Choosing among refined poses when some pairs may be wrong: by consensus, not by least squares.
+
+Least squares (and Huber's loss, which grows linearly) prefer a pose that spreads one mis-click's
+100 px over several good pairs: with 5 pairs and one 50-200 px off, the robust solve once fitted
+three pairs exactly, flagged two good ones and called a pose up to 550 mm wrong ``ok`` in 64 of 200
+scenes. RANSAC's MSAC score caps each pair's squared error at the inlier threshold, so a pose is
+judged by how many pairs it explains and how well: the pose that fits the four good pairs wins.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from calib_core.solver.candidates import RefinedPose, refine_seed
+from calib_core.solver.problem import PoseProblem
+from calib_core.solver.refine import NewtonResult, residuals_and_jacobian
+
+INLIER_SIGMAS = 4.0
+"""A pair is an inlier within this many times the pick noise (the outlier flag's threshold)."""
+
+
+def inlier_threshold_px(noise_px: float) -> float:
+    return INLIER_SIGMAS * float(noise_px)
+
+
+def msac_score(residuals_px: np.ndarray, threshold_px: float) -> float:
+    """Sum over pairs of min(e^2, threshold^2), px^2: ``residuals_px`` (n, 2)."""
+    e2 = np.sum(np.square(np.asarray(residuals_px, dtype=float)), axis=1)
+    return float(np.sum(np.minimum(e2, threshold_px**2)))
+
+
+def by_consensus(poses: list[RefinedPose], threshold_px: float) -> list[RefinedPose]:
+    """``poses`` ordered by MSAC score at their own residuals, converged first (stable otherwise)."""
+    return sorted(poses, key=lambda p: (not p.converged, msac_score(p.newton.residuals, threshold_px)))
+
+
+def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, threshold_px: float, *, rounds: int = 4) -> RefinedPose | None:
+    """Local optimisation as LO-RANSAC does it, in place of Huber's loss (which, with few pairs, walks from
+    the right pose to one that spreads a mis-click over good pairs: 170 mm off from a right seed): the pairs
+    within reach of the pose, least squares on those alone, again until the set stays. The result's
+    residuals and Jacobian are over *every* pair, at the inliers' pose. ``None`` when fewer pairs than a
+    pose needs agree. Pinhole model."""
+    minimal = 4 if problem.estimate_focal else 3
+    r, _, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
+    inliers = np.linalg.norm(r, axis=1) < 3.0 * threshold_px  # a seed from three pairs is only near the pose
+    fit = None
+    for _ in range(rounds):
+        if inliers.sum() < minimal:
+            return None
+        idx = np.flatnonzero(inliers)
+        sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+        fit = refine_seed(sub, R, t_mm, fu, fv, None)
+        if fit is None or not np.all(np.isfinite(fit.obj2cam)):
+            return None
+        R, t_mm, fu, fv = fit.newton.R, fit.newton.t, fit.fu, fit.fv
+        r, J, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
+        again = np.linalg.norm(r, axis=1) < threshold_px
+        if np.array_equal(again, inliers):
+            break
+        inliers = again
+    if fit is None or not np.all(np.isfinite(r)):
+        return None
+    newton = NewtonResult(R, t_mm, fu, fv, r, J, fit.newton.iterations, fit.newton.outcome)
+    cost = float(np.sum(r**2))
+    return RefinedPose(fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton)
