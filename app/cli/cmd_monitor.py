@@ -37,6 +37,12 @@ def run(args: argparse.Namespace) -> int:
     mode, rate = ("poll", args.poll) if args.poll is not None else ("stream", args.stream or 20.0)
     link = ControllerLink(args.url, mode=mode, rate_hz=rate, baudrate=args.baud, parity=args.parity)
     link.start(wait_open=True)
+    # The robot's joint count: the controller's own word ($VER), else the first sample's. A sample of
+    # another count is not this robot's (a second writer, a corrupted line): not printed as if it were.
+    version = link.request_version(1.0)
+    if version is not None:
+        link.n_joints = version.n_joints  # the driver then drops and counts them (wrong_joint_count)
+    expected, skipped = (version.n_joints if version is not None else None), 0
     printed = 0
     code = 0
     last = time.monotonic()
@@ -55,6 +61,11 @@ def run(args: argparse.Namespace) -> int:
                 if args.count is not None and printed >= args.count:
                     break
                 q = s.sample.joints_deg
+                expected = expected or len(q)
+                if len(q) != expected:
+                    skipped += 1
+                    print(f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown", file=sys.stderr)
+                    continue
                 if args.json:
                     print(json.dumps({"seq": s.sample.seq, "t_ms": s.sample.t_ms, "joints_deg": list(q)}), flush=True)
                 else:

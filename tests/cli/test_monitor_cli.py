@@ -49,3 +49,43 @@ def test_sim_controller_bad_options_exit_2():
     assert run.returncode == 2 and "drop-rate must lie in [0, 1]" in run.stderr
     run = _videocal("sim-controller", "--tcp", "5000", "--link", "/tmp/x")
     assert run.returncode == 2 and "--link applies to --pty" in run.stderr
+
+
+def test_monitor_does_not_show_a_sample_of_another_joint_count(tmp_path):
+    """Issue 33: a 3-joint sample in the middle of a 6-joint stream was printed as if it were valid. The
+    controller here is the test itself on a pty: it answers nothing but streams samples, one of them short."""
+    import os
+    import threading
+    import time
+    import tty
+
+    from calib_core.link.protocol import JointSample, encode
+
+    master, slave = os.openpty()
+    tty.setraw(master)
+    tty.setraw(slave)
+    stop = threading.Event()
+
+    def stream():
+        seq = 0
+        while not stop.is_set():
+            joints = (1.0, 2.0, 3.0) if seq % 10 == 5 else (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)  # one short in ten
+            os.write(master, encode(JointSample(seq, 1000 + 20 * seq, joints).body()))
+            seq += 1
+            time.sleep(0.02)
+
+    writer = threading.Thread(target=stream, daemon=True)
+    writer.start()
+    try:
+        run = _videocal("monitor", os.ttyname(slave), "--count", "12", "--json", "--timeout", "5")
+    finally:
+        stop.set()
+        writer.join(2)
+        os.close(master)
+        os.close(slave)
+    assert run.returncode == 0, run.stderr
+    lines = [json.loads(line) for line in run.stdout.splitlines()]
+    assert len(lines) == 12 and all(len(x["joints_deg"]) == 6 for x in lines)
+    shown = [x["seq"] for x in lines]
+    assert not any(seq % 10 == 5 for seq in shown) and shown[-1] - shown[0] >= 10  # a short one fell inside, unshown
+    assert "has 3 joint values, the robot has 6: not shown" in run.stderr
