@@ -33,6 +33,8 @@ class RefinedPose:
     rms_px: float
     converged: bool
     newton: NewtonResult
+    inliers: np.ndarray | None = None
+    """(n,) bool: the pairs it was fitted to by least squares (a consensus refinement), or ``None`` (all)."""
 
 
 def refine_seed(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, huber_px: float | None, *, damped: bool = True, max_iterations: int = 100) -> RefinedPose | None:

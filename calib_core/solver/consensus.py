@@ -31,20 +31,25 @@ def msac_score(residuals_px: np.ndarray, threshold_px: float) -> float:
     return float(np.sum(np.minimum(e2, threshold_px**2)))
 
 
-def by_consensus(poses: list[RefinedPose], threshold_px: float) -> list[RefinedPose]:
-    """``poses`` ordered by MSAC score at their own residuals, converged first (stable otherwise)."""
-    return sorted(poses, key=lambda p: (not p.converged, msac_score(p.newton.residuals, threshold_px)))
+def by_consensus(poses: list[RefinedPose], threshold_px: float) -> tuple[list[RefinedPose], list[float]]:
+    """``poses`` ordered by MSAC score at their own residuals, converged first (stable otherwise), and
+    their scores in that order."""
+    scored = sorted(((not p.converged, msac_score(p.newton.residuals, threshold_px), k) for k, p in enumerate(poses)))
+    return [poses[k] for _, _, k in scored], [score for _, score, _ in scored]
 
 
-def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, threshold_px: float, *, rounds: int = 4) -> RefinedPose | None:
+def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, threshold_px: float, *, rounds: int = 4,
+                     inliers: np.ndarray | None = None) -> RefinedPose | None:
     """Local optimisation as LO-RANSAC does it, in place of Huber's loss (which, with few pairs, walks from
     the right pose to one that spreads a mis-click over good pairs: 170 mm off from a right seed): the pairs
     within reach of the pose, least squares on those alone, again until the set stays. The result's
     residuals and Jacobian are over *every* pair, at the inliers' pose. ``None`` when fewer pairs than a
-    pose needs agree. Pinhole model."""
+    pose needs agree. Pinhole model. ``inliers`` (n,) bool: the set to start from (a sampler's), instead of
+    the pairs near the seed."""
     minimal = 4 if problem.estimate_focal else 3
-    r, _, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
-    inliers = np.linalg.norm(r, axis=1) < 3.0 * threshold_px  # a seed from three pairs is only near the pose
+    if inliers is None:
+        r, _, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
+        inliers = np.linalg.norm(r, axis=1) < 3.0 * threshold_px  # a seed from three pairs is only near the pose
     fit = None
     for _ in range(rounds):
         if inliers.sum() < minimal:
@@ -64,4 +69,4 @@ def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: 
         return None
     newton = NewtonResult(R, t_mm, fu, fv, r, J, fit.newton.iterations, fit.newton.outcome)
     cost = float(np.sum(r**2))
-    return RefinedPose(fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton)
+    return RefinedPose(fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton, inliers.copy())

@@ -57,10 +57,12 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     noise = noise_px(sigma_px)
     iterations = chosen.newton.iterations
     outliers = np.zeros(problem.n_points, dtype=bool)
+    fitted_already = False  # a consensus fit's residuals and Jacobian are over every pair at the inliers' pose
     if huber_px is not None:
         outliers = _flag_outliers(chosen.newton.residuals, noise)
         inliers = np.flatnonzero(~outliers)
-        if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3):
+        fitted_already = chosen.inliers is not None and np.array_equal(chosen.inliers, ~outliers)
+        if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3) and not fitted_already:
             # Least squares on the inliers alone: the Huber fit still leans slightly on the outliers.
             # (checked already: a subset of checked pairs needs no second check)
             sub = replace(problem, points_3d=problem.points_3d[inliers], points_2d=problem.points_2d[inliers], off_image=(), repeated_3d=())
@@ -68,9 +70,10 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
             if again is not None and again.converged:
                 iterations += again.newton.iterations
                 chosen = again
+        if outliers.any():
             warnings.append(f"{points_label(np.flatnonzero(outliers))} rejected as outliers (robust fit); check those picks")
     residuals, jacobian = chosen.newton.residuals, chosen.newton.jacobian
-    if outliers.any():
+    if outliers.any() and not fitted_already:
         # The inlier re-fit's own arrays lack the outliers: evaluate every point at the final pose.
         residuals, jacobian, _ = residuals_and_jacobian(problem, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv)
     weights = (~outliers).astype(float)

@@ -17,7 +17,7 @@ from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import distinct_poses, refine_seed
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
-from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px, msac_score
+from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
 from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label
@@ -111,12 +111,16 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     # (a few pairs: every triplet's roots as well, so that a second pose fitting another subset as well is
     # found and the answer called ambiguous rather than ok)
     seeds = [] if sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS else initial_seeds(problem, fu0, fv0, gate)
-    if sampled is not None:
+    if sampled is not None and problem.model != "pinhole":
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
     refine = _refiner(problem, fu0, fv0, huber, noise)
     refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
+    if sampled is not None and problem.model == "pinhole":
+        # the sampler's own inliers are where its seed's consensus starts (one least-squares fit, usually)
+        fit = consensus_refine(problem, sampled.R, sampled.t, fu0, fv0, inlier_threshold_px(noise), inliers=sampled.inliers)
+        refined += [fit] if fit is not None else []
     best_rms = min((r.rms_px for r in refined), default=np.inf)
     if problem.n_points > SMALL_PROBLEM_POINTS and sampled is None and (best_rms > limit or robust):
         # A mis-click spoils the all-points seeds; triplets that avoid it still find the pose.
@@ -125,12 +129,12 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         return _no_pose(problem, "no starting pose could be found for these picks (P3P/SQPnP found no pose in front of the camera)")
 
     poses = distinct_poses(refined)
-    score = (lambda p: p.cost)
     if robust:  # judged by what they explain: two poses that each fit a different four of five pairs are ambiguous
-        poses = by_consensus(poses, inlier_threshold_px(noise))
-        score = (lambda p: msac_score(p.newton.residuals, inlier_threshold_px(noise)))
+        poses, scores = by_consensus(poses, inlier_threshold_px(noise))
+    else:
+        scores = [p.cost for p in poses]
     best = poses[0]
-    close = [p for p in poses if p.converged and score(p) - score(best) <= _AMBIGUITY_CHI2 * noise**2]
+    close = [p for p, score in zip(poses, scores) if p.converged and score - scores[0] <= _AMBIGUITY_CHI2 * noise**2]
     if not close:
         close = [best]
     distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
