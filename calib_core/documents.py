@@ -40,6 +40,8 @@ def read_text(path: str | Path, what: str, max_bytes: int = MAX_DOCUMENT_BYTES) 
         raise FileFormatError(path, f"no such {what}") from None
     except OSError as exc:
         raise FileFormatError(path, f"cannot be read ({exc.strerror})") from None
+    except ValueError as exc:  # a NUL byte in the name (a name read from another file)
+        raise FileFormatError(str(path).replace("\0", "\\0"), f"is not a usable file name ({exc})") from None
     if path.is_dir():
         raise FileFormatError(path, f"is a folder, not a {what}")
     if size > max_bytes:

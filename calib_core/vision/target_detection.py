@@ -82,7 +82,7 @@ def _set_fields(target, values, path: Path, section: str) -> None:
             value = float(value)
         try:
             setattr(target, name, value)
-        except (TypeError, OverflowError, cv2.error) as exc:
+        except (TypeError, ValueError, OverflowError, cv2.error) as exc:  # ValueError: "integer won't fit into a C int"
             raise FileFormatError(path, f"OpenCV refuses {value!r} ({exc})", where) from None
 
 

@@ -60,3 +60,22 @@ def test_a_mesh_path_no_file_system_takes(folder, name):
     with pytest.raises(FileFormatError, match="not a usable file name") as info:
         load_workcell(path)
     assert info.value.field == "components[1].mesh"
+
+
+def test_a_detector_parameter_past_a_c_int_is_refused_naming_it(tmp_path):
+    """The reliability bench's fuzzing (session 15): ``integer won't fit into a C int`` escaped as a ValueError."""
+    from calib_core.vision.target_detection import load_detector_settings
+
+    path = tmp_path / "detector.yaml"
+    path.write_text(yaml.safe_dump({"aruco": {"adaptiveThreshWinSizeMax": 10**12}}))
+    with pytest.raises(FileFormatError, match="OpenCV refuses 1000000000000") as info:
+        load_detector_settings(path)
+    assert info.value.field == "aruco.adaptiveThreshWinSizeMax"
+
+
+def test_a_file_name_with_a_nul_byte_in_a_data_file_is_refused(tmp_path):
+    """cal_data.yaml naming its pose file '\\x00': ``embedded null byte`` escaped as a ValueError."""
+    from calib_core.documents import read_yaml
+
+    with pytest.raises(FileFormatError, match="not a usable file name"):
+        read_yaml(tmp_path / "a\0b.yaml", "pose file")
