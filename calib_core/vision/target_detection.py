@@ -77,9 +77,13 @@ def _set_fields(target, values, path: Path, section: str) -> None:
             if isinstance(value, bool) or not isinstance(value, int):
                 raise FileFormatError(path, f"must be a whole number, got {value!r}", where)
         elif isinstance(current, float):
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-                raise FileFormatError(path, f"must be a finite number, got {value!r}", where)
-            value = float(value)
+            try:  # (an integer past 2^63 made np.isfinite raise TypeError; one past 1e308 makes float() overflow)
+                number = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+            except OverflowError:
+                number = None
+            if number is None or not np.isfinite(number):
+                raise FileFormatError(path, f"must be a finite number, got {str(value)[:40]}", where)
+            value = number
         try:
             setattr(target, name, value)
         except (TypeError, ValueError, OverflowError, cv2.error) as exc:  # ValueError: "integer won't fit into a C int"

@@ -79,3 +79,16 @@ def test_a_file_name_with_a_nul_byte_in_a_data_file_is_refused(tmp_path):
 
     with pytest.raises(FileFormatError, match="not a usable file name"):
         read_yaml(tmp_path / "a\0b.yaml", "pose file")
+
+
+def test_a_huge_integer_for_a_detector_number_is_taken_as_a_float_or_refused_naming_it(tmp_path):
+    """``ufunc 'isfinite' not supported`` for an integer past 2^63 escaped as a TypeError (reliability bench, session 15)."""
+    from calib_core.vision.target_detection import load_detector_settings
+
+    path = tmp_path / "detector.yaml"
+    path.write_text("circle_blobs:\n  minArea: 1180591620717411303423\n")
+    assert load_detector_settings(path).circle_blobs.minArea == pytest.approx(1.1805916e21)
+    path.write_text(f"circle_blobs:\n  minArea: {10**400}\n")
+    with pytest.raises(FileFormatError) as info:
+        load_detector_settings(path)
+    assert info.value.field == "circle_blobs.minArea"
