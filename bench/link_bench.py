@@ -60,7 +60,7 @@ def latency() -> tuple[float, float]:
     master, path, slave = _pty_pair()
     arrivals: dict[int, float] = {}
     link = ControllerLink(path, mode="stream", rate_hz=250, stale_after_s=10)
-    link.on_sample(lambda s: arrivals.__setitem__(s.sample.seq, time.perf_counter()))
+    link.sample_received.connect(lambda s: arrivals.__setitem__(s.sample.seq, time.perf_counter()))
     link.start(wait_open=True)
     time.sleep(0.2)
     sent_at = {}

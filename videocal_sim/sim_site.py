@@ -42,7 +42,7 @@ class SimulatedSite:
         return lambda: self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True)
 
     def attach(self, link) -> None:
-        link.on_sample(self._follow)
+        link.sample_received.connect(self._follow)
 
     def _follow(self, sample) -> None:
         # The physical robot is where its controller says: the simulated camera renders from there.

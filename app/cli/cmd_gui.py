@@ -16,30 +16,47 @@ from calib_core.workcell import DEFAULT_WORKCELL
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=resolved_path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
-    parser.add_argument("--port", help="a real controller link URL (serial port, socket://host:port, ...) instead of the simulator")
-    parser.add_argument("--camera", help="a real camera: an OpenCV device index, a video file, a stream URL or a folder of images, instead of the simulated camera")
+    parser.add_argument("--port", help="a real controller's connector URL (a serial port, socket://host:port, ros2:///joint_states, ...; see docs/connectors.md)")
+    parser.add_argument("--camera", help="a real camera's spec (an OpenCV device index, a video file, a stream URL, a folder of images, aravis://ID, ...)")
+    parser.add_argument("--site", choices=("auto", "sim", "real"), default="auto",
+                        help="sim: the simulated cell; real: the controller and camera of --port/--camera or the workcell's site: section; "
+                             "auto (default): real when either is given, else simulated")
     parser.add_argument("--hand-eye", type=resolved_path, help="a cam2flange file from videocal calibrate-hand-eye: the measured camera mounting replaces the modelled one")
     parser.add_argument("--recording", type=resolved_path, help="open this MCAP recording on the replay timeline at start")
     parser.add_argument("--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)")
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.errors import VideocalError
     from calib_core.plugins import SITES, load_plugin
 
-    if args.port is None:
-        if args.camera:
-            raise VideocalError("--camera needs --port: a real camera belongs to a real controller (the simulated cell brings its own camera)")
+    if _is_real(args):
+        site_kind, simulator = None, None
+    else:
         site_kind = load_plugin(SITES, "sim")
         # Start the controller simulator first: its start-up then overlaps the window's imports. It dies with us.
         simulator = site_kind.start_early(args.workcell)
-    else:
-        site_kind, simulator = None, None
     try:
         return _run_window(args, site_kind, simulator)
     finally:
         if simulator is not None:
             simulator.stop()
+
+
+def _is_real(args: argparse.Namespace) -> bool:
+    """Whether ``gui`` drives a real cell (see ``--site``)."""
+    from calib_core.errors import VideocalError
+    from calib_core.workcell.loader import load_site_section
+
+    given = args.port is not None or args.camera is not None
+    if args.site == "sim":
+        if given:
+            raise VideocalError("--site sim brings its own controller and camera: leave out --port and --camera")
+        return False
+    section = load_site_section(args.workcell)
+    has_section = section is not None and (section.controller or section.camera)
+    if args.site == "real" and not (given or has_section):
+        raise VideocalError(f"--site real needs --port or --camera, or a site: section in {args.workcell}")
+    return given or bool(has_section)
 
 
 def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:

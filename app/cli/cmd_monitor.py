@@ -1,5 +1,6 @@
-"""``videocal monitor URL``: print the joint samples of a controller link (the paper's
-"monitoring", without the CAD). Link statistics go to stderr at the end.
+"""``videocal monitor URL [--workcell F]``: print the joint samples of any controller connector (the
+paper's "monitoring", without the CAD); with ``--workcell``, in F's robot's joint order and zero. Link
+statistics go to stderr at the end.
 
 Exit codes: 0 after ``--count`` samples (or on Ctrl-C), 4 when ``--timeout`` seconds pass
 without a sample, 2 for an unusable URL (one ``error:`` line).
@@ -12,49 +13,87 @@ import json
 import sys
 import time
 
-from app.cli.options import bounded_float, bounded_int
+from app.cli.options import bounded_float, bounded_int, resolved_path
 
 EXIT_TIMEOUT = 4
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("url", help="a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port or loop://")
+    parser.add_argument("url", help="a controller connector URL: a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port, loop://, ros2:///joint_states, ...")
+    parser.add_argument("--workcell", type=resolved_path, help="the cell's workcell file: samples in its robot's joint order and zero, its joint count checked (needed by connectors that name joints, such as ros2://)")
     rate = parser.add_mutually_exclusive_group()
     rate.add_argument("--poll", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="request samples at this rate (the paper's cyclic request)")
     rate.add_argument("--stream", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="ask the controller to stream at this rate (default 20)")
     parser.add_argument("--count", type=bounded_int(1, 10**12), help="stop after this many samples")
     parser.add_argument("--timeout", type=bounded_float(0.0, 86400.0, exclusive_low=True), default=5.0, help="give up after this many seconds without a sample (default 5)")
     parser.add_argument("--json", action="store_true", help="one JSON object per line: seq, t_ms, joints_deg")
-    parser.add_argument("--baud", type=bounded_int(50, 20_000_000), default=115200, help="serial baud rate")
-    parser.add_argument("--parity", choices=("N", "E", "O"), default="N", help="serial parity")
+    parser.add_argument("--baud", type=bounded_int(50, 20_000_000), help="serial baud rate (videocal's protocol; default 115200)")
+    parser.add_argument("--parity", choices=("N", "E", "O"), help="serial parity (videocal's protocol; default N)")
+
+
+def _context(args: argparse.Namespace, rate_hz: float, options: dict):
+    """The connector's context: the workcell's robot, or none (any joint count, the controller's order)."""
+    from calib_core.connectors.controller import ControllerContext
+    from calib_core.link.joint_map import JointMap
+
+    if args.workcell is None:
+        return ControllerContext((), (), JointMap.identity(0), rate_hz, options)
+    from calib_core.operator.cell import Cell
+
+    cell = Cell.open(args.workcell)
+    return ControllerContext.of(cell.robot, cell.joint_map, rate_hz, options)
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.link.driver import ControllerLink
+    import queue
+
+    from calib_core.connectors.registry import open_controller
 
     if args.count is not None and args.count <= 0:
         raise ValueError(f"--count must be positive, got {args.count}")
     mode, rate = ("poll", args.poll) if args.poll is not None else ("stream", args.stream or 20.0)
-    link = ControllerLink(args.url, mode=mode, rate_hz=rate, baudrate=args.baud, parity=args.parity)
-    link.start(wait_open=True)
-    # The robot's joint count: the controller's own word ($VER), else the first sample's. A sample of
-    # another count is not this robot's (a second writer, a corrupted line): not printed as if it were.
-    version = link.request_version(1.0)
+    options = {"mode": mode} if args.poll is not None else {}
+    options.update({k: v for k, v in (("baudrate", args.baud), ("parity", args.parity)) if v is not None})
+    context = _context(args, rate, options)
+    link = open_controller(args.url, context)
+    samples_in: queue.Queue = queue.Queue(maxsize=100_000)  # bounded: a stalled terminal drops, never grows
+
+    def keep(sample) -> None:
+        try:
+            samples_in.put_nowait(sample)
+        except queue.Full:
+            pass
+
+    link.sample_received.connect(keep)
+    if hasattr(link, "request_version"):  # videocal's own protocol opens at once and says its joint count
+        link.start(wait_open=True)
+    else:
+        link.start()
+    # The robot's joint count: the workcell's, else the controller's own word ($VER), else the first
+    # sample's. A sample of another count is not this robot's (a second writer, a corrupted line): not
+    # printed as if it were.
+    expected = context.n_joints or None
+    version = link.request_version(1.0) if expected is None and hasattr(link, "request_version") else None
     if version is not None:
         link.n_joints = version.n_joints  # the driver then drops and counts them (wrong_joint_count)
-    expected, skipped = (version.n_joints if version is not None else None), 0
+        expected = version.n_joints
+    skipped = 0
+    to_model = link.joint_map.to_model if context.n_joints else None
     printed = 0
     code = 0
     last = time.monotonic()
     try:
         while args.count is None or printed < args.count:
-            samples = link.drain()
+            try:
+                samples = [samples_in.get(timeout=0.05)]
+            except queue.Empty:
+                samples = []
             if not samples:
                 if time.monotonic() - last > args.timeout:
-                    print(f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {link.last_error or 'no reply'})", file=sys.stderr)
+                    why = getattr(link, "last_error", None) or "no reply"
+                    print(f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {why})", file=sys.stderr)
                     code = EXIT_TIMEOUT
                     break
-                time.sleep(0.002)
                 continue
             last = time.monotonic()
             for s in samples:
@@ -66,6 +105,8 @@ def run(args: argparse.Namespace) -> int:
                     skipped += 1
                     print(f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown", file=sys.stderr)
                     continue
+                if to_model is not None:
+                    q = tuple(float(v) for v in to_model(q))
                 if args.json:
                     print(json.dumps({"seq": s.sample.seq, "t_ms": s.sample.t_ms, "joints_deg": list(q)}), flush=True)
                 else:

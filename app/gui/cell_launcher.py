@@ -12,12 +12,23 @@ from pathlib import Path
 from PySide6.QtCore import QSettings
 
 
-def real_site(port: str, camera: str | None) -> Callable:
-    """``open_site`` for a real controller at ``port`` and a real ``camera`` spec."""
+def real_site(port: str | None, camera: str | None) -> Callable:
+    """``open_site`` for a real cell: the controller ``port`` and the ``camera`` spec given on the command
+    line, else those of each cell's ``site:`` section (either may be absent)."""
     from calib_core.operator.cell import Cell
     from calib_core.operator.site import RealSite
 
-    return lambda workcell, simulator=None: (Cell.open(workcell), RealSite(port, camera))
+    def open_site(workcell, simulator=None):
+        cell = Cell.open(workcell)
+        section = cell.workcell.site
+        controller = port if port is not None else (section.controller if section else None)
+        spec = camera if camera is not None else (section.camera if section else None)
+        # A connector's options belong to the section's own URL, not to one given on the command line.
+        controller_options = section.controller_options if section and controller == section.controller else None
+        camera_options = section.camera_options if section and spec == section.camera else None
+        return cell, RealSite(controller, spec, controller_options=controller_options, camera_options=camera_options)
+
+    return open_site
 
 
 @dataclass(frozen=True)

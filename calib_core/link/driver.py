@@ -16,9 +16,8 @@ import secrets
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
-
 import serial
+from psygnal import Signal
 
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.link_key import default_key_path, user_key
@@ -56,7 +55,8 @@ MODES = ("poll", "stream")
 
 
 class ControllerLink:
-    """A link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
+    """The connector of videocal's own protocol (``videocal.controllers``: a port path, ``serial://``,
+    ``socket://``, ``rfc2217://``, ``loop://``): a link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
     ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
     at least 0.25 s); ``n_joints``: how many joints the robot has (samples with another count are
     counted in ``stats.wrong_joint_count`` and not delivered; ``None`` takes any count).
@@ -64,7 +64,16 @@ class ControllerLink:
     (:func:`~calib_core.link.link_key.user_key`); ``None`` for a protocol-3 controller without
     authentication. With a key every (re)connection opens an authenticated session, and moves are
     sent sealed, or not at all (``auth_state``, ``auth_failure``).
-    Serial settings (``baudrate``, ``parity``...) pass to pyserial."""
+    Serial settings (``baudrate``, ``parity``...) pass to pyserial.
+
+    Events (psygnal, emitted on the reader thread; keep slots short, a slot that raises is counted
+    in ``stats.errors`` and does not stop the link): ``sample_received(TimedSample)`` for every
+    delivered sample, ``state_changed(LinkState, reason)`` on a change of state,
+    ``auth_changed(AuthState, failure)`` when a handshake ends (``ready`` or ``failed``)."""
+
+    sample_received = Signal(object)
+    state_changed = Signal(object, str)
+    auth_changed = Signal(object, object)
 
     def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
                  deadman_ms: int = 1000, key: bytes | str | None = "user", **serial_settings):
@@ -94,8 +103,6 @@ class ControllerLink:
         self._queue: deque[TimedSample] = deque(maxlen=queue_size)
         self._latest: TimedSample | None = None
         self._order = SampleOrder(self.stats)
-        self._sample_callbacks: list[Callable[[TimedSample], None]] = []
-        self._state_callbacks: list[Callable[[LinkState, str], None]] = []
         self._moves = MoveBook()
         if key == "user":
             self._auth = WorkstationAuth(user_key(), f"the link key in {default_key_path()}")
@@ -103,6 +110,9 @@ class ControllerLink:
             self._auth = WorkstationAuth(key)
         else:
             raise ValueError(f"key: 32 bytes, 'user' or None, got {type(key).__name__}")
+        self._auth.settled.connect(lambda state, failure: self._emit(self.auth_changed, state, failure))
+        self.joint_map = None
+        """The cell's map between model joints and this controller's axes (set by the connector's opener)."""
         self._next_hello_s = 0.0
         self._state_reports: deque[StateReport] = deque(maxlen=16)
         self._version_reports: deque[VersionReport] = deque(maxlen=4)
@@ -179,18 +189,6 @@ class ControllerLink:
     def stats_snapshot(self) -> dict[str, int]:
         with self._lock:
             return self.stats.as_dict()
-
-    def on_sample(self, callback: Callable[[TimedSample], None]) -> None:
-        """``callback(sample)`` on the reader thread for every sample (keep it short)."""
-        self._sample_callbacks.append(callback)
-
-    def on_auth(self, callback: Callable[[AuthState, str | None], None]) -> None:
-        """``callback(state, failure)`` on the reader thread when a handshake ends (``ready`` or ``failed``)."""
-        self._auth.listeners.append(callback)
-
-    def on_state(self, callback: Callable[[LinkState, str], None]) -> None:
-        """``callback(state, reason)`` on the reader thread when the state changes."""
-        self._state_callbacks.append(callback)
 
     # --- commands --------------------------------------------------------------------------
     def move_joints(self, joints_deg, *, timeout_s: float = 60.0) -> MoveHandle:
@@ -296,12 +294,14 @@ class ControllerLink:
         if state is self._state:
             return
         self._state = state
-        for cb in list(self._state_callbacks):
-            try:
-                cb(state, reason)
-            except Exception as exc:  # a caller's bug must not kill the link
-                self.stats.errors += 1
-                self.last_error = f"state callback failed: {exc!r}"
+        self._emit(self.state_changed, state, reason)
+
+    def _emit(self, signal, *args) -> None:
+        try:
+            signal.emit(*args)
+        except Exception as exc:  # a caller's bug must not kill the link
+            self.stats.errors += 1
+            self.last_error = f"{signal.name} slot failed: {exc!r}"
 
     def _run(self) -> None:
         backoff = iter(_BACKOFF_S)
@@ -428,9 +428,4 @@ class ControllerLink:
             self.stats.samples += 1
         if self._state is not LinkState.UP:
             self._set_state(LinkState.UP, "samples arriving")
-        for cb in list(self._sample_callbacks):
-            try:
-                cb(sample)
-            except Exception as exc:  # a caller's bug must not kill the link
-                self.stats.errors += 1
-                self.last_error = f"sample callback failed: {exc!r}"
+        self._emit(self.sample_received, sample)

@@ -11,6 +11,8 @@ import threading
 import time
 from enum import Enum
 
+from psygnal import Signal
+
 from calib_core.link import auth
 from calib_core.link.protocol import Authenticate, ErrorReply, Hello, HelloReply
 
@@ -31,6 +33,11 @@ class AuthState(str, Enum):
 
 
 class WorkstationAuth:
+    """The workstation's side of the link's handshake. ``settled(state, failure)`` when a handshake
+    ends (on the link's reader thread)."""
+
+    settled = Signal(object, object)
+
     def __init__(self, key: bytes | None, key_name: str = "the link key"):
         self._key = key
         self._key_name = key_name
@@ -43,16 +50,13 @@ class WorkstationAuth:
         self._counter = 0
         self._sent_s = 0.0
         self._attempts = 0
-        self.listeners: list = []
-        """``callback(state, failure)`` when the handshake ends (on the link's reader thread)."""
 
     def _set(self, state: AuthState, failure: str | None = None) -> None:
         with self._changed:
             self.state, self.failure = state, failure
             self._changed.notify_all()
         if state is not AuthState.PENDING:
-            for callback in list(self.listeners):
-                callback(state, failure)
+            self.settled.emit(state, failure)
 
     def hello(self) -> str | None:
         """The ``HEL`` body that opens a new session (``None`` without a key)."""

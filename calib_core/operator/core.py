@@ -24,7 +24,8 @@ from calib_core.calibration.look_place import LookNotAtTask, LookPlace, place_of
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert, pose_difference
-from calib_core.link.driver import ControllerLink
+from calib_core.connectors.controller import ControllerConnector, ControllerContext
+from calib_core.connectors.registry import open_controller
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.calibration.verification import Verification, verify
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
@@ -85,7 +86,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.task: TaskLocation | None = next(iter(self.workcell.task_locations.values()), None)
         if self.task is not None and self.task.component:
             self.session.set_target(self.task.component)
-        self.link: ControllerLink | None = None
+        self.link: ControllerConnector | None = None
         self.recorder = None
         self._tap = None
         self.replaying = False
@@ -135,21 +136,26 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         return self.cell.intrinsics
 
     # --- robot and link -----------------------------------------------------------------------
-    def start_controller(self) -> str:
-        """Ask the site for its controller and connect to it; returns the link URL."""
+    def start_controller(self) -> str | None:
+        """Ask the site for its controller and connect to it; returns the controller URL (``None``: the
+        site has no controller, a camera alone)."""
         if self.site is None:
             raise CalibrationError("no site: give a controller (--port) or use the simulated cell")
         url = self.site.start_controller()
-        self.connect_link(url)
+        if url is not None:
+            self.connect_link(url, options=getattr(self.site, "controller_options", None))
         return url
 
-    def connect_link(self, url: str, rate_hz: float = 50.0) -> None:
+    def connect_link(self, url: str, rate_hz: float = 50.0, options: dict | None = None) -> None:
+        """Open the controller connector registered for ``url``'s scheme and start it."""
         if self.link is not None:
             self.link.close()
-        self.link = ControllerLink(url, mode="stream", rate_hz=rate_hz, n_joints=self.robot.n_joints)
-        self.link.on_sample(lambda sample: self._call_soon(self.observe_sample, sample))
-        self.link.on_state(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
-        self.link.on_auth(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
+            self.link = None
+        context = ControllerContext.of(self.robot, self.cell.joint_map, rate_hz, options)
+        self.link = open_controller(url, context)
+        self.link.sample_received.connect(lambda sample: self._call_soon(self.observe_sample, sample))
+        self.link.state_changed.connect(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
+        self.link.auth_changed.connect(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
         if self.site is not None:
             self.site.attach(self.link)
         self.link.start()
@@ -177,7 +183,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     def observe_sample(self, sample: TimedSample) -> None:
         """A joint sample from the link (its reader thread hands it here through ``call_soon``)."""
         self.last_sample_s = time.monotonic()
-        q = self.cell.joint_map.to_model(sample.joints_deg)
+        q = self.link.joint_map.to_model(sample.joints_deg) if self.link is not None else self.cell.joint_map.to_model(sample.joints_deg)
         restarts = self.controller_clock.restarts
         t_sent = self.controller_clock.stamp(sample.t_host_s, sample.sample.t_ms / 1000.0)
         if self.controller_clock.restarts != restarts:

@@ -74,7 +74,7 @@ class Moves:
             if isinstance(confirmed, Confirmation) and (confirmed.stops_seen != self.stops_sent or confirmed.what != what):
                 raise CalibrationError(f"not moving to {what}: the robot was stopped after this move was asked for; ask for it again")
             self.record_event("move_confirmed", what=what, reasons=list(preview.confirm_reasons))
-        handle = self.link.move_joints(self.cell.joint_map.to_controller(q), timeout_s=timeout_s)
+        handle = self.link.move_joints(self.link.joint_map.to_controller(q), timeout_s=timeout_s)
         if not handle.sent:
             handle.wait(0)  # raises the link's reason
         self.last_move_sent_s = time.monotonic()  # frames from before it show the old pose (board captures)

@@ -9,9 +9,9 @@ simulated camera for the cell the operator opened, and is the only code that kno
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 from typing import Protocol
 
+from calib_core.connectors.registry import open_camera
 from calib_core.scene import SceneItem
 from calib_core.video.frame import FrameSource
 
@@ -21,8 +21,9 @@ class Site(Protocol):
 
     description: str
 
-    def start_controller(self) -> str:
-        """Make the controller reachable; returns the link URL (a port, a pty, ``socket://``)."""
+    def start_controller(self) -> str | None:
+        """Make the controller reachable; returns its connector URL (a port, ``socket://``, ``ros2://``...),
+        or ``None`` when the site has no controller."""
 
     def camera_factory(self) -> Callable[[], FrameSource]:
         """A function that opens the camera (called on the camera's worker thread)."""
@@ -37,34 +38,28 @@ class Site(Protocol):
         """Stop what the site started; safe to call twice."""
 
 
-def open_camera_spec(spec: str) -> FrameSource:
-    """A camera from a command-line spec: an OpenCV device index, a video file or stream URL, or
-    a folder of images (played in a loop)."""
-    from calib_core.video.folder_source import ImageFolderSource
-    from calib_core.video.opencv_source import OpenCVSource
-
-    if Path(spec).is_dir():
-        return ImageFolderSource(spec, loop=True)
-    return OpenCVSource(int(spec) if spec.isdigit() else spec)
-
-
 class RealSite:
-    """A real controller at ``controller_url`` and a real camera (``camera`` spec, see
-    :func:`open_camera_spec`; ``None`` for no camera)."""
+    """A real controller at ``controller_url`` and a real camera ``camera``, each through the connector
+    registered for its URL's scheme (:mod:`calib_core.connectors.registry`); either may be ``None`` (a
+    camera alone, for picking and solving without moving; a controller alone). ``controller_options`` and
+    ``camera_options``: the connectors' options from the workcell's ``site:`` section."""
 
-    def __init__(self, controller_url: str, camera: str | None = None):
+    def __init__(self, controller_url: str | None, camera: str | None = None, *, controller_options: dict | None = None, camera_options: dict | None = None):
         self.controller_url = controller_url
         self.camera = camera
-        self.description = f"controller {controller_url}" + (f", camera {camera}" if camera else "")
+        self.controller_options = controller_options
+        self.camera_options = camera_options
+        parts = ([f"controller {controller_url}"] if controller_url else ["no controller"]) + ([f"camera {camera}"] if camera else [])
+        self.description = ", ".join(parts)
 
-    def start_controller(self) -> str:
+    def start_controller(self) -> str | None:
         return self.controller_url
 
     def camera_factory(self) -> Callable[[], FrameSource] | None:
         if self.camera is None:
             return None
-        spec = self.camera
-        return lambda: open_camera_spec(spec)
+        spec, options = self.camera, self.camera_options
+        return lambda: open_camera(spec, options)
 
     def attach(self, link) -> None:
         pass

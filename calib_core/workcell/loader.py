@@ -24,13 +24,14 @@ from calib_core.scene import SceneItem
 from calib_core.workcell.feature_kinds import CORNER, KINDS, FeatureKind
 from calib_core.workcell.model import TaskLocation, Workcell
 from calib_core.workcell.robot_section import check_against_robot, read_robot_section
+from calib_core.workcell.site_section import read_site_section
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SAFETY_KEYS, SafetyLimits
 
 DEFAULT_WORKCELL = Path(__file__).resolve().parents[2] / "resources" / "workcell" / "workcell.yaml"
 SCHEMA_VERSION = 2
 # Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
 _READABLE_VERSIONS = (1, 2)
-_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board", "safety"}
+_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board", "safety", "site"}
 _COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
 _TASK_KEYS = {"name", "component", "tcp2base", "approach_mm", "tolerance_mm"}
 _KINDS = {"component", "fixture"}
@@ -193,6 +194,15 @@ def _safety(reader: _Reader, raw) -> SafetyLimits:
     return SafetyLimits(**values)
 
 
+def load_site_section(path: str | Path):
+    """Only the ``site:`` section of a workcell file (``None`` when it has none), without loading its
+    robot: the command line decides from it whether a cell is real or simulated before anything starts."""
+    path = Path(path)
+    reader = _Reader(path)
+    data = reader.mapping(read_yaml(path, "workcell file"), "(top level)", _TOP_KEYS, set())
+    return read_site_section(reader, data["site"], path.parent) if data.get("site") is not None else None
+
+
 def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     """Read and validate a workcell file; raise :class:`FileFormatError` naming the field at fault."""
     path = Path(path)
@@ -237,4 +247,6 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
         # Where the hand-eye board's centre stands (x along its columns, y down its rows, z into it).
         meta["hand_eye_board_centre"] = reader.placement(data["hand_eye_board"], "hand_eye_board")
     safety = _safety(reader, data.get("safety"))
+    if data.get("site") is not None:
+        meta["site"] = read_site_section(reader, data["site"], path.parent)
     return Workcell(str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta, safety)

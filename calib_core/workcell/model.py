@@ -52,6 +52,11 @@ class Workcell:
     safety: SafetyLimits = field(default_factory=SafetyLimits)
 
     @property
+    def site(self):
+        """The cell's ``site:`` section (:class:`~calib_core.workcell.site_section.SiteSection`), or None."""
+        return self.meta.get("site")
+
+    @property
     def robot_urdf(self) -> Path:
         return self.robot_spec.urdf
 

@@ -137,3 +137,27 @@ def test_a_relative_workcell_path_opens_the_window(cell_copy, tmp_path):
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "shot.png").stat().st_size > 10_000
     assert _wait_gone(cell_copy) == []
+
+
+def test_a_camera_alone_from_the_site_section_opens_a_window_without_a_simulator(cell_copy, tmp_path):
+    """A cell with a ``site:`` camera and no controller: the window comes up on the camera, the link
+    'not connected', and no simulator is started (``--camera`` no longer needs ``--port``)."""
+    import cv2
+    import numpy as np
+
+    shots = cell_copy.parent / "shots"
+    shots.mkdir()
+    cv2.imwrite(str(shots / "a.png"), np.full((48, 64, 3), 90, np.uint8))
+    cell_copy.write_text(cell_copy.read_text().replace("\nrobot:", "\nsite:\n  camera: shots\nrobot:", 1))
+    png = tmp_path / "window.png"
+    gui = _gui("--workcell", str(cell_copy), "--screenshot", str(png))
+    started = time.monotonic()
+    while gui.poll() is None and time.monotonic() - started < 120:
+        assert _simulators_for(cell_copy) == []
+        time.sleep(0.2)
+    out, err = gui.communicate(timeout=10)
+    assert gui.returncode == 0, err
+    assert png.stat().st_size > 10_000 and "Traceback" not in err
+    gui = _gui("--workcell", str(cell_copy), "--site", "sim", "--camera", str(shots))
+    out, err = gui.communicate(timeout=60)
+    assert gui.returncode == 2 and "--site sim brings its own controller and camera" in err

@@ -84,7 +84,7 @@ def test_stop_ends_the_running_move_with_the_controllers_reason(sim):  # noqa: F
 def test_replies_are_matched_by_id_and_samples_going_back_are_not_fresh():
     link = ControllerLink("loop://", rate_hz=10, deadman_ms=0, n_joints=1, key=None)  # no controller: nothing to authenticate with
     delivered = []
-    link.on_sample(delivered.append)
+    link.sample_received.connect(delivered.append)
     link.start(wait_open=True)
     try:
         first, second = link.move_joints((1.0,)), link.move_joints((2.0,))

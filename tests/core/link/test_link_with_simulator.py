@@ -124,7 +124,7 @@ def test_pty_reboot_reconnects_and_samples_resume(sim):
     s = sim("--pty", "--reboot-after", "1.0", "--reboot-downtime", "0.5")
     states = []
     with ControllerLink(s.url, rate_hz=100) as link:
-        link.on_state(lambda state, why: states.append(state))
+        link.state_changed.connect(lambda state, why: states.append(state))
         assert link.wait_for_samples(20, 5.0)
         s.next_announcement()
         gone = time.monotonic()
