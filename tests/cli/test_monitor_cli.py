@@ -89,3 +89,32 @@ def test_monitor_does_not_show_a_sample_of_another_joint_count(tmp_path):
     shown = [x["seq"] for x in lines]
     assert not any(seq % 10 == 5 for seq in shown) and shown[-1] - shown[0] >= 10  # a short one fell inside, unshown
     assert "has 3 joint values, the robot has 6: not shown" in run.stderr
+
+
+def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch):
+    """``sim-ros2`` (a ros2_control arm on Cyclone DDS) and ``monitor ros2://`` as two processes: the
+    samples come in the workcell's joint order, stamped by the arm's clock (ms since the epoch)."""
+    import os
+    import time
+
+    from calib_core.workcell import DEFAULT_WORKCELL
+
+    env = {**os.environ, "ROS_DOMAIN_ID": str(150 + os.getpid() % 50)}
+    arm = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-ros2", "--rate", "200", "--joints", "10,-20,30,-40,50,-60"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        assert arm.stdout.readline().strip() == "ready"
+        before_ms = time.time() * 1000
+        run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ros2:///joint_states", "--workcell", str(DEFAULT_WORKCELL),
+                              "--count", "5", "--json", "--timeout", "20"], capture_output=True, text=True, timeout=60, env=env)
+        assert run.returncode == 0, run.stderr
+        lines = [json.loads(line) for line in run.stdout.splitlines()]
+        assert len(lines) == 5
+        assert [round(v, 9) for v in lines[0]["joints_deg"]] == [10.0, -20.0, 30.0, -40.0, 50.0, -60.0]
+        assert all(before_ms - 60_000 < x["t_ms"] < time.time() * 1000 + 1000 for x in lines)
+        assert [x["t_ms"] for x in lines] == sorted(x["t_ms"] for x in lines)
+        no_cell = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ros2:///joint_states", "--count", "1"], capture_output=True, text=True, timeout=60, env=env)
+        assert no_cell.returncode == 2 and "give the cell (--workcell)" in no_cell.stderr and "Traceback" not in no_cell.stderr
+    finally:
+        arm.terminate()
+        arm.wait(10)

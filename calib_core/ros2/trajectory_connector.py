@@ -1,0 +1,272 @@
+"""The ROS 2 controller connector: joints from ``sensor_msgs/JointState``, moves through ros2_control's
+``joint_trajectory_controller``, on Cyclone DDS.
+
+URL ``ros2:///joint_states`` (the joint states topic; ``?controller=NAME&domain=N&qos=sensor`` or the
+``site:`` section's ``controller_options`` with the same names). Joints are taken by URDF name (the cell's
+robot), so the connector's axes are the model's (:meth:`JointMap.identity`); ROS's rad and m become deg and
+mm. A sample's time is its header stamp (the controller's clock), never its arrival.
+
+Moves: a one-point ``trajectory_msgs/JointTrajectory`` on ``/<controller>/joint_trajectory`` (the
+controller's topic interface: no goal handshake to lose on a slow link), its ``time_from_start`` from the
+distance at ``speed_deg_s``. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the
+target; *refused* at once when no trajectory controller subscribes to the topic; *stopped* by Stop, which
+sends a trajectory that holds the current position (what the controller does with a new trajectory: it
+replaces the old one). No joint states for ``stale_after_s``: the link is ``stale`` and the robot's pose unknown.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import threading
+import time
+from urllib.parse import parse_qs, urlsplit
+
+import numpy as np
+from psygnal import Signal
+
+from calib_core.connectors.controller import ControllerContext
+from calib_core.link.joint_map import JointMap
+from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
+from calib_core.link.protocol import JointSample
+from calib_core.link.sample_order import SampleOrder
+from calib_core.ros2.joint_units import user_per_si
+
+DEFAULT_CONTROLLER = "joint_trajectory_controller"
+_OPTIONS = {"controller", "domain", "qos", "speed_deg_s", "done_tolerance_deg", "stale_after_s"}
+
+
+def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
+    parts = urlsplit(url)
+    if parts.netloc:
+        raise LinkError(f"{url!r}: a ros2 URL has no host (ros2:///joint_states); the domain is ROS_DOMAIN_ID or ?domain=N")
+    topic = parts.path or "/joint_states"
+    options = dict(context.options or {})
+    for key, values in parse_qs(parts.query, keep_blank_values=True).items():
+        options[key] = values[-1]
+    unknown = set(options) - _OPTIONS
+    if unknown:
+        raise LinkError(f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+    return topic, options
+
+
+def _number(options: dict, key: str, default: float, low: float, high: float) -> float:
+    raw = options.get(key, default)
+    try:
+        value = float(raw)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not low <= value <= high:
+        raise LinkError(f"ros2 option {key}: must be a number in [{low:g}, {high:g}], got {raw!r}")
+    return value
+
+
+class Ros2TrajectoryController:
+    """See the module. ``context.joint_names`` are the joints looked for in each JointState message."""
+
+    sample_received = Signal(object)
+    state_changed = Signal(object, str)
+    auth_changed = Signal(object, object)  # no session on ROS 2: never emitted
+
+    def __init__(self, url: str, context: ControllerContext):
+        from calib_core.ros2.wire import domain_id, dds_topic
+
+        if not context.n_joints:
+            raise LinkError(f"{url}: a ROS 2 controller is read by joint names: give the cell (--workcell)")
+        self.url = url
+        topic, options = _options(url, context)
+        self.controller = str(options.get("controller", DEFAULT_CONTROLLER)).strip("/")
+        self.domain = domain_id(options.get("domain"))
+        self._qos_name = str(options.get("qos", "default"))
+        if self._qos_name not in ("default", "sensor"):
+            raise LinkError(f"ros2 option qos: 'default' or 'sensor', got {self._qos_name!r}")
+        self.speed_deg_s = _number(options, "speed_deg_s", 20.0, 0.1, 1000.0)
+        self.done_tolerance_deg = _number(options, "done_tolerance_deg", 0.05, 1e-4, 10.0)
+        self.stale_after_s = _number(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0)
+        self.joint_states_topic = dds_topic(topic)
+        self.trajectory_topic = dds_topic(f"/{self.controller}/joint_trajectory")
+        self.joint_names = list(context.joint_names)
+        self.n_joints = context.n_joints
+        self.joint_map = JointMap.identity(self.n_joints)
+        self._per_si = user_per_si(context.joint_units)
+        self.stats = LinkStats()
+        self.last_error: str | None = None
+        self._state = LinkState.CLOSED
+        self._lock = threading.Lock()
+        self._order = SampleOrder(self.stats)
+        self._seq = itertools.count()
+        self._ids = itertools.count(1)
+        self._latest: TimedSample | None = None
+        self._last_sample_s: float | None = None
+        self._move: MoveHandle | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._reader = self._writer = None
+
+    # --- life cycle ----------------------------------------------------------------------------
+    def start(self) -> Ros2TrajectoryController:
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.sub import DataReader
+        from cyclonedds.topic import Topic
+
+        from calib_core.ros2 import messages as msg
+        from calib_core.ros2.participant import participant
+        from calib_core.ros2.taker import Taker
+        from calib_core.ros2.wire import default_qos, sensor_qos
+
+        if self._thread is not None:
+            return self
+        dp = participant(self.domain)
+        reader_qos = sensor_qos(100) if self._qos_name == "sensor" else default_qos(100)
+        self._reader = DataReader(dp, Topic(dp, self.joint_states_topic, msg.JointState), qos=reader_qos)
+        self._writer = DataWriter(dp, Topic(dp, self.trajectory_topic, msg.JointTrajectory), qos=default_qos(1))
+        self._taker = Taker(self._reader)
+        self._set_state(LinkState.CONNECTING, f"waiting for {self.joint_states_topic[2:]} on ROS domain {self.domain}")
+        self._thread = threading.Thread(target=self._run, name=f"ros2 {self.url}", daemon=True)
+        self._thread.start()
+        return self
+
+    def close(self) -> None:
+        if self._move is not None and not self._move.finished:
+            self.stop()
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=1.0)
+        self._set_state(LinkState.CLOSED, "closed by the caller")
+        self._finish_move(MoveError("the link was closed"))
+
+    @property
+    def state(self) -> LinkState:
+        return self._state
+
+    @property
+    def latest(self) -> TimedSample | None:
+        return self._latest
+
+    def stats_snapshot(self) -> dict[str, int]:
+        with self._lock:
+            return self.stats.as_dict()
+
+    # --- commands ------------------------------------------------------------------------------
+    def move_joints(self, joints_deg, *, timeout_s: float = 60.0) -> MoveHandle:
+        q = np.array([float(v) for v in joints_deg])
+        if len(q) != self.n_joints or not np.all(np.abs(q) < 1e6):
+            raise ValueError(f"a move needs {self.n_joints} finite joint values, got {list(q)}")
+        handle = MoveHandle(f"ros2.{next(self._ids)}", tuple(q), time.monotonic() + timeout_s)
+        latest = self._latest
+        reason = self._why_not_sendable(latest)
+        if reason is not None:
+            handle.sent = False
+            handle._finish(MoveError(f"move {handle.id}: not sent: {reason}"))
+            return handle
+        distance = float(np.max(np.abs(q - np.asarray(latest.joints_deg))))
+        duration_s = max(distance / self.speed_deg_s, 0.5)
+        self._finish_move(MoveError("a newer move replaced it"))
+        with self._lock:
+            self._move = handle
+        self._publish(q, duration_s)
+        handle.acked = True  # the controller's topic takes it as given: reliable delivery, no reply
+        return handle
+
+    def stop(self) -> bool:
+        """Hold where the joints stand now: a one-point trajectory at the current position."""
+        latest = self._latest
+        if latest is None or self._writer is None or self._stop.is_set():
+            return False
+        self._publish(np.asarray(latest.joints_deg), 0.1)
+        self._finish_move(MoveError("ERR,STOPPED: stopped by the operator"))
+        return True
+
+    def _why_not_sendable(self, latest: TimedSample | None) -> str | None:
+        if self._writer is None:
+            return "the connector is not started"
+        if self._state is not LinkState.UP or latest is None:
+            return f"the link is {self._state.value} (no fresh joint states on {self.joint_states_topic[2:]})"
+        if self._writer.get_publication_matched_status().current_count == 0:
+            return f"no trajectory controller subscribes to /{self.trajectory_topic[3:]} (is '{self.controller}' loaded and active?)"
+        return None
+
+    def _publish(self, q_user: np.ndarray, duration_s: float) -> None:
+        from calib_core.ros2 import messages as msg
+
+        point = msg.JointTrajectoryPoint(positions=[float(v) for v in q_user / self._per_si], time_from_start=msg.Duration.of_s(duration_s))
+        # An empty stamp: the controller starts the trajectory on receipt (its own clock, not ours).
+        self._writer.write(msg.JointTrajectory(msg.Header(), list(self.joint_names), [point]))
+
+    def _finish_move(self, error: MoveError | None) -> None:
+        with self._lock:
+            move, self._move = self._move, None
+        if move is not None and not move.finished:
+            if error is not None:
+                error = type(error)(f"move {move.id}: {error}")
+            move._finish(error)
+
+    # --- the reader thread ---------------------------------------------------------------------
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                for message in self._taker.take(100, 0.02):
+                    self._on_joint_state(message)
+            except Exception as exc:  # a DDS hiccup must not end the thread: reported, retried
+                self.stats.errors += 1
+                self.last_error = f"reading {self.joint_states_topic[2:]}: {exc!r}"
+                time.sleep(0.05)
+            self._watch(time.monotonic())
+
+    def _watch(self, now: float) -> None:
+        last = self._last_sample_s
+        if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s:
+            self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
+        move = self._move
+        if move is not None and now > move.deadline_s:
+            from calib_core.link.link_types import MoveTimeout
+
+            self._finish_move(MoveTimeout("the joints did not reach the target in time"))
+
+    def _on_joint_state(self, message) -> None:
+        names = list(message.name)
+        if len(message.position) != len(names):
+            self.stats.malformed += 1
+            return
+        index = {name: i for i, name in enumerate(names)}
+        if any(name not in index for name in self.joint_names):
+            self.stats.wrong_joint_count += 1  # another group's states (a gripper): not this arm's
+            return
+        q_si = np.array([message.position[index[name]] for name in self.joint_names], dtype=float)
+        if not np.all(np.isfinite(q_si)):
+            self.stats.non_finite += 1
+            return
+        q = q_si * self._per_si
+        t_ns = message.header.stamp.ns()
+        sample = TimedSample(JointSample(next(self._seq), t_ns // 1_000_000, tuple(float(v) for v in q)), time.monotonic())
+        with self._lock:
+            if not self._order.admit(sample.sample):
+                return
+            self.stats.sentences += 1
+            self.stats.samples += 1
+            self._latest = sample
+        self._last_sample_s = sample.t_host_s
+        if self._state is not LinkState.UP:
+            self._set_state(LinkState.UP, "joint states arriving")
+        self._emit(self.sample_received, sample)
+        move = self._move
+        if move is not None and float(np.max(np.abs(q - np.asarray(move.joints_deg)))) <= self.done_tolerance_deg:
+            self._finish_move(None)
+
+    def _set_state(self, state: LinkState, reason: str) -> None:
+        if state is self._state:
+            return
+        self._state = state
+        self._emit(self.state_changed, state, reason)
+
+    def _emit(self, signal, *args) -> None:
+        try:
+            signal.emit(*args)
+        except Exception as exc:  # a caller's bug must not kill the link
+            self.stats.errors += 1
+            self.last_error = f"{signal.name} slot failed: {exc!r}"
+
+
+def open_ros2(url: str, context: ControllerContext) -> Ros2TrajectoryController:
+    """Entry point of ``videocal.controllers`` for ``ros2://``."""
+    return Ros2TrajectoryController(url, context)

@@ -1,0 +1,187 @@
+"""The ROS 2 controller connector against a publisher of our own (its own IDL, written from the ROS message
+definitions, not videocal's) and against the simulated ros2_control arm."""
+
+
+import math
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from cyclonedds.core import Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.idl import IdlStruct
+from cyclonedds.idl.types import float64, int32, sequence, uint32
+from cyclonedds.pub import DataWriter
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.registry import open_controller
+from calib_core.link.joint_map import JointMap
+from calib_core.link.link_types import LinkState, MoveError
+from calib_core.ros2.trajectory_connector import Ros2TrajectoryController
+from videocal_sim.ros2_arm import SimulatedRos2Arm
+
+
+# --- sensor_msgs/msg/JointState as the ROS 2 definitions give it, written here on their own ---------
+@dataclass
+class Stamp(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+    sec: int32
+    nanosec: uint32
+
+
+@dataclass
+class Hdr(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+    stamp: Stamp
+    frame_id: str
+
+
+@dataclass
+class Joints(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
+    header: Hdr
+    name: sequence[str]
+    position: sequence[float64]
+    velocity: sequence[float64]
+    effort: sequence[float64]
+
+
+NAMES = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "slide")
+UNITS = ("deg",) * 5 + ("mm",)
+
+
+def _context(**options):
+    return ControllerContext(NAMES, UNITS, JointMap.identity(6), 100.0, options)
+
+
+def _wait(predicate, timeout_s=10.0):
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(domain):
+    dp = DomainParticipant(domain)
+    qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10))
+    writer = DataWriter(dp, Topic(dp, "rt/joint_states", Joints), qos=qos)
+    link = open_controller("ros2:///joint_states", _context())
+    assert isinstance(link, Ros2TrajectoryController)
+    got = []
+    link.sample_received.connect(got.append)
+    link.start()
+    try:
+        assert _wait(lambda: writer.get_publication_matched_status().current_count > 0)
+        # Another order, an extra gripper joint, radians and metres, a stamp of the publisher's clock.
+        order = ["slide", "gripper", "wrist_2", "elbow", "shoulder_pan", "wrist_1", "shoulder_lift"]
+        values = {"slide": 0.125, "gripper": 0.02, "wrist_2": -math.pi / 2, "elbow": 1.0, "shoulder_pan": 0.1, "wrist_1": 0.0, "shoulder_lift": -0.5}
+        writer.write(Joints(Hdr(Stamp(1_700_000_000, 250_000_000), "base"), order, [values[n] for n in order], [], []))
+        # A message with the arm's joints missing (a gripper's own states) is not the arm's sample.
+        writer.write(Joints(Hdr(Stamp(1_700_000_000, 260_000_000), "base"), ["gripper"], [0.01], [], []))
+        # An older stamp after a newer one is not the robot now.
+        writer.write(Joints(Hdr(Stamp(1_700_000_000, 200_000_000), "base"), order, [values[n] for n in order], [], []))
+        assert _wait(lambda: link.stats_snapshot()["wrong_joint_count"] == 1 and link.stats_snapshot()["backwards_samples"] == 1)
+        assert len(got) == 1 and link.state is LinkState.UP
+        sample = got[0].sample
+        assert sample.t_ms == 1_700_000_000_250
+        expected = [math.degrees(0.1), math.degrees(-0.5), math.degrees(1.0), 0.0, -90.0, 125.0]
+        assert np.allclose(sample.joints_deg, expected, atol=1e-9)
+    finally:
+        link.close()
+
+
+def test_no_joint_states_is_stale_and_the_reason_says_where(domain):
+    link = open_controller(f"ros2:///arm/joint_states?stale_after_s=0.2", _context())
+    states = []
+    link.state_changed.connect(lambda state, why: states.append((state, why)))
+    link.start()
+    try:
+        assert link.state is LinkState.CONNECTING and "/arm/joint_states" in states[0][1]
+        handle = link.move_joints([0.0] * 6)
+        assert not handle.sent and "connecting" in str(handle.error)
+    finally:
+        link.close()
+
+
+@pytest.fixture
+def arm(domain):
+    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 5 + [1000.0], [-170.0] * 5 + [0.0], [170.0] * 5 + [500.0], [0, -30, 60, 0, 45, 100],
+                           rate_hz=200.0, domain=domain, controller="arm_controller").start()
+    yield arm
+    arm.close()
+
+
+def _connected(**options):
+    link = open_controller("ros2:///joint_states", _context(controller="arm_controller", **options)).start()
+    assert _wait(lambda: link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0)
+    return link
+
+
+def test_a_move_through_the_trajectory_controller_ends_at_its_target(arm):
+    link = _connected(speed_deg_s=100)
+    try:
+        target = [10.0, -20.0, 50.0, 5.0, 40.0, 150.0]
+        handle = link.move_joints(target, timeout_s=20)
+        assert handle.sent and handle.acked
+        handle.wait(20)
+        assert np.allclose(link.latest.joints_deg, target, atol=0.05)
+        assert np.allclose(arm.position(time.monotonic()), target, atol=1e-6)
+    finally:
+        link.close()
+
+
+def test_stop_holds_the_arm_where_it_stands(arm):
+    link = _connected(speed_deg_s=20)
+    try:
+        handle = link.move_joints([60.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=20)
+        assert _wait(lambda: link.latest.joints_deg[0] > 5.0)
+        assert link.stop()
+        with pytest.raises(MoveError, match="STOPPED"):
+            handle.wait(1)
+        assert _wait(lambda: arm._plan is not None and arm._plan[1][-1] <= 0.11 or arm._plan is None)
+        time.sleep(0)  # the hold trajectory lasts 0.1 s; then the arm stands still
+        assert _wait(lambda: arm._plan is None, 2.0)
+        held = arm.position(time.monotonic())[0]
+        assert 5.0 < held < 30.0  # stopped on the way, far from 60
+        assert _wait(lambda: abs(link.latest.joints_deg[0] - held) < 1e-6, 2.0)
+    finally:
+        link.close()
+
+
+def test_a_move_with_no_controller_listening_is_not_sent(arm):
+    link = open_controller("ros2:///joint_states", _context(controller="no_such_controller")).start()
+    try:
+        assert _wait(lambda: link.state is LinkState.UP)
+        handle = link.move_joints([0.0] * 5 + [100.0])
+        assert not handle.sent
+        assert "no trajectory controller subscribes to /no_such_controller/joint_trajectory" in str(handle.error)
+        assert arm.trajectories == 0
+    finally:
+        link.close()
+
+
+def test_the_arm_rejects_a_trajectory_past_its_limits(arm):
+    link = _connected()
+    try:
+        handle = link.move_joints([0, -30, 60, 0, 45, 900.0], timeout_s=1.0)  # slide limit 500 mm
+        with pytest.raises(MoveError):
+            handle.wait(3)
+        assert arm.rejected == 1 and np.allclose(arm.position(time.monotonic()), [0, -30, 60, 0, 45, 100])
+    finally:
+        link.close()
+
+
+def test_wrong_urls_and_options_are_named(domain):
+    from calib_core.link.link_types import LinkError
+
+    with pytest.raises(LinkError, match="has no host"):
+        open_controller("ros2://robot/joint_states", _context())
+    with pytest.raises(LinkError, match="unknown option"):
+        open_controller("ros2:///joint_states?controler=x", _context())
+    with pytest.raises(LinkError, match="speed_deg_s"):
+        open_controller("ros2:///joint_states?speed_deg_s=fast", _context())
+    with pytest.raises(LinkError, match="give the cell"):
+        open_controller("ros2:///joint_states", ControllerContext((), (), JointMap.identity(0)))
