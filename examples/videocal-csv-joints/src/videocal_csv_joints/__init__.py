@@ -1,0 +1,1 @@
+"""An example videocal controller connector (see ``connector.py``)."""
