@@ -7,15 +7,17 @@ from collections.abc import Callable
 
 from PySide6.QtCore import QThread, Signal
 
-from calib_core.video.frame import FrameSource, VideoSourceError
+from calib_core.video.frame import FrameSource, FrameTimeout, VideoSourceError
 
 
 class FrameWorker(QThread):
     """Creates the source in its own thread (a VTK-rendering source must live there), reads it
-    at its frame rate and emits ``frame(Frame)``; ``failed(str)`` when the source breaks."""
+    at its frame rate and emits ``frame(Frame)``; ``failed(str)`` when the source breaks;
+    ``waiting(str)`` while a live camera sends nothing (it keeps reading)."""
 
     frame = Signal(object)
     failed = Signal(str)
+    waiting = Signal(str)
 
     def __init__(self, make_source: Callable[[], FrameSource], parent=None):
         super().__init__(parent)
@@ -44,6 +46,9 @@ class FrameWorker(QThread):
                 t0 = time.monotonic()
                 try:
                     frame = source.read()
+                except FrameTimeout as exc:  # a live camera gone quiet: say so, keep waiting for it
+                    self.waiting.emit(str(exc))
+                    continue
                 except VideoSourceError as exc:
                     self.failed.emit(str(exc))
                     return

@@ -231,6 +231,7 @@ class MainWindow(QMainWindow):
         self.worker = FrameWorker(make_source, self)
         self.worker.frame.connect(self.workbench.observe_frame)  # the camera pane shows what the core observed
         self.worker.failed.connect(self.show_error)
+        self.worker.waiting.connect(lambda text: self.statusBar().showMessage(text, 5000))
         self.worker.start()
 
     # --- actions ---------------------------------------------------------------------------

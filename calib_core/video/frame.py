@@ -65,3 +65,8 @@ class FrameSource(ABC):
 
 class VideoSourceError(VideocalError, RuntimeError):
     """A video source could not be opened or stopped delivering frames; the message names it."""
+
+
+class FrameTimeout(VideoSourceError):
+    """A live source had no new frame within its wait: the camera or its stream may come back (the reader
+    keeps reading and says it is waiting), unlike a :class:`VideoSourceError`, which ends it."""
