@@ -23,6 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
+    parser.add_argument("--site", choices=("sim", "ros2"), default="sim",
+                        help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default), or ROS 2 "
+                             "(a simulated ros2_control arm and a camera topic on Cyclone DDS, domain ROS_DOMAIN_ID)")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
                         help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 
@@ -38,8 +41,8 @@ def run(args: argparse.Namespace) -> int:
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method)
-    print(json.dumps({k: report[k] for k in ("status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
+    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method, site_kind=args.site)
+    print(json.dumps({k: report[k] for k in ("site", "status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
     print(f"screenshots and report.json in {args.out}")
     return 0
 

@@ -91,7 +91,7 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
 METHODS = ("find-points", "picks", "edges")
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points") -> dict:
+def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points", site_kind: str = "sim") -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
@@ -104,6 +104,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     n_joints = load_workcell(workcell).load_robot().n_joints
     typical = RobotErrors.typical(0, n_joints=n_joints)
     cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale)
+    if site_kind == "ros2":  # the same simulated cell, its robot and camera reached through ROS 2
+        from videocal_sim.ros2_site import Ros2SimulatedSite
+
+        site = Ros2SimulatedSite(site)
     bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
     wb = Workbench(cell, site)
     if location is not None:
@@ -284,6 +288,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "robot_joints": n_joints,
             "task_location": task.name,
             "method": method,
+            "site": site.description,
+            "connectors": {"controller": wb.link.url, "camera": "ros2:///camera/image_raw" if site_kind == "ros2" else "the simulated camera (in process)"},
             "target": wb.session.target,
             "features_skipped": skipped,
             "subpixel_refinement_refused": refined_away,

@@ -42,11 +42,12 @@ class SimulatedSite:
         return lambda: self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True)
 
     def attach(self, link) -> None:
+        self._link_joint_map = link.joint_map  # the connector's axes: the cell's controller map, or URDF names
         link.sample_received.connect(self._follow)
 
     def _follow(self, sample) -> None:
         # The physical robot is where its controller says: the simulated camera renders from there.
-        self.bed.joints_deg = self.joint_map.to_model(sample.joints_deg)
+        self.bed.joints_deg = self._link_joint_map.to_model(sample.joints_deg)
 
     def put_up(self, items: list[SceneItem]) -> None:
         self.bed.extra_items = list(items)

@@ -28,3 +28,21 @@ def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     for name in report["screenshots"]:
         image = cv2.imread(str(out / name))
         assert image is not None and image.shape[1] >= (300 if name in lists else 1000) and image.std() > 10
+
+
+def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
+    """``demo --site ros2``: the robot a simulated ros2_control arm in another process, the camera a ROS 2 image
+    topic; the window reaches both only through its ROS 2 connectors, on Cyclone DDS."""
+    import os
+
+    out = tmp_path / "demo"
+    env = {**os.environ, "ROS_DOMAIN_ID": str(200 + os.getpid() % 30)}
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "ros2", "--out", str(out), "--scale", "0.5"],
+                         capture_output=True, text=True, timeout=400, env=env)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads((out / "report.json").read_text())
+    assert report["connectors"] == {"controller": f"ros2:///joint_states?domain={env['ROS_DOMAIN_ID']}", "camera": "ros2:///camera/image_raw"}
+    assert "over ROS 2" in report["site"]
+    assert report["status"] == "ok" and report["pairs"] >= 6
+    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
+    assert report["estimate_within_3_sigma"]

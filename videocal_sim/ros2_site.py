@@ -1,0 +1,131 @@
+"""The simulated cell over ROS 2: the robot is a simulated ros2_control arm in a child process
+(``videocal sim-ros2``) and the gripper camera is published as ``sensor_msgs/Image`` with its CameraInfo, so
+the operator core reaches both only through its ROS 2 connectors (``ros2:///joint_states``,
+``ros2:///camera/image_raw``), on Cyclone DDS, as it would a real cell's.
+
+The camera publisher runs here (it renders the test bed's true view, which is the truth and stays in
+``videocal_sim``); it poses the camera from the joint states the core receives, as the simulated site does.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from videocal_sim.sim_process import _PROJECT, SiteError, _die_with_parent
+from videocal_sim.sim_site import SimulatedSite
+
+
+class Ros2ArmProcess:
+    """``videocal sim-ros2`` for a cell, a child that dies with us; :meth:`wait_ready` waits for its ``ready``."""
+
+    def __init__(self, workcell_path: Path, joints_deg, domain: int, rate_hz: float = 100.0):
+        self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-ros2-")
+        self._stderr_path = Path(self._folder.name) / "stderr.txt"
+        cmd = [sys.executable, "-m", "app.cli.main", "sim-ros2", "--workcell", str(Path(workcell_path).resolve()), "--domain", str(domain),
+               "--rate", f"{rate_hz:g}", "--joints", ",".join(f"{v:.6f}" for v in joints_deg)]
+        with open(self._stderr_path, "w") as err:
+            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), preexec_fn=_die_with_parent)
+        self._ready = False
+
+    def wait_ready(self) -> None:
+        if not self._ready:
+            if self.process.stdout.readline().strip() != "ready":
+                self.process.wait(timeout=5)
+                why = self._stderr_path.read_text().strip().splitlines()
+                raise SiteError(f"the simulated ROS 2 arm did not start: {why[-1] if why else f'exit code {self.process.returncode}'}")
+            self._ready = True
+
+    def stop(self) -> None:
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=3)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait(timeout=3)
+        if self.process.stdout is not None:
+            self.process.stdout.close()
+        self._folder.cleanup()
+
+
+class CameraPublisher:
+    """Publishes ``source``'s frames on ``/camera/image_raw`` (rgb8, stamped at exposure on the epoch clock)
+    and ``intrinsics`` (the cell's camera file, as a driver publishes its calibration file) on
+    ``/camera/camera_info``, until :meth:`stop`."""
+
+    def __init__(self, source, intrinsics, domain: int):
+        self.source, self.intrinsics, self.domain = source, intrinsics, domain
+        self.published = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="sim ros2 camera", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        from cyclonedds.pub import DataWriter
+        from cyclonedds.topic import Topic
+
+        from calib_core.ros2 import messages as msg
+        from calib_core.ros2.participant import participant
+        from calib_core.ros2.wire import default_qos, sensor_qos
+
+        dp = participant(self.domain)
+        images = DataWriter(dp, Topic(dp, "rt/camera/image_raw", msg.Image), qos=sensor_qos(1))
+        infos = DataWriter(dp, Topic(dp, "rt/camera/camera_info", msg.CameraInfo), qos=default_qos(1))
+        i = self.intrinsics
+        k = [i.fu, 0.0, i.cx, 0.0, i.fv, i.cy, 0.0, 0.0, 1.0]
+        while not self._stop.is_set():
+            frame = self.source.read()
+            if frame is None:
+                break
+            h, w = frame.image.shape[:2]
+            stamp = msg.Time.of_ns(time.time_ns() - int((time.monotonic() - frame.t_host_s) * 1e9))
+            header = msg.Header(stamp, "camera")
+            images.write(msg.Image(header, h, w, "rgb8", 0, w * 3, frame.image.tobytes()))
+            infos.write(msg.CameraInfo(header, h, w, "plumb_bob", [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
+                                       [i.fu, 0.0, i.cx, 0.0, 0.0, i.fv, i.cy, 0.0, 0.0, 0.0, 1.0, 0.0]))
+            self.published += 1
+        self.source.close()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=3.0)
+
+
+class Ros2SimulatedSite(SimulatedSite):
+    """A :class:`SimulatedSite` whose robot and camera are reached through ROS 2 (domain ``ROS_DOMAIN_ID``)."""
+
+    def __init__(self, site: SimulatedSite, domain: int | None = None):
+        super().__init__(site.bed, camera_fps=site.camera_fps, camera_seed=site.camera_seed)
+        from calib_core.ros2.wire import domain_id
+
+        self.domain = domain_id(domain)
+        self.description = f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain})"
+        self.arm: Ros2ArmProcess | None = None
+        self.publisher: CameraPublisher | None = None
+
+    def start_controller(self) -> str:
+        if self.arm is None:
+            self.arm = Ros2ArmProcess(self.bed.workcell.path, self.bed.joints_deg, self.domain)
+        self.arm.wait_ready()
+        return f"ros2:///joint_states?domain={self.domain}"
+
+    def camera_factory(self, fps: float | None = None) -> Callable:
+        if self.publisher is None:
+            self.publisher = CameraPublisher(self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True), self.bed.intrinsics, self.domain)
+        from calib_core.connectors.registry import open_camera
+
+        spec = f"ros2:///camera/image_raw?domain={self.domain}"
+        return lambda: open_camera(spec)
+
+    def close(self) -> None:
+        if self.publisher is not None:
+            self.publisher.stop()
+        if self.arm is not None:
+            self.arm.stop()
