@@ -156,6 +156,9 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.link.sample_received.connect(lambda sample: self._call_soon(self.observe_sample, sample))
         self.link.state_changed.connect(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
         self.link.auth_changed.connect(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
+        status = getattr(self.link, "status_changed", None)  # a controller's own state (a UR's protective stop, speed slider)
+        if status is not None:
+            status.connect(lambda text: self._call_soon(self._on_link_status, text))
         if self.site is not None:
             self.site.attach(self.link)
         self.link.start()
@@ -170,6 +173,12 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
             if self.motion.motion is Motion.MOVING:
                 self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
         self.link_state.emit(f"{state}: {why}")
+
+    def _on_link_status(self, text: str) -> None:
+        self.record_event("controller_status", text=text)
+        self.message.emit(f"controller: {text}")
+        if self.link is not None:
+            self.link_state.emit(f"{self.link.state.value}: {text}")
 
     def _on_link_auth(self, state: str, failure: str | None) -> None:
         self.record_event("link_auth", state=state, failure=failure)
