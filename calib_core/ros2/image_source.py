@@ -103,7 +103,8 @@ class Ros2ImageSource(FrameSource):
         age_s = t_arrival_epoch - stamp_s
         # A stamp from a clock ahead of ours (or a zero stamp) cannot date the frame: its arrival does.
         t_host = t_arrival_host - age_s if 0.0 <= age_s < 10.0 else t_arrival_host
-        frame = Frame(rgb, self._index, t_host, stamp_s if stamp_s > 0 else None)
+        stamp_ns = message.header.stamp.ns()
+        frame = Frame(rgb, self._index, t_host, stamp_s if stamp_s > 0 else None, stamp_ns if stamp_ns > 0 else None)
         self._index += 1
         return frame
 

@@ -19,13 +19,15 @@ class Frame:
     device: when ``read`` returned it, its latency later; the simulated camera: the exposure). The
     joint history stamps picks with the joints at this time, so the cell's settle time must cover
     the camera's latency. ``t_source_s``: the source's own timestamp (position in a file, capture
-    time of a recording), or None.
+    time of a recording), or None. ``t_device_ns``: the camera's own timestamp of the exposure, ns (a ROS 2
+    header stamp, a GenICam device tick), where the device stamps its frames; else None.
     """
 
     image: np.ndarray
     index: int
     t_host_s: float
     t_source_s: float | None = None
+    t_device_ns: int | None = None
 
     @property
     def size(self) -> tuple[int, int]:
