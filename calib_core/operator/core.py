@@ -163,6 +163,31 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
             self.site.attach(self.link)
         self.link.start()
         self.message.emit(f"controller link: {url}")
+        if hasattr(self.link, "publish_static_transforms"):  # a ROS 2 cell: the results on /tf_static too
+            for signal in (self.camera_model_changed, self.correction_stored):
+                signal.connect(self._publish_static_transforms, unique=True)
+            self._publish_static_transforms()
+
+    def static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
+        """What the cell's ROS side is told: ``(parent, child, child2parent_mm)`` for the camera mounting in use
+        (``videocal_camera`` on the flange; z along the optical axis, x right, y down: ROS's optical frame) and
+        each task's corrected target (``videocal/<task>`` in the base frame; the correction, or the plan if none)."""
+        frames = self.workcell.robot_spec.frames
+        flange, base = str(frames.get("flange") or "flange"), str(frames.get("base") or "base_link")
+        q = self.joints_deg
+        out = [(flange, "videocal_camera", concat(self.robot.fk(q, "camera"), invert(self.robot.fk(q, "flange"))))]
+        for name, task in self.workcell.task_locations.items():
+            out.append((base, f"videocal/{name}", self.session.corrections.corrected_target(name, task.tcp2base)))
+        return out
+
+    def _publish_static_transforms(self, *_) -> None:
+        link = self.link
+        if link is None or not hasattr(link, "publish_static_transforms"):
+            return
+        try:
+            link.publish_static_transforms(self.static_transforms())
+        except Exception as exc:  # the ROS side is an output: its failure must not stop the calibration
+            self.message.emit(f"could not publish /tf_static: {exc}")
 
     def _on_link_state(self, state: str, why: str) -> None:
         self.record_event("link_state", state=state, why=why)

@@ -102,6 +102,7 @@ class Ros2TrajectoryController:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._reader = self._writer = None
+        self._tf = None
 
     # --- life cycle ----------------------------------------------------------------------------
     def start(self) -> Ros2TrajectoryController:
@@ -176,6 +177,14 @@ class Ros2TrajectoryController:
         self._publish(np.asarray(latest.joints_deg), 0.1)
         self._finish_move(MoveError("ERR,STOPPED: stopped by the operator"))
         return True
+
+    def publish_static_transforms(self, transforms: list[tuple[str, str, np.ndarray]]) -> None:
+        """``(parent, child, child2parent_mm)`` on ``/tf_static`` (the measured camera mounting, corrected targets)."""
+        if self._tf is None:
+            from calib_core.ros2.tf_static import StaticTransformBroadcaster
+
+            self._tf = StaticTransformBroadcaster(self.domain)
+        self._tf.publish(transforms)
 
     def _why_not_sendable(self, latest: TimedSample | None) -> str | None:
         if self._writer is None:
