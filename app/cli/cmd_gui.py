@@ -72,7 +72,11 @@ def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
 
     def quit_by_signal(signum, _frame):
         if not running:
-            raise SystemExit(128 + signum)
+            # Nothing is open for writing yet, and the children started so far (the simulator) die with us
+            # (PR_SET_PDEATHSIG). Raising SystemExit here was not enough: raised inside a Qt callback or a
+            # finaliser it was swallowed, and the start went on (exit 1 once under load).
+            sys.stderr.flush()
+            os._exit(128 + signum)
         app.setProperty("videocal_quit_by_signal", True)  # closing asks nothing; unsaved work stays in the autosave
         app.quit()
 

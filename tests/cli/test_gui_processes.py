@@ -120,7 +120,7 @@ def test_sigterm_during_start_up_ends_it_and_leaves_no_simulator(cell_copy, tmp_
         assert not shown.with_suffix(".ready").exists()
         gui.send_signal(signal.SIGTERM)
         gui.wait(timeout=20)
-        assert gui.returncode == 128 + signal.SIGTERM
+        assert gui.returncode == 128 + signal.SIGTERM, gui.stderr.read()[-2000:]
         assert not shown.with_suffix(".ready").exists()  # it did not come up after all
         assert _wait_gone(cell_copy) == []
     finally:
