@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the system libraries videocal needs: OSMesa/EGL/GL for offscreen VTK rendering,
-# and what Qt's xcb platform plugin needs to open a window on a desktop.
+# what Qt's xcb platform plugin needs to open a window on a desktop, and Aravis for GenICam cameras.
 # As root it runs apt-get; otherwise it prints the exact command and stops.
 set -euo pipefail
 
@@ -9,6 +9,8 @@ PACKAGES=(
   libxkbcommon0 libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1
   libxcb-shape0 libxcb-xinerama0 libxcb-randr0 libxcb-render-util0 libxcb-image0
   libxcb-xfixes0 libxcb-xkb1 libx11-xcb1 libxrender1 libxi6
+  # GenICam cameras: Aravis and its GObject introspection data; PyGObject is built against these
+  libaravis-0.8-0 gir1.2-aravis-0.8 libgirepository1.0-dev libcairo2-dev pkg-config gcc python3-dev
 )
 
 missing=()

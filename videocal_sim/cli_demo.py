@@ -23,9 +23,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
-    parser.add_argument("--site", choices=("sim", "ros2"), default="sim",
-                        help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default), or ROS 2 "
-                             "(a simulated ros2_control arm and a camera topic on Cyclone DDS, domain ROS_DOMAIN_ID)")
+    parser.add_argument("--site", choices=("sim", "ros2", "gige"), default="sim",
+                        help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default); ROS 2 "
+                             "(a simulated ros2_control arm and a camera topic on Cyclone DDS, domain ROS_DOMAIN_ID); or gige (the camera "
+                             "served as a GigE Vision camera on the loopback interface, read through Aravis)")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
                         help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 

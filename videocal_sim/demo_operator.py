@@ -108,6 +108,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         from videocal_sim.ros2_site import Ros2SimulatedSite
 
         site = Ros2SimulatedSite(site)
+    elif site_kind == "gige":  # the same cell, its camera served over GigE Vision and read through Aravis
+        from videocal_sim.gige_site import GigESimulatedSite
+
+        site = GigESimulatedSite(site)
     bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
     wb = Workbench(cell, site)
     if location is not None:
@@ -289,7 +293,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "task_location": task.name,
             "method": method,
             "site": site.description,
-            "connectors": {"controller": wb.link.url, "camera": "ros2:///camera/image_raw" if site_kind == "ros2" else "the simulated camera (in process)"},
+            "connectors": {"controller": wb.link.url, "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(site_kind, "the simulated camera (in process)")},
             "target": wb.session.target,
             "features_skipped": skipped,
             "subpixel_refinement_refused": refined_away,

@@ -101,8 +101,9 @@ class Ros2ImageSource(FrameSource):
         rgb = compressed_to_rgb(message, self.description) if self.compressed else image_to_rgb(message, self.description)
         stamp_s = message.header.stamp.ns() / 1e9
         age_s = t_arrival_epoch - stamp_s
-        # A stamp from a clock ahead of ours (or a zero stamp) cannot date the frame: its arrival does.
-        t_host = t_arrival_host - age_s if 0.0 <= age_s < 10.0 else t_arrival_host
+        # However old the frame, its stamp dates it (a late frame must never pass for a new one); a zero stamp
+        # or one from a clock ahead of ours cannot, and then its arrival does.
+        t_host = t_arrival_host - age_s if age_s >= 0.0 and stamp_s > 0 else t_arrival_host
         stamp_ns = message.header.stamp.ns()
         frame = Frame(rgb, self._index, t_host, stamp_s if stamp_s > 0 else None, stamp_ns if stamp_ns > 0 else None)
         self._index += 1

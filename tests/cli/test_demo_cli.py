@@ -30,6 +30,20 @@ def test_demo_writes_screenshots_and_a_report(tmp_path, method):
         assert image is not None and image.shape[1] >= (300 if name in lists else 1000) and image.std() > 10
 
 
+def test_demo_with_a_gige_camera_reaches_the_same_accuracy(tmp_path):
+    """``demo --site gige``: the camera is Aravis's fake GigE Vision camera on the loopback interface sending the
+    simulated images; the window reads it through the ``aravis://`` connector (GVCP/GVSP over UDP)."""
+    out = tmp_path / "demo"
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "gige", "--out", str(out), "--scale", "0.5"],
+                         capture_output=True, text=True, timeout=400)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads((out / "report.json").read_text())
+    assert report["connectors"]["camera"] == "aravis://127.0.0.1" and "GigE Vision" in report["site"]
+    assert report["status"] == "ok" and report["pairs"] >= 6
+    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
+    assert report["estimate_within_3_sigma"]
+
+
 def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
     """``demo --site ros2``: the robot a simulated ros2_control arm in another process, the camera a ROS 2 image
     topic; the window reaches both only through its ROS 2 connectors, on Cyclone DDS."""

@@ -106,6 +106,11 @@ def test_a_frame_is_dated_by_its_stamp_and_camera_info_is_kept(domain):
         while camera.camera_info is None and time.monotonic() < deadline:
             time.sleep(0.01)
         assert list(camera.camera_info.k) == k and camera.camera_info.distortion_model == "plumb_bob"
+        # A frame that arrives 30 s late is 30 s old: it must never pass for a new one (a GigE run showed an
+        # image of an earlier pose taken as settled when late frames were dated by their arrival).
+        images.write(_image(np.zeros((4, 4, 3), np.uint8), time.time_ns() - 30_000_000_000))
+        sent_host = time.monotonic()
+        assert sent_host - 30.2 < camera.read().t_host_s < sent_host - 29.8
         # Quiet: the reader says it is waiting (and keeps the source open) ...
         with pytest.raises(FrameTimeout, match="no image for 0.3 s"):
             camera.read()

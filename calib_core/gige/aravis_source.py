@@ -1,0 +1,173 @@
+"""The GenICam camera connector: ``aravis://DEVICE`` (an Aravis device id: ``Vendor-Model-Serial``, an IP
+address for a GigE Vision camera, or ``Fake_1``, Aravis's own fake camera once its interface is enabled).
+
+Options (``?exposure_us=8000&gain_db=2&pixel_format=RGB8&width=1280&height=960``, or the ``site:`` section's
+``camera_options``): set on the camera when it opens and set again after a reconnect; a camera that refuses one
+is an error naming it. Frames carry the camera's own timestamp (``t_device_ns``: the device's clock, ns) and the
+host's time at the frame (``t_host_s``, from Aravis's system timestamp). A camera that stops sending gives
+:class:`~calib_core.video.frame.FrameTimeout`; after ``reopen_after_s`` of silence the device is opened again
+(a GigE camera that was unplugged or rebooted comes back without restarting videocal).
+"""
+
+from __future__ import annotations
+
+import time
+from urllib.parse import parse_qs, unquote, urlsplit
+
+from calib_core.gige.aravis_lib import aravis
+from calib_core.gige.pixel_formats import NAMES, to_rgb
+from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
+
+_OPTIONS = {"exposure_us", "gain_db", "pixel_format", "width", "height", "timeout_s", "reopen_after_s", "fake"}
+_BUFFERS = 8
+
+
+def _device_id(spec: str) -> str:
+    parts = urlsplit(spec)
+    device = unquote(parts.netloc + parts.path).strip("/")
+    if not device:
+        raise VideoSourceError(f"{spec!r}: name the camera: aravis://DEVICE-ID (see `arv-tool-0.8`), an IP address, or Fake_1")
+    return device
+
+
+class AravisSource(FrameSource):
+    def __init__(self, spec: str, options: dict | None = None):
+        merged = dict(options or {})
+        merged.update({k: v[-1] for k, v in parse_qs(urlsplit(spec).query).items()})
+        unknown = set(merged) - _OPTIONS
+        if unknown:
+            raise VideoSourceError(f"{spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+        self.device = _device_id(spec.split("?", 1)[0])
+        self.options = merged
+        try:
+            self.timeout_s = float(merged.get("timeout_s", 2.0))
+            self.reopen_after_s = float(merged.get("reopen_after_s", 3.0))
+        except ValueError as exc:
+            raise VideoSourceError(f"{spec!r}: {exc}") from None
+        self.description = f"GenICam camera {self.device}"
+        self.reopened = 0
+        self.skipped = 0
+        """Frames passed over because a newer one had arrived (the pane shows the newest, never a queue)."""
+        self._index = 0
+        self._camera = self._stream = None
+        self._last_frame_s = time.monotonic()
+        self._Aravis = aravis()
+        if str(merged.get("fake", "")).lower() in ("1", "true", "yes") or self.device.startswith("Fake_"):
+            self._Aravis.enable_interface("Fake")  # Aravis's own fake camera, for trying it without hardware
+        self._open()
+
+    # --- the device ----------------------------------------------------------------------------
+    def _open(self) -> None:
+        Aravis = self._Aravis
+        try:
+            camera = Aravis.Camera.new(self.device)
+        except Exception as exc:  # GLib.Error: the device is not there (yet)
+            raise VideoSourceError(f"{self.description}: cannot open it: {getattr(exc, 'message', exc)}") from None
+        self._configure(camera)
+        stream = camera.create_stream(None, None)
+        if stream is None:
+            raise VideoSourceError(f"{self.description}: Aravis could not open its stream")
+        payload = camera.get_payload()
+        for _ in range(_BUFFERS):
+            stream.push_buffer(Aravis.Buffer.new_allocate(payload))
+        camera.set_acquisition_mode(Aravis.AcquisitionMode.CONTINUOUS)
+        camera.start_acquisition()
+        self._camera, self._stream = camera, stream
+        self.model = f"{camera.get_vendor_name()} {camera.get_model_name()}"
+        self.pixel_format = camera.get_pixel_format_as_string()
+        self.exposure_us = camera.get_exposure_time() if camera.is_exposure_time_available() else None
+        self.gain_db = camera.get_gain() if camera.is_gain_available() else None
+
+    def _configure(self, camera) -> None:
+        """The options, each set and read back; a refusal names the setting and what the camera allows."""
+        o = self.options
+
+        def setting(name: str, apply) -> None:
+            try:
+                apply()
+            except Exception as exc:
+                raise VideoSourceError(f"{self.description}: it refuses {name}={o[name]!r}: {getattr(exc, 'message', exc)}") from None
+
+        if "pixel_format" in o:
+            allowed = list(camera.dup_available_pixel_formats_as_strings() or [])
+            if o["pixel_format"] not in allowed:
+                raise VideoSourceError(f"{self.description}: it refuses pixel_format={o['pixel_format']!r}; it offers {', '.join(allowed)}")
+            setting("pixel_format", lambda: camera.set_pixel_format_from_string(str(o["pixel_format"])))
+        if "width" in o or "height" in o:
+            x, y, w, h = camera.get_region()
+            setting("width", lambda: camera.set_region(0, 0, int(o.get("width", w)), int(o.get("height", h))))
+        if "exposure_us" in o:
+            setting("exposure_us", lambda: camera.set_exposure_time(float(o["exposure_us"])))
+        if "gain_db" in o:
+            setting("gain_db", lambda: camera.set_gain(float(o["gain_db"])))
+
+    def _close_device(self) -> None:
+        if self._camera is not None:
+            try:
+                self._camera.stop_acquisition()
+            except Exception:  # a vanished camera cannot be told to stop: nothing to do
+                pass
+        self._camera = self._stream = None
+
+    # --- frames --------------------------------------------------------------------------------
+    @property
+    def fps(self) -> float:
+        try:
+            return float(self._camera.get_frame_rate()) if self._camera is not None else 0.0
+        except Exception:
+            return 0.0
+
+    def read(self) -> Frame:
+        Aravis = self._Aravis
+        deadline = time.monotonic() + self.timeout_s
+        while True:
+            if self._stream is None:
+                self._reopen()
+            buffer = self._stream.timeout_pop_buffer(int(max(deadline - time.monotonic(), 0.01) * 1e6)) if self._stream is not None else None
+            while buffer is not None:  # frames queued while the caller was busy are old: keep only the newest
+                newer = self._stream.try_pop_buffer()
+                if newer is None:
+                    break
+                self._stream.push_buffer(buffer)
+                self.skipped += 1
+                buffer = newer
+            if buffer is not None:
+                status = buffer.get_status()
+                if status == Aravis.BufferStatus.SUCCESS:
+                    frame = self._frame(buffer)
+                    self._stream.push_buffer(buffer)
+                    return frame
+                self._stream.push_buffer(buffer)  # a damaged frame (lost packets): the next one
+            now = time.monotonic()
+            if now - self._last_frame_s > self.reopen_after_s and self._stream is not None:
+                self._close_device()  # gone quiet for long: open it afresh on the next read
+            if now >= deadline:
+                raise FrameTimeout(f"{self.description}: no frame for {now - self._last_frame_s:.1f} s (waiting; reconnecting after {self.reopen_after_s:g} s)")
+
+    def _reopen(self) -> None:
+        try:
+            self._open()
+            self.reopened += 1
+        except VideoSourceError:
+            time.sleep(0.2)  # not back yet
+
+    def _frame(self, buffer) -> Frame:
+        data = buffer.get_data()
+        rgb = to_rgb(data, buffer.get_image_width(), buffer.get_image_height(), buffer.get_image_pixel_format(), self.description)
+        received_ns = buffer.get_system_timestamp()  # the host's realtime clock at the frame
+        age_s = (time.time_ns() - received_ns) / 1e9 if received_ns else 0.0
+        now = time.monotonic()
+        self._last_frame_s = now
+        # However old the frame, its stamp dates it (a late frame must never pass for a new one); only a stamp
+        # ahead of the host's clock cannot, and then its arrival does.
+        frame = Frame(rgb, self._index, now - age_s if age_s >= 0.0 else now, None, int(buffer.get_timestamp()) or None)
+        self._index += 1
+        return frame
+
+    def close(self) -> None:
+        self._close_device()
+
+
+def open_aravis(spec: str, options: dict) -> AravisSource:
+    """Entry point of ``videocal.cameras`` for ``aravis://``."""
+    return AravisSource(spec, options)
