@@ -65,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
             pass
 
     link.sample_received.connect(keep)
+    reasons = []  # the connector's own words for its state: what it waits for
+    link.state_changed.connect(lambda state, why: reasons.append(why))
     if hasattr(link, "request_version"):  # videocal's own protocol opens at once and says its joint count
         link.start(wait_open=True)
     else:
@@ -90,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
                 samples = []
             if not samples:
                 if time.monotonic() - last > args.timeout:
-                    why = getattr(link, "last_error", None) or "no reply"
+                    why = getattr(link, "last_error", None) or (reasons[-1] if reasons else "no reply")
                     print(f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {why})", file=sys.stderr)
                     code = EXIT_TIMEOUT
                     break
