@@ -10,13 +10,13 @@ error naming the URDF, the link and every place looked in.
 from __future__ import annotations
 
 import math
-
-import os
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable
 from pathlib import Path
 
 from calib_core.errors import FileFormatError
+from calib_core.robot.ros_packages import find_package, search_roots
+from calib_core.robot.xacro_expand import expand_xacro
 
 _MESH_SUFFIXES = {".stl", ".obj", ".dae", ".gltf", ".glb", ".ply"}
 
@@ -25,34 +25,23 @@ def _is_xacro(path: Path, text: str) -> bool:
     return path.suffix == ".xacro" or path.name.endswith(".urdf.xacro") or "http://www.ros.org/wiki/xacro" in text[:4000]
 
 
-def _expand_xacro(path: Path) -> str:
-    try:
-        import xacro
-    except ImportError:  # a dependency of videocal: only a broken install gets here
-        raise FileFormatError(path, "this is a xacro file and the 'xacro' package is not installed") from None
-    try:
-        document = xacro.process_file(str(path))
-    except Exception as exc:  # xacro raises its own XacroException, NameError, IOError...: all mean "cannot expand"
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise FileFormatError(path, f"cannot expand xacro: {message}") from None
-    return document.toxml()
-
-
 def package_search_roots(package_paths: Iterable[str | Path]) -> list[Path]:
-    """The folders searched for ``package://`` packages: the cell's package paths, then each
-    entry of ``ROS_PACKAGE_PATH``."""
-    roots = [Path(p) for p in package_paths]
-    roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-    return roots
+    """The folders searched for packages (:func:`calib_core.robot.ros_packages.search_roots`)."""
+    return search_roots(package_paths)
 
 
 def _package_candidates(package: str, rest: str, roots: list[Path]) -> list[Path]:
-    # A root is either a folder that holds packages (root/pkg/rest) or a package itself (root/rest).
+    # A root is either a folder that holds packages (root/pkg/rest) or a package itself (root/rest); else the
+    # package is looked for by its package.xml, as $(find) does.
     candidates = []
     for root in roots:
         candidates.append(root / package / rest)
         if root.name == package:
             candidates.append(root / rest)
+    if not any(c.is_file() for c in candidates):
+        found = find_package(package, roots)
+        if found is not None:
+            candidates.append(found / rest)
     return candidates
 
 
@@ -87,8 +76,9 @@ def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path]) -> None:
                     mesh.set("filename", str(found))
 
 
-def read_description(path: str | Path, package_paths: Iterable[str | Path] = ()) -> str:
-    """URDF text of a URDF or xacro file with every mesh as an absolute path.
+def read_description(path: str | Path, package_paths: Iterable[str | Path] = (), xacro_args: dict[str, str] | None = None) -> str:
+    """URDF text of a URDF or xacro file with every mesh as an absolute path. A xacro file is expanded with
+    ``xacro_args`` (``$(arg name)``) and packages found as :mod:`calib_core.robot.ros_packages` says.
 
     :class:`FileFormatError` names the file for a missing, unreadable or malformed file, a xacro
     that cannot be expanded, and (with the link) a mesh that cannot be found.
@@ -101,7 +91,7 @@ def read_description(path: str | Path, package_paths: Iterable[str | Path] = ())
     except (IsADirectoryError, UnicodeDecodeError, PermissionError) as exc:
         raise FileFormatError(path, f"cannot read: {exc}") from None
     if _is_xacro(path, text):
-        text = _expand_xacro(path)
+        text = expand_xacro(path, package_search_roots(package_paths), xacro_args)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:

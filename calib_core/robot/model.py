@@ -279,7 +279,7 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
     path = Path(spec.urdf)
     if not path.is_file():
         raise FileFormatError(path, "no such URDF file")
-    xml = read_description(path, spec.package_paths)
+    xml = read_description(path, spec.package_paths, spec.xacro_args)
     try:
         full = pin.buildModelFromXML(xml)
     except (RuntimeError, ValueError) as exc:

@@ -46,7 +46,7 @@ class ControllerMap:
 class RobotSpec:
     """The ``robot`` section of a workcell. ``home_joints``: the driven joints' home values
     (deg or mm, URDF order), ``None`` for all zero; ``held_joints``: joints not driven (gripper
-    fingers), held at the value given (deg or mm)."""
+    fingers), held at the value given (deg or mm); ``xacro_args``: a xacro description's arguments."""
 
     urdf: Path
     package_paths: tuple[Path, ...] = ()
@@ -54,3 +54,5 @@ class RobotSpec:
     home_joints: np.ndarray | None = None
     held_joints: dict[str, float] = field(default_factory=dict)
     controller: ControllerMap | None = None
+    xacro_args: dict[str, str] = field(default_factory=dict)
+    """``$(arg name)`` values for a xacro description (``ur_type: ur10e``)."""

@@ -10,7 +10,7 @@ import numpy as np
 from calib_core.frames import transform_from_xyz_rpy
 from calib_core.robot.spec import FRAME_ROLES, ControllerMap, NewFrame, RobotSpec
 
-ROBOT_KEYS = {"urdf", "package_paths", "frames", "home_joints_deg", "held_joints", "controller"}
+ROBOT_KEYS = {"urdf", "package_paths", "xacro_args", "frames", "home_joints_deg", "held_joints", "controller"}
 
 
 def _frame(reader, value, field: str) -> str | NewFrame | None:
@@ -44,6 +44,14 @@ def read_robot_section(reader, raw) -> RobotSpec:
     if not isinstance(paths_raw, list):
         raise reader.fail("robot.package_paths", "must be a list of folders (relative to the workcell file)")
     package_paths = tuple(_folder(reader, p, f"robot.package_paths[{i}]") for i, p in enumerate(paths_raw))
+    args_raw = raw.get("xacro_args", {}) or {}
+    if not isinstance(args_raw, dict):
+        raise reader.fail("robot.xacro_args", "must be a mapping of xacro argument: value (ur_type: ur10e)")
+    xacro_args = {}
+    for k, v in args_raw.items():
+        if not isinstance(k, str) or not isinstance(v, (str, int, float, bool)):
+            raise reader.fail(f"robot.xacro_args.{k}", f"must be a plain value (text or number), got {v!r}")
+        xacro_args[k] = str(v).lower() if isinstance(v, bool) else str(v)
     frames_raw = raw.get("frames", {}) or {}
     reader.mapping(frames_raw, "robot.frames", set(FRAME_ROLES), set())
     frames = {"base": None, "flange": "flange", "tcp": "tcp", "camera": "camera"}
@@ -63,7 +71,7 @@ def read_robot_section(reader, raw) -> RobotSpec:
         if len(offsets) != len(joints):
             raise reader.fail("robot.controller.zero_offsets", f"needs one value per controller joint ({len(joints)}), got {len(offsets)}")
         controller = ControllerMap(joints, offsets)
-    return RobotSpec(urdf, package_paths, frames, home, held, controller)
+    return RobotSpec(urdf, package_paths, frames, home, held, controller, xacro_args)
 
 
 def check_against_robot(reader, spec: RobotSpec, robot) -> np.ndarray:

@@ -8,6 +8,7 @@ camera seeing the target. The operator then replaces the example by the real com
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from dataclasses import dataclass
@@ -189,7 +190,8 @@ def _frame_yaml(parent: str, T: np.ndarray) -> str:
     return "{parent: %s, xyz: [%s], rpy: [%s]}" % (parent, ", ".join(f"{v:.2f}" for v in xyz), ", ".join(f"{v:.4f}" for v in rpy))
 
 
-def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list[str | Path] = (), *, flange: str | None = None, name: str | None = None) -> StarterCell:
+def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list[str | Path] = (), *, flange: str | None = None, name: str | None = None,
+                       xacro_args: dict[str, str] | None = None) -> StarterCell:
     """Write a starting cell for the robot ``urdf`` into ``folder`` (created; an existing
     ``workcell.yaml`` there is refused). Returns what was chosen."""
     folder = Path(folder)
@@ -197,16 +199,17 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     package_paths = [Path(p).resolve() for p in package_paths]
     if (folder / "workcell.yaml").exists():
         raise StarterCellError(f"{folder / 'workcell.yaml'} exists already: choose an empty folder")
-    plain = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": None}))
+    xacro_args = dict(xacro_args or {})
+    plain = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": None}, xacro_args=xacro_args))
     flange = _choose_flange(plain, flange)
     base = "base" if plain.model.existFrame("base") and plain.model.frames[plain.model.getFrameId("base")].parentJoint == 0 else None
     driven = _chain_to(plain.full_model, flange)
     held = {plain.full_model.names[j]: 0.0 for j in range(1, plain.full_model.njoints) if j not in driven}
-    robot = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": base}, None, held))
+    robot = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": base}, None, held, xacro_args=xacro_args))
     yaw, offset = _tool_side(robot, flange)
     turn = transform_from_xyz_rpy([0, 0, 0], [0, 0, yaw])
     frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, turn @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])), "camera": NewFrame(flange, turn @ _camera_frame(offset))}
-    robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held))
+    robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held, xacro_args=xacro_args))
     home = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
     tcp, q_approach = _find_task(robot, home)
     home = q_approach  # start where the camera already sees the target from the approach
@@ -240,6 +243,8 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     ]
     if package_paths:
         lines.append("  package_paths: [" + ", ".join(rel(p) for p in package_paths) + "]")
+    if xacro_args:
+        lines.append("  xacro_args: {" + ", ".join(f"{k}: {json.dumps(v)}" for k, v in xacro_args.items()) + "}")
     lines += [
         "  frames:",
         f"    base: {base if base else '~'}" + ("" if base else "                # the URDF's root link"),
