@@ -1,7 +1,8 @@
 """``videocal calibrate-intrinsics SOURCE --out FILE``: the camera's intrinsics from calibration board views
 (ChArUco, chessboard, circle grid or ArUco grid: ``--board``).
 
-SOURCE is a folder of images, a video file (every ``--every``-th frame), or ``sim`` (views of the
+SOURCE is a folder of images, a video file (every ``--every``-th frame), a ROS bag (its image topic, ``--topic``
+when it has several), or ``sim`` (views of the
 board rendered by the simulated camera, whose truth is then printed beside the result).
 """
 
@@ -17,14 +18,15 @@ from app.cli.options import bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="a folder of images, a video file, or 'sim'")
+    parser.add_argument("source", help="a folder of images, a video file, a ROS bag (a bag folder, .mcap or .db3), or 'sim'")
+    parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
     parser.add_argument("--board", default="charuco:9x7:30:22:DICT_5X5_100", help="charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM (inner corners), circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
     parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="intrinsics file to write (YAML)")
     parser.add_argument("--format", choices=("opencv", "ros"), default="opencv")
     parser.add_argument("--no-distortion", action="store_true", help="fit the pinhole only (as the paper's tool did)")
     parser.add_argument("--k-coefficients", type=int, choices=(2, 3), default=2, help="radial distortion terms: 2 (k1 k2, k3 held at 0; the default, as ROS's camera_calibration) or 3 (wide lenses, with views reaching the image's corners)")
-    parser.add_argument("--every", type=bounded_int(1, 100_000), default=15, help="with a video: use every n-th frame")
+    parser.add_argument("--every", type=bounded_int(1, 100_000), default=None, help="with a video: use every n-th frame (default 15); with a bag: every n-th image (default 1)")
     parser.add_argument("--views", type=bounded_int(3, 500), default=15, help="with 'sim': how many views to render")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
@@ -36,6 +38,10 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.vision.image_sources import folder_images, video_frames
     from calib_core.vision.intrinsics_calibration import calibrate_intrinsics, detect_views
 
+    args.every_given = args.every is not None
+    args.every = args.every or 15
+    if args.topic is not None and args.source == "sim":
+        raise VideocalError("--topic applies to a bag source")
     spec = parse_board(args.board)
     settings = load_detector_settings(args.detector_params) if args.detector_params else None
     truth = None
@@ -45,8 +51,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"rendering {args.views} simulated views of {spec}...", file=sys.stderr)
         truth, images = load_plugin(SITES, "sim").board_images(spec, args.views)
     else:
+        from calib_core.bags.bag_source import bag_images, looks_like_bag
+
         source = Path(args.source)
-        if source.is_dir():
+        if looks_like_bag(source):
+            images = bag_images(source, args.topic, args.every if args.every_given else 1)
+        elif args.topic is not None:
+            raise VideocalError(f"--topic applies to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
+        elif source.is_dir():
             images = folder_images(source)
         elif source.is_file():
             images = video_frames(source, args.every)

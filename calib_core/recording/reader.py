@@ -102,6 +102,9 @@ def read_recording(path: str | Path) -> RecordingContents:
     (``problem`` says which) and reading goes on. A file that is not an MCAP recording raises
     ``FileFormatError``."""
     path = Path(path)
+    if path.is_dir():
+        what = "a ROS bag folder" if (path / "metadata.yaml").is_file() else "a folder"
+        raise FileFormatError(path, f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics and calibrate-hand-eye")
     try:
         handle = open(path, "rb")
     except FileNotFoundError:
@@ -138,6 +141,12 @@ def read_recording(path: str | Path) -> RecordingContents:
                 attachments.append(record)
             elif isinstance(record, Footer):
                 complete = True
+    if not any(m.topic in KNOWN_TOPICS for m in messages):
+        # Another program's MCAP (a ROS 2 bag) or an empty one: replaying it would show "0 frames" and succeed.
+        topics = sorted({f"{c.topic} ({c.message_encoding})" for c in channels.values()})
+        held = f"its topics: {', '.join(topics[:8])}{' ...' if len(topics) > 8 else ''}" if topics else "it holds no messages"
+        hint = "; a ROS 2 bag is read by calibrate-intrinsics and calibrate-hand-eye" if any("cdr" in t or "ros" in t for t in topics) else ""
+        raise FileFormatError(path, f"not a videocal recording: no videocal message ({held}){hint}")
     if bad_messages:
         problems.append(f"{bad_messages} message{'s' if bad_messages > 1 else ''} could not be decoded: skipped")
     if not complete and not any("ends" in p for p in problems):

@@ -1,0 +1,118 @@
+"""A ROS bag as a source: its image topics (``sensor_msgs/msg/Image``, ``CompressedImage``) and ``CameraInfo``.
+
+A bag is a bag folder (``metadata.yaml`` and its storage files), one of its ``.mcap``/``.db3`` files, or a lone
+``.mcap`` file. Which image topic: the only one, or ``topic``; several without ``topic`` is an error listing them,
+and a bag with none is an error naming what it holds (never an empty result).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from calib_core.errors import FileFormatError
+
+IMAGE_TYPES = ("sensor_msgs/msg/Image", "sensor_msgs/msg/CompressedImage")
+CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+BAG_SUFFIXES = (".mcap", ".db3", ".bag")
+
+
+def looks_like_bag(path: Path) -> bool:
+    """A bag folder, a bag storage file, or an MCAP file (a videocal recording is told apart when it is read)."""
+    path = Path(path)
+    return (path.is_dir() and (path / "metadata.yaml").is_file()) or (path.is_file() and path.suffix.lower() in BAG_SUFFIXES)
+
+
+@dataclass(frozen=True)
+class Topic:
+    name: str
+    msgtype: str
+    count: int
+
+    def __str__(self) -> str:
+        return f"{self.name} ({self.msgtype}, {self.count})"
+
+
+def _bag_paths(path: Path) -> list[Path]:
+    # A storage file inside a bag folder is read as the folder (its metadata says how).
+    if path.is_file() and (path.parent / "metadata.yaml").is_file():
+        return [path.parent]
+    return [path]
+
+
+@contextmanager
+def open_bag(path: str | Path):
+    """The ``rosbags`` reader, open; :class:`FileFormatError` naming the file when it is not a readable bag."""
+    from rosbags.highlevel import AnyReader
+
+    path = Path(path)
+    if not path.exists():
+        raise FileFormatError(path, "no such bag (a bag folder, a .mcap or a .db3 file)")
+    try:
+        reader = AnyReader(_bag_paths(path))
+        reader.open()
+    except Exception as exc:  # rosbags raises its own errors per storage and profile
+        raise FileFormatError(path, f"not a ROS bag rosbags can read: {str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}") from None
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
+def bag_topics(path: str | Path) -> list[Topic]:
+    with open_bag(path) as reader:
+        counts: dict[tuple[str, str], int] = {}
+        for c in reader.connections:
+            counts[(c.topic, c.msgtype)] = counts.get((c.topic, c.msgtype), 0) + c.msgcount
+    return [Topic(t, m, n) for (t, m), n in sorted(counts.items())]
+
+
+def choose_image_topic(path: str | Path, topic: str | None = None) -> Topic:
+    """The image topic to read (see the module)."""
+    topics = bag_topics(path)
+    images = [t for t in topics if t.msgtype in IMAGE_TYPES and t.count > 0]
+    if topic is not None:
+        for t in topics:
+            if t.name == topic:
+                if t.msgtype not in IMAGE_TYPES:
+                    raise FileFormatError(Path(path), f"topic {topic} holds {t.msgtype}, not images; image topics: {', '.join(map(str, images)) or 'none'}")
+                return t
+        raise FileFormatError(Path(path), f"no topic {topic}; image topics: {', '.join(map(str, images)) or 'none'}")
+    if len(images) == 1:
+        return images[0]
+    if not images:
+        held = ", ".join(map(str, topics)) or "no messages at all"
+        raise FileFormatError(Path(path), f"no images in this bag (it holds {held})")
+    raise FileFormatError(Path(path), f"several image topics: choose one with --topic: {', '.join(map(str, images))}")
+
+
+def _rgb(message, msgtype: str, where: str) -> np.ndarray:
+    from calib_core.ros2.image_decoding import compressed_to_rgb, image_to_rgb
+
+    return compressed_to_rgb(message, where) if msgtype.endswith("CompressedImage") else image_to_rgb(message, where)
+
+
+def bag_images(path: str | Path, topic: str | None = None, every: int = 1) -> Iterator[tuple[str, np.ndarray]]:
+    """(name, RGB image) of every ``every``-th image of the topic, in time order; the name is ``t_<stamp ns>``."""
+    chosen = choose_image_topic(path, topic)
+    with open_bag(path) as reader:
+        connections = [c for c in reader.connections if c.topic == chosen.name]
+        for k, (connection, log_ns, raw) in enumerate(reader.messages(connections=connections)):
+            if k % every:
+                continue
+            message = reader.deserialize(raw, connection.msgtype)
+            stamp = message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
+            yield f"t_{stamp or log_ns}", _rgb(message, connection.msgtype, f"{path} {chosen.name} message {k}")
+
+
+def bag_camera_info(path: str | Path):
+    """The first ``CameraInfo`` of the bag as ``(topic, message)``, or None."""
+    with open_bag(path) as reader:
+        connections = [c for c in reader.connections if c.msgtype == CAMERA_INFO]
+        for connection, _, raw in reader.messages(connections=connections):
+            return connection.topic, reader.deserialize(raw, connection.msgtype)
+    return None
