@@ -33,11 +33,18 @@ def load_intrinsics(path: str | Path, image_size: tuple[int, int] | None = None)
     text = read_text(path, "intrinsics file", max_bytes=1024 * 1024)
     if text.lstrip().startswith("%YAML") or "!!opencv-matrix" in text:
         return _load_opencv(path, image_size)
-    data = parse_yaml(text, path)
+    # `ros2 topic echo --once` ends its message with a "---" line: the first document is the message.
+    lines = text.splitlines()
+    while lines and lines[-1].strip() in ("---", "...", ""):
+        lines.pop()
+    data = parse_yaml("\n".join(lines) + "\n", path)
     if isinstance(data, dict) and "camera_matrix" in data and isinstance(data["camera_matrix"], dict):
         return _load_ros(path, data, image_size)
+    if isinstance(data, dict) and ("k" in data or "K" in data) and ("width" in data or "height" in data):
+        return _load_camera_info_message(path, data, image_size)
     raise FileFormatError(path, "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
-                          "!!opencv-matrix) or ROS camera_info YAML (camera_matrix: {rows, cols, data})")
+                          "!!opencv-matrix), ROS camera_info YAML (camera_matrix: {rows, cols, data}) or a "
+                          "sensor_msgs/CameraInfo message as `ros2 topic echo` prints it (k, d, width, height)")
 
 
 def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv", camera_name: str = "videocal_camera") -> None:
@@ -138,6 +145,33 @@ def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None)
     K = _ros_matrix(path, data, "camera_matrix", 9).reshape(3, 3)
     dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(5)
     return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")
+
+
+def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
+    """A ``sensor_msgs/CameraInfo`` message as YAML: ROS 2's lower-case fields (``k``, ``d``) or ROS 1's (``K``, ``D``)."""
+    def field(name: str):
+        return data.get(name, data.get(name.upper()))
+
+    known = {"header", "height", "width", "distortion_model", "d", "k", "r", "p", "binning_x", "binning_y", "roi", "D", "K", "R", "P"}
+    unknown = sorted(set(map(str, data)) - known)
+    if unknown:
+        raise FileFormatError(path, f"unknown key(s) for a CameraInfo message: {', '.join(unknown)}")
+    width = _image_side(path, "width", data.get("width") or None, image_size[0] if image_size else None)
+    height = _image_side(path, "height", data.get("height") or None, image_size[1] if image_size else None)
+    model = data.get("distortion_model") or "plumb_bob"
+    if model not in ("plumb_bob", "rational_polynomial"):
+        raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
+    values = {}
+    for name, size in (("k", 9), ("d", None)):
+        v = field(name)
+        if v is None and name == "d":
+            v = [0.0] * 5
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v) or (size and len(v) != size):
+            raise FileFormatError(path, f"must be a list of {size or 'the distortion'} numbers, got {v!r}", name)
+        values[name] = np.asarray(v, dtype=float)
+    if not values["d"].size:
+        values["d"] = np.zeros(5)
+    return _build(path, values["k"].reshape(3, 3), values["d"], width, height, "k", "d")
 
 
 def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarray:
