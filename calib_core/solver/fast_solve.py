@@ -1,7 +1,7 @@
 """The common cases in one compiled call: four or more non-coplanar pairs, known focal lengths,
 pinhole model, no robust loss (six and more seeded by a DLT, four and five by P3P over every
 triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit
-worse than the limit, or, for a few pairs, a second pose that fits about as well)."""
+worse than the limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well)."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from calib_core.solver.finish import noise_px, operator_warnings
 from calib_core.solver.candidates import SAME_POSE_DEG, SAME_POSE_REL
 from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
+from calib_core.solver.misfit import threshold
 from calib_core.solver.problem import PoseProblem
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
@@ -41,6 +42,11 @@ def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float, am
     R, t, r, cov, cov_c, loo, scalars = out
     iterations, outcome, rms, sigma, source, condition = scalars
     if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
+        return None
+    finite = loo[np.isfinite(loo)]
+    if finite.size and float(np.max(finite)) ** 2 > threshold(finite.size) * noise_px(sigma_px) ** 2:
+        # A pair the others miss by more than the noise allows may be a mis-pick: the full path tests it
+        # (r^T (I - H)^-1 r <= |loo|^2, so below this no pair can be flagged and the fast answer stands).
         return None
     obj2cam = np.zeros((4, 4))
     obj2cam[:3, :3] = R
