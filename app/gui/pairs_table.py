@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import Qt
+from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
 from app.gui.workbench import Workbench
@@ -50,10 +51,20 @@ class PairsTable(QTableWidget):
         norms = result.solution.residual_norms_px
         return {n: float(r) for n, r in zip(numbers, norms)}
 
+    def _suspects(self) -> set[int]:
+        """The pairs the last solve rejected or found not to fit the others (drawn red, with why)."""
+        result = self.workbench.session.result
+        if result is None:
+            return set()
+        s = result.solution
+        flags = np.asarray(s.outliers, dtype=bool) | (np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False)
+        return {n for n, f in zip(self.workbench.session.solved_numbers, flags) if f}
+
     def refresh(self) -> None:
         self._updating = True
         pairs = self.workbench.session.pairs.pairs()
         residuals = self._residuals()
+        suspects = self._suspects()
         self.setRowCount(len(pairs))
         for row, p in enumerate(pairs):
             x, y, z = p.point_world_mm
@@ -64,6 +75,9 @@ class PairsTable(QTableWidget):
             for col, text in enumerate(texts):
                 item = QTableWidgetItem(text)
                 item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter if col >= 2 else Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+                if p.number in suspects and col in (0, 7):
+                    item.setForeground(QColor(230, 80, 70))
+                    item.setToolTip("this pick does not fit the others (the last solve): check it, or untick it")
                 self.setItem(row, col, item)
             check = QTableWidgetItem()
             check.setFlags(Qt.ItemFlag.ItemIsUserCheckable | Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsSelectable)

@@ -101,15 +101,29 @@ class ResultsPanel(QWidget):
         if self._solved_elsewhere() != self._elsewhere:
             self.refresh()
 
+    def _fit_text(self) -> None:
+        # A word-wrapped label in a layout under a splitter gets one line's height: the rest of a failure's
+        # reason (which pair to check) was hidden under the numbers. Each text label takes the height its text
+        # needs at its width; the chart gives up the room.
+        for label in (self.verdict, self.status):
+            label.setMinimumHeight(label.heightForWidth(max(label.width(), 100)) if label.text() else 0)
+        self.details.setMinimumHeight(self.details.sizeHint().height() if self.details.text() else 0)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        self._fit_text()
+
     def _choose(self, index: int, *_) -> None:
         self.candidate_chosen.emit(index)
 
     def show_message(self, text: str, ok: bool = True) -> None:
         """A step's outcome on the message line (green, or orange when it found a problem)."""
         self.status.setText(f"<span style='color:{'#5fd35f' if ok else '#ffb347'}'>{html.escape(text, quote=False)}</span>")
+        self._fit_text()
 
     def show_error(self, text: str) -> None:
         self.status.setText(f"<span style='color:#ff6b6b'>{html.escape(text, quote=False)}</span>")
+        self._fit_text()
 
     def refresh(self) -> None:
         session = self.workbench.session
@@ -120,6 +134,7 @@ class ResultsPanel(QWidget):
                 w.deleteLater()
         if r is None:
             self.verdict.setText("No solve yet. Pick at least %d pairs, then Calibrate." % session.required_pairs)
+            self._fit_text()
             self.details.setText("")
             self.chart.set_values([])
             return
@@ -143,6 +158,7 @@ class ResultsPanel(QWidget):
         if self._elsewhere:
             text += "<br><span style='color:#ff9a30'>solved from another robot pose than the robot's now (the pairs' frame): it describes that pose</span>"
         self.verdict.setText(text)
+        self._fit_text()
         d, rv, sd, sr = r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
         cam = r.cam2world_measured[:3, 3]
         self.details.setText(
@@ -156,6 +172,7 @@ class ResultsPanel(QWidget):
             f"<td>{'on the edges' if sol.method == 'edges' else f'{sol.iterations} iterations'}</td><td></td></tr>"
             "</table>"
         )
+        self._fit_text()
         numbers = session.solved_numbers
         present = {p.number for p in session.pairs.usable()}
         # bars only for pairs that still exist as they were solved; a stale result shows none

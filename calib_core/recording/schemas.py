@@ -115,6 +115,7 @@ SOLVE_RESULT = {
         "fu": _NULLABLE_NUMBER, "fv": _NULLABLE_NUMBER, "iterations": {"type": "integer"}, "rms_px": _NULLABLE_NUMBER,
         "residuals_px": {"type": "array", "items": _vector(2, items=_NULLABLE_NUMBER), "description": "observed - reprojected, px, one row per pair"},
         "leave_one_out_px": _vector(None, items=_NULLABLE_NUMBER), "outliers": _vector(None, items={"type": "boolean"}),
+        "misfits": {"type": ["array", "null"], "items": {"type": "boolean"}, "description": "pairs that do not fit the others (likely mis-picks)"},
         "std": _STD, "condition_number": _NULLABLE_NUMBER,
         "candidates": {"type": "array", "items": {"type": "object"}, "description": "poses that fit about as well, best first"},
         "warnings": _vector(None, items={"type": "string"}),

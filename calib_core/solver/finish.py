@@ -118,5 +118,5 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     return PoseSolution(
         status=status, obj2cam=chosen.obj2cam, fu=chosen.fu, fv=chosen.fv, model=problem.model,
         iterations=iterations, residuals_px=residuals, uncertainty=uncertainty, leave_one_out_px=loo,
-        outliers=outliers, candidates=candidates, reason=reason, warnings=tuple(warnings),
+        outliers=outliers, candidates=candidates, reason=reason, warnings=tuple(warnings), misfits=misfits,
     )

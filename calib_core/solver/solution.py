@@ -74,6 +74,8 @@ class PoseSolution:
     method: str = "points"
     """``points``: solved from point pairs; ``edges``: from the target's edges on the image (the
     residuals are then the edge samples' offsets, one per sample)."""
+    misfits: np.ndarray | None = None
+    """(n,) bool: the pairs the leave-one-out test says do not fit the others (likely mis-picks), or None."""
 
     @property
     def ok(self) -> bool:
@@ -128,6 +130,7 @@ class PoseSolution:
             "residuals_px": self.residuals_px.tolist(),
             "leave_one_out_px": finite(self.leave_one_out_px),
             "outliers": [bool(x) for x in self.outliers],
+            "misfits": [bool(x) for x in self.misfits] if self.misfits is not None else None,
             "std": None if u is None else {
                 "t_obj2cam_mm": finite(u.std_t_obj2cam_mm),
                 "rotation_deg": finite(u.std_rotation_deg),
