@@ -151,7 +151,8 @@ class SimulatedURController:
                 if delay > 0:
                     time.sleep(delay)
                 else:
-                    next_s = time.monotonic()
+                    next_s = time.monotonic() + period  # behind: skip ahead, never a burst (a controller's packages are a period apart)
+                    time.sleep(period)
 
         try:
             while not self._stop.is_set():

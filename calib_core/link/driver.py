@@ -17,8 +17,8 @@ import threading
 import time
 from collections import deque
 import serial
-from psygnal import Signal
 
+from calib_core.connectors.events import ConnectorEvents
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.link_key import default_key_path, user_key
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
@@ -54,7 +54,7 @@ _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
 MODES = ("poll", "stream")
 
 
-class ControllerLink:
+class ControllerLink(ConnectorEvents):
     """The connector of videocal's own protocol (``videocal.controllers``: a port path, ``serial://``,
     ``socket://``, ``rfc2217://``, ``loop://``): a link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
     ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
@@ -70,10 +70,6 @@ class ControllerLink:
     in ``stats.errors`` and does not stop the link): ``sample_received(TimedSample)`` for every
     delivered sample, ``state_changed(LinkState, reason)`` on a change of state,
     ``auth_changed(AuthState, failure)`` when a handshake ends (``ready`` or ``failed``)."""
-
-    sample_received = Signal(object)
-    state_changed = Signal(object, str)
-    auth_changed = Signal(object, object)
 
     def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
                  deadman_ms: int = 1000, key: bytes | str | None = "user", **serial_settings):
@@ -161,10 +157,6 @@ class ControllerLink:
         self.close()
 
     # --- what callers read ---------------------------------------------------------------
-    @property
-    def state(self) -> LinkState:
-        return self._state
-
     @property
     def auth_state(self) -> AuthState:
         """Whether moves can be sent: ``ready`` (sealed), ``off`` (no key), ``pending`` or ``failed``."""
@@ -289,19 +281,6 @@ class ControllerLink:
         except (serial.SerialException, OSError, ValueError) as exc:
             self.last_error = f"write failed: {exc}"
             return False
-
-    def _set_state(self, state: LinkState, reason: str) -> None:
-        if state is self._state:
-            return
-        self._state = state
-        self._emit(self.state_changed, state, reason)
-
-    def _emit(self, signal, *args) -> None:
-        try:
-            signal.emit(*args)
-        except Exception as exc:  # a caller's bug must not kill the link
-            self.stats.errors += 1
-            self.last_error = f"{signal.name} slot failed: {exc!r}"
 
     def _run(self) -> None:
         backoff = iter(_BACKOFF_S)

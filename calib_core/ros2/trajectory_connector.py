@@ -23,9 +23,9 @@ import time
 from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
-from psygnal import Signal
 
 from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.protocol import JointSample
@@ -61,12 +61,9 @@ def _number(options: dict, key: str, default: float, low: float, high: float) ->
     return value
 
 
-class Ros2TrajectoryController:
-    """See the module. ``context.joint_names`` are the joints looked for in each JointState message."""
-
-    sample_received = Signal(object)
-    state_changed = Signal(object, str)
-    auth_changed = Signal(object, object)  # no session on ROS 2: never emitted
+class Ros2TrajectoryController(ConnectorEvents):
+    """See the module. ``context.joint_names`` are the joints looked for in each JointState message.
+    (``auth_changed`` is never emitted: ROS 2 has no session.)"""
 
     def __init__(self, url: str, context: ControllerContext):
         from calib_core.ros2.wire import domain_id, dds_topic
@@ -90,15 +87,13 @@ class Ros2TrajectoryController:
         self.joint_map = JointMap.identity(self.n_joints)
         self._per_si = user_per_si(context.joint_units)
         self.stats = LinkStats()
-        self.last_error: str | None = None
-        self._state = LinkState.CLOSED
         self._lock = threading.Lock()
+        self._moves = SingleMove()
         self._order = SampleOrder(self.stats)
         self._seq = itertools.count()
         self._ids = itertools.count(1)
         self._latest: TimedSample | None = None
         self._last_sample_s: float | None = None
-        self._move: MoveHandle | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._reader = self._writer = None
@@ -128,17 +123,13 @@ class Ros2TrajectoryController:
         return self
 
     def close(self) -> None:
-        if self._move is not None and not self._move.finished:
+        if self._moves.current is not None and not self._moves.current.finished:
             self.stop()
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=1.0)
         self._set_state(LinkState.CLOSED, "closed by the caller")
-        self._finish_move(MoveError("the link was closed"))
-
-    @property
-    def state(self) -> LinkState:
-        return self._state
+        self._moves.finish(MoveError("the link was closed"))
 
     @property
     def latest(self) -> TimedSample | None:
@@ -162,9 +153,7 @@ class Ros2TrajectoryController:
             return handle
         distance = float(np.max(np.abs(q - np.asarray(latest.joints_deg))))
         duration_s = max(distance / self.speed_deg_s, 0.5)
-        self._finish_move(MoveError("a newer move replaced it"))
-        with self._lock:
-            self._move = handle
+        self._moves.begin(handle)
         self._publish(q, duration_s)
         handle.acked = True  # the controller's topic takes it as given: reliable delivery, no reply
         return handle
@@ -175,7 +164,7 @@ class Ros2TrajectoryController:
         if latest is None or self._writer is None or self._stop.is_set():
             return False
         self._publish(np.asarray(latest.joints_deg), 0.1)
-        self._finish_move(MoveError("ERR,STOPPED: stopped by the operator"))
+        self._moves.finish(MoveError("ERR,STOPPED: stopped by the operator"))
         return True
 
     def publish_static_transforms(self, transforms: list[tuple[str, str, np.ndarray]]) -> None:
@@ -202,14 +191,6 @@ class Ros2TrajectoryController:
         # An empty stamp: the controller starts the trajectory on receipt (its own clock, not ours).
         self._writer.write(msg.JointTrajectory(msg.Header(), list(self.joint_names), [point]))
 
-    def _finish_move(self, error: MoveError | None) -> None:
-        with self._lock:
-            move, self._move = self._move, None
-        if move is not None and not move.finished:
-            if error is not None:
-                error = type(error)(f"move {move.id}: {error}")
-            move._finish(error)
-
     # --- the reader thread ---------------------------------------------------------------------
     def _run(self) -> None:
         while not self._stop.is_set():
@@ -226,11 +207,11 @@ class Ros2TrajectoryController:
         last = self._last_sample_s
         if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s:
             self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
-        move = self._move
+        move = self._moves.current
         if move is not None and now > move.deadline_s:
             from calib_core.link.link_types import MoveTimeout
 
-            self._finish_move(MoveTimeout("the joints did not reach the target in time"))
+            self._moves.finish(MoveTimeout("the joints did not reach the target in time"))
 
     def _on_joint_state(self, message) -> None:
         names = list(message.name)
@@ -258,22 +239,9 @@ class Ros2TrajectoryController:
         if self._state is not LinkState.UP:
             self._set_state(LinkState.UP, "joint states arriving")
         self._emit(self.sample_received, sample)
-        move = self._move
+        move = self._moves.current
         if move is not None and float(np.max(np.abs(q - np.asarray(move.joints_deg)))) <= self.done_tolerance_deg:
-            self._finish_move(None)
-
-    def _set_state(self, state: LinkState, reason: str) -> None:
-        if state is self._state:
-            return
-        self._state = state
-        self._emit(self.state_changed, state, reason)
-
-    def _emit(self, signal, *args) -> None:
-        try:
-            signal.emit(*args)
-        except Exception as exc:  # a caller's bug must not kill the link
-            self.stats.errors += 1
-            self.last_error = f"{signal.name} slot failed: {exc!r}"
+            self._moves.finish(None)
 
 
 def open_ros2(url: str, context: ControllerContext) -> Ros2TrajectoryController:

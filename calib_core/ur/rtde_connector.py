@@ -27,6 +27,7 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
 from calib_core.link.protocol import JointSample
@@ -48,10 +49,9 @@ def _number(options: dict, key: str, default: float, low: float, high: float) ->
     return value
 
 
-class URRtdeController:
-    sample_received = Signal(object)
-    state_changed = Signal(object, str)
-    auth_changed = Signal(object, object)  # no session: never emitted
+class URRtdeController(ConnectorEvents):
+    """See the module. ``status_changed(text)``: the controller's own state in words."""
+
     status_changed = Signal(str)
 
     def __init__(self, url: str, context: ControllerContext):
@@ -75,13 +75,11 @@ class URRtdeController:
         self.n_joints = 6
         self.joint_map = JointMap.identity(6)
         self.stats = LinkStats()
-        self.last_error: str | None = None
         self.protective_stop = False
         self.speed_scaling = 1.0
         self.remote_control: bool | None = None
-        self._state = LinkState.CLOSED
         self._latest: TimedSample | None = None
-        self._move: MoveHandle | None = None
+        self._moves = SingleMove()
         self._lock = threading.Lock()
         self._ids = itertools.count(1)
         self._seq = itertools.count()
@@ -99,17 +97,13 @@ class URRtdeController:
         return self
 
     def close(self) -> None:
-        if self._move is not None and not self._move.finished:
+        if self._moves.current is not None and not self._moves.current.finished:
             self.stop()
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)
         self._set_state(LinkState.CLOSED, "closed by the caller")
-        self._finish_move(MoveError("the link was closed"))
-
-    @property
-    def state(self) -> LinkState:
-        return self._state
+        self._moves.finish(MoveError("the link was closed"))
 
     @property
     def latest(self) -> TimedSample | None:
@@ -130,16 +124,14 @@ class URRtdeController:
                    f"  movej([{', '.join(f'{v:.6f}' for v in np.radians(q))}], a={math.radians(self.acceleration_deg_s2):.4f}, v={math.radians(self.speed_deg_s):.4f})\n"
                    "end\n")
         if why is None:
-            self._finish_move(MoveError("a newer move replaced it"))
-            with self._lock:
-                self._move = handle
+            self._moves.begin(handle)
             why = self._send_script(program)
             if why is not None:
-                with self._lock:
-                    self._move = None
+                self._moves.finish(MoveError(why))
         if why is not None:
             handle.sent = False
-            handle._finish(MoveError(f"move {handle.id}: not sent: {why}"))
+            if not handle.finished:
+                handle._finish(MoveError(f"move {handle.id}: not sent: {why}"))
             return handle
         handle.acked = True
         return handle
@@ -147,7 +139,7 @@ class URRtdeController:
     def stop(self) -> bool:
         """``stopj`` on the script port: the robot decelerates to a stand where it is."""
         sent = self._send_script(f"stopj({math.radians(4 * self.acceleration_deg_s2):.4f})\n") is None
-        self._finish_move(MoveError("ERR,STOPPED: stopped by the operator"))
+        self._moves.finish(MoveError("ERR,STOPPED: stopped by the operator"))
         return sent
 
     def _why_not_sendable(self) -> str | None:
@@ -184,14 +176,6 @@ class URRtdeController:
                 return f.readline().decode(errors="replace").strip()
         except OSError:
             return None
-
-    def _finish_move(self, error: MoveError | None) -> None:
-        with self._lock:
-            move, self._move = self._move, None
-        if move is not None and not move.finished:
-            if error is not None:
-                error = type(error)(f"move {move.id}: {error}")
-            move._finish(error)
 
     # --- the reader thread ---------------------------------------------------------------------
     def _connect(self) -> bool:
@@ -242,13 +226,17 @@ class URRtdeController:
                 last_dashboard = now
                 remote = self._dashboard("is in remote control")
                 self._update_status(remote_control=None if remote is None else remote.lower() == "true")
-            move = self._move
+            move = self._moves.current
             if move is not None and now > move.deadline_s:
-                self._finish_move(MoveTimeout("the joints did not reach the target in time"))
+                self._moves.finish(MoveTimeout("the joints did not reach the target in time"))
             time.sleep(period / 2)
 
     def _on_sample(self, stamp_s: float, q: np.ndarray, safety_bits: int, scaling: float) -> None:
-        sample = TimedSample(JointSample(next(self._seq), int(round(stamp_s * 1000)), tuple(float(v) for v in q)), time.monotonic())
+        t_ms = int(round(stamp_s * 1000))
+        if self._latest is not None and t_ms <= self._latest.sample.t_ms:
+            self.stats.backwards_samples += 1  # within the same millisecond as the last, or older: not the robot now
+            return
+        sample = TimedSample(JointSample(next(self._seq), t_ms, tuple(float(v) for v in q)), time.monotonic())
         with self._lock:
             self.stats.sentences += 1
             self.stats.samples += 1
@@ -257,12 +245,12 @@ class URRtdeController:
             self._set_state(LinkState.UP, "RTDE data arriving")
         self._update_status(protective_stop=bool(safety_bits & _PROTECTIVE_STOP_BIT), speed_scaling=scaling)
         self._emit(self.sample_received, sample)
-        move = self._move
+        move = self._moves.current
         if move is not None:
             if self.protective_stop:
-                self._finish_move(MoveError("ERR,STOPPED: the robot went into a protective stop"))
+                self._moves.finish(MoveError("ERR,STOPPED: the robot went into a protective stop"))
             elif float(np.max(np.abs(q - np.asarray(move.joints_deg)))) <= self.done_tolerance_deg:
-                self._finish_move(None)
+                self._moves.finish(None)
 
     def _update_status(self, **changes) -> None:
         before = (self.protective_stop, round(self.speed_scaling, 2), self.remote_control)
@@ -278,19 +266,6 @@ class URRtdeController:
         if self.remote_control is not None:
             parts.append("remote control" if self.remote_control else "LOCAL control (moves not sent)")
         return ", ".join(parts)
-
-    def _set_state(self, state: LinkState, reason: str) -> None:
-        if state is self._state:
-            return
-        self._state = state
-        self._emit(self.state_changed, state, reason)
-
-    def _emit(self, signal, *args) -> None:
-        try:
-            signal.emit(*args)
-        except Exception as exc:  # a caller's bug must not kill the link
-            self.stats.errors += 1
-            self.last_error = f"{signal.name} slot failed: {exc!r}"
 
 
 def open_ur_rtde(url: str, context: ControllerContext) -> URRtdeController:

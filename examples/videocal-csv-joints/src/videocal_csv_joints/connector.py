@@ -13,9 +13,8 @@ import time
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
-from psygnal import Signal
-
 from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.events import ConnectorEvents
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.protocol import JointSample
@@ -41,30 +40,17 @@ def _read(path: Path, n_joints: int) -> list[tuple[int, tuple[float, ...]]]:
     return rows
 
 
-class CsvJoints:
-    """The connector: the events and methods of :class:`calib_core.connectors.controller.ControllerConnector`."""
-
-    sample_received = Signal(object)
-    state_changed = Signal(object, str)
-    auth_changed = Signal(object, object)
+class CsvJoints(ConnectorEvents):
+    """The connector: the events (from :class:`ConnectorEvents`) and methods of
+    :class:`calib_core.connectors.controller.ControllerConnector`."""
 
     def __init__(self, url: str, context: ControllerContext):
         self.url = url
         self.joint_map = JointMap.identity(context.n_joints)  # the file is in the model's joint order and zero
         self._rows = _read(Path(unquote(urlsplit(url).path)), context.n_joints)
         self.stats = LinkStats()
-        self._state = LinkState.CLOSED
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-
-    @property
-    def state(self) -> LinkState:
-        return self._state
-
-    def _set_state(self, state: LinkState, why: str) -> None:
-        if state is not self._state:
-            self._state = state
-            self.state_changed.emit(state, why)
 
     def start(self) -> CsvJoints:
         self._set_state(LinkState.CONNECTING, "opening the file")
@@ -79,7 +65,7 @@ class CsvJoints:
                 return
             self.stats.samples += 1
             self._set_state(LinkState.UP, "playing the file")
-            self.sample_received.emit(TimedSample(JointSample(seq, t_ms, q), time.monotonic()))
+            self._emit(self.sample_received, TimedSample(JointSample(seq, t_ms, q), time.monotonic()))
         self._set_state(LinkState.STALE, "the end of the file: no more samples")
 
     def close(self) -> None:
