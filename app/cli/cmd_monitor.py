@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
         link.start(wait_open=True)
     else:
         link.start()
-    # The robot's joint count: the workcell's, else the controller's own word ($VER), else the first
+    # The robot's joint count: the workcell's, else the controller's own word ($VER), else most of the first
     # sample's. A sample of another count is not this robot's (a second writer, a corrupted line): not
     # printed as if it were.
     expected = context.n_joints or None
@@ -83,13 +83,25 @@ def run(args: argparse.Namespace) -> int:
     to_model = link.joint_map.to_model if context.n_joints else None
     printed = 0
     code = 0
-    last = time.monotonic()
+    last = started = time.monotonic()
+    pending = []
     try:
         while args.count is None or printed < args.count:
             try:
                 samples = [samples_in.get(timeout=0.05)]
             except queue.Empty:
                 samples = []
+            if samples:
+                last = time.monotonic()
+            if expected is None:
+                # No workcell and no VER: the robot's joint count is the one most of the first samples carry (the
+                # very first may be the odd one out): wait for five, or a second.
+                pending.extend(samples)
+                samples = []
+                if pending and (len(pending) >= 5 or time.monotonic() - started >= 1.0):
+                    counts = [len(p.sample.joints_deg) for p in pending]
+                    expected = max(set(counts), key=counts.count)
+                    samples, pending = pending, []
             if not samples:
                 if time.monotonic() - last > args.timeout:
                     why = getattr(link, "last_error", None) or (reasons[-1] if reasons else "no reply")
@@ -97,12 +109,10 @@ def run(args: argparse.Namespace) -> int:
                     code = EXIT_TIMEOUT
                     break
                 continue
-            last = time.monotonic()
             for s in samples:
                 if args.count is not None and printed >= args.count:
                     break
                 q = s.sample.joints_deg
-                expected = expected or len(q)
                 if len(q) != expected:
                     skipped += 1
                     print(f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown", file=sys.stderr)
