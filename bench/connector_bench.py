@@ -180,7 +180,7 @@ def main() -> str:
         "| what | connector | bare client | ratio |",
         "|---|---|---|---|",
         f"| ROS 2 `/joint_states` at 500 Hz: samples/s delivered | {c['rate']:.0f} | {b['rate']:.0f} (cyclonedds reader) | {c['rate'] / b['rate']:.2f} |",
-        f"| ROS 2: samples lost | {c['lost']} | {b['lost']} | |",
+        f"| ROS 2: samples lost (from the stamps' span; +-1: stamps are whole ms) | {c['lost']} | {b['lost']} | |",
         f"| ROS 2: stamp to delivery, median / 99th percentile | {c['p50']:.2f} / {c['p99']:.2f} ms | {b['p50']:.2f} / {b['p99']:.2f} ms | {c['p50'] / max(b['p50'], 1e-6):.2f} |",
         f"| UR RTDE at 500 Hz: controller samples/s seen | {rtde['connector']:.0f} | {rtde['bare']:.0f} (ur_rtde polled) | {rtde['connector'] / rtde['bare']:.2f} |",
         f"| GigE Vision 1280 x 960 RGB8: frames/s at the connector | {g['fps']:.1f} | {gige['bare']:.1f} (Aravis stream) | {g['fps'] / gige['bare']:.2f} |",
