@@ -9,7 +9,6 @@ The camera publisher runs here (it renders the test bed's true view, which is th
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 import tempfile

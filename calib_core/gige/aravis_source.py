@@ -15,7 +15,7 @@ import time
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from calib_core.gige.aravis_lib import aravis
-from calib_core.gige.pixel_formats import NAMES, to_rgb
+from calib_core.gige.pixel_formats import to_rgb
 from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 _OPTIONS = {"exposure_us", "gain_db", "pixel_format", "width", "height", "timeout_s", "reopen_after_s", "fake"}

@@ -5,7 +5,6 @@ import csv
 import os
 import subprocess
 import sys
-import threading
 import time
 
 import cv2

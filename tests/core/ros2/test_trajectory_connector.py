@@ -3,7 +3,6 @@ definitions, not videocal's) and against the simulated ros2_control arm."""
 
 
 import math
-import threading
 import time
 from dataclasses import dataclass
 
