@@ -44,6 +44,9 @@ def read_text(path: str | Path, what: str, max_bytes: int = MAX_DOCUMENT_BYTES) 
         raise FileFormatError(str(path).replace("\0", "\\0"), f"is not a usable file name ({exc})") from None
     if path.is_dir():
         raise FileFormatError(path, f"is a folder, not a {what}")
+    if not path.is_file():
+        # A FIFO would block the read until a writer came (forever); a device would stream without end.
+        raise FileFormatError(path, f"is not a regular file (a pipe or a device), not a {what}")
     if size > max_bytes:
         raise FileFormatError(path, f"is {_size(size)}; a {what} is at most {_size(max_bytes)}")
     try:
