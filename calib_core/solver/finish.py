@@ -10,6 +10,7 @@ import numpy as np
 from calib_core.solver.candidates import RefinedPose, refine_seed
 from calib_core.solver.errors import point_label, points_label
 from calib_core.solver.paper_model import paper_to_metric_jacobian
+from calib_core.solver.kernels.newton import FOCAL_RANGE
 from calib_core.solver.misfit import flag_misfits, misfit_statistics
 from calib_core.solver.problem import PoseProblem
 from calib_core.solver.refine import residuals_and_jacobian
@@ -50,6 +51,16 @@ def operator_warnings(problem: PoseProblem, condition_number: float, noise: floa
     if problem.model == "paper" and problem.intrinsics.has_distortion:
         warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
     return warnings
+
+
+def _at_focal_limit(problem: PoseProblem, fu: float, fv: float) -> str | None:
+    """Words for focal lengths within 2 % of the search's range around the camera file's, or None."""
+    low, high = FOCAL_RANGE
+    for name, f, f0 in (("fu", fu, problem.intrinsics.fu), ("fv", fv, problem.intrinsics.fv)):
+        ratio = f / f0
+        if ratio > high / 1.02 or ratio < low * 1.02:
+            return f"{name} = {f:.0f} px, {ratio:.2f} x the camera file's {f0:.0f} px; the range is {low:g}-{high:g} x"
+    return None
 
 
 def _worst(statistics: np.ndarray, loo: np.ndarray, e: np.ndarray) -> int:
@@ -93,6 +104,12 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     misfits, sigma_test, limit = flag_misfits(statistics, residuals, ~outliers, problem.n_params, noise)
     if not chosen.converged:
         status, reason = SolveStatus.FAILED, f"Newton iterations stopped: {chosen.newton.reason}"
+    elif problem.estimate_focal and (clamp := _at_focal_limit(problem, chosen.fu, chosen.fv)) is not None:
+        # The search stops the focal lengths at a range around the camera file's: a solve resting there did not
+        # find a camera, and blaming the worst pick would send the operator after good picks.
+        status = SolveStatus.FAILED
+        reason = (f"the focal lengths ran to the edge of their search range ({clamp}): the pairs do not determine them; "
+                  "spread the picks over the image and in depth, or solve with the camera file's focal lengths")
     elif outliers.any() and 2 * agreeing - problem.n_params < 2:
         # The pairs left fit exactly by construction: nothing checks them, and a mis-click among them
         # would pass unseen (5 pairs, one off: three fitted exactly, two good ones rejected, 550 mm wrong).
