@@ -22,25 +22,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from calib_core.errors import VideocalError
     from calib_core.operator.cell import Cell
     from calib_core.ros2.joint_units import user_per_si
     from calib_core.ros2.wire import domain_id
     from calib_core.workcell import DEFAULT_WORKCELL
     from videocal_sim.ros2_arm import SimulatedRos2Arm
+    from videocal_sim.sim_process import joints_option
 
     cell = Cell.open(args.workcell or DEFAULT_WORKCELL)
     robot = cell.robot
-    initial = cell.home_joints
-    if args.joints:
-        try:
-            initial = np.array([float(v) for v in args.joints.split(",")])
-        except ValueError:
-            raise VideocalError(f"--joints: numbers separated by commas, got {args.joints!r}") from None
-        if len(initial) != robot.n_joints:
-            raise VideocalError(f"--joints: the robot has {robot.n_joints} joints, got {len(initial)} values")
+    initial = joints_option(args.joints, robot.n_joints, cell.home_joints)
     arm = SimulatedRos2Arm(robot.joint_names, user_per_si(robot.joint_units), robot.lower_limits_deg, robot.upper_limits_deg, initial,
                            rate_hz=args.rate, domain=domain_id(args.domain), controller=args.controller, joint_states=args.joint_states).start()
     done = threading.Event()

@@ -26,20 +26,14 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.errors import VideocalError
     from calib_core.operator.cell import Cell
     from calib_core.workcell import DEFAULT_WORKCELL
+    from videocal_sim.sim_process import joints_option
     from videocal_sim.ur_controller import SimulatedURController
 
     cell = Cell.open(args.workcell or DEFAULT_WORKCELL)
     robot = cell.robot
     if robot.n_joints != 6 or any(u != "deg" for u in robot.joint_units):
         raise VideocalError(f"a UR controller drives 6 revolute joints; {cell.workcell.path}'s robot has {robot.n_joints} ({', '.join(robot.joint_units)})")
-    initial = cell.home_joints
-    if args.joints:
-        try:
-            initial = np.array([float(v) for v in args.joints.split(",")])
-        except ValueError:
-            raise VideocalError(f"--joints: numbers separated by commas, got {args.joints!r}") from None
-        if len(initial) != 6:
-            raise VideocalError(f"--joints: 6 values, got {len(initial)}")
+    initial = joints_option(args.joints, 6, cell.home_joints)
     lower = np.radians(np.where(np.isfinite(robot.lower_limits_deg), robot.lower_limits_deg, -360.0))
     upper = np.radians(np.where(np.isfinite(robot.upper_limits_deg), robot.upper_limits_deg, 360.0))
     try:

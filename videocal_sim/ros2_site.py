@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from videocal_sim.sim_process import _PROJECT, SiteError, _die_with_parent
+from videocal_sim.sim_process import _PROJECT, SiteError, _die_with_parent, stop_child
 from videocal_sim.sim_site import SimulatedSite
 
 
@@ -42,15 +42,7 @@ class Ros2ArmProcess:
             self._ready = True
 
     def stop(self) -> None:
-        if self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(timeout=3)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=3)
-        if self.process.stdout is not None:
-            self.process.stdout.close()
+        stop_child(self.process)
         self._folder.cleanup()
 
 

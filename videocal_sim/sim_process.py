@@ -29,6 +29,34 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child before e
         pass
 
 
+def joints_option(text: str | None, n_joints: int, default):
+    """``--joints`` of a simulator: ``n_joints`` numbers separated by commas (deg or mm), or ``default``."""
+    import numpy as np
+
+    if not text:
+        return default
+    try:
+        joints = np.array([float(v) for v in text.split(",")])
+    except ValueError:
+        raise VideocalError(f"--joints: numbers separated by commas, got {text!r}") from None
+    if len(joints) != n_joints:
+        raise VideocalError(f"--joints: the robot has {n_joints} joints, got {len(joints)} values")
+    return joints
+
+
+def stop_child(process: subprocess.Popen) -> None:
+    """Terminate (then kill) a child started by a simulated site; safe to call twice."""
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(timeout=3)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=3)
+    if process.stdout is not None:
+        process.stdout.close()
+
+
 class SimulatorProcess:
     """``videocal sim-controller --pty`` for the cell at ``workcell_path``, as a child process with
     a stable link path in a private folder. It starts at once; :meth:`wait_ready` returns the path."""
@@ -64,13 +92,5 @@ class SimulatorProcess:
 
     def stop(self) -> None:
         """Terminate (then kill) the child and remove its folder; safe to call twice."""
-        if self.process.poll() is None:
-            self.process.terminate()
-            try:
-                self.process.wait(timeout=3)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait(timeout=3)
-        if self.process.stdout is not None:
-            self.process.stdout.close()
+        stop_child(self.process)
         self._folder.cleanup()

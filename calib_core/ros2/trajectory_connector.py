@@ -17,7 +17,6 @@ replaces the old one). No joint states for ``stale_after_s``: the link is ``stal
 from __future__ import annotations
 
 import itertools
-import math
 import threading
 import time
 from urllib.parse import parse_qs, urlsplit
@@ -25,6 +24,7 @@ from urllib.parse import parse_qs, urlsplit
 import numpy as np
 
 from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
@@ -50,17 +50,6 @@ def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
     return topic, options
 
 
-def _number(options: dict, key: str, default: float, low: float, high: float) -> float:
-    raw = options.get(key, default)
-    try:
-        value = float(raw)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not low <= value <= high:
-        raise LinkError(f"ros2 option {key}: must be a number in [{low:g}, {high:g}], got {raw!r}")
-    return value
-
-
 class Ros2TrajectoryController(ConnectorEvents):
     """See the module. ``context.joint_names`` are the joints looked for in each JointState message.
     (``auth_changed`` is never emitted: ROS 2 has no session.)"""
@@ -77,9 +66,9 @@ class Ros2TrajectoryController(ConnectorEvents):
         self._qos_name = str(options.get("qos", "default"))
         if self._qos_name not in ("default", "sensor"):
             raise LinkError(f"ros2 option qos: 'default' or 'sensor', got {self._qos_name!r}")
-        self.speed_deg_s = _number(options, "speed_deg_s", 20.0, 0.1, 1000.0)
-        self.done_tolerance_deg = _number(options, "done_tolerance_deg", 0.05, 1e-4, 10.0)
-        self.stale_after_s = _number(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0)
+        self.speed_deg_s = number_option(options, "speed_deg_s", 20.0, 0.1, 1000.0, "ros2")
+        self.done_tolerance_deg = number_option(options, "done_tolerance_deg", 0.05, 1e-4, 10.0, "ros2")
+        self.stale_after_s = number_option(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0, "ros2")
         self.joint_states_topic = dds_topic(topic)
         self.trajectory_topic = dds_topic(f"/{self.controller}/joint_trajectory")
         self.joint_names = list(context.joint_names)

@@ -27,6 +27,7 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
@@ -36,17 +37,6 @@ SCRIPT_PORT, DASHBOARD_PORT = 30002, 29999
 _VARIABLES = ["timestamp", "actual_q", "safety_status_bits", "speed_scaling", "robot_status_bits", "runtime_state"]
 _OPTIONS = {"rate_hz", "speed_deg_s", "acceleration_deg_s2", "done_tolerance_deg", "stale_after_s"}
 _PROTECTIVE_STOP_BIT = 1 << 2
-
-
-def _number(options: dict, key: str, default: float, low: float, high: float) -> float:
-    raw = options.get(key, default)
-    try:
-        value = float(raw)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not low <= value <= high:
-        raise LinkError(f"ur-rtde option {key}: must be a number in [{low:g}, {high:g}], got {raw!r}")
-    return value
 
 
 class URRtdeController(ConnectorEvents):
@@ -67,11 +57,11 @@ class URRtdeController(ConnectorEvents):
             raise LinkError(f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
         self.url = url
         self.host = parts.hostname
-        self.rate_hz = _number(options, "rate_hz", 500.0, 1.0, 500.0)
-        self.speed_deg_s = _number(options, "speed_deg_s", 30.0, 0.1, 180.0)
-        self.acceleration_deg_s2 = _number(options, "acceleration_deg_s2", 60.0, 1.0, 800.0)
-        self.done_tolerance_deg = _number(options, "done_tolerance_deg", 0.05, 1e-4, 10.0)
-        self.stale_after_s = _number(options, "stale_after_s", 0.5, 0.05, 60.0)
+        self.rate_hz = number_option(options, "rate_hz", 500.0, 1.0, 500.0, "ur-rtde")
+        self.speed_deg_s = number_option(options, "speed_deg_s", 30.0, 0.1, 180.0, "ur-rtde")
+        self.acceleration_deg_s2 = number_option(options, "acceleration_deg_s2", 60.0, 1.0, 800.0, "ur-rtde")
+        self.done_tolerance_deg = number_option(options, "done_tolerance_deg", 0.05, 1e-4, 10.0, "ur-rtde")
+        self.stale_after_s = number_option(options, "stale_after_s", 0.5, 0.05, 60.0, "ur-rtde")
         self.n_joints = 6
         self.joint_map = JointMap.identity(6)
         self.stats = LinkStats()

@@ -12,15 +12,9 @@ from calib_core.operator.motion import Motion
 from calib_core.operator.site import RealSite
 from calib_core.ros2.joint_units import user_per_si
 from videocal_sim.ros2_arm import SimulatedRos2Arm
+from tests.waiting import wait_until
 
 
-def _wait(predicate, timeout_s=15.0):
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def test_go_to_task_over_ros2_and_pose_unknown_when_the_states_stop(domain):
@@ -32,14 +26,14 @@ def test_go_to_task_over_ros2_and_pose_unknown_when_the_states_stop(domain):
     core = OperatorCore(cell, RealSite("ros2:///joint_states?stale_after_s=0.3", controller_options={"speed_deg_s": 90}))
     try:
         assert core.start_controller() == "ros2:///joint_states?stale_after_s=0.3"
-        assert _wait(lambda: core.link_up and np.allclose(core.joints_deg, start, atol=1e-6))
+        assert wait_until(lambda: core.link_up and np.allclose(core.joints_deg, start, atol=1e-6))
         handle = core.go_to_task(approach=True, wait=True, confirmed=True)
         assert handle.error is None and core.motion.motion is Motion.ARRIVED
         # The trajectory carried the model's joints by URDF name: the arm stands where the core aimed.
         assert np.allclose(arm.position(time.monotonic()), handle.joints_deg, atol=1e-6)
         assert np.allclose(core.joints_deg, handle.joints_deg, atol=0.05)
         arm.close()  # the driver goes away: no more joint states
-        assert _wait(lambda: core.link.state is LinkState.STALE and not core.link_up, 5.0)
+        assert wait_until(lambda: core.link.state is LinkState.STALE and not core.link_up, 5.0)
     finally:
         core.close()
 
@@ -72,7 +66,7 @@ def test_the_camera_mounting_and_targets_on_tf_static_for_a_late_subscriber(doma
         peer = DomainParticipant(domain)  # joins after both publications
         reader = DataReader(peer, Topic(peer, "rt/tf_static", msg.TFMessage), qos=static_tf_qos())
         got = []
-        assert _wait(lambda: got.extend(reader.take()) or got, 10.0)
+        assert wait_until(lambda: got.extend(reader.take()) or got, 10.0)
         by_child = {t.child_frame_id: t for t in got[-1].transforms}
         camera = by_child["videocal_camera"]
         assert camera.header.frame_id == "flange"

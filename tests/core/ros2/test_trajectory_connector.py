@@ -22,6 +22,7 @@ from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkState, MoveError
 from calib_core.ros2.trajectory_connector import Ros2TrajectoryController
 from videocal_sim.ros2_arm import SimulatedRos2Arm
+from tests.waiting import wait_until
 
 
 # --- sensor_msgs/msg/JointState as the ROS 2 definitions give it, written here on their own ---------
@@ -54,13 +55,6 @@ def _context(**options):
     return ControllerContext(NAMES, UNITS, JointMap.identity(6), 100.0, options)
 
 
-def _wait(predicate, timeout_s=10.0):
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(domain):
@@ -73,7 +67,7 @@ def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(dom
     link.sample_received.connect(got.append)
     link.start()
     try:
-        assert _wait(lambda: writer.get_publication_matched_status().current_count > 0)
+        assert wait_until(lambda: writer.get_publication_matched_status().current_count > 0)
         # Another order, an extra gripper joint, radians and metres, a stamp of the publisher's clock.
         order = ["slide", "gripper", "wrist_2", "elbow", "shoulder_pan", "wrist_1", "shoulder_lift"]
         values = {"slide": 0.125, "gripper": 0.02, "wrist_2": -math.pi / 2, "elbow": 1.0, "shoulder_pan": 0.1, "wrist_1": 0.0, "shoulder_lift": -0.5}
@@ -82,7 +76,7 @@ def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(dom
         writer.write(Joints(Hdr(Stamp(1_700_000_000, 260_000_000), "base"), ["gripper"], [0.01], [], []))
         # An older stamp after a newer one is not the robot now.
         writer.write(Joints(Hdr(Stamp(1_700_000_000, 200_000_000), "base"), order, [values[n] for n in order], [], []))
-        assert _wait(lambda: link.stats_snapshot()["wrong_joint_count"] == 1 and link.stats_snapshot()["backwards_samples"] == 1)
+        assert wait_until(lambda: link.stats_snapshot()["wrong_joint_count"] == 1 and link.stats_snapshot()["backwards_samples"] == 1)
         assert len(got) == 1 and link.state is LinkState.UP
         sample = got[0].sample
         assert sample.t_ms == 1_700_000_000_250
@@ -115,7 +109,7 @@ def arm(domain):
 
 def _connected(**options):
     link = open_controller("ros2:///joint_states", _context(controller="arm_controller", **options)).start()
-    assert _wait(lambda: link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0)
+    assert wait_until(lambda: link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0)
     return link
 
 
@@ -136,16 +130,16 @@ def test_stop_holds_the_arm_where_it_stands(arm):
     link = _connected(speed_deg_s=20)
     try:
         handle = link.move_joints([60.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=20)
-        assert _wait(lambda: link.latest.joints_deg[0] > 5.0)
+        assert wait_until(lambda: link.latest.joints_deg[0] > 5.0)
         assert link.stop()
         with pytest.raises(MoveError, match="STOPPED"):
             handle.wait(1)
-        assert _wait(lambda: arm._plan is not None and arm._plan[1][-1] <= 0.11 or arm._plan is None)
+        assert wait_until(lambda: arm._plan is not None and arm._plan[1][-1] <= 0.11 or arm._plan is None)
         time.sleep(0)  # the hold trajectory lasts 0.1 s; then the arm stands still
-        assert _wait(lambda: arm._plan is None, 2.0)
+        assert wait_until(lambda: arm._plan is None, 2.0)
         held = arm.position(time.monotonic())[0]
         assert 5.0 < held < 30.0  # stopped on the way, far from 60
-        assert _wait(lambda: abs(link.latest.joints_deg[0] - held) < 1e-6, 2.0)
+        assert wait_until(lambda: abs(link.latest.joints_deg[0] - held) < 1e-6, 2.0)
     finally:
         link.close()
 
@@ -153,7 +147,7 @@ def test_stop_holds_the_arm_where_it_stands(arm):
 def test_a_move_with_no_controller_listening_is_not_sent(arm):
     link = open_controller("ros2:///joint_states", _context(controller="no_such_controller")).start()
     try:
-        assert _wait(lambda: link.state is LinkState.UP)
+        assert wait_until(lambda: link.state is LinkState.UP)
         handle = link.move_joints([0.0] * 5 + [100.0])
         assert not handle.sent
         assert "no trajectory controller subscribes to /no_such_controller/joint_trajectory" in str(handle.error)

@@ -13,6 +13,7 @@ from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, MoveError
+from tests.waiting import wait_until
 
 NAMES = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
 HOME = [0.0, 10.0, -30.0, 0.0, 45.0, 0.0]  # within the bundled robot's limits
@@ -22,13 +23,6 @@ def _context(**options):
     return ControllerContext(NAMES, ("deg",) * 6, JointMap.identity(6), 500.0, options)
 
 
-def _wait(predicate, timeout_s=10.0):
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 class SimUR:
@@ -65,7 +59,7 @@ def link(sim):
     link.status_changed.connect(statuses.append)
     link.statuses = statuses
     link.start()
-    assert _wait(lambda: link.state is LinkState.UP and link.remote_control is not None)
+    assert wait_until(lambda: link.state is LinkState.UP and link.remote_control is not None)
     yield link
     link.close()
 
@@ -87,7 +81,7 @@ def test_a_move_then_a_stop_on_the_way(link):
     link.move_joints(target, timeout_s=20).wait(20)
     assert np.allclose(link.latest.joints_deg, target, atol=0.05)
     handle = link.move_joints(start, timeout_s=20)
-    assert _wait(lambda: link.latest.joints_deg[0] < 15.0)
+    assert wait_until(lambda: link.latest.joints_deg[0] < 15.0)
     assert link.stop()
     with pytest.raises(MoveError, match="STOPPED"):
         handle.wait(1)
@@ -100,21 +94,21 @@ def test_a_move_then_a_stop_on_the_way(link):
 
 def test_protective_stop_and_local_control_refuse_moves_and_say_so(sim, link):
     sim.command("protective-stop")
-    assert _wait(lambda: link.protective_stop)
+    assert wait_until(lambda: link.protective_stop)
     assert "PROTECTIVE STOP" in link.statuses[-1]
     handle = link.move_joints(HOME)
     assert not handle.sent and "protective stop" in str(handle.error)
     sim.command("speed 0.5")
-    assert _wait(lambda: any("speed 50 %" in s for s in link.statuses))
+    assert wait_until(lambda: any("speed 50 %" in s for s in link.statuses))
     with __import__("socket").create_connection((sim.host, 29999)) as s:  # as the operator would clear it
         f = s.makefile("rwb")
         f.readline()
         f.write(b"unlock protective stop\n")
         f.flush()
         assert f.readline().strip() == b"Protective stop releasing"
-    assert _wait(lambda: not link.protective_stop)
+    assert wait_until(lambda: not link.protective_stop)
     sim.command("local")
-    assert _wait(lambda: link.remote_control is False, 5.0)
+    assert wait_until(lambda: link.remote_control is False, 5.0)
     handle = link.move_joints(HOME)
     assert not handle.sent and "local control" in str(handle.error)
     sim.command("remote")
@@ -127,7 +121,7 @@ def test_an_unreachable_controller_and_wrong_urls():
     link.state_changed.connect(lambda state, why: states.append((state, why)))
     link.start()
     try:
-        assert _wait(lambda: len(states) >= 1)
+        assert wait_until(lambda: len(states) >= 1)
         assert states[0][0] is LinkState.CONNECTING and "127.0.0.1" in states[0][1]
         assert not link.move_joints(HOME).sent
     finally:
