@@ -1,7 +1,7 @@
 """The status bar's permanent fields: recording, link, camera, pairs; refreshed once a second.
 
-The link shows its state, sample rate and rejected lines, and turns orange when it is up but no
-joint sample came for ``STALE_LINK_S``; the camera shows its frame rate, and turns orange when no
+The link shows its state, sample rate, rejected lines and its measured one-way delay (a far controller),
+and turns orange when it is up but no joint sample came for ``STALE_LINK_S`` (plus a far link's spread); the camera shows its frame rate, and turns orange when no
 frame came for ``STALE_CAMERA_S`` while live.
 """
 
@@ -58,9 +58,13 @@ class StatusLine:
             s = link.stats_snapshot()
             prev, self._samples_then = self._samples_then, (now, s["samples"])
             rate = "" if prev is None or now <= prev[0] else f"{(s['samples'] - prev[1]) / (now - prev[0]):.0f} Hz, "
-            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected"
+            delay = getattr(link, "delay_s", None)
+            delay_text = "" if delay is None else f", delay {delay:.2f} s" if delay >= 0.01 else ", delay < 0.01 s"
+            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected{delay_text}"
             last = self.workbench.last_sample_s
-            if link.state.value == "up" and last is not None and now - last > STALE_LINK_S:
+            # a far link delivers its samples in bursts: late only past its own spread of delays
+            late_after = STALE_LINK_S + (link.stale_after_now_s() if hasattr(link, "stale_after_now_s") else 0.0)
+            if link.state.value == "up" and last is not None and now - last > late_after:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)
         self._show_settled()

@@ -26,6 +26,11 @@ class ConnectorEvents:
     def state(self) -> LinkState:
         return self._state
 
+    @property
+    def delay_s(self) -> float | None:
+        """The link's one-way delay (s) where the connector measures it, else ``None``."""
+        return None
+
     def _set_state(self, state: LinkState, reason: str) -> None:
         if state is self._state:
             return

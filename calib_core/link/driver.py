@@ -44,10 +44,14 @@ from calib_core.link.protocol import (
     parse_body,
 )
 
-from calib_core.link.workstation_auth import HANDSHAKE_ATTEMPTS, HANDSHAKE_TIMEOUT_S, AuthState, WorkstationAuth
+from calib_core.link.round_trip import RoundTrip
+from calib_core.link.workstation_auth import AuthState, WorkstationAuth, handshake_budget_s
 
-HANDSHAKE_WAIT_S = HANDSHAKE_TIMEOUT_S * sum(range(1, HANDSHAKE_ATTEMPTS + 1)) + 0.5
+HANDSHAKE_WAIT_S = handshake_budget_s() + 0.5
 """How long a move waits for a handshake under way (its retries included) before it is not sent."""
+
+PING_EVERY_S = 2.0
+"""With no other reply timed for this long, a ``$STA`` times the round trip (the link's delay can change)."""
 
 _READ_TIMEOUT_S = 0.01
 _BACKOFF_S = (0.05, 0.1, 0.2, 0.4, 0.8, 1.0)
@@ -69,7 +73,13 @@ class ControllerLink(ConnectorEvents):
     Events (psygnal, emitted on the reader thread; keep slots short, a slot that raises is counted
     in ``stats.errors`` and does not stop the link): ``sample_received(TimedSample)`` for every
     delivered sample, ``state_changed(LinkState, reason)`` on a change of state,
-    ``auth_changed(AuthState, failure)`` when a handshake ends (``ready`` or ``failed``)."""
+    ``auth_changed(AuthState, failure)`` when a handshake ends (``ready`` or ``failed``).
+
+    Far controllers: every timeout follows the measured round trip (:attr:`round_trip`, timed on the
+    handshake, move acknowledgements and a ``$STA`` every :data:`PING_EVERY_S` when nothing else was): the
+    dead-man time sent to the controller is ``deadman_ms`` plus the round trip's timeout (a heartbeat
+    held up on a slow link is no reason to stop the robot), a link is stale only after ``stale_after_s``
+    plus the round trip's spread, and a hello waits at least the round trip's timeout."""
 
     def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
                  deadman_ms: int = 1000, key: bytes | str | None = "user", **serial_settings):
@@ -100,10 +110,13 @@ class ControllerLink(ConnectorEvents):
         self._latest: TimedSample | None = None
         self._order = SampleOrder(self.stats)
         self._moves = MoveBook()
+        self.round_trip = RoundTrip()
+        """The measured round trip to the controller (s): what the timeouts follow."""
+        self._pings: deque[float] = deque(maxlen=8)
         if key == "user":
-            self._auth = WorkstationAuth(user_key(), f"the link key in {default_key_path()}")
+            self._auth = WorkstationAuth(user_key(), f"the link key in {default_key_path()}", self.round_trip)
         elif key is None or isinstance(key, bytes):
-            self._auth = WorkstationAuth(key)
+            self._auth = WorkstationAuth(key, round_trip=self.round_trip)
         else:
             raise ValueError(f"key: 32 bytes, 'user' or None, got {type(key).__name__}")
         self._auth.settled.connect(lambda state, failure: self._emit(self.auth_changed, state, failure))
@@ -171,6 +184,19 @@ class ControllerLink(ConnectorEvents):
     def latest(self) -> TimedSample | None:
         return self._latest
 
+    @property
+    def delay_s(self) -> float | None:
+        """The link's one-way delay (s): half the measured round trip; ``None`` before one was measured."""
+        return self.round_trip.one_way_s()
+
+    def deadman_sent_ms(self) -> int:
+        """The dead-man time the heartbeats carry (ms): ``deadman_ms`` plus the round trip's timeout."""
+        return min(60_000, self.deadman_ms + int(1000 * self.round_trip.rto_s))
+
+    def stale_after_now_s(self) -> float:
+        """No sample for this long marks the link stale (s): ``stale_after_s`` plus the round trip's spread."""
+        return self.stale_after_s + self.round_trip.spread_s
+
     def drain(self) -> list[TimedSample]:
         """Every sample queued since the last drain, oldest first."""
         with self._lock:
@@ -198,6 +224,7 @@ class ControllerLink(ConnectorEvents):
             handle._finish(MoveError(f"move {handle.id}: not sent: {self._auth.why_not}"))
             return handle
         self._moves.add(handle)
+        handle.sent_s = time.monotonic()
         if not self._send(MoveJoints(handle.id, q).body(), sealed=True):
             self._moves.withdraw(handle)
             handle.sent = False
@@ -222,7 +249,8 @@ class ControllerLink(ConnectorEvents):
         """Send a request and wait for the first reply the reader thread puts in ``replies``."""
         with self._lock:
             replies.clear()
-        self._send(body)
+        if self._send(body) and body == RequestState().body():
+            self._pings.append(time.monotonic())
         with self._state_event:
             self._state_event.wait_for(lambda: bool(replies), timeout_s)
             return replies.popleft() if replies else None
@@ -251,6 +279,7 @@ class ControllerLink(ConnectorEvents):
         except (serial.SerialException, OSError, AttributeError):
             pass
         self._assembler.reset()
+        self._pings.clear()
         self._set_state(LinkState.CONNECTING, "open, waiting for samples")
         # Polling stops any stream a previous session left running; streaming (re)starts it.
         self._send(Stream(self.rate_hz if self.mode == "stream" else 0).body())
@@ -325,9 +354,13 @@ class ControllerLink(ConnectorEvents):
             if self.deadman_ms and now >= next_heartbeat and self._auth.state in (AuthState.READY, AuthState.OFF):
                 # five heartbeats per dead-man time: a reader thread that waits for the CPU does not trip it.
                 # Sealed in the session: the controller believes no one else's (none is sent without a session).
-                self._send(Heartbeat(self.deadman_ms).body(), sealed=True)
+                self._send(Heartbeat(self.deadman_sent_ms()).body(), sealed=True)
                 next_heartbeat = now + self.deadman_ms / 5000.0
-            if self._state in (LinkState.UP, LinkState.CONNECTING) and now - last_sample_t > self.stale_after_s:
+            if self._state is LinkState.UP and not self._pings and now - self._last_timed_s > PING_EVERY_S:
+                self._last_timed_s = now
+                if self._send(RequestState().body()):
+                    self._pings.append(now)
+            if self._state in (LinkState.UP, LinkState.CONNECTING) and now - last_sample_t > self.stale_after_now_s():
                 self._set_state(LinkState.STALE, f"no joint sample for {now - last_sample_t:.2f} s")
                 if self.mode == "stream":
                     self._send(Stream(self.rate_hz).body())  # a controller that forgot the stream gets asked again
@@ -367,7 +400,9 @@ class ControllerLink(ConnectorEvents):
             self._deliver(TimedSample(msg, t_host))
             return True
         if isinstance(msg, Ack) and msg.cmd == "MVJ":
-            self._moves.acknowledged(msg.id)
+            handle = self._moves.acknowledged(msg.id)
+            if handle is not None and handle.sent_s is not None:
+                self._timed(t_host - handle.sent_s)
         elif isinstance(msg, Ack) and msg.cmd == "AUT":
             self._auth.on_accepted()
         elif isinstance(msg, HelloReply):
@@ -389,6 +424,8 @@ class ControllerLink(ConnectorEvents):
             if self._auth.lost_session(msg) and t_host >= self._next_hello_s:
                 self._hello()  # the controller restarted and forgot the session: open a new one
         elif isinstance(msg, StateReport):
+            if self._pings:  # the controller answers in order: the oldest $STA out is this one's
+                self._timed(t_host - self._pings.popleft())
             with self._state_event:
                 self._state_reports.append(msg)
                 self._state_event.notify_all()
@@ -397,6 +434,12 @@ class ControllerLink(ConnectorEvents):
                 self._version_reports.append(msg)
                 self._state_event.notify_all()
         return False
+
+    _last_timed_s = 0.0
+
+    def _timed(self, rtt_s: float) -> None:
+        self.round_trip.add(rtt_s)
+        self._last_timed_s = time.monotonic()
 
     def _deliver(self, sample: TimedSample) -> None:
         with self._lock:

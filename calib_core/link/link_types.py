@@ -86,6 +86,8 @@ class MoveHandle:
         self.deadline_s = deadline_s
         self.acked = False
         self.sent = True  # False when the link could not send it (then it has finished with the reason)
+        self.sent_s: float | None = None
+        """When it was written to the controller (host monotonic s): its ACK times the round trip."""
         self._event = threading.Event()
         self._error: MoveError | None = None
         self._callbacks: list = []

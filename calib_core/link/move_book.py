@@ -37,13 +37,16 @@ class MoveBook:
         if handle in self._awaiting_ack:
             self._awaiting_ack.remove(handle)
 
-    def acknowledged(self, move_id: str) -> None:
+    def acknowledged(self, move_id: str) -> MoveHandle | None:
+        """An ``ACK,MVJ``: the move it names, now acknowledged (``None``: no such move in flight, or acknowledged before)."""
         with self._lock:
             handle = self._moves.get(move_id)
-            if handle is not None:
-                handle.acked = True
-                if handle in self._awaiting_ack:
-                    self._awaiting_ack.remove(handle)
+            if handle is None or handle.acked:
+                return None
+            handle.acked = True
+            if handle in self._awaiting_ack:
+                self._awaiting_ack.remove(handle)
+            return handle
 
     def done(self, move_id: str) -> str | None:
         """A ``DON``: finishes the move; returns why it was not believed (no ``ACK`` came first)."""

@@ -15,11 +15,21 @@ from psygnal import Signal
 
 from calib_core.link import auth
 from calib_core.link.protocol import Authenticate, ErrorReply, Hello, HelloReply
+from calib_core.link.round_trip import RoundTrip
 
 HANDSHAKE_TIMEOUT_S = 1.5
-HANDSHAKE_ATTEMPTS = 3
-"""An unanswered hello is sent again (after 1.5 s, then 3 s more) before the handshake is given up: a
-controller simulator starting on a loaded two-core machine once missed the first 1.5 s."""
+HANDSHAKE_ATTEMPTS = 4
+"""An unanswered hello is sent again, each try waiting twice as long as the one before (1.5, 3, 6, 12 s) or
+the measured round trip's timeout if that is longer, before the handshake is given up: a controller
+simulator starting on a loaded two-core machine once missed the first 1.5 s, and a controller seconds away
+(a relay satellite) answers after its round trip. A late answer to an earlier hello is no failure: it times
+the round trip, and the newest hello's answer is waited for (the controller answers hellos in order and
+keeps only the newest)."""
+
+
+def handshake_budget_s() -> float:
+    """How long every try together waits at least (s): 22.5 s."""
+    return HANDSHAKE_TIMEOUT_S * sum(2**k for k in range(HANDSHAKE_ATTEMPTS))
 
 
 class AuthState(str, Enum):
@@ -38,8 +48,9 @@ class WorkstationAuth:
 
     settled = Signal(object, object)
 
-    def __init__(self, key: bytes | None, key_name: str = "the link key"):
+    def __init__(self, key: bytes | None, key_name: str = "the link key", round_trip: RoundTrip | None = None):
         self._key = key
+        self.round_trip = round_trip if round_trip is not None else RoundTrip()
         self._key_name = key_name
         self._changed = threading.Condition()
         self.state = AuthState.OFF if key is None else AuthState.PENDING
@@ -50,6 +61,8 @@ class WorkstationAuth:
         self._counter = 0
         self._sent_s = 0.0
         self._attempts = 0
+        self._earlier: dict[str, float] = {}  # the nonces of this series' earlier hellos: when each was sent
+        self._aut_sent_s: float | None = None
 
     def _set(self, state: AuthState, failure: str | None = None) -> None:
         with self._changed:
@@ -64,8 +77,10 @@ class WorkstationAuth:
             return None
         retry = self.state is AuthState.PENDING and self._nonce is not None
         self._attempts = self._attempts + 1 if retry else 1
+        self._earlier = {**self._earlier, self._nonce: self._sent_s} if retry else {}
         self._nonce, self._session, self._counter = auth.new_nonce(), None, 0
         self._sent_s = time.monotonic()
+        self._aut_sent_s = None
         self._set(AuthState.PENDING)
         return Hello(self._nonce).body()
 
@@ -73,15 +88,28 @@ class WorkstationAuth:
         """The ``AUT`` body answering the controller's ``HEL`` (``None``: the controller is not to be trusted)."""
         if self._key is None or self.state is not AuthState.PENDING or self._nonce is None:
             return None
+        now = time.monotonic()
+        if auth.is_nonce(msg.nonce):
+            for nonce, sent_s in self._earlier.items():
+                if auth.proof_is_valid(auth.controller_proof(self._key, nonce, msg.nonce), msg.proof):
+                    # A late answer to an earlier hello: the controller holds the key and is far away; the
+                    # newest hello is the one it will take an AUT for. Wait for that answer a round trip longer.
+                    self.round_trip.add(now - sent_s)
+                    return None
         if not auth.is_nonce(msg.nonce) or not auth.proof_is_valid(auth.controller_proof(self._key, self._nonce, msg.nonce), msg.proof):
             self._set(AuthState.FAILED, f"the controller does not hold {self._key_name}: its proof is wrong (another key installed?); the robot is not moved")
             return None
+        if not self._earlier:  # Karn's rule: the answer to a hello sent once times the round trip
+            self.round_trip.add(now - self._sent_s)
         self._session = auth.session_key(self._key, self._nonce, msg.nonce)
+        self._aut_sent_s = now
         return Authenticate(auth.workstation_proof(self._key, self._nonce, msg.nonce)).body()
 
     def on_accepted(self) -> None:
         """``ACK,AUT``: the session is open."""
         if self.state is AuthState.PENDING and self._session is not None:
+            if self._aut_sent_s is not None:
+                self.round_trip.add(time.monotonic() - self._aut_sent_s)
             self.sessions += 1
             self._set(AuthState.READY)
 
@@ -103,15 +131,20 @@ class WorkstationAuth:
         """A move refused for want of a session (the controller restarted): time for a new hello."""
         return self._key is not None and msg.code == "AUTH" and "no authenticated session" in msg.text
 
+    def _try_wait_s(self) -> float:
+        """How long the current try waits for its answer (s): doubling per try, at least the round trip's
+        timeout (an AUT already sent waits its own round trip too)."""
+        return max(HANDSHAKE_TIMEOUT_S * 2 ** (self._attempts - 1), 2.0 * self.round_trip.rto_s if self._aut_sent_s else self.round_trip.rto_s)
+
     def check_timeout(self, now_s: float) -> bool:
         """True when an unanswered hello is due to be sent again; after :data:`HANDSHAKE_ATTEMPTS` the
         handshake has failed."""
-        if self.state is not AuthState.PENDING or self._nonce is None or now_s - self._sent_s <= HANDSHAKE_TIMEOUT_S * self._attempts:
+        if self.state is not AuthState.PENDING or self._nonce is None or now_s - self._sent_s <= self._try_wait_s():
             return False
         if self._attempts < HANDSHAKE_ATTEMPTS:
             return True
-        waited = HANDSHAKE_TIMEOUT_S * sum(range(1, HANDSHAKE_ATTEMPTS + 1))
-        self._set(AuthState.FAILED, f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:g} s; a protocol-3 controller?); the robot is not moved")
+        waited = now_s - min([self._sent_s, *self._earlier.values()])
+        self._set(AuthState.FAILED, f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:.1f} s; a protocol-3 controller?); the robot is not moved")
         return False
 
     def wait_settled(self, timeout_s: float) -> AuthState:

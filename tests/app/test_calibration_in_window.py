@@ -172,6 +172,9 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     assert win.camera.last_frame is not None
     win._update_status()
     qtbot.waitUntil(lambda: (win._update_status(), "no frame for" in win.fps_label.text())[1], timeout=10_000)
+    # The link shows its measured delay (the handshake timed the round trip; a near controller: milliseconds).
+    qtbot.waitUntil(lambda: (win._update_status(), "delay" in win.link_label.text())[1], timeout=10_000)
+    assert wb.link.delay_s is not None and wb.link.delay_s < 1.0
     # The link: the controller process dies; the state shows it and no pair is lost.
     wb.site.process.process.kill()
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)

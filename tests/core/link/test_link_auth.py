@@ -189,20 +189,56 @@ def test_the_user_key_lives_in_the_config_folder():
 
 
 def test_an_unanswered_hello_is_sent_again_before_the_handshake_fails():
-    """A controller simulator starting on a loaded machine once missed the only 1.5 s the driver gave it."""
+    """A controller simulator starting on a loaded machine once missed the only 1.5 s the driver gave it:
+    each try waits twice as long as the one before (1.5, 3, 6, 12 s) before the handshake fails."""
     ws = WorkstationAuth(KEY)
     first = ws.hello()
     t0 = ws._sent_s
     assert not ws.check_timeout(t0 + 1.4) and ws.check_timeout(t0 + 1.6)
     second = ws.hello()
     assert second != first and ws.state is AuthState.PENDING
-    t1 = ws._sent_s
-    assert not ws.check_timeout(t1 + 2.9) and ws.check_timeout(t1 + 3.1)  # 3 s for the second
-    ws.hello()
-    t2 = ws._sent_s
-    assert not ws.check_timeout(t2 + 4.4) and ws.state is AuthState.PENDING
-    assert not ws.check_timeout(t2 + 4.6) and ws.state is AuthState.FAILED and "3 tries in 9 s" in ws.failure
+    for wait in (3.0, 6.0):
+        t = ws._sent_s
+        assert not ws.check_timeout(t + wait - 0.1) and ws.check_timeout(t + wait + 0.1)
+        ws.hello()
+    t3 = ws._sent_s
+    assert not ws.check_timeout(t3 + 11.9) and ws.state is AuthState.PENDING
+    assert not ws.check_timeout(t3 + 12.1) and ws.state is AuthState.FAILED and "4 tries in" in ws.failure
     # the reply to the latest hello is what counts; a late reply to the failed one is not believed
     nonce = ws._nonce
     reply = HelloReply("0123456789abcdef", auth.controller_proof(KEY, nonce, "0123456789abcdef"))
     assert ws.on_hello_reply(reply) is None
+
+
+def test_a_late_answer_to_an_earlier_hello_times_the_round_trip_and_the_newest_one_opens_the_session():
+    """A controller a few seconds away: its answer to the first hello arrives after the second was sent.
+    That answer is no wrong key: it measures the round trip (the next try then waits at least that
+    long), and the answer to the newest hello, the one the controller keeps, opens the session."""
+    controller = ControllerLogic(key=KEY)
+    ws = WorkstationAuth(KEY)
+    to_controller = [ws.hello()]
+    ws._sent_s -= 3.0  # the first hello went out 3 s ago ...
+    assert ws.check_timeout(time.monotonic())  # ... and its try (1.5 s) is over: sent again
+    to_controller.append(ws.hello())
+    replies = [r for body in to_controller for r in controller.handle(body)]  # in order, as TCP delivers
+    assert all(isinstance(r, HelloReply) for r in replies) and len(replies) == 2
+    assert ws.on_hello_reply(replies[0]) is None and ws.state is AuthState.PENDING  # late: not a failure
+    assert ws.round_trip.samples == 1 and ws.round_trip.last_s >= 3.0
+    assert ws._try_wait_s() >= ws.round_trip.rto_s >= 3.0  # the newest try now waits a round trip at least
+    aut = ws.on_hello_reply(replies[1])
+    assert aut is not None
+    answer = controller.handle(aut)
+    assert answer == [Ack("AUT", "-")]
+    ws.on_accepted()
+    assert ws.state is AuthState.READY
+
+
+def test_answers_under_the_wrong_key_fail_whichever_hello_they_claim_to_answer():
+    controller = ControllerLogic(key=bytes(32))
+    ws = WorkstationAuth(KEY)
+    first = ws.hello()
+    ws._sent_s -= 2.0
+    assert ws.check_timeout(time.monotonic())
+    ws.hello()
+    reply = controller.handle(first)[0]
+    assert ws.on_hello_reply(reply) is None and ws.state is AuthState.FAILED and "proof is wrong" in ws.failure
