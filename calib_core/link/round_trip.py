@@ -26,6 +26,7 @@ class RoundTrip:
         self.rttvar_s = 0.0
         self.last_s: float | None = None
         self.samples = 0
+        self._backoff = 1
         self._lock = threading.Lock()
 
     def add(self, rtt_s: float) -> None:
@@ -40,6 +41,13 @@ class RoundTrip:
                 self.srtt_s = (1.0 - _ALPHA) * self.srtt_s + _ALPHA * rtt_s
             self.last_s = rtt_s
             self.samples += 1
+            self._backoff = 1
+
+    def timed_out(self) -> None:
+        """A reply did not come within :attr:`rto_s`: wait twice as long next time, until one is timed
+        (RFC 6298 5.5; without it a link further away than the first guess would never be timed)."""
+        with self._lock:
+            self._backoff = min(self._backoff * 2, 64)
 
     @property
     def measured(self) -> bool:
@@ -47,11 +55,10 @@ class RoundTrip:
 
     @property
     def rto_s(self) -> float:
-        """How long to wait for a reply before it counts as late (s): ``srtt + 4 rttvar`` within the bounds,
-        ``min_rto_s`` before the first sample."""
-        if self.srtt_s is None:
-            return self.min_rto_s
-        return min(self.max_rto_s, max(self.min_rto_s, self.srtt_s + 4.0 * self.rttvar_s))
+        """How long to wait for a reply before it counts as late (s): ``srtt + 4 rttvar`` (``min_rto_s`` before
+        the first sample), doubled for each :meth:`timed_out` since the last sample, within the bounds."""
+        base = self.min_rto_s if self.srtt_s is None else max(self.min_rto_s, self.srtt_s + 4.0 * self.rttvar_s)
+        return min(self.max_rto_s, base * self._backoff)
 
     @property
     def spread_s(self) -> float:

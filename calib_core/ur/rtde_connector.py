@@ -32,6 +32,7 @@ from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
 from calib_core.link.protocol import JointSample
+from calib_core.link.round_trip import RoundTrip
 
 SCRIPT_PORT, DASHBOARD_PORT = 30002, 29999
 _VARIABLES = ["timestamp", "actual_q", "safety_status_bits", "speed_scaling", "robot_status_bits", "runtime_state"]
@@ -77,6 +78,9 @@ class URRtdeController(ConnectorEvents):
         self._thread: threading.Thread | None = None
         self._receive = None
         self._script: socket.socket | None = None
+        self._dashboard_asked = threading.Event()
+        self.round_trip = RoundTrip()
+        """The round trip to the controller (s), timed on the dashboard's answers: its waits follow it."""
 
     # --- life cycle ----------------------------------------------------------------------------
     def start(self) -> URRtdeController:
@@ -84,6 +88,9 @@ class URRtdeController(ConnectorEvents):
             self._set_state(LinkState.CONNECTING, f"connecting to the UR controller at {self.host}")
             self._thread = threading.Thread(target=self._run, name=f"ur-rtde {self.host}", daemon=True)
             self._thread.start()
+            # The pendant's mode is asked on a thread of its own: a far robot answers seconds later, and the
+            # reader must not miss RTDE samples meanwhile.
+            threading.Thread(target=self._watch_dashboard, name=f"ur-dashboard {self.host}", daemon=True).start()
         return self
 
     def close(self) -> None:
@@ -135,6 +142,8 @@ class URRtdeController(ConnectorEvents):
     def _why_not_sendable(self) -> str | None:
         if self._state is not LinkState.UP or self._latest is None:
             return f"the link is {self._state.value} (no fresh RTDE data from {self.host})"
+        if not self._dashboard_asked.is_set():
+            return f"the dashboard server {self.host}:{DASHBOARD_PORT} has not said yet whether the robot is in remote control"
         if self.protective_stop:
             return "the robot is in a protective stop: clear it on the teach pendant (or the dashboard's 'unlock protective stop')"
         if self.remote_control is False:
@@ -156,14 +165,28 @@ class URRtdeController(ConnectorEvents):
                     return f"the script port {self.host}:{SCRIPT_PORT} refused it: {exc}"
         return None
 
+    @property
+    def delay_s(self) -> float | None:
+        """The one-way delay to the controller (s): half the round trip of the dashboard's answers."""
+        return self.round_trip.one_way_s()
+
     def _dashboard(self, command: str) -> str | None:
+        """The dashboard server's answer to ``command`` (``None``: no answer). Its question and answer time the
+        round trip; each wait is the round trip's timeout doubled (a far robot answers seconds later)."""
         try:
-            with socket.create_connection((self.host, DASHBOARD_PORT), timeout=1.0) as s:
+            with socket.create_connection((self.host, DASHBOARD_PORT), timeout=2.0 * self.round_trip.rto_s) as s:
                 f = s.makefile("rwb")
                 f.readline()  # the greeting
+                asked = time.monotonic()
                 f.write(command.encode() + b"\n")
                 f.flush()
-                return f.readline().decode(errors="replace").strip()
+                answer = f.readline().decode(errors="replace").strip()
+                if answer:
+                    self.round_trip.add(time.monotonic() - asked)
+                return answer
+        except TimeoutError:
+            self.round_trip.timed_out()
+            return None
         except OSError:
             return None
 
@@ -177,15 +200,19 @@ class URRtdeController(ConnectorEvents):
             self.last_error = str(exc)
             self._receive = None
             return False
-        remote = self._dashboard("is in remote control")
-        self.remote_control = None if remote is None else remote.lower() == "true"
         return True
+
+    def _watch_dashboard(self) -> None:
+        while not self._stop.is_set():
+            remote = self._dashboard("is in remote control")
+            self._update_status(remote_control=None if remote is None else remote.lower() == "true")
+            self._dashboard_asked.set()
+            self._stop.wait(2.0)
 
     def _run(self) -> None:
         backoff = 0.2
         last_stamp = None
         last_new = time.monotonic()
-        last_dashboard = time.monotonic()
         period = 1.0 / self.rate_hz
         while not self._stop.is_set():
             if self._receive is None or not self._receive.isConnected():
@@ -210,12 +237,8 @@ class URRtdeController(ConnectorEvents):
                 self._receive = None
                 continue
             now = time.monotonic()
-            if self._state is LinkState.UP and now - last_new > self.stale_after_s:
+            if self._state is LinkState.UP and now - last_new > self.stale_after_s + self.round_trip.spread_s:
                 self._set_state(LinkState.STALE, f"no RTDE data for {now - last_new:.1f} s")
-            if now - last_dashboard > 2.0:  # the pendant's mode can change under us
-                last_dashboard = now
-                remote = self._dashboard("is in remote control")
-                self._update_status(remote_control=None if remote is None else remote.lower() == "true")
             move = self._moves.current
             if move is not None and now > move.deadline_s:
                 self._moves.finish(MoveTimeout("the joints did not reach the target in time"))

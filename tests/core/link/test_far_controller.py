@@ -38,6 +38,15 @@ def test_the_round_trip_estimate_follows_rfc_6298():
         rt.add(3.0)
     assert rt.srtt_s == pytest.approx(3.0, abs=1e-6) and rt.rto_s == pytest.approx(3.0, abs=1e-3)
     assert RoundTrip(min_rto_s=1.0).rto_s == 1.0 and RoundTrip(max_rto_s=5.0).rto_s == 1.0
+    far = RoundTrip(min_rto_s=1.0, max_rto_s=5.0)  # unanswered: each wait twice the one before, within the bound
+    far.timed_out()
+    assert far.rto_s == 2.0
+    far.timed_out(), far.timed_out()
+    assert far.rto_s == 5.0
+    far.add(3.0)  # timed at last: the estimate, no backoff
+    assert far.rto_s == pytest.approx(5.0) and far.srtt_s == 3.0
+    far.add(3.0)
+    assert far.rttvar_s == pytest.approx(1.125) and far.rto_s == 5.0  # rttvar = 3/4 * 1.5; 3 + 4.5 s, bounded
 
 
 def test_the_delay_line_delays_in_order_by_its_weather():
