@@ -28,10 +28,23 @@ def open_file(spec: str, options: dict) -> FrameSource:
 
 
 def open_stream(spec: str, options: dict) -> FrameSource:
-    """An RTSP or HTTP stream through OpenCV's FFmpeg back end."""
-    from calib_core.video.opencv_source import OpenCVSource
+    """An RTSP or HTTP stream through OpenCV's FFmpeg back end, opened again when it drops (``timeout_s``,
+    ``reopen_every_s`` from the ``site:`` section's camera options)."""
+    from calib_core.connectors.options import number_option
+    from calib_core.video.stream_source import StreamSource
 
-    return OpenCVSource(spec)
+    options = dict(options or {})
+    unknown = set(options) - {"timeout_s", "reopen_every_s"}
+    if unknown:
+        raise VideoSourceError(f"camera {spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: reopen_every_s, timeout_s")
+    from calib_core.link.link_types import LinkError
+
+    try:
+        timeout_s = number_option(options, "timeout_s", 5.0, 0.1, 600.0, spec)
+        reopen_every_s = number_option(options, "reopen_every_s", 1.0, 0.05, 600.0, spec)
+    except LinkError as exc:
+        raise VideoSourceError(f"camera {exc}") from None
+    return StreamSource(spec, timeout_s=timeout_s, reopen_every_s=reopen_every_s)
 
 
 def open_folder(spec: str, options: dict) -> FrameSource:
