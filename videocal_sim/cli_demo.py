@@ -23,10 +23,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell to calibrate in (default: the bundled one)")
     parser.add_argument("--location", help="the task location to calibrate at (default: the cell's first)")
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
-    parser.add_argument("--site", choices=("sim", "ros2", "gige"), default="sim",
+    parser.add_argument("--site", choices=("sim", "ros2", "gige", "ur"), default="sim",
                         help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default); ROS 2 "
                              "(a simulated ros2_control arm and a camera topic on Cyclone DDS, domain ROS_DOMAIN_ID); or gige (the camera "
-                             "served as a GigE Vision camera on the loopback interface, read through Aravis)")
+                             "served as a GigE Vision camera on the loopback interface, read through Aravis); or ur (the robot a simulated Universal "
+                             "Robots controller: RTDE through ur_rtde, moves as URScript)")
+    parser.add_argument("--link-delay-ms", type=bounded_float(0.0, 5000.0), default=0.0, metavar="MS",
+                        help="put the controller far away: videocal's link through a delay line of this one-way delay, +-30 %% jitter, 1 %% lost "
+                             "(the frames follow the link's samples, as a gripper camera's would); with --site sim")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
                         help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 
@@ -42,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method, site_kind=args.site)
+    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method, site_kind=args.site, link_delay_ms=args.link_delay_ms)
     print(json.dumps({k: report[k] for k in ("site", "status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
     print(f"screenshots and report.json in {args.out}")
     return 0

@@ -91,7 +91,8 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
 METHODS = ("find-points", "picks", "edges")
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points", site_kind: str = "sim") -> dict:
+def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points", site_kind: str = "sim",
+             link_delay_ms: float = 0.0) -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
@@ -112,6 +113,17 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         from videocal_sim.gige_site import GigESimulatedSite
 
         site = GigESimulatedSite(site)
+    elif site_kind == "ur":  # the same cell, its robot a simulated UR controller reached through ur_rtde and URScript
+        from videocal_sim.ur_site import URSimulatedSite
+
+        site = URSimulatedSite(site)
+    if link_delay_ms:  # the same cell far away: the link through a delay line with the issue's weather
+        from videocal_sim.delay_line import LinkWeather
+        from videocal_sim.far_site import FarSimulatedSite
+
+        if site_kind != "sim":
+            raise ValueError("--link-delay-ms puts the delay line on videocal's own link: use it with --site sim")
+        site = FarSimulatedSite(site, LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01))
     bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
     wb = Workbench(cell, site)
     if location is not None:
@@ -141,6 +153,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
     confirmed: list[str] = []  # moves the operator confirmed in the overview (large joint changes)
     moves_seen: list[str] = []
+    looks_s: list[float] = []  # Go pressed -> a frame the core accepts for picks
+    last_go = [time.monotonic()]
     wb.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
     try:
@@ -165,11 +179,13 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 frame = win.camera.last_frame_received
                 return frame is not None and frame.t_host_s >= since and wb.observations.stillness(frame).settled
 
-            _wait(app, usable, 30, f"a camera frame with the robot settled {what}")
+            _wait(app, usable, 60, f"a camera frame with the robot settled {what}")
+            looks_s.append(time.monotonic() - last_go[0])
             _wait(app, win.virtual.is_current, 10, "the virtual camera")
 
         def go(button) -> None:
             """A move button; the operator looks at the ghost in the overview and presses Move when asked."""
+            last_go[0] = time.monotonic()
             _click(button, 10, 10)
             if win.overview.preview_bar.isVisible() and win.overview.move_button.isVisible():
                 confirmed.append(win.overview.preview.what)
@@ -293,6 +309,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "task_location": task.name,
             "method": method,
             "site": site.description,
+            "link": {"one_way_ms": link_delay_ms, "measured_one_way_s": getattr(wb.link, "delay_s", None), "go_to_settled_frame_s": [round(v, 2) for v in looks_s]},
             "connectors": {"controller": wb.link.url, "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(site_kind, "the simulated camera (in process)")},
             "target": wb.session.target,
             "features_skipped": skipped,

@@ -59,16 +59,19 @@ def stop_child(process: subprocess.Popen) -> None:
 
 class SimulatorProcess:
     """``videocal sim-controller --pty`` for the cell at ``workcell_path``, as a child process with
-    a stable link path in a private folder. It starts at once; :meth:`wait_ready` returns the path."""
+    a stable link path in a private folder (``tcp``: on a loopback TCP port instead). It starts at once;
+    :meth:`wait_ready` returns the path (or the ``socket://`` URL)."""
 
-    def __init__(self, workcell_path: str | Path, joints_controller=None):
+    def __init__(self, workcell_path: str | Path, joints_controller=None, *, tcp: bool = False):
         # Resolved here, where the caller's folder is known: the child runs in the project's folder.
         workcell_path = Path(workcell_path).expanduser().resolve()
         self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-")
         folder = Path(self._folder.name)
         self.link_path = folder / "controller"
         self._stderr_path = folder / "stderr.txt"
-        cmd = [sys.executable, "-m", "app.cli.main", "sim-controller", "--pty", "--link", str(self.link_path), "--workcell", str(workcell_path)]
+        self.tcp = tcp
+        where = ["--tcp", "0"] if tcp else ["--pty", "--link", str(self.link_path)]
+        cmd = [sys.executable, "-m", "app.cli.main", "sim-controller", *where, "--workcell", str(workcell_path)]
         if joints_controller is not None:
             cmd += ["--joints", ",".join(f"{v:.4f}" for v in joints_controller)]
         with open(self._stderr_path, "w") as err:
@@ -84,7 +87,7 @@ class SimulatorProcess:
                 why = self._stderr_path.read_text().strip().splitlines()
                 raise SiteError(f"the controller simulator did not start: {why[-1] if why else f'exit code {self.process.returncode}'}")
             self.device = line
-        return str(self.link_path)
+        return self.device if self.tcp else str(self.link_path)
 
     @property
     def running(self) -> bool:

@@ -30,19 +30,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     mount.add_argument("--camera-on-robot", dest="static", action="store_const", const=False, help="the camera is on the robot's flange (the default)")
     parser.add_argument("--pose-sigma-mm", type=bounded_float(0.001, 100.0), default=1.0, help="how well the robot's poses are known, 1-sigma mm (sets when views are said to disagree)")
     parser.add_argument("--poses", type=bounded_int(3, 200), default=10, help="with 'sim': robot poses to view the board from (3 to 200)")
-    parser.add_argument("--out", type=Path, required=True, help="YAML file for the mounting (xyz mm, rpy deg) and its 1-sigma")
+    parser.add_argument("--out", type=Path, required=True, action="append",
+                        help="where to write the mounting, in the form the name asks (repeat for several): .yaml videocal's (xyz mm, rpy deg, "
+                             "1-sigma); .launch.py a ROS 2 launch file running tf2_ros's static_transform_publisher; .urdf or .xacro a "
+                             "fixed-joint snippet for the robot's description")
+    parser.add_argument("--parent-frame", help="the ROS frame the camera hangs from in the .launch.py and .urdf outputs (default: the workcell's "
+                                               "robot flange link, else tool0; the base link for --static-camera)")
     parser.add_argument("--robot-errors", action="store_true", help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.vision.hand_eye_io import hand_eye_document, save_hand_eye
+    from calib_core.vision.hand_eye_io import hand_eye_document
 
     if args.source == "sim":
         result, truth = _simulated(args)
     else:
         result, truth = _from_files(args), None
-    save_hand_eye(args.out, result)
+    written = _write_outputs(args, result)
     doc = hand_eye_document(result)
     if truth is not None:
         doc["error_against_truth"] = truth
@@ -57,8 +62,34 @@ def run(args: argparse.Namespace) -> int:
         print(f"error against the test bed's truth: {truth['mm']:.3f} mm, {truth['deg']:.4f} deg")
     for w in result.warnings:
         print(f"warning: {w}")
-    print(f"wrote {args.out}")
+    for path in written:
+        print(f"wrote {path}")
     return 0
+
+
+def _write_outputs(args, result) -> list[Path]:
+    """Each ``--out`` in the form its name asks; the ROS forms name ``--parent-frame`` (or the cell's flange)."""
+    from calib_core.atomic_file import atomic_write_text
+    from calib_core.ros2.mounting_out import mounting_text_for
+    from calib_core.vision.hand_eye_io import save_hand_eye
+
+    parent = args.parent_frame
+    if parent is None:
+        frames = {}
+        if args.workcell is not None:
+            from calib_core.workcell import load_workcell
+
+            frames = load_workcell(args.workcell).robot_spec.frames or {}
+        key, fallback = ("base", "base_link") if result.static_camera else ("flange", "tool0")
+        parent = str(frames.get(key) or fallback)
+    note = f"{result.views} poses, RMS {result.rms_px:.3f} px, 1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)} mm"
+    for path in args.out:
+        text = mounting_text_for(path, result.camera2mount, parent, note=note)
+        if text is None:
+            save_hand_eye(path, result)
+        else:
+            atomic_write_text(path, text)
+    return list(args.out)
 
 
 def _detector(args, spec):

@@ -62,7 +62,11 @@ class ControllerClock:
     the reader's jitter. A controller clock that jumps back (a restart) starts the estimate again.
     ``delay_s`` is the last sample's arrival delay over that, the stamp difference kept per sample."""
 
+    SPREAD_WINDOW_S = 10.0
+    """How far back :attr:`spread_s` looks (s)."""
+
     def __init__(self, drift_allowance: float = 1e-4):
+        self._recent: deque[tuple[float, float]] = deque()  # (host arrival s, delay over the fastest s)
         self.offset_s: float | None = None
         self._last_controller_s: float | None = None
         self._last_host_s: float | None = None
@@ -83,7 +87,17 @@ class ControllerClock:
             self.offset_s = offset
         self._last_controller_s, self._last_host_s = t_controller_s, t_host_s
         self.delay_s = offset - self.offset_s
+        self._recent.append((t_host_s, self.delay_s))
+        while self._recent and t_host_s - self._recent[0][0] > self.SPREAD_WINDOW_S:
+            self._recent.popleft()
         return t_controller_s + self.offset_s
+
+    @property
+    def spread_s(self) -> float:
+        """The largest arrival delay over the fastest one in the last :data:`SPREAD_WINDOW_S` (s): how far a
+        frame that crossed the same link, stamped on arrival, may sit from the joints of its capture (a near link:
+        milliseconds; a relay satellite's: a large part of a second)."""
+        return max((d for _, d in self._recent), default=0.0)
 
 
 class JointHistory:
@@ -151,14 +165,24 @@ class JointHistory:
         w = 0.0 if t1 <= t0 else (t_s - t0) / (t1 - t0)
         return JointsAt((1 - w) * self._q[i - 1] + w * self._q[i], gap)
 
-    def stillness(self, t_s: float) -> Stillness:
-        """Whether the robot was still for ``rule.hold_s`` up to ``t_s``, from the samples."""
+    def stillness(self, t_s: float, margin_s: float = 0.0) -> Stillness:
+        """Whether the robot was still for ``rule.hold_s`` up to ``t_s``, from the samples. ``margin_s`` (s): how much
+        older than ``t_s`` the frame's content may be on the joints' time base (a frame stamped on arrival that
+        crossed a far link: :attr:`ControllerClock.spread_s`); the robot must then have been still from
+        ``t_s - hold_s - margin_s`` to ``t_s``."""
+        held = self._stillness(t_s, self.rule.hold_s + margin_s, self.rule.max_gap_s + margin_s)
+        if margin_s >= 0.005 and not held.settled and held.reason.startswith("the robot was moving"):
+            return Stillness(False, held.reason + f" (the frame may be up to {margin_s:.2f} s older than it says: the link's spread of delays)",
+                             held.still_for_s, held.speed_deg_s, held.joint)
+        return held
+
+    def _stillness(self, t_s: float, hold_s: float, unknown_after_s: float) -> Stillness:
         rule = self.rule
         if not self._t:
             why = "the link dropped: the robot's pose is unknown until a fresh joint sample arrives" if self.unknown_since_s is not None else "no joint samples: the robot's pose is unknown (is the controller link up?)"
             return Stillness(False, why, 0.0)
         times = np.fromiter(self._t, float)
-        if t_s - times[-1] > rule.max_gap_s:
+        if t_s - times[-1] > unknown_after_s:
             return Stillness(False, f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown", 0.0)
         if t_s < times[0]:
             return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
@@ -181,14 +205,14 @@ class JointHistory:
                 break
             lo, hi, k = new_lo, new_hi, k - 1
         still_for = max(0.0, t_s - times[k])
-        if still_for + 1e-9 >= rule.hold_s:
+        if still_for + 1e-9 >= hold_s:
             return Stillness(True, "", still_for)
         if k == 0:
-            return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({rule.hold_s:g} s of stillness needed)", still_for)
+            return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({hold_s:.2g} s of stillness needed)", still_for)
         if times[k] - times[k - 1] > rule.max_gap_s:
             return Stillness(False, f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen", still_for)
         # moving: the fastest joint speed in the hold window, over sample pairs >= 0.1 s apart
-        first = max(0, bisect.bisect_left(self._t, t_s - rule.hold_s) - 1)
+        first = max(0, bisect.bisect_left(self._t, t_s - hold_s) - 1)
         speed, joint = 0.0, 0
         for a in range(first, stop - 1):
             b = bisect.bisect_left(self._t, times[a] + 0.1, lo=a + 1, hi=stop)

@@ -106,7 +106,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
-        self.live = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names))
+        self.live = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.controller_clock.spread_s)
         """The live frames and the link's joint history."""
         self.observations = self.live
         self.controller_clock = ControllerClock()

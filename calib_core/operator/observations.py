@@ -10,6 +10,7 @@ goes on; every pick of the set carries the still's stamp.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
@@ -36,8 +37,10 @@ class Observations:
     stamps them. ``source``: ``live``, or the name of the recording being replayed (then the
     history is the recording's, on its time axis)."""
 
-    def __init__(self, history: JointHistory, source: str = "live"):
+    def __init__(self, history: JointHistory, source: str = "live", margin_s: Callable[[], float] = lambda: 0.0):
         self.history = history
+        self.margin_s = margin_s
+        """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread."""
         self.source = source
         self.latest: Frame | None = None
         self.previous: Frame | None = None
@@ -47,7 +50,10 @@ class Observations:
         self.previous, self.latest = self.latest, frame
 
     def stillness(self, frame: Frame) -> Stillness:
-        return self.history.stillness(frame.t_host_s)
+        return self.stillness_at(frame.t_host_s)
+
+    def stillness_at(self, t_s: float) -> Stillness:
+        return self.history.stillness(t_s, self.margin_s())
 
     def stamp(self, frame: Frame) -> ViewStamp:
         """The frame's stamp; :class:`NotSettledError` when the robot was not still before it or

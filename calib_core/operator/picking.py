@@ -195,9 +195,7 @@ class Picking:
         the newest frame's time (or the newest sample's)."""
         obs = self.observations
         t = obs.latest.t_host_s if obs.latest is not None else obs.history.latest_s
-        if t is None:
-            return obs.history.stillness(time.monotonic())
-        return obs.history.stillness(t)
+        return obs.stillness_at(time.monotonic() if t is None else t)
 
     def accept_pair(self) -> int:
         """*Accept*: the pair being made is done. Returns its number."""

@@ -60,3 +60,17 @@ def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
     assert report["status"] == "ok" and report["pairs"] >= 6
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
     assert report["estimate_within_3_sigma"]
+
+
+def test_demo_on_a_ur_controller_reaches_the_same_accuracy(tmp_path):
+    """``demo --site ur``: the robot a simulated Universal Robots controller in another process; the window reaches
+    it only through the ``ur-rtde://`` connector (ur_rtde's RTDE client for the joints, URScript for the moves)."""
+    out = tmp_path / "demo"
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "ur", "--out", str(out), "--scale", "0.5"],
+                         capture_output=True, text=True, timeout=400)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads((out / "report.json").read_text())
+    assert report["connectors"]["controller"].startswith("ur-rtde://127.") and "Universal Robots" in report["site"]
+    assert report["status"] == "ok" and report["pairs"] >= 6
+    assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
+    assert report["estimate_within_3_sigma"]

@@ -33,9 +33,22 @@ def test_ros_industrial_static_camera_set_gives_the_camera_in_the_base(tmp_path)
     """The file says static_camera, the board and the intrinsics (no image size: the images give it).
     ROS-Industrial's own starting guess for this set puts the camera at (-19.6, 1278.4, 284.0) mm."""
     out = tmp_path / "he.yaml"
-    run = _videocal("calibrate-hand-eye", ROSI / "cal_data.yaml", "--out", out, "--json")
+    run = _videocal("calibrate-hand-eye", ROSI / "cal_data.yaml", "--out", out, "--out", tmp_path / "camera.launch.py", "--out", tmp_path / "camera.urdf.xacro", "--json")
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
+    # The same mounting for ROS 2: a static_transform_publisher launch file and a URDF snippet on the base link.
+    import pinocchio as pin
+
+    cam2base = transform_from_xyz_rpy(doc["cam2base"]["xyz"], doc["cam2base"]["rpy"])
+    launch = (tmp_path / "camera.launch.py").read_text()
+    assert '"--frame-id", "base_link"' in launch and "static_transform_publisher" in launch
+    compile(launch, "camera.launch.py", "exec")
+    model = pin.buildModelFromXML(f'<robot name="r"><link name="base_link"/>{(tmp_path / "camera.urdf.xacro").read_text()}</robot>')
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, np.zeros(model.nq))
+    placed = data.oMf[model.getFrameId("videocal_camera_optical_frame")]
+    np.testing.assert_allclose(placed.translation * 1000.0, cam2base[:3, 3], atol=1e-3)
+    np.testing.assert_allclose(placed.rotation, cam2base[:3, :3], atol=1e-6)
     assert "cam2base" in doc and "board2flange" in doc and "cam2flange" not in doc
     assert np.linalg.norm(np.array(doc["cam2base"]["xyz"]) - [-19.646, 1278.43, 283.965]) < 15.0
     assert max(doc["std"]["xyz_mm"]) < 0.5 and doc["poses"] == 16

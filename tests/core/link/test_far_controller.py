@@ -85,13 +85,17 @@ def far_controller(request):
     """The controller simulator on a TCP port, 1.5 s (+-30 %, 1 % lost: the param) away through a delay line
     whose tap counts the move sentences that reach the controller."""
     sim = SimProcess("--tcp", "0", "--joints", "0,0,0,0,0,0")
-    port = int(re.search(r":(\d+)", sim.device).group(1))
-    moves_seen: list[str] = []
-    tap = lambda direction, data: moves_seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace"))) if direction == "up" else None
-    line = DelayLine(("127.0.0.1", 0), ("127.0.0.1", port), LinkWeather(1.5, 0.3, request.param), seed=7, tap=tap).start()
-    yield f"socket://{line.address[0]}:{line.address[1]}", moves_seen, line
-    line.close()
-    sim.stop()
+    try:
+        port = int(re.search(r":(\d+)", sim.device).group(1))
+        moves_seen: list[str] = []
+        tap = lambda direction, data: moves_seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace"))) if direction == "up" else None
+        line = DelayLine(("127.0.0.1", 0), ("127.0.0.1", port), LinkWeather(1.5, 0.3, request.param), seed=7, tap=tap).start()
+        try:
+            yield f"socket://{line.address[0]}:{line.address[1]}", moves_seen, line
+        finally:
+            line.close()
+    finally:
+        sim.stop()
 
 
 @pytest.mark.parametrize("far_controller", [0.01, 0.25], indirect=True, ids=["1%-lost", "25%-lost"])

@@ -77,3 +77,25 @@ def test_the_controller_clock_removes_the_arrival_delay():
     assert clock.delay_s == pytest.approx(delays[-1] - 0.005)
     clock.stamp(200.0, 1.0)  # the controller's clock went back: a restart, the estimate starts again
     assert clock.restarts == 1 and clock.offset_s == pytest.approx(199.0)
+
+
+def test_a_far_links_spread_of_delays_is_measured_and_widens_the_stillness_it_takes():
+    """A frame stamped on arrival that crossed a far link may show the robot up to the link's spread of delays
+    earlier than its stamp says (on the joints' time base): the robot must have been still that much longer."""
+    clock = ControllerClock()
+    for t_c, delay in ((0.0, 1.2), (0.02, 1.5), (0.04, 1.3), (0.06, 1.9)):  # 1.5 s +-30 % one way
+        clock.stamp(100.0 + t_c + delay, t_c)
+    assert clock.spread_s == pytest.approx(0.7, abs=1e-3)  # the slowest over the fastest (less the drift allowance)
+    clock.stamp(100.0 + 20.0 + 1.2, 20.0)  # ten seconds on: the old delays have aged out of the window
+    assert clock.spread_s == pytest.approx(0.0, abs=1e-2)
+    h = JointHistory(rule=SettleRule(speed_deg_s=0.5, hold_s=0.3), joint_names=["a"])
+    _ramp(h, 0.0, 1.0, [0], [20])  # moving until t = 1
+    _ramp(h, 1.02, 3.0, [20], [20])  # still after
+    assert h.stillness(1.4).settled  # a near link: 0.3 s of stillness before the frame are enough
+    far = h.stillness(1.4, margin_s=0.5)  # its content may be from t = 0.9: the robot was moving then
+    assert not far.settled and "0.50 s older than it says" in far.reason and far.joint == 0
+    assert h.stillness(1.9, margin_s=0.5).settled
+    # a frame newer than the newest sample by more than the gap allowed, less than the gap plus the spread: pending,
+    # not "pose unknown" (the samples of its time are on their way)
+    assert h.stillness(3.5).reason.startswith("no joint sample") and not h.stillness(3.5).pending
+    assert h.stillness(3.5, margin_s=0.5).pending
