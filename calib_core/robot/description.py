@@ -60,7 +60,7 @@ def resolve_uri(uri: str, urdf_dir: Path, roots: list[Path]) -> tuple[Path | Non
     return None, looked
 
 
-def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path]) -> None:
+def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path], uris: dict[str, str] | None = None) -> None:
     for link in root.iter("link"):
         for role in ("visual", "collision"):
             for element in link.iter(role):
@@ -74,11 +74,16 @@ def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path]) -> None:
                     if found.suffix.lower() not in _MESH_SUFFIXES:
                         raise FileFormatError(path, f"{where} {uri!r}: unsupported format {found.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
                     mesh.set("filename", str(found))
+                    if uris is not None:
+                        uris[str(found)] = uri
 
 
-def read_description(path: str | Path, package_paths: Iterable[str | Path] = (), xacro_args: dict[str, str] | None = None) -> str:
+def read_description(path: str | Path, package_paths: Iterable[str | Path] = (), xacro_args: dict[str, str] | None = None,
+                     mesh_uris: dict[str, str] | None = None) -> str:
     """URDF text of a URDF or xacro file with every mesh as an absolute path. A xacro file is expanded with
     ``xacro_args`` (``$(arg name)``) and packages found as :mod:`calib_core.robot.ros_packages` says.
+    ``mesh_uris``, when given, receives each absolute path's reference as the file wrote it (``package://...``),
+    so a description written back for ROS keeps them.
 
     :class:`FileFormatError` names the file for a missing, unreadable or malformed file, a xacro
     that cannot be expanded, and (with the link) a mesh that cannot be found.
@@ -99,7 +104,7 @@ def read_description(path: str | Path, package_paths: Iterable[str | Path] = (),
     if root.tag != "robot":
         raise FileFormatError(path, f"not a URDF: the top element is <{root.tag}>, not <robot>")
     _check_numbers(root, path)
-    _resolve_meshes(root, path, package_search_roots(package_paths))
+    _resolve_meshes(root, path, package_search_roots(package_paths), mesh_uris)
     return ET.tostring(root, encoding="unicode")
 
 

@@ -71,6 +71,8 @@ class RobotModel:
     full_model: pin.Model | None = None
     locked_joint_ids: tuple[int, ...] = ()
     locked_configuration: np.ndarray | None = None
+    mesh_uris: dict[str, str] = field(default_factory=dict)
+    """Each mesh's absolute path in ``urdf_xml`` -> its reference as the description wrote it (``package://...``)."""
 
     def __post_init__(self):
         kinds = []
@@ -219,7 +221,8 @@ class RobotModel:
 
     def copy(self) -> RobotModel:
         model = self.model.copy()
-        return RobotModel(model, model.createData(), self.urdf_path, self.urdf_xml, dict(self.roles), self.base2root.copy(), self.full_model, self.locked_joint_ids, self.locked_configuration)
+        return RobotModel(model, model.createData(), self.urdf_path, self.urdf_xml, dict(self.roles), self.base2root.copy(), self.full_model, self.locked_joint_ids,
+                          self.locked_configuration, dict(self.mesh_uris))
 
 
 def _held_configuration(full: pin.Model, held: dict[str, float], path: Path) -> tuple[list[int], np.ndarray]:
@@ -279,7 +282,8 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
     path = Path(spec.urdf)
     if not path.is_file():
         raise FileFormatError(path, "no such URDF file")
-    xml = read_description(path, spec.package_paths, spec.xacro_args)
+    mesh_uris: dict[str, str] = {}
+    xml = read_description(path, spec.package_paths, spec.xacro_args, mesh_uris)
     try:
         full = pin.buildModelFromXML(xml)
     except (RuntimeError, ValueError) as exc:
@@ -295,4 +299,4 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
         raise RobotSpecError("robot.frames.base", f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world", path)
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     base2root = _to_mm(data.oMf[base_id])
-    return RobotModel(model, data, path, xml, roles, base2root, full, tuple(locked), q_ref)
+    return RobotModel(model, data, path, xml, roles, base2root, full, tuple(locked), q_ref, mesh_uris)

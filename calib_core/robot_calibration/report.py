@@ -2,7 +2,9 @@
 
 ``robot_calibration.yaml``: every parameter with its value and 1-sigma (identified or left at zero),
 the observability, the residuals per view, the camera. ``<robot>_calibrated.urdf``: the robot's own
-description (xacro expanded) with the corrected joint origins, the same structure otherwise.
+description (xacro expanded) with the corrected joint origins, the same structure otherwise, its meshes named as the
+description named them (``package://...`` kept, so ROS finds them where it found the original's), as
+robot_calibration writes it.
 """
 
 from __future__ import annotations
@@ -63,6 +65,10 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
             _set_origin(element, invert(folded) @ after)
         else:
             left.append(f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})")
+    for mesh in root.iter("mesh"):  # package:// meshes as the description named them, not where this machine found them
+        original = nominal.mesh_uris.get(mesh.get("filename", ""), "")
+        if original.startswith("package://"):
+            mesh.set("filename", original)  # (a path relative to the original URDF stays absolute: the file is written elsewhere)
     return ET.tostring(root, encoding="unicode"), left
 
 

@@ -107,3 +107,24 @@ def test_runaway_expressions_are_bounded(tmp_path):
     big.write_text("""<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${'a'*10**10}"/><link name="${x}"/></robot>""")
     with pytest.raises(FileFormatError, match="big.xacro.*needed more than 512 MB"):
         expand_xacro(big, [], memory_mb=512)
+
+
+def test_a_calibrated_kr6_keeps_its_package_meshes_and_its_corrected_joint(tmp_path):
+    """The calibrated URDF as robot_calibration writes it: the vendor's ``package://`` mesh names, not this machine's
+    paths; read back (with the package path) it has the corrected joint origin and the same meshes."""
+    from calib_core.robot_calibration.report import calibrated_urdf
+
+    spec = RobotSpec(KR6, (KUKA,), {"base": None, "flange": "tool0", "tcp": "tool0", "camera": "tool0"})
+    nominal = load_robot(spec)
+    calibrated = nominal.copy()
+    k = calibrated.model.getJointId("joint_a2")
+    calibrated.model.jointPlacements[k].translation = calibrated.model.jointPlacements[k].translation + np.array([0.0004, -0.0002, 0.0003])
+    text, left = calibrated_urdf(nominal, calibrated, camera_frame="tool0")
+    meshes = [m.get("filename") for m in ET.fromstring(text).iter("mesh")]
+    assert meshes and all(m.startswith("package://kuka_kr6_support/meshes/") for m in meshes), meshes[:3]
+    out = tmp_path / "kr6_calibrated.urdf"
+    out.write_text(text)
+    again = load_robot(RobotSpec(out, (KUKA,), {"base": None, "flange": "tool0", "tcp": "tool0", "camera": "tool0"}))
+    q = np.array([10.0, -20.0, 30.0, 5.0, 40.0, -15.0])  # deg
+    np.testing.assert_allclose(again.fk(q, "tool0"), calibrated.fk(q, "tool0"), atol=1e-6)
+    assert not np.allclose(again.fk(q, "tool0"), nominal.fk(q, "tool0"), atol=1e-3)
