@@ -10,6 +10,7 @@ goes on; every pick of the set carries the still's stamp.
 from __future__ import annotations
 
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -18,6 +19,10 @@ from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory, Stillness
 from calib_core.video.frame import Frame
+
+
+RECENT_FRAMES = 16
+"""The frames kept to fall back on while the newest wait for their joint samples (at 15 fps, about a second)."""
 
 
 class NotSettledError(OperatorError):
@@ -43,11 +48,12 @@ class Observations:
         """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread."""
         self.source = source
         self.latest: Frame | None = None
-        self.previous: Frame | None = None
+        self._recent: deque[Frame] = deque(maxlen=RECENT_FRAMES)
         self.still: HeldFrame | None = None
 
     def observe(self, frame: Frame) -> None:
-        self.previous, self.latest = self.latest, frame
+        self.latest = frame
+        self._recent.append(frame)
 
     def stillness(self, frame: Frame) -> Stillness:
         return self.stillness_at(frame.t_host_s)
@@ -72,12 +78,13 @@ class Observations:
         return ViewStamp(int(frame.index), float(frame.t_host_s), tuple(float(v) for v in at.joints_deg), float(at.stamp_gap_s), captured_at, self.source)
 
     def newest_usable(self) -> Frame | None:
-        """The newest frame; when its joint samples have not arrived yet (the joint stream lags a frame
-        by up to a sample period, 20 ms at 50 Hz), the one before it."""
-        frame = self.latest
-        if frame is not None and self.previous is not None and self.stillness(frame).pending:
-            frame = self.previous
-        return frame
+        """The newest frame whose joint samples have arrived: the joint stream lags the frames by up to a sample
+        period (20 ms at 50 Hz) on a near link, and by the link's spread of delays on a far one (most of a second at
+        1.5 s +-30 %), so the newest frames may not be judged yet. The newest of all when none can be."""
+        for frame in reversed(self._recent):
+            if not self.stillness(frame).pending:
+                return frame
+        return self.latest
 
     def hold(self, frame: Frame | None = None) -> HeldFrame:
         """Hold ``frame`` for picking. By default the newest; when its joint samples have not arrived

@@ -191,10 +191,11 @@ class Picking:
             self.release_frame()
 
     def robot_settled(self):
-        """Whether the robot is still now (a :class:`~calib_core.link.joint_history.Stillness`), from
-        the newest frame's time (or the newest sample's)."""
+        """Whether the robot is still now (a :class:`~calib_core.link.joint_history.Stillness`), at the newest frame
+        that can be judged (its joint samples arrived), or the newest sample's time."""
         obs = self.observations
-        t = obs.latest.t_host_s if obs.latest is not None else obs.history.latest_s
+        frame = obs.newest_usable()
+        t = frame.t_host_s if frame is not None else obs.history.latest_s
         return obs.stillness_at(time.monotonic() if t is None else t)
 
     def accept_pair(self) -> int:
