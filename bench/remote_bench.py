@@ -134,8 +134,11 @@ def main() -> str:
         lines.append(f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
                      f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |")
     lines += ["", "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored against "
-              "the truth). The spread of delays the settle rule adds includes a lost segment's (a round trip late): the window "
-              "waits that out for 10 s after it, which is most of a far look's time. The measured one-way delay is half TCP's "
+              "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is judged "
+              "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a round "
+              "trip late every two seconds or so, so the spread stays near 4 s (1.5 s +-30 % plus a lost segment's 3.2 s) and a far "
+              "look waits about that twice, on top of the link-level look above. That is the price of never taking a frame whose "
+              "content may be from before the robot stopped. The measured one-way delay is half TCP's "
               "smoothed round trip, which the lost segments' late answers raise above the mean delay. The move's own duration "
               "(the simulator's trapezoid) and the hold are in every row; what the delay adds is about one round trip (the move "
               "out, its DON and the samples of the hold back). The handshake is two round trips once the first hello's answer "

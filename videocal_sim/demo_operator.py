@@ -176,7 +176,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             since = time.monotonic()
 
             def usable() -> bool:
-                frame = win.camera.last_frame_received
+                # the frame a click would hold: the newest whose joint samples have arrived (a far link's lag behind)
+                frame = wb.observations.newest_usable()
                 return frame is not None and frame.t_host_s >= since and wb.observations.stillness(frame).settled
 
             _wait(app, usable, 60, f"a camera frame with the robot settled {what}")
