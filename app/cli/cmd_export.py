@@ -23,7 +23,7 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.workspace.workspace import load_workspace
 
     ws = load_workspace(args.workspace)
-    text = export_corrections(args.format, ws.corrections, ws.task_locations)
+    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None)
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")

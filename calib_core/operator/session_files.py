@@ -4,6 +4,8 @@ file; it uses the core's cell, session, task locations, events and recorder."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from calib_core.calibration.session import CalibrationError
 
 
@@ -44,7 +46,7 @@ class SessionFiles:
 
         if not self.session.corrections.tasks():
             raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
-        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations))
+        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations, Path(path).name.split(".")[0]))
         self.message.emit(f"corrections exported to {path} ({fmt})")
 
     def start_recording(self, path, **options) -> None:

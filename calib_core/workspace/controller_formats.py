@@ -12,7 +12,9 @@ language declares a Cartesian target:
 
 A pose alone does not fix the arm's configuration (ABB ``confdata``, FANUC ``CONFIG``, KUKA
 ``S``/``T``): the listings say so, and leave it to be taught on the controller.
-Variable names are made unique within a listing after the vendor's length limit.
+Variable names are made unique within a listing after the vendor's length limit. The listing's own name (RAPID's
+``MODULE``, KRL's ``DEFDAT``, FANUC's ``/PROG``) is the file's, as the controllers require (a KRL data list whose
+``DEFDAT`` differs from its file name is refused when loaded; a FANUC ``.ls`` is loaded under its ``/PROG`` name).
 """
 
 from __future__ import annotations
@@ -97,8 +99,24 @@ def pdl2_pos(T: np.ndarray) -> str:
 Entry = tuple[str, np.ndarray, str]
 """(variable name, target pose (4, 4) mm in base, a remark)."""
 
+DEFAULT_NAME = "videocal_corrections"
 
-def _urscript(entries: list[Entry], when: str) -> list[str]:
+
+def listing_name(fmt: str, stem: str | None) -> str:
+    """The listing's own name for a file named ``stem`` (``None``: :data:`DEFAULT_NAME`), as ``fmt`` requires it: an
+    identifier within the language's limit (KRL 24, RAPID 32, FANUC 36 upper case). :class:`InvalidNameError` says why
+    a file name cannot be one (the controller would refuse the file)."""
+    name = stem or DEFAULT_NAME
+    limit = {"krl": 24, "rapid": 32, "fanuc": 36}.get(fmt)
+    if limit is None:
+        return name
+    if not _IDENTIFIER.fullmatch(name) or len(name) > limit:
+        raise InvalidNameError(f"{name!r}: a {fmt} file's name is its {'DEFDAT' if fmt == 'krl' else 'MODULE' if fmt == 'rapid' else 'program'} name: "
+                               f"a letter, then letters, digits or _, at most {limit} characters; rename the output file")
+    return name.upper() if fmt == "fanuc" else name
+
+
+def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
     lines = [f"# videocal corrected task locations, {when}",
              "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location"]
     for ident, T, note in entries:
@@ -106,26 +124,36 @@ def _urscript(entries: list[Entry], when: str) -> list[str]:
     return lines
 
 
-def _rapid(entries: list[Entry], when: str) -> list[str]:
-    lines = ["MODULE videocal_corrections", f"  ! videocal corrected task locations, {when}",
+def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+    lines = [f"MODULE {name}", f"  ! videocal corrected task locations, {when}",
              "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0); confdata [0,0,0,0] must be taught"]
     for ident, T, note in entries:
         lines += [f"  ! {note}", f"  CONST robtarget {ident} := {rapid_robtarget(T)};"]
     return lines + ["ENDMODULE"]
 
 
-def _krl(entries: list[Entry], when: str) -> list[str]:
-    lines = ["DEFDAT videocal_corrections PUBLIC", f"; videocal corrected task locations, {when}",
+def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+    lines = [f"DEFDAT {name} PUBLIC", f"; videocal corrected task locations, {when}",
              "; FRAME {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; S and T are taught"]
     for ident, T, note in entries:
         lines += [f"; {note}", f"DECL GLOBAL FRAME {ident}={krl_frame(T)}"]
     return lines + ["ENDDAT"]
 
 
-def _fanuc(entries: list[Entry], when: str) -> list[str]:
+def _fanuc_attr(line_count: int, when: str) -> list[str]:
+    """The ``/ATTR`` section every ``.ls`` file the controller writes has (dates as ``DATE yy-mm-dd TIME hh:mm:ss``)."""
+    stamp = time.strptime(when, "%Y-%m-%d %H:%M:%S")
+    date = f"DATE {time.strftime('%y-%m-%d', stamp)}  TIME {time.strftime('%H:%M:%S', stamp)}"
+    return ["/ATTR", "OWNER\t\t= MNEDITOR;", 'COMMENT\t\t= "videocal";', "PROG_SIZE\t= 0;", f"CREATE\t\t= {date};", f"MODIFIED\t= {date};",
+            "FILE_NAME\t= ;", "VERSION\t\t= 0;", f"LINE_COUNT\t= {line_count};", "MEMORY_SIZE\t= 0;", "PROTECT\t\t= READ_WRITE;",
+            "TCD:  STACK_SIZE\t= 0,", "      TASK_PRIORITY\t= 50,", "      TIME_SLICE\t= 0,", "      BUSY_LAMP_OFF\t= 0,",
+            "      ABORT_REQUEST\t= 0,", "      PAUSE_REQUEST\t= 0;", "DEFAULT_GROUP\t= 1,*,*,*,*;", "CONTROL_CODE\t= 00000000 00000000;"]
+
+
+def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper()) -> list[str]:
     notes = [f"videocal corrected task locations, {when}", "X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W)) in the robot's world frame; CONFIG must be taught"]
     notes += [f"P[{k}] {ident}: {note}" for k, (ident, _, note) in enumerate(entries, start=1)]
-    lines = ["/PROG VIDEOCAL_CORR", "/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
+    lines = [f"/PROG  {name}"] + _fanuc_attr(len(notes), when) + ["/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
     for k, (ident, T, _) in enumerate(entries, start=1):
         x, y, z, w, p, r = fanuc_position(T)
         lines += [
@@ -136,7 +164,7 @@ def _fanuc(entries: list[Entry], when: str) -> list[str]:
     return lines + ["/END"]
 
 
-def _pdl2(entries: list[Entry], when: str) -> list[str]:
+def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
     lines = [f"-- videocal corrected task locations, {when}",
              "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
     lines += [f"  {ident} : POSITION  -- {note}" for ident, _, note in entries]
@@ -155,10 +183,11 @@ def corrected_targets(table: CorrectionTable, tasks: dict[str, TaskLocation]) ->
     return {name: table.corrected_target(name, tasks[name].tcp2base) for name in table.tasks() if name in tasks}
 
 
-def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation]) -> str:
+def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None) -> str:
     """The corrected targets as a ``fmt`` listing (:data:`FORMATS`), one variable per task location,
-    each with its measured displacement as a remark."""
+    each with its measured displacement as a remark; named after the file it goes to (``file_stem``)."""
     writer, max_name = LISTINGS[fmt]
+    listing = listing_name(fmt, file_stem)
     targets = corrected_targets(table, tasks)
     for name in targets:  # never write a name that was not checked, whatever let it in
         check_name(name, "task location")
@@ -170,4 +199,4 @@ def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLo
     for name, T in targets.items():
         c = table.latest(name)
         entries.append((idents[name], T, f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
-    return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S")) + [""])
+    return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S"), listing) + [""])

@@ -70,10 +70,11 @@ def corrections_pdl2(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> 
     return controller_listing("pdl2", table, tasks)
 
 
-def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation]) -> str:
-    """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`)."""
+def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None) -> str:
+    """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`); a controller listing is named after the file it
+    goes to (``file_stem``, the name without its suffixes), as the controller requires."""
     if fmt == "json":
         return corrections_json(table, tasks)
     if fmt == "csv":
         return corrections_csv(table, tasks)
-    return controller_listing(fmt, table, tasks)
+    return controller_listing(fmt, table, tasks, file_stem)

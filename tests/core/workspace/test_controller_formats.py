@@ -107,3 +107,25 @@ def test_csv_and_json_hold_the_target_to_command(table):
     assert row["source"].startswith("'=")  # a spreadsheet must not run it
     data = json.loads(corrections_json(t, tasks))
     assert data["frame"] == "base" and np.allclose(data["corrections"][0]["target_to_command"]["xyz"], target[:3, 3])
+
+
+def test_each_listing_is_named_after_its_file_as_the_controller_requires(table):
+    """KRL loads a data list only when its DEFDAT is the file's name; FANUC loads an .ls under its /PROG name; a
+    file name the language cannot take is refused before anything is written, naming the rule."""
+    from calib_core.names import InvalidNameError
+
+    t, tasks = table
+    assert controller_listing("krl", t, tasks, "cell_targets").startswith("DEFDAT cell_targets PUBLIC\n")
+    assert controller_listing("rapid", t, tasks, "CellTargets").startswith("MODULE CellTargets\n")
+    fanuc = controller_listing("fanuc", t, tasks, "cell_targets")
+    assert fanuc.startswith("/PROG  CELL_TARGETS\n/ATTR\n")
+    # the /ATTR section as the controller writes it: its fields in order, the line count that of /MN
+    attr = fanuc[fanuc.index("/ATTR"):fanuc.index("/MN")]
+    fields = [line.split("=")[0].strip() for line in attr.splitlines()[1:] if "=" in line and not line.startswith(" ")]
+    assert fields[:11] == ["OWNER", "COMMENT", "PROG_SIZE", "CREATE", "MODIFIED", "FILE_NAME", "VERSION", "LINE_COUNT", "MEMORY_SIZE", "PROTECT", "TCD:  STACK_SIZE"]
+    mn = fanuc[fanuc.index("/MN") + 4:fanuc.index("/POS")].strip().splitlines()
+    assert f"LINE_COUNT\t= {len(mn)};" in attr and re.search(r"CREATE\t\t= DATE \d\d-\d\d-\d\d  TIME \d\d:\d\d:\d\d;", attr)
+    assert controller_listing("krl", t, tasks).startswith("DEFDAT videocal_corrections PUBLIC")  # no file: the default
+    for fmt, bad in (("krl", "my-targets"), ("krl", "a" * 25), ("fanuc", "1cell")):
+        with pytest.raises(InvalidNameError, match="rename the output file"):
+            controller_listing(fmt, t, tasks, bad)

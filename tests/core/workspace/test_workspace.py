@@ -111,3 +111,9 @@ def test_exports(tmp_path, workspace):
     assert run.returncode == 0 and "oru_1_grasp_c := POS(" in run.stdout
     bad = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(tmp_path / "nope.json")], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "no such workspace file" in bad.stderr
+    # a KRL data list named after its file; a file name KRL cannot take is one error line, and nothing is written
+    krl = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "krl", "--out", str(tmp_path / "cell_targets.dat")], capture_output=True, text=True, timeout=60)
+    assert krl.returncode == 0 and (tmp_path / "cell_targets.dat").read_text().startswith("DEFDAT cell_targets PUBLIC")
+    dashed = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "krl", "--out", str(tmp_path / "cell-targets.dat")], capture_output=True, text=True, timeout=60)
+    assert dashed.returncode == 2 and dashed.stderr.startswith("error:") and "rename the output file" in dashed.stderr and "Traceback" not in dashed.stderr
+    assert not (tmp_path / "cell-targets.dat").exists()
