@@ -172,12 +172,9 @@ def csv_numbers(cells: list[str], columns: list[str], path: str | Path, where: s
 def read_grey_image(image_path: str | Path, listed_in: str | Path, where: str) -> "np.ndarray":
     """The image (h, w) uint8 grey that a row ``where`` of the file ``listed_in`` names. Refused with a
     :class:`FileFormatError`: a missing image names the list and its row, an unreadable one the image."""
-    import cv2
+    from calib_core.image_files import read_image
 
     image_path = Path(image_path)
     if not image_path.is_file():
         raise FileFormatError(listed_in, f"no such image {image_path}", where)
-    image = cv2.imread(str(image_path), cv2.IMREAD_GRAYSCALE)
-    if image is None:
-        raise FileFormatError(image_path, "not an image OpenCV can read", where)
-    return image
+    return read_image(image_path, grey=True, where=where)

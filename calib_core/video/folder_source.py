@@ -5,8 +5,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import cv2
-
+from calib_core.errors import FileFormatError
+from calib_core.image_files import read_image
 from calib_core.video.frame import Frame, FrameSource, VideoSourceError
 
 SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
@@ -36,9 +36,10 @@ class ImageFolderSource(FrameSource):
             if not self.loop:
                 return None
         path = self.files[self._index % len(self.files)]
-        bgr = cv2.imread(str(path), cv2.IMREAD_COLOR)
-        if bgr is None:
-            raise VideoSourceError(f"{path}: not a readable image")
-        frame = Frame(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), self._index, time.monotonic(), self._index / self._fps if self._fps else None)
+        try:
+            rgb = read_image(path)
+        except FileFormatError as exc:
+            raise VideoSourceError(str(exc)) from None
+        frame = Frame(rgb, self._index, time.monotonic(), self._index / self._fps if self._fps else None)
         self._index += 1
         return frame

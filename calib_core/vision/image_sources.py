@@ -9,6 +9,7 @@ import cv2
 import numpy as np
 
 from calib_core.errors import FileFormatError
+from calib_core.image_files import read_image
 
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
 
@@ -19,10 +20,7 @@ def folder_images(folder: Path) -> Iterator[tuple[str, np.ndarray]]:
     if not files:
         raise FileFormatError(folder, f"no images ({', '.join(sorted(IMAGE_SUFFIXES))}) in this folder")
     for p in files:
-        bgr = cv2.imread(str(p), cv2.IMREAD_COLOR)
-        if bgr is None:
-            raise FileFormatError(p, "not a readable image")
-        yield p.name, cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
+        yield p.name, read_image(p)  # its size checked from the header before decoding
 
 
 def video_frames(path: Path, every: int = 15) -> Iterator[tuple[str, np.ndarray]]:
