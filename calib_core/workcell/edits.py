@@ -16,11 +16,10 @@ from calib_core.calibration.undo import Command
 from calib_core.names import check_typed_name
 from calib_core.errors import FileFormatError, OperatorError
 from calib_core.frames import check_transform
+from calib_core.mesh_files import MESH_SCALE, MESH_SUFFIXES, load_mesh
 from calib_core.scene import SceneItem
 from calib_core.workcell.model import TaskLocation, Workcell
 
-MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
-_SCALE = {"mm": 1.0, "m": 1000.0}
 
 Notify = Callable[[str, str], None]
 
@@ -31,21 +30,10 @@ def check_name(name: str, what: str) -> str:
 
 
 def load_component_mesh(path: str | Path, units: str = "mm") -> trimesh.Trimesh:
-    """A component's mesh (mm) from a file; :class:`FileFormatError` names the file."""
-    path = Path(path)
-    if path.suffix.lower() not in MESH_SUFFIXES:
-        raise FileFormatError(path, f"unsupported mesh format {path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
-    if units not in _SCALE:
+    """A component's mesh (mm) from a file; :class:`FileFormatError` names the file (:func:`calib_core.mesh_files.load_mesh`)."""
+    if units not in MESH_SCALE:
         raise OperatorError(f"mesh units must be 'mm' or 'm', got {units!r}")
-    try:
-        mesh = trimesh.load(path, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
-        raise FileFormatError(path, f"cannot read the mesh: {exc}") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise FileFormatError(path, "the mesh has no triangles")
-    if _SCALE[units] != 1.0:
-        mesh.apply_scale(_SCALE[units])
-    return mesh
+    return load_mesh(path, units)
 
 
 class AddComponent(Command):

@@ -12,12 +12,12 @@ import math
 from pathlib import Path
 
 import numpy as np
-import trimesh
 from calib_core.documents import read_yaml
 
 from calib_core.names import name_problem
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
+from calib_core.mesh_files import MESH_SCALE, MESH_SUFFIXES, load_mesh
 from calib_core.robot.errors import RobotSpecError
 from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
@@ -35,8 +35,6 @@ _TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components",
 _COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
 _TASK_KEYS = {"name", "component", "tcp2base", "approach_mm", "tolerance_mm"}
 _KINDS = {"component", "fixture"}
-_MESH_SCALE = {"mm": 1.0, "m": 1000.0}
-_MESH_SUFFIXES = {".stl", ".obj", ".dae", ".glb", ".gltf", ".ply"}
 
 
 class _Reader:
@@ -111,18 +109,14 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
     raw = reader.mapping(raw, f, _COMPONENT_KEYS, {"name", "mesh", "mesh_units", "placement"})
     name = reader.name(raw["name"], f"{f}.name")
     kind = reader.choice(raw.get("kind", "component"), f"{f}.kind", _KINDS)
-    units = reader.choice(raw["mesh_units"], f"{f}.mesh_units", set(_MESH_SCALE))
+    units = reader.choice(raw["mesh_units"], f"{f}.mesh_units", set(MESH_SCALE))
     mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
-    if mesh_path.suffix.lower() not in _MESH_SUFFIXES:
+    if mesh_path.suffix.lower() not in MESH_SUFFIXES:
         raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
     try:
-        mesh = trimesh.load(mesh_path, force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
-        raise reader.fail(f"{f}.mesh", f"cannot read mesh {mesh_path.name}: {exc}") from None
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise reader.fail(f"{f}.mesh", f"mesh {mesh_path.name} has no triangles")
-    if _MESH_SCALE[units] != 1.0:
-        mesh.apply_scale(_MESH_SCALE[units])
+        mesh = load_mesh(mesh_path, units)
+    except FileFormatError as exc:  # said as the workcell's field, the mesh file named
+        raise reader.fail(f"{f}.mesh", f"mesh {mesh_path.name}: {exc.detail}") from None
     color = tuple(reader.vector(raw.get("color", [0.7, 0.7, 0.7]), 3, f"{f}.color"))
     if not all(0.0 <= c <= 1.0 for c in color):
         raise reader.fail(f"{f}.color", f"RGB values must lie in [0, 1], got {list(color)}")

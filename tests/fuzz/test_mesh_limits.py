@@ -1,0 +1,62 @@
+"""Meshes beyond their limits (issue 33): a 5-million-triangle STL refused from its header before it is read, a mesh
+with coordinates of 3e38 or no area refused, each error naming the file; through the workcell, the error names the
+workcell's field too."""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+import pytest
+import trimesh
+
+from calib_core.errors import FileFormatError
+from calib_core.mesh_files import MAX_TRIANGLES, load_mesh
+
+
+def _binary_stl_claiming(path, triangles: int) -> None:
+    """A binary STL header declaring ``triangles`` (followed by one triangle only: nothing large is written)."""
+    path.write_bytes(b"videocal test" + b" " * 67 + struct.pack("<I", triangles) + struct.pack("<12fH", *([0.0] * 12), 0))
+
+
+def test_a_huge_binary_stl_is_refused_from_its_header(tmp_path):
+    path = tmp_path / "huge.stl"
+    _binary_stl_claiming(path, 5_000_000)
+    with pytest.raises(FileFormatError, match=f"5000000 triangles is over the limit of {MAX_TRIANGLES}"):
+        load_mesh(path)
+
+
+def test_absurd_or_empty_meshes_are_refused_and_a_good_one_is_read_in_mm(tmp_path):
+    box = trimesh.creation.box((0.1, 0.2, 0.3))  # metres
+    good = tmp_path / "box.stl"
+    box.export(good)
+    mesh = load_mesh(good, "m")
+    np.testing.assert_allclose(mesh.extents, [100.0, 200.0, 300.0], atol=1e-4)  # mm
+    far = box.copy()
+    far.vertices = far.vertices * 1e38
+    far.export(tmp_path / "far.stl")
+    flat = trimesh.Trimesh(vertices=[[0, 0, 0], [1, 0, 0], [2, 0, 0]], faces=[[0, 1, 2]], process=False)
+    flat.export(tmp_path / "flat.stl")
+    (tmp_path / "text.stl").write_text("solid nothing\nendsolid nothing\n")
+    for name, why in (("far.stl", "beyond 1e\\+07 mm: are its units right"), ("flat.stl", "no area|no triangles"), ("text.stl", "no triangles|cannot read"),
+                      ("missing.stl", "no such mesh file")):
+        with pytest.raises(FileFormatError, match=why) as info:
+            load_mesh(tmp_path / name)
+        assert info.value.path.name == name
+    with pytest.raises(FileFormatError, match="unsupported mesh format '.xyz'"):
+        load_mesh(tmp_path / "cloud.xyz")
+
+
+def test_the_workcell_names_its_field_and_the_mesh(tmp_path):
+    import shutil
+
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    resources = tmp_path / "resources"  # the workcell names the robot and camera beside it
+    shutil.copytree(DEFAULT_WORKCELL.parents[1], resources, ignore=shutil.ignore_patterns("*.png", "*.mcap", "recordings"))
+    cell = resources / DEFAULT_WORKCELL.parent.name
+    text = (cell / DEFAULT_WORKCELL.name).read_text()
+    first_mesh = next(line.split(":", 1)[1].strip() for line in text.splitlines() if line.strip().startswith("mesh:"))
+    _binary_stl_claiming(cell / first_mesh, 5_000_000)
+    with pytest.raises(FileFormatError, match=r"field 'components\[0\]\.mesh'.*5000000 triangles is over the limit"):
+        load_workcell(cell / DEFAULT_WORKCELL.name)
