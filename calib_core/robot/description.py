@@ -116,19 +116,36 @@ def _numbers(text: str | None, n: int) -> list[float] | None:
     return values if len(values) == n else None
 
 
+MAX_URDF_JOINTS = 500
+"""The most joints a description may have (a humanoid has about 50; a 2999-joint URDF exhausted memory)."""
+MAX_ORIGIN_M = 1000.0
+"""The farthest an origin may place a link from its parent (m): beyond, a unit error (mm read as m)."""
+
+
 def _check_numbers(root: ET.Element, path: Path) -> None:
-    """Origins finite (a NaN origin made Pinocchio drop the visual without a word) and joint limits
-    in order: the robot model every move is previewed with must be the one the file says."""
+    """Origins finite and within reach (a NaN origin made Pinocchio drop the visual without a word), joint axes
+    not zero, joint limits in order, and no more joints than a robot has: the robot model every move is
+    previewed with must be the one the file says."""
+    joints = root.findall(".//joint")
+    if len(joints) > MAX_URDF_JOINTS:
+        raise FileFormatError(path, f"{len(joints)} joints: over the limit of {MAX_URDF_JOINTS} for one robot description")
     for parent in root.iter():
         for origin in parent.findall("origin"):
             for attr in ("xyz", "rpy"):
                 if origin.get(attr) is None:
                     continue
                 values = _numbers(origin.get(attr), 3)
+                owner = f"{parent.tag} '{parent.get('name')}'" if parent.get("name") else f"a {parent.tag}"
                 if values is None or not all(math.isfinite(v) for v in values):
-                    owner = f"{parent.tag} '{parent.get('name')}'" if parent.get("name") else f"a {parent.tag}"
                     raise FileFormatError(path, f"{owner}: origin {attr}={origin.get(attr)!r} must be three finite numbers")
+                if attr == "xyz" and max(abs(v) for v in values) > MAX_ORIGIN_M:
+                    raise FileFormatError(path, f"{owner}: origin xyz={origin.get(attr)!r} is over {MAX_ORIGIN_M:g} m away: a URDF is in metres (mm written as m?)")
     for joint in root.iter("joint"):
+        axis = joint.find("axis")
+        if axis is not None and joint.get("type") in ("revolute", "continuous", "prismatic"):
+            values = _numbers(axis.get("xyz", "1 0 0"), 3)
+            if values is None or not all(math.isfinite(v) for v in values) or math.hypot(*values) < 1e-9:
+                raise FileFormatError(path, f"joint '{joint.get('name')}': axis xyz={axis.get('xyz')!r} must be three finite numbers, not all zero")
         limit = joint.find("limit")
         if limit is None or joint.get("type") not in ("revolute", "prismatic"):
             continue

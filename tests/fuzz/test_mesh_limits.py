@@ -60,3 +60,29 @@ def test_the_workcell_names_its_field_and_the_mesh(tmp_path):
     _binary_stl_claiming(cell / first_mesh, 5_000_000)
     with pytest.raises(FileFormatError, match=r"field 'components\[0\]\.mesh'.*5000000 triangles is over the limit"):
         load_workcell(cell / DEFAULT_WORKCELL.name)
+
+
+def _chain(n: int, axis: str = "0 0 1", xyz: str = "0 0 0.1") -> str:
+    links = "".join(f'<link name="l{k}"/>' for k in range(n + 1))
+    joints = "".join(f'<joint name="j{k}" type="revolute"><parent link="l{k}"/><child link="l{k + 1}"/><origin xyz="{xyz}"/>'
+                     f'<axis xyz="{axis}"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>' for k in range(n))
+    return f'<robot name="chain">{links}{joints}</robot>'
+
+
+@pytest.mark.parametrize("text, why", [(_chain(2999), "2999 joints: over the limit of 500"), (_chain(3, axis="0 0 0"), "axis xyz='0 0 0' must be three finite numbers, not all zero"),
+                                       (_chain(3, xyz="0 0 1e308"), "over 1000 m away"), (_chain(3, axis="nan 0 1"), "axis")])
+def test_urdfs_beyond_a_robots_limits_are_refused_by_name(tmp_path, text, why):
+    """A 2999-joint URDF ended in a MemoryError traceback; a zero axis and 1e308 m origins loaded."""
+    from calib_core.robot.description import read_description
+
+    path = tmp_path / "robot.urdf"
+    path.write_text(text)
+    with pytest.raises(FileFormatError, match=why) as info:
+        read_description(path)
+    assert info.value.path == path
+    read_description(_write(tmp_path / "ok.urdf", _chain(6)))  # a plain chain still reads
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
