@@ -99,6 +99,12 @@ class URRtdeController(ConnectorEvents):
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)
+        receive, self._receive = self._receive, None
+        if receive is not None:  # ended by us, before the controller's side goes: ur_rtde then prints no exception
+            try:
+                receive.disconnect()
+            except RuntimeError:
+                pass
         self._set_state(LinkState.CLOSED, "closed by the caller")
         self._moves.finish(MoveError("the link was closed"))
 
