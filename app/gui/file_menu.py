@@ -11,6 +11,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QFileDialog, QMenu
 
+from app.gui.camera_chooser import CameraChooser
 from app.gui.confirm import ask, ask_save
 from app.gui.error_boundary import attempt
 from app.gui.session_files import Autosave, RecentFiles
@@ -49,6 +50,8 @@ class FileMenu:
         menu.addAction(self.record_action)
         menu.addAction(QAction("Open r&ecording...", w, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
         self.recent = RecentFiles(w.settings, menu.addMenu("Recent &files"), self.open_recent)
+        menu.addSeparator()
+        self.camera = CameraChooser(w, menu)
         self.recorder_watch = QTimer(w, interval=250, timeout=self.watch_recorder)
         menu.addSeparator()
         # StandardKey.Quit is empty on some platforms (the offscreen one among them).

@@ -35,6 +35,11 @@ def open_controller(url: str, context: ControllerContext) -> ControllerConnector
     return opener(url, context)
 
 
+def check_camera_spec(spec: str) -> None:
+    """:class:`ConnectorNotFoundError` when no installed connector handles ``spec``'s scheme (nothing is opened)."""
+    _load(CAMERAS, camera_scheme(spec), spec, "camera")
+
+
 def open_camera(spec: str, options: dict | None = None) -> FrameSource:
     """The camera for ``spec``, open (its first :meth:`read` may still wait for the device)."""
     opener = _load(CAMERAS, camera_scheme(spec), spec, "camera")
