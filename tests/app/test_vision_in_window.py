@@ -207,7 +207,8 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         refusals.append(win.results.status.text())
         qtbot.wait(150)
-    assert len(refusals) >= 2 and len(vision.capture.views) == 1, refusals
+    # (how many tries fit in the move depends on the machine's load: at least one, all refused)
+    assert len(refusals) >= 1 and len(vision.capture.views) == 1, refusals
     assert all("before the last move" in r or "cannot be used" in r for r in refusals), refusals
     _fresh_still_frame(qtbot, win)
     qtbot.waitUntil(lambda: wb.observations.latest.t_host_s > wb.last_move_sent_s and wb.observations.stillness(wb.observations.newest_usable()).settled, timeout=10_000)
