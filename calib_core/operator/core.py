@@ -20,19 +20,17 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.calibration.commands import SetTaskApproach
-from calib_core.calibration.look_place import LookNotAtTask, LookPlace, place_of_look
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.frames import concat, invert, pose_difference
+from calib_core.frames import concat, invert
 from calib_core.connectors.controller import ControllerConnector, ControllerContext
 from calib_core.connectors.registry import open_controller
 from calib_core.calibration.verdict import ResultVerdict, judge
-from calib_core.calibration.verification import Verification, verify
-from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.link.joint_history import ControllerClock, JointHistory
 from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
+from calib_core.operator.correction_desk import CorrectionDesk
 from calib_core.operator.motion import Motion, MotionState
 from calib_core.operator.move_preview import joint_path
 from calib_core.operator.observations import Observations
@@ -47,7 +45,7 @@ from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring):
+class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring, CorrectionDesk):
     """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
@@ -311,97 +309,6 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         result = self.session.calibrate(self.intrinsics, obj2world, self.robot.fk(joints, "camera"), self.robot.fk(joints, "tcp"), joints)
         self.solved.emit()
         return result
-
-    def look_place(self) -> LookPlace | None:
-        """Where the last result's look was made against the chosen task location (``None`` before a
-        solve, without a task location or for a look that carries no robot pose)."""
-        context = self.session.context
-        if self.task is None or context is None or context.joints_deg is None:
-            return None
-        corrected = None
-        if self.session.corrections.latest(self.task.name) is not None:
-            corrected = self.session.corrections.corrected_target(self.task.name, self.task.tcp2base)
-        return place_of_look(self.task, self.robot.fk(context.joints_deg, "tcp"), corrected, context.view_sources)
-
-    def store_correction(self, *, confirmation: str = "", convert: str = ""):
-        """Store the last result as the task location's correction. Only a look made live at the task's
-        pose (or its corrected pose) counts (:mod:`~calib_core.calibration.look_place`); any other raises
-        :class:`LookNotAtTask` unless ``convert`` says who converted it and why (kept with the correction
-        and recorded). One that is not ``ok`` needs ``confirmation`` likewise. With a robot calibration
-        applied, the look is stored fused with the calibrated model (:meth:`look_fused_with_robot`); with a
-        measured tool (:meth:`measure_tool`) its covariance is in the stored 1-sigma either way."""
-        if self.task is None:
-            raise CalibrationError("choose the task location the correction is for")
-        if self.session.result is None:
-            raise CalibrationError("calibrate first")
-        if self.session.stale_reason:  # said first: a look that changed since is no look at all
-            raise CalibrationError(f"the result is from an earlier state ({self.session.stale_reason}); nothing stored")
-        place = self.look_place()
-        if place is None:
-            raise CalibrationError("the look carries no robot pose: pick the image points again on a frame of this pose, then Calibrate")
-        if not place.counts and not convert.strip():
-            raise LookNotAtTask(place, *self._conversion_change())
-        tool, context = getattr(self, "measured_tool", None), self.session.context
-        tool_covariance = None
-        if tool is not None and context.joints_deg is not None:
-            tool_covariance = tool.covariance_in_base(self.robot.fk(context.joints_deg, "camera"))
-        source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
-        if source:
-            source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source
-        c = self.session.store_correction(self.task.name, source, confirmation=confirmation, fused=self.look_fused_with_robot(self.session.result),
-                                          tool_covariance=tool_covariance)
-        if not place.counts:
-            self.record_event("look_converted", task=c.task, at=place.at, offset_mm=place.offset_mm, offset_deg=place.offset_deg, source=place.source, conversion=convert.strip())
-        if c.confirmation:
-            self.record_event("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
-        self.correction_stored.emit(c)
-        self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
-        return c
-
-    def store_measurement(self):
-        """Keep the last result as what it is: a measurement at its own pose, in the task location's
-        history, never commanded."""
-        if self.task is None:
-            raise CalibrationError("choose the task location the measurement belongs with")
-        place = self.look_place()
-        where = place.text if place is not None else "a look without a robot pose"
-        c = self.session.store_correction(self.task.name, f"measurement: {where}", kind="measurement")
-        self.correction_stored.emit(c)
-        self.message.emit(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
-        return c
-
-    def _conversion_change(self) -> tuple[float, float]:
-        """How far the target commanded for the task would move (mm, deg) if the last result became its correction."""
-        r, task = self.session.result, self.task
-        now = self.session.corrections.corrected_target(task.name, task.tcp2base)
-        delta = concat(invert(r.tcp2base_model), r.tcp2base_measured)  # tcp_real = delta @ tcp_model, as a stored correction's
-        converted = concat(task.tcp2base, invert(delta))
-        d, rot = pose_difference(converted, now)
-        return float(np.linalg.norm(d)), float(np.linalg.norm(rot))
-
-    def verify(self) -> Verification:
-        """*Verify*: after executing the task with its correction, solve the pairs picked from there and
-        report the tool's remaining error against the task location with its 1-sigma, and whether this look
-        agrees with the one the correction came from. Kept in the correction table's history."""
-        task = self.task
-        if task is None:
-            raise CalibrationError("choose the task location to verify")
-        correction = self.session.corrections.latest(task.name)
-        if correction is None:
-            raise CalibrationError(f"no stored correction for {task.name}: calibrate, store and execute one first")
-        executed = f"{task.name} (task, corrected)"
-        if self.motion.motion is not Motion.ARRIVED or self.motion.what != executed:
-            raise CalibrationError(f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({self.motion.text})")
-        use = self.session.pairs.usable()
-        here = [p for p in use if p.view is not None and np.max(np.abs(np.array(p.view.joints_deg) - self.joints_deg)) <= SAME_STATE_DEG]
-        if len(here) != len(use) or not use:
-            raise CalibrationError("the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify")
-        look = self.calibrate()
-        v = verify(task.name, task.tcp2base, correction, look, task.tolerance_mm)
-        self.session.corrections.add_verification(v)
-        self.record_event("verified", task=task.name, remaining_mm=v.remaining_mm.tolist(), std_remaining_mm=v.std_remaining_mm.tolist(), disagreement_mm=v.disagreement_mm, agree=v.agree, within_tolerance=v.within_tolerance, tolerance_mm=v.tolerance_mm)
-        self.message.emit(v.text)
-        return v
 
     def apply_hand_eye_file(self, path) -> None:
         """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""
