@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from calib_core.frames import invert
+from calib_core.frames import concat, invert
 
 
 @dataclass(frozen=True)
@@ -44,7 +44,7 @@ class Correction:
     @property
     def delta_base(self) -> np.ndarray:
         """``Δ`` with ``tcp_real = Δ @ tcp_model`` (base frame) near this location."""
-        return self.tcp2base_measured @ invert(self.tcp2base_model)
+        return concat(invert(self.tcp2base_model), self.tcp2base_measured)
 
 
 class CorrectionTable:

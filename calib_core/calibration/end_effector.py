@@ -41,7 +41,7 @@ class EndEffectorEstimate:
     @property
     def delta_base(self) -> np.ndarray:
         """``Δ`` (4, 4) with ``tcp_real = Δ @ tcp_model`` in the base frame."""
-        return self.tcp2base_measured @ invert(self.tcp2base_model)
+        return concat(invert(self.tcp2base_model), self.tcp2base_measured)
 
 
 SHARED_BIAS_PX = 0.1
@@ -77,7 +77,7 @@ def shared_shift_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intr
 
 
 def _measured_tcp(obj2cam: np.ndarray, obj2world: np.ndarray, tcp2cam: np.ndarray) -> np.ndarray:
-    cam2world = obj2world @ invert(obj2cam)
+    cam2world = concat(invert(obj2cam), obj2world)
     return concat(tcp2cam, cam2world)
 
 
@@ -112,4 +112,4 @@ def end_effector_from_solution(solution: PoseSolution, obj2world: np.ndarray, ca
         cov = J @ pose_cov @ J.T
         std = np.sqrt(np.clip(np.diag(cov), 0, None))
         std_d, std_r = std[:3], std[3:]
-    return EndEffectorEstimate(solution, obj2world, cam2world_model, obj2world @ invert(obj2cam), tcp2base_model, tcp_meas, d, rv, std_d, std_r, cov)
+    return EndEffectorEstimate(solution, obj2world, cam2world_model, concat(invert(obj2cam), obj2world), tcp2base_model, tcp_meas, d, rv, std_d, std_r, cov)

@@ -17,6 +17,7 @@ from calib_core.camera.distortion_map import distortion_map
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.render.renderer import RenderOptions, SceneRenderer
 from calib_core.scene import SceneItem
+from calib_core.frames import concat, invert
 
 
 class ModelView:
@@ -80,14 +81,14 @@ class ModelView:
         cell (a robot's error moves the camera 10-20 mm from where the model puts it, and the fingers
         with it, 40-90 px at a task location)."""
         if cam2world_model is None or not riding:
-            return lambda obj2cam, box_px=None, supersample=1: self.render(items, item2world @ np.linalg.inv(obj2cam), box_px=box_px, supersample=supersample)
+            return lambda obj2cam, box_px=None, supersample=1: self.render(items, concat(invert(obj2cam), item2world), box_px=box_px, supersample=supersample)
         own = {i.name: np.array(i.item2world, dtype=float) for i in items if i.name in riding}
         scene = [replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items]  # the caller's items keep their poses
         world2cam_model = np.linalg.inv(cam2world_model)
 
         def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1) -> np.ndarray:
-            cam2world = item2world @ np.linalg.inv(obj2cam)
-            carry = cam2world @ world2cam_model  # the modelled camera onto the one placed here
+            cam2world = concat(invert(obj2cam), item2world)
+            carry = concat(world2cam_model, cam2world)  # the modelled camera onto the one placed here
             return self.render(scene, cam2world, {name: carry @ pose for name, pose in own.items()}, box_px, supersample)
 
         return expected

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from calib_core.robot.model import RobotModel, _to_se3
 from calib_core.robot.visuals import geometry_model
 from calib_core.scene import SceneItem
+from calib_core.frames import concat
 
 CELL_PREFIX = "cell/"
 
@@ -60,7 +61,7 @@ class CollisionWorld:
         self._robot_ids = list(range(self.geometry.ngeoms))
         self._cell_ids = []
         for item in components:
-            placement = _to_se3(robot.base2root @ np.asarray(item.item2world, dtype=float))
+            placement = _to_se3(concat(item.item2world, robot.base2root))  # the item in the URDF root
             obj = pin.GeometryObject(CELL_PREFIX + item.name, 0, 0, placement, _bvh(item.mesh))
             self._cell_ids.append(self.geometry.addGeometryObject(obj))
         self.ignored: list[Contact] = []

@@ -24,6 +24,7 @@ from calib_core.errors import FileFormatError
 from calib_core.robot.description import read_description
 from calib_core.robot.errors import RobotModelError, RobotSpecError, UnknownFrameError
 from calib_core.robot.spec import DEFAULT_FRAMES, FRAME_ROLES, NewFrame, RobotSpec
+from calib_core.frames import concat
 
 RESOURCES = Path(__file__).resolve().parents[2] / "resources" / "robot"
 DEFAULT_URDF = RESOURCES / "videocal_arm.urdf"
@@ -171,12 +172,12 @@ class RobotModel:
         """``frame2base`` (4, 4), mm, at joints ``q_deg`` (n,) deg/mm."""
         fid = self.frame_id(frame)
         pin.framesForwardKinematics(self.model, self.data, self.configuration(q_deg))
-        return self._root2base @ _to_mm(self.data.oMf[fid])
+        return concat(_to_mm(self.data.oMf[fid]), self._root2base)
 
     def all_frames(self, q_deg: ArrayLike) -> dict[str, np.ndarray]:
         """``frame2base`` (4, 4) mm of every frame at ``q_deg``, by URDF name and by role."""
         pin.framesForwardKinematics(self.model, self.data, self.configuration(q_deg))
-        poses = {f.name: self._root2base @ _to_mm(self.data.oMf[i]) for i, f in enumerate(self.model.frames)}
+        poses = {f.name: concat(_to_mm(self.data.oMf[i]), self._root2base) for i, f in enumerate(self.model.frames)}
         poses.update({role: poses[name] for role, name in self.roles.items()})
         return poses
 
@@ -195,7 +196,7 @@ class RobotModel:
             while parent != 0 and parent not in kept_set:
                 parent = frames[parent].parentFrame
             if parent == 0 or parent == i:
-                tree.append((None, frames[i].name, self._root2base @ _to_mm(self.data.oMf[i])))
+                tree.append((None, frames[i].name, concat(_to_mm(self.data.oMf[i]), self._root2base)))
             else:
                 tree.append((frames[parent].name, frames[i].name, _to_mm(self.data.oMf[parent].actInv(self.data.oMf[i]))))
         return tree

@@ -17,7 +17,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
-from calib_core.frames import invert
+from calib_core.frames import concat, invert
 from calib_core.robot import solve_ik
 from calib_core.robot.errors import UnreachableTargetError
 from calib_core.robot.model import RobotModel
@@ -67,7 +67,7 @@ def _approach_camera(robot: RobotModel, task) -> np.ndarray:
     """The modelled camera's pose (4, 4) mm when the TCP is at the task's approach."""
     tcp2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("tcp")
     cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
-    return task.approach2base @ np.linalg.inv(tcp2flange) @ cam2flange
+    return concat(cam2flange, invert(tcp2flange), task.approach2base)
 
 
 def _look_at(target_mm: np.ndarray, distance_mm: float, eye_height_mm: float) -> np.ndarray:
@@ -97,7 +97,7 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
         item = workcell.component(component)
         points = np.array(list(item.features.values()), dtype=float)
         try:
-            q0 = solve_ik(robot, camera2base @ np.linalg.inv(cam2flange), home, frame="flange").q_deg
+            q0 = solve_ik(robot, concat(invert(cam2flange), camera2base), home, frame="flange").q_deg
         except UnreachableTargetError:
             continue
         found, attempts = 0, 0

@@ -21,7 +21,7 @@ import numpy as np
 from calib_core.calibration.end_effector import shared_shift_covariance
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import VideocalError
-from calib_core.frames import invert
+from calib_core.frames import concat, invert
 from calib_core.render.model_view import ModelView
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
@@ -88,4 +88,4 @@ def see_grasp(image: np.ndarray, intrinsics: Intrinsics, robot: RobotModel, work
     pose_cov = solution.uncertainty.covariance[:6, :6] + shared_shift_covariance(obj2cam, features, intrinsics)
     tcp2obj = invert(item.item2world) @ np.asarray(task.tcp2base, dtype=float)
     covariance = tcp_covariance_in_camera(obj2cam, tcp2obj, pose_cov) + np.diag([CENTRING_SIGMA_MM**2] * 3 + [0.0] * 3)
-    return SeenGrasp(obj2cam @ tcp2obj, covariance, item.name, found.edges.samples)
+    return SeenGrasp(concat(tcp2obj, obj2cam), covariance, item.name, found.edges.samples)

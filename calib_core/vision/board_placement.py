@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from calib_core.frames import make_transform
+from calib_core.frames import concat, invert, make_transform
 from calib_core.robot import UnreachableTargetError, solve_ik
 from calib_core.robot.model import RobotModel
 from calib_core.vision.board import BoardSpec
@@ -80,7 +80,7 @@ def board_view_joints(robot: RobotModel, start_deg, spec: BoardSpec, board2base:
         aim = Rotation.from_euler("xy", rng.uniform(-off_centre_deg, off_centre_deg, 2), degrees=True).as_matrix() if off_centre_deg else np.eye(3)
         cam2base = make_transform(roll @ np.column_stack([x, y, z]) @ aim, position)
         try:
-            sol = solve_ik(robot, cam2base @ np.linalg.inv(cam2flange), q, frame="flange", extra_seeds=4)
+            sol = solve_ik(robot, concat(invert(cam2flange), cam2base), q, frame="flange", extra_seeds=4)
         except UnreachableTargetError:
             continue
         q = sol.q_deg

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from calib_core.frames import apply, make_transform
+from calib_core.frames import apply, concat, make_transform
 from calib_core.robot.model import RobotModel, load_robot
 from calib_core.robot.spec import RobotSpec
 from calib_core.scene import SceneItem
@@ -32,7 +32,7 @@ class TaskLocation:
     @property
     def approach2base(self) -> np.ndarray:
         """The TCP pose (4, 4) mm at the approach: ``approach_mm`` back along the tool z axis."""
-        return self.tcp2base @ make_transform(np.eye(3), [0.0, 0.0, -self.approach_mm])
+        return concat(make_transform(np.eye(3), [0.0, 0.0, -self.approach_mm]), self.tcp2base)
 
 
 @dataclass
