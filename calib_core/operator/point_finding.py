@@ -17,7 +17,7 @@ from calib_core.calibration.commands import AddPairs
 from calib_core.calibration.session import CalibrationError
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
-from calib_core.frames import apply
+from calib_core.frames import apply, concat, invert
 
 if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
     from calib_core.vision.find_points import FoundPoints
@@ -82,7 +82,7 @@ class PointFinding:
         item = self.workcell.component(found.result.component)
         q = np.asarray(found.view.joints_deg, dtype=float)
         cam2world_model = self.robot.fk(q, "camera")
-        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.intrinsics, prior=np.linalg.inv(cam2world_model) @ item.item2world)
+        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.intrinsics, prior=concat(item.item2world, invert(cam2world_model)))
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.session.last_solve_inputs = inputs
         self.current_pair = None

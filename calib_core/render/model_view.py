@@ -84,7 +84,7 @@ class ModelView:
             return lambda obj2cam, box_px=None, supersample=1: self.render(items, concat(invert(obj2cam), item2world), box_px=box_px, supersample=supersample)
         own = {i.name: np.array(i.item2world, dtype=float) for i in items if i.name in riding}
         scene = [replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items]  # the caller's items keep their poses
-        world2cam_model = np.linalg.inv(cam2world_model)
+        world2cam_model = invert(cam2world_model)
 
         def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1) -> np.ndarray:
             cam2world = concat(invert(obj2cam), item2world)

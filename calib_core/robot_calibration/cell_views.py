@@ -108,7 +108,7 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
                 T[:3, :3] = Rotation.from_rotvec(np.radians(SPREAD_DEG) * rng.normal(size=3) / np.sqrt(3)).as_matrix() @ T[:3, :3]
                 T[:3, 3] += rng.normal(0.0, SPREAD_MM / np.sqrt(3), 3)
             try:
-                q = solve_ik(robot, T @ np.linalg.inv(cam2flange), q0, frame="flange").q_deg
+                q = solve_ik(robot, concat(invert(cam2flange), T), q0, frame="flange").q_deg  # T: a camera2base
             except UnreachableTargetError:
                 continue
             uv = project_points(points, invert(robot.fk(q, "camera")) @ item.item2world, intrinsics)

@@ -23,7 +23,7 @@ from scipy.spatial.transform import Rotation
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
 from calib_core.errors import VideocalError
-from calib_core.frames import apply, invert, make_transform
+from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
@@ -134,12 +134,12 @@ class _Problem:
         for k, v in enumerate(self.views):
             base2cam = invert(self.corrected.cam2base(v.joints_deg))
             if v.target == OBJECT:
-                r = pose_residual(base2cam @ v.obj2base, v.obj2cam)
+                r = pose_residual(concat(v.obj2base, base2cam), v.obj2cam)
                 if k in self.moves_with_intrinsics:
                     r = r + self.moves_with_intrinsics[k] @ p[self.corrected.layout.intrinsics_block]
                 out.append(self.whiten[k] @ r)
                 continue
-            obj2cam = base2cam @ board2base if v.target == BOARD else base2cam
+            obj2cam = concat(board2base, base2cam) if v.target == BOARD else base2cam
             out.append((project(apply(obj2cam, v.points_mm), intr) - v.pixels).ravel())
         return np.concatenate(out)
 
