@@ -1,5 +1,6 @@
 """``videocal export WORKSPACE --format F [--out FILE]``: the corrected task locations for a robot
-controller (URScript, RAPID, KRL, FANUC TP, PDL2) or a spreadsheet (CSV, JSON); stdout without ``--out``."""
+controller (URScript, RAPID, KRL, FANUC TP, PDL2) or a spreadsheet (CSV, JSON); stdout without ``--out``.
+``videocal export RECORDING.mcap --format ros2-bag --out FOLDER``: a session recording as a ROS 2 bag."""
 
 from __future__ import annotations
 
@@ -7,18 +8,39 @@ import argparse
 import sys
 from pathlib import Path
 
+from app.cli.options import resolved_path
 from calib_core.workspace.exports import EXPORT_FORMATS
+
+BAG_FORMAT = "ros2-bag"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("workspace", type=Path)
-    parser.add_argument("--format", choices=EXPORT_FORMATS, default="csv",
-                        help="csv, json (every correction, with the target to command), or a controller listing: urscript (UR), rapid (ABB), krl (KUKA), fanuc (FANUC TP), pdl2 (COMAU)")
+    parser.add_argument("workspace", type=Path, help="a workspace file (a recording .mcap with --format ros2-bag)")
+    parser.add_argument("--format", choices=EXPORT_FORMATS + (BAG_FORMAT,), default="csv",
+                        help="csv, json (every correction, with the target to command), a controller listing: urscript (UR), rapid (ABB), krl (KUKA), "
+                             "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: images, "
+                             "joint states in rad and m, camera_info)")
     parser.add_argument("--out", type=Path)
+    parser.add_argument("--workcell", type=resolved_path, help="with ros2-bag: the cell whose robot says each joint's unit (default: the recording's)")
 
 
 def run(args: argparse.Namespace) -> int:
     from calib_core.atomic_file import atomic_write_text
+    from calib_core.errors import VideocalError
+
+    if args.format == BAG_FORMAT:
+        from calib_core.bags.bag_export import recording_to_bag
+
+        if args.out is None:
+            raise VideocalError("--format ros2-bag writes a bag folder: give --out FOLDER")
+        units = None
+        if args.workcell is not None:
+            from calib_core.workcell import load_workcell
+
+            units = list(load_workcell(args.workcell).load_robot().joint_units)
+        counts = recording_to_bag(args.workspace, args.out, joint_units=units)
+        print(f"wrote {args.out}: " + ", ".join(f"{n} on {topic}" for topic, n in counts.items()))
+        return 0
     from calib_core.workspace.exports import export_corrections
     from calib_core.workspace.workspace import load_workspace
 

@@ -1,0 +1,121 @@
+"""A videocal recording as a ROS 2 bag (issue 31): what ``ros2 bag info``/``play`` and rosbags-based tools read, beside
+the Foxglove MCAP the recorder writes. Written with ``rosbags`` (MCAP storage, ROS 2 Humble's message definitions):
+
+- ``/camera/image_raw/compressed``: ``sensor_msgs/CompressedImage`` (JPEG), each frame stamped with its time in the
+  recording (the H.264 track decoded frame by frame);
+- ``/joint_states``: ``sensor_msgs/JointState`` in the robot's URDF joint names, **radians and metres** (a recording
+  holds degrees and mm: the workcell's robot says which joint is prismatic);
+- ``/camera/camera_info``: ``sensor_msgs/CameraInfo`` from the recording's camera (plumb_bob), once.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from calib_core.errors import FileFormatError
+
+IMAGE_TOPIC = "/camera/image_raw/compressed"
+JOINT_TOPIC = "/joint_states"
+INFO_TOPIC = "/camera/camera_info"
+
+
+def _stamp(T, t_ns: int):
+    return T["builtin_interfaces/msg/Time"](sec=t_ns // 10**9, nanosec=t_ns % 10**9)
+
+
+def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: list[str] | None = None, camera_frame: str = "videocal_camera_optical_frame") -> dict:
+    """Write the recording at ``recording`` as a ROS 2 bag folder ``out`` (which must not exist). ``joint_units``: each
+    joint's unit (``deg``/``mm``) in the recording's joint order (default: the recording's workcell's robot).
+    Returns what was written per topic. :class:`FileFormatError` names the file: no recording, no frames and no
+    joints, joints whose units cannot be told, or an ``out`` that exists."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from calib_core.recording.frame_track import FrameTrack
+    from calib_core.recording.reader import read_recording
+    from calib_core.recording.schemas import JOINTS_TOPIC, SETUP_TOPIC
+
+    recording, out = Path(recording), Path(out)
+    if out.exists():
+        raise FileFormatError(out, "exists already: a bag is written into a new folder (nothing was replaced)")
+    contents = read_recording(recording)
+    setup = (contents.topic(SETUP_TOPIC) or [None])[-1]
+    setup = setup.payload if setup is not None else {}
+    joints = contents.topic(JOINTS_TOPIC)
+    track = FrameTrack(contents)
+    if not joints and not len(track):
+        raise FileFormatError(recording, "the recording holds no camera frames and no joint samples: nothing to write")
+    names = list(setup.get("joint_names") or [])
+    n = len(joints[0].payload["joints_deg"]) if joints else 0
+    if joints and len(names) != n:
+        names = [f"joint_{k + 1}" for k in range(n)]
+    if joints and joint_units is None:
+        joint_units = _units_from_workcell(recording, setup.get("workcell"), n)
+    intrinsics = setup.get("intrinsics") or None
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    counts = {IMAGE_TOPIC: 0, JOINT_TOPIC: 0, INFO_TOPIC: 0}
+    try:
+        _write(Writer(out, version=9, storage_plugin=StoragePlugin.MCAP), ts, T, track, joints, names, joint_units, intrinsics, camera_frame, counts)
+    except BaseException:
+        shutil.rmtree(out, ignore_errors=True)  # no half-written bag left behind
+        raise
+    return counts
+
+
+def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_frame: str, counts: dict) -> None:
+    with writer:
+        if len(track):
+            images = writer.add_connection(IMAGE_TOPIC, "sensor_msgs/msg/CompressedImage", typestore=ts)
+            for k, message in enumerate(track.messages):
+                rgb = track.image(k)
+                if rgb is None:
+                    continue  # before the first keyframe of a cut recording: no picture to give
+                ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 92])
+                header = T["std_msgs/msg/Header"](stamp=_stamp(T, message.log_time_ns), frame_id=camera_frame)
+                msg = T["sensor_msgs/msg/CompressedImage"](header=header, format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
+                writer.write(images, message.log_time_ns, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
+                counts[IMAGE_TOPIC] += 1
+            if intrinsics:
+                counts[INFO_TOPIC] = _write_camera_info(writer, ts, T, intrinsics, track.messages[0].log_time_ns, camera_frame)
+        if joints:
+            connection = writer.add_connection(JOINT_TOPIC, "sensor_msgs/msg/JointState", typestore=ts)
+            per_si = np.array([math.pi / 180.0 if u == "deg" else 1e-3 for u in joint_units])
+            for message in joints:
+                q = np.asarray(message.payload["joints_deg"], float) * per_si
+                header = T["std_msgs/msg/Header"](stamp=_stamp(T, message.log_time_ns), frame_id="")
+                js = T["sensor_msgs/msg/JointState"](header=header, name=names, position=q, velocity=np.array([], float), effort=np.array([], float))
+                writer.write(connection, message.log_time_ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
+                counts[JOINT_TOPIC] += 1
+
+
+def _units_from_workcell(recording: Path, workcell: str | None, n: int) -> list[str]:
+    """Each joint's unit from the robot of the workcell the recording was made with."""
+    from calib_core.workcell import load_workcell
+
+    if not workcell or not Path(workcell).is_file():
+        raise FileFormatError(recording, f"the joints' units (deg or mm) come from the recording's workcell, {workcell or 'not named'}, which is not there: "
+                                         "give --workcell")
+    units = list(load_workcell(workcell).load_robot().joint_units)
+    if len(units) != n:
+        raise FileFormatError(recording, f"the recording's samples have {n} joints, the workcell's robot {len(units)}: another cell's recording?")
+    return units
+
+
+def _write_camera_info(writer, ts, T, intrinsics: dict, t_ns: int, camera_frame: str) -> int:
+    fu, fv, cx, cy = (float(intrinsics[k]) for k in ("fu", "fv", "cx", "cy"))
+    d = [float(v) for v in intrinsics.get("distortion", [0.0] * 5)]
+    kind = "sensor_msgs/msg/CameraInfo"
+    connection = writer.add_connection(INFO_TOPIC, kind, typestore=ts)
+    roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+    info = T[kind](header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=camera_frame), height=int(intrinsics["height"]), width=int(intrinsics["width"]),
+                   distortion_model="plumb_bob", d=np.array(d, float), k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
+                   p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float), binning_x=0, binning_y=0, roi=roi)
+    writer.write(connection, t_ns, ts.serialize_cdr(info, kind))
+    return 1

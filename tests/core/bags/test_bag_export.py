@@ -1,0 +1,75 @@
+"""A recording as a ROS 2 bag, read back by rosbags' AnyReader (the reader ROS 2 users' Python tools use): the
+frames, the joint states in radians in the URDF's names, the camera_info; a bad export loses nothing."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from calib_core.bags.bag_export import IMAGE_TOPIC, INFO_TOPIC, JOINT_TOPIC, recording_to_bag
+from calib_core.errors import FileFormatError
+from calib_core.recording.frame_track import FrameTrack
+from calib_core.recording.reader import read_recording
+from calib_core.recording.schemas import JOINTS_TOPIC, SETUP_TOPIC
+
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "recordings" / "sample_session.mcap"
+
+
+def test_the_sample_session_reads_back_as_ros_messages(tmp_path):
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    out = tmp_path / "session_bag"
+    counts = recording_to_bag(SAMPLE, out, joint_units=["deg"] * 6)
+    contents = read_recording(SAMPLE)
+    track = FrameTrack(contents)
+    samples = contents.topic(JOINTS_TOPIC)
+    setup = contents.topic(SETUP_TOPIC)[-1].payload
+    assert counts[JOINT_TOPIC] == len(samples) and counts[INFO_TOPIC] == 1 and 0 < counts[IMAGE_TOPIC] <= len(track)
+    with AnyReader([out], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        topics = {c.topic: c.msgtype for c in reader.connections}
+        assert topics == {IMAGE_TOPIC: "sensor_msgs/msg/CompressedImage", JOINT_TOPIC: "sensor_msgs/msg/JointState", INFO_TOPIC: "sensor_msgs/msg/CameraInfo"}
+        states = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == JOINT_TOPIC])]
+        images = [(t, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages([c for c in reader.connections if c.topic == IMAGE_TOPIC])]
+        info = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == INFO_TOPIC])][0]
+    assert list(states[0].name) == list(setup["joint_names"])
+    np.testing.assert_allclose(states[5].position, np.radians(samples[5].payload["joints_deg"]), atol=1e-12)  # deg -> rad
+    assert states[5].header.stamp.sec * 10**9 + states[5].header.stamp.nanosec == samples[5].log_time_ns
+    first = cv2.cvtColor(cv2.imdecode(np.asarray(images[0][1].data), cv2.IMREAD_COLOR), cv2.COLOR_BGR2RGB)
+    original = track.image(next(k for k in range(len(track)) if track.image(k) is not None))
+    assert first.shape == original.shape and np.abs(first.astype(int) - original.astype(int)).mean() < 3.0  # JPEG at 92
+    i = setup["intrinsics"]
+    assert (info.width, info.height) == (i["width"], i["height"]) and info.k[0] == i["fu"] and info.k[2] == i["cx"] and info.distortion_model == "plumb_bob"
+
+
+def test_a_prismatic_joint_goes_out_in_metres(tmp_path):
+    """ROS's JointState is in radians and metres: a joint the robot says is in mm is divided by 1000, not by 57.3."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    out = tmp_path / "bag"
+    recording_to_bag(SAMPLE, out, joint_units=["deg"] * 5 + ["mm"])
+    sample = read_recording(SAMPLE).topic(JOINTS_TOPIC)[3].payload["joints_deg"]
+    with AnyReader([out], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        states = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == JOINT_TOPIC])]
+    np.testing.assert_allclose(states[3].position, list(np.radians(sample[:5])) + [sample[5] / 1000.0], atol=1e-12)
+
+
+def test_a_bad_export_says_why_and_leaves_nothing(tmp_path):
+    out = tmp_path / "bag"
+    out.mkdir()
+    with pytest.raises(FileFormatError, match="exists already"):
+        recording_to_bag(SAMPLE, out, joint_units=["deg"] * 6)
+    assert list(out.iterdir()) == []  # nothing written into the folder that was there
+    with pytest.raises(FileFormatError, match="which is not there: give --workcell"):
+        from calib_core.bags import bag_export
+
+        bag_export._units_from_workcell(SAMPLE, str(Path(__file__).resolve().parents[2] / "data" / "nope.yaml"), 6)
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(SAMPLE), "--format", "ros2-bag"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "give --out FOLDER" in run.stderr and "Traceback" not in run.stderr
