@@ -9,11 +9,12 @@ from pathlib import Path
 import yaml
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from calib_core.atomic_file import atomic_write_text
 from calib_core.documents import finite_number, read_yaml
 from calib_core.errors import FileFormatError
-from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.frames import make_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.vision.hand_eye import HandEyeCalibration
 
 
@@ -45,9 +46,11 @@ def load_cam2flange(path: str | Path) -> np.ndarray:
 
     ``cam2flange.xyz`` (mm) and ``cam2flange.rpy`` (deg) are three finite numbers each; a ``units``
     section, when there is one, must say mm and deg (a file in metres would put the camera a thousand
-    times too close)."""
+    times too close). easy_handeye2's ``.calib`` (an ``eye_in_hand`` calibration) is read too."""
     path = Path(path)
     doc = read_yaml(path, "hand-eye file", max_bytes=1024 * 1024)
+    if isinstance(doc, dict) and isinstance(doc.get("parameters"), dict) and "transform" in doc:
+        return _easy_handeye2(path, doc)
     if isinstance(doc, dict) and "cam2base" in doc and "cam2flange" not in doc:
         raise FileFormatError(path, "this is a static camera's calibration (cam2base): the camera is not on the robot's flange", "cam2base")
     if not isinstance(doc, dict) or not isinstance(doc.get("cam2flange"), dict):
@@ -64,3 +67,20 @@ def load_cam2flange(path: str | Path) -> np.ndarray:
             raise FileFormatError(path, f"must be a list of 3 numbers, got {v!r}", f"cam2flange.{key}")
         values[key] = [finite_number(x, path, f"cam2flange.{key}[{i}]") for i, x in enumerate(v)]
     return transform_from_xyz_rpy(values["xyz"], values["rpy"])
+
+
+def _easy_handeye2(path: Path, doc: dict) -> np.ndarray:
+    """easy_handeye2's ``.calib``: ``transform`` is the tracking frame (the camera) in the robot's effector frame, metres
+    and a unit quaternion (x, y, z, w), as its publisher puts it on tf. Only an ``eye_in_hand`` calibration is a
+    camera mounting on the flange; the tracking frame is taken as the camera's optical frame (z along the axis)."""
+    kind = doc["parameters"].get("calibration_type")
+    if kind != "eye_in_hand":
+        raise FileFormatError(path, f"an easy_handeye2 calibration of type {kind!r}: only eye_in_hand is a camera on the robot's flange", "parameters.calibration_type")
+    transform = doc.get("transform")
+    if not isinstance(transform, dict) or not isinstance(transform.get("translation"), dict) or not isinstance(transform.get("rotation"), dict):
+        raise FileFormatError(path, "expected transform.translation {x, y, z} (m) and transform.rotation {x, y, z, w}", "transform")
+    t = [finite_number(transform["translation"].get(k), path, f"transform.translation.{k}") for k in "xyz"]
+    q = np.array([finite_number(transform["rotation"].get(k), path, f"transform.rotation.{k}") for k in "xyzw"])
+    if abs(np.linalg.norm(q) - 1.0) > 1e-3:
+        raise FileFormatError(path, f"not a unit quaternion (norm {np.linalg.norm(q):.4f})", "transform.rotation")
+    return make_transform(Rotation.from_quat(q / np.linalg.norm(q)).as_matrix(), np.array(t) * 1000.0)
