@@ -21,7 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: images, "
                              "joint states in rad and m, camera_info)")
     parser.add_argument("--out", type=Path)
-    parser.add_argument("--workcell", type=resolved_path, help="with ros2-bag: the cell whose robot says each joint's unit (default: the recording's)")
+    parser.add_argument("--workcell", type=resolved_path, help="the cell whose robot gives the tool data of a controller listing, or with ros2-bag each "
+                                                               "joint's unit (default: the workspace's or recording's own)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -45,10 +46,22 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.workspace.workspace import load_workspace
 
     ws = load_workspace(args.workspace)
-    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None)
+    robot = _robot(args.workcell or ws.workcell_path) if args.format not in ("csv", "json") else None
+    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None, robot)
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _robot(workcell: str | Path | None):
+    """The workcell's robot, for the tool data of a listing; ``None`` (the listing then has no tool data, and says
+    nothing wrong) when the workspace names no workcell or it is not there."""
+    if not workcell or not Path(workcell).is_file():
+        print(f"note: no tool data in the listing: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
+        return None
+    from calib_core.workcell import load_workcell
+
+    return load_workcell(workcell).load_robot()

@@ -46,7 +46,7 @@ class SessionFiles:
 
         if not self.session.corrections.tasks():
             raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
-        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations, Path(path).name.split(".")[0]))
+        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations, Path(path).name.split(".")[0], self.robot))
         self.message.emit(f"corrections exported to {path} ({fmt})")
 
     def start_recording(self, path, **options) -> None:

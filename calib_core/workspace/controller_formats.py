@@ -66,23 +66,39 @@ def urscript_pose(T: np.ndarray) -> str:
     return f"p[{x:.6f}, {y:.6f}, {z:.6f}, {rx:.6f}, {ry:.6f}, {rz:.6f}]"
 
 
-def rapid_robtarget(T: np.ndarray) -> str:
+def rapid_pose(T: np.ndarray) -> str:
+    """RAPID's ``pose``: ``[[x, y, z], [q1, q2, q3, q4]]``, mm and a unit quaternion, scalar first."""
     x, y, z = T[:3, 3]
     qx, qy, qz, qw = Rotation.from_matrix(T[:3, :3]).as_quat()
     if qw < 0:  # the same rotation; RAPID's examples keep q1 >= 0
         qw, qx, qy, qz = -qw, -qx, -qy, -qz
-    return f"[[{x:.3f},{y:.3f},{z:.3f}],[{qw:.8f},{qx:.8f},{qy:.8f},{qz:.8f}],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+    return f"[[{x:.3f},{y:.3f},{z:.3f}],[{qw:.8f},{qx:.8f},{qy:.8f},{qz:.8f}]]"
+
+
+def rapid_robtarget(T: np.ndarray) -> str:
+    return f"[{rapid_pose(T)[1:-1]},[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+
+
+def rapid_tooldata(tcp2flange: np.ndarray) -> str:
+    """RAPID's ``tooldata`` held by the robot (``robhold`` TRUE): the TCP frame on the flange, and tool0's own load
+    (0.001 kg at [0, 0, 0.001]): the tool's mass is not something a camera measures."""
+    return f"[TRUE,{rapid_pose(tcp2flange)},[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]"
 
 
 def krl_frame(T: np.ndarray) -> str:
     x, y, z = T[:3, 3]
-    a, b, c = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+    with warnings.catch_warnings():
+        # B = +-90 deg (a tool turned square): A and C are not unique; scipy's choice gives the same rotation
+        warnings.simplefilter("ignore", UserWarning)
+        a, b, c = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
     return f"{{X {x:.3f},Y {y:.3f},Z {z:.3f},A {a:.4f},B {b:.4f},C {c:.4f}}}"
 
 
 def fanuc_position(T: np.ndarray) -> tuple[float, ...]:
     """(X, Y, Z, W, P, R): mm and degrees."""
-    w, p, r = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # P = +-90 deg: W and R not unique, the rotation is
+        w, p, r = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
     x, y, z = T[:3, 3]
     return float(x), float(y), float(z), float(w), float(p), float(r)
 
@@ -116,25 +132,33 @@ def listing_name(fmt: str, stem: str | None) -> str:
     return name.upper() if fmt == "fanuc" else name
 
 
-def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"# videocal corrected task locations, {when}",
              "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location"]
+    if tool is not None:
+        lines += ["# the tool (TCP) the targets are for, on the flange: set it before moving to them", f"set_tcp({urscript_pose(tool)})"]
     for ident, T, note in entries:
         lines += [f"# {note}", f"global {ident} = {urscript_pose(T)}"]
     return lines
 
 
-def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"MODULE {name}", f"  ! videocal corrected task locations, {when}",
              "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0); confdata [0,0,0,0] must be taught"]
+    if tool is not None:
+        lines += ["  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and centre of gravity",
+                  f"  PERS tooldata videocal_tool := {rapid_tooldata(tool)};"]
     for ident, T, note in entries:
         lines += [f"  ! {note}", f"  CONST robtarget {ident} := {rapid_robtarget(T)};"]
     return lines + ["ENDMODULE"]
 
 
-def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"DEFDAT {name} PUBLIC", f"; videocal corrected task locations, {when}",
              "; FRAME {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; S and T are taught"]
+    if tool is not None:
+        lines += ["; the tool (TCP) the targets are for, on the flange: TOOL_DATA[n]=videocal_tool, then $TOOL=TOOL_DATA[n]",
+                  f"DECL GLOBAL FRAME videocal_tool={krl_frame(tool)}"]
     for ident, T, note in entries:
         lines += [f"; {note}", f"DECL GLOBAL FRAME {ident}={krl_frame(T)}"]
     return lines + ["ENDDAT"]
@@ -150,8 +174,11 @@ def _fanuc_attr(line_count: int, when: str) -> list[str]:
             "      ABORT_REQUEST\t= 0,", "      PAUSE_REQUEST\t= 0;", "DEFAULT_GROUP\t= 1,*,*,*,*;", "CONTROL_CODE\t= 00000000 00000000;"]
 
 
-def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper()) -> list[str]:
+def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), tool: np.ndarray | None = None) -> list[str]:
     notes = [f"videocal corrected task locations, {when}", "X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W)) in the robot's world frame; CONFIG must be taught"]
+    if tool is not None:
+        x, y, z, w, p, r = fanuc_position(tool)
+        notes += ["the tool frame (UTOOL 1) the targets are for, on the faceplate:", f"X {x:.3f} Y {y:.3f} Z {z:.3f} W {w:.3f} P {p:.3f} R {r:.3f}"]
     notes += [f"P[{k}] {ident}: {note}" for k, (ident, _, note) in enumerate(entries, start=1)]
     lines = [f"/PROG  {name}"] + _fanuc_attr(len(notes), when) + ["/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
     for k, (ident, T, _) in enumerate(entries, start=1):
@@ -164,11 +191,14 @@ def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper()) ->
     return lines + ["/END"]
 
 
-def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME) -> list[str]:
+def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"-- videocal corrected task locations, {when}",
              "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
     lines += [f"  {ident} : POSITION  -- {note}" for ident, _, note in entries]
-    return lines + ["BEGIN"] + [f"  {ident} := {pdl2_pos(T)}" for ident, T, _ in entries] + ["END"]
+    body = [f"  {ident} := {pdl2_pos(T)}" for ident, T, _ in entries]
+    if tool is not None:
+        body = ["  $TOOL := " + pdl2_pos(tool) + "  -- the tool (TCP) the targets are for, on the flange"] + body
+    return lines + ["BEGIN"] + body + ["END"]
 
 
 # format -> (writer, longest variable name the language takes)
@@ -183,9 +213,10 @@ def corrected_targets(table: CorrectionTable, tasks: dict[str, TaskLocation]) ->
     return {name: table.corrected_target(name, tasks[name].tcp2base) for name in table.tasks() if name in tasks}
 
 
-def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None) -> str:
+def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, tool: np.ndarray | None = None) -> str:
     """The corrected targets as a ``fmt`` listing (:data:`FORMATS`), one variable per task location,
-    each with its measured displacement as a remark; named after the file it goes to (``file_stem``)."""
+    each with its measured displacement as a remark; named after the file it goes to (``file_stem``); with ``tool``
+    (``tcp2flange`` (4, 4) mm), the tool data the targets are for, in the language's own form."""
     writer, max_name = LISTINGS[fmt]
     listing = listing_name(fmt, file_stem)
     targets = corrected_targets(table, tasks)
@@ -199,4 +230,4 @@ def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLo
     for name, T in targets.items():
         c = table.latest(name)
         entries.append((idents[name], T, f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
-    return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S"), listing) + [""])
+    return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S"), listing, tool) + [""])

@@ -8,8 +8,10 @@ import csv
 import io
 import json
 
+import numpy as np
+
 from calib_core.calibration.corrections import Correction, CorrectionTable
-from calib_core.frames import invert, xyz_rpy_from_transform
+from calib_core.frames import concat, invert, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
 from calib_core.workspace.controller_formats import FORMATS, controller_listing
 from calib_core.workspace.workspace import _correction_dict, _pose
@@ -70,11 +72,18 @@ def corrections_pdl2(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> 
     return controller_listing("pdl2", table, tasks)
 
 
-def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None) -> str:
+def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, robot=None) -> str:
     """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`); a controller listing is named after the file it
-    goes to (``file_stem``, the name without its suffixes), as the controller requires."""
+    goes to (``file_stem``, the name without its suffixes), as the controller requires, and with ``robot`` (the cell's
+    :class:`~calib_core.robot.model.RobotModel`) carries the tool data the targets are for."""
     if fmt == "json":
         return corrections_json(table, tasks)
     if fmt == "csv":
         return corrections_csv(table, tasks)
-    return controller_listing(fmt, table, tasks, file_stem)
+    return controller_listing(fmt, table, tasks, file_stem, None if robot is None else tool_on_flange(robot))
+
+
+def tool_on_flange(robot) -> np.ndarray:
+    """``tcp2flange`` (4, 4) mm: the robot's TCP on its flange (fixed: taken at the neutral joints)."""
+    q = np.zeros(robot.n_joints)
+    return concat(robot.fk(q, "tcp"), invert(robot.fk(q, "flange")))

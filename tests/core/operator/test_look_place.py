@@ -130,3 +130,21 @@ def test_the_nearest_of_task_and_corrected_pose_is_reported():
     place = place_of_look(task, look, corrected, ("live",))
     assert place.at == "corrected" and place.offset_mm == pytest.approx(0.3)
     assert place_of_look(task, look, None, ("live",)).at == "elsewhere"
+
+
+def test_the_stored_correction_exports_as_a_krl_data_list_named_after_its_file_with_the_cells_tool(cell_and_site, tmp_path):
+    """*File > Export corrections* of the core: the listing is named after its file and carries the cell's tool."""
+    import re
+
+    from calib_core.frames import concat, invert
+
+    cell, site = cell_and_site
+    core, _ = _look(cell, site, _at_task)
+    core.store_correction()
+    path = tmp_path / "cell_targets.dat"
+    core.export_corrections(path, "krl")
+    text = path.read_text()
+    assert text.startswith("DEFDAT cell_targets PUBLIC")
+    tool = concat(core.robot.fk(core.joints_deg, "tcp"), invert(core.robot.fk(core.joints_deg, "flange")))
+    xyz = [float(v) for v in re.search(r"videocal_tool=\{X ([-\d.]+),Y ([-\d.]+),Z ([-\d.]+)", text).groups()]
+    assert np.allclose(xyz, tool[:3, 3], atol=1e-3)

@@ -129,3 +129,28 @@ def test_each_listing_is_named_after_its_file_as_the_controller_requires(table):
     for fmt, bad in (("krl", "my-targets"), ("krl", "a" * 25), ("fanuc", "1cell")):
         with pytest.raises(InvalidNameError, match="rename the output file"):
             controller_listing(fmt, t, tasks, bad)
+
+
+def test_each_listing_carries_the_tool_its_targets_are_for(table):
+    """The TCP on the flange in each language's own form, read back from the printed numbers with the vendor's
+    definition: URScript set_tcp (m, rotation vector), RAPID tooldata (robhold, pose, tool0's load), KRL FRAME
+    (A about Z, B about Y, C about X), FANUC W P R, PDL2 $TOOL."""
+    t, tasks = table
+    tool = transform_from_xyz_rpy([12.5, -3.0, 187.25], [0.0, 30.0, 90.0])
+    ur = controller_listing("urscript", t, tasks, tool=tool)
+    x, y, z, rx, ry, rz = _numbers(re.search(r"set_tcp\(p\[([^\]]*)\]\)", ur).group(1))
+    assert np.allclose([x, y, z], tool[:3, 3] / 1000, atol=1e-6) and np.allclose(Rotation.from_rotvec([rx, ry, rz]).as_matrix(), tool[:3, :3], atol=1e-5)
+    rapid = controller_listing("rapid", t, tasks, tool=tool)
+    data = re.search(r"PERS tooldata videocal_tool := \[TRUE,\[\[([^\]]*)\],\[([^\]]*)\]\],\[0.001,\[0,0,0.001\],\[1,0,0,0\],0,0,0\]\];", rapid)
+    assert data, rapid
+    q1, q2, q3, q4 = _numbers(data.group(2))
+    assert np.allclose(_numbers(data.group(1)), tool[:3, 3], atol=1e-3) and np.allclose(Rotation.from_quat([q2, q3, q4, q1]).as_matrix(), tool[:3, :3], atol=1e-6)
+    krl = controller_listing("krl", t, tasks, tool=tool)
+    X, Y, Z, A, B, C = _numbers(re.search(r"DECL GLOBAL FRAME videocal_tool=\{([^}]*)\}", krl).group(1))
+    R = Rotation.from_euler("ZYX", [A, B, C], degrees=True).as_matrix()
+    assert np.allclose([X, Y, Z], tool[:3, 3], atol=1e-3) and np.allclose(R, tool[:3, :3], atol=1e-5)
+    fanuc = controller_listing("fanuc", t, tasks, tool=tool)
+    values = _numbers(re.search(r"! (X [^;]*) ;", fanuc).group(1))
+    assert np.allclose(values[:3], tool[:3, 3], atol=1e-3) and np.allclose(Rotation.from_euler("xyz", values[3:], degrees=True).as_matrix(), tool[:3, :3], atol=1e-5)
+    assert "$TOOL := POS(12.500, -3.000, 187.250," in controller_listing("pdl2", t, tasks, tool=tool)
+    assert "videocal_tool" not in controller_listing("krl", t, tasks)  # no robot given: no tool data, nothing made up
