@@ -75,7 +75,9 @@ def run(args: argparse.Namespace) -> int:
     # sample's. A sample of another count is not this robot's (a second writer, a corrupted line): not
     # printed as if it were.
     expected = context.n_joints or None
-    version = link.request_version(1.0) if expected is None and hasattr(link, "request_version") else None
+    # a far controller answers a round trip later: wait at least twice the link's measured timeout
+    wait_s = max(1.0, 2.0 * link.round_trip.rto_s) if hasattr(link, "round_trip") else 1.0
+    version = link.request_version(wait_s) if expected is None and hasattr(link, "request_version") else None
     if version is not None:
         link.n_joints = version.n_joints  # the driver then drops and counts them (wrong_joint_count)
         expected = version.n_joints
