@@ -10,9 +10,14 @@ requests whose reply is unambiguous (Karn's rule: an answer to a request sent tw
 from __future__ import annotations
 
 import threading
+from collections import deque
+
+import numpy as np
 
 _ALPHA, _BETA = 1.0 / 8.0, 1.0 / 4.0
 """RFC 6298's gains for the smoothed round trip and its deviation."""
+RECENT = 15
+"""Round trips kept for the delay shown."""
 
 
 class RoundTrip:
@@ -26,6 +31,7 @@ class RoundTrip:
         self.rttvar_s = 0.0
         self.last_s: float | None = None
         self.samples = 0
+        self._recent: deque[float] = deque(maxlen=RECENT)
         self._backoff = 1
         self._lock = threading.Lock()
 
@@ -41,6 +47,7 @@ class RoundTrip:
                 self.srtt_s = (1.0 - _ALPHA) * self.srtt_s + _ALPHA * rtt_s
             self.last_s = rtt_s
             self.samples += 1
+            self._recent.append(rtt_s)
             self._backoff = 1
 
     def timed_out(self) -> None:
@@ -66,5 +73,8 @@ class RoundTrip:
         return 4.0 * self.rttvar_s
 
     def one_way_s(self) -> float | None:
-        """Half the smoothed round trip (s), ``None`` before the first sample: the delay the window shows."""
-        return None if self.srtt_s is None else self.srtt_s / 2.0
+        """Half the median of the last :data:`RECENT` round trips (s), ``None`` before the first: the delay the window
+        shows. The median, not the smoothed mean the timeouts use: a lost segment's answer, a round trip late, would
+        raise the mean above the link's usual delay."""
+        with self._lock:
+            return None if not self._recent else float(np.median(self._recent)) / 2.0

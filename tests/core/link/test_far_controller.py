@@ -31,9 +31,11 @@ def test_the_round_trip_estimate_follows_rfc_6298():
     assert (rt.srtt_s, rt.rttvar_s, rt.rto_s) == (2.0, 1.0, 6.0)
     rt.add(4.0)  # rttvar = 3/4 * 1 + 1/4 * |2 - 4| = 1.25; srtt = 7/8 * 2 + 1/8 * 4 = 2.25
     assert rt.rttvar_s == pytest.approx(1.25) and rt.srtt_s == pytest.approx(2.25) and rt.rto_s == pytest.approx(7.25)
-    assert rt.one_way_s() == pytest.approx(1.125)
+    assert rt.one_way_s() == pytest.approx(1.5)  # half the median of 2 and 4 s (the delay shown; the timeouts use srtt)
+    rt.add(9.0)  # a lost segment's late answer moves the mean, not the delay shown
+    assert rt.one_way_s() == pytest.approx(2.0) and rt.srtt_s > 2.0 * 1.0
     rt.add(-1.0)  # clock trouble: not a sample
-    assert rt.samples == 2
+    assert rt.samples == 3
     for _ in range(200):  # a steady link: the deviation dies away, the timeout settles on the round trip
         rt.add(3.0)
     assert rt.srtt_s == pytest.approx(3.0, abs=1e-6) and rt.rto_s == pytest.approx(3.0, abs=1e-3)
@@ -106,7 +108,8 @@ def test_a_controller_1_5_s_away_opens_a_session_and_completes_a_move_sent_once(
     with ControllerLink(url, rate_hz=50, deadman_ms=1000) as link:
         assert link._auth.wait_settled(40.0) is AuthState.READY, link.auth_failure
         assert 2.0 < link.round_trip.srtt_s < 10.0  # measured: 3 s of round trip, give or take the jitter (and the lost ones)
-        assert link.delay_s == pytest.approx(link.round_trip.srtt_s / 2)
+        # the delay shown: half the median round trip (1.5 s +-30 % one way; at 25 % lost most answers are late too)
+        assert 1.0 < link.delay_s < (2.5 if line.weather.loss < 0.1 else 6.0)
         assert link.deadman_sent_ms() >= 1000 + 1000 * link.round_trip.srtt_s  # the heartbeat's allowance covers the trip
         assert wait_until(lambda: link.state is LinkState.UP, 10.0)
         handles = []
