@@ -15,10 +15,10 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from calib_core.errors import FileFormatError
+from calib_core.mesh_files import MESH_SUFFIXES
 from calib_core.robot.ros_packages import find_package, search_roots
 from calib_core.robot.xacro_expand import expand_xacro
 
-_MESH_SUFFIXES = {".stl", ".obj", ".dae", ".gltf", ".glb", ".ply"}
 
 
 def _is_xacro(path: Path, text: str) -> bool:
@@ -71,7 +71,7 @@ def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path], uris: dict[
                     if found is None:
                         places = "; ".join(str(p) for p in looked) or "(no package path: add robot.package_paths to the workcell)"
                         raise FileFormatError(path, f"{where} {uri!r} not found; looked in: {places}")
-                    if found.suffix.lower() not in _MESH_SUFFIXES:
+                    if found.suffix.lower() not in MESH_SUFFIXES:
                         raise FileFormatError(path, f"{where} {uri!r}: unsupported format {found.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
                     mesh.set("filename", str(found))
                     if uris is not None:

@@ -17,7 +17,7 @@ from calib_core.documents import read_yaml
 from calib_core.names import name_problem
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
-from calib_core.mesh_files import MESH_SCALE, MESH_SUFFIXES, load_mesh
+from calib_core.mesh_files import MESH_SCALE, load_mesh
 from calib_core.robot.errors import RobotSpecError
 from calib_core.robot.model import load_robot
 from calib_core.scene import SceneItem
@@ -111,8 +111,6 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
     kind = reader.choice(raw.get("kind", "component"), f"{f}.kind", _KINDS)
     units = reader.choice(raw["mesh_units"], f"{f}.mesh_units", set(MESH_SCALE))
     mesh_path = reader.file(raw["mesh"], f"{f}.mesh")
-    if mesh_path.suffix.lower() not in MESH_SUFFIXES:
-        raise reader.fail(f"{f}.mesh", f"unsupported mesh format {mesh_path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
     try:
         mesh = load_mesh(mesh_path, units)
     except FileFormatError as exc:  # said as the workcell's field, the mesh file named
