@@ -26,6 +26,7 @@ from calib_core.solver.paper_table1 import run_table1
 from calib_core.solver.problem import make_problem
 from calib_core.solver.refine import run_newton
 from calib_core.solver.sampler import INLIER_SIGMAS
+from bench.solver_reliability import mis_pick_section, robust_reliability_section
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "solver.md"
 CAM = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
@@ -363,6 +364,7 @@ def main() -> str:
     rng = np.random.default_rng(20261122)
     t0 = time.time()
     body = table1_section() + convergence_section(rng) + accuracy_section(rng) + speed_section(rng) + robust_section(rng)
+    body += robust_reliability_section(rng) + mis_pick_section(rng)
     header = [
         "# Pose solver benchmarks",
         "",

@@ -78,7 +78,8 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
     outliers = np.zeros(problem.n_points, dtype=bool)
     fitted_already = False  # a consensus fit's residuals and Jacobian are over every pair at the inliers' pose
     if huber_px is not None:
-        outliers = _flag_outliers(chosen.newton.residuals, noise)
+        # a consensus fit has judged each pair already (threshold, then the prediction test); Huber's fit has not
+        outliers = ~chosen.inliers if chosen.inliers is not None else _flag_outliers(chosen.newton.residuals, noise)
         inliers = np.flatnonzero(~outliers)
         fitted_already = chosen.inliers is not None and np.array_equal(chosen.inliers, ~outliers)
         if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3) and not fitted_already:

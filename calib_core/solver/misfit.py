@@ -16,6 +16,10 @@ from __future__ import annotations
 import numpy as np
 
 FALSE_FLAG_PER_SOLVE = 0.001
+OWN_SCALE_MIN_DOF = 4
+"""The picks' own scale replaces the noise model only when measured with this many degrees of freedom: from
+fewer (5 pairs: 2) a least-squares pose that absorbed a 5-10 px mis-pick into the others looks like coarse
+picks, and the mis-pick passed (a pose 20 mm wrong called ok)."""
 
 
 def misfit_statistics(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray) -> np.ndarray:
@@ -40,6 +44,49 @@ def misfit_statistics(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndar
     return out
 
 
+def prediction_statistics(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray) -> np.ndarray:
+    """``r_j^T (I + H_jj)^-1 r_j`` (n,) px^2 for the pairs *not* ``used`` by the fit (NaN for the used ones and
+    without redundancy): how far the fit's prediction misses pair j, against the prediction's own spread
+    (``sigma^2 (I + H_jj)`` for a good pick). Chi-square with 2 degrees of freedom once divided by sigma^2,
+    like :func:`misfit_statistics` for the pairs in the fit. Same arguments."""
+    out = np.full(len(residuals), np.nan)
+    J = jacobian[used]
+    if len(J) * 2 <= jacobian.shape[2]:
+        return out
+    try:
+        C = np.linalg.inv(np.einsum("nip,niq->pq", J, J))
+    except np.linalg.LinAlgError:
+        return out
+    for j in np.flatnonzero(~used):
+        M = np.eye(2) + jacobian[j] @ C @ jacobian[j].T
+        out[j] = float(residuals[j] @ np.linalg.solve(M, residuals[j]))
+    return out
+
+
+def admissible(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_params: int, noise_px: float) -> np.ndarray:
+    """(n,) bool: the pairs outside the fit (``used`` False) that its pose predicts as well as a good pick's
+    noise allows, by :func:`prediction_statistics` against the larger of ``noise_px`` and the fit's own scale
+    (its squared residuals over their degrees of freedom; then the limit is 2 F(2, dof), as in
+    :func:`flag_misfits`), at the same false-flag rate per solve."""
+    statistics = prediction_statistics(jacobian, residuals, used)
+    finite = np.isfinite(statistics)
+    dof = 2 * int(used.sum()) - n_params
+    if not finite.any() or dof <= 0:
+        return np.zeros(len(residuals), dtype=bool)
+    scale = float(np.sqrt(np.sum(residuals[used] ** 2) / dof)) if dof >= OWN_SCALE_MIN_DOF else 0.0
+    sigma = max(float(noise_px), scale)
+    tested = len(residuals)
+    limit = 2.0 * _fisher_quantile(tested, dof) if scale > noise_px else threshold(tested)
+    return np.where(finite, statistics, np.inf) / sigma**2 <= limit
+
+
+def _fisher_quantile(n_tested: int, dof: int) -> float:
+    """F(2, dof) at the quantile leaving one false flag per thousand solves among ``n_tested`` pairs."""
+    from scipy.stats import f as fisher
+
+    return float(fisher.ppf(1.0 - FALSE_FLAG_PER_SOLVE / max(n_tested, 1), 2, dof))
+
+
 def threshold(n_pairs: int) -> float:
     """The chi-square (2 dof) limit of one pick's statistic among ``n_pairs``: ``-2 ln(0.001 / n)``."""
     return -2.0 * float(np.log(FALSE_FLAG_PER_SOLVE / max(n_pairs, 1)))
@@ -57,11 +104,11 @@ def flag_misfits(statistics: np.ndarray, residuals: np.ndarray, used: np.ndarray
         return np.zeros(n, dtype=bool), sigma, limit
     rss = float(np.sum(residuals[used] ** 2))
     others = np.where(finite, np.maximum(rss - np.nan_to_num(statistics), 0.0) / dof, 0.0)
+    if dof < OWN_SCALE_MIN_DOF:
+        others = np.zeros(n)  # too few to measure a scale: the noise model alone
     sigma = np.maximum(noise_px, np.sqrt(others))
     # Where the scale is the picks' own estimate, the statistic over it is 2 F(2, dof), not chi-square: the
     # heavier tail of an estimated scale (12 degrees of freedom for 10 pairs) must not flag coarse good picks.
-    from scipy.stats import f as fisher
-
-    limits = np.where(np.sqrt(others) > noise_px, 2.0 * fisher.ppf(1.0 - FALSE_FLAG_PER_SOLVE / max(int(finite.sum()), 1), 2, dof), limit)
+    limits = np.where(np.sqrt(others) > noise_px, 2.0 * _fisher_quantile(int(finite.sum()), dof), limit)
     with np.errstate(invalid="ignore"):
         return np.nan_to_num(statistics / sigma**2, nan=0.0) > limits, sigma, limit

@@ -14,11 +14,12 @@ from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
-from calib_core.solver.candidates import distinct_poses, refine_seed
+from calib_core.solver.candidates import distinct_poses, refine_seed, same_pose
 from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
-from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px
+from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px, rival_consensus
 from calib_core.solver.sampler import robust_seed
+from calib_core.solver.pick_scale import pick_scale_px
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
 from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
@@ -85,10 +86,14 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
             raise
         return _solve_distinct(first, points_3d, points_2d, intrinsics, prior=prior, estimate_focal=estimate_focal, model=model,
                                sigma_px=sigma_px, robust=robust, max_rms_px=max_rms_px, confidence=confidence)
-    noise = noise_px(sigma_px)
+    fu0, fv0 = intrinsics.fu, intrinsics.fv
+    order = _confidence_order(confidence, problem.n_points)
+    noise = floor = noise_px(sigma_px)
+    if robust and problem.model == "pinhole":
+        # thresholds at the picks' own scale where it is coarser than the noise model (hand picks on a photo)
+        noise = max(noise, pick_scale_px(problem, fu0, fv0, order) or 0.0)
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
     huber = 2.0 * noise if robust else None
-    fu0, fv0 = intrinsics.fu, intrinsics.fv
 
     if fast_path_applies(problem, robust):
         # A DLT seed (many points) or P3P's roots (a few) refined to one good fit is the answer; the
@@ -96,12 +101,6 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         solution = fast_solve(problem, sigma_px, limit, _AMBIGUITY_CHI2)
         if solution is not None:
             return solution
-    order = None
-    if confidence is not None:
-        c = np.asarray(confidence, dtype=float).reshape(-1)
-        if c.shape != (problem.n_points,) or not np.all(np.isfinite(c)):
-            raise ValueError(f"confidence: one finite number per pair ({problem.n_points}), got {c.shape[0]}")
-        order = np.argsort(-c, kind="stable")
     sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust else None
     # With a sampled seed the all-points seeds add nothing: outliers spoil them, and on a clean set the
     # sampler's seed is theirs.
@@ -115,11 +114,11 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
-    refine = _refiner(problem, fu0, fv0, huber, noise)
+    refine = _refiner(problem, fu0, fv0, huber, noise, floor)
     refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
     if sampled is not None and problem.model == "pinhole":
         # the sampler's own inliers are where its seed's consensus starts (one least-squares fit, usually)
-        fit = consensus_refine(problem, sampled.R, sampled.t, fu0, fv0, inlier_threshold_px(noise), inliers=sampled.inliers)
+        fit = consensus_refine(problem, sampled.R, sampled.t, fu0, fv0, inlier_threshold_px(noise), inliers=sampled.inliers, noise_floor_px=floor)
         refined += [fit] if fit is not None else []
     best_rms = min((r.rms_px for r in refined), default=np.inf)
     if problem.n_points > SMALL_PROBLEM_POINTS and sampled is None and (best_rms > limit or robust):
@@ -137,18 +136,31 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     close = [p for p, score in zip(poses, scores) if p.converged and score - scores[0] <= _AMBIGUITY_CHI2 * noise**2]
     if not close:
         close = [best]
+    if robust and problem.model == "pinhole":
+        # with few pairs, the pair rejected is known only if no other one could be the mis-pick instead
+        close += distinct_poses([r for r in rival_consensus(problem, close[0], noise) if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)])
     distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
-    order = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
-    ranked = [close[i] for i in order]
-    candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, order))
+    rank = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
+    ranked = [close[i] for i in rank]
+    candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, rank))
     return finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
 
 
-def _refiner(problem: PoseProblem, fu: float, fv: float, huber: float | None, noise: float):
+def _confidence_order(confidence: ArrayLike | None, n: int) -> np.ndarray | None:
+    """The pairs' indices (n,) most confident first, or ``None`` without confidences."""
+    if confidence is None:
+        return None
+    c = np.asarray(confidence, dtype=float).reshape(-1)
+    if c.shape != (n,) or not np.all(np.isfinite(c)):
+        raise ValueError(f"confidence: one finite number per pair ({n}), got {c.shape[0]}")
+    return np.argsort(-c, kind="stable")
+
+
+def _refiner(problem: PoseProblem, fu: float, fv: float, huber: float | None, noise: float, floor: float):
     """How each seed is refined: least squares, or when robust, on the pairs it agrees with (pinhole; the
     paper's model keeps Huber's loss)."""
     if huber is not None and problem.model == "pinhole":
-        return lambda R, t: consensus_refine(problem, R, t, fu, fv, inlier_threshold_px(noise))
+        return lambda R, t: consensus_refine(problem, R, t, fu, fv, inlier_threshold_px(noise), noise_floor_px=floor)
     return lambda R, t: refine_seed(problem, R, t, fu, fv, huber)
 
 

@@ -73,3 +73,22 @@ def test_robust_finds_the_pose_through_a_third_of_wrong_pairs(pairs):
     assert len(flagged - truly) <= 0.01 * len(P)
     dt, dr = pose_error(sol.obj2cam, clean.obj2cam)
     assert dt < 3 * np.linalg.norm(sol.uncertainty.std_t_obj2cam_mm) and dr < 0.05  # within its own 3 sigma of the clean pose
+
+
+def test_robust_on_seven_coarse_picks_of_the_photo_gives_the_plain_answer(pairs):
+    """Issue 33: robust mode on 7 clean hand picks of the tutorial's photo (about 2 px) failed where the plain
+    solve was fine. Seven of the photo's registered pairs spread over the box, moved by 2 px as a hand would."""
+    P, uv = pairs
+    rng = np.random.default_rng(12)
+    plain_ok = robust_ok = 0
+    for _ in range(40):
+        pick = rng.choice(len(P), 7, replace=False)
+        hand = uv[pick] + rng.normal(0.0, 2.0, (7, 2))
+        plain, robust = solve_pose(P[pick], hand, CAMERA), solve_pose(P[pick], hand, CAMERA, robust=True)
+        robust_ok += robust.status is SolveStatus.OK and not robust.outliers.any()
+        if plain.status is SolveStatus.OK:
+            plain_ok += 1
+            assert robust.status is SolveStatus.OK and not robust.outliers.any(), robust.reason
+            dt, dr = pose_error(robust.obj2cam, plain.obj2cam)
+            assert dt < 1e-6 and dr < 1e-6
+    assert plain_ok >= 20 and robust_ok >= plain_ok
