@@ -16,9 +16,10 @@ import trimesh
 from calib_core.errors import FileFormatError
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
-MESH_SCALE = {"mm": 1.0, "m": 1000.0}
+MESH_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
 """A mesh's units -> mm."""
 MAX_TRIANGLES = 2_000_000
+_WINDING_FIX_TRIANGLES = 200_000  # trimesh's winding repair walks the face graph (networkx): bounded in time
 """The most triangles a component may have: a cell's CAD part decimated for viewing has tens of thousands."""
 MAX_FILE_BYTES = 500 * 1024**2
 MAX_COORDINATE_MM = 1e7
@@ -39,14 +40,14 @@ def _stl_header_triangles(path: Path) -> int | None:
 
 
 def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> trimesh.Trimesh:
-    """The mesh at ``path`` in mm (``units``: the file's, ``mm`` or ``m``). :class:`FileFormatError` names the file (and
+    """The mesh at ``path`` in mm (``units``: the file's, ``mm``, ``cm`` or ``m``). :class:`FileFormatError` names the file (and
     ``field``, the workcell key that named it) for an unknown format, a file or mesh over the limits, an unreadable
     file, no triangles, non-finite or absurd coordinates, or no area."""
     path = Path(path)
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise FileFormatError(path, f"unsupported mesh format {path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY", field)
     if units not in MESH_SCALE:
-        raise FileFormatError(path, f"mesh units must be 'mm' or 'm', got {units!r}", field)
+        raise FileFormatError(path, f"mesh units must be one of {', '.join(MESH_SCALE)}, got {units!r}", field)
     if not path.is_file():
         raise FileFormatError(path, "no such mesh file (or not a regular file)", field)
     size = path.stat().st_size
@@ -74,6 +75,10 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
                                     "are its units right (mesh_units)?", field)
     if not float(mesh.area) * MESH_SCALE[units] ** 2 > 0.0:
         raise FileFormatError(path, "the mesh has no area (every triangle is degenerate)", field)
+    if len(mesh.faces) <= _WINDING_FIX_TRIANGLES and not mesh.is_winding_consistent:
+        # faces wound both ways (OpenCV's tutorial box.ply): a face's normal then points in, and the creases and
+        # silhouettes the edge fit and the renders take from the normals come out wrong (diagonals as creases)
+        mesh.fix_normals()
     if MESH_SCALE[units] != 1.0:
         mesh.apply_scale(MESH_SCALE[units])
     return mesh

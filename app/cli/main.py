@@ -40,6 +40,7 @@ _register("calibrate-intrinsics", "app.cli.cmd_calibrate_intrinsics", "calibrate
 _register("calibrate-hand-eye", "app.cli.cmd_calibrate_hand_eye", "calibrate the camera's mounting from robot poses viewing a board (sim, cal_data.yaml, CSV)")
 _register("calibrate-robot", "app.cli.cmd_calibrate_robot", "identify the robot's geometric parameters and camera mounting from board views at many poses")
 _register("new-cell", "app.cli.cmd_new_cell", "write a starting cell for a robot description (URDF or xacro): loads and renders at once")
+_register("locate", "app.cli.cmd_locate", "a known object's pose in a photo (mesh, intrinsics, rough pose): Find points and the edge fit, as JSON")
 _register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
 
 

@@ -15,6 +15,7 @@ import trimesh
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
+from calib_core.vision import colour_contrast
 
 SHARP_DEG = 30.0
 TRUNCATE_PX = 8.0
@@ -61,9 +62,10 @@ def edge_samples_px(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intr
     return uv[intrinsics.contains(uv, margin_px=2)]
 
 
-def edge_distance_map(grey: np.ndarray, truncate_px: float = TRUNCATE_PX) -> np.ndarray:
-    """Distance (px, float32, truncated at ``truncate_px``) from every pixel to the nearest image edge (Canny)."""
-    edges = cv2.Canny(cv2.GaussianBlur(grey, (5, 5), 1.0), 20, 60)
+def edge_distance_map(image: np.ndarray, truncate_px: float = TRUNCATE_PX) -> np.ndarray:
+    """Distance (px, float32, truncated at ``truncate_px``) from every pixel to the nearest image edge (Canny;
+    ``image`` grey, or RGB for edges of colour as well: :mod:`calib_core.vision.colour_contrast`)."""
+    edges = colour_contrast.edges(image)
     dist = cv2.distanceTransform((edges == 0).astype(np.uint8), cv2.DIST_L2, 3)
     return np.minimum(dist, truncate_px).astype(np.float32)
 

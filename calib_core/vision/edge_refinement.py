@@ -28,6 +28,16 @@ _CROWDED_PX = 3.0
 _TUKEY = 4.685
 
 
+SETTLED_RMS_PX = 1.5
+"""The largest RMS of a settled edge fit, px. The simulated camera's edges fit to 0.1-0.4 px and the bound was
+0.5 px; a photographed cardboard box (OpenCV's pose tutorial: rounded edges, JPEG, a lens nobody calibrated)
+fits its outline to 1.1-1.4 px with 88-100 % of its samples on their edges."""
+COARSE_FIT_SHARE = 0.75
+"""The share of samples on their edges a fit coarser than 0.5 px must hold: on that photo a start 150 mm off
+settled on the print and the table at 1.46 px with 51 % (and seven "corners" agreeing with it); the right fits
+held 88-100 %."""
+
+
 @dataclass(frozen=True)
 class EdgeFit:
     """``obj2cam`` (4, 4) the refined pose (mm); ``rms_px`` the weighted RMS of the samples' normal
@@ -57,8 +67,11 @@ class EdgeFit:
 
     @property
     def settled(self) -> bool:
-        """Converged, the samples within 0.5 px RMS, and at least half of them on their edges."""
-        return self.converged and self.rms_px <= 0.5 and self.inlier_share >= 0.5
+        """Converged, and either within 0.5 px RMS with at least half the samples on their edges, or within
+        :data:`SETTLED_RMS_PX` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold more of its edges)."""
+        if not self.converged:
+            return False
+        return (self.rms_px <= 0.5 and self.inlier_share >= 0.5) or (self.rms_px <= SETTLED_RMS_PX and self.inlier_share >= COARSE_FIT_SHARE)
 
 
 def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:

@@ -25,6 +25,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project, undistort_pixels, unproject
 from calib_core.vision.profile_matching import match_profiles
+from calib_core.vision import colour_contrast
 
 _ALIKE = 0.5  # the least correlation of a rim point's gradient profile with the model's to measure it by
 
@@ -76,10 +77,10 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
     return Detection(refined, confidence)
 
 
-def gradient_magnitude(grey: np.ndarray) -> np.ndarray:
-    """The image's gradient magnitude (float32), lightly smoothed: what edge searches climb."""
-    g = cv2.GaussianBlur(grey, (3, 3), 0.8).astype(np.float32)
-    return np.hypot(cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3))
+def gradient_magnitude(image: np.ndarray) -> np.ndarray:
+    """The image's gradient magnitude (float32), lightly smoothed: what edge searches climb. ``image`` grey, or
+    RGB for edges of colour as well as lightness (:func:`calib_core.vision.colour_contrast.gradient_magnitude`)."""
+    return colour_contrast.gradient_magnitude(image)
 
 
 def search_normals(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarray, search_px: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

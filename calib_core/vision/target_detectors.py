@@ -51,13 +51,14 @@ class TargetDetectors:
     """The detectors of one image and one target: the gradient computed once, the edges that end at
     each corner found once."""
 
-    def __init__(self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None):
+    def __init__(self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None, colour: np.ndarray | None = None):
         self.grey = grey
         self.expected = expected
-        self._rendered: tuple[np.ndarray, np.ndarray] | None = None  # (obj2cam, grey image)
+        self._rendered: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (obj2cam, the view as rendered, its grey)
         self._expected_magnitude: np.ndarray | None = None
         self._box = (0, 0, 0, 0)
-        self.magnitude = gradient_magnitude(grey)
+        # edges from colour as well as lightness (``colour``: the frame as taken, RGB): an orange top on a tan table
+        self.magnitude = gradient_magnitude(grey if colour is None else colour)
         self.intrinsics = intrinsics
         self.segments, self.normals = crease_segments(item.mesh)
         self.box_corners = trimesh.bounds.corners(item.mesh.bounds)
@@ -84,9 +85,10 @@ class TargetDetectors:
             lo, hi = np.floor(corners.min(axis=0)) - _BOX_MARGIN_PX, np.ceil(corners.max(axis=0)) + _BOX_MARGIN_PX
             h, w = self.grey.shape
             self._box = (max(int(lo[0]), 0), max(int(lo[1]), 0), min(int(hi[0]) + 1, w), min(int(hi[1]) + 1, h))
-            self._rendered = (obj2cam.copy(), as_grey(self.expected(obj2cam, box_px=self._box, supersample=_COARSE)))
+            view = self.expected(obj2cam, box_px=self._box, supersample=_COARSE)
+            self._rendered = (obj2cam.copy(), view, as_grey(view))
             self._expected_magnitude = None
-        return self._rendered[1]
+        return self._rendered[2]
 
     def expected_magnitude(self, obj2cam: np.ndarray) -> np.ndarray:
         """The gradient magnitude (h, w) of the model's view at ``obj2cam``, computed once per render and
@@ -94,9 +96,10 @@ class TargetDetectors:
         image = self.expected_image(obj2cam)
         if self._expected_magnitude is None:
             u0, v0, u1, v1 = self._box
+            view = self._rendered[1]  # in the cell's colours: a colour-only edge shows there too
             self._expected_magnitude = np.zeros(image.shape, dtype=np.float32)
             if u1 > u0 and v1 > v0:
-                self._expected_magnitude[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
+                self._expected_magnitude[v0:v1, u0:u1] = gradient_magnitude(view[v0:v1, u0:u1])
         return self._expected_magnitude
 
     def detail_magnitude(self, obj2cam: np.ndarray, points_px: np.ndarray) -> np.ndarray:
@@ -110,7 +113,7 @@ class TargetDetectors:
         u0, v0, u1, v1 = max(lo[0], 0), max(lo[1], 0), min(hi[0], w), min(hi[1], h)
         out = np.zeros((h, w), dtype=np.float32)
         if u1 > u0 and v1 > v0:
-            image = as_grey(self.expected(obj2cam, box_px=(u0, v0, u1, v1), supersample=_DETAIL_SAMPLES))
+            image = self.expected(obj2cam, box_px=(u0, v0, u1, v1), supersample=_DETAIL_SAMPLES)
             out[v0:v1, u0:u1] = gradient_magnitude(image[v0:v1, u0:u1])
         return out
 

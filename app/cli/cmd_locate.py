@@ -1,0 +1,144 @@
+"""``videocal locate PHOTO --mesh MESH --intrinsics FILE --prior POSE.json``: a known object's pose in a photo.
+
+Runs Find points and the edge fit (:mod:`calib_core.vision.locate`) on one photo of one object and prints the
+object's pose in the camera's frame with its 1-sigma as JSON (``R_obj2cam``, ``t_obj2cam_mm``, ``std``,
+``status``, the features found). ``--overlay OUT.png`` draws the located outline (green) and the prior's (red) on
+the photo. The prior is JSON: ``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as this command prints them, or
+``obj2cam`` (4 x 4, mm). ``--features`` is YAML: ``name: [x, y, z]`` in the mesh's units, corners of the object
+(default: the vertices of a mesh of at most 64, a box's eight).
+
+Exit codes: 0 located (``ok``), 2 bad input (one ``error:`` line), 3 not located (the JSON says why).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from calib_core.documents import read_json, read_text, parse_yaml
+from calib_core.errors import FileFormatError
+from calib_core.frames import check_transform, make_transform
+from calib_core.mesh_files import MESH_SCALE, load_mesh
+
+EXIT_NOT_LOCATED = 3
+MAX_FEATURES = 1000
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from calib_core.vision.find_points import REACH_DEG, REACH_MM
+
+    parser.add_argument("photo", type=Path, help="the photo (PNG, JPEG, ...) of the object")
+    parser.add_argument("--mesh", type=Path, required=True, help="the object's mesh (STL, OBJ, PLY, DAE, glTF)")
+    parser.add_argument("--intrinsics", type=Path, required=True, help="the camera's intrinsics (OpenCV YAML or ROS camera_info YAML)")
+    parser.add_argument("--prior", type=Path, required=True, help="JSON: the object's rough pose in the camera frame (R_obj2cam, t_obj2cam_mm)")
+    parser.add_argument("--features", type=Path, help="YAML: name: [x, y, z] corner points in the mesh's units (default: a small mesh's vertices)")
+    parser.add_argument("--units", choices=sorted(MESH_SCALE, key=MESH_SCALE.get), default="mm", help="the mesh's and the features' units (default mm)")
+    parser.add_argument("--reach-mm", type=float, default=REACH_MM, help=f"how far the prior's position may be off, mm (default {REACH_MM:g})")
+    parser.add_argument("--reach-deg", type=float, default=REACH_DEG, help=f"how far the prior may be turned, degrees (default {REACH_DEG:g})")
+    parser.add_argument("--overlay", type=Path, help="write the photo with the located outline (green) and the prior's (red) to this PNG")
+    parser.add_argument("--indent", type=int, default=2, help="JSON indentation (0 for one line)")
+
+
+def read_prior(path: Path) -> np.ndarray:
+    """The prior pose (4, 4) mm from JSON: ``R_obj2cam`` + ``t_obj2cam_mm``, or ``obj2cam``; the error names the field."""
+    data = read_json(path, "prior pose file")
+    if not isinstance(data, dict):
+        raise FileFormatError(path, "the top level must be a JSON object with R_obj2cam and t_obj2cam_mm (or obj2cam)")
+    try:
+        if "obj2cam" in data:
+            pose = np.asarray(data["obj2cam"], dtype=float).reshape(4, 4)
+        else:
+            for key in ("R_obj2cam", "t_obj2cam_mm"):
+                if data.get(key) is None:
+                    raise FileFormatError(path, "required field is missing (or give obj2cam, 4 x 4)", key)
+            pose = make_transform(np.asarray(data["R_obj2cam"], dtype=float).reshape(3, 3), np.asarray(data["t_obj2cam_mm"], dtype=float).reshape(3))
+    except (TypeError, ValueError) as exc:
+        raise FileFormatError(path, f"R_obj2cam must be 3 x 3 and t_obj2cam_mm 3 numbers (or obj2cam 4 x 4): {exc}") from None
+    # a rough prior written by hand (four decimals) is a rotation to a few 1e-4: the nearest rotation is meant
+    u, singular, vt = np.linalg.svd(pose[:3, :3]) if np.all(np.isfinite(pose)) else (None, None, None)
+    if singular is not None and np.max(np.abs(singular - 1.0)) < 0.01 and np.linalg.det(u @ vt) > 0:
+        pose[:3, :3] = u @ vt
+    try:
+        return check_transform(pose, name="prior")
+    except ValueError as exc:
+        raise FileFormatError(path, str(exc)) from None
+
+
+def read_features(path: Path, scale: float) -> dict[str, np.ndarray]:
+    """``name: [x, y, z]`` (the mesh's units) -> mm; the error names the feature."""
+    data = parse_yaml(read_text(path, "features file", max_bytes=1024 * 1024), path)
+    if not isinstance(data, dict) or not data:
+        raise FileFormatError(path, "must be a mapping of feature names to [x, y, z]")
+    if len(data) > MAX_FEATURES:
+        raise FileFormatError(path, f"{len(data)} features; at most {MAX_FEATURES}")
+    out = {}
+    for name, value in data.items():
+        if not (isinstance(value, list) and len(value) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+            raise FileFormatError(path, f"must be [x, y, z] numbers, got {value!r}", str(name))
+        point = np.asarray(value, dtype=float) * scale
+        if not np.all(np.isfinite(point)):
+            raise FileFormatError(path, "must be finite numbers", str(name))
+        out[str(name)] = point
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.image_files import read_image
+    from calib_core.render.model_view import ModelView
+    from calib_core.vision.locate import locate
+
+    for name in ("reach_mm", "reach_deg"):
+        value = getattr(args, name)
+        if not (np.isfinite(value) and 0.0 < value <= (500.0 if name == "reach_mm" else 30.0)):
+            raise ValueError(f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got {value:g}")
+    image = read_image(args.photo)
+    intrinsics = load_intrinsics(args.intrinsics, image_size=(image.shape[1], image.shape[0]))
+    if (intrinsics.width, intrinsics.height) != (image.shape[1], image.shape[0]):
+        raise FileFormatError(args.photo, f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x {intrinsics.height} px")
+    mesh = load_mesh(args.mesh, args.units)
+    features = read_features(args.features, MESH_SCALE[args.units]) if args.features else None
+    prior = read_prior(args.prior)
+    view = ModelView(intrinsics)
+    try:
+        from calib_core.scene import SceneItem
+
+        # the model's view only says which edges show: the object alone, light on the renderer's black, its faces
+        # shaded apart by the light
+        expected = view.of([SceneItem(args.mesh.stem, mesh, np.eye(4), color=(0.75, 0.75, 0.75))], np.eye(4))
+        result = locate(image, intrinsics, mesh, prior, features=features, expected=expected, reach_mm=args.reach_mm, reach_deg=args.reach_deg, name=args.mesh.stem)
+    finally:
+        view.close()
+    if args.overlay:
+        _write_overlay(args.overlay, image, intrinsics, mesh, prior, result)
+    json.dump(result.to_dict(), sys.stdout, indent=args.indent or None)
+    sys.stdout.write("\n")
+    return 0 if result.status == "ok" else EXIT_NOT_LOCATED
+
+
+def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.ndarray, result) -> None:
+    import cv2
+
+    from calib_core.atomic_file import atomic_path
+    from calib_core.camera.projection import project_points
+
+    out = cv2.cvtColor(image, cv2.COLOR_RGB2BGR) if image.ndim == 3 else cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
+    creases = mesh.face_adjacency_edges[mesh.face_adjacency_angles > np.radians(20)]
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    for pose, colour in ((prior, (0, 0, 255)), (result.obj2cam, (0, 200, 0))):
+        if pose is None or len(creases) == 0:
+            continue
+        for a, b in project_points(vertices[creases.reshape(-1)], pose, intrinsics).reshape(-1, 2, 2):
+            cv2.line(out, (int(round(a[0] * 4)), int(round(a[1] * 4))), (int(round(b[0] * 4)), int(round(b[1] * 4))), colour, 1, cv2.LINE_AA, shift=2)
+    for f in result.features:
+        cv2.drawMarker(out, (int(round(f.uv_px[0])), int(round(f.uv_px[1]))), (255, 200, 0), cv2.MARKER_CROSS, 9, 1)
+    if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):
+        raise FileFormatError(path, "the overlay is written as PNG or JPEG: name it .png or .jpg")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:  # (the temporary name keeps the suffix, which tells OpenCV the format)
+        if not cv2.imwrite(str(tmp), out):
+            raise FileFormatError(path, "could not write the overlay image")

@@ -1,0 +1,153 @@
+"""A look on any photograph: a known object's pose in a camera's frame from one image, its edges and features.
+
+What the window does at a task location (Find points and the edge fit, :mod:`calib_core.vision.find_points`),
+on a photo of one object with nothing else known: the object's mesh, the camera's intrinsics and a rough pose
+(the prior) to start from. So a look can be checked on real photographs (a phone photo of a box and its mesh),
+not only on the simulated camera.
+
+The pose reported is the edge fit's: hundreds of samples along the object's outline and creases, with its
+covariance (each edge chain's samples taken as one measurement). The features found are reported with their
+pixels and, when four or more agree, the pose they give on their own: two measurements that share no sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.frames import check_transform, rotation_angle_deg
+from calib_core.scene import SceneItem
+from calib_core.solver import solve_pose
+from calib_core.vision.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
+
+MAX_DEFAULT_FEATURES = 64
+"""A mesh of at most this many vertices (a box, a plate) gives its vertices as corner features by default."""
+
+
+@dataclass(frozen=True)
+class LocatedFeature:
+    """A feature found: ``name``, ``uv_px`` (2,) px in the photo, ``point_mm`` (3,) in the object's frame."""
+
+    name: str
+    uv_px: np.ndarray
+    point_mm: np.ndarray
+    confidence: float
+
+
+@dataclass(frozen=True)
+class Located:
+    """``status``: ``ok`` (the edges settled: converged, within their RMS bound, at least half the samples on
+    their edges), else ``not found`` with ``message`` saying why. ``obj2cam`` (4, 4) mm: the edge fit's pose
+    (``None`` when not found); ``std_rotation_deg`` (3,) and ``std_translation_mm`` (3,): its 1-sigma, about the
+    camera's axes; ``features`` found and ``missed`` (name, reason); ``features_obj2cam`` the pose of the features
+    alone (four or more, else ``None``) and ``features_vs_edges_mm`` how far its origin is from the edges' (the two
+    share no measurement)."""
+
+    status: str
+    message: str
+    obj2cam: np.ndarray | None
+    std_rotation_deg: np.ndarray | None
+    std_translation_mm: np.ndarray | None
+    edge_rms_px: float | None
+    edge_share: float | None
+    edge_samples: int
+    features: tuple[LocatedFeature, ...] = ()
+    missed: tuple[tuple[str, str], ...] = ()
+    features_obj2cam: np.ndarray | None = None
+    features_vs_edges_mm: float | None = None
+    prior_moved_mm: float | None = None
+    prior_turned_deg: float | None = None
+    seconds: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The JSON form (mm, degrees): ``R_obj2cam``, ``t_obj2cam_mm``, ``std`` and the rest."""
+        def matrix(a):
+            return None if a is None else np.round(np.asarray(a, float), 9).tolist()
+
+        return {
+            "status": self.status, "message": self.message,
+            "R_obj2cam": matrix(None if self.obj2cam is None else self.obj2cam[:3, :3]),
+            "t_obj2cam_mm": matrix(None if self.obj2cam is None else self.obj2cam[:3, 3]),
+            "std": None if self.std_translation_mm is None else {"rotation_deg": matrix(self.std_rotation_deg), "translation_mm": matrix(self.std_translation_mm)},
+            "edges": {"rms_px": _finite(self.edge_rms_px), "share_on_edges": _finite(self.edge_share), "samples": self.edge_samples},
+            "features": [{"name": f.name, "uv_px": matrix(f.uv_px), "point_mm": matrix(f.point_mm), "confidence": round(f.confidence, 3)} for f in self.features],
+            "missed": [{"name": n, "reason": r} for n, r in self.missed],
+            "features_pose": None if self.features_obj2cam is None else {
+                "R_obj2cam": matrix(self.features_obj2cam[:3, :3]), "t_obj2cam_mm": matrix(self.features_obj2cam[:3, 3]),
+                "origin_from_edges_mm": self.features_vs_edges_mm},
+            "moved_from_prior": None if self.prior_moved_mm is None else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
+            "seconds": round(self.seconds, 3),
+        }
+
+
+def _finite(value: float | None) -> float | None:
+    """JSON has no infinity: a fit that found no sample has no RMS."""
+    return None if value is None or not np.isfinite(value) else round(float(value), 4)
+
+
+def default_features(mesh) -> dict[str, np.ndarray]:
+    """The mesh's vertices (mm) named ``v0``, ``v1``, ... as corners when it has at most
+    :data:`MAX_DEFAULT_FEATURES` (a box's eight), else none: a finely meshed object's vertices are not corners."""
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    if len(vertices) > MAX_DEFAULT_FEATURES:
+        return {}
+    return {f"v{i}": v.copy() for i, v in enumerate(vertices)}
+
+
+def locate(image: np.ndarray, intrinsics: Intrinsics, mesh, prior_obj2cam: np.ndarray, *, features: dict[str, np.ndarray] | None = None,
+           expected=None, reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, name: str = "object", color=(0.7, 0.7, 0.7)) -> Located:
+    """The pose of the object ``mesh`` (mm, its own frame) in ``image`` (h, w[, 3]) uint8 taken by a camera of
+    ``intrinsics``, starting from ``prior_obj2cam`` (4, 4, mm: the object's frame to the camera's) and searching
+    ``reach_mm`` and ``reach_deg`` round it. ``features`` name -> (3,) mm (default :func:`default_features`);
+    ``expected``: the object rendered as the camera would see it (as :func:`find_points` takes it), to leave out
+    edges without contrast."""
+    prior = check_transform(prior_obj2cam, name="prior (obj2cam)")
+    item = SceneItem(name, mesh, np.eye(4), color=tuple(color), features=default_features(mesh) if features is None else dict(features))
+    if item.features:
+        found = find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg)
+    else:
+        found = _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg)
+    return _report(found, intrinsics, prior, reach_mm, reach_deg)
+
+
+def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -> FoundPoints:
+    """Find points' pose search and edge fit for an object without features: one dummy feature at its centre,
+    reported as missed, so the same code runs."""
+    centre = np.asarray(item.mesh.bounding_box.centroid, dtype=float)
+    from calib_core.workcell.feature_kinds import FeatureKind
+
+    item = SceneItem(item.name, item.mesh, item.item2world, color=item.color, features={"centre": centre}, feature_kinds={"centre": FeatureKind("point")})
+    return find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg)
+
+
+def _report(found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float) -> Located:
+    edges = found.edges
+    features = tuple(LocatedFeature(p.feature, p.uv_px, p.point_mm, p.confidence) for p in found.proposals)
+    missed = tuple((m.feature, m.reason) for m in found.missed if m.feature != "centre")
+    if edges is None or not edges.settled:
+        why = found.message.replace(": pick the points by hand", "")
+        return Located("not found", f"{why}; give a prior nearer the object, or a larger reach", None, None, None,
+                       None if edges is None else edges.rms_px, None if edges is None else edges.inlier_share, 0 if edges is None else edges.samples,
+                       features, missed, seconds=found.seconds)
+    moved = float(np.linalg.norm(edges.obj2cam[:3, 3] - prior[:3, 3]))
+    turned = rotation_angle_deg(edges.obj2cam[:3, :3] @ prior[:3, :3].T)
+    if moved > 3.0 * reach_mm or turned > 3.0 * reach_deg:
+        # the search covered the reach round the prior; a fit that walked far beyond it found something else
+        return Located("not found", f"the edges settled {moved:.0f} mm and {turned:.1f} deg from the prior, beyond three times the reach "
+                       f"({reach_mm:g} mm, {reach_deg:g} deg) the search covered: give a prior nearer the object, or a larger reach",
+                       None, None, None, edges.rms_px, edges.inlier_share, edges.samples, (), missed, prior_moved_mm=round(moved, 3),
+                       prior_turned_deg=round(float(turned), 4), seconds=found.seconds)
+    std = np.sqrt(np.clip(np.diag(edges.covariance), 0.0, None))
+    features_pose, apart = None, None
+    if len(features) >= 4:
+        solution = solve_pose(np.array([f.point_mm for f in features]), np.array([f.uv_px for f in features]), intrinsics, prior=edges.obj2cam)
+        if solution.status.value != "failed":
+            features_pose = solution.obj2cam
+            apart = round(float(np.linalg.norm(features_pose[:3, 3] - edges.obj2cam[:3, 3])), 3)
+    message = (f"located by its edges: {edges.samples} samples, {100 * edges.inlier_share:.0f} % on their edges, RMS {edges.rms_px:.2f} px; "
+               f"{len(features)} features found" + (f", {len(missed)} not" if missed else ""))
+    return Located("ok", message, edges.obj2cam, np.degrees(std[:3]), std[3:], round(edges.rms_px, 3), round(edges.inlier_share, 3), edges.samples,
+                   features, missed, features_pose, apart, round(moved, 3), round(float(turned), 4), found.seconds)
