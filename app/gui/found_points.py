@@ -1,5 +1,5 @@
 """*Find points* in the window (F6): the core finds the target's features on the held frame; a list
-shows each proposal (feature, kind, confidence, distance from the fitted pose) with a check box and
+shows each proposal (feature, kind, confidence, distance from the fitted pose, and why a detector was unsure) with a check box and
 each feature not found with the reason; *Accept checked* adds the checked ones as pairs, one undo
 step. The camera pane draws the proposals while the list is open."""
 
@@ -28,14 +28,14 @@ class FoundPointsDialog(QDialog):
         self.message.setTextFormat(Qt.TextFormat.PlainText)
         self.message.setWordWrap(True)
         layout.addWidget(self.message)
-        self.table = QTableWidget(len(result.proposals), 4, self)
-        self.table.setHorizontalHeaderLabels(["feature", "kind", "confidence", "off the fit (px)"])
+        self.table = QTableWidget(len(result.proposals), 5, self)
+        self.table.setHorizontalHeaderLabels(["feature", "kind", "confidence", "off the fit (px)", "unsure because"])
         for row, p in enumerate(result.proposals):
             name = QTableWidgetItem(p.feature)
             name.setFlags(Qt.ItemFlag.ItemIsUserCheckable | Qt.ItemFlag.ItemIsEnabled)
             name.setCheckState(Qt.CheckState.Checked)
             self.table.setItem(row, 0, name)
-            for col, text in ((1, p.kind), (2, f"{p.confidence:.2f}"), (3, f"{p.residual_px:.2f}")):
+            for col, text in ((1, p.kind), (2, f"{p.confidence:.2f}"), (3, f"{p.residual_px:.2f}"), (4, p.why)):
                 item = QTableWidgetItem(text)
                 item.setFlags(Qt.ItemFlag.ItemIsEnabled)
                 self.table.setItem(row, col, item)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.vision.feature_detectors import Detection, NotDetected, search_normals
+from calib_core.vision.feature_detectors import Detection, NotDetected, detection, search_normals
 from calib_core.vision.profile_matching import match_profiles
 
 _FROM_CORNER_PX = 4.0  # clear of the junction, where three faces meet
@@ -79,4 +79,6 @@ def detect_corner_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     if np.linalg.norm(delta) > search_px:
         return NotDetected("its edges lie away from where the model's view draws them")
     rms = float(np.sqrt(np.mean(residual[keep] ** 2)))
-    return Detection(corner_px + delta, float(np.clip(keep.mean(), 0.0, 1.0) * np.exp(-rms / 0.5)))
+    return detection(corner_px + delta, float(np.clip(keep.mean(), 0.0, 1.0) * np.exp(-rms / 0.5)),
+                     (float(keep.mean()), f"only {100 * keep.mean():.0f} % of its edges' samples agree with the model's view"),
+                     (float(np.exp(-rms / 0.5)), f"its edges differ from the model's view by {rms:.1f} px RMS"))

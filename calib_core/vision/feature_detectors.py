@@ -30,10 +30,24 @@ from calib_core.vision import colour_contrast
 _ALIKE = 0.5  # the least correlation of a rim point's gradient profile with the model's to measure it by
 
 
+UNCERTAIN = 0.5
+"""Below this confidence a detection says why it is unsure (the found-points table shows it)."""
+
+
 @dataclass(frozen=True)
 class Detection:
+    """``uv_px`` (2,) px, ``confidence`` in [0, 1], ``why``: what lowered it, when below :data:`UNCERTAIN`."""
+
     uv_px: np.ndarray
     confidence: float
+    why: str = ""
+
+
+def detection(uv_px: np.ndarray, confidence: float, *causes: tuple[float, str]) -> Detection:
+    """A detection whose ``why`` is the cause (factor, words) that lowered ``confidence`` most, when it is below
+    :data:`UNCERTAIN`."""
+    why = min(causes, key=lambda c: c[0])[1] if causes and confidence < UNCERTAIN else ""
+    return Detection(uv_px, float(confidence), why)
 
 
 @dataclass(frozen=True)
@@ -72,9 +86,10 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
     others = np.sort(dist)[1:2]
     if len(others) and others[0] < 2.5:
         confidence *= 0.5
-    if np.linalg.norm(refined - cand[k]) > 1.5:
-        return Detection(cand[k].astype(float), 0.3 * confidence)  # the refinement walked off: three faces meet here
-    return Detection(refined, confidence)
+    crowded = (confidence, "another corner lies within 2.5 px")
+    if np.linalg.norm(refined - cand[k]) > 1.5:  # the refinement walked off: three faces meet here
+        return detection(cand[k].astype(float), 0.3 * confidence, (0.3, "the sub-pixel refinement walked off it (three faces meeting?)"), crowded)
+    return detection(refined, confidence, crowded)
 
 
 def gradient_magnitude(image: np.ndarray) -> np.ndarray:
@@ -137,14 +152,16 @@ def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.nda
             pts = pts[keep]
         ellipse = cv2.fitEllipse(pts)
         rms = float(np.sqrt(np.mean(_ellipse_residual(pts, ellipse) ** 2)))
-        return Detection(np.array(ellipse[0]) + centre_offset_px, float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)))
+        return detection(np.array(ellipse[0]) + centre_offset_px, float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)),
+                         (float(coverage), f"only {100 * coverage:.0f} % of its rim found"), (float(np.exp(-rms / 0.7)), f"its rim is off an ellipse by {rms:.1f} px RMS"))
     # a partial rim: the predicted ellipse moved as a whole onto the edge points (two unknowns)
     shift = _rim_shift(normals[strong], np.einsum("ij,ij->i", points[strong] - rim_px[strong], normals[strong]), 0.5)
     if isinstance(shift, NotDetected):
         return shift
     delta, rms, _ = shift
     predicted_centre = np.array(cv2.fitEllipse(rim_px.astype(np.float32))[0]) + centre_offset_px
-    return Detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)))
+    return detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)),
+                     (float(coverage / 0.7 * 0.7), f"only {100 * coverage:.0f} % of its rim found: placed by the part seen"), (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"))
 
 
 def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.ndarray, rim_px: np.ndarray, centre_px: np.ndarray, search_px: float = 2.0) -> Detection | NotDetected:
@@ -181,7 +198,9 @@ def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     if isinstance(shift, NotDetected):
         return shift
     delta, rms, kept = shift
-    return Detection(centre_px + delta, float(np.clip(kept / len(rim_px) / 0.5, 0, 1) * np.exp(-rms / 0.5)))
+    return detection(centre_px + delta, float(np.clip(kept / len(rim_px) / 0.5, 0, 1) * np.exp(-rms / 0.5)),
+                     (float(kept / len(rim_px) / 0.5), f"only {100 * kept / len(rim_px):.0f} % of its rim measured against the model's"),
+                     (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"))
 
 
 def _rim_shift(normals: np.ndarray, offsets_px: np.ndarray, floor_px: float) -> tuple[np.ndarray, float, int] | NotDetected:
@@ -253,7 +272,7 @@ def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: l
     if np.linalg.norm(uv - corner_px) > search_px + 2.0:
         return NotDetected("its edges meet away from where they should")
     rms = max(r for _, _, r, _ in lines)
-    return Detection(uv, float(np.exp(-rms / 0.5)))
+    return detection(uv, float(np.exp(-rms / 0.5)), (0.0, f"its edges are off straight lines by {rms:.1f} px RMS"))
 
 
 def _ellipse_residual(points: np.ndarray, ellipse) -> np.ndarray:
@@ -285,4 +304,4 @@ def detect_blob(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> Dete
     if x == 0 or y == 0 or x + bw >= roi.shape[1] or y + bh >= roi.shape[0]:
         return NotDetected(f"no blob smaller than {2 * radius_px:.0f} px there")
     contrast = abs(float(roi[labels == k].mean()) - float(roi[labels != k].mean())) / 255.0
-    return Detection(centroids[k] + (x0, y0), float(np.clip(4 * contrast, 0, 1)))
+    return detection(centroids[k] + (x0, y0), float(np.clip(4 * contrast, 0, 1)), (0.0, f"a faint blob ({100 * contrast:.0f} % contrast)"))

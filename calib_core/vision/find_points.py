@@ -61,6 +61,8 @@ class Proposal:
     point_mm: np.ndarray
     confidence: float
     residual_px: float
+    why: str = ""
+    """What made the detector unsure, when its confidence is below one half (empty otherwise)."""
 
 
 @dataclass(frozen=True)
@@ -245,7 +247,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         if not fit.get(i, False):
             missed[names[i]] = f"rejected by the pose fit: {residual:.1f} px from where the other features put it"
             continue
-        proposals.append(Proposal(names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual))
+        proposals.append(Proposal(names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual, d.why))
     found = len(proposals) >= 4
     message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
                if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")

@@ -34,6 +34,7 @@ class LocatedFeature:
     uv_px: np.ndarray
     point_mm: np.ndarray
     confidence: float
+    why: str = ""
 
 
 @dataclass(frozen=True)
@@ -73,7 +74,7 @@ class Located:
             "t_obj2cam_mm": matrix(None if self.obj2cam is None else self.obj2cam[:3, 3]),
             "std": None if self.std_translation_mm is None else {"rotation_deg": matrix(self.std_rotation_deg), "translation_mm": matrix(self.std_translation_mm)},
             "edges": {"rms_px": _finite(self.edge_rms_px), "share_on_edges": _finite(self.edge_share), "samples": self.edge_samples},
-            "features": [{"name": f.name, "uv_px": matrix(f.uv_px), "point_mm": matrix(f.point_mm), "confidence": round(f.confidence, 3)} for f in self.features],
+            "features": [{"name": f.name, "uv_px": matrix(f.uv_px), "point_mm": matrix(f.point_mm), "confidence": round(f.confidence, 3), **({"unsure_because": f.why} if f.why else {})} for f in self.features],
             "missed": [{"name": n, "reason": r} for n, r in self.missed],
             "features_pose": None if self.features_obj2cam is None else {
                 "R_obj2cam": matrix(self.features_obj2cam[:3, :3]), "t_obj2cam_mm": matrix(self.features_obj2cam[:3, 3]),
@@ -125,7 +126,7 @@ def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -
 
 def _report(found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float) -> Located:
     edges = found.edges
-    features = tuple(LocatedFeature(p.feature, p.uv_px, p.point_mm, p.confidence) for p in found.proposals)
+    features = tuple(LocatedFeature(p.feature, p.uv_px, p.point_mm, p.confidence, p.why) for p in found.proposals)
     missed = tuple((m.feature, m.reason) for m in found.missed if m.feature != "centre")
     if edges is None or not edges.settled:
         why = found.message.replace(": pick the points by hand", "")

@@ -152,7 +152,8 @@ class TargetDetectors:
             return why
         modelled = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=detail, lens=self.intrinsics)
         if isinstance(modelled, Detection):
-            return Detection(lines.uv_px - (modelled.uv_px - uv), min(lines.confidence, modelled.confidence))
+            weaker = lines if lines.confidence <= modelled.confidence else modelled
+            return Detection(lines.uv_px - (modelled.uv_px - uv), weaker.confidence, weaker.why)
         return lines
 
     def detect(self, kind: FeatureKind, point, obj2cam, radius) -> Detection | NotDetected:

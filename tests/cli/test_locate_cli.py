@@ -65,6 +65,10 @@ def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_fi
     assert np.all(std > 0.2) and np.all(std < 6.0)
     # the corners alone (no sample shared with the edges) put the box where its edges do, within their scatter
     assert out["features_pose"]["origin_from_edges_mm"] < 3.0 * np.linalg.norm(std)
+    # a corner the detector is unsure of says why (the box's far bottom corner: its edges are no straight lines)
+    unsure = [f for f in out["features"] if f["confidence"] < 0.5]
+    assert unsure and all(f.get("unsure_because") for f in unsure)
+    assert not any("unsure_because" in f for f in out["features"] if f["confidence"] >= 0.5)
     R = np.array(out["R_obj2cam"])
     np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-6)
     picture = cv2.imread(str(overlay))

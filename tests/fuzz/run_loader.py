@@ -109,6 +109,21 @@ def mutated_text(draw, text: str):
     return text
 
 
+@st.composite
+def mutated_bytes(draw, data: bytes):
+    """A binary file cut, with bytes overwritten, or with bytes inserted."""
+    op = draw(st.sampled_from(["cut", "flip", "insert"]))
+    if op == "cut":
+        return data[: draw(st.integers(0, len(data)))]
+    if op == "flip":
+        out = bytearray(data)
+        for _ in range(draw(st.integers(1, 8))):
+            out[draw(st.integers(0, len(out) - 1))] = draw(st.integers(0, 255))
+        return bytes(out)
+    at = draw(st.integers(0, len(data)))
+    return data[:at] + draw(st.binary(max_size=64)) + data[at:]
+
+
 # --- the loaders ----------------------------------------------------------------------------------
 def _cell_folder() -> Path:
     folder = Path(tempfile.mkdtemp(prefix="fuzz_cell_"))
@@ -142,6 +157,22 @@ def loaders(folder: Path) -> dict:
                     "intrinsics": {"fx": 1352.0, "fy": 1356.1, "cx": 789.7, "cy": 627.3}, "static_camera": True}
     csv_text = "image,x_mm,y_mm,z_mm,qx,qy,qz,qw\nimages/0.png,110.0,590.0,650.0,-0.5186,0.8156,0.0932,0.2390\nimages/1.png,120,600,640,0,0,0,1\n"
 
+    from app.cli.cmd_locate import read_features, read_prior
+    from calib_core.mesh_files import load_mesh
+    from calib_core.recording.reader import read_recording
+    from calib_core.robot.model import load_robot
+
+    urdf_text = (folder / "robot" / "videocal_arm.urdf").read_text()
+    recording_bytes = (ROOT / "resources" / "recordings" / "sample_session.mcap").read_bytes()
+    box_ply = (ROOT / "tests" / "data" / "third_party" / "opencv_samples" / "box.ply").read_text()
+    prior_doc = {"R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]], "t_obj2cam_mm": [-5.9, 110.7, 943.5]}
+    features_doc = {"top_left": [0.0, 25.8, 7.5], "top_right": [18.9, 25.8, 7.5], "corner": [0, 0, 0]}
+
+    def binary_file(name: str, data: bytes) -> Path:
+        path = out / name
+        path.write_bytes(data)
+        return path
+
     def yaml_file(name: str, doc=None, text: str | None = None) -> Path:
         path = out / name
         path.write_text(text if text is not None else yaml.safe_dump(doc, sort_keys=False, allow_unicode=True))
@@ -167,6 +198,12 @@ def loaders(folder: Path) -> dict:
         "cal_data": (st.one_of(mutated(cal_data_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(cal_data_doc)).map(lambda t: ("text", t))),
                      lambda v: load_posed_images(yaml_file("cal_data.yaml", v[1]) if v[0] == "doc" else yaml_file("cal_data.yaml", text=v[1]))),
         "pose_csv": (mutated_text(csv_text), lambda t: load_posed_images(yaml_file("views.csv", text=t))),
+        "robot_urdf": (mutated_text(urdf_text), lambda t: load_robot(yaml_file("../robot/fuzz.urdf", text=t))),
+        "recording": (mutated_bytes(recording_bytes), lambda b: read_recording(binary_file("fuzz.mcap", b))),
+        "mesh_ply": (mutated_text(box_ply), lambda t: load_mesh(yaml_file("fuzz.ply", text=t), "cm")),
+        "locate_prior": (mutated(prior_doc), lambda d: read_prior(json_file("prior.json", d))),
+        "locate_features": (st.one_of(mutated(features_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(features_doc)).map(lambda t: ("text", t))),
+                            lambda v: read_features(yaml_file("features.yaml", v[1]) if v[0] == "doc" else yaml_file("features.yaml", text=v[1]), 10.0)),
         "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"(charuco|aruco):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}(:legacy)?", fullmatch=True),
                         st.from_regex(r"(chessboard|circles):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}(:asymmetric)?", fullmatch=True)), parse_board),
     }

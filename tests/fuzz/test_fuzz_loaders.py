@@ -13,7 +13,8 @@ import pytest
 
 from tests.fuzz.run_loader import ROOT
 
-LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec", "detector_settings", "cal_data", "pose_csv"]
+LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec", "detector_settings", "cal_data", "pose_csv",
+           "robot_urdf", "recording", "mesh_ply", "locate_prior", "locate_features"]
 EXAMPLES = int(os.environ.get("VIDEOCAL_FUZZ_EXAMPLES", "150"))
 
 

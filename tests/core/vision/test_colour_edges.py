@@ -84,3 +84,12 @@ def test_dark_on_dark_is_found_as_well():
         found = find_points(image, intrinsics, item, model, expected=expected)
         assert found.found, found.message
         assert _pixel_errors(item, found.obj2cam, truth, intrinsics).max() < 0.5
+
+
+def test_an_unsure_detection_names_what_made_it_unsure():
+    from calib_core.vision.feature_detectors import UNCERTAIN, detection
+
+    sure = detection(np.zeros(2), 0.8, (0.9, "rim partly found"), (0.89, "rim scatters"))
+    assert sure.why == ""
+    unsure = detection(np.zeros(2), 0.3, (0.9, "only 90 % of its rim found"), (0.33, "its rim scatters by 0.6 px"))
+    assert unsure.confidence < UNCERTAIN and unsure.why == "its rim scatters by 0.6 px"
