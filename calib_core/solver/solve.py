@@ -21,7 +21,7 @@ from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_t
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.pick_scale import pick_scale_px
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
-from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label
+from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label, points_label
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
 from calib_core.solver.finish import finish_solution, noise_px
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
@@ -136,14 +136,22 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     close = [p for p, score in zip(poses, scores) if p.converged and score - scores[0] <= _AMBIGUITY_CHI2 * noise**2]
     if not close:
         close = [best]
+    rivals = []
     if robust and problem.model == "pinhole":
         # with few pairs, the pair rejected is known only if no other one could be the mis-pick instead
-        close += distinct_poses([r for r in rival_consensus(problem, close[0], noise) if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)])
+        rivals = distinct_poses([r for r in rival_consensus(problem, close[0], noise) if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)])
+        close += rivals
     distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
     rank = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
     ranked = [close[i] for i in rank]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, rank))
-    return finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+    solution = finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+    if rivals and solution.status is SolveStatus.AMBIGUOUS:
+        # name the pairs: the operator re-picks those, not every point
+        suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
+        solution = replace(solution, reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the others fit as well); "
+                                            "pick them again or add a point")
+    return solution
 
 
 def _confidence_order(confidence: ArrayLike | None, n: int) -> np.ndarray | None:

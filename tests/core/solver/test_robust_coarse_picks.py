@@ -77,6 +77,9 @@ def test_with_five_pairs_a_pair_that_another_could_replace_is_not_called_the_mis
     for T, P, uv, bad, std in _one_off(6, 5, 300):
         s = solve_pose(P, uv, CAM, robust=True)
         ambiguous += s.status.value == "ambiguous"
+        if s.status.value == "ambiguous" and "could be the pick that is off" in s.reason:
+            named = {int(n) for n in s.reason.split(":")[0].replace("points", "").replace("point", "").split(",")}
+            assert bad + 1 in named, (bad + 1, s.reason)  # the mis-pick is among the pairs it names
         if s.status.value == "ok":
             wrong_ok += pose_error(s.obj2cam, T)[0] > 5 * std + 0.5
     # one scene of 300 is left: the mis-pick at a point of such leverage (h = 0.97) that no pick can check it;
