@@ -12,6 +12,8 @@ SHARE = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
 ROBOTS = SHARE / "example-robot-data" / "robots"
 UR5 = ROBOTS / "ur_description" / "urdf" / "ur5_robot.urdf"
 PANDA = ROBOTS / "panda_description" / "urdf" / "panda.urdf"
+JACO2 = ROBOTS / "kinova_description" / "robots" / "kinova.urdf"  # Kinova JACO2 j2s6s200, fingers fixed
+Z1 = ROBOTS / "z1_description" / "urdf" / "z1.urdf"  # Unitree Z1, a moving gripper joint
 
 
 def require(path: Path) -> Path:

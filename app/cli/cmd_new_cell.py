@@ -32,7 +32,9 @@ def run(args: argparse.Namespace) -> int:
         xacro_args[name.strip()] = value
     made = write_starter_cell(args.folder, args.urdf, args.package_path, flange=args.flange, name=args.name, xacro_args=xacro_args)
     print(f"wrote {made.workcell_path}")
-    print(f"  flange {made.flange}, base {made.base or '(URDF root)'}, held joints: {', '.join(made.held_joints) or 'none'}")
+    print(f"  flange {made.flange} ({made.flange_why}), base {made.base or '(URDF root)'}, held joints: {', '.join(made.held_joints) or 'none'}")
+    if made.tool_axis_warning:
+        print(f"  warning: {made.tool_axis_warning}")
     print(f"  home joints: {', '.join(f'{v:.1f}' for v in made.home_joints)}")
     print(f"next: videocal render --workcell {made.workcell_path} --location target_grasp --view overview --out overview.png")
     return 0

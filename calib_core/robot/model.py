@@ -166,7 +166,10 @@ class RobotModel:
         name = self.roles.get(name, name)
         if not self.model.existFrame(name):
             raise UnknownFrameError(name, self.frame_names)
-        return self.model.getFrameId(name)
+        try:
+            return self.model.getFrameId(name)
+        except ValueError:  # a link and a joint of one name (Unitree Z1's gripperStator): the link is meant
+            return self.model.getFrameId(name, pin.FrameType.BODY)
 
     def fk(self, q_deg: ArrayLike, frame: str = "tcp") -> np.ndarray:
         """``frame2base`` (4, 4), mm, at joints ``q_deg`` (n,) deg/mm."""
