@@ -2,8 +2,9 @@
 camera, or the simulated true camera.
 
 ``--location NAME`` drives the robot (by IK) to the task location's approach pose, from which
-the camera sees its component; ``--joints`` sets the joints directly; neither renders the
-home pose.
+the camera sees its component; ``--at-task NAME`` to the task pose itself (where the demo's and the
+operator's first look is made: a cell whose approach view looked fine can show too little there);
+``--joints`` sets the joints directly; none renders the home pose.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--joints", help="one value per driven joint (deg, or mm for a prismatic joint), comma separated")
     where.add_argument("--location", help="a task location: the robot goes to its approach pose")
+    where.add_argument("--at-task", metavar="LOCATION", help="a task location: the robot goes to the task pose itself, where the first look is made")
     parser.add_argument("--view", choices=VIEWS, default="virtual", help="virtual (modelled camera), overview, or true (the simulated camera on the true robot)")
     parser.add_argument("--out", type=Path, required=True, help="PNG file to write")
     parser.add_argument("--highlight", help="component to highlight (default: the location's component)")
@@ -67,12 +69,14 @@ def run(args: argparse.Namespace) -> int:
             q = robot.check_joints(_joints(args.joints))
         except ValueError as exc:
             raise VideocalError(f"--joints: {exc}") from None
-    elif args.location:
+    elif args.location or args.at_task:
         try:
-            task = cell.task(args.location)
+            task = cell.task(args.location or args.at_task)
         except KeyError as exc:
             raise VideocalError(str(exc.args[0])) from None
         q = solve_ik(robot, task.approach2base, q).q_deg
+        if args.at_task:  # from the approach, as the robot gets there
+            q = solve_ik(robot, task.tcp2base, q).q_deg
         highlight = highlight or task.component
     if highlight is not None:
         try:

@@ -46,3 +46,24 @@ def test_bad_arguments_exit_2(tmp_path, args, message):
     assert run.returncode == 2
     assert message in run.stderr and "Traceback" not in run.stderr
     assert not out.exists()
+
+
+def test_at_task_renders_from_the_task_pose_itself(tmp_path):
+    """``--location`` shows the approach; the first look is made at the task location itself (issue 31: a cell
+    whose approach render looked fine failed its first look there). ``--at-task`` shows that view."""
+    from calib_core.robot import solve_ik
+    from calib_core.workcell import load_workcell
+
+    a, t = tmp_path / "approach.png", tmp_path / "task.png"
+    run_a = _videocal("render", "--location", "oru_1_grasp", "--scale", "0.25", "--out", str(a))
+    run_t = _videocal("render", "--at-task", "oru_1_grasp", "--scale", "0.25", "--out", str(t))
+    assert run_a.returncode == 0 and run_t.returncode == 0, run_t.stderr
+    joints = [np.array([float(v) for v in r.stdout.split("joints ")[1].split(" deg")[0].split(", ")]) for r in (run_a, run_t)]
+    cell = load_workcell()
+    robot = cell.load_robot()
+    task = cell.task("oru_1_grasp")
+    np.testing.assert_allclose(robot.fk(joints[1], "tcp")[:3, 3], task.tcp2base[:3, 3], atol=0.5)  # (joints printed to 0.01 deg)
+    np.testing.assert_allclose(robot.fk(joints[0], "tcp")[:3, 3], task.approach2base[:3, 3], atol=0.5)
+    assert np.abs(cv2.imread(str(a)).astype(int) - cv2.imread(str(t)).astype(int)).mean() > 5.0  # another view
+    both = _videocal("render", "--location", "oru_1_grasp", "--at-task", "oru_1_grasp", "--out", str(t))
+    assert both.returncode == 2 and "not allowed with" in both.stderr
