@@ -6,12 +6,19 @@ URL ``ros2:///joint_states`` (the joint states topic; ``?controller=NAME&domain=
 robot), so the connector's axes are the model's (:meth:`JointMap.identity`); ROS's rad and m become deg and
 mm. A sample's time is its header stamp (the controller's clock), never its arrival.
 
-Moves: a one-point ``trajectory_msgs/JointTrajectory`` on ``/<controller>/joint_trajectory`` (the
-controller's topic interface: no goal handshake to lose on a slow link), its ``time_from_start`` from the
-distance at ``speed_deg_s``. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the
-target; *refused* at once when no trajectory controller subscribes to the topic; *stopped* by Stop, which
-sends a trajectory that holds the current position (what the controller does with a new trajectory: it
-replaces the old one). No joint states for ``stale_after_s``: the link is ``stale`` and the robot's pose unknown.
+Moves: ``trajectory_msgs/JointTrajectory`` on ``/<controller>/joint_trajectory`` (the controller's topic
+interface: no goal handshake to lose on a slow link), streamed as a dead-man: the move is a straight line in
+joint space at ``speed_deg_s``, and the controller is only ever given the next ``horizon_s`` of it (one point,
+``horizon_s`` of motion beyond where the joint states put the arm), renewed every third of that. Each message
+replaces the last (what the controller does with a new trajectory), so while they arrive the arm moves without
+a pause; when they stop (the workstation gone, the network cut, the joint states stale) the arm stops within
+``horizon_s`` of motion, on the line. A one-point trajectory to the target did run on to it whatever became of
+the workstation. The commanded point only moves forward along the line, so a late joint state never turns the
+arm back. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
+once when no trajectory controller subscribes to the topic; *stopped* by Stop, which sends a trajectory that
+holds the current position. No joint states for ``stale_after_s``: the link is ``stale``, the robot's pose
+unknown, and the move is not renewed. On a link slower than ``horizon_s`` a round trip the arm moves in steps
+(it reaches each point before the next arrives): set ``horizon_s`` above the round trip.
 """
 
 from __future__ import annotations
@@ -33,7 +40,7 @@ from calib_core.link.sample_order import SampleOrder
 from calib_core.ros2.joint_units import user_per_si
 
 DEFAULT_CONTROLLER = "joint_trajectory_controller"
-_OPTIONS = {"controller", "domain", "qos", "speed_deg_s", "done_tolerance_deg", "stale_after_s"}
+_OPTIONS = {"controller", "domain", "qos", "speed_deg_s", "done_tolerance_deg", "stale_after_s", "horizon_s"}
 
 
 def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
@@ -69,6 +76,7 @@ class Ros2TrajectoryController(ConnectorEvents):
         self.speed_deg_s = number_option(options, "speed_deg_s", 20.0, 0.1, 1000.0, "ros2")
         self.done_tolerance_deg = number_option(options, "done_tolerance_deg", 0.05, 1e-4, 10.0, "ros2")
         self.stale_after_s = number_option(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0, "ros2")
+        self.horizon_s = number_option(options, "horizon_s", 0.5, 0.1, 30.0, "ros2")
         self.joint_states_topic = dds_topic(topic)
         self.trajectory_topic = dds_topic(f"/{self.controller}/joint_trajectory")
         self.joint_names = list(context.joint_names)
@@ -87,6 +95,11 @@ class Ros2TrajectoryController(ConnectorEvents):
         self._thread: threading.Thread | None = None
         self._reader = self._writer = None
         self._tf = None
+        # the move being streamed: (start (n,), target (n,), duration s), the commanded fraction of it, when renewed
+        self._path: tuple[np.ndarray, np.ndarray, float] | None = None
+        self._s_commanded = 0.0
+        self._renewed_s = 0.0
+        self._path_lock = threading.Lock()
 
     # --- life cycle ----------------------------------------------------------------------------
     def start(self) -> Ros2TrajectoryController:
@@ -140,10 +153,12 @@ class Ros2TrajectoryController(ConnectorEvents):
             handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: not sent: {reason}"))
             return handle
-        distance = float(np.max(np.abs(q - np.asarray(latest.joints_deg))))
-        duration_s = max(distance / self.speed_deg_s, 0.5)
+        start = np.asarray(latest.joints_deg, dtype=float)
+        duration_s = max(float(np.max(np.abs(q - start))) / self.speed_deg_s, 0.5)
         self._moves.begin(handle)
-        self._publish(q, duration_s)
+        with self._path_lock:
+            self._path, self._s_commanded = (start, q, duration_s), 0.0
+            self._renew(time.monotonic())
         handle.acked = True  # the controller's topic takes it as given: reliable delivery, no reply
         return handle
 
@@ -152,6 +167,8 @@ class Ros2TrajectoryController(ConnectorEvents):
         latest = self._latest
         if latest is None or self._writer is None or self._stop.is_set():
             return False
+        with self._path_lock:
+            self._path = None
         self._publish(np.asarray(latest.joints_deg), 0.1)
         self._moves.finish(MoveError("ERR,STOPPED: stopped by the operator"))
         return True
@@ -173,6 +190,32 @@ class Ros2TrajectoryController(ConnectorEvents):
             return f"no trajectory controller subscribes to /{self.trajectory_topic[3:]} (is '{self.controller}' loaded and active?)"
         return None
 
+    def _renew(self, now: float) -> None:
+        """Give the controller the next ``horizon_s`` of the move (under ``_path_lock``): a point that far along the
+        line beyond the arm's measured place on it, never behind the last one given."""
+        start, target, duration_s = self._path
+        latest = self._latest
+        line = target - start
+        length2 = float(line @ line)
+        s_measured = 0.0 if length2 == 0.0 or latest is None else float(np.clip((np.asarray(latest.joints_deg) - start) @ line / length2, 0.0, 1.0))
+        s_next = min(1.0, max(self._s_commanded, s_measured + self.horizon_s / duration_s))
+        self._publish(start + s_next * line, max((s_next - s_measured) * duration_s, 0.05))
+        self._s_commanded, self._renewed_s = s_next, now
+
+    def _keep_moving(self, now: float) -> None:
+        """Renew the streamed move every third of the horizon while the link is up and the move runs; the target
+        once given, nothing more is needed."""
+        with self._path_lock:
+            move = self._moves.current
+            if self._path is None:
+                return
+            if move is None or move.finished:
+                self._path = None
+                return
+            if self._s_commanded >= 1.0 or self._state is not LinkState.UP or now - self._renewed_s < self.horizon_s / 3.0:
+                return
+            self._renew(now)
+
     def _publish(self, q_user: np.ndarray, duration_s: float) -> None:
         from calib_core.ros2 import messages as msg
 
@@ -190,7 +233,9 @@ class Ros2TrajectoryController(ConnectorEvents):
                 self.stats.errors += 1
                 self.last_error = f"reading {self.joint_states_topic[2:]}: {exc!r}"
                 time.sleep(0.05)
-            self._watch(time.monotonic())
+            now = time.monotonic()
+            self._watch(now)
+            self._keep_moving(now)
 
     def _watch(self, now: float) -> None:
         last = self._last_sample_s

@@ -157,14 +157,58 @@ def test_a_move_with_no_controller_listening_is_not_sent(arm):
 
 
 def test_the_arm_rejects_a_trajectory_past_its_limits(arm):
-    link = _connected()
+    link = _connected(speed_deg_s=1000)  # the first half second of the move already crosses the limit
     try:
         handle = link.move_joints([0, -30, 60, 0, 45, 900.0], timeout_s=1.0)  # slide limit 500 mm
         with pytest.raises(MoveError):
             handle.wait(3)
-        assert arm.rejected == 1 and np.allclose(arm.position(time.monotonic()), [0, -30, 60, 0, 45, 100])
+        assert arm.rejected >= 1 and np.allclose(arm.position(time.monotonic()), [0, -30, 60, 0, 45, 100])
     finally:
         link.close()
+
+
+_WORKSTATION = """
+import sys, time
+from calib_core.connectors.controller import ControllerContext
+from calib_core.connectors.registry import open_controller
+from calib_core.link.joint_map import JointMap
+from calib_core.link.link_types import LinkState
+names = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "slide")
+link = open_controller("ros2:///joint_states", ControllerContext(names, ("deg",) * 5 + ("mm",), JointMap.identity(6), 100.0,
+                       {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5})).start()
+while not (link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0):
+    time.sleep(0.01)
+handle = link.move_joints([80.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=30)
+print("moving", flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm):
+    """The dead-man (issue 30): a one-point trajectory ran on to the target whatever became of the workstation.
+    A real process, killed with SIGKILL mid-move (no Stop, no goodbye): the arm stops within the horizon's
+    motion (0.5 s at 20 deg/s: 10 deg) of where it was, on the way, and stays there."""
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3]
+    station = subprocess.Popen([sys.executable, "-c", _WORKSTATION], cwd=root, stdout=subprocess.PIPE, text=True)
+    try:
+        assert station.stdout.readline().strip() == "moving"
+        assert wait_until(lambda: arm.position(time.monotonic())[0] > 20.0, 10.0)
+        station.send_signal(signal.SIGKILL)
+        station.wait(5)
+        at_kill = arm.position(time.monotonic())[0]
+        assert wait_until(lambda: arm._plan is None, 3.0)  # the last point given reached: the arm stands
+        held = arm.position(time.monotonic())[0]
+        assert at_kill <= held <= at_kill + 10.0 + 0.5  # 10 deg of motion at most (and a sample's worth)
+        assert held < 60.0  # far from the 80 deg target it would have run on to
+        assert arm.rejected == 0 and arm.trajectories >= 3  # streamed: renewed while it moved
+    finally:
+        if station.poll() is None:
+            station.kill()
 
 
 def test_wrong_urls_and_options_are_named(domain):
