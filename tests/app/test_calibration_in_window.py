@@ -175,6 +175,11 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     # The link shows its measured delay (the handshake timed the round trip; a near controller: milliseconds).
     qtbot.waitUntil(lambda: (win._update_status(), "delay" in win.link_label.text())[1], timeout=10_000)
     assert wb.link.delay_s is not None and wb.link.delay_s < 1.0
+    # the sample rate by the controller's stamps: the 50 Hz the link asks for (arrivals per second of ours showed
+    # 182 Hz on a far link's bursts)
+    qtbot.waitUntil(lambda: (win._update_status(), " Hz, " in win.link_label.text())[1], timeout=10_000)
+    hz = float(win.link_label.text().split(" Hz, ")[0].split(", ")[-1])
+    assert 40.0 <= hz <= 60.0, win.link_label.text()
     # The link: the controller process dies; the state shows it and no pair is lost.
     wb.site.process.process.kill()
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
