@@ -35,6 +35,7 @@ from calib_core.link.protocol import JointSample
 from calib_core.link.round_trip import RoundTrip
 
 SCRIPT_PORT, DASHBOARD_PORT = 30002, 29999
+RTDE_PORT = 30004  # the controller's RTDE interface (UR's RTDE guide)
 _VARIABLES = ["timestamp", "actual_q", "safety_status_bits", "speed_scaling", "robot_status_bits", "runtime_state"]
 _OPTIONS = {"rate_hz", "speed_deg_s", "acceleration_deg_s2", "done_tolerance_deg", "stale_after_s"}
 _PROTECTIVE_STOP_BIT = 1 << 2
@@ -200,6 +201,15 @@ class URRtdeController(ConnectorEvents):
     def _connect(self) -> bool:
         import rtde_receive
 
+        # ur_rtde prints "connect: Connection refused" on stderr at every failed try (C++, verbose or not): ahead of
+        # the one error line, once per retry. A plain TCP connect first says the same thing quietly.
+        try:
+            with socket.create_connection((self.host, RTDE_PORT), timeout=2.0):
+                pass
+        except OSError as exc:
+            self.last_error = f"cannot reach {self.host}:{RTDE_PORT}: {exc.strerror or exc}"
+            self._receive = None
+            return False
         try:
             self._receive = rtde_receive.RTDEReceiveInterface(self.host, self.rate_hz, _VARIABLES)
         except RuntimeError as exc:
@@ -223,7 +233,7 @@ class URRtdeController(ConnectorEvents):
         while not self._stop.is_set():
             if self._receive is None or not self._receive.isConnected():
                 self._set_state(LinkState.DOWN if self._receive is not None or self.stats.reconnects else LinkState.CONNECTING,
-                                f"no RTDE connection to {self.host}:30004 ({self.last_error or 'connecting'})")
+                                f"no RTDE connection to {self.host}:{RTDE_PORT} ({self.last_error or 'connecting'})")
                 if self._stop.wait(backoff) or not self._connect():
                     backoff = min(backoff * 2, 2.0)
                     continue

@@ -164,3 +164,18 @@ def test_a_ur_1_5_s_away_connects_measures_its_delay_and_completes_a_move():
         line.terminate()
         line.wait(10)
         sim.stop()
+
+
+def test_an_unreachable_controller_is_one_error_line_without_the_library_s_noise():
+    """``ur_rtde`` printed "connect: Connection refused" on stderr at every retry (C++, whatever its verbose flag),
+    ahead of videocal's one error line (issue 33)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3]
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ur-rtde://127.0.0.1", "--count", "1", "--workcell", str(root / "resources" / "workcell" / "workcell.yaml")],
+                         capture_output=True, text=True, timeout=60, cwd=root)
+    lines = [line for line in run.stderr.splitlines() if line.strip()]
+    assert lines[0].startswith("error: ") and "cannot reach 127.0.0.1:30004" in lines[0], run.stderr
+    assert "connect: Connection refused" not in run.stderr
