@@ -311,10 +311,13 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         return result
 
     def apply_hand_eye_file(self, path) -> None:
-        """Use a measured camera mounting (``videocal calibrate-hand-eye`` output) in place of the model's."""
-        from calib_core.vision.hand_eye_io import load_cam2flange
+        """Use a measured camera mounting in place of the model's: ``videocal calibrate-hand-eye`` output, easy_handeye2's
+        ``.calib``, or a ``static_transform_publisher`` launch file (MoveIt 2's hand-eye result) on any frame of the arm
+        fixed to the flange's link (``tool0`` for a cell whose flange is ``flange``)."""
+        from calib_core.vision.hand_eye_io import load_mounting
 
-        self.apply_cam2flange(load_cam2flange(path), f"camera mounting from {path}")
+        cam2frame, frame = load_mounting(path)
+        self.apply_cam2flange(self.robot.on_flange(cam2frame, frame, str(path)), f"camera mounting from {path}")
 
     def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
         """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""

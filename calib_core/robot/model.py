@@ -24,7 +24,7 @@ from calib_core.errors import FileFormatError
 from calib_core.robot.description import read_description
 from calib_core.robot.errors import RobotModelError, RobotSpecError, UnknownFrameError
 from calib_core.robot.spec import DEFAULT_FRAMES, FRAME_ROLES, NewFrame, RobotSpec
-from calib_core.frames import concat
+from calib_core.frames import concat, invert
 
 RESOURCES = Path(__file__).resolve().parents[2] / "resources" / "robot"
 DEFAULT_URDF = RESOURCES / "videocal_arm.urdf"
@@ -222,6 +222,22 @@ class RobotModel:
     def frame_placement(self, frame: str) -> np.ndarray:
         """The frame's placement in its parent joint's frame (4, 4), mm."""
         return _to_mm(self.model.frames[self.frame_id(frame)].placement)
+
+    def on_flange(self, pose_on_frame_mm: np.ndarray, frame: str | None, source: str = "the mounting") -> np.ndarray:
+        """A pose (4, 4, mm) given on ``frame`` of the arm re-expressed on the ``flange``: the frame must ride on the
+        flange's link (a fixed offset, whatever the joints); ``None`` or the flange's own name: as given.
+        :class:`~calib_core.errors.VideocalError` names ``source`` and the frame when it is not the arm's or moves
+        against the flange."""
+        from calib_core.errors import VideocalError
+
+        if frame is None or frame == "flange" or frame == self.roles.get("flange"):
+            return np.asarray(pose_on_frame_mm, dtype=float)
+        if not self.model.existFrame(frame):
+            raise VideocalError(f"{source}: frame {frame!r} is not on this cell's robot (its flange is {self.roles.get('flange', 'flange')!r})")
+        if self.model.frames[self.frame_id(frame)].parentJoint != self.model.frames[self.frame_id("flange")].parentJoint:
+            raise VideocalError(f"{source}: frame {frame!r} is not fixed to the flange's link: a joint moves between them")
+        frame2flange = concat(self.frame_placement(frame), invert(self.frame_placement("flange")))
+        return concat(np.asarray(pose_on_frame_mm, dtype=float), frame2flange)
 
     def copy(self) -> RobotModel:
         model = self.model.copy()

@@ -41,6 +41,22 @@ def save_hand_eye(path: str | Path, result: HandEyeCalibration) -> None:
     atomic_write_text(Path(path), yaml.safe_dump(hand_eye_document(result), sort_keys=False))
 
 
+def load_mounting(path: str | Path) -> tuple[np.ndarray, str | None]:
+    """(``cam2frame`` (4, 4) mm, the frame it is on, or ``None`` for the cell's flange): a hand-eye file
+    (:func:`load_cam2flange`), or a ``static_transform_publisher`` launch file (MoveIt 2's hand-eye calibration, an
+    XML launch, videocal's own: :mod:`calib_core.ros2.mounting_in`) whose child frame must be an optical frame
+    (z along the view, as videocal's camera frame): a ``camera_link`` (x forward) would turn the view 90 deg."""
+    from calib_core.ros2.mounting_in import is_launch_file, read_static_transform
+
+    if not is_launch_file(path):
+        return load_cam2flange(path), None
+    found = read_static_transform(path)
+    if "optical" not in found.child.lower():
+        raise FileFormatError(path, f"the camera frame {found.child!r} is not an optical frame (z along the view, x right, y down): "
+                                    "give the transform to the camera's *_optical_frame", "arguments")
+    return found.child2parent_mm, found.parent
+
+
 def load_cam2flange(path: str | Path) -> np.ndarray:
     """``cam2flange`` (4, 4) mm from a hand-eye file; ``FileFormatError`` names the file and the field.
 
