@@ -1,8 +1,9 @@
 """``videocal calibrate-hand-eye SOURCE --out FILE``: the camera's mounting from robot poses and board views.
 
 SOURCE is ``sim`` (the simulated test bed, its truth printed beside the result), a ROS-Industrial
-``cal_data.yaml`` (or its folder), or a CSV of images with flange poses or joints
-(docs/calibration.md). A camera on the robot gives ``cam2flange``; a static camera
+``cal_data.yaml`` (or its folder), a CSV of images with flange poses or joints, or a ROS 2 bag (the flange pose at
+each image's stamp from ``/joint_states`` through the cell's robot, only where the arm stood still; the
+intrinsics from its CameraInfo unless ``--intrinsics``) (docs/calibration.md). A camera on the robot gives ``cam2flange``; a static camera
 (``--static-camera``, or the data file's ``static_camera``) gives ``cam2base``.
 """
 
@@ -20,7 +21,11 @@ from app.cli.options import bounded_float, bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="'sim', a cal_data.yaml (or its folder), or a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>")
+    parser.add_argument("source", help="'sim', a cal_data.yaml (or its folder), a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>, "
+                                        "or a ROS 2 bag (a bag folder, .mcap or .db3: images, /joint_states, CameraInfo)")
+    parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
+    parser.add_argument("--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)")
+    parser.add_argument("--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)")
     parser.add_argument("--workcell", type=Path, help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)")
     parser.add_argument("--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)")
     parser.add_argument("--intrinsics", type=Path, help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics")
@@ -98,6 +103,49 @@ def _detector(args, spec):
     return spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
 
 
+def _from_bag(args, source: Path):
+    """Hand-eye from a ROS 2 bag: the board's images on ``--topic`` (the only image topic by default), the flange pose at
+    each image's stamp from ``/joint_states`` through the cell's robot, taken only where the arm stood still; the
+    camera's intrinsics from ``--intrinsics`` or the bag's CameraInfo."""
+    from calib_core.bags.bag_source import bag_intrinsics, bag_stamped_images
+    from calib_core.bags.joint_track import read_joint_track, settled_joints
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.ros2.joint_units import user_per_si
+    from calib_core.vision.board import DEFAULT_SPEC, parse_board
+    from calib_core.vision.hand_eye import calibrate_hand_eye
+    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
+    track = read_joint_track(source, robot.joint_names, user_per_si(robot.joint_units), args.joint_topic)
+    spec = parse_board(args.board or DEFAULT_SPEC)
+    detect = _detector(args, spec)
+    views, flanges, size, images, moving = [], [], None, 0, 0
+    for stamp, name, image in bag_stamped_images(source, args.topic, args.every):
+        images += 1
+        if size is None:
+            size = (image.shape[1], image.shape[0])
+        elif (image.shape[1], image.shape[0]) != size:
+            raise VideocalError(f"{source} {name}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+        q, why = settled_joints(track, stamp)
+        if q is None:
+            moving += 1
+            print(f"skipped {name}: {why}", file=sys.stderr)
+            continue
+        v = detect_view(name, image, spec, detect)
+        if not isinstance(v, BoardView):
+            print(f"rejected {name}: {v.reason}", file=sys.stderr)
+            continue
+        views.append(v)
+        flanges.append(robot.fk(q, "flange"))
+    print(f"{source}: {images} images, {images - moving} taken while the arm stood still, {len(views)} with the board", file=sys.stderr)
+    intrinsics = load_intrinsics(args.intrinsics, image_size=size) if args.intrinsics is not None else bag_intrinsics(source, size)
+    if intrinsics is None:
+        raise VideocalError(f"{source}: the bag has no CameraInfo: pass --intrinsics FILE")
+    static = bool(args.static)
+    return calibrate_hand_eye(views, flanges, spec, intrinsics, static_camera=static, pose_sigma_mm=args.pose_sigma_mm)
+
+
 def _from_files(args):
     from calib_core.camera.intrinsics import Intrinsics
     from calib_core.camera.intrinsics_io import load_intrinsics
@@ -109,6 +157,12 @@ def _from_files(args):
     source = Path(args.source)
     if not source.exists():
         raise VideocalError(f"{source}: no such file or folder (or use 'sim')")
+    from calib_core.bags.bag_source import looks_like_bag
+
+    if looks_like_bag(source) and not source.name.endswith(".yaml"):
+        return _from_bag(args, source)
+    if args.topic or args.joint_topic:
+        raise VideocalError(f"--topic and --joint-topic apply to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
     data = load_posed_images(source)
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     static = args.static if args.static is not None else bool(data.static_camera)

@@ -98,6 +98,13 @@ def _rgb(message, msgtype: str, where: str) -> np.ndarray:
 
 def bag_images(path: str | Path, topic: str | None = None, every: int = 1) -> Iterator[tuple[str, np.ndarray]]:
     """(name, RGB image) of every ``every``-th image of the topic, in time order; the name is ``t_<stamp ns>``."""
+    for _, name, image in bag_stamped_images(path, topic, every):
+        yield name, image
+
+
+def bag_stamped_images(path: str | Path, topic: str | None = None, every: int = 1) -> Iterator[tuple[int, str, np.ndarray]]:
+    """(header stamp ns, name, RGB image) of every ``every``-th image of the topic, in the bag's order; the stamp is
+    the camera driver's (the bag's record time when the header has none)."""
     chosen = choose_image_topic(path, topic)
     with open_bag(path) as reader:
         connections = [c for c in reader.connections if c.topic == chosen.name]
@@ -105,8 +112,22 @@ def bag_images(path: str | Path, topic: str | None = None, every: int = 1) -> It
             if k % every:
                 continue
             message = reader.deserialize(raw, connection.msgtype)
-            stamp = message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
-            yield f"t_{stamp or log_ns}", _rgb(message, connection.msgtype, f"{path} {chosen.name} message {k}")
+            stamp = message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec or log_ns
+            yield stamp, f"t_{stamp}", _rgb(message, connection.msgtype, f"{path} {chosen.name} message {k}")
+
+
+def bag_intrinsics(path: str | Path, image_size: tuple[int, int]):
+    """The intrinsics of the bag's first ``CameraInfo`` (ROS's ``k``, ``d``, ``distortion_model``), or ``None``;
+    :class:`FileFormatError` names the bag and the topic for one videocal cannot use."""
+    from calib_core.camera.intrinsics_io import _load_camera_info_message
+
+    found = bag_camera_info(path)
+    if found is None:
+        return None
+    topic, message = found
+    data = {"width": int(message.width), "height": int(message.height), "distortion_model": str(message.distortion_model),
+            "k": [float(v) for v in message.k], "d": [float(v) for v in message.d]}
+    return _load_camera_info_message(Path(f"{path} {topic}"), data, image_size)
 
 
 def bag_camera_info(path: str | Path):
