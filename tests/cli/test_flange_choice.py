@@ -14,7 +14,7 @@ import pytest
 
 from calib_core.robot.model import RobotSpec, load_robot
 from calib_core.workcell import load_workcell
-from calib_core.workcell.starter import _choose_flange, tool_alignment
+from calib_core.workcell.flange_choice import choose_flange as _choose_flange, tool_alignment
 from tests.vendor_robots import JACO2, PANDA, SHARE, UR5, Z1, require
 
 KR6 = Path(__file__).resolve().parents[1] / "data" / "third_party" / "ros_industrial" / "kuka_experimental"

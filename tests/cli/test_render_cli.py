@@ -51,7 +51,6 @@ def test_bad_arguments_exit_2(tmp_path, args, message):
 def test_at_task_renders_from_the_task_pose_itself(tmp_path):
     """``--location`` shows the approach; the first look is made at the task location itself (issue 31: a cell
     whose approach render looked fine failed its first look there). ``--at-task`` shows that view."""
-    from calib_core.robot import solve_ik
     from calib_core.workcell import load_workcell
 
     a, t = tmp_path / "approach.png", tmp_path / "task.png"
