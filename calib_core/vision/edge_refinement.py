@@ -28,14 +28,16 @@ _CROWDED_PX = 3.0
 _TUKEY = 4.685
 
 
-SETTLED_RMS_PX = 1.5
-"""The largest RMS of a settled edge fit, px. The simulated camera's edges fit to 0.1-0.4 px and the bound was
-0.5 px; a photographed cardboard box (OpenCV's pose tutorial: rounded edges, JPEG, a lens nobody calibrated)
-fits its outline to 1.1-1.4 px with 88-100 % of its samples on their edges."""
+SETTLED_RMS_PX = 0.5
+"""The largest RMS of a settled edge fit by default, px: the simulated camera's edges fit to 0.1-0.4 px, and a fit
+coarser than that there is a poor one (admitting up to 1.5 px let such views into the robot's identification:
+a grasp 0.48 mm off where 0.1 is the target). A photographed cardboard box (OpenCV's pose tutorial: rounded edges,
+JPEG, a lens nobody calibrated) fits its outline to 1.1-1.4 px with 88-100 % of its samples on their edges:
+``videocal locate`` gives a coarser bound (:data:`calib_core.vision.locate.PHOTO_EDGE_RMS_PX`)."""
 COARSE_FIT_SHARE = 0.75
-"""The share of samples on their edges a fit coarser than 0.5 px must hold: on that photo a start 150 mm off
-settled on the print and the table at 1.46 px with 51 % (and seven "corners" agreeing with it); the right fits
-held 88-100 %."""
+"""The share of samples on their edges a fit coarser than 0.5 px must hold (under a coarser bound): on that photo a
+start 150 mm off settled on the print and the table at 1.46 px with 51 % (and seven "corners" agreeing with it);
+the right fits held 88-100 %."""
 
 
 @dataclass(frozen=True)
@@ -64,14 +66,16 @@ class EdgeFit:
     covariance_independent: np.ndarray | None = None
     """(6, 6) as ``covariance`` with every sample taken as independent (``sigma_px^2 H^-1``):
     ``covariance`` takes each edge chain's samples as one measurement as well, and is never less."""
+    rms_bound_px: float = SETTLED_RMS_PX
+    """The largest RMS at which this fit may count as settled (what the caller asked of its images)."""
 
     @property
     def settled(self) -> bool:
-        """Converged, and either within 0.5 px RMS with at least half the samples on their edges, or within
-        :data:`SETTLED_RMS_PX` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold more of its edges)."""
+        """Converged, and either within 0.5 px RMS with at least half the samples on their edges, or within its
+        ``rms_bound_px`` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold more of its edges)."""
         if not self.converged:
             return False
-        return (self.rms_px <= 0.5 and self.inlier_share >= 0.5) or (self.rms_px <= SETTLED_RMS_PX and self.inlier_share >= COARSE_FIT_SHARE)
+        return (self.rms_px <= 0.5 and self.inlier_share >= 0.5) or (self.rms_px <= self.rms_bound_px and self.inlier_share >= COARSE_FIT_SHARE)
 
 
 def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:
@@ -235,10 +239,10 @@ def normal_jacobian(points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndar
 
 
 def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected_magnitude: np.ndarray | None = None, search_px: float = 8.0,
-                    iterations: int = 30, magnitude: np.ndarray | None = None) -> EdgeFit:
+                    iterations: int = 30, magnitude: np.ndarray | None = None, rms_bound_px: float = SETTLED_RMS_PX) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
-    ``obj2cam``, to leave out edges without contrast;
+    ``obj2cam``, to leave out edges without contrast; ``rms_bound_px`` the fit's settle bound (:attr:`EdgeFit.settled`);
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
     pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected_magnitude)
@@ -301,5 +305,5 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         covariance = independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
     except np.linalg.LinAlgError:
         independent = covariance = np.full((6, 6), np.nan)
-    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent)
+    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent, rms_bound_px)
 

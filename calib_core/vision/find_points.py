@@ -30,7 +30,7 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import edge_distance_map, edge_samples_px, matched_share
-from calib_core.vision.edge_refinement import EdgeFit, edge_points, refine_to_edges
+from calib_core.vision.edge_refinement import SETTLED_RMS_PX, EdgeFit, edge_points, refine_to_edges
 from calib_core.vision.feature_detectors import Detection, NotDetected
 from calib_core.vision.target_detectors import TargetDetectors, as_grey
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -130,14 +130,15 @@ def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Int
 
 
 def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2cam_model: np.ndarray, *, kinds: dict[str, FeatureKind] | None = None,
-                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None) -> FoundPoints:
+                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None, edge_rms_px: float = SETTLED_RMS_PX) -> FoundPoints:
     """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
     ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
     the item's own, corner when absent). ``expected(obj2cam, box_px) -> image``: the cell rendered as this
     camera would see it with the item at ``obj2cam`` (lens distortion included; only the box
     (u0, v0, u1, v1) px need be, :meth:`~calib_core.render.model_view.ModelView.render`): edges it shows no
     contrast on are not searched for. ``reach_mm`` and ``reach_deg``: how far the true camera may be
-    from the modelled one (the robot's error), which bounds the search."""
+    from the modelled one (the robot's error), which bounds the search. ``edge_rms_px``: the edge fit's settle bound
+    (:data:`~calib_core.vision.edge_refinement.SETTLED_RMS_PX` for the cell's camera; coarser for a photo)."""
     t0 = time.perf_counter()
     kinds = item.feature_kinds if kinds is None else kinds
     names = list(item.features)
@@ -173,7 +174,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     def refined(start_pose: np.ndarray) -> EdgeFit:
         return refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected_magnitude=detectors.expected_magnitude(start_pose) if expected is not None else None,
-                               magnitude=detectors.magnitude)
+                               magnitude=detectors.magnitude, rms_bound_px=edge_rms_px)
 
     best = None
     for start_pose in ranked:
@@ -226,7 +227,7 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
         across = refine_to_edges(grey, intrinsics, item.mesh, pose, expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
-                                 magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX)
+                                 magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX, rms_bound_px=edge_rms_px)
         if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
             edge_fit = across
         edge_seconds += time.perf_counter() - t_across

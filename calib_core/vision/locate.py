@@ -22,6 +22,10 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.vision.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
 
+PHOTO_EDGE_RMS_PX = 1.5
+"""The edge fit's settle bound on a photograph, px (with three quarters of the samples on their edges): a
+photographed cardboard box fits its outline to 1.1-1.4 px (rounded edges, JPEG, an uncalibrated lens), where the
+cell's camera is held to 0.5 px."""
 MAX_DEFAULT_FEATURES = 64
 """A mesh of at most this many vertices (a box, a plate) gives its vertices as corner features by default."""
 
@@ -108,7 +112,7 @@ def locate(image: np.ndarray, intrinsics: Intrinsics, mesh, prior_obj2cam: np.nd
     prior = check_transform(prior_obj2cam, name="prior (obj2cam)")
     item = SceneItem(name, mesh, np.eye(4), color=tuple(color), features=default_features(mesh) if features is None else dict(features))
     if item.features:
-        found = find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg)
+        found = find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg, edge_rms_px=PHOTO_EDGE_RMS_PX)
     else:
         found = _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg)
     return _report(found, intrinsics, prior, reach_mm, reach_deg)
@@ -121,7 +125,7 @@ def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -
     from calib_core.workcell.feature_kinds import FeatureKind
 
     item = SceneItem(item.name, item.mesh, item.item2world, color=item.color, features={"centre": centre}, feature_kinds={"centre": FeatureKind("point")})
-    return find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg)
+    return find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg, edge_rms_px=PHOTO_EDGE_RMS_PX)
 
 
 def _report(found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float) -> Located:

@@ -49,7 +49,7 @@ def _write(path: Path, data) -> Path:
     [
         (lambda d: d["components"][1].update(colour=[1, 0, 0]), "components[1]", "unknown key(s) colour"),
         (lambda d: d["components"][1].update(mesh="meshes/nothing.stl"), "components[1].mesh", "file not found"),
-        (lambda d: d["components"][1].update(mesh_units="inch"), "components[1].mesh_units", "must be one of m, mm"),
+        (lambda d: d["components"][1].update(mesh_units="inch"), "components[1].mesh_units", "must be one of cm, m, mm"),
         (lambda d: d["components"][2].update(name="rack_1"), "components[2].name", "duplicate component name"),
         (lambda d: d["components"][1]["placement"].update(rpy=[0, "ten", 0]), "components[1].placement.rpy[1]", "finite number"),
         (lambda d: d["components"][1]["placement"].update(xyz=[0, 0]), "components[1].placement.xyz", "list of 3 numbers"),
