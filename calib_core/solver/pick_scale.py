@@ -35,13 +35,19 @@ from calib_core.solver.sampler import robust_seed
 COARSEST_PICKS_PX = 4.0
 """The coarsest pick noise the robust mode expects, px (1-sigma per axis)."""
 
-_RAYLEIGH_MEDIAN = float(np.sqrt(2.0 * np.log(2.0)))  # median of a 2-D Gaussian's length over its sigma
+SCALE_SAMPLE_PAIRS = 300
+"""Beyond this many pairs the scale is measured on this many of them, spread over the list."""
 
 
 def pick_scale_px(problem: PoseProblem, fu: float, fv: float, order: np.ndarray | None = None) -> float | None:
     """The picks' noise (1-sigma per axis, px) as the consensus of the pairs shows it, at most
     :data:`COARSEST_PICKS_PX`; ``None`` when the pairs leave nothing to measure it with (no consensus, or
     no more pairs than the pose has unknowns). Pinhole model; ``order`` as for the sampler."""
+    if problem.n_points > SCALE_SAMPLE_PAIRS:
+        # the scale of a few hundred pairs is the scale of them all: a second sampler over 5000 pairs cost as much as
+        # the rest of the solve (a fixed, spread choice: the same answer every time)
+        problem = _subset(problem, np.linspace(0, problem.n_points - 1, SCALE_SAMPLE_PAIRS).round().astype(int))
+        order = None
     seed = robust_seed(problem, fu, fv, COARSEST_PICKS_PX, order=order)
     if seed is None:
         return None
@@ -49,7 +55,7 @@ def pick_scale_px(problem: PoseProblem, fu: float, fv: float, order: np.ndarray 
     dof = 2 * len(idx) - problem.n_params
     if dof - 2 < OWN_SCALE_MIN_DOF:
         return None
-    sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+    sub = _subset(problem, idx)
     fit = refine_seed(sub, seed.R, seed.t, fu, fv, None)
     if fit is None or not fit.converged:
         return None
@@ -59,3 +65,7 @@ def pick_scale_px(problem: PoseProblem, fu: float, fv: float, order: np.ndarray 
         return None
     scale = float(np.sqrt(max(float(np.sum(r**2)) - float(np.nanmax(drops)), 0.0) / (dof - 2)))
     return min(scale, COARSEST_PICKS_PX) if np.isfinite(scale) else None
+
+
+def _subset(problem: PoseProblem, idx: np.ndarray) -> PoseProblem:
+    return replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
