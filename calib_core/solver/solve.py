@@ -89,8 +89,9 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     fu0, fv0 = intrinsics.fu, intrinsics.fv
     order = _confidence_order(confidence, problem.n_points)
     noise = floor = noise_px(sigma_px)
-    if robust and problem.model == "pinhole":
-        # thresholds at the picks' own scale where it is coarser than the noise model (hand picks on a photo)
+    if robust and problem.model == "pinhole" and sigma_px is None:
+        # thresholds at the picks' own scale where it is coarser than the default noise model (hand picks on a photo);
+        # a caller who states the noise (a detector's) has it taken as stated
         noise = max(noise, pick_scale_px(problem, fu0, fv0, order) or 0.0)
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
     huber = 2.0 * noise if robust else None
