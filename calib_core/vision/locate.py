@@ -157,7 +157,7 @@ def _with_spread(located: Located, ends: list[np.ndarray]) -> Located:
     from scipy.spatial.transform import Rotation
 
     if len(ends) < 2:
-        return with_fields(located, message=located.message + f"; {1 + 2 - (len(ends) - 1)} of 3 starts settled")
+        return with_fields(located, message=located.message + "; 1 of 3 starts settled: the 1-sigma is the edge fit's own")
     t = np.array([e[:3, 3] for e in ends])
     turn = np.array([Rotation.from_matrix(e[:3, :3] @ ends[0][:3, :3].T).as_rotvec() for e in ends])
     spread_t, spread_r = t.std(axis=0, ddof=1), np.degrees(turn.std(axis=0, ddof=1))
