@@ -13,13 +13,14 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import invert, pose_difference
-from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCalibration, identify, pose_covariance
+from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCalibration, pose_covariance
+from calib_core.robot_calibration.identify_robot import identify_robot
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
 from calib_core.robot_calibration.cell_views import cell_view_joints
 from calib_core.robot_calibration.grasp_view import GraspNotSeenError, see_grasp
 from videocal_sim.compliant_grasp import grasp_frame, grasp_joints
-from videocal_sim.robot_calibration_views import simulated_cell_views, simulated_pose_views
+from videocal_sim.robot_calibration_views import simulated_cell_frames, simulated_pose_views
 from videocal_sim.cold_cell import cold_test_bed
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
@@ -64,18 +65,17 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     board_views, pose_views, rejected = simulated_pose_views(bed, spec, board2base, calibration_q, seed=seed, progress=progress)
     intrinsics = calibrate_intrinsics(board_views, spec)
     say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views")
-    board_count, cell_views = len(pose_views), []
+    cell_frames = []
     if cell_views_per_task:
         from calib_core.robot.collision import CollisionWorld
 
         world = CollisionWorld(bed.model_robot, list(bed.workcell.components), bed.workcell.home_joints_deg)
         targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed, collisions=world)
         say(f"locating surveyed features in {len(targets)} views...")
-        cell_views, cell_rejected = simulated_cell_views(bed, intrinsics.intrinsics, targets, seed=seed)
-        pose_views += cell_views
-        rejected += cell_rejected
+        cell_frames = simulated_cell_frames(bed, targets, seed=seed)
     say("identifying...")
-    result = identify(bed.model_robot, intrinsics.intrinsics, pose_views, with_intrinsics=with_intrinsics)
+    identified = identify_robot(bed.model_robot, intrinsics.intrinsics, bed.workcell, pose_views, cell_frames, visuals=bed.visuals_for_model(), with_intrinsics=with_intrinsics)
+    result = identified.result
     robot, tool = result.robot, None
     if grasps:
         tasks = [t for t in bed.workcell.task_locations.values() if grasp_tasks is None or t.name in grasp_tasks]
@@ -93,8 +93,8 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
         robot = with_tool(result.robot, tool.tcp2cam)
         say(f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
-    score["parameters_against_truth"] = parameters_against_truth(result, bed, pose_views, intrinsics.intrinsics)
-    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, board_count, len(cell_views))
+    score["parameters_against_truth"] = parameters_against_truth(result, bed, identified.views, intrinsics.intrinsics)
+    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, identified.board_views, identified.cell_views)
 
 
 def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray, robot=None) -> dict:

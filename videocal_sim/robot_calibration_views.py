@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from calib_core.robot_calibration.identify_robot import CellFrame
 from calib_core.robot_calibration.observations import PoseView
 from videocal_sim.sim_camera import SimulatedCamera
 from videocal_sim.test_bed import TestBed
@@ -39,28 +40,18 @@ def simulated_pose_views(bed: TestBed, spec, board2base: np.ndarray, joints: lis
     return board_views, pose_views, rejected
 
 
-def simulated_cell_views(bed: TestBed, intrinsics, targets: list[tuple[str, np.ndarray]], robot=None, seed: int = 0, progress=None) -> tuple[list[PoseView], list[str]]:
-    """Views of surveyed features (:mod:`calib_core.robot_calibration.cell_views`) at ``targets``
-    ((component, commanded joints deg)), rendered by the true camera and located through
-    ``intrinsics`` (calibrated, not the truth); the modelled camera from ``robot`` (default nominal)."""
-    from calib_core.render.model_view import ModelView
-    from calib_core.robot_calibration.cell_views import cell_view
-
-    robot = robot or bed.model_robot
+def simulated_cell_frames(bed: TestBed, targets: list[tuple[str, np.ndarray]], seed: int = 0, progress=None) -> list[CellFrame]:
+    """Frames of surveyed features (:mod:`calib_core.robot_calibration.cell_views`) at ``targets``
+    ((component, commanded joints deg)), rendered by the true camera; the identification's driver
+    locates them as it does a real camera's."""
     camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 1)
-    view = ModelView(intrinsics)
-    visuals = bed.visuals_for_model()
-    views, rejected = [], []
+    frames = []
     try:
         for k, (component, q) in enumerate(targets):
             bed.joints_deg = np.asarray(q, dtype=float)
-            item = bed.workcell.component(component)
-            expected = view.of_cell(bed.workcell.components, visuals, bed.joints_deg, item.item2world)
-            found = cell_view(f"cell_{k + 1:02d}_{component}", camera.read().image, bed.joints_deg.copy(), bed.workcell, component, robot, intrinsics, expected)
-            (rejected if isinstance(found, str) else views).append(found)
+            frames.append(CellFrame(component, bed.joints_deg.copy(), camera.read().image, f"cell_{k + 1:02d}_{component}"))
             if progress is not None:
                 progress(k + 1, len(targets))
     finally:
         camera.close()
-        view.close()
-    return views, rejected
+    return frames

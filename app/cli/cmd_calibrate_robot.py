@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     save_robot_calibration(args.out, result, nominal, robot=robot, tool=tool)
     summary = {"views": len(result.per_view_rms_px), **counts, "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
                "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
-               "intrinsics_rms_px": intrinsics_rms, "out": str(args.out)}
+               "intrinsics_rms_px": intrinsics_rms, "warnings": list(result.warnings), "out": str(args.out)}
     if tool is not None:
         summary["tool"] = {"grasps": len(tool.per_grasp), "seen": tool.seen_grasps, "spread_mm": tool.spread_mm, "spread_deg": tool.spread_deg}
     if score is not None:
@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _from_files(args):
     from calib_core.camera.intrinsics_io import load_intrinsics
-    from calib_core.robot_calibration.identification import identify
+    from calib_core.robot_calibration.identify_robot import CellFrame, identify_robot
     from calib_core.robot_calibration.observations import PoseView
     from calib_core.vision.board import DEFAULT_SPEC, parse_board
     from calib_core.vision.hand_eye_data import load_posed_images
@@ -144,23 +144,9 @@ def _from_files(args):
     else:
         calibrated = calibrate_intrinsics(board_views, spec, rejected=[])
         intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
-    board_count = len(views)
-    if of_components:
-        from calib_core.render.model_view import ModelView
-        from calib_core.robot.visuals import RobotVisuals
-        from calib_core.robot_calibration.cell_views import cell_view
-
-        visuals, view = RobotVisuals.from_robot(robot), ModelView(intrinsics)
-        try:
-            for posed in of_components:
-                q = posed.joints_deg[order]
-                item = cell.component(posed.component)
-                found = cell_view(posed.name, data.read_image(posed), q, cell, posed.component, robot, intrinsics, view.of_cell(cell.components, visuals, q, item.item2world))
-                (rejected.append(found) if isinstance(found, str) else views.append(found))
-        finally:
-            view.close()
-    counts = {"board_views": board_count, "cell_views": len(views) - board_count}
-    return identify(robot, intrinsics, views, with_intrinsics=not args.fixed_intrinsics), robot, rejected, rms, counts
+    frames = [CellFrame(posed.component, posed.joints_deg[order], data.read_image(posed), posed.name) for posed in of_components]
+    done = identify_robot(robot, intrinsics, cell, views, frames, with_intrinsics=not args.fixed_intrinsics)
+    return done.result, robot, rejected, rms, {"board_views": done.board_views, "cell_views": done.cell_views}
 
 
 def _seen_grasps(rows, grasps_path: Path, result, cell) -> list:

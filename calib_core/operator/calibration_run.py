@@ -17,6 +17,7 @@ from psygnal import Signal
 
 from calib_core.errors import VideocalError
 from calib_core.operator.motion import Motion
+from calib_core.robot_calibration.identify_robot import CellFrame
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.intrinsics_calibration import RejectedView
 
@@ -25,16 +26,6 @@ VIA = "via"
 """In a plan's ``cell_views``: a pose passed through on the way to the next (home, round an obstacle), nothing captured."""
 MAX_FRAMES_PER_POSE = 60
 """Settled frames tried at a pose before it is given up (the board not found in any)."""
-
-
-@dataclass(frozen=True)
-class CellFrame:
-    """A settled frame ``image`` at ``joints_deg`` viewing surveyed ``component``: located later,
-    by the identification (Find points' edges take a second or two, too long between moves)."""
-
-    component: str
-    joints_deg: np.ndarray
-    image: np.ndarray
 
 
 @dataclass(frozen=True)

@@ -61,15 +61,12 @@ class RobotCalibrating:
 
     def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False, progress=None):
         """Identify the robot from a :class:`~calib_core.vision.capture.BoardCapture`'s views with
-        joints and the run's ``cell_frames`` (:class:`~calib_core.operator.calibration_run.CellFrame`:
-        each component located by Find points' edges, through the intrinsics in use); the robot as it
-        is now (nominal, or calibrated before) is the start. A component not located is named in the
-        result's warnings. ``progress(done, total, text)`` is told before each component's location
-        (1-2 s each) and before the identification."""
-        from dataclasses import replace
-
-        from calib_core.robot_calibration.cell_views import cell_view
-        from calib_core.robot_calibration.identification import identify
+        joints and the run's ``cell_frames``
+        (:class:`~calib_core.robot_calibration.identify_robot.CellFrame`), through the one driver
+        (:func:`~calib_core.robot_calibration.identify_robot.identify_robot`); the robot as it is now
+        (nominal, or calibrated before) is the start. A component not located is named in the
+        result's warnings. ``progress(done, total, text)``."""
+        from calib_core.robot_calibration.identify_robot import identify_robot
         from calib_core.robot_calibration.observations import PoseView
 
         posed = [(v, q) for v, q in zip(capture.views, capture.joints_deg) if q is not None]
@@ -77,20 +74,10 @@ class RobotCalibrating:
             raise OperatorError(f"{len(posed)} views with a robot pose, at least 6 needed (run the calibration plan)")
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
-        objects, missed = [], []
-        total = len(cell_frames) + 1
-        for k, f in enumerate(cell_frames):
-            if progress is not None:
-                progress(k, total, f"locating {f.component} in view {k + 1} of {len(cell_frames)} ...")
-            item = self.workcell.component(f.component)
-            found = cell_view(f"cell_{k + 1:02d}_{f.component}", f.image, f.joints_deg, self.workcell, f.component, self.robot, self.intrinsics, self.modelled_view(f.joints_deg, item))
-            (missed if isinstance(found, str) else objects).append(found)
-        if progress is not None:
-            progress(total - 1, total, f"identifying the robot from {len(views)} board and {len(objects)} component views ...")
-        result = identify(self.robot, self.intrinsics, views + objects, with_intrinsics=with_intrinsics)
-        if missed:
-            result = replace(result, warnings=list(result.warnings) + missed)
-        self.record_event("robot_calibrated", views=len(views), component_views=len(objects), rms_px=result.rms_px, identified=len(result.observability.identified))
+        done = identify_robot(self.robot, self.intrinsics, self.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.scene_extras,
+                              with_intrinsics=with_intrinsics, progress=progress)
+        result = done.result
+        self.record_event("robot_calibrated", views=done.board_views, component_views=done.cell_views, rms_px=result.rms_px, identified=len(result.observability.identified))
         return result
 
     def apply_robot_calibration(self, result) -> None:
