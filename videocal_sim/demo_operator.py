@@ -256,7 +256,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
                 refined = wb.session.pairs.get(pending.number).pixel
                 if refined is None:
-                    h = wb.live.history
+                    h = wb.observations.live_history
                     tail = [(round(t - h.latest_s, 3), np.round(q, 3).tolist()) for t, q in list(zip(h._t, h._q))[-40::4]]
                     frame = win.camera.last_frame_received
                     raise RuntimeError(f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; {wb.motion.text}; "

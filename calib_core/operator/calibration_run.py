@@ -64,7 +64,7 @@ class CalibrationRun:
         if not self.plan:
             raise VideocalError("no poses planned: plan the robot calibration first")
         self.core.motion_changed.connect(self._on_motion)
-        self.core.frame_observed.connect(self._on_frame)
+        self.core.observations.frame_observed.connect(self._on_frame)
         self._visit()
 
     def stop(self, why: str = "stopped by the operator") -> None:
@@ -75,7 +75,7 @@ class CalibrationRun:
     def _end(self, phase: str, text: str) -> None:
         self.phase = phase
         self.core.motion_changed.disconnect(self._on_motion)
-        self.core.frame_observed.disconnect(self._on_frame)
+        self.core.observations.frame_observed.disconnect(self._on_frame)
         self._say(text)
         self.finished.emit(text)
 

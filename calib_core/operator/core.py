@@ -50,12 +50,11 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
     status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
     ``scene_changed()``, ``move_finished(what, error)`` (``error`` empty when the move arrived),
-    ``frame_observed(frame)``, ``correction_stored(correction)``, ``event(kind, detail)``
-    (operator actions worth recording), ``still_changed(held)`` (the frame held for picking, a
-    :class:`~calib_core.operator.observations.HeldFrame`, or ``None`` when released),
-    ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`),
+    ``correction_stored(correction)``, ``event(kind, detail)``
+    (operator actions worth recording), ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`),
     ``move_previewed(preview)`` (a :class:`~calib_core.operator.move_preview.MovePreview`, before
-    every move, sent or not), ``prompts_withdrawn()`` (a Stop voided every move prompt still waiting)."""
+    every move, sent or not), ``prompts_withdrawn()`` (a Stop voided every move prompt still waiting).
+    Frames and the held one are :attr:`observations`' events (``frame_observed``, ``still_changed``)."""
 
     joints_changed = Signal(object)
     sample_received = Signal(object, object)
@@ -66,10 +65,8 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     camera_model_changed = Signal()
     scene_changed = Signal()
     move_finished = Signal(str, str)
-    frame_observed = Signal(object)
     correction_stored = Signal(object)
     event = Signal(str, object)
-    still_changed = Signal(object)
     motion_changed = Signal(object)
     move_previewed = Signal(object)
     points_found = Signal(object)
@@ -87,7 +84,6 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.link: ControllerConnector | None = None
         self.recorder = None
         self._tap = None
-        self.replaying = False
         self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
         self.stops_sent = 0  # a prompt's confirmation carries the count it saw: a later Stop voids it
@@ -104,12 +100,11 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
-        self.live = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.controller_clock.spread_s)
-        """The live frames and the link's joint history."""
-        self.observations = self.live
+        self.observations = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.controller_clock.spread_s)
+        """The frames (live, or a recording's while it is replayed), the held one, and the joint history
+        that stamps them."""
         self.controller_clock = ControllerClock()
         """Stamps each joint sample with its controller time on the host clock (not its arrival)."""
-        """What picks are stamped by: the live one, or a recording's while it is replayed."""
         self.motion = MotionState()
         self._pending_move: tuple[str, MoveHandle] | None = None
         self._collision_world = None  # built on the first move preview, again when the cell changes
@@ -192,7 +187,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         if state in ("down", "closed"):
             # The device is gone: the robot may move unseen, no earlier sample vouches for a later frame.
             # (A stale link, open but late, leaves a gap in the samples: the settle rule sees it.)
-            self.live.history.forget(time.monotonic())
+            self.observations.live_history.forget(time.monotonic())
             if self.motion.motion is Motion.MOVING:
                 self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
         self.link_state.emit(f"{state}: {why}")
@@ -219,8 +214,8 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         restarts = self.controller_clock.restarts
         t_sent = self.controller_clock.stamp(sample.t_host_s, sample.sample.t_ms / 1000.0)
         if self.controller_clock.restarts != restarts:
-            self.live.history.forget(sample.t_host_s)  # a restarted controller: nothing before vouches for now
-        self.live.history.add(t_sent, q)
+            self.observations.live_history.forget(sample.t_host_s)  # a restarted controller: nothing before vouches for now
+        self.observations.live_history.add(t_sent, q)
         if self.motion.motion is Motion.UNKNOWN:
             pending = self._pending_move
             if pending is not None and not pending[1].finished:

@@ -15,6 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
+from psygnal import Signal
+
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory, Stillness
@@ -40,20 +42,55 @@ class HeldFrame:
 class Observations:
     """The newest frame (``latest``), the held one (``still``) and the joint ``history`` that
     stamps them. ``source``: ``live``, or the name of the recording being replayed (then the
-    history is the recording's, on its time axis)."""
+    history is the recording's, on its time axis). One object for the program's life: a replay
+    swaps its source, so whoever listens keeps listening.
 
-    def __init__(self, history: JointHistory, source: str = "live", margin_s: Callable[[], float] = lambda: 0.0):
-        self.history = history
+    Events (psygnal): ``frame_observed(frame)`` (every frame of the current source),
+    ``still_changed(held)`` (a :class:`HeldFrame`, or ``None`` when let go; only on a change),
+    ``source_changed(source)`` (``live`` or the recording's name)."""
+
+    frame_observed = Signal(object)
+    still_changed = Signal(object)
+    source_changed = Signal(str)
+
+    def __init__(self, live_history: JointHistory, margin_s: Callable[[], float] = lambda: 0.0):
+        self.live_history = live_history
+        """The link's joints in time: written by every joint sample, replay or not."""
+        self._live_margin_s = margin_s
+        self.history = live_history
         self.margin_s = margin_s
         """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread."""
-        self.source = source
+        self.source = "live"
         self.latest: Frame | None = None
         self._recent: deque[Frame] = deque(maxlen=RECENT_FRAMES)
         self.still: HeldFrame | None = None
 
+    @property
+    def replaying(self) -> bool:
+        return self.source != "live"
+
     def observe(self, frame: Frame) -> None:
+        """A frame of the current source arrived: ``frame_observed``."""
         self.latest = frame
         self._recent.append(frame)
+        self.frame_observed.emit(frame)
+
+    def replay(self, history: JointHistory, name: str) -> None:
+        """A recording ``name`` stands in for the live source: its frames, stamped by its ``history``
+        (on the recording's time axis, which has no link spread)."""
+        self._switch(history, name, lambda: 0.0)
+
+    def go_live(self) -> None:
+        """Back to the camera and the link's joints. Frames seen before the replay are not kept: their
+        joints are minutes old by now."""
+        self._switch(self.live_history, "live", self._live_margin_s)
+
+    def _switch(self, history: JointHistory, source: str, margin_s: Callable[[], float]) -> None:
+        self.release()
+        self.history, self.source, self.margin_s = history, source, margin_s
+        self.latest = None
+        self._recent.clear()
+        self.source_changed.emit(source)
 
     def stillness(self, frame: Frame) -> Stillness:
         return self.stillness_at(frame.t_host_s)
@@ -95,7 +132,11 @@ class Observations:
         if frame is None:
             raise OperatorError("no camera image yet: start the camera (Execute > Live) or open a recording")
         self.still = HeldFrame(frame, self.stamp(frame))
+        self.still_changed.emit(self.still)
         return self.still
 
     def release(self) -> None:
-        self.still = None
+        """Let the held frame go (``still_changed(None)`` if one was held)."""
+        if self.still is not None:
+            self.still = None
+            self.still_changed.emit(None)

@@ -15,7 +15,7 @@ from calib_core.calibration.session import CalibrationError
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory
-from calib_core.operator.observations import HeldFrame, NotSettledError, Observations
+from calib_core.operator.observations import HeldFrame, NotSettledError
 
 
 class Picking:
@@ -160,7 +160,6 @@ class Picking:
         """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
         held = self.observations.hold()
         self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
-        self.still_changed.emit(held)
         return held
 
     def frame_to_capture(self) -> tuple:
@@ -182,9 +181,7 @@ class Picking:
 
     def release_frame(self) -> None:
         """Back to the live image for picking (the pairs keep their stamps)."""
-        if self.observations.still is not None:
-            self.observations.release()
-            self.still_changed.emit(None)
+        self.observations.release()
 
     def _release_unused_still(self, *_) -> None:
         if self.observations.still is not None and not any(p.complete for p in self.session.pairs):
@@ -225,15 +222,14 @@ class Picking:
         if self.replaying != replayed:
             return
         self.observations.observe(frame)
-        self.frame_observed.emit(frame)
 
     def begin_replay(self, history: JointHistory, name: str) -> None:
         """A recording is being replayed: its frames and joints stand in for the live ones."""
-        self.release_frame()
-        self.replaying = True
-        self.observations = Observations(history, source=name)
+        self.observations.replay(history, name)
 
     def end_replay(self) -> None:
-        self.release_frame()
-        self.replaying = False
-        self.observations = self.live
+        self.observations.go_live()
+
+    @property
+    def replaying(self) -> bool:
+        return self.observations.replaying

@@ -42,7 +42,7 @@ class RecordingTap:
         self._reprojected: list | None = None
         self._record_static()
         self._connections = [
-            (core.frame_observed, self._frame),
+            (core.observations.frame_observed, self._frame),
             (core.sample_received, self._sample),
             (core.event, self._event),
             (core.solved, self._solved),
