@@ -155,7 +155,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     moves_seen: list[str] = []
     looks_s: list[float] = []  # Go pressed -> a frame the core accepts for picks
     last_go = [time.monotonic()]
-    wb.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
+    wb.arm.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
     try:
         _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")

@@ -106,7 +106,7 @@ class CameraPane(QWidget):
         workbench.observations.still_changed.connect(self._still_changed)
         workbench.session.pairs.changed.connect(lambda *_: self.refresh_overlay())
         workbench.session.changed.connect(self._on_solved)
-        workbench.joints_changed.connect(self._joints_changed)
+        workbench.arm.joints_changed.connect(self._joints_changed)
 
     # --- frames ---------------------------------------------------------------------------------
     @property

@@ -117,9 +117,9 @@ class OverviewPane(QWidget):
         workbench.session.changed.connect(self.mark_dirty)
         workbench.scene_changed.connect(self.mark_dirty)
         workbench.session.pairs.changed.connect(lambda *_: self.mark_dirty())
-        workbench.move_previewed.connect(lambda preview: self.show_preview(preview))
-        workbench.motion_changed.connect(self._motion_changed)
-        workbench.prompts_withdrawn.connect(self._withdraw_prompt)
+        workbench.arm.move_previewed.connect(lambda preview: self.show_preview(preview))
+        workbench.arm.motion_changed.connect(self._motion_changed)
+        workbench.arm.prompts_withdrawn.connect(self._withdraw_prompt)
 
     # --- previewed moves ------------------------------------------------------------------------
     def show_preview(self, preview, send: Callable[[], None] | None = None) -> None:

@@ -87,7 +87,7 @@ class ResultsPanel(QWidget):
         workbench.session.changed.connect(self.refresh)
         workbench.session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
         self._elsewhere = False
-        workbench.joints_changed.connect(self._joints_changed)
+        workbench.arm.joints_changed.connect(self._joints_changed)
 
     def _solved_elsewhere(self) -> bool:
         """The last result was solved from another robot pose than the robot's now."""

@@ -35,7 +35,7 @@ class StatusLine:
         self.settled_label.setObjectName("settled")
         for w in (self.motion_label, self.settled_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
             bar.addPermanentWidget(w)
-        workbench.motion_changed.connect(self.show_motion)
+        workbench.arm.motion_changed.connect(self.show_motion)
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
         self.timer = QTimer(parent)
         self.timer.setInterval(1000)
@@ -66,7 +66,7 @@ class StatusLine:
             delay = getattr(link, "delay_s", None)
             delay_text = "" if delay is None else f", delay {delay:.2f} s" if delay >= 0.01 else ", delay < 0.01 s"
             text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected{delay_text}"
-            last = self.workbench.last_sample_s
+            last = self.workbench.arm.last_sample_s
             # a far link delivers its samples in bursts: late only past its own spread of delays
             late_after = STALE_LINK_S + (link.stale_after_now_s() if hasattr(link, "stale_after_now_s") else 0.0)
             if link.state.value == "up" and last is not None and now - last > late_after:

@@ -1,7 +1,7 @@
 """A robot calibration run: the robot driven through planned poses, one board view captured at each,
 then the poses that view the surveyed components, one settled frame kept at each.
 
-Each move is awaited (the core's ``motion_changed`` says it arrived, or why not), then a frame taken
+Each move is awaited (the arm's ``motion_changed`` says it arrived, or why not), then a frame taken
 after the robot settled (the same stillness rule every pick and capture follows) is detected and kept
 with the joints at its capture. A refused or failed move, or a stop, ends the run with the reason;
 what was captured stays. The operator previewed the whole plan before starting, so each move goes
@@ -63,7 +63,7 @@ class CalibrationRun:
     def start(self) -> None:
         if not self.plan:
             raise VideocalError("no poses planned: plan the robot calibration first")
-        self.core.motion_changed.connect(self._on_motion)
+        self.core.arm.motion_changed.connect(self._on_motion)
         self.core.observations.frame_observed.connect(self._on_frame)
         self._visit()
 
@@ -74,7 +74,7 @@ class CalibrationRun:
 
     def _end(self, phase: str, text: str) -> None:
         self.phase = phase
-        self.core.motion_changed.disconnect(self._on_motion)
+        self.core.arm.motion_changed.disconnect(self._on_motion)
         self.core.observations.frame_observed.disconnect(self._on_frame)
         self._say(text)
         self.finished.emit(text)

@@ -13,7 +13,6 @@ window passes a function that queues them into the Qt event loop.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
@@ -23,15 +22,14 @@ from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
-from calib_core.connectors.controller import ControllerConnector, ControllerContext
-from calib_core.connectors.registry import open_controller
 from calib_core.calibration.verdict import ResultVerdict, judge
-from calib_core.link.joint_history import ControllerClock, JointHistory
-from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
+from calib_core.link.joint_history import JointHistory
+from calib_core.link.link_types import TimedSample
+from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.correction_desk import CorrectionDesk
-from calib_core.operator.motion import Motion, MotionState
+from calib_core.operator.motion import MotionState
 from calib_core.operator.move_preview import joint_path
 from calib_core.operator.observations import Observations
 from calib_core.operator.moves import Moves
@@ -46,48 +44,32 @@ from calib_core.workcell import TaskLocation
 
 
 class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring, CorrectionDesk):
-    """Events (psygnal): ``joints_changed(q)`` (model joints, deg/mm), ``sample_received(sample, q)``
-    (every joint sample, with its model joints), ``link_state(text)``, ``message(text)`` (for a
-    status line), ``solved()``, ``task_changed(name)``, ``camera_model_changed()``,
-    ``scene_changed()``, ``move_finished(what, error)`` (``error`` empty when the move arrived),
-    ``correction_stored(correction)``, ``event(kind, detail)``
-    (operator actions worth recording), ``motion_changed(state)`` (a :class:`~calib_core.operator.motion.MotionState`),
-    ``move_previewed(preview)`` (a :class:`~calib_core.operator.move_preview.MovePreview`, before
-    every move, sent or not), ``prompts_withdrawn()`` (a Stop voided every move prompt still waiting).
-    Frames and the held one are :attr:`observations`' events (``frame_observed``, ``still_changed``)."""
+    """Events (psygnal): ``message(text)`` (for a status line), ``solved()``, ``task_changed(name)``,
+    ``camera_model_changed()``, ``scene_changed()``, ``correction_stored(correction)``,
+    ``event(kind, detail)`` (operator actions and link changes worth recording), ``points_found(found)``.
+    The arm's events (joints, samples, the link, moves) are :attr:`arm`'s; frames and the held one
+    :attr:`observations`'."""
 
-    joints_changed = Signal(object)
-    sample_received = Signal(object, object)
-    link_state = Signal(str)
     message = Signal(str)
     solved = Signal()
     task_changed = Signal(str)
     camera_model_changed = Signal()
     scene_changed = Signal()
-    move_finished = Signal(str, str)
     correction_stored = Signal(object)
     event = Signal(str, object)
-    motion_changed = Signal(object)
-    move_previewed = Signal(object)
     points_found = Signal(object)
-    prompts_withdrawn = Signal()
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
         self.site = site
         self._call_soon = call_soon or (lambda fn, *args: fn(*args))
         self.session = CalibrationSession()
-        self.joints_deg = cell.home_joints
         self.task: TaskLocation | None = next(iter(self.workcell.task_locations.values()), None)
         if self.task is not None and self.task.component:
             self.session.set_target(self.task.component)
-        self.link: ControllerConnector | None = None
         self.recorder = None
         self._tap = None
-        self.last_sample_s: float | None = None
         self.scene_extras: list[SceneItem] = []
-        self.stops_sent = 0  # a prompt's confirmation carries the count it saw: a later Stop voids it
-        self.last_move_sent_s: float | None = None  # host monotonic s
         """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the
@@ -100,13 +82,13 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         """Counts the changes of what the CAD views show (components edited, a board put up)."""
         self.editor = CellEditor(self)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
-        self.observations = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.controller_clock.spread_s)
+        self.observations = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.arm.controller_clock.spread_s)
         """The frames (live, or a recording's while it is replayed), the held one, and the joint history
         that stamps them."""
-        self.controller_clock = ControllerClock()
-        """Stamps each joint sample with its controller time on the host clock (not its arrival)."""
-        self.motion = MotionState()
-        self._pending_move: tuple[str, MoveHandle] | None = None
+        self.arm = Arm(cell, self.observations, self.collision_world, call_soon=self._call_soon)
+        """The robot behind the link: its joints, its moves and how the last one stands, Stop."""
+        self.arm.message.connect(self.message.emit)
+        self.arm.event.connect(self.event.emit)
         self._collision_world = None  # built on the first move preview, again when the cell changes
         self._collision_version = -1
         self.session.judge = self._judge
@@ -141,25 +123,44 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
 
     def connect_link(self, url: str, rate_hz: float = 50.0, options: dict | None = None) -> None:
         """Open the controller connector registered for ``url``'s scheme and start it."""
-        if self.link is not None:
-            self.link.close()
-            self.link = None
-        context = ControllerContext.of(self.robot, self.cell.joint_map, rate_hz, options)
-        self.link = open_controller(url, context)
-        self.link.sample_received.connect(lambda sample: self._call_soon(self.observe_sample, sample))
-        self.link.state_changed.connect(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
-        self.link.auth_changed.connect(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
-        status = getattr(self.link, "status_changed", None)  # a controller's own state (a UR's protective stop, speed slider)
-        if status is not None:
-            status.connect(lambda text: self._call_soon(self._on_link_status, text))
+        link = self.arm.connect(url, rate_hz, options)
         if self.site is not None:
-            self.site.attach(self.link)
-        self.link.start()
+            self.site.attach(link)
+        link.start()
         self.message.emit(f"controller link: {url}")
-        if hasattr(self.link, "publish_static_transforms"):  # a ROS 2 cell: the results on /tf_static too
+        if hasattr(link, "publish_static_transforms"):  # a ROS 2 cell: the results on /tf_static too
             for signal in (self.camera_model_changed, self.correction_stored):
                 signal.connect(self._publish_static_transforms, unique=True)
             self._publish_static_transforms()
+
+    # The arm's state, read where the workflow needs it (the arm alone changes it).
+    @property
+    def link(self):
+        return self.arm.link
+
+    @property
+    def joints_deg(self) -> np.ndarray:
+        return self.arm.joints_deg
+
+    @property
+    def motion(self) -> MotionState:
+        return self.arm.state
+
+    @property
+    def link_up(self) -> bool:
+        return self.arm.link_up
+
+    @property
+    def last_move_sent_s(self) -> float | None:
+        return self.arm.last_move_sent_s
+
+    def observe_sample(self, sample: TimedSample) -> None:
+        """A joint sample from the link (or a test standing in for it)."""
+        self.arm.observe_sample(sample)
+
+    def show_replayed_joints(self, joints_deg) -> None:
+        """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
+        self.arm.show_joints(joints_deg)
 
     def static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
         """What the cell's ROS side is told: ``(parent, child, child2parent_mm)`` for the camera mounting in use
@@ -182,66 +183,9 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         except Exception as exc:  # the ROS side is an output: its failure must not stop the calibration
             self.message.emit(f"could not publish /tf_static: {exc}")
 
-    def _on_link_state(self, state: str, why: str) -> None:
-        self.record_event("link_state", state=state, why=why)
-        if state in ("down", "closed"):
-            # The device is gone: the robot may move unseen, no earlier sample vouches for a later frame.
-            # (A stale link, open but late, leaves a gap in the samples: the settle rule sees it.)
-            self.observations.live_history.forget(time.monotonic())
-            if self.motion.motion is Motion.MOVING:
-                self._set_motion(MotionState(Motion.UNKNOWN, self.motion.what, f"the link went {state} during the move to {self.motion.what}; waiting for a fresh joint sample"))
-        self.link_state.emit(f"{state}: {why}")
-
-    def _on_link_status(self, text: str) -> None:
-        self.record_event("controller_status", text=text)
-        self.message.emit(f"controller: {text}")
-        if self.link is not None:
-            self.link_state.emit(f"{self.link.state.value}: {text}")
-
-    def _on_link_auth(self, state: str, failure: str | None) -> None:
-        self.record_event("link_auth", state=state, failure=failure)
-        if failure:
-            self.message.emit(f"the robot cannot be moved: {failure}")
-
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
         self.event.emit(kind, detail)
-
-    def observe_sample(self, sample: TimedSample) -> None:
-        """A joint sample from the link (its reader thread hands it here through ``call_soon``)."""
-        self.last_sample_s = time.monotonic()
-        q = self.link.joint_map.to_model(sample.joints_deg) if self.link is not None else self.cell.joint_map.to_model(sample.joints_deg)
-        restarts = self.controller_clock.restarts
-        t_sent = self.controller_clock.stamp(sample.t_host_s, sample.sample.t_ms / 1000.0)
-        if self.controller_clock.restarts != restarts:
-            self.observations.live_history.forget(sample.t_host_s)  # a restarted controller: nothing before vouches for now
-        self.observations.live_history.add(t_sent, q)
-        if self.motion.motion is Motion.UNKNOWN:
-            pending = self._pending_move
-            if pending is not None and not pending[1].finished:
-                self._set_motion(MotionState(Motion.MOVING, pending[0], "the link is back"))
-            else:
-                self._set_motion(MotionState(Motion.IDLE, self.motion.what, "the link is back: the robot stands where its joints say"))
-        self.sample_received.emit(sample, q)
-        if self.replaying:
-            return  # the recorded joints drive the views while a recording is replayed
-        self._show_joints(q)
-
-    def show_replayed_joints(self, joints_deg) -> None:
-        """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
-        self._show_joints(np.array(joints_deg, dtype=float))
-
-    def _show_joints(self, q: np.ndarray) -> None:
-        # Emitted only on a change: a still robot streams the same joints 50 times a second, and every
-        # pane would redraw (or filter the repeats itself).
-        changed = q.shape != np.shape(self.joints_deg) or not np.array_equal(q, self.joints_deg)
-        self.joints_deg = q
-        if changed:
-            self.joints_changed.emit(self.joints_deg)
-
-    @property
-    def link_up(self) -> bool:
-        return self.link is not None and self.link.state is LinkState.UP
 
     def set_task_approach(self, name: str, approach_mm: float) -> None:
         """Edit a task location's approach distance (mm): an undoable edit."""
@@ -374,7 +318,6 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         self.stop_recording()
         if rec is not None:
             rec.wait_finished(5.0)  # a file finishing in the background is not cut off by the exit
-        if self.link is not None:
-            self.link.close()
+        self.arm.close()
         if self.site is not None:
             self.site.close()

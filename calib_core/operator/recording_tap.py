@@ -43,7 +43,7 @@ class RecordingTap:
         self._record_static()
         self._connections = [
             (core.observations.frame_observed, self._frame),
-            (core.sample_received, self._sample),
+            (core.arm.sample_received, self._sample),
             (core.event, self._event),
             (core.solved, self._solved),
             (core.correction_stored, self._correction),

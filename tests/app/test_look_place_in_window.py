@@ -22,10 +22,10 @@ def test_a_look_from_the_approach_is_kept_as_a_measurement_and_moves_nothing(qtb
     table = wb.session.corrections
     assert table.latest(wb.task.name) is None and [c.kind for c in table.history(wb.task.name)] == ["measurement"]
     assert "no correction (0 stored, 1 measurement at other poses)" in win.commands.corrections.text()
-    before, last_move = np.array(wb.joints_deg), wb._pending_move
+    before, last_move = np.array(wb.joints_deg), wb.arm.pending_move
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
     assert "no stored correction for oru_1_grasp" in win.results.status.text(), win.results.status.text()
-    assert wb._pending_move is last_move and np.max(np.abs(wb.joints_deg - before)) < 1e-6
+    assert wb.arm.pending_move is last_move and np.max(np.abs(wb.joints_deg - before)) < 1e-6
 
 
 def test_cancel_stores_nothing(qtbot, window):

@@ -82,7 +82,7 @@ def test_an_implausible_result_is_stored_only_with_a_confirmation(qtbot, window)
 def test_a_click_while_the_robot_moves_picks_nothing(qtbot, window):
     win, wb = window, window.workbench
     shown = []  # the status bar's motion field after each change (it is connected first)
-    wb.motion_changed.connect(lambda state: shown.append(win.status_line.motion_label.text()))
+    wb.arm.motion_changed.connect(lambda state: shown.append(win.status_line.motion_label.text()))
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
     start = np.array(wb.joints_deg)
@@ -111,7 +111,7 @@ def test_a_move_into_an_obstacle_is_refused_and_shown(qtbot, window, tmp_path):
     assert win.overview.preview is not None and win.overview.preview.blocked and "refused" in win.overview.preview_text.text()
     assert not win.overview.move_button.isVisible()
     # nothing was sent: no move handle exists, the robot stands where it stood
-    assert wb._pending_move is None and wb.motion.motion.value == "idle"
+    assert wb.arm.pending_move is None and wb.motion.motion.value == "idle"
     assert np.max(np.abs(wb.joints_deg - before)) < 1e-6
     # Take the crate away (undo): the same move is free, ghosted, and goes.
     wb.undo()

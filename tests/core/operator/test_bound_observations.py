@@ -132,7 +132,7 @@ def test_a_link_that_drops_leaves_the_pose_unknown_until_a_fresh_sample(cell_and
     cell, site = cell_and_site
     core = OperatorCore(cell, site)
     still_for(core)
-    core._on_link_state("down", "device lost")
+    core.arm._on_link_state("down", "device lost")
     frame_now(core)
     assert not core.robot_settled().settled and "pose is unknown" in core.robot_settled().reason
     core.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))

@@ -12,7 +12,7 @@ def test_joints_changed_only_when_the_joints_change():
     cell, site = simulated_cell(image_scale=0.25)
     core = OperatorCore(cell, site)
     seen = []
-    core.joints_changed.connect(lambda q: seen.append(np.array(q)))
+    core.arm.joints_changed.connect(lambda q: seen.append(np.array(q)))
     q = np.array(cell.home_joints, dtype=float) + 1.0
     t = still_for(core, 0.5, joints_deg=q)  # 26 samples of a still robot
     assert len(seen) == 1 and np.array_equal(seen[0], q)
