@@ -180,11 +180,11 @@ def main() -> str:
         wb.pick_image_point(uv)  # on the frame the first pick held (the robot has settled at the approach)
         wb.accept_pair()
         if len(wb.session.pairs.usable()) >= 3:
-            edges_before = win.edges_drawn
+            edges_before = win.camera.edges_drawn
             win._calibrate()
             win.camera.view.repaint()
             pick_ms.append(1000 * (time.perf_counter() - t0))
-            while win.edges_drawn == edges_before and time.perf_counter() - t0 < 2.0:
+            while win.camera.edges_drawn == edges_before and time.perf_counter() - t0 < 2.0:
                 app.processEvents()
             win.camera.view.repaint()
             edges_ms.append(1000 * (time.perf_counter() - t0))

@@ -14,7 +14,6 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
 
 from calib_core.errors import VideocalError
 from app.cli.options import bounded_float, bounded_int

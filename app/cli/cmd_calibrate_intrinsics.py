@@ -32,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.camera.intrinsics_io import load_intrinsics, save_intrinsics
+    from calib_core.camera.intrinsics_io import save_intrinsics
     from calib_core.vision.board import parse_board
     from calib_core.vision.target_detection import load_detector_settings
     from calib_core.vision.image_sources import folder_images, video_frames

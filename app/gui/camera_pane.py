@@ -3,13 +3,14 @@ refinement, freezing, and the overlays that show the fit after a solve."""
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QSlider, QVBoxLayout, QWidget
 
+from app.gui.error_boundary import attempt
 from app.gui.image_view import ImageView, Overlay
+from app.gui.solved_edges import SolvedEdges
 from app.gui.workbench import Workbench
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.camera.projection import project_points
@@ -28,34 +29,17 @@ EXPECTED_COLOR = QColor(255, 255, 255)
 STALE_COLOR = QColor(120, 120, 120)
 
 
-def refine_subpixel(image_rgb: np.ndarray, u: float, v: float, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
-    """The corner nearest (u, v) to sub-pixel accuracy (``cv2.cornerSubPix``); the click itself
-    when the refinement wanders further than ``max_shift_px`` (no corner there: a circle centre,
-    a flat patch), since the operator's click is then the better estimate."""
-    grey = cv2.cvtColor(image_rgb, cv2.COLOR_RGB2GRAY).astype(np.float32)
-    corner = np.array([[[u, v]]], dtype=np.float32)
-    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 40, 0.01)
-    try:
-        refined = cv2.cornerSubPix(grey, corner, (half_window, half_window), (-1, -1), criteria)[0, 0]
-    except cv2.error:  # a click too near the border for the search window
-        return u, v
-    if np.hypot(refined[0] - u, refined[1] - v) > max_shift_px:
-        return u, v
-    return float(refined[0]), float(refined[1])
-
-
 class CameraPane(QWidget):
-    """Shows the core's frames; ``picked(u, v)`` when the operator picks a pixel (refined if asked).
+    """Shows the core's frames; a click picks the waiting pair's image point in the core (refined if
+    asked), a drag moves a pair's point; ``pick_rejected(text)`` says why a click picked nothing.
 
     Picks are made on a still: the core holds a frame at the first image pick of a set (``Hold``
     shows it; unticking it goes back to the live image) and the live video goes on in the corner.
     What is drawn belongs to a robot state: picks and results made at another pose than the one
     the image shows are greyed or hidden, with a banner that says so."""
 
-    picked = Signal(float, float)
-    pick_rejected = Signal(str)  # a click that picks nothing, and why
+    pick_rejected = Signal(str)  # a click or a drag that picks nothing, and why
     pair_selected = Signal(int)  # a click on a pair's point
-    pair_moved = Signal(int, float, float)  # a pair's point dragged to (u, v) px
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
@@ -97,6 +81,8 @@ class CameraPane(QWidget):
         self._board_joints: np.ndarray | None = None  # the robot state it was detected at
         self._board_text = ""
         self._edges_image: np.ndarray | None = None
+        self.solved_edges = SolvedEdges(workbench.intrinsics)
+        self.edges_drawn = 0  # the solves whose CAD edges were drawn (tests and the bench wait on it)
         self._drawn_state: tuple | None = None
         self.view.clicked.connect(self._on_click)
         self.freeze.toggled.connect(self._hold_toggled)
@@ -107,6 +93,7 @@ class CameraPane(QWidget):
         workbench.session.pairs.changed.connect(lambda *_: self.refresh_overlay())
         workbench.session.changed.connect(self._on_solved)
         workbench.arm.joints_changed.connect(self._joints_changed)
+        workbench.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.workbench.intrinsics))
 
     # --- frames ---------------------------------------------------------------------------------
     @property
@@ -157,19 +144,8 @@ class CameraPane(QWidget):
         if not (-0.5 <= u < w - 0.5 and -0.5 <= v < h - 0.5):
             self.pick_rejected.emit(f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked")
             return
-        if self.held is None:
-            # The first pick of a set holds the newest frame; refine on that one.
-            try:
-                self.workbench.hold_frame()
-            except OperatorError as exc:
-                self.pick_rejected.emit(f"nothing picked: {exc}")
-                return
-        if self.subpixel.isChecked():
-            # a round feature to its rim's centre; anything else to the nearest corner
-            image = self.held.frame.image if self.held is not None else self.last_frame.image
-            centre = self.workbench.refine_circle_pick(image, (u, v))
-            u, v = (float(centre[0]), float(centre[1])) if centre is not None else refine_subpixel(self.last_frame.image, u, v)
-        self.picked.emit(u, v)
+        # The core holds the newest frame at the first pick of a set and refines on it.
+        attempt(lambda text: self.pick_rejected.emit(f"nothing picked: {text}"), self.workbench.pick_image_point, (u, v), refine=self.subpixel.isChecked())
 
     # --- a picked point dragged (after Accept too), or clicked to select its pair ------------------------
     def _grab(self, u: float, v: float, radius_px: float) -> bool:
@@ -193,9 +169,7 @@ class CameraPane(QWidget):
             return
         self.pair_selected.emit(number)
         if moved:
-            if self.subpixel.isChecked() and self.last_frame is not None:
-                u, v = refine_subpixel(self.last_frame.image, u, v)
-            self.pair_moved.emit(number, u, v)
+            attempt(self.pick_rejected.emit, self.workbench.move_pair_pixel, number, (u, v), refine=self.subpixel.isChecked())
         self.refresh_overlay()
 
     def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
@@ -218,7 +192,24 @@ class CameraPane(QWidget):
         self.refresh_overlay()
 
     def _on_solved(self) -> None:
+        # The reprojected points and residuals are drawn at once; the CAD edges take a render, so they
+        # follow on the next turn of the event loop, after that repaint.
+        if self.workbench.session.result is None:
+            self._edges_image = None
+        else:
+            QTimer.singleShot(0, self._draw_solved_edges)
         self.refresh_overlay()
+
+    def _draw_solved_edges(self) -> None:
+        wb = self.workbench
+        r = wb.session.result
+        if r is None:
+            return
+        self.set_edges_image(self.solved_edges.render(wb.workcell.components, r.cam2world_measured, wb.session.target))
+        self.edges_drawn += 1
+
+    def close_renderer(self) -> None:
+        self.solved_edges.close()
 
     # --- which robot state the image shows ----------------------------------------------------------
     def shown_joints(self) -> np.ndarray:

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSignalBlocker, Qt
+from PySide6.QtCore import QSignalBlocker, Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -44,7 +44,11 @@ def _spin(suffix: str, limit: float, decimals: int, name: str) -> QDoubleSpinBox
 
 
 class CellPanel(QWidget):
-    """``report(text)`` shows an error; ``attempt(fn, *args)`` runs an action through the window's error boundary."""
+    """``attempt(fn, *args)`` runs an action through the window's error boundary.
+    ``feature_mode_changed(component or None)``: features of that component are named by clicking
+    in the virtual camera (``None``: not any more)."""
+
+    feature_mode_changed = Signal(object)
 
     def __init__(self, workbench: Workbench, attempt, parent=None):
         super().__init__(parent)
@@ -126,6 +130,8 @@ class CellPanel(QWidget):
         self.add_task.clicked.connect(lambda: self._attempt(self.add_task_location))
         self.save.clicked.connect(lambda: self._attempt(self.workbench.editor.save))
         workbench.scene_changed.connect(self._sync)
+        self.pick_features.toggled.connect(self._feature_mode)
+        self.component.currentTextChanged.connect(lambda _: self._feature_mode(self.picking_features))
         self._sync()
         self.fill_current_pose()
 
@@ -179,6 +185,9 @@ class CellPanel(QWidget):
         wb.editor.add_task_location(name, T, self.task_approach.value())
         self.task_name.clear()
         wb.message.emit(f"task location {name} added")
+
+    def _feature_mode(self, on: bool) -> None:
+        self.feature_mode_changed.emit(self.component.currentText() if on else None)
 
     @property
     def picking_features(self) -> bool:

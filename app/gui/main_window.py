@@ -20,7 +20,6 @@ from app.gui.replay_bar import ReplayBar
 from app.gui.results_panel import ResultsPanel
 from app.gui.file_menu import FileMenu
 from app.gui.found_points import FindPoints
-from app.gui.solved_edges import SolvedEdges
 from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
 from app.gui.robot_panel import RobotPanel
@@ -29,8 +28,6 @@ from app.gui.window_layout import restore_layout, save_layout
 from app.gui.workbench import Workbench
 from app.gui.store_correction import store_with_consent
 from calib_core.operator.move_preview import MoveNeedsConfirmation
-from calib_core.robot import solve_ik
-from calib_core.errors import OperatorError
 
 
 VIRTUAL_EVERY_TICKS = 2  # the virtual camera follows a moving robot at 10 fps, the overview at 20
@@ -60,9 +57,7 @@ class MainWindow(QMainWindow):
             self.commands.addTab(scroll, title)
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0
-        self.solved_edges = SolvedEdges(workbench.intrinsics)
         self.worker: FrameWorker | None = None
-        self.edges_drawn = 0
         self._build_layout()
         self._build_menus()
         self._build_status()
@@ -148,10 +143,10 @@ class MainWindow(QMainWindow):
         wb = self.workbench
         c = self.commands
         self.report = guarded(self.show_error)
-        self.virtual.picked.connect(self.report(self._on_pick_3d))
-        self.camera.picked.connect(self.report(self._on_pick_2d))
+        self.virtual.pick_rejected.connect(self.show_error)
+        self.virtual.feature_picked.connect(self.report(self.cell_panel.feature_clicked))
+        self.cell_panel.feature_mode_changed.connect(self.virtual.set_feature_component)
         self.camera.pick_rejected.connect(self.show_error)
-        self.camera.pair_moved.connect(self.report(lambda number, u, v: wb.move_pair_pixel(number, (u, v))))
         self.camera.pair_selected.connect(self.table.select_number)
         self.virtual.pair_selected.connect(self.table.select_number)
         c.accept.clicked.connect(self._accept)
@@ -178,8 +173,6 @@ class MainWindow(QMainWindow):
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self._add_location))
         c.live.toggled.connect(self._live_toggled)
-        self.cell_panel.pick_features.toggled.connect(self._feature_mode)
-        self.cell_panel.component.currentTextChanged.connect(lambda _: self._feature_mode(self.cell_panel.picking_features))
         self.results.candidate_chosen.connect(self.report(self._choose_candidate))
         wb.arm.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
@@ -190,7 +183,6 @@ class MainWindow(QMainWindow):
         wb.session.undo.changed.connect(self._update_actions)
         wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
         wb.session.corrections.changed.connect(lambda task: self.commands.show_corrections(wb.session.corrections))
-        wb.session.changed.connect(self._after_solve)
         self.finder = FindPoints(self)
         self._update_actions()
 
@@ -217,11 +209,6 @@ class MainWindow(QMainWindow):
         self.commands.approach.setValue(task.approach_mm)
         self.commands.approach.blockSignals(False)
 
-    def _feature_mode(self, on: bool) -> None:
-        """While features are named by clicking, the virtual camera picks on the chosen component."""
-        self.virtual.feature_component = self.cell_panel.component.currentText() if on else None
-        self.virtual.refresh()
-
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
             self.worker.paused = not on
@@ -238,16 +225,6 @@ class MainWindow(QMainWindow):
     def show_error(self, text: str) -> None:
         self.results.show_error(text)
         self.statusBar().showMessage(text, 15000)
-
-    def _on_pick_3d(self, hit) -> None:
-        if self.cell_panel.picking_features:
-            self.cell_panel.feature_clicked(hit, self.workbench.model_cam2world(), self.virtual.intrinsics.fu)
-            return
-        number = self.workbench.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
-        self.statusBar().showMessage(f"pair {number}: now pick {hit.feature or 'the point'} on the camera image", 8000)
-
-    def _on_pick_2d(self, u: float, v: float) -> None:
-        self.workbench.pick_image_point((u, v))
 
     def _choose_candidate(self, index: int) -> None:
         self.workbench.choose_candidate(index)
@@ -301,15 +278,9 @@ class MainWindow(QMainWindow):
             self.statusBar().showMessage(f"{exc}: press Move in the overview to send it", 15000)
 
     def _animate(self) -> None:
-        wb = self.workbench
-        if wb.task is None:
-            raise OperatorError("choose a task location")
-        goal = solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg).q_deg
-        start = wb.joints_deg.copy()
-        margin = np.minimum(goal - wb.robot.lower_limits_deg, wb.robot.upper_limits_deg - goal)
-        warn = [f"joint {i + 1} within {m:.1f} deg of its limit" for i, m in enumerate(margin) if m < 10.0]
-        self.commands.sim_status.setText("; ".join(warn) if warn else f"path to {wb.task.name}: joints within limits")
-        self.overview.play_path([start + (goal - start) * (k / 30) for k in range(31)])
+        path = self.workbench.simulate_approach()
+        self.commands.sim_status.setText(path.text)
+        self.overview.play_path(list(path.joints_deg))
 
     def _add_location(self, name: str | None = None) -> None:
         wb = self.workbench
@@ -335,24 +306,7 @@ class MainWindow(QMainWindow):
             self.virtual.refresh_if_moved()
         self.overview.refresh()
 
-    def _after_solve(self) -> None:
-        r = self.workbench.session.result
-        if r is None:
-            self.camera.set_edges_image(None)
-            return
-        # The reprojected points and residuals are drawn at once (the camera pane hears the session); the CAD
-        # edges take a render, so they follow on the next turn of the event loop, after that repaint.
-        QTimer.singleShot(0, self._draw_solved_edges)
-
-    def _draw_solved_edges(self) -> None:
-        r = self.workbench.session.result
-        if r is None:
-            return
-        self.camera.set_edges_image(self.solved_edges.render(self.workbench.workcell.components, r.cam2world_measured, self.workbench.session.target))
-        self.edges_drawn += 1
-
     def _camera_model_changed(self) -> None:
-        self.solved_edges.set_intrinsics(self.workbench.intrinsics)
         self.overview.mark_dirty()
 
     def _pairs_changed(self, event: str, number) -> None:
@@ -389,6 +343,6 @@ class MainWindow(QMainWindow):
             self.worker.stop()
         self.virtual.close_renderer()
         self.overview.renderer.close()
-        self.solved_edges.close()
+        self.camera.close_renderer()
         self.workbench.close()
         super().closeEvent(event)

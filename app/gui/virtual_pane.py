@@ -7,6 +7,7 @@ import numpy as np
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
+from app.gui.error_boundary import attempt
 from app.gui.image_view import ImageView, Overlay
 from app.gui.workbench import Workbench
 from calib_core.camera.projection import project
@@ -23,11 +24,14 @@ SELECT_RADIUS_PX = 6.0  # a click this close to a pair's mark (pane pixels) sele
 
 
 class VirtualPane(QWidget):
-    """``picked(PickResult)`` when the operator picks on the target object; ``pair_selected(number)``
-    when they click a pair's mark while no pair waits for its 3D point."""
+    """A click on the target object picks a pair's 3D point in the core (``pick_rejected(text)`` when
+    it cannot); ``pair_selected(number)`` when the operator clicks a pair's mark while no pair waits for
+    its 3D point; while features are named (:meth:`set_feature_component`), ``feature_picked(hit,
+    cam2world (4, 4) mm, the pane's focal px)`` instead of a pick."""
 
-    picked = Signal(object)
     pair_selected = Signal(int)
+    pick_rejected = Signal(str)
+    feature_picked = Signal(object, object, float)
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
@@ -126,8 +130,21 @@ class VirtualPane(QWidget):
         if hit is None:
             self.info.setText(f"nothing of {target or 'the target object'} there")
             return
-        self.info.setText(f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm")
-        self.picked.emit(hit)
+        where = f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm"
+        if self.feature_component is not None:
+            self.info.setText(where)
+            self.feature_picked.emit(hit, self.workbench.model_cam2world(), self.intrinsics.fu)  # the pane's own pixels
+            return
+        attempt(self.pick_rejected.emit, self._pick, hit, where)
+
+    def _pick(self, hit: PickResult, where: str) -> None:
+        number = self.workbench.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
+        self.info.setText(f"pair {number}: {where}")
+
+    def set_feature_component(self, component: str | None) -> None:
+        """Name features by clicking on ``component`` (``None``: clicks pick pairs again)."""
+        self.feature_component = component
+        self.refresh()
 
     def close_renderer(self) -> None:
         self.renderer.close()

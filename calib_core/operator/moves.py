@@ -8,12 +8,26 @@ A mixin of :class:`~calib_core.operator.core.OperatorCore`: it uses the core's a
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from calib_core.calibration.session import CalibrationError
 from calib_core.link.link_types import MoveHandle
 from calib_core.operator.move_preview import Confirmation, MovePreview
+from calib_core.robot import solve_ik
 from calib_core.robot.collision import CollisionWorld
+
+NEAR_LIMIT_DEG = 10.0  # a simulated path's goal this close to a joint limit is worth a warning
+
+
+@dataclass(frozen=True)
+class SimulatedPath:
+    """A path the model alone follows (the robot does not move): ``joints_deg`` (n, dof) model joints
+    from the current ones to the goal, and ``text``, what the operator should know of it."""
+
+    joints_deg: np.ndarray
+    text: str
 
 
 class Moves:
@@ -52,3 +66,16 @@ class Moves:
         # at the task pose itself the tool works on the task's object: touching it is the task
         allowed = frozenset({self.task.component}) if (not approach and self.task.component) else frozenset()
         return self.move_to(target, what, wait=wait, confirmed=confirmed, allowed_contacts=allowed)
+
+    def simulate_approach(self, steps: int = 30) -> SimulatedPath:
+        """The model's path from the current joints to the task location's approach, straight in joint
+        space over ``steps`` steps (IK from the current joints), with the goal's joints near a limit named."""
+        if self.task is None:
+            raise CalibrationError("choose a task location first")
+        robot = self.robot
+        start = np.array(self.joints_deg, dtype=float)
+        goal = solve_ik(robot, self.task.approach2base, start).q_deg
+        margin = np.minimum(goal - robot.lower_limits_deg, robot.upper_limits_deg - goal)
+        near = [f"joint {robot.joint_names[i]} within {m:.1f} {robot.joint_units[i]} of its limit" for i, m in enumerate(margin) if m < NEAR_LIMIT_DEG]
+        text = "; ".join(near) if near else f"path to {self.task.name}: joints within limits"
+        return SimulatedPath(start + (goal - start) * (np.arange(steps + 1)[:, None] / steps), text)

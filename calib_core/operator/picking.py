@@ -16,6 +16,7 @@ from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.observations import HeldFrame, NotSettledError
+from calib_core.vision.corner_pick import refine_corner_pick
 
 
 class Picking:
@@ -28,28 +29,34 @@ class Picking:
         if pending is not None:
             self.session.delete(pending.number)
         self.current_pair = self.session.pick_3d(component, feature, point_world_mm)
+        self.message.emit(f"pair {self.current_pair}: now pick {feature or 'the point'} on the camera image")
         return self.current_pair
 
-    def pick_image_point(self, pixel) -> int:
+    def pick_image_point(self, pixel, *, refine: bool = False) -> int:
         """*Point*, second half: the same point on the camera image (u, v) px. Until *Accept*, a
         second click moves it. The pick is made on the held frame; the first pick of a set holds
         the newest one, and only when the robot had settled before it (else
-        :class:`~calib_core.operator.observations.NotSettledError`, nothing picked)."""
+        :class:`~calib_core.operator.observations.NotSettledError`, nothing picked). ``refine``: a
+        round feature's click moves to its rim's centre, any other to the nearest corner, on the
+        held frame."""
         session = self.session
         pending = session.pairs.pending()
         moving = pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
         if pending is None and not moving:
             session.pick_2d(pixel)  # raises with what to do instead
         view = self._view_for_pick(self.current_pair if moving else pending.number)
+        if refine:
+            pixel = self.refine_pick(self.observations.still.frame.image, pixel)
         if moving:
             session.move_2d(self.current_pair, pixel, view)
         else:
             self.current_pair = session.pick_2d(pixel, view)
         return self.current_pair
 
-    def move_pair_pixel(self, number: int, pixel) -> None:
+    def move_pair_pixel(self, number: int, pixel, *, refine: bool = False) -> None:
         """Move pair ``number``'s image point to ``pixel`` (u, v) px, after Accept too (undoable). The
-        point stays on the frame it was picked on: the robot must be shown in that state."""
+        point stays on the frame it was picked on: the robot must be shown in that state. ``refine``:
+        to the nearest corner on the frame shown (the held one, else the newest)."""
         pair = self.session.pairs.get(number)
         if pair.pixel is None:
             raise OperatorError(f"pair {number} has no image point yet: click it on the camera image")
@@ -57,6 +64,9 @@ class Picking:
         held = self.observations.still
         if view is not None and held is not None and not held.stamp.same_state(view):
             raise CalibrationError(f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move its point")
+        shown = held.frame if held is not None else self.observations.latest
+        if refine and shown is not None:
+            pixel = refine_corner_pick(shown.image, pixel)
         self.session.move_2d(number, pixel, view)
         self.record_event("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
 
@@ -100,6 +110,14 @@ class Picking:
         obj2world = self.workcell.component(self.session.target).item2world
         uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.intrinsics)[0]
         return (uv, basis) if np.all(np.isfinite(uv)) else None
+
+    def refine_pick(self, image, pixel) -> tuple[float, float]:
+        """``pixel`` (u, v) px on ``image`` refined: to the rim's centre for a round feature
+        (:meth:`refine_circle_pick`), else to the nearest corner (``cv2.cornerSubPix``)."""
+        centre = self.refine_circle_pick(image, pixel)
+        if centre is not None:
+            return float(centre[0]), float(centre[1])
+        return refine_corner_pick(image, pixel)
 
     def refine_circle_pick(self, image, pixel):
         """A click on a round feature (the waiting pair's feature is a circle in the workcell) moved to the

@@ -14,7 +14,7 @@ import trimesh
 
 from calib_core.calibration.undo import Command
 from calib_core.names import check_typed_name
-from calib_core.errors import FileFormatError, OperatorError
+from calib_core.errors import OperatorError
 from calib_core.frames import check_transform
 from calib_core.mesh_files import MESH_SCALE, load_mesh
 from calib_core.scene import SceneItem

@@ -75,7 +75,7 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     assert "OK" in win.results.verdict.text()
     # The CAD edges from the solved pose follow the points (next turn of the event loop) and lie on the
     # plate's outline: the overlay is opaque at the projected corners' neighbourhood.
-    qtbot.waitUntil(lambda: win.edges_drawn > 0, timeout=5_000)
+    qtbot.waitUntil(lambda: win.camera.edges_drawn > 0, timeout=5_000)
     edges = win.camera.view.overlay.image
     assert edges is not None and edges.shape[:2] == (wb.intrinsics.height, wb.intrinsics.width)
     for name in ("plate_top_left", "plate_bottom_right"):
@@ -231,8 +231,8 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.files.start_recording(tmp_path / "session.mcap")
     assert win.files.record_action.isChecked()
     wait_for_settled_frame(qtbot, win)  # a pick holds the newest frame: one taken with the robot settled
-    win._on_pick_3d(type("Hit", (), {"component": "oru_1_fixture", "feature": "pin_tip", "point_world_mm": (1.0, 2.0, 3.0)})())
-    win._on_pick_2d(100.0, 120.0)
+    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.pick_image_point((100.0, 120.0))
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
     qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
 

@@ -63,7 +63,7 @@ def calibrated_window(qtbot, tmp_path):
         p = apply(fixture.item2world, fixture.features[name])
         pick_pair(wb, "oru_1_fixture", name, p, project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
     win._calibrate()
-    qtbot.waitUntil(lambda: win.edges_drawn > 0, timeout=5_000)
+    qtbot.waitUntil(lambda: win.camera.edges_drawn > 0, timeout=5_000)
     win.virtual.refresh()
     win.overview.mark_dirty()
     win.overview.refresh()
