@@ -94,6 +94,7 @@ class CameraPane(QWidget):
         workbench.session.changed.connect(self._on_solved)
         workbench.arm.joints_changed.connect(self._joints_changed)
         workbench.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.workbench.intrinsics))
+        workbench.points_found.connect(self._points_found)
 
     # --- frames ---------------------------------------------------------------------------------
     @property
@@ -186,6 +187,12 @@ class CameraPane(QWidget):
         self._proposals = None if not proposals else list(proposals)
         self._proposal_joints = None if joints_deg is None else np.asarray(joints_deg, dtype=float)
         self.refresh_overlay()
+
+    def _points_found(self, found) -> None:
+        if found is None:
+            self.set_proposals(None)
+        else:
+            self.set_proposals([(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg)
 
     def set_edges_image(self, rgba: np.ndarray | None) -> None:
         self._edges_image = rgba

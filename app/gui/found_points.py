@@ -1,7 +1,7 @@
 """*Find points* in the window (F6): the core finds the target's features on the held frame; a list
 shows each proposal (feature, kind, confidence, distance from the fitted pose, and why a detector was unsure) with a check box and
 each feature not found with the reason; *Accept checked* adds the checked ones as pairs, one undo
-step. The camera pane draws the proposals while the list is open."""
+step. The camera pane draws the proposals (it hears ``points_found``) while the list is open."""
 
 from __future__ import annotations
 
@@ -96,11 +96,10 @@ class FindPoints:
 
     def show(self, found) -> None:
         window = self.window
-        window.camera.set_proposals([(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg)
         if self.dialog is not None:
             self.dialog.close()
         self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, window)
-        self.dialog.finished.connect(lambda _: window.camera.set_proposals(None))
+        self.dialog.finished.connect(lambda _: window.workbench.dismiss_found_points())  # the camera pane hides them
         self.dialog.show()
 
     def _calibrate_on_edges(self) -> bool:

@@ -47,7 +47,8 @@ class MainWindow(QMainWindow):
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
         self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
-        self.vision = VisionPanel(workbench, self.camera.set_board_corners, self.show_error, lambda send: self.move(send))
+        self.vision = VisionPanel(workbench, self.show_error, lambda send: self.move(send))
+        self.vision.board_detected.connect(self.camera.set_board_corners)
         self.robot_calibration = RobotPanel(workbench, self.show_error)
         self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
         for panel, title in ((self.vision, "Vision"), (self.robot_calibration, "Robot"), (self.cell_panel, "Cell")):

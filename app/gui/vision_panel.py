@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QVBoxLayout, QWidget
 
 from app.gui.buttons import button
@@ -29,15 +29,16 @@ from calib_core.errors import OperatorError
 
 
 class VisionPanel(QWidget):
-    """Captures take the core's newest frame (:meth:`frame_to_capture`); ``show_corners``
-    draws a detection on the camera pane; ``show_error`` puts a failed step's reason in the window;
-    progress goes to the workbench's messages (the status bar)."""
+    """Captures take the core's newest frame (:meth:`frame_to_capture`); ``board_detected(corners
+    (n, 2) px or None, text)`` tells the camera pane what to draw; ``show_error`` puts a failed step's
+    reason in the window; progress goes to the workbench's messages (the status bar)."""
 
-    def __init__(self, workbench, show_corners: Callable, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
+    board_detected = Signal(object, str)
+
+    def __init__(self, workbench, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
         super().__init__(parent)
         self.workbench = workbench
         self._move = move or (lambda send: send(False))  # the window previews and confirms moves
-        self._show_corners = show_corners
         self._report = workbench.message.emit
         guard = guarded(show_error)
         self.capture: BoardCapture | None = None
@@ -155,10 +156,10 @@ class VisionPanel(QWidget):
         joints = None if stamp is None else np.array(stamp.joints_deg)
         view = self.capture.add(frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s))
         if isinstance(view, RejectedView):
-            self._show_corners(None, "")
+            self.board_detected.emit(None, "")
             self._report(f"{view.name} rejected: {view.reason}")
         else:
-            self._show_corners(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
+            self.board_detected.emit(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
             lost = views_with_lost_corners([len(v.ids) for v in self.capture.views]).get(len(self.capture.views) - 1)
             self._report(f"{view.name}: {len(view.ids)} corners" + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
                          + ("" if lost is None else f"; it lost corners against its neighbours ({lost:.0f}): look at it, remove it if the board was cut off or blurred"))

@@ -46,7 +46,7 @@ from calib_core.workcell import TaskLocation
 class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring, CorrectionDesk):
     """Events (psygnal): ``message(text)`` (for a status line), ``solved()``, ``task_changed(name)``,
     ``camera_model_changed()``, ``scene_changed()``, ``correction_stored(correction)``,
-    ``event(kind, detail)`` (operator actions and link changes worth recording), ``points_found(found)``.
+    ``event(kind, detail)`` (operator actions and link changes worth recording), ``points_found(found)`` (``None``: the proposals withdrawn).
     The arm's events (joints, samples, the link, moves) are :attr:`arm`'s; frames and the held one
     :attr:`observations`'."""
 

@@ -55,6 +55,11 @@ class PointFinding:
         self.message.emit(result.message)
         return self.found
 
+    def dismiss_found_points(self) -> None:
+        """The proposals are no longer on offer (their list closed): ``points_found(None)``. The last
+        ones stay in :attr:`found` for *Calibrate on edges* and the recording."""
+        self.points_found.emit(None)
+
     def modelled_view(self, q_deg, item):
         """What the modelled camera at joints ``q_deg`` sees of ``item`` (the modelled cell, the robot
         and what is put up in it), for Find points' checks against the image."""

@@ -142,6 +142,8 @@ class RecordingTap:
 
     def _found(self, found) -> None:
         """Find points' proposals and its edge fit's edge points, on the frame they were found on."""
+        if found is None:
+            return  # the proposals withdrawn from the view: the recording keeps them
         t_ns = self.recorder.unix_ns(found.view.t_capture_s)
         edges = found.result.edges.edges_px if found.result.edges is not None and found.result.edges.settled else None
         self.recorder.record_message(FOUND_TOPIC, fm.found_points_annotations([(p.feature, p.uv_px) for p in found.result.proposals], t_ns, edges))
