@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from PySide6.QtCore import QSignalBlocker
+from PySide6.QtCore import QSignalBlocker, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -19,12 +19,18 @@ from PySide6.QtWidgets import (
 )
 
 from app.gui.buttons import button
+from app.gui.error_boundary import attempt
 from app.gui.workbench import Workbench
 
 
 
 class CommandPanel(QTabWidget):
-    """Buttons only: the main window connects them to actions."""
+    """The panel binds what only sets the session or the task to the core itself (target, solve options,
+    task location and its approach, Clear) and shows what they hold; the actions that need the window
+    (moves with their confirmation, dialogs, the status bar) are connected by the main window.
+    ``error(text)``: a setting the core refused, and why."""
+
+    error = Signal(str)
 
     def __init__(self, workbench: Workbench, parent=None):
         super().__init__(parent)
@@ -138,6 +144,40 @@ class CommandPanel(QTabWidget):
         self.setCurrentIndex(2)
         workbench.task_changed.connect(self._sync_tasks)
         workbench.scene_changed.connect(self._sync_targets)
+        self._bind(workbench)
+
+    def _bind(self, wb: Workbench) -> None:
+        def run(fn, *args):
+            attempt(self.error.emit, fn, *args)
+
+        self.clear.clicked.connect(lambda: run(wb.session.clear))
+        self.target.currentTextChanged.connect(lambda name: run(wb.session.set_target, name))
+        self.estimate_focal.toggled.connect(lambda on: run(wb.session.set_option, "estimate_focal", on))
+        self.robust.toggled.connect(lambda on: run(wb.session.set_option, "robust", on))
+        wb.session.option_changed.connect(self.show_option)  # an undo sets the box back
+
+        def task_chosen(name: str) -> None:
+            if name:
+                run(wb.set_task, name)
+
+        def approach_edited(mm: float) -> None:
+            if wb.task is not None:
+                run(wb.set_task_approach, wb.task.name, mm)
+
+        self.tasks.currentTextChanged.connect(task_chosen)
+        self.approach.valueChanged.connect(approach_edited)
+        wb.task_changed.connect(self._show_task)
+        if wb.task is not None:
+            self._show_task(wb.task.name)
+        wb.session.corrections.changed.connect(lambda task: self.show_corrections(wb.session.corrections))
+
+    def _show_task(self, name: str) -> None:
+        """The approach box shows the chosen task location's approach distance (without sending it back)."""
+        task = self.workbench.task
+        if task is None or task.name != name:
+            return
+        with QSignalBlocker(self.approach):
+            self.approach.setValue(task.approach_mm)
 
     def show_option(self, name: str, value: bool) -> None:
         """A solve option changed in the session (a click, an undo): the box shows it without sending it back."""

@@ -152,20 +152,11 @@ class MainWindow(QMainWindow):
         self.virtual.pair_selected.connect(self.table.select_number)
         c.accept.clicked.connect(self._accept)
         c.delete.clicked.connect(self._delete)
-        c.clear.clicked.connect(self.report(lambda: wb.session.clear()))
         c.undo.clicked.connect(self._undo)
         c.redo.clicked.connect(self._redo)
         c.calibrate.clicked.connect(self._calibrate)
         c.store.clicked.connect(self._store)
-        c.target.currentTextChanged.connect(self.report(lambda name: wb.session.set_target(name)))
-        c.estimate_focal.toggled.connect(lambda on: self.report(wb.session.set_option)("estimate_focal", on))
-        c.robust.toggled.connect(lambda on: self.report(wb.session.set_option)("robust", on))
-        wb.session.option_changed.connect(c.show_option)  # an undo sets the box back
-        c.tasks.currentTextChanged.connect(self.report(self._task_selected))
-        c.approach.valueChanged.connect(self.report(self._approach_edited))
-        wb.task_changed.connect(self._show_task)
-        if wb.task is not None:
-            self._show_task(wb.task.name)
+        c.error.connect(self.show_error)
         c.go_approach.clicked.connect(lambda: self._go(approach=True))
         c.go_task.clicked.connect(lambda: self._go(approach=False))
         c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
@@ -177,13 +168,10 @@ class MainWindow(QMainWindow):
         self.results.candidate_chosen.connect(self.report(self._choose_candidate))
         wb.arm.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
-        wb.camera_model_changed.connect(self._camera_model_changed)
-        wb.arm.link_state.connect(self.status_line.show_link_state)
         wb.arm.move_finished.connect(self._move_finished)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         wb.session.undo.changed.connect(self._update_actions)
         wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
-        wb.session.corrections.changed.connect(lambda task: self.commands.show_corrections(wb.session.corrections))
         self.finder = FindPoints(self)
         self._update_actions()
 
@@ -192,23 +180,6 @@ class MainWindow(QMainWindow):
             self.show_error(f"move to {what} failed: {error}")
         else:
             self.statusBar().showMessage(f"arrived at {what}", 8000)
-
-    def _task_selected(self, name: str) -> None:
-        if name:
-            self.workbench.set_task(name)
-
-    def _approach_edited(self, value_mm: float) -> None:
-        task = self.workbench.task
-        if task is not None:
-            self.workbench.set_task_approach(task.name, value_mm)
-
-    def _show_task(self, name: str) -> None:
-        task = self.workbench.task
-        if task is None or task.name != name:
-            return
-        self.commands.approach.blockSignals(True)
-        self.commands.approach.setValue(task.approach_mm)
-        self.commands.approach.blockSignals(False)
 
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
@@ -306,9 +277,6 @@ class MainWindow(QMainWindow):
             self._joints_dirty = False
             self.virtual.refresh_if_moved()
         self.overview.refresh()
-
-    def _camera_model_changed(self) -> None:
-        self.overview.mark_dirty()
 
     def _pairs_changed(self, event: str, number) -> None:
         self._update_actions()

@@ -116,6 +116,7 @@ class OverviewPane(QWidget):
         self._path_timer.timeout.connect(self._path_step)
         workbench.session.changed.connect(self.mark_dirty)
         workbench.scene_changed.connect(self.mark_dirty)
+        workbench.camera_model_changed.connect(self.mark_dirty)
         workbench.session.pairs.changed.connect(lambda *_: self.mark_dirty())
         workbench.arm.move_previewed.connect(lambda preview: self.show_preview(preview))
         workbench.arm.motion_changed.connect(self._motion_changed)

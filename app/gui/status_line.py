@@ -36,6 +36,7 @@ class StatusLine:
         for w in (self.motion_label, self.settled_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
             bar.addPermanentWidget(w)
         workbench.arm.motion_changed.connect(self.show_motion)
+        workbench.arm.link_state.connect(self.show_link_state)
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
         self.timer = QTimer(parent)
         self.timer.setInterval(1000)
