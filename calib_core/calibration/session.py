@@ -61,6 +61,32 @@ class SolveContext:
     :class:`~calib_core.calibration.view_stamp.ViewStamp`)."""
 
 
+def _shared(context: SolveContext | None, obj2cam):
+    """The result's covariance (6, 6) from the image points' shared error, or None when the solve's
+    points or camera are not known."""
+    if context is None or context.points_obj_mm is None or context.intrinsics is None:
+        return None
+    return shared_shift_covariance(obj2cam, context.points_obj_mm, context.intrinsics)
+
+
+class _ShowResult(Command):
+    """A solve: the session's result becomes ``solved`` (a :meth:`CalibrationSession.result_snapshot`);
+    undo puts back the result it replaced, redo the solve's (not solved again)."""
+
+    def __init__(self, session: "CalibrationSession", solved: tuple, label: str):
+        self.session = session
+        self.before = session.result_snapshot()
+        self.solved = solved
+        self.label = label
+
+    # The verdict is judged again on each: the task, and with it the tolerance, may have changed since.
+    def do(self) -> None:
+        self.session.restore_result(self.solved[:3])
+
+    def undo(self) -> None:
+        self.session.restore_result(self.before[:3])
+
+
 class ChooseCandidate(Command):
     """Take candidate ``index`` of an ambiguous solve as the answer."""
 
@@ -180,32 +206,32 @@ class CalibrationSession:
         with named_points("pair", numbers):  # messages name pairs by the numbers the table shows
             solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
-        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics)
+        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics,
+                                label=f"Calibrate ({len(numbers)} pairs)")
 
     def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int], *,
-                    points_obj_mm=None, intrinsics: Intrinsics | None = None, view_sources: tuple[str, ...] | None = None) -> EndEffectorEstimate:
-        """Show a solve made elsewhere (a recording's) as this session's result, as if calibrated here.
-        With the solve's ``points_obj_mm`` (m, 3, the target's frame) and ``intrinsics`` the result's
-        covariance carries the image points' shared error
-        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`). ``view_sources``: where
-        the look's frames came from (default: the used pairs' stamps)."""
+                    points_obj_mm=None, intrinsics: Intrinsics | None = None, view_sources: tuple[str, ...] | None = None,
+                    label: str | None = None) -> EndEffectorEstimate:
+        """Make ``solution`` this session's result. With a ``label`` it is an operator's solve: one
+        command on the undo stack (undo brings the previous result back); without, a solve shown from
+        elsewhere (a recording being replayed), which is not an edit. With the solve's
+        ``points_obj_mm`` (m, 3, the target's frame) and ``intrinsics`` the result's covariance
+        carries the image points' shared error
+        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`). ``view_sources``:
+        where the look's frames came from (default: the used pairs' stamps)."""
         used = [p for p in self.pairs if p.number in set(numbers)]
         points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
         if view_sources is None:
             view_sources = tuple(sorted({p.view.source for p in used if p.view is not None})) or ("live",)
-        self._context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
-                                     points, intrinsics, tuple(view_sources))
-        self.result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=self._shared(solution.obj2cam))
-        self.chosen_candidate = 0
-        self.verdict = self._judge(self.result)
-        self._changed()
-        return self.result
-
-    def _shared(self, obj2cam):
-        c = self._context
-        if c is None or c.points_obj_mm is None or c.intrinsics is None:
-            return None
-        return shared_shift_covariance(obj2cam, c.points_obj_mm, c.intrinsics)
+        context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
+                               points, intrinsics, tuple(view_sources))
+        result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=_shared(context, solution.obj2cam))
+        solved = (result, context, 0, self._judge(result))
+        if label is None:
+            self.restore_result(solved)
+        else:
+            self.undo.push(_ShowResult(self, solved, label))
+        return result
 
     def _judge(self, estimate) -> ResultVerdict:
         return (self.judge or judge)(estimate)
@@ -266,7 +292,7 @@ class CalibrationSession:
         c = self._context
         obj2cam = candidates[index].obj2cam if candidates else None
         self.result = end_effector_from_solution(self.result.solution, c.obj2world, c.cam2world_model, c.tcp2base_model, obj2cam,
-                                                 shared_covariance=self._shared(self.result.solution.obj2cam if obj2cam is None else obj2cam))
+                                                 shared_covariance=_shared(c, self.result.solution.obj2cam if obj2cam is None else obj2cam))
         self.chosen_candidate = index
         self.verdict = self._judge(self.result)
         self._changed()

@@ -93,7 +93,7 @@ class PointFinding:
         self.current_pair = None
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
         estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.intrinsics,
-                                          view_sources=(found.view.source,))
+                                          view_sources=(found.view.source,), label="Calibrate on edges")
         self.solved.emit()
         return estimate
 

@@ -87,6 +87,16 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     OUTPUT.mkdir(exist_ok=True)
     win.grab().save(str(OUTPUT / "window_after_calibration.png"))
 
+    # The solve is an edit like the picks: Undo takes it (and its edges) back, Redo shows the same answer.
+    assert win.undo_action.text() == f"&Undo Calibrate ({len(FEATURES)} pairs)"
+    qtbot.mouseClick(win.commands.undo, Qt.MouseButton.LeftButton)
+    assert wb.session.result is None and win.camera.view.overlay.image is None
+    assert "OK" not in win.results.verdict.text()
+    drawn = win.camera.edges_drawn
+    qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
+    assert wb.session.result is result and "OK" in win.results.verdict.text()
+    qtbot.waitUntil(lambda: win.camera.edges_drawn > drawn, timeout=5_000)
+
     # Store the correction, undo it, redo it.
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     assert wb.session.corrections.latest(wb.task.name) is not None

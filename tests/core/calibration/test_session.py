@@ -112,6 +112,32 @@ def test_undo_redo_and_workflow_errors(bed):
         s.calibrate(bed.intrinsics, np.eye(4), np.eye(4), np.eye(4))
 
 
+def test_a_solve_is_one_undo_step_that_puts_the_previous_result_back(bed):
+    """Calibrate is a command: undo shows the result it replaced (none before the first solve), redo the
+    solve's own answer (not solved again), and the verdict is judged anew each time."""
+    q = solve_ik(bed.model_robot, bed.workcell.task("oru_1_grasp").approach2base, bed.workcell.home_joints_deg).q_deg
+    s = CalibrationSession()
+    s.set_target("oru_1_fixture")
+    _pick_all(s, bed, q, names=FEATURES[:5], seed=1)
+    first = _calibrate(s, bed, q)
+    assert s.undo.undo_label == "Calibrate (5 pairs)"
+    _pick_all(s, bed, q, names=FEATURES[5:], seed=2)
+    second = _calibrate(s, bed, q)
+    assert s.result is second and s.solved_numbers == list(range(1, 10))
+    changes = []
+    s.changed.connect(lambda: changes.append(s.result))
+    assert s.undo.undo() == "Calibrate (9 pairs)"
+    assert s.result is first and s.solved_numbers == [1, 2, 3, 4, 5] and changes == [first]
+    assert s.stale_reason is not None and "6, 7, 8, 9" in s.stale_reason  # the first answer, told apart from the pairs on screen
+    s.undo.redo()
+    assert s.result is second and s.verdict is not None and s.stale_reason is None
+    for _ in range(9):  # the second solve and the second look's four pairs (3D and 2D each)
+        s.undo.undo()
+    assert s.undo.undo_label == "Calibrate (5 pairs)"
+    s.undo.undo()
+    assert s.result is None and s.verdict is None and s.solved_numbers == []
+
+
 def test_listeners_hear_every_change():
     s = CalibrationSession()
     events = []
