@@ -71,3 +71,42 @@ def test_headless_commands_do_not_load_qt():
     code = "import sys, app.cli.main as m; m.main(['table1', '--json']); print('PySide6' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert out.stdout.strip().endswith("False")
+
+
+_POSE_CALLS = {"invert", "inv", "fk", "frame_placement", "make_transform", "delta_transform", "transform_from_xyz_rpy", "concat"}
+
+
+def _is_pose(node: ast.AST) -> bool:
+    """A 4 x 4 pose by its name (``a2b``, ``item.item2world``) or by the function that makes one."""
+    import re
+
+    if isinstance(node, ast.Name | ast.Attribute):
+        name = node.id if isinstance(node, ast.Name) else node.attr
+        return re.fullmatch(r"[a-z_]*[a-z]2[a-z][a-z_]*", name) is not None
+    if isinstance(node, ast.Call):
+        f = node.func
+        return (f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else "") in _POSE_CALLS
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
+        return _is_pose(node.left) or _is_pose(node.right)
+    return False
+
+
+def _bare_compositions(source: str, filename: str) -> list[str]:
+    tree = ast.parse(source, filename=filename)
+    return [
+        f"{filename}:{node.lineno}: {ast.unparse(node)}"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult) and _is_pose(node.left) and _is_pose(node.right)
+    ]
+
+
+def test_poses_are_composed_with_concat_and_invert():
+    # concat(a2b, b2c) reads in the order the frames chain; ``b2c @ a2b`` reads backwards, and a wrong order still runs.
+    assert len(_bare_compositions("x = invert(cam2world) @ obj2world\ny = concat(obj2world, invert(cam2world)) @ p", "probe")) == 1
+    offenders = [
+        hit
+        for package in ("calib_core", "app", "videocal_sim")
+        for p in sorted((ROOT / package).rglob("*.py"))
+        for hit in _bare_compositions(p.read_text(), str(p.relative_to(ROOT)))
+    ]
+    assert offenders == [], "\n".join(offenders)

@@ -19,7 +19,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
-from calib_core.frames import make_transform
+from calib_core.frames import concat, make_transform
 from videocal_sim.test_bed import TestBed
 from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import Workcell, load_workcell
@@ -70,6 +70,6 @@ def cold_test_bed(workcell: Workcell | None = None, seed: int = 0) -> tuple[Test
         d = rng.uniform(-1.0, 1.0, 3)
         d *= rng.uniform(0.0, SURVEY_MM) / max(np.linalg.norm(d), 1e-9)
         survey[item.name] = d
-        moved.append(replace(item, item2world=make_transform(np.eye(3), d) @ item.item2world))
+        moved.append(replace(item, item2world=concat(item.item2world, make_transform(np.eye(3), d))))
     bed.true_components = moved
     return bed, ColdTruth(intrinsics, errors, survey)

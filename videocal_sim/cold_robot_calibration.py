@@ -12,7 +12,7 @@ import pinocchio as pin
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
-from calib_core.frames import invert, pose_difference
+from calib_core.frames import concat, invert, pose_difference
 from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCalibration, pose_covariance
 from calib_core.robot_calibration.identify_robot import identify_robot
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
@@ -165,7 +165,7 @@ def truth_in_model_parameters(bed) -> np.ndarray:
         P = _to_mm(nominal.model.jointPlacements[j])
         T = _to_mm(true.robot.model.jointPlacements[j]) @ np.linalg.inv(P) @ _to_mm(data.liMi[j])
         if j == 1:  # the base's error is the first joint's: the survey is in the base frame
-            T = np.linalg.inv(root2base) @ true.base_true2base_model @ root2base @ T
+            T = concat(T, root2base, true.base_true2base_model, invert(root2base))
         p[layout.joint_block(j - 1)] = delta_of(T @ np.linalg.inv(P))
     Pc, Tc = nominal.frame_placement("camera"), true.robot.frame_placement("camera")
     p[layout.camera_block] = delta_of(Tc @ np.linalg.inv(Pc))

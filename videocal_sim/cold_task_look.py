@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from calib_core.calibration.end_effector import end_effector_from_solution, shared_shift_covariance
-from calib_core.frames import invert, pose_difference
+from calib_core.frames import concat, invert, pose_difference
 from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
 from calib_core.robot.visuals import RobotVisuals
@@ -53,7 +53,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     try:
         image = camera.read().image
         cam2world_model = robot.fk(q_approach, "camera")
-        obj2cam_model = invert(cam2world_model) @ item.item2world
+        obj2cam_model = concat(item.item2world, invert(cam2world_model))
         expected = view.of_cell(cell.components, RobotVisuals.from_robot(robot), q_approach, item.item2world)
         found = find_points(image, intrinsics, item, obj2cam_model, expected=expected)
     finally:
@@ -61,7 +61,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         view.close()
     out = {"task": task.name, "looked_from": from_where, "found": bool(found.edges is not None and found.edges.settled), "message": found.message}
     true_item = next((c for c in bed.true_components or () if c.name == item.name), item)
-    task_true = true_item.item2world @ invert(item.item2world) @ task.tcp2base
+    task_true = concat(task.tcp2base, invert(item.item2world), true_item.item2world)
 
     def error(q):
         d, r = pose_difference(bed.true_robot.fk(q, "tcp"), task_true)
@@ -76,7 +76,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
     estimate = end_effector_from_solution(solution, item.item2world, cam2world_model, robot.fk(q_approach, "tcp"),
                                           shared_covariance=shared_shift_covariance(solution.obj2cam, features, intrinsics))
-    q_task = solve_ik(robot, invert(estimate.delta_base) @ task.tcp2base, q_approach).q_deg
+    q_task = solve_ik(robot, concat(task.tcp2base, invert(estimate.delta_base)), q_approach).q_deg
     d, r, after = error(q_task)
     tool_covariance = tool.covariance_in_base(cam2world_model) if tool is not None else None
     look_std = np.sqrt(np.diag(estimate.covariance + tool_covariance)) if tool_covariance is not None and estimate.covariance is not None else None
@@ -92,7 +92,7 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         from calib_core.calibration.look_fusion import fuse_look
 
         fused = fuse_look(estimate, model_covariance(q_approach), placement_sigma_mm=placement_sigma_mm)
-        q_fused = solve_ik(robot, invert(fused.delta_base) @ task.tcp2base, q_approach).q_deg
+        q_fused = solve_ik(robot, concat(task.tcp2base, invert(fused.delta_base)), q_approach).q_deg
         d, r, after = error(q_fused)
         s = np.sqrt(np.diag(fused.covariance if tool_covariance is None else fused.covariance + tool_covariance))
         out["fused"] = {

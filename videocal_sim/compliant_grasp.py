@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.frames import invert, make_transform
+from calib_core.frames import concat, invert, make_transform
 from calib_core.robot import solve_ik
 from videocal_sim.sim_camera import SimulatedCamera
 from videocal_sim.test_bed import TestBed
@@ -31,13 +31,13 @@ def grasp_joints(bed: TestBed, tcp2base: np.ndarray, seed: int = 0, component: s
     if component is not None and bed.true_components is not None:
         true_item = next((c for c in bed.true_components if c.name == component), None)
         if true_item is not None:
-            on_pin = true_item.item2world @ invert(bed.workcell.component(component).item2world) @ surveyed
-    target = make_transform(np.eye(3), off) @ on_pin
+            on_pin = concat(surveyed, invert(bed.workcell.component(component).item2world), true_item.item2world)
+    target = concat(on_pin, make_transform(np.eye(3), off))
     true = bed.true_robot
     # TrueRobot.fk(q) = base_true2base_model . robot.fk(q + offsets): solve on its robot, then undo the offsets.
     start = np.asarray(bed.workcell.home_joints_deg, dtype=float)
     seed_q = solve_ik(bed.model_robot, surveyed, start).q_deg
-    q_true = solve_ik(true.robot, invert(true.base_true2base_model) @ target, seed_q + true.joint_offsets).q_deg
+    q_true = solve_ik(true.robot, concat(target, invert(true.base_true2base_model)), seed_q + true.joint_offsets).q_deg
     return q_true - true.joint_offsets
 
 

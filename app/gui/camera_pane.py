@@ -15,7 +15,7 @@ from app.gui.workbench import Workbench
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.camera.projection import project_points
 from calib_core.errors import OperatorError
-from calib_core.frames import apply, invert
+from calib_core.frames import apply, concat, invert
 
 PICK_COLOR = QColor(255, 214, 10)
 PENDING_COLOR = QColor(255, 140, 0)
@@ -289,7 +289,7 @@ class CameraPane(QWidget):
         self.view.set_overlay(overlay)
 
     def _draw_result(self, overlay: Overlay, session, result) -> None:
-        obj2cam = invert(result.cam2world_measured) @ result.obj2world
+        obj2cam = concat(result.obj2world, invert(result.cam2world_measured))
         used = set(session.solved_numbers)
         for pair in session.pairs:
             if pair.pixel is None or pair.number not in used:

@@ -18,7 +18,7 @@ from app.gui.buttons import button
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.camera.intrinsics_io import save_intrinsics
-from calib_core.frames import pose_difference
+from calib_core.frames import concat, invert, pose_difference
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.hand_eye import HandEyeCalibration
@@ -213,7 +213,7 @@ class VisionPanel(QWidget):
     def calibrate_hand_eye(self) -> None:
         intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
         r = self.hand_eye_result = self.capture.calibrate_hand_eye(self.workbench.robot, intrinsics)
-        modelled = np.linalg.inv(self.workbench.robot.frame_placement("flange")) @ self.workbench.robot.frame_placement("camera")
+        modelled = concat(self.workbench.robot.frame_placement("camera"), invert(self.workbench.robot.frame_placement("flange")))
         d, rot = pose_difference(r.cam2flange, modelled)
         lines = [
             f"<b>Camera mounting</b> from {r.views} poses, RMS {r.rms_px:.3f} px",

@@ -100,4 +100,4 @@ class CorrectionTable:
         """The pose (4, 4) mm to command through the model so the real TCP reaches ``target2base``:
         ``Δ^-1 @ target``, with ``Δ`` the latest correction (the target itself when there is none)."""
         c = self.latest(task)
-        return target2base.copy() if c is None else invert(c.delta_base) @ target2base
+        return target2base.copy() if c is None else concat(target2base, invert(c.delta_base))

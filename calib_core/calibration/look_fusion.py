@@ -19,7 +19,7 @@ from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
 from calib_core.calibration.end_effector import EndEffectorEstimate
-from calib_core.frames import invert, make_transform
+from calib_core.frames import concat, invert, make_transform
 
 AGREEMENT = 0.9973
 """The look and the model agree when their difference lies within this share of both covariances
@@ -81,5 +81,5 @@ def fuse_look(look: EndEffectorEstimate, model_covariance: np.ndarray, placement
                    f"{np.linalg.norm(x[3:]):.4f} deg): not used; look again or pick the points by hand")
     tcp = look.tcp2base_model
     R = Rotation.from_rotvec(np.radians(fused[3:])).as_matrix() @ tcp[:3, :3]
-    delta = make_transform(R, tcp[:3, 3] + fused[:3]) @ invert(tcp)
+    delta = concat(invert(tcp), make_transform(R, tcp[:3, 3] + fused[:3]))
     return FusedCorrection(fused[:3], fused[3:], cov, weight, m2, bool(agree), delta, message)

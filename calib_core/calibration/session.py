@@ -20,7 +20,7 @@ from calib_core.calibration.undo import Command, UndoStack
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
-from calib_core.frames import apply, invert
+from calib_core.frames import apply, concat, invert
 from calib_core.recording.replay import solve_inputs
 from calib_core.solver.solution import SolveStatus
 
@@ -199,7 +199,7 @@ class CalibrationSession:
             raise CalibrationError(f"{len(use)} complete pairs; calibrating needs {self.required_pairs}{' (focal lengths are estimated)' if self.estimate_focal else ''}")
         points_world, pixels, numbers = self.pairs.arrays()
         points_obj = apply(invert(obj2world), points_world)
-        prior = invert(cam2world_model) @ obj2world
+        prior = concat(obj2world, invert(cam2world_model))
         from calib_core.solver.errors import named_points
         from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on the first solve
 
@@ -333,7 +333,7 @@ class CalibrationSession:
         measured, d, rv, std_d, std_r = r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
         if fused is not None and fused.agree:
             std = np.sqrt(np.clip(np.diag(fused.covariance), 0.0, None))
-            measured, d, rv, std_d, std_r = fused.delta_base @ r.tcp2base_model, fused.displacement_mm, fused.rotation_deg, std[:3], std[3:]
+            measured, d, rv, std_d, std_r = concat(r.tcp2base_model, fused.delta_base), fused.displacement_mm, fused.rotation_deg, std[:3], std[3:]
             source += f"; {fused.message}"
         else:
             if fused is not None:

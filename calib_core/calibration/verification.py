@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from calib_core.frames import pose_difference
+from calib_core.frames import concat, pose_difference
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM
 
 
@@ -75,7 +75,7 @@ def verify(task: str, target2base: np.ndarray, correction, look, tolerance_mm: f
     ``look``: the :class:`~calib_core.calibration.end_effector.EndEffectorEstimate` from the corrected
     joints (look 2); ``target2base`` (4, 4) mm the task location; ``tolerance_mm`` the task's."""
     remaining, rotation = pose_difference(look.tcp2base_measured, target2base)
-    predicted = correction.delta_base @ look.tcp2base_model  # look 1's Δ at the pose look 2 was made from
+    predicted = concat(look.tcp2base_model, correction.delta_base)  # look 1's Δ at the pose look 2 was made from
     disagreement = float(np.linalg.norm(look.tcp2base_measured[:3, 3] - predicted[:3, 3]))
     sigma = float(np.sqrt(np.sum(np.square(correction.std_displacement_mm)) + np.sum(np.square(look.std_displacement_mm))))
     return Verification(task, remaining, rotation, np.asarray(look.std_displacement_mm, float), disagreement, 3.0 * sigma, float(look.solution.rms_px), len(look.solution.residuals_px),

@@ -261,7 +261,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
         """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
         flange = self.robot.frame_placement("flange")
-        self.robot.set_frame_placement("camera", flange @ np.asarray(cam2flange, dtype=float))
+        self.robot.set_frame_placement("camera", concat(cam2flange, flange))
         self.camera_model_changed.emit()
         self.message.emit(why)
 

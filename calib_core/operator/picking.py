@@ -14,6 +14,7 @@ import time
 from calib_core.calibration.session import CalibrationError
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
+from calib_core.frames import apply, concat, invert
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.observations import HeldFrame, NotSettledError
 from calib_core.vision.corner_pick import refine_corner_pick
@@ -75,12 +76,10 @@ class Picking:
         the complete pairs on that frame when there are three or more, else from the model's camera."""
         import numpy as np
 
-        from calib_core.frames import apply, invert
-
         held = self.observations.still
         joints = np.asarray(held.stamp.joints_deg if held is not None else self.joints_deg, dtype=float)
         obj2world = self.workcell.component(self.session.target).item2world
-        obj2cam = invert(self.robot.fk(joints, "camera")) @ obj2world
+        obj2cam = concat(obj2world, invert(self.robot.fk(joints, "camera")))
         done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
         if len(done) >= 3:
             from calib_core.solver import solve_pose
@@ -101,7 +100,6 @@ class Picking:
         import numpy as np
 
         from calib_core.camera.projection import project_points
-        from calib_core.frames import apply, invert
 
         pending = self.session.pairs.pending()
         if pending is None or self.session.target is None:

@@ -44,7 +44,7 @@ class PointFinding:
         held = self.observations.still or self.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.workcell.component(target)
-        obj2cam_model = np.linalg.inv(self.robot.fk(q, "camera")) @ item.item2world
+        obj2cam_model = concat(item.item2world, invert(self.robot.fk(q, "camera")))
         from calib_core.vision.find_points import find_points
 
         result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))

@@ -15,6 +15,7 @@ import numpy as np
 
 from calib_core.calibration.correspondences import pair_to_dict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
+from calib_core.frames import concat, invert
 from calib_core.recording import foxglove_messages as fm
 from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, FOUND_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC
 
@@ -79,7 +80,7 @@ class RecordingTap:
         for g, mesh, visual2base in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q)):
             link = core.robot.model.frames[g.parentFrame].name
             color = tuple(float(c) for c in np.asarray(g.meshColor)[:3])
-            entities.append(fm.mesh_entity(f"robot/{g.name}", link, mesh, np.linalg.inv(links[link]) @ visual2base, color, t_ns))
+            entities.append(fm.mesh_entity(f"robot/{g.name}", link, mesh, concat(visual2base, invert(links[link])), color, t_ns))
         for item in core.workcell.components:
             entities.append(fm.mesh_entity(f"cell/{item.name}", fm.WORLD_FRAME, item.mesh, item.item2world, item.color, t_ns))
             if item.features:

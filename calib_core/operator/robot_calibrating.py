@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from calib_core.errors import OperatorError
+from calib_core.frames import concat, invert
 from calib_core.operator.calibration_run import VIA
 from calib_core.robot.model import _to_mm, _to_se3
 
@@ -110,12 +111,11 @@ class RobotCalibrating:
         if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
             return None
         from calib_core.calibration.look_fusion import fuse_look, tcp_covariance_from_camera
-        from calib_core.frames import invert
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
         q = context.joints_deg
         cam2base = self.robot.fk(q, "camera")
-        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, invert(cam2base) @ self.robot.fk(q, "tcp"))
+        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, concat(self.robot.fk(q, "tcp"), invert(cam2base)))
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
         tool = getattr(self, "measured_tool", None)
         tool_covariance = tool.covariance_in_base(cam2base) if tool is not None else None

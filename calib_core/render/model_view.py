@@ -89,7 +89,7 @@ class ModelView:
         def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1) -> np.ndarray:
             cam2world = concat(invert(obj2cam), item2world)
             carry = concat(world2cam_model, cam2world)  # the modelled camera onto the one placed here
-            return self.render(scene, cam2world, {name: carry @ pose for name, pose in own.items()}, box_px, supersample)
+            return self.render(scene, cam2world, {name: concat(pose, carry) for name, pose in own.items()}, box_px, supersample)
 
         return expected
 

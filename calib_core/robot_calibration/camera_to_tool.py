@@ -27,7 +27,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.calibration.look_fusion import tcp_covariance_from_camera
 from calib_core.errors import VideocalError
-from calib_core.frames import invert, make_transform, pose_difference
+from calib_core.frames import concat, invert, make_transform, pose_difference
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.grasp_view import SeenGrasp
 
@@ -88,7 +88,7 @@ def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "
         raise CameraToToolError("no grasp: close the gripper on a surveyed fixture pin at least once")
     grasps = [g for g in grasps if g.seen is not None] or list(grasps)
     cams = {g.name: robot.fk(g.joints_deg, camera_frame) for g in grasps}
-    per = {g.name: g.seen.tcp2cam if g.seen is not None else invert(cams[g.name]) @ np.asarray(g.tcp2base, dtype=float) for g in grasps}
+    per = {g.name: g.seen.tcp2cam if g.seen is not None else concat(g.tcp2base, invert(cams[g.name])) for g in grasps}
     Ts = list(per.values())
     mean = make_transform(Rotation.from_matrix([T[:3, :3] for T in Ts]).mean().as_matrix(), np.mean([T[:3, 3] for T in Ts], axis=0))
     spreads = [pose_difference(T, mean) for T in Ts]
@@ -115,5 +115,5 @@ def with_tool(robot: RobotModel, tcp2cam: np.ndarray, tcp_frame: str = "tcp", ca
     if robot.model.frames[tcp_id].parentJoint != robot.model.frames[cam_id].parentJoint:
         raise CameraToToolError(f"the {tcp_frame} and {camera_frame} frames move with different joints: the camera must ride on the tool's joint")
     out = robot.copy()
-    out.set_frame_placement(tcp_frame, robot.frame_placement(camera_frame) @ np.asarray(tcp2cam, dtype=float))
+    out.set_frame_placement(tcp_frame, concat(tcp2cam, robot.frame_placement(camera_frame)))
     return out

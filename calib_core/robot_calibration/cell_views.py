@@ -65,8 +65,8 @@ def _centroid(item) -> np.ndarray:
 
 def _approach_camera(robot: RobotModel, task) -> np.ndarray:
     """The modelled camera's pose (4, 4) mm when the TCP is at the task's approach."""
-    tcp2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("tcp")
-    cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
+    tcp2flange = concat(robot.frame_placement("tcp"), invert(robot.frame_placement("flange")))
+    cam2flange = concat(robot.frame_placement("camera"), invert(robot.frame_placement("flange")))
     return concat(cam2flange, invert(tcp2flange), task.approach2base)
 
 
@@ -91,7 +91,7 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
     (a :class:`~calib_core.robot.collision.CollisionWorld`) only poses free of contacts."""
     rng = np.random.default_rng(seed)
     home = np.asarray(workcell.home_joints_deg, dtype=float)
-    cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
+    cam2flange = concat(robot.frame_placement("camera"), invert(robot.frame_placement("flange")))
     out = []
     for component, camera2base in surveyed_targets(robot, workcell):
         item = workcell.component(component)
@@ -111,7 +111,7 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
                 q = solve_ik(robot, concat(invert(cam2flange), T), q0, frame="flange").q_deg  # T: a camera2base
             except UnreachableTargetError:
                 continue
-            uv = project_points(points, invert(robot.fk(q, "camera")) @ item.item2world, intrinsics)
+            uv = project_points(points, concat(item.item2world, invert(robot.fk(q, "camera"))), intrinsics)
             if intrinsics.contains(uv, margin_px=40).all() and np.all(robot.within_limits(q, 1.0)) and (collisions is None or not collisions.check(q)):
                 out.append((component, q))
                 found += 1
@@ -126,7 +126,7 @@ def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, co
     from calib_core.vision.find_points import find_points
 
     item = workcell.component(component)
-    obj2cam_model = invert(robot.fk(joints_deg, "camera")) @ item.item2world
+    obj2cam_model = concat(item.item2world, invert(robot.fk(joints_deg, "camera")))
     result = find_points(image, intrinsics, item, obj2cam_model, expected=expected)
     if result.edges is None or not result.edges.settled:
         return f"{name}: {component} not located ({result.message})"

@@ -76,7 +76,7 @@ def see_grasp(image: np.ndarray, intrinsics: Intrinsics, robot: RobotModel, work
     try:
         if view is not None:
             expected = view.of_cell(workcell.components, RobotVisuals.from_robot(robot), q, item.item2world, camera_frame)
-        found = find_points(image, intrinsics, item, invert(cam2base) @ item.item2world, expected=expected)
+        found = find_points(image, intrinsics, item, concat(item.item2world, invert(cam2base)), expected=expected)
     finally:
         if view is not None:
             view.close()
@@ -86,6 +86,6 @@ def see_grasp(image: np.ndarray, intrinsics: Intrinsics, robot: RobotModel, work
     obj2cam = solution.obj2cam
     features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
     pose_cov = solution.uncertainty.covariance[:6, :6] + shared_shift_covariance(obj2cam, features, intrinsics)
-    tcp2obj = invert(item.item2world) @ np.asarray(task.tcp2base, dtype=float)
+    tcp2obj = concat(task.tcp2base, invert(item.item2world))
     covariance = tcp_covariance_in_camera(obj2cam, tcp2obj, pose_cov) + np.diag([CENTRING_SIGMA_MM**2] * 3 + [0.0] * 3)
     return SeenGrasp(concat(tcp2obj, obj2cam), covariance, item.name, found.edges.samples)

@@ -129,7 +129,7 @@ class _Problem:
     def residuals(self, p: np.ndarray, board: np.ndarray) -> np.ndarray:
         self.corrected.set(p)
         intr = self.corrected.intrinsics(self.nominal_intrinsics)
-        board2base = delta_transform(board) @ self.board0
+        board2base = concat(self.board0, delta_transform(board))
         out = []
         for k, v in enumerate(self.views):
             base2cam = invert(self.corrected.cam2base(v.joints_deg))
@@ -195,7 +195,7 @@ def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[Po
             continue
         ok, rvec, tvec = cv2.solvePnP(v.points_mm, v.pixels, intrinsics.K, intrinsics.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
         if ok:
-            placements.append(robot.fk(v.joints_deg, camera_frame) @ make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()))
+            placements.append(concat(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()), robot.fk(v.joints_deg, camera_frame)))
     if not placements:
         raise RobotCalibrationError("no board view gives the board's pose: every board view needs 4 points or more")
     R = Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix()
@@ -297,7 +297,7 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
-    board2base = delta_transform(board) @ problem.board0 if problem.has_board else None
+    board2base = concat(problem.board0, delta_transform(board)) if problem.has_board else None
     return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))), per_view, noise,
                             problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
                             float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame, weights.copy(),

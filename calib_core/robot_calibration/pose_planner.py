@@ -21,7 +21,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
-from calib_core.frames import apply, invert
+from calib_core.frames import apply, concat, invert
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.identification import _Problem
 from calib_core.robot_calibration.observations import PoseView
@@ -47,7 +47,7 @@ class PosePlan:
 
 
 def _sees_board(robot: RobotModel, intrinsics: Intrinsics, q, board2base, corners) -> bool:
-    px = project(apply(invert(robot.fk(q, "camera")) @ board2base, corners), intrinsics)
+    px = project(apply(concat(board2base, invert(robot.fk(q, "camera"))), corners), intrinsics)
     return bool(np.all(np.isfinite(px)) and np.all(intrinsics.contains(px, EDGE_MARGIN_PX)))
 
 
@@ -72,7 +72,7 @@ def plan_poses(robot: RobotModel, intrinsics: Intrinsics, spec, board2base: np.n
     if not kept:
         return PosePlan([], len(pool), rejected, float("-inf"))
     # Each candidate's block of the identification Jacobian at the nominal model, board as nuisance.
-    views = [PoseView(f"c{k}", q, corners, project(apply(invert(robot.fk(q, "camera")) @ board2base, corners), intrinsics)) for k, q in enumerate(kept)]
+    views = [PoseView(f"c{k}", q, corners, project(apply(concat(board2base, invert(robot.fk(q, "camera"))), corners), intrinsics)) for k, q in enumerate(kept)]
     problem = _Problem(robot, intrinsics, views, "camera", True)
     problem.board0 = board2base
     J, Jb = problem.jacobian(np.zeros(problem.size), np.zeros(6), list(range(problem.size)))

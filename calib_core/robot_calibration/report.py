@@ -16,7 +16,7 @@ import numpy as np
 import yaml
 
 from calib_core.atomic_file import atomic_write_text
-from calib_core.frames import invert, transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.frames import concat, invert, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.robot.model import RobotModel, _to_mm
 from calib_core.robot_calibration.identification import RobotCalibration
 
@@ -52,8 +52,8 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
             continue
         before, after = _to_mm(nominal.model.jointPlacements[k]), _to_mm(calibrated.model.jointPlacements[k])
         # Pinocchio folds fixed joints before this one into its placement: keep them, change this origin.
-        folded = before @ invert(_origin_mm(element))
-        _set_origin(element, invert(folded) @ after)
+        folded = concat(invert(_origin_mm(element)), before)
+        _set_origin(element, concat(after, invert(folded)))
     for role in (camera_frame, "tcp"):
         frame = nominal.roles.get(role, role)
         element = by_child.get(frame)
@@ -61,8 +61,8 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
         if np.allclose(before, after, atol=1e-9):
             continue
         if element is not None and element.get("type") == "fixed":
-            folded = before @ invert(_origin_mm(element))
-            _set_origin(element, invert(folded) @ after)
+            folded = concat(invert(_origin_mm(element)), before)
+            _set_origin(element, concat(after, invert(folded)))
         else:
             left.append(f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})")
     for mesh in root.iter("mesh"):  # package:// meshes as the description named them, not where this machine found them

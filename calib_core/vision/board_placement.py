@@ -62,7 +62,7 @@ def board_view_joints(robot: RobotModel, start_deg, spec: BoardSpec, board2base:
     rng = np.random.default_rng(seed)
     w, h = spec.size_mm
     centre = board2base[:3, :3] @ np.array([w / 2, h / 2, 0.0]) + board2base[:3, 3]
-    cam2flange = np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera")
+    cam2flange = concat(robot.frame_placement("camera"), invert(robot.frame_placement("flange")))
     q = np.asarray(start_deg, dtype=float).copy()
     out: list[np.ndarray] = []
     attempts = 0

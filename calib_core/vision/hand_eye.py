@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
-from calib_core.frames import apply, invert, make_transform
+from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError
 
 MIN_POSES = 3
@@ -192,7 +192,7 @@ def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
         raise CalibrationInputError("the robot poses and the board views give no rotation for the camera's mounting: are the poses the flange's in the base, in the views' order?")
     start = make_transform(R_cam2flange, np.asarray(t_cam2flange).ravel())
     # The board's placement from the start: average over views of flange2base . cam2flange . board2cam.
-    placements = [F @ start @ B for F, B in zip(moving, board2cam)]
+    placements = [concat(B, start, F) for F, B in zip(moving, board2cam)]
     board2base0 = make_transform(Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix(), np.mean([P[:3, 3] for P in placements], axis=0))
     corners = spec.corners_mm()
 
@@ -203,7 +203,7 @@ def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
         cam2flange, board2base = unpack(x)
         out = []
         for v, F in zip(views, moving):
-            board2cam_i = invert(cam2flange) @ invert(F) @ board2base
+            board2cam_i = concat(board2base, invert(F), invert(cam2flange))
             out.append((project(apply(board2cam_i, corners[v.ids]), intrinsics) - v.corners_px).ravel())
         return np.concatenate(out)
 

@@ -23,6 +23,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
+from calib_core.frames import concat
 
 TRUNCATE_PX = 40.0
 """The distance map's cap (px): wide enough that a pose 30 px from the target still sees its way down
@@ -55,7 +56,7 @@ def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndar
     moved = np.tile(np.eye(4), (len(shifts_mm), 1, 1))
     moved[:, :3, :3] = Rotation.from_rotvec(np.radians(rolls_deg)[:, None] * np.array([0.0, 0.0, 1.0])).as_matrix()
     moved[:, :3, 3] = -np.einsum("hij,hj->hi", moved[:, :3, :3], shifts_mm)
-    return moved @ obj2cam
+    return concat(obj2cam, moved)
 
 
 def _scores(padded_flat: np.ndarray, base: np.ndarray, offsets_flat: np.ndarray) -> np.ndarray:

@@ -28,7 +28,7 @@ def _target(c: Correction, tasks: dict[str, TaskLocation]):
     task = tasks.get(c.task)
     if task is None or c.kind != "correction":  # a measurement at another pose is never commanded
         return None
-    return invert(c.delta_base) @ task.tcp2base
+    return concat(task.tcp2base, invert(c.delta_base))
 
 
 def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:
