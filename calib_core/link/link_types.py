@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-import threading
+from concurrent.futures import Future, InvalidStateError
+from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 from enum import Enum
 
@@ -88,42 +89,35 @@ class MoveHandle:
         self.sent = True  # False when the link could not send it (then it has finished with the reason)
         self.sent_s: float | None = None
         """When it was written to the controller (host monotonic s): its ACK times the round trip."""
-        self._event = threading.Event()
-        self._error: MoveError | None = None
-        self._callbacks: list = []
-        self._callback_lock = threading.Lock()
+        # A move's outcome is a future: it ends once, and a callback added after the end runs at once.
+        self._outcome: Future = Future()
 
     @property
     def finished(self) -> bool:
-        return self._event.is_set()
+        return self._outcome.done()
 
     @property
     def error(self) -> MoveError | None:
         """Why the move failed, once it has finished (``None`` while running or when it arrived)."""
-        return self._error
+        return self._outcome.exception() if self._outcome.done() else None
 
     def on_finished(self, callback) -> None:
-        """``callback(handle)`` once the move has ended (done, refused, timed out), on the link's
-        reader thread; at once if it has already ended."""
-        with self._callback_lock:
-            if not self._event.is_set():
-                self._callbacks.append(callback)
-                return
-        callback(self)
+        """``callback(handle)`` once the move has ended (done, refused, timed out), on the thread
+        that ended it (the link's reader); at once if it has already ended."""
+        self._outcome.add_done_callback(lambda _: callback(self))
 
     def _finish(self, error: MoveError | None = None) -> None:
-        with self._callback_lock:
-            if self._event.is_set():
-                return
-            self._error = error
-            self._event.set()
-            callbacks, self._callbacks = self._callbacks, []
-        for callback in callbacks:
-            callback(self)
+        try:
+            if error is None:
+                self._outcome.set_result(None)
+            else:
+                self._outcome.set_exception(error)
+        except InvalidStateError:  # ended already (a late ACK after a timeout): the first outcome stands
+            pass
 
     def wait(self, timeout: float | None = None) -> None:
         """Block until the move is done (at most ``timeout`` s, then :class:`MoveTimeout`)."""
-        if not self._event.wait(timeout):
-            raise MoveTimeout(f"move {self.id}: still running after {timeout:g} s of waiting")
-        if self._error is not None:
-            raise self._error
+        try:
+            self._outcome.result(timeout)
+        except FutureTimeout:
+            raise MoveTimeout(f"move {self.id}: still running after {timeout:g} s of waiting") from None
