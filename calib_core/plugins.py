@@ -40,5 +40,11 @@ def plugin_entry(group: str, name: str) -> EntryPoint:
 
 
 def load_plugin(group: str, name: str):
-    """The object the entry point ``name`` of ``group`` names, imported now."""
-    return plugin_entry(group, name).load()
+    """The object the entry point ``name`` of ``group`` names, imported now. A plug-in still registered
+    but no longer importable (its package deleted or broken) is a :class:`PluginNotFoundError` that
+    says so, not a traceback."""
+    ep = plugin_entry(group, name)
+    try:
+        return ep.load()
+    except ImportError as exc:
+        raise PluginNotFoundError(f"the {group.split('.')[-1][:-1]} plug-in {name!r} is registered ({ep.value}) but cannot be loaded: {exc}") from None

@@ -48,8 +48,9 @@ def run(args: argparse.Namespace) -> int:
     if args.source == "sim":
         from calib_core.plugins import SITES, load_plugin
 
+        simulated = load_plugin(SITES, "sim")
         print(f"rendering {args.views} simulated views of {spec}...", file=sys.stderr)
-        truth, images = load_plugin(SITES, "sim").board_images(spec, args.views)
+        truth, images = simulated.board_images(spec, args.views)
     else:
         from calib_core.bags.bag_source import bag_images, looks_like_bag
 

@@ -65,13 +65,24 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _plugin_help(module: str) -> str:
+    """A plug-in command's one line (its module's ``HELP``); one that cannot be imported says so
+    instead of taking every other command down with it."""
+    try:
+        return getattr(importlib.import_module(module), "HELP", f"(from {module})")
+    except ImportError as exc:
+        return f"(cannot be loaded: {exc})"
+
+
+def build_parser(*, plugin_help: bool = True) -> argparse.ArgumentParser:
+    """``plugin_help``: import the plug-in commands' modules for their one-line help (only when the
+    list of commands may be shown)."""
     parser = _Parser(prog="videocal", description="Remote video calibration of a robot workcell.")
     parser.add_argument("--version", action="version", version=f"videocal {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, (module, help_text) in COMMANDS.items():
         if help_text is None:  # a plug-in's: its one line is the module's HELP
-            help_text = getattr(importlib.import_module(module), "HELP", f"(from {module})")
+            help_text = _plugin_help(module) if plugin_help else f"(from {module})"
         sp = sub.add_parser(name, help=help_text, description=help_text)
         sp.set_defaults(_module=module)
         # Arguments are declared by the module itself, imported lazily only for this parser.
@@ -81,11 +92,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    # Let the chosen command's module declare its arguments before the full parse.
     first = next((a for a in argv if not a.startswith("-")), None)
+    parser = build_parser(plugin_help=first not in COMMANDS)  # a command's run imports no other plug-in
+    # Let the chosen command's module declare its arguments before the full parse.
     if first in COMMANDS:
-        module = importlib.import_module(COMMANDS[first][0])
+        try:
+            module = importlib.import_module(COMMANDS[first][0])
+        except ImportError as exc:  # a registered plug-in whose package is gone or broken
+            print(f"error: the command {first!r} cannot be loaded: {exc}", file=sys.stderr)
+            return 2
         module.add_arguments(parser._subparsers._group_actions[0].choices[first])  # type: ignore[union-attr]
     args = parser.parse_args(argv)
     if args.command is None:
