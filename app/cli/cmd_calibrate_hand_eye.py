@@ -106,38 +106,21 @@ def _from_bag(args, source: Path):
     """Hand-eye from a ROS 2 bag: the board's images on ``--topic`` (the only image topic by default), the flange pose at
     each image's stamp from ``/joint_states`` through the cell's robot, taken only where the arm stood still; the
     camera's intrinsics from ``--intrinsics`` or the bag's CameraInfo."""
-    from calib_core.bags.bag_source import bag_intrinsics, bag_stamped_images
-    from calib_core.bags.joint_track import read_joint_track, settled_joints
+    from calib_core.bags.bag_source import bag_intrinsics
+    from calib_core.bags.board_views import bag_board_views
     from calib_core.camera.intrinsics_io import load_intrinsics
-    from calib_core.ros2.joint_units import user_per_si
     from calib_core.vision.board import DEFAULT_SPEC, parse_board
     from calib_core.vision.hand_eye import calibrate_hand_eye
-    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
     from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
     robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
-    track = read_joint_track(source, robot.joint_names, user_per_si(robot.joint_units), args.joint_topic)
     spec = parse_board(args.board or DEFAULT_SPEC)
-    detect = _detector(args, spec)
-    views, flanges, size, images, moving = [], [], None, 0, 0
-    for stamp, name, image in bag_stamped_images(source, args.topic, args.every):
-        images += 1
-        if size is None:
-            size = (image.shape[1], image.shape[0])
-        elif (image.shape[1], image.shape[0]) != size:
-            raise VideocalError(f"{source} {name}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
-        q, why = settled_joints(track, stamp)
-        if q is None:
-            moving += 1
-            print(f"skipped {name}: {why}", file=sys.stderr)
-            continue
-        v = detect_view(name, image, spec, detect)
-        if not isinstance(v, BoardView):
-            print(f"rejected {name}: {v.reason}", file=sys.stderr)
-            continue
-        views.append(v)
-        flanges.append(robot.fk(q, "flange"))
-    print(f"{source}: {images} images, {images - moving} taken while the arm stood still, {len(views)} with the board", file=sys.stderr)
+    found = bag_board_views(source, robot, spec, _detector(args, spec), topic=args.topic, joint_topic=args.joint_topic, every=args.every,
+                            say=lambda text: print(text, file=sys.stderr))
+    print(f"{source}: {found.summary}", file=sys.stderr)
+    views = [v for v, _ in found.views]
+    flanges = [robot.fk(q, "flange") for _, q in found.views]
+    size = found.size
     intrinsics = load_intrinsics(args.intrinsics, image_size=size) if args.intrinsics is not None else bag_intrinsics(source, size)
     if intrinsics is None:
         raise VideocalError(f"{source}: the bag has no CameraInfo: pass --intrinsics FILE")

@@ -8,7 +8,8 @@ closed on each task's fixture for the tool; the result scored against the truth,
 reads. ``FILE`` is a CSV of images and joints (``image[,component],<joint names | j1..jn>``,
 docs/calibration.md) of the cell's robot (``--workcell``) viewing a board, or with ``component`` one of
 the cell's surveyed components (their edges tie the robot's base to the cell); ``--grasps`` a CSV of
-``task[,image],<joints>``: the gripper closed on each task's pin, seen when its frame is given.
+``task[,image],<joints>``: the gripper closed on each task's pin, seen when its frame is given. A ROS 2
+bag gives board views with the joints from its JointState at each image's stamp, where the arm stood still.
 """
 
 from __future__ import annotations
@@ -23,13 +24,17 @@ from calib_core.errors import VideocalError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, or a folder holding views.csv (and grasps.csv)")
+    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, a folder holding views.csv (and grasps.csv), "
+                                       "or a ROS 2 bag (a bag folder, .mcap or .db3: board images, /joint_states, CameraInfo)")
+    parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
+    parser.add_argument("--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)")
+    parser.add_argument("--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)")
     parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)")
     parser.add_argument("--fixed-intrinsics", action="store_true", help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot")
     parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="with 'sim': which cold cell (its errors are drawn from this)")
     parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
     parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
-    parser.add_argument("--intrinsics", type=Path, help="with a CSV: the camera's intrinsics file (default: calibrated from the same views)")
+    parser.add_argument("--intrinsics", type=Path, help="with a CSV or a bag: the camera's intrinsics file (default: a bag's CameraInfo, else calibrated from the same views)")
     parser.add_argument("--grasps", type=Path, help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)")
     parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
     parser.add_argument("--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF")
@@ -103,9 +108,15 @@ def _from_files(args):
     from calib_core.vision.target_detection import load_detector_settings
     from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
+    from calib_core.bags.bag_source import looks_like_bag
+
     source = Path(args.source)
     if not source.exists():
         raise VideocalError(f"{source}: no such file (or use 'sim')")
+    if looks_like_bag(source):
+        return _from_bag(args, source)
+    if args.topic is not None or args.joint_topic is not None:
+        raise VideocalError(f"--topic and --joint-topic apply to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
     data = load_posed_images(source)
     if data.joint_columns is None:
         raise VideocalError(f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses")
@@ -147,6 +158,46 @@ def _from_files(args):
     frames = [CellFrame(posed.component, posed.joints_deg[order], data.read_image(posed), posed.name) for posed in of_components]
     done = identify_robot(robot, intrinsics, cell, views, frames, with_intrinsics=not args.fixed_intrinsics)
     return done.result, robot, rejected, rms, {"board_views": done.board_views, "cell_views": done.cell_views}
+
+
+def _from_bag(args, source: Path):
+    """Board views from a ROS 2 bag: its images (``--topic``) where the arm stood still, the joints from its
+    JointState at each image's stamp; the intrinsics from ``--intrinsics``, the bag's CameraInfo, or the views."""
+    from calib_core.bags.bag_source import bag_intrinsics
+    from calib_core.bags.board_views import bag_board_views
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.robot_calibration.identify_robot import identify_robot
+    from calib_core.robot_calibration.observations import PoseView
+    from calib_core.vision.board import DEFAULT_SPEC, parse_board
+    from calib_core.vision.intrinsics_calibration import calibrate_intrinsics
+    from calib_core.vision.target_detection import load_detector_settings
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+    robot = cell.load_robot()
+    spec = parse_board(args.board or DEFAULT_SPEC)
+    if not spec.unambiguous:
+        raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+    detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
+    found = bag_board_views(source, robot, spec, detect, topic=args.topic, joint_topic=args.joint_topic, every=args.every)
+    for why in found.skipped:  # the rejected ones are said with the identification's (run)
+        print(f"skipped {why}", file=sys.stderr)
+    print(f"{source}: {found.summary}", file=sys.stderr)
+    if not found.views:
+        raise VideocalError(f"{source}: no still view of the board ({found.summary})")
+    corners = spec.corners_mm()
+    views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in found.views]
+    rms = None
+    if args.intrinsics is not None:
+        intrinsics = load_intrinsics(args.intrinsics, image_size=found.size)
+    else:
+        intrinsics = bag_intrinsics(source, found.size)
+        if intrinsics is None:
+            calibrated = calibrate_intrinsics([v for v, _ in found.views], spec, rejected=[])
+            intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
+            print(f"{source}: no CameraInfo: the intrinsics calibrated from the same views (RMS {rms:.2f} px)", file=sys.stderr)
+    done = identify_robot(robot, intrinsics, cell, views, [], with_intrinsics=not args.fixed_intrinsics)
+    return done.result, robot, found.rejected, rms, {"board_views": done.board_views, "cell_views": done.cell_views}
 
 
 def _seen_grasps(rows, grasps_path: Path, result, cell) -> list:

@@ -53,3 +53,64 @@ def write_bag(folder: Path, storage: str, topics: dict[str, list], camera_info: 
                      velocity=np.array([], float), effort=np.array([], float))
         writer.write(connection, 1_700_000_000_000_000_000, ts.serialize_cdr(js, kind))
     return folder
+
+
+def hold_and_move(poses, t0_ns: int, hold_s: float = 1.0, move_s: float = 1.0, rate_hz: float = 100.0):
+    """A recorded session's timeline: the arm holds each of ``poses`` (joint vectors) for ``hold_s``, then moves
+    to the next in ``move_s``, sampled at ``rate_hz``. Returns ``(track, shots, moving)``: the joint samples
+    ``(t_ns, q)``, a frame's ``(t_ns, q)`` mid-hold and mid-move, and how many of those were taken moving."""
+    track, shots, t = [], [], t0_ns
+    for k, q in enumerate(poses):
+        q = np.asarray(q, float)
+        for j in range(int(hold_s * rate_hz)):
+            track.append((t + int(j / rate_hz * 1e9), q))
+        shots.append((t + int(hold_s / 2 * 1e9), q))
+        t += int(hold_s * 1e9)
+        if k + 1 < len(poses):
+            nxt = np.asarray(poses[k + 1], float)
+            for j in range(int(move_s * rate_hz)):
+                f = j / (move_s * rate_hz)
+                track.append((t + int(j / rate_hz * 1e9), (1 - f) * q + f * nxt))
+            shots.append((t + int(move_s / 2 * 1e9), 0.5 * (q + nxt)))
+            t += int(move_s * 1e9)
+    return track, shots, len(poses) - 1
+
+
+def write_arm_bag(folder: Path, intrinsics, robot, shots: list[tuple[int, np.ndarray]], track: list[tuple[int, np.ndarray]], *, camera_info: bool = True) -> Path:
+    """A ROS 2 bag (MCAP) as a ROS 2 system records a gripper camera and its arm: ``shots`` (``(t_ns, RGB image)``)
+    as JPEG CompressedImage on ``/camera/image_raw/compressed`` (recorded 30 ms after the stamp), ``track``
+    (``(t_ns, model joints)``) as JointState on ``/joint_states`` in SI units with a gripper joint beside the
+    arm's (recorded 2 ms after), and ``intrinsics`` as one CameraInfo."""
+    import math
+
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    T = ts.types
+    Time, Header = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"]
+    stamp = lambda t: Time(sec=t // 10**9, nanosec=t % 10**9)  # noqa: E731
+    t0 = min(t for t, _ in track)
+    with Writer(folder, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        images = writer.add_connection("/camera/image_raw/compressed", "sensor_msgs/msg/CompressedImage", typestore=ts)
+        joints = writer.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
+        if camera_info:
+            info = writer.add_connection("/camera/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
+            roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+            i = intrinsics
+            msg = T["sensor_msgs/msg/CameraInfo"](header=Header(stamp=stamp(t0), frame_id="camera_optical_frame"), height=i.height, width=i.width,
+                                                   distortion_model="plumb_bob", d=np.array(i.distortion, float),
+                                                   k=np.array([i.fu, 0, i.cx, 0, i.fv, i.cy, 0, 0, 1.0]), r=np.eye(3).ravel(), p=np.zeros(12),
+                                                   binning_x=0, binning_y=0, roi=roi)
+            writer.write(info, t0, ts.serialize_cdr(msg, "sensor_msgs/msg/CameraInfo"))
+        names = list(robot.joint_names) + ["gripper_finger"]  # the gripper's joint in the same message, as many drivers do
+        si = np.array([math.pi / 180.0 if u == "deg" else 1e-3 for u in robot.joint_units])
+        for t, q in track:
+            msg = T["sensor_msgs/msg/JointState"](header=Header(stamp=stamp(t), frame_id=""), name=names, position=np.append(q * si, 0.01),
+                                                  velocity=np.array([], float), effort=np.array([], float))
+            writer.write(joints, t + 2_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/JointState"))
+        for t, image in shots:
+            ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 95])
+            msg = T["sensor_msgs/msg/CompressedImage"](header=Header(stamp=stamp(t), frame_id="camera_optical_frame"), format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
+            writer.write(images, t + 30_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
+    return folder

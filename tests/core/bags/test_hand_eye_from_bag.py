@@ -7,12 +7,10 @@ CameraInfo. The truth only scores."""
 from __future__ import annotations
 
 import json
-import math
 import subprocess
 import sys
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pytest
 
@@ -20,46 +18,13 @@ from calib_core.frames import concat, invert, pose_difference
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
 from calib_core.workcell import load_workcell
+from tests.core.bags.bag_writing import hold_and_move, write_arm_bag
 from videocal_sim.hand_eye_views import hand_eye_poses, simulated_hand_eye_images
 from videocal_sim.test_bed import TestBed
 from videocal_sim.true_robot import RobotErrors
 
 ROOT = Path(__file__).resolve().parents[3]
 T0 = 1_760_000_000_000_000_000  # the robot's clock, ns
-HOLD_S, MOVE_S, RATE_HZ = 1.0, 1.0, 100.0
-
-
-def _write_bag(folder: Path, bed: TestBed, shots: list[tuple[int, np.ndarray]], track: list[tuple[int, np.ndarray]]) -> Path:
-    from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.typesys import Stores, get_typestore
-
-    ts = get_typestore(Stores.ROS2_HUMBLE)
-    T = ts.types
-    Time, Header = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"]
-    stamp = lambda t: Time(sec=t // 10**9, nanosec=t % 10**9)  # noqa: E731
-    robot = bed.model_robot
-    with Writer(folder, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
-        images = writer.add_connection("/camera/image_raw/compressed", "sensor_msgs/msg/CompressedImage", typestore=ts)
-        info = writer.add_connection("/camera/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
-        joints = writer.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=ts)
-        intr = bed.intrinsics
-        roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
-        camera_info = T["sensor_msgs/msg/CameraInfo"](header=Header(stamp=stamp(T0), frame_id="camera_optical_frame"), height=intr.height, width=intr.width,
-                                                       distortion_model="plumb_bob", d=np.array(intr.distortion, float),
-                                                       k=np.array([intr.fu, 0, intr.cx, 0, intr.fv, intr.cy, 0, 0, 1.0]), r=np.eye(3).ravel(), p=np.zeros(12),
-                                                       binning_x=0, binning_y=0, roi=roi)
-        writer.write(info, T0, ts.serialize_cdr(camera_info, "sensor_msgs/msg/CameraInfo"))
-        names = list(robot.joint_names) + ["gripper_finger"]  # the gripper's joint in the same message, as many drivers do
-        si = np.array([math.pi / 180.0 if u == "deg" else 1e-3 for u in robot.joint_units])
-        for t, q in track:
-            msg = T["sensor_msgs/msg/JointState"](header=Header(stamp=stamp(t), frame_id=""), name=names, position=np.append(q * si, 0.01),
-                                                  velocity=np.array([], float), effort=np.array([], float))
-            writer.write(joints, t + 2_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/JointState"))  # recorded 2 ms after its stamp
-        for t, image in shots:
-            ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 95])
-            msg = T["sensor_msgs/msg/CompressedImage"](header=Header(stamp=stamp(t), frame_id="camera_optical_frame"), format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
-            writer.write(images, t + 30_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
-    return folder
 
 
 @pytest.fixture(scope="module")
@@ -70,26 +35,13 @@ def recorded(tmp_path_factory):
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, cell, bed.model_robot)
     poses = hand_eye_poses(bed, spec, board2base, 8)
-    # the timeline: hold each pose, then move to the next; a frame mid-hold and one mid-move
-    track, shot_at = [], []
-    t = T0
-    for k, q in enumerate(poses):
-        for j in range(int(HOLD_S * RATE_HZ)):
-            track.append((t + int(j / RATE_HZ * 1e9), np.asarray(q, float)))
-        shot_at.append((t + int(HOLD_S / 2 * 1e9), np.asarray(q, float)))
-        t += int(HOLD_S * 1e9)
-        if k + 1 < len(poses):
-            for j in range(int(MOVE_S * RATE_HZ)):
-                f = j / (MOVE_S * RATE_HZ)
-                track.append((t + int(j / RATE_HZ * 1e9), (1 - f) * np.asarray(q, float) + f * np.asarray(poses[k + 1], float)))
-            shot_at.append((t + int(MOVE_S / 2 * 1e9), 0.5 * (np.asarray(q, float) + np.asarray(poses[k + 1], float))))
-            t += int(MOVE_S * 1e9)
+    track, shot_at, moving = hold_and_move(poses, T0)
     rendered = simulated_hand_eye_images(bed, spec, [q for _, q in shot_at], board2base)
-    shots = [(ts_, image) for (ts_, _), (_, image, _) in zip(shot_at, rendered)]
-    bag = _write_bag(tmp_path_factory.mktemp("bag") / "hand_eye_bag", bed, shots, track)
+    shots = [(t, image) for (t, _), (_, image, _) in zip(shot_at, rendered)]
+    bag = write_arm_bag(tmp_path_factory.mktemp("bag") / "hand_eye_bag", bed.intrinsics, bed.model_robot, shots, track)
     true_robot = bed.true_robot.robot
     truth = concat(true_robot.frame_placement("camera"), invert(true_robot.frame_placement("flange")))
-    return bag, truth, len(poses), len(poses) - 1
+    return bag, truth, len(poses), moving
 
 
 def test_the_mounting_from_a_bag_of_images_and_joint_states(recorded, tmp_path):
