@@ -25,6 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
     parser.add_argument("--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)")
     parser.add_argument("--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)")
+    parser.add_argument("--flange-from", choices=("auto", "joints", "tf"), default="auto",
+                        help="with a bag: the flange pose from the joint states through the cell's robot, or from /tf (default: the joints when the bag has a JointState topic, else /tf)")
+    parser.add_argument("--base-frame", help="with a bag's /tf: the robot's base frame (default: the workcell's base link)")
+    parser.add_argument("--flange-frame", help="with a bag's /tf: the flange frame (default: the workcell's flange link)")
     parser.add_argument("--workcell", type=Path, help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)")
     parser.add_argument("--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)")
     parser.add_argument("--intrinsics", type=Path, help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics")
@@ -104,22 +108,31 @@ def _detector(args, spec):
 
 def _from_bag(args, source: Path):
     """Hand-eye from a ROS 2 bag: the board's images on ``--topic`` (the only image topic by default), the flange pose at
-    each image's stamp from ``/joint_states`` through the cell's robot, taken only where the arm stood still; the
-    camera's intrinsics from ``--intrinsics`` or the bag's CameraInfo."""
-    from calib_core.bags.bag_source import bag_intrinsics
-    from calib_core.bags.board_views import bag_board_views
+    each image's stamp from ``/joint_states`` through the cell's robot or from ``/tf``, taken only where the arm stood
+    still; the camera's intrinsics from ``--intrinsics`` or the bag's CameraInfo."""
+    from calib_core.bags.bag_source import bag_intrinsics, bag_topics
+    from calib_core.bags.board_views import bag_board_views, flange_settled, joints_settled
+    from calib_core.bags.joint_track import JOINT_STATE
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.vision.board import DEFAULT_SPEC, parse_board
     from calib_core.vision.hand_eye import calibrate_hand_eye
     from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
-    robot = load_workcell(args.workcell or DEFAULT_WORKCELL).load_robot()
+    cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
+    robot = cell.load_robot()
     spec = parse_board(args.board or DEFAULT_SPEC)
-    found = bag_board_views(source, robot, spec, _detector(args, spec), topic=args.topic, joint_topic=args.joint_topic, every=args.every,
-                            say=lambda text: print(text, file=sys.stderr))
+    use_tf = args.flange_from == "tf" or (args.flange_from == "auto" and args.joint_topic is None and not any(t.msgtype == JOINT_STATE and t.count for t in bag_topics(source)))
+    if use_tf:
+        frames = cell.robot_spec.frames
+        base, flange = args.base_frame or str(frames.get("base") or "base_link"), args.flange_frame or str(frames.get("flange") or "tool0")
+        settled, to_flange = flange_settled(source, base, flange), lambda pose: pose
+        print(f"{source}: the flange ({flange} in {base}) from /tf", file=sys.stderr)
+    else:
+        settled, to_flange = joints_settled(source, robot, args.joint_topic), lambda q: robot.fk(q, "flange")
+    found = bag_board_views(source, spec, _detector(args, spec), settled, topic=args.topic, every=args.every, say=lambda text: print(text, file=sys.stderr))
     print(f"{source}: {found.summary}", file=sys.stderr)
     views = [v for v, _ in found.views]
-    flanges = [robot.fk(q, "flange") for _, q in found.views]
+    flanges = [to_flange(pose) for _, pose in found.views]
     size = found.size
     intrinsics = load_intrinsics(args.intrinsics, image_size=size) if args.intrinsics is not None else bag_intrinsics(source, size)
     if intrinsics is None:

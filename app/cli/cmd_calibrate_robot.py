@@ -164,7 +164,7 @@ def _from_bag(args, source: Path):
     """Board views from a ROS 2 bag: its images (``--topic``) where the arm stood still, the joints from its
     JointState at each image's stamp; the intrinsics from ``--intrinsics``, the bag's CameraInfo, or the views."""
     from calib_core.bags.bag_source import bag_intrinsics
-    from calib_core.bags.board_views import bag_board_views
+    from calib_core.bags.board_views import bag_board_views, joints_settled
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.robot_calibration.identify_robot import identify_robot
     from calib_core.robot_calibration.observations import PoseView
@@ -179,7 +179,7 @@ def _from_bag(args, source: Path):
     if not spec.unambiguous:
         raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
-    found = bag_board_views(source, robot, spec, detect, topic=args.topic, joint_topic=args.joint_topic, every=args.every)
+    found = bag_board_views(source, spec, detect, joints_settled(source, robot, args.joint_topic), topic=args.topic, every=args.every)
     for why in found.skipped:  # the rejected ones are said with the identification's (run)
         print(f"skipped {why}", file=sys.stderr)
     print(f"{source}: {found.summary}", file=sys.stderr)

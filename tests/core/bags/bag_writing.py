@@ -76,11 +76,18 @@ def hold_and_move(poses, t0_ns: int, hold_s: float = 1.0, move_s: float = 1.0, r
     return track, shots, len(poses) - 1
 
 
-def write_arm_bag(folder: Path, intrinsics, robot, shots: list[tuple[int, np.ndarray]], track: list[tuple[int, np.ndarray]], *, camera_info: bool = True) -> Path:
+FOREARM2FLANGE_MM = (120.0, -35.0, 410.0)
+"""Where the bag's made-up ``forearm`` frame stands from the flange (tf2 walks the chain through it)."""
+
+
+def write_arm_bag(folder: Path, intrinsics, robot, shots: list[tuple[int, np.ndarray]], track: list[tuple[int, np.ndarray]], *, camera_info: bool = True,
+                  joint_states: bool = True, tf: bool = False) -> Path:
     """A ROS 2 bag (MCAP) as a ROS 2 system records a gripper camera and its arm: ``shots`` (``(t_ns, RGB image)``)
     as JPEG CompressedImage on ``/camera/image_raw/compressed`` (recorded 30 ms after the stamp), ``track``
     (``(t_ns, model joints)``) as JointState on ``/joint_states`` in SI units with a gripper joint beside the
-    arm's (recorded 2 ms after), and ``intrinsics`` as one CameraInfo."""
+    arm's (recorded 2 ms after), and ``intrinsics`` as one CameraInfo. With ``tf`` the arm is on ``/tf`` as a
+    driver publishes it: ``base_link -> forearm`` streamed, ``forearm -> flange`` and ``world -> base_link`` on
+    ``/tf_static`` (metres, quaternions)."""
     import math
 
     from rosbags.rosbag2 import StoragePlugin, Writer
@@ -105,7 +112,9 @@ def write_arm_bag(folder: Path, intrinsics, robot, shots: list[tuple[int, np.nda
             writer.write(info, t0, ts.serialize_cdr(msg, "sensor_msgs/msg/CameraInfo"))
         names = list(robot.joint_names) + ["gripper_finger"]  # the gripper's joint in the same message, as many drivers do
         si = np.array([math.pi / 180.0 if u == "deg" else 1e-3 for u in robot.joint_units])
-        for t, q in track:
+        if tf:
+            _write_tf(writer, ts, robot, track)
+        for t, q in (track if joint_states else []):
             msg = T["sensor_msgs/msg/JointState"](header=Header(stamp=stamp(t), frame_id=""), name=names, position=np.append(q * si, 0.01),
                                                   velocity=np.array([], float), effort=np.array([], float))
             writer.write(joints, t + 2_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/JointState"))
@@ -114,3 +123,30 @@ def write_arm_bag(folder: Path, intrinsics, robot, shots: list[tuple[int, np.nda
             msg = T["sensor_msgs/msg/CompressedImage"](header=Header(stamp=stamp(t), frame_id="camera_optical_frame"), format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
             writer.write(images, t + 30_000_000, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
     return folder
+
+
+def _write_tf(writer, ts, robot, track) -> None:
+    from scipy.spatial.transform import Rotation
+
+    from calib_core.frames import concat, invert, make_transform
+
+    T = ts.types
+    kind = "tf2_msgs/msg/TFMessage"
+    Time, Header = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"]
+
+    def stamped(t_ns, parent, child, child2parent):
+        x, y, z = np.asarray(child2parent)[:3, 3] / 1000.0
+        qx, qy, qz, qw = Rotation.from_matrix(np.asarray(child2parent)[:3, :3]).as_quat()
+        return T["geometry_msgs/msg/TransformStamped"](header=Header(stamp=Time(sec=t_ns // 10**9, nanosec=t_ns % 10**9), frame_id=parent), child_frame_id=child,
+                                                       transform=T["geometry_msgs/msg/Transform"](translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
+                                                                                                  rotation=T["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw)))
+
+    flange2forearm = make_transform(Rotation.from_euler("xyz", [20, -35, 50], degrees=True).as_matrix(), FOREARM2FLANGE_MM)
+    t0 = min(t for t, _ in track)
+    static = writer.add_connection("/tf_static", kind, typestore=ts)
+    latched = [stamped(t0, "forearm", "flange", flange2forearm), stamped(t0, "world", "base_link", make_transform(np.eye(3), (0.0, 0.0, 800.0)))]
+    writer.write(static, t0, ts.serialize_cdr(T[kind](transforms=latched), kind))
+    dynamic = writer.add_connection("/tf", kind, typestore=ts)
+    for t, q in track:
+        forearm2base = concat(invert(flange2forearm), robot.fk(q, "flange"))
+        writer.write(dynamic, t + 1_000_000, ts.serialize_cdr(T[kind](transforms=[stamped(t, "base_link", "forearm", forearm2base)]), kind))
