@@ -156,8 +156,10 @@ def _from_files(args):
 
     if looks_like_bag(source) and not source.name.endswith(".yaml"):
         return _from_bag(args, source)
-    if args.topic or args.joint_topic:
-        raise VideocalError(f"--topic and --joint-topic apply to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
+    bag_only = [flag for flag, given in (("--topic", args.topic), ("--joint-topic", args.joint_topic), ("--flange-from", args.flange_from != "auto"),
+                                         ("--base-frame", args.base_frame), ("--flange-frame", args.flange_frame)) if given]
+    if bag_only:
+        raise VideocalError(f"{', '.join(bag_only)} appl{'ies' if len(bag_only) == 1 else 'y'} to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
     data = load_posed_images(source)
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     static = args.static if args.static is not None else bool(data.static_camera)

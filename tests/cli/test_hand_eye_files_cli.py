@@ -118,3 +118,10 @@ def test_a_view_with_a_wrong_pose_is_named(joint_views, tmp_path):
     warnings = json.loads(run.stdout)["warnings"]
     assert any("do not agree" in w for w in warnings)
     assert any(w.startswith(f"view {cells[0][:-4]} disagrees") for w in warnings), warnings
+
+
+def test_a_bag_s_options_on_a_file_that_is_no_bag_are_named(tmp_path):
+    run = _videocal("calibrate-hand-eye", ROSI, "--flange-from", "tf", "--flange-frame", "tool0", "--out", tmp_path / "x.yaml", timeout=120)
+    assert run.returncode == 2 and run.stderr.startswith("error: "), run.stderr
+    assert "--flange-from, --flange-frame apply to a ROS bag" in run.stderr and str(ROSI) in run.stderr
+    assert not (tmp_path / "x.yaml").exists()
