@@ -70,7 +70,7 @@ def _shared(context: SolveContext | None, obj2cam):
 
 
 class _ShowResult(Command):
-    """A solve: the session's result becomes ``solved`` (a :meth:`CalibrationSession.result_snapshot`);
+    """A solve: the session's result becomes ``solved`` (result, context, chosen candidate);
     undo puts back the result it replaced, redo the solve's (not solved again)."""
 
     def __init__(self, session: "CalibrationSession", solved: tuple, label: str):
@@ -81,7 +81,7 @@ class _ShowResult(Command):
 
     # The verdict is judged again on each: the task, and with it the tolerance, may have changed since.
     def do(self) -> None:
-        self.session.restore_result(self.solved[:3])
+        self.session.restore_result(self.solved)
 
     def undo(self) -> None:
         self.session.restore_result(self.before[:3])
@@ -226,7 +226,7 @@ class CalibrationSession:
         context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
                                points, intrinsics, tuple(view_sources))
         result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=_shared(context, solution.obj2cam))
-        solved = (result, context, 0, self._judge(result))
+        solved = (result, context, 0)  # the verdict is judged where it is shown (restore_result)
         if label is None:
             self.restore_result(solved)
         else:
