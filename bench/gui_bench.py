@@ -69,7 +69,7 @@ def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
     win.resize(1600, 1000)
     win.show()
     _spin(app, 2.0)
-    wb.go_to_task(approach=True)
+    wb.moves.go_to_task(approach=True)
     redraws0, t_start = win.overview.redraws, time.monotonic()
     _spin(app, 3.0)
     fps = (win.overview.redraws - redraws0) / (time.monotonic() - t_start)
@@ -86,14 +86,14 @@ def _preview_ms(workcell: Path | None) -> tuple[float, float, int]:
 
     core = OperatorCore(Cell.open(workcell) if workcell is not None else Cell.open())
     t0 = time.perf_counter()
-    world = core.collision_world()
+    world = core.cell.collision_world()
     build_ms = 1000 * (time.perf_counter() - t0)
     goal = np.array(core.joints_deg, dtype=float)
     goal[0] += 60.0
     times = []
     for _ in range(5):
         t0 = time.perf_counter()
-        core.preview_move(goal, "bench")
+        core.moves.preview_move(goal, "bench")
         times.append(1000 * (time.perf_counter() - t0))
     return build_ms, float(np.median(times)), world.pair_count
 
@@ -142,7 +142,7 @@ def main() -> str:
     # 2. Camera pane fps on a 30 fps 1280 x 960 file while the overview follows a 50 Hz joint stream and the robot moves.
     shown_frames = []
     win.worker.frame.connect(lambda f: shown_frames.append(time.monotonic()))
-    wb.go_to_task(approach=True)
+    wb.moves.go_to_task(approach=True)
     redraws0 = win.overview.redraws
     t_start = time.monotonic()
     _spin(app, 4.0)
@@ -174,14 +174,14 @@ def main() -> str:
     pick_ms, edges_ms = [], []
     for name in ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left"):
         p = apply(fixture.item2world, fixture.features[name])
-        wb.pick_model_point("oru_1_fixture", name, p)
+        wb.picking.pick_model_point("oru_1_fixture", name, p)
         uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0]
         t0 = time.perf_counter()
-        wb.pick_image_point(uv)  # on the frame the first pick held (the robot has settled at the approach)
-        wb.accept_pair()
+        wb.picking.pick_image_point(uv)  # on the frame the first pick held (the robot has settled at the approach)
+        wb.picking.accept_pair()
         if len(wb.session.pairs.usable()) >= 3:
             edges_before = win.camera.edges_drawn
-            win._calibrate()
+            win.actions.calibrate()
             win.camera.view.repaint()
             pick_ms.append(1000 * (time.perf_counter() - t0))
             while win.camera.edges_drawn == edges_before and time.perf_counter() - t0 < 2.0:

@@ -133,7 +133,7 @@ def link_lost_mid_move() -> float:
             time.sleep(0.01)
         q = np.array(cell.home_joints, float)
         q[0] += 120.0  # long enough to be killed in the middle of
-        core.move_joints(q, "a 120 deg turn", confirmed=True)
+        core.moves.move_joints(q, "a 120 deg turn", confirmed=True)
         while core.motion.motion is not Motion.MOVING and time.monotonic() < deadline:
             time.sleep(0.005)
         time.sleep(0.1)

@@ -110,3 +110,28 @@ def test_poses_are_composed_with_concat_and_invert():
         for hit in _bare_compositions(p.read_text(), str(p.relative_to(ROOT)))
     ]
     assert offenders == [], "\n".join(offenders)
+
+
+def _parts_taking_the_core(source: str) -> list[str]:
+    """Classes whose ``__init__`` takes a parameter named ``core`` (a part handed the whole program)."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ClassDef):
+            for item in node.body:
+                if isinstance(item, ast.FunctionDef) and item.name == "__init__" and any(a.arg == "core" for a in item.args.args):
+                    found.append(node.name)
+    return found
+
+
+def test_the_operator_parts_are_given_what_they_need():
+    # Each part of the operator core is handed its dependencies (the cell, the session, the arm...), never the
+    # core itself: no part shares the program's state by convention. The recording tap alone listens to every part.
+    assert _parts_taking_the_core("class Probe:\n    def __init__(self, core, log):\n        pass\n") == ["Probe"]  # the check sees one
+    offenders = {
+        p.name: names
+        for p in (ROOT / "calib_core" / "operator").glob("*.py")
+        if p.name != "recording_tap.py" and (names := _parts_taking_the_core(p.read_text()))
+    }
+    assert offenders == {}
+    bases = [n for n in ast.walk(ast.parse((ROOT / "calib_core" / "operator" / "core.py").read_text())) if isinstance(n, ast.ClassDef) and n.name == "OperatorCore"]
+    assert bases and bases[0].bases == []  # composed of its parts, not mixed from them

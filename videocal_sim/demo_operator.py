@@ -197,7 +197,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         def store() -> None:
             """Store correction, checked: one more entry in the task location's history."""
             stored_before = len(wb.session.corrections.history(task.name))
-            place = wb.look_place()
+            place = wb.desk.look_place()
             if place is None or not place.counts:  # the window would ask; the demo's looks are made where they count
                 raise RuntimeError(f"demo: the look does not count for {task.name}: {place.text if place else 'no robot pose'}")
             _click(win.commands.store, 10, 10)
@@ -268,7 +268,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                     _click_image(win.camera.view, *(uv_true + hand.uniform(-_HAND_PX, _HAND_PX, 2)))
                     refined_away.append(f"{round_name}: {name}")
                 win.camera.view.reset_view()
-                win._accept()
+                win.actions.accept()
                 app.processEvents()
             if len(picked) < _MIN_FEATURES:
                 raise RuntimeError(f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} ({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}")
@@ -339,7 +339,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                     "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they are); the "
                     "correction is measured at the task location, then again from the corrected location, and the second one is stored last",
         }
-        wb.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
+        wb.files.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
         report["workspace"] = "workspace.json"
         atomic_write_text(out_dir / "report.json", json.dumps(report, indent=2))
         return report

@@ -112,14 +112,14 @@ class CameraPane(QWidget):
     def _hold_toggled(self, on: bool) -> None:
         if on and self.held is None:
             try:
-                self.workbench.hold_frame()
+                self.workbench.picking.hold_frame()
             except OperatorError as exc:
                 self.freeze.blockSignals(True)
                 self.freeze.setChecked(False)
                 self.freeze.blockSignals(False)
                 self.pick_rejected.emit(str(exc))
         elif not on and self.held is not None:
-            self.workbench.release_frame()
+            self.workbench.picking.release_frame()
 
     def _still_changed(self, held) -> None:
         self.freeze.blockSignals(True)
@@ -146,7 +146,7 @@ class CameraPane(QWidget):
             self.pick_rejected.emit(f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked")
             return
         # The core holds the newest frame at the first pick of a set and refines on it.
-        attempt(lambda text: self.pick_rejected.emit(f"nothing picked: {text}"), self.workbench.pick_image_point, (u, v), refine=self.subpixel.isChecked())
+        attempt(lambda text: self.pick_rejected.emit(f"nothing picked: {text}"), self.workbench.picking.pick_image_point, (u, v), refine=self.subpixel.isChecked())
 
     # --- a picked point dragged (after Accept too), or clicked to select its pair ------------------------
     def _grab(self, u: float, v: float, radius_px: float) -> bool:
@@ -170,7 +170,7 @@ class CameraPane(QWidget):
             return
         self.pair_selected.emit(number)
         if moved:
-            attempt(self.pick_rejected.emit, self.workbench.move_pair_pixel, number, (u, v), refine=self.subpixel.isChecked())
+            attempt(self.pick_rejected.emit, self.workbench.picking.move_pair_pixel, number, (u, v), refine=self.subpixel.isChecked())
         self.refresh_overlay()
 
     def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
@@ -266,7 +266,7 @@ class CameraPane(QWidget):
                 banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
-            expected = self.workbench.expected_pixel()
+            expected = self.workbench.picking.expected_pixel()
             if expected is not None:
                 (u, v), basis = expected
                 overlay.points.append((u, v, "expected", EXPECTED_COLOR))

@@ -92,7 +92,7 @@ class FileMenu:
         if Path(path).resolve().parent == self.autosave.folder.resolve():
             self.window.show_error(f"{path}: that is the recovery folder, which holds autosaves only; save the workspace somewhere else")
             return False
-        if not attempt(self.window.show_error, self.window.workbench.save_workspace, path):
+        if not attempt(self.window.show_error, self.window.workbench.files.save_workspace, path):
             return False
         self.recent.remember(path)
         self.autosave.mark_saved()
@@ -103,7 +103,7 @@ class FileMenu:
         """Open a workspace file. ``restored``: an autosave, which is no file of the operator's: it joins
         no recent list and *Save* asks where (it once wrote into the recovery folder, offered again at
         the next start as an unsaved autosave)."""
-        if not attempt(self.window.show_error, self.window.workbench.open_workspace, path):
+        if not attempt(self.window.show_error, self.window.workbench.files.open_workspace, path):
             return False
         if restored:
             self.workspace_path = None
@@ -137,7 +137,7 @@ class FileMenu:
     def _export_dialog(self) -> None:
         path, chosen = QFileDialog.getSaveFileName(self.window, "Export corrections", "corrections.script", ";;".join(EXPORT_FILTERS))
         if path:
-            self.window.report(self.window.workbench.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
+            self.window.report(self.window.workbench.files.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
 
     # --- recordings -----------------------------------------------------------------------------------
     def _open_recording_dialog(self) -> None:
@@ -204,7 +204,7 @@ class FileMenu:
         """Autosave every minute when the session changed. Sessions that ended without saving left their
         autosave: offer each (File > Restore autosave of ...) rather than load one unasked."""
         wb = self.window.workbench
-        self.autosave = Autosave(self.window.settings, lambda: wb.revision, wb.save_workspace, self._status, self.window)
+        self.autosave = Autosave(self.window.settings, lambda: wb.revision, wb.files.save_workspace, self._status, self.window)
         self.restore_actions: dict[str, QAction] = {}
         for path in self.autosave.orphans():
             stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))

@@ -90,7 +90,7 @@ class FindPoints:
         window, wb = self.window, self.window.workbench
         found = {}
         with busy(window, "finding points ..."):  # rendering and fitting take a second
-            if not attempt(window.show_error, lambda: found.setdefault("found", wb.find_points())):
+            if not attempt(window.show_error, lambda: found.setdefault("found", wb.finder.find_points())):
                 return
         self.show(found["found"])
 
@@ -99,18 +99,18 @@ class FindPoints:
         if self.dialog is not None:
             self.dialog.close()
         self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, window)
-        self.dialog.finished.connect(lambda _: window.workbench.dismiss_found_points())  # the camera pane hides them
+        self.dialog.finished.connect(lambda _: window.workbench.finder.dismiss_found_points())  # the camera pane hides them
         self.dialog.show()
 
     def _calibrate_on_edges(self) -> bool:
-        return attempt(self.window.show_error, self.window.workbench.calibrate_on_edges)
+        return attempt(self.window.show_error, self.window.workbench.finder.calibrate_on_edges)
 
     def _accept(self, features: list[str]) -> bool:
         if not features:
             self.window.show_error("check at least one point to accept, or Cancel")
             return False
         numbers = {}
-        ok = attempt(self.window.show_error, lambda: numbers.setdefault("n", self.window.workbench.accept_found_points(features)))
+        ok = attempt(self.window.show_error, lambda: numbers.setdefault("n", self.window.workbench.finder.accept_found_points(features)))
         if ok:
             self.window.statusBar().showMessage(f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000)
         return ok

@@ -1,10 +1,9 @@
-"""The main window: it only assembles the panes and connects them to the workbench."""
+"""The main window: it builds the layout and the menus from the panes and the workflow's actions
+(:mod:`app.gui.workflow_actions`); each pane binds itself to the workbench."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 
-import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
@@ -26,8 +25,7 @@ from app.gui.robot_panel import RobotPanel
 from app.gui.vision_panel import VisionPanel
 from app.gui.window_layout import restore_layout, save_layout
 from app.gui.workbench import Workbench
-from app.gui.store_correction import store_with_consent
-from calib_core.operator.move_preview import MoveNeedsConfirmation
+from app.gui.workflow_actions import WorkflowActions
 
 
 VIRTUAL_EVERY_TICKS = 2  # the virtual camera follows a moving robot at 10 fps, the overview at 20
@@ -46,8 +44,8 @@ class MainWindow(QMainWindow):
         self.table = PairsTable(workbench)
         self.results = ResultsPanel(workbench)
         self.commands = CommandPanel(workbench)
-        self.replay = ReplayBar(workbench, lambda frame: workbench.observe_frame(frame, replayed=True))
-        self.vision = VisionPanel(workbench, self.show_error, lambda send: self.move(send))
+        self.replay = ReplayBar(workbench, lambda frame: workbench.picking.observe_frame(frame, replayed=True))
+        self.vision = VisionPanel(workbench, self.show_error, lambda send: self.actions.move(send))
         self.vision.board_detected.connect(self.camera.set_board_corners)
         self.robot_calibration = RobotPanel(workbench, self.show_error)
         self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
@@ -56,6 +54,10 @@ class MainWindow(QMainWindow):
             scroll.setWidgetResizable(True)
             scroll.setWidget(panel)
             self.commands.addTab(scroll, title)
+        self.actions = WorkflowActions(workbench, self.commands, self.table, self.results, self.overview, lambda text, ms: self.statusBar().showMessage(text, ms), self.show_error, self)
+        # the actions by their old names (tests, the bench and the demo's scripted operator use them)
+        for name in ("undo_action", "redo_action", "delete_action", "accept_action", "calibrate_action", "stop_action"):
+            setattr(self, name, getattr(self.actions, name))
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0
         self.worker: FrameWorker | None = None
@@ -114,25 +116,17 @@ class MainWindow(QMainWindow):
         self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
         self.addAction(self.play_action)
         edit = self.menuBar().addMenu("&Edit")
-        self.undo_action = QAction("&Undo", self, shortcut=QKeySequence.StandardKey.Undo, triggered=self._undo)
-        self.redo_action = QAction("&Redo", self, shortcut=QKeySequence.StandardKey.Redo, triggered=self._redo)
-        self.delete_action = QAction("&Delete pair", self, shortcut=QKeySequence.StandardKey.Delete, triggered=self._delete)
-        self.accept_action = QAction("&Accept pair", self, shortcut=QKeySequence("Ctrl+Return"), triggered=self._accept)
-        for a in (self.undo_action, self.redo_action, self.delete_action, self.accept_action):
+        for a in (self.actions.undo_action, self.actions.redo_action, self.actions.delete_action, self.actions.accept_action):
             edit.addAction(a)
         cal = self.calibration_menu = self.menuBar().addMenu("&Calibration")
-        self.calibrate_action = QAction("&Calibrate", self, shortcut=QKeySequence("F5"), triggered=self._calibrate)
-        cal.addAction(self.calibrate_action)
-        cal.addAction(QAction("&Store correction", self, triggered=self._store))
+        cal.addAction(self.actions.calibrate_action)
+        cal.addAction(self.actions.store_action)
         view = self.menuBar().addMenu("&View")
         view.addAction(QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view))
         view.addAction(QAction("&Fit the overview to the cell", self, shortcut=QKeySequence("Ctrl+F"), triggered=lambda: (self.overview.fit_view(), self.overview.refresh())))
         robot = self.menuBar().addMenu("&Robot")
-        self.stop_action = QAction("&Stop the robot", self, shortcut=QKeySequence("Esc"), triggered=lambda: self.report(self.workbench.stop_robot)())
-        self.stop_action.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
-        robot.addAction(self.stop_action)
-        robot.addAction(QAction("Go to &approach", self, triggered=lambda: self._go(approach=True)))
-        robot.addAction(QAction("Go to task, &corrected", self, triggered=lambda: self._go(approach=False, corrected=True)))
+        for a in (self.actions.stop_action, self.actions.approach_action, self.actions.corrected_action):
+            robot.addAction(a)
 
     def _build_status(self) -> None:
         self.status_line = StatusLine(self.statusBar(), self.workbench, self._camera_state, self)
@@ -150,36 +144,12 @@ class MainWindow(QMainWindow):
         self.camera.pick_rejected.connect(self.show_error)
         self.camera.pair_selected.connect(self.table.select_number)
         self.virtual.pair_selected.connect(self.table.select_number)
-        c.accept.clicked.connect(self._accept)
-        c.delete.clicked.connect(self._delete)
-        c.undo.clicked.connect(self._undo)
-        c.redo.clicked.connect(self._redo)
-        c.calibrate.clicked.connect(self._calibrate)
-        c.store.clicked.connect(self._store)
         c.error.connect(self.show_error)
-        c.go_approach.clicked.connect(lambda: self._go(approach=True))
-        c.go_task.clicked.connect(lambda: self._go(approach=False))
-        c.go_corrected.clicked.connect(lambda: self._go(approach=False, corrected=True))
-        c.go_uncorrected.clicked.connect(lambda: self._go(approach=False, corrected=False))
-        c.verify.clicked.connect(self.report(self._verify))
-        c.animate.clicked.connect(self.report(self._animate))
-        c.add_location.clicked.connect(self.report(self._add_location))
         c.live.toggled.connect(self._live_toggled)
-        self.results.candidate_chosen.connect(self.report(self._choose_candidate))
         wb.arm.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
-        wb.arm.move_finished.connect(self._move_finished)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
-        wb.session.undo.changed.connect(self._update_actions)
-        wb.session.pairs.changed.connect(self._pairs_changed)  # pairs also change outside the undo stack (replay, workspace)
         self.finder = FindPoints(self)
-        self._update_actions()
-
-    def _move_finished(self, what: str, error: str) -> None:
-        if error:
-            self.show_error(f"move to {what} failed: {error}")
-        else:
-            self.statusBar().showMessage(f"arrived at {what}", 8000)
 
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
@@ -188,7 +158,7 @@ class MainWindow(QMainWindow):
     # --- camera ----------------------------------------------------------------------------
     def start_camera(self, make_source) -> None:
         self.worker = FrameWorker(make_source, self)
-        self.worker.frame.connect(self.workbench.observe_frame)  # the camera pane shows what the core observed
+        self.worker.frame.connect(self.workbench.picking.observe_frame)  # the camera pane shows what the core observed
         self.worker.failed.connect(self.show_error)
         self.worker.waiting.connect(lambda text: self.statusBar().showMessage(text, 5000))
         self.worker.start()
@@ -197,68 +167,6 @@ class MainWindow(QMainWindow):
     def show_error(self, text: str) -> None:
         self.results.show_error(text)
         self.statusBar().showMessage(text, 15000)
-
-    def _choose_candidate(self, index: int) -> None:
-        self.workbench.choose_candidate(index)
-
-    def _accept(self) -> None:
-        self.report(lambda: self.statusBar().showMessage(f"pair {self.workbench.accept_pair()} accepted", 5000))()
-
-    def _delete(self) -> None:
-        self.report(lambda: self.workbench.delete_pair(self.table.selected_number()))()
-
-    def _undo(self) -> None:
-        label = self.workbench.undo()
-        self.statusBar().showMessage(f"undone: {label}" if label else "nothing to undo", 5000)
-
-    def _redo(self) -> None:
-        label = self.workbench.redo()
-        self.statusBar().showMessage(f"redone: {label}" if label else "nothing to redo", 5000)
-
-    def _calibrate(self) -> None:
-        self.report(self._calibrate_impl)()
-
-    def _calibrate_impl(self) -> None:
-        result = self.workbench.calibrate()
-        s = result.solution
-        self.statusBar().showMessage(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)
-
-    def _verify(self) -> None:
-        v = self.workbench.verify()
-        self.results.show_message(v.text, ok=v.ok)
-
-    def _store(self) -> None:
-        self.report(self._store_impl)()
-
-    def _store_impl(self) -> None:
-        store_with_consent(self, self.workbench, lambda text: self.statusBar().showMessage(text, 5000))
-
-    def _go(self, *, approach: bool, corrected: bool = False) -> None:
-        self.move(lambda confirmed: self.workbench.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))
-
-    def move(self, send: Callable[[object], object]) -> None:
-        """Send a move (``send(confirmed)`` calls the core). The core previews it in the overview; one
-        that needs a confirmation waits there for *Move*; a refused one says why."""
-        self.report(self._move_impl)(send)
-
-    def _move_impl(self, send: Callable[[bool], object]) -> None:
-        try:
-            send(False)
-        except MoveNeedsConfirmation as exc:
-            confirmation = exc.confirmation  # the name ``exc`` is gone once the except block ends
-            self.overview.show_preview(exc.preview, lambda: self.report(send)(confirmation))  # void after a Stop
-            self.statusBar().showMessage(f"{exc}: press Move in the overview to send it", 15000)
-
-    def _animate(self) -> None:
-        path = self.workbench.simulate_approach()
-        self.commands.sim_status.setText(path.text)
-        self.overview.play_path(list(path.joints_deg))
-
-    def _add_location(self, name: str | None = None) -> None:
-        wb = self.workbench
-        name = name or f"location_{len(wb.workcell.task_locations) + 1}"
-        wb.editor.add_task_location(name)
-        self.statusBar().showMessage(f"task location {name} added at the current pose", 5000)
 
     def _replay_closed(self) -> None:
         self.commands.live.setChecked(True)
@@ -277,20 +185,6 @@ class MainWindow(QMainWindow):
             self._joints_dirty = False
             self.virtual.refresh_if_moved()
         self.overview.refresh()
-
-    def _pairs_changed(self, event: str, number) -> None:
-        self._update_actions()
-
-    def _update_actions(self) -> None:
-        undo = self.workbench.session.undo
-        self.undo_action.setEnabled(undo.can_undo)
-        self.redo_action.setEnabled(undo.can_redo)
-        self.undo_action.setText(f"&Undo {undo.undo_label}" if undo.undo_label else "&Undo")
-        self.redo_action.setText(f"&Redo {undo.redo_label}" if undo.redo_label else "&Redo")
-        self.commands.undo.setEnabled(undo.can_undo)
-        self.commands.redo.setEnabled(undo.can_redo)
-        self.commands.calibrate.setEnabled(self.workbench.session.can_calibrate)
-        self.status_line.show_pairs(len(self.workbench.session.pairs.usable()), self.workbench.session.required_pairs)
 
     def _update_status(self) -> None:
         self.status_line.update()

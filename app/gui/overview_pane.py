@@ -141,7 +141,7 @@ class OverviewPane(QWidget):
     def _cancel(self) -> None:
         """Cancel a move waiting for Move; while one runs, the button is Stop (``$STP``)."""
         if self._send is None and self.preview is not None and self.workbench.motion.motion.value == "moving" and self.workbench.motion.what == self.preview.what:
-            self.workbench.stop_robot()
+            self.workbench.moves.stop_robot()
             return
         self.show_preview(None)
 
@@ -244,7 +244,7 @@ class OverviewPane(QWidget):
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
         q = wb.joints_deg if self._shown_joints is None else self._shown_joints
-        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.scene_extras) + self._ghost_items())
+        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.cell.extras) + self._ghost_items())
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if self.preview is not None and self.preview.tcp_path_mm is not None and len(self.preview.tcp_path_mm) > 1:
             lines.append((self.preview.tcp_path_mm, (1.0, 0.7, 0.3)))

@@ -110,10 +110,10 @@ class ReplayBar(QWidget):
             self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.workbench.intrinsics)
         # Picks and solves on the recorded frames need the camera they were recorded with.
         if recorded_intrinsics is not None:
-            self.workbench.use_intrinsics(recorded_intrinsics)
+            self.workbench.cell.use_intrinsics(recorded_intrinsics)
         self.playback, self.path = playback, path
         history = JointHistory.from_arrays(playback.joint_times_s, playback.joints_deg, self.workbench.workcell.safety.settle_rule, self.workbench.robot.joint_names)
-        self.workbench.begin_replay(history, path.name)
+        self.workbench.picking.begin_replay(history, path.name)
         self.branched_at_s = None
         self._shown_frame = self._shown_solve = None
         self._applying = True  # clearing the live session's undo history is not an operator edit
@@ -137,7 +137,7 @@ class ReplayBar(QWidget):
         self.pause()
         branched = self.branched_at_s is not None
         if self._live_state is not None:
-            self.workbench.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
+            self.workbench.cell.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
         if not branched and self._live_state is not None:
             pairs, result, _ = self._live_state
             s = self.workbench.session
@@ -149,7 +149,7 @@ class ReplayBar(QWidget):
             finally:
                 self._applying = False
         self.playback = self.path = self._live_state = None
-        self.workbench.end_replay()
+        self.workbench.picking.end_replay()
         self.hide()
         self.workbench.message.emit("replay closed: " + ("the branched session stays open" if branched else "the live session is back as it was"))
         self.closed.emit()

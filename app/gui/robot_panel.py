@@ -124,12 +124,12 @@ class RobotPanel(QWidget):
         self.identify_button.setEnabled(views >= 6 and not running)
         self.apply_button.setEnabled(self.result is not None)
         self.save_button.setEnabled(self.result is not None)
-        self.revert_button.setEnabled(getattr(self.workbench, "_robot_before_calibration", None) is not None)
+        self.revert_button.setEnabled(self.workbench.robot_calibration.can_revert)
 
     # --- plan and run --------------------------------------------------------------------------
     def make_plan(self) -> None:
         with busy(self, "planning the calibration poses ..."):
-            self.plan = self.workbench.plan_robot_calibration(self._spec(), self.poses.value())
+            self.plan = self.workbench.robot_calibration.plan_robot_calibration(self._spec(), self.poses.value())
         n = len(self.plan.joints_deg)
         why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
         seen = [c for c, _ in self.plan.cell_views if c != VIA]
@@ -148,7 +148,7 @@ class RobotPanel(QWidget):
                    "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
                    "Stop ends the run after the current move.", "Run"):
             return
-        self.run = self.workbench.robot_calibration_run(self._spec(), self.plan.joints_deg, self.plan.cell_views)
+        self.run = self.workbench.robot_calibration.robot_calibration_run(self._spec(), self.plan.joints_deg, self.plan.cell_views)
         self.progress.setRange(0, n)
         self.progress.setValue(0)
         self.run.progress.connect(self._on_progress)
@@ -175,7 +175,7 @@ class RobotPanel(QWidget):
         self.identify_button.setEnabled(False)
         try:
             with busy(self, "identifying the robot ..."):
-                r = self.result = self.workbench.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked(), progress=step)
+                r = self.result = self.workbench.robot_calibration.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked(), progress=step)
         finally:  # the run's own progress back (the panel says what the run did)
             self.progress.setRange(0, before[0])
             self.progress.setValue(before[1])
@@ -197,18 +197,18 @@ class RobotPanel(QWidget):
     def apply(self) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.workbench.apply_robot_calibration(self.result)
+        self.workbench.robot_calibration.apply_robot_calibration(self.result)
         self._refresh()
 
     def revert(self) -> None:
-        self.workbench.revert_robot_calibration()
+        self.workbench.robot_calibration.revert_robot_calibration()
         self.tool.tool = None
         self._refresh()
 
     def save(self, folder) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.workbench.save_robot_calibration(folder, self.result, self.tool.tool)
+        self.workbench.robot_calibration.save_robot_calibration(folder, self.result, self.tool.tool)
 
     def _save_dialog(self) -> None:
         folder = QFileDialog.getExistingDirectory(self, "Save the robot calibration into")

@@ -37,6 +37,9 @@ class StatusLine:
             bar.addPermanentWidget(w)
         workbench.arm.motion_changed.connect(self.show_motion)
         workbench.arm.link_state.connect(self.show_link_state)
+        for signal in (workbench.session.pairs.changed, workbench.session.changed):  # pairs change outside the undo stack too
+            signal.connect(self.show_pairs)
+        self.show_pairs()
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
         self.timer = QTimer(parent)
         self.timer.setInterval(1000)
@@ -87,15 +90,16 @@ class StatusLine:
     def _show_settled(self) -> None:
         """Whether the newest frame can be picked on: the settle rule, from the joint samples."""
         wb = self.workbench
-        if wb.link is None and not wb.replaying:
+        if wb.link is None and not wb.picking.replaying:
             self.settled_label.setText("")
             return
-        still = wb.robot_settled()
+        still = wb.picking.robot_settled()
         self.settled_label.setText("<span style='color:#5fd35f'>settled</span>" if still.settled else "<span style='color:#ff9a30'>not settled</span>")
         self.settled_label.setToolTip(still.reason or f"still for {still.still_for_s:.1f} s: frames can be picked on")
 
-    def show_pairs(self, usable: int, required: int) -> None:
-        self.pairs_label.setText(f"pairs: {usable}/{required} needed")
+    def show_pairs(self, *_) -> None:
+        session = self.workbench.session
+        self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.required_pairs} needed")
 
     def show_link_state(self, text: str) -> None:
         self.link_label.setText(f"link: {html.escape(text, quote=False)}")  # the label shows markup (warnings); a device's text is not

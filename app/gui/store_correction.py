@@ -35,7 +35,7 @@ def store_with_consent(parent: QWidget, core, say) -> None:
         ])
         chosen = ask_choice(parent, "A look from another place", question, [("measurement", "Store as measurement"), ("convert", f"Convert into {task}'s correction")])
         if chosen == "measurement":
-            core.store_measurement()
+            core.desk.store_measurement()
         elif chosen == "convert":
             _store(parent, core, f"converted in the window by {_who()}", say)
         else:
@@ -44,11 +44,11 @@ def store_with_consent(parent: QWidget, core, say) -> None:
 
 def _store(parent: QWidget, core, convert: str, say) -> None:
     try:
-        core.store_correction(convert=convert)
+        core.desk.store_correction(convert=convert)
     except ConfirmationNeeded as exc:
         question = "\n".join(["This result is not OK:", *[f"- {r}" for r in exc.reasons], "", "Store it as the correction for this task location anyway?",
                               "Your confirmation is kept with the correction."])
         if not ask(parent, "Store an implausible result?", question, "Store anyway"):
             say("nothing stored")
             return
-        core.store_correction(convert=convert, confirmation=f"confirmed in the window by {_who()}: {'; '.join(exc.reasons)}")
+        core.desk.store_correction(convert=convert, confirmation=f"confirmed in the window by {_who()}: {'; '.join(exc.reasons)}")

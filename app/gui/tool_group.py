@@ -43,18 +43,18 @@ class ToolGroup(QGroupBox):
         self.refresh()
 
     def refresh(self) -> None:
-        n = len(self.workbench.grasps)
+        n = len(self.workbench.tool.grasps)
         self.measure_button.setEnabled(n > 0)
         self.clear_button.setEnabled(n > 0)
 
     def record(self) -> None:
-        g = self.workbench.record_grasp()
-        self.text.setText(f"{len(self.workbench.grasps)} grasps (last: {g.name})")
+        g = self.workbench.tool.record_grasp()
+        self.text.setText(f"{len(self.workbench.tool.grasps)} grasps (last: {g.name})")
         self.text.setToolTip("joints " + " ".join(f"{v:.3f}" for v in g.joints_deg) + " deg")
         self.refresh()
 
     def measure(self) -> None:
-        t = self.tool = self.workbench.measure_tool()
+        t = self.tool = self.workbench.tool.measure_tool()
         self.text.setText(f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: "
                           "in use (Revert takes it back)")
         self.text.setToolTip(f"TCP in the camera frame: {t.tcp2cam[0, 3]:.3f} {t.tcp2cam[1, 3]:.3f} {t.tcp2cam[2, 3]:.3f} mm; saved with the robot calibration")
@@ -62,6 +62,6 @@ class ToolGroup(QGroupBox):
         self.changed()
 
     def clear(self) -> None:
-        self.workbench.clear_grasps()
+        self.workbench.tool.clear_grasps()
         self.text.setText("No grasp recorded.")
         self.refresh()

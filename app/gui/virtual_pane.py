@@ -68,9 +68,9 @@ class VirtualPane(QWidget):
     def refresh(self) -> None:
         """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
         wb = self.workbench
-        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, wb.scene_version)
+        key = (tuple(np.round(wb.joints_deg, 6)), wb.session.target, wb.cell.scene_version)
         if key != self._render_key:
-            items = wb.workcell.components + wb.cell.model_visuals().scene_items(wb.joints_deg) + list(wb.scene_extras)
+            items = wb.workcell.components + wb.cell.model_visuals().scene_items(wb.joints_deg) + list(wb.cell.extras)
             self.renderer.set_items(items)
             # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
             # cover the very surface points the picker tests for visibility.
@@ -138,7 +138,7 @@ class VirtualPane(QWidget):
         attempt(self.pick_rejected.emit, self._pick, hit, where)
 
     def _pick(self, hit: PickResult, where: str) -> None:
-        number = self.workbench.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
+        number = self.workbench.picking.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
         self.info.setText(f"pair {number}: {where}")
 
     def set_feature_component(self, component: str | None) -> None:

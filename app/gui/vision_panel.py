@@ -145,14 +145,14 @@ class VisionPanel(QWidget):
         q = self._plan[self._plan_index % len(self._plan)]
         self._plan_index += 1
         what = f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}"
-        self._move(lambda confirmed: self.workbench.move_joints(q, what, confirmed=confirmed))
+        self._move(lambda confirmed: self.workbench.moves.move_joints(q, what, confirmed=confirmed))
 
     # --- capturing -----------------------------------------------------------------------------
     def capture_view(self) -> None:
         """Detect the board in the current frame; keep it (with the joints) or say why not."""
         # The newest frame (not the still held for picking), taken after the last move and once the
         # robot had settled, with the joints then: a refusal says why, nothing is captured.
-        frame, stamp = self.workbench.frame_to_capture()
+        frame, stamp = self.workbench.picking.frame_to_capture()
         joints = None if stamp is None else np.array(stamp.joints_deg)
         view = self.capture.add(frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s))
         if isinstance(view, RejectedView):

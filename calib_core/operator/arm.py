@@ -26,7 +26,6 @@ from calib_core.operator.motion import Motion, MotionState, ended
 from calib_core.operator.move_preview import Confirmation, MoveNeedsConfirmation, MovePreview, MoveRefused, preview_move
 from calib_core.operator.observations import Observations
 from calib_core.robot import solve_ik
-from calib_core.robot.collision import CollisionWorld
 
 
 class Arm:
@@ -50,11 +49,10 @@ class Arm:
     message = Signal(str)
     event = Signal(str, object)
 
-    def __init__(self, cell: Cell, observations: Observations, collision_world: Callable[[], CollisionWorld], *, call_soon: Callable[..., None] | None = None):
+    def __init__(self, cell: Cell, observations: Observations, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
         self.observations = observations
         """Where the joint samples go (its live history) and whether a recording is being replayed (no moves then)."""
-        self._collision_world = collision_world
         self._call_soon = call_soon or (lambda fn, *args: fn(*args))
         self.link: ControllerConnector | None = None
         self.joints_deg = cell.home_joints
@@ -156,7 +154,7 @@ class Arm:
 
     def preview(self, q, what: str, allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
         """The move from the current joints to ``q`` (deg/mm), checked; ``move_previewed`` shows it."""
-        preview = preview_move(self.robot, self._collision_world(), self.joints_deg, q, what, self.cell.workcell.safety, allowed_contacts)
+        preview = preview_move(self.robot, self.cell.collision_world(), self.joints_deg, q, what, self.cell.workcell.safety, allowed_contacts)
         self.move_previewed.emit(preview)
         return preview
 

@@ -16,7 +16,9 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.errors import VideocalError
+from calib_core.operator.arm import Arm
 from calib_core.operator.motion import Motion
+from calib_core.operator.operator_log import OperatorLog
 from calib_core.robot_calibration.identify_robot import CellFrame
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.intrinsics_calibration import RejectedView
@@ -44,8 +46,8 @@ class CalibrationRun:
     progress = Signal(object)
     finished = Signal(str)
 
-    def __init__(self, core, spec, plan: list[np.ndarray], cell_views=()):
-        self.core = core
+    def __init__(self, arm: Arm, log: OperatorLog, spec, plan: list[np.ndarray], cell_views=()):
+        self.arm, self.log = arm, log
         self.capture = BoardCapture(spec)
         self.components = [None] * len(plan) + [c for c, _ in cell_views]
         self.plan = [np.asarray(q, dtype=float) for q in plan] + [np.asarray(q, dtype=float) for _, q in cell_views]
@@ -63,8 +65,8 @@ class CalibrationRun:
     def start(self) -> None:
         if not self.plan:
             raise VideocalError("no poses planned: plan the robot calibration first")
-        self.core.arm.motion_changed.connect(self._on_motion)
-        self.core.observations.frame_observed.connect(self._on_frame)
+        self.arm.motion_changed.connect(self._on_motion)
+        self.arm.observations.frame_observed.connect(self._on_frame)
         self._visit()
 
     def stop(self, why: str = "stopped by the operator") -> None:
@@ -74,14 +76,14 @@ class CalibrationRun:
 
     def _end(self, phase: str, text: str) -> None:
         self.phase = phase
-        self.core.arm.motion_changed.disconnect(self._on_motion)
-        self.core.observations.frame_observed.disconnect(self._on_frame)
+        self.arm.motion_changed.disconnect(self._on_motion)
+        self.arm.observations.frame_observed.disconnect(self._on_frame)
         self._say(text)
         self.finished.emit(text)
 
     def _say(self, text: str) -> None:
         self.progress.emit(RunProgress(self.index, len(self.plan), self.phase, text))
-        self.core.message.emit(text)
+        self.log.say(text)
 
     def _visit(self) -> None:
         if self.index >= len(self.plan):
@@ -89,7 +91,7 @@ class CalibrationRun:
             return
         self.phase, self._tries = MOVING, 0
         try:
-            self.core.move_joints(self.plan[self.index], self.what, confirmed=True)
+            self.arm.move_joints(self.plan[self.index], self.what, confirmed=True)
         except VideocalError as exc:
             self.stop(str(exc))
             return
@@ -108,10 +110,10 @@ class CalibrationRun:
             self.stop(state.text)
 
     def _on_frame(self, frame) -> None:
-        if self.phase != SETTLING or not self.core.observations.stillness(frame).settled:
+        if self.phase != SETTLING or not self.arm.observations.stillness(frame).settled:
             return
         try:
-            joints = np.array(self.core.stamp_frame(frame).joints_deg)
+            joints = np.array(self.arm.observations.stamp(frame).joints_deg)
         except VideocalError:  # settled, but its joints not known yet (a sample late): the next frame
             return
         if self.components[self.index] is not None:

@@ -1,6 +1,8 @@
 """The cell the operator opened: its workcell, its robot model, its camera model, and how its
-controller numbers the joints. Everything the core knows about the world comes from here (and
-from the devices); nothing here is simulated.
+controller numbers the joints, with what is put up in it for a while (a calibration board).
+Everything the core knows about the world comes from here (and from the devices); nothing here is
+simulated. Its events say which of its parts changed: ``camera_model_changed()`` (the intrinsics,
+the camera mounting or the robot's placements), ``scene_changed()`` (components, what is put up).
 """
 
 from __future__ import annotations
@@ -9,15 +11,19 @@ import hashlib
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
+from psygnal import Signal
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.errors import VideocalError
 from calib_core.link.joint_map import JointMap
+from calib_core.robot.collision import CollisionWorld
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
+from calib_core.scene import SceneItem
 from calib_core.workcell import DEFAULT_WORKCELL, Workcell, load_workcell
 
 
@@ -56,14 +62,22 @@ class CellMismatchError(VideocalError, ValueError):
 class Cell:
     """``workcell``; ``robot``: the model robot (its camera mounting may be replaced by a
     measured one); ``intrinsics``: the camera model in use; ``joint_map``: model joints to
-    controller axes; ``identity``: see :class:`CellIdentity`."""
+    controller axes; ``identity``: see :class:`CellIdentity`; ``extras``: things put into the cell for a
+    while (a calibration board), drawn in the CAD views and avoided by moves; ``scene_version`` counts the
+    changes of what the CAD views show."""
+
+    camera_model_changed: ClassVar[Signal] = Signal()
+    scene_changed: ClassVar[Signal] = Signal()
 
     workcell: Workcell
     robot: RobotModel
     intrinsics: Intrinsics
     joint_map: JointMap
     identity: CellIdentity
+    extras: list[SceneItem] = field(default_factory=list)
+    scene_version: int = 0
     _visuals: RobotVisuals | None = field(default=None, repr=False)
+    _collision: tuple[int, CollisionWorld] | None = field(default=None, repr=False)
 
     @classmethod
     def from_workcell(cls, workcell: Workcell, intrinsics: Intrinsics | None = None) -> Cell:
@@ -91,6 +105,37 @@ class Cell:
     def refresh_identity(self) -> None:
         """After an edit of the cell: its identity follows its content."""
         self.identity = cell_identity(self.workcell, self.robot)
+
+    def use_intrinsics(self, intrinsics: Intrinsics) -> None:
+        """Picks, solves and the virtual camera use ``intrinsics`` from now on (any size: a replay uses
+        the recording's camera while it plays)."""
+        if intrinsics != self.intrinsics:
+            self.intrinsics = intrinsics
+            self.camera_model_changed.emit()
+
+    def put_up(self, extras: list[SceneItem]) -> None:
+        """Put ``extras`` into the cell in place of what was put up before (``[]``: take it down)."""
+        self.extras = list(extras)
+        self.scene_edited()
+
+    def robot_edited(self) -> None:
+        """The robot's placements changed in place (a calibration applied or reverted, a measured tool):
+        the camera the views model and the bodies moves are checked against."""
+        self.scene_version += 1
+        self.camera_model_changed.emit()
+        self.scene_changed.emit()
+
+    def scene_edited(self) -> None:
+        """What the CAD views show changed (a component edited, something put up)."""
+        self.scene_version += 1
+        self.scene_changed.emit()
+
+    def collision_world(self) -> CollisionWorld:
+        """The robot's collision bodies and the cell's components with what is put up in it, built again
+        only after the scene changed."""
+        if self._collision is None or self._collision[0] != self.scene_version:
+            self._collision = (self.scene_version, CollisionWorld(self.robot, list(self.workcell.components) + list(self.extras), self.home_joints))
+        return self._collision[1]
 
     def model_visuals(self) -> RobotVisuals:
         """The modelled robot's meshes (loaded once)."""

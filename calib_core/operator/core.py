@@ -31,68 +31,106 @@ from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.correction_desk import CorrectionDesk
 from calib_core.operator.motion import MotionState
 from calib_core.operator.move_preview import joint_path
-from calib_core.operator.observations import Observations
 from calib_core.operator.moves import Moves
+from calib_core.operator.observations import Observations
+from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.picking import Picking
 from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.session_files import SessionFiles
 from calib_core.operator.site import Site
+from calib_core.operator.task_choice import TaskChoice
 from calib_core.operator.tool_measuring import ToolMeasuring
-from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
 
 
-class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating, ToolMeasuring, CorrectionDesk):
-    """Events (psygnal): ``message(text)`` (for a status line), ``solved()``, ``task_changed(name)``,
-    ``camera_model_changed()``, ``scene_changed()``, ``correction_stored(correction)``,
-    ``event(kind, detail)`` (operator actions and link changes worth recording), ``points_found(found)`` (``None``: the proposals withdrawn).
-    The arm's events (joints, samples, the link, moves) are :attr:`arm`'s; frames and the held one
-    :attr:`observations`'."""
+class OperatorCore:
+    """The parts, each given what it needs: :attr:`cell` (with its events ``camera_model_changed()``,
+    ``scene_changed()``), :attr:`session` (pairs, options, result, corrections, the one undo stack),
+    :attr:`tasks` (the task location worked at), :attr:`observations` (frames, the held one),
+    :attr:`arm` (joints, link, moves, Stop), :attr:`picking` (*Point*, *Accept*, *Calibrate*),
+    :attr:`finder` (*Find points*), :attr:`moves` (moves by name), :attr:`robot_calibration` (and the
+    measured tool in use), :attr:`tool` (grasps, *Measure tool*), :attr:`desk` (store, *Verify*),
+    :attr:`files` (workspace, exports), :attr:`editor` (edits of the cell) and :attr:`log`.
 
-    message = Signal(str)
+    Events (psygnal), here for whoever follows the whole program (a status line, the recorder):
+    ``message(text)`` and ``event(kind, detail)`` (:attr:`log`'s), ``solved()`` (after *Calibrate* or
+    *Calibrate on edges*), ``task_changed(name)``, ``camera_model_changed()``, ``scene_changed()``,
+    ``correction_stored(correction)``, ``points_found(found)`` (the parts' own). The arm's events are
+    :attr:`arm`'s; frames and the held one :attr:`observations`'."""
+
     solved = Signal()
-    task_changed = Signal(str)
-    camera_model_changed = Signal()
-    scene_changed = Signal()
-    correction_stored = Signal(object)
-    event = Signal(str, object)
-    points_found = Signal(object)
 
     def __init__(self, cell: Cell, site: Site | None = None, *, call_soon: Callable[..., None] | None = None):
         self.cell = cell
         self.site = site
         self._call_soon = call_soon or (lambda fn, *args: fn(*args))
+        self.log = OperatorLog()
         self.session = CalibrationSession()
-        self.task: TaskLocation | None = next(iter(self.workcell.task_locations.values()), None)
+        self.tasks = TaskChoice(cell.workcell)
+        self.tasks.changed.connect(self._task_chosen)  # first: the session's target and verdict follow before any view
         if self.task is not None and self.task.component:
             self.session.set_target(self.task.component)
         self.recorder = None
         self._tap = None
-        self.scene_extras: list[SceneItem] = []
-        """Things put into the cell for a while (a calibration board), drawn in the CAD views."""
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the
         target): the autosave writes only when it moved."""
-        for signal in (self.session.pairs.changed, self.session.corrections.changed, self.session.undo.changed, self.session.changed, self.task_changed):
+        for signal in (self.session.pairs.changed, self.session.corrections.changed, self.session.undo.changed, self.session.changed, self.tasks.changed):
             signal.connect(self._count_change)
-        self.current_pair: int | None = None
-        """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
-        self.scene_version = 0
-        """Counts the changes of what the CAD views show (components edited, a board put up)."""
-        self.editor = CellEditor(self)
-        """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
         self.observations = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.arm.controller_clock.spread_s)
         """The frames (live, or a recording's while it is replayed), the held one, and the joint history
         that stamps them."""
-        self.arm = Arm(cell, self.observations, self.collision_world, call_soon=self._call_soon)
+        self.arm = Arm(cell, self.observations, call_soon=self._call_soon)
         """The robot behind the link: its joints, its moves and how the last one stands, Stop."""
-        self.arm.message.connect(self.message.emit)
-        self.arm.event.connect(self.event.emit)
-        self._collision_world = None  # built on the first move preview, again when the cell changes
-        self._collision_version = -1
+        self.arm.message.connect(self.log.say)
+        self.arm.event.connect(self.log.event.emit)
+        self.picking = Picking(cell, self.session, self.observations, self.arm, self.log)
+        self.finder = PointFinding(cell, self.session, self.picking, self.log)
+        self.moves = Moves(cell, self.session, self.tasks, self.arm)
+        self.robot_calibration = RobotCalibrating(cell, self.session, self.arm, self.log)
+        self.tool = ToolMeasuring(cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log)
+        self.desk = CorrectionDesk(cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log)
+        self.files = SessionFiles(cell, self.session, self.log)
+        self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
+        """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
+        for signal in (self.picking.solved, self.finder.solved):
+            signal.connect(self.solved.emit)
         self.session.judge = self._judge
-        self.session.pairs.changed.connect(self._release_unused_still)
+
+    # The events of the parts, where a listener to the whole program finds them.
+    @property
+    def message(self):
+        return self.log.message
+
+    @property
+    def event(self):
+        return self.log.event
+
+    @property
+    def task_changed(self):
+        return self.tasks.changed
+
+    @property
+    def camera_model_changed(self):
+        return self.cell.camera_model_changed
+
+    @property
+    def scene_changed(self):
+        return self.cell.scene_changed
+
+    @property
+    def correction_stored(self):
+        return self.desk.correction_stored
+
+    @property
+    def points_found(self):
+        return self.finder.points_found
+
+    @property
+    def task(self) -> TaskLocation | None:
+        """The task location worked at (:attr:`tasks`' choice)."""
+        return self.tasks.task
 
     def _count_change(self, *_) -> None:
         self.revision += 1
@@ -127,7 +165,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         if self.site is not None:
             self.site.attach(link)
         link.start()
-        self.message.emit(f"controller link: {url}")
+        self.log.say(f"controller link: {url}")
         if hasattr(link, "publish_static_transforms"):  # a ROS 2 cell: the results on /tf_static too
             for signal in (self.camera_model_changed, self.correction_stored):
                 signal.connect(self._publish_static_transforms, unique=True)
@@ -181,29 +219,28 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         try:
             link.publish_static_transforms(self.static_transforms())
         except Exception as exc:  # the ROS side is an output: its failure must not stop the calibration
-            self.message.emit(f"could not publish /tf_static: {exc}")
+            self.log.say(f"could not publish /tf_static: {exc}")
 
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
-        self.event.emit(kind, detail)
+        self.log.record(kind, **detail)
 
     def set_task_approach(self, name: str, approach_mm: float) -> None:
         """Edit a task location's approach distance (mm): an undoable edit."""
         if abs(self.workcell.task(name).approach_mm - approach_mm) < 1e-9:
             return
-        self.session.undo.push(SetTaskApproach(self.workcell.task_locations, name, approach_mm, self._task_edited))
-
-    def _task_edited(self, name: str) -> None:
-        if self.task is not None and self.task.name == name:
-            self.task = self.workcell.task(name)
-        self.task_changed.emit(name)
+        self.session.undo.push(SetTaskApproach(self.workcell.task_locations, name, approach_mm, self.tasks.edited))
 
     def set_task(self, name: str) -> None:
-        self.task = self.workcell.task(name)
-        if self.task.component:
-            self.session.set_target(self.task.component)
-        self.session.rejudge()  # the task's tolerance is part of the verdict
-        self.task_changed.emit(name)
+        """Work at task location ``name``: its component becomes the target."""
+        self.tasks.choose(name)
+
+    def _task_chosen(self, name: str) -> None:
+        task = self.task
+        if task is not None and task.name == name:
+            if task.component and task.component != self.session.target:
+                self.session.set_target(task.component)
+            self.session.rejudge()  # the task's tolerance is part of the verdict
 
     def _judge(self, estimate) -> ResultVerdict:
         tolerance = self.task.tolerance_mm if self.task is not None else None
@@ -211,7 +248,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
 
     def undo(self) -> str | None:
         """Undo the last edit (its label, None if there was none); the pair being made is let go."""
-        self.current_pair = None
+        self.picking.let_go()
         return self.session.undo.undo()
 
     def redo(self) -> str | None:
@@ -229,26 +266,7 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
     def model_tcp2base(self) -> np.ndarray:
         return self.robot.fk(self.joints_deg, "tcp")
 
-    # --- calibration -------------------------------------------------------------------------
-    def calibrate(self):
-        target = self.session.target
-        if target is None:
-            raise CalibrationError("choose the target object first")
-        obj2world = self.workcell.component(target).item2world
-        use = self.session.pairs.usable()
-        unbound = [p.number for p in use if p.view is None]
-        if unbound:
-            raise CalibrationError(
-                f"pair{'s' if len(unbound) > 1 else ''} {', '.join(map(str, unbound))} {'carry' if len(unbound) > 1 else 'carries'} no robot pose "
-                "(picked outside the program's frames, or saved by an older videocal): pick the image point again, on a frame of this pose"
-            )
-        self.check_same_state(use)
-        joints = np.array(use[0].view.joints_deg) if use else self.joints_deg
-        self.current_pair = None
-        result = self.session.calibrate(self.intrinsics, obj2world, self.robot.fk(joints, "camera"), self.robot.fk(joints, "tcp"), joints)
-        self.solved.emit()
-        return result
-
+    # --- the camera model ------------------------------------------------------------------------
     def apply_hand_eye_file(self, path) -> None:
         """Use a measured camera mounting in place of the model's: ``videocal calibrate-hand-eye`` output, easy_handeye2's
         ``.calib``, or a ``static_transform_publisher`` launch file (MoveIt 2's hand-eye result) on any frame of the arm
@@ -262,22 +280,15 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
         flange = self.robot.frame_placement("flange")
         self.robot.set_frame_placement("camera", concat(cam2flange, flange))
-        self.camera_model_changed.emit()
-        self.message.emit(why)
+        self.cell.robot_edited()
+        self.log.say(why)
 
     def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
         """Use calibrated intrinsics for picking, solving and the virtual camera (the size must match)."""
         if (intrinsics.width, intrinsics.height) != (self.intrinsics.width, self.intrinsics.height):
             raise CalibrationError(f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px")
-        self.use_intrinsics(intrinsics)
-        self.message.emit(why)
-
-    def use_intrinsics(self, intrinsics: Intrinsics) -> None:
-        """Picks, solves and the virtual camera use ``intrinsics`` from now on (a replay uses the
-        recording's camera while it plays, whatever its size)."""
-        if intrinsics != self.cell.intrinsics:
-            self.cell.intrinsics = intrinsics
-            self.camera_model_changed.emit()
+        self.cell.use_intrinsics(intrinsics)
+        self.log.say(why)
 
     # --- the calibration board --------------------------------------------------------------------
     def board_placement(self, spec) -> np.ndarray:
@@ -292,11 +303,10 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         from calib_core.vision.board import board_item
 
         board2base = self.board_placement(spec)
-        self.scene_extras = [board_item(spec, board2base)] if on else []
+        extras = [board_item(spec, board2base)] if on else []
         if self.site is not None:
-            self.site.put_up(list(self.scene_extras))
-        self.scene_version += 1
-        self.scene_changed.emit()
+            self.site.put_up(list(extras))
+        self.cell.put_up(extras)
         return board2base
 
     def board_view_plan(self, spec, n: int = 16) -> list[np.ndarray]:
@@ -305,13 +315,48 @@ class OperatorCore(SessionFiles, Picking, Moves, PointFinding, RobotCalibrating,
         with the robot itself and the cell (the board among it); a pose without such a path is left out."""
         from calib_core.vision.board_placement import board_view_joints
 
-        world = self.collision_world()
+        world = self.cell.collision_world()
         plan, q = [], np.asarray(self.joints_deg, dtype=float)
         for goal in board_view_joints(self.robot, self.cell.home_joints, spec, self.board_placement(spec), n):
             if not any(world.check(p) for p in joint_path(q, goal)):
                 plan.append(goal)
                 q = goal
         return plan
+
+    def start_recording(self, path, **options) -> None:
+        """Record the session to ``path`` (MCAP); ``options`` go to the
+        :class:`~calib_core.recording.recorder.SessionRecorder` (``frames="jpeg"``, ``clock``...)."""
+        from calib_core.operator.recording_tap import RecordingTap
+        from calib_core.recording.recorder import SessionRecorder
+
+        self.stop_recording()
+        self.recorder = SessionRecorder(path, **options)
+        self._tap = RecordingTap(self, self.recorder)
+        self.log.say(f"recording to {path}")
+
+    def recording_failure(self) -> str | None:
+        """Poll the recorder (the window does on its status tick): when its disk or encoder failed, the
+        recording is stopped and the reason returned, once. ``None`` while all is well."""
+        rec = self.recorder
+        if rec is None or rec.failure is None:
+            return None
+        failure = rec.failure
+        self.stop_recording()
+        return failure
+
+    def stop_recording(self) -> None:
+        rec = self.recorder
+        if rec is not None:
+            self._tap.detach()
+            rec.close()
+            if rec.failure is not None:
+                self.log.say(f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal recover` completes it")
+            elif not rec.finished:
+                self.log.say(f"recording {rec.path}: the file is being finished in the background")
+            else:
+                dropped = f", {rec.frames_dropped} frames dropped" if rec.frames_dropped else ""
+                self.log.say(f"recording {rec.path} closed ({rec.messages} messages, {rec.frames_written} frames{dropped})")
+        self.recorder, self._tap = None, None
 
     def close(self) -> None:
         rec = self.recorder

@@ -1,22 +1,46 @@
 """The operator core's correction desk: where a look counts (:mod:`~calib_core.calibration.look_place`), storing it
 as the task location's correction (or keeping it as a measurement), the conversion a look from elsewhere needs, and
 *Verify* after the corrected task was executed. Every stored correction is announced by ``correction_stored``.
+
+A part of :class:`~calib_core.operator.core.OperatorCore` (``core.desk``), given the cell, the session, the task
+choice, the arm (how the last move ended), the picking (the solve Verify makes), the robot calibration (the
+model a look is fused with, the measured tool) and the log.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from psygnal import Signal
 
 from calib_core.calibration.look_place import LookNotAtTask, LookPlace, place_of_look
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.calibration.verification import Verification, verify
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.frames import concat, invert, pose_difference
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
 from calib_core.operator.motion import Motion
+from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.picking import Picking
+from calib_core.operator.robot_calibrating import RobotCalibrating
+from calib_core.operator.task_choice import TaskChoice
 
 
 class CorrectionDesk:
-    """Mixed into :class:`~calib_core.operator.core.OperatorCore`: reads its task, session, robot and motion."""
+    """Event: ``correction_stored(correction)`` after a correction or a measurement is stored."""
+
+    correction_stored = Signal(object)
+
+    def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, arm: Arm, picking: Picking, robot_calibration: RobotCalibrating, log: OperatorLog):
+        self.cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log = cell, session, tasks, arm, picking, robot_calibration, log
+
+    @property
+    def task(self):
+        return self.tasks.task
+
+    @property
+    def robot(self):
+        return self.cell.robot
 
     def look_place(self) -> LookPlace | None:
         """Where the last result's look was made against the chosen task location (``None`` before a
@@ -34,8 +58,8 @@ class CorrectionDesk:
         pose (or its corrected pose) counts (:mod:`~calib_core.calibration.look_place`); any other raises
         :class:`LookNotAtTask` unless ``convert`` says who converted it and why (kept with the correction
         and recorded). One that is not ``ok`` needs ``confirmation`` likewise. With a robot calibration
-        applied, the look is stored fused with the calibrated model (:meth:`look_fused_with_robot`); with a
-        measured tool (:meth:`measure_tool`) its covariance is in the stored 1-sigma either way."""
+        applied, the look is stored fused with the calibrated model (:meth:`~calib_core.operator.robot_calibrating.RobotCalibrating.look_fused_with_robot`); with a
+        measured tool (:meth:`~calib_core.operator.tool_measuring.ToolMeasuring.measure_tool`) its covariance is in the stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
         if self.session.result is None:
@@ -47,21 +71,21 @@ class CorrectionDesk:
             raise CalibrationError("the look carries no robot pose: pick the image points again on a frame of this pose, then Calibrate")
         if not place.counts and not convert.strip():
             raise LookNotAtTask(place, *self._conversion_change())
-        tool, context = getattr(self, "measured_tool", None), self.session.context
+        tool, context = self.robot_calibration.measured_tool, self.session.context
         tool_covariance = None
         if tool is not None and context.joints_deg is not None:
             tool_covariance = tool.covariance_in_base(self.robot.fk(context.joints_deg, "camera"))
         source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
         if source:
             source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source
-        c = self.session.store_correction(self.task.name, source, confirmation=confirmation, fused=self.look_fused_with_robot(self.session.result),
+        c = self.session.store_correction(self.task.name, source, confirmation=confirmation, fused=self.robot_calibration.look_fused_with_robot(self.session.result),
                                           tool_covariance=tool_covariance)
         if not place.counts:
-            self.record_event("look_converted", task=c.task, at=place.at, offset_mm=place.offset_mm, offset_deg=place.offset_deg, source=place.source, conversion=convert.strip())
+            self.log.record("look_converted", task=c.task, at=place.at, offset_mm=place.offset_mm, offset_deg=place.offset_deg, source=place.source, conversion=convert.strip())
         if c.confirmation:
-            self.record_event("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
+            self.log.record("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)
-        self.message.emit(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
+        self.log.say(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
         return c
 
     def store_measurement(self):
@@ -73,7 +97,7 @@ class CorrectionDesk:
         where = place.text if place is not None else "a look without a robot pose"
         c = self.session.store_correction(self.task.name, f"measurement: {where}", kind="measurement")
         self.correction_stored.emit(c)
-        self.message.emit(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
+        self.log.say(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
         return c
 
     def _conversion_change(self) -> tuple[float, float]:
@@ -96,15 +120,16 @@ class CorrectionDesk:
         if correction is None:
             raise CalibrationError(f"no stored correction for {task.name}: calibrate, store and execute one first")
         executed = f"{task.name} (task, corrected)"
-        if self.motion.motion is not Motion.ARRIVED or self.motion.what != executed:
-            raise CalibrationError(f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({self.motion.text})")
+        motion = self.arm.state
+        if motion.motion is not Motion.ARRIVED or motion.what != executed:
+            raise CalibrationError(f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({motion.text})")
         use = self.session.pairs.usable()
-        here = [p for p in use if p.view is not None and np.max(np.abs(np.array(p.view.joints_deg) - self.joints_deg)) <= SAME_STATE_DEG]
+        here = [p for p in use if p.view is not None and np.max(np.abs(np.array(p.view.joints_deg) - self.arm.joints_deg)) <= SAME_STATE_DEG]
         if len(here) != len(use) or not use:
             raise CalibrationError("the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify")
-        look = self.calibrate()
+        look = self.picking.calibrate()
         v = verify(task.name, task.tcp2base, correction, look, task.tolerance_mm)
         self.session.corrections.add_verification(v)
-        self.record_event("verified", task=task.name, remaining_mm=v.remaining_mm.tolist(), std_remaining_mm=v.std_remaining_mm.tolist(), disagreement_mm=v.disagreement_mm, agree=v.agree, within_tolerance=v.within_tolerance, tolerance_mm=v.tolerance_mm)
-        self.message.emit(v.text)
+        self.log.record("verified", task=task.name, remaining_mm=v.remaining_mm.tolist(), std_remaining_mm=v.std_remaining_mm.tolist(), disagreement_mm=v.disagreement_mm, agree=v.agree, within_tolerance=v.within_tolerance, tolerance_mm=v.tolerance_mm)
+        self.log.say(v.text)
         return v

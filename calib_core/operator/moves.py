@@ -3,7 +3,8 @@ or corrected), and the collision world every move is checked against (the cell a
 with what is put up in it). The moves themselves, their preview, confirmation and Stop are the arm's
 (:mod:`calib_core.operator.arm`); the core's methods here hand them on.
 
-A mixin of :class:`~calib_core.operator.core.OperatorCore`: it uses the core's arm, task, session and scene.
+A part of :class:`~calib_core.operator.core.OperatorCore` (``core.moves``), given the cell, the session (its
+corrections), the task choice and the arm.
 """
 
 from __future__ import annotations
@@ -12,11 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.link.link_types import MoveHandle
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
 from calib_core.operator.move_preview import Confirmation, MovePreview
+from calib_core.operator.task_choice import TaskChoice
 from calib_core.robot import solve_ik
-from calib_core.robot.collision import CollisionWorld
 
 NEAR_LIMIT_DEG = 10.0  # a simulated path's goal this close to a joint limit is worth a warning
 
@@ -33,12 +36,12 @@ class SimulatedPath:
 class Moves:
     """Moves of the core's robot, by name (``core.arm`` makes them)."""
 
-    def collision_world(self) -> CollisionWorld:
-        """The robot's collision bodies and the cell's components (and what is put up in it, a board)."""
-        if self._collision_world is None or self._collision_version != self.scene_version:
-            self._collision_world = CollisionWorld(self.robot, list(self.workcell.components) + list(self.scene_extras), self.cell.home_joints)
-            self._collision_version = self.scene_version
-        return self._collision_world
+    def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, arm: Arm):
+        self.cell, self.session, self.tasks, self.arm = cell, session, tasks, arm
+
+    @property
+    def task(self):
+        return self.tasks.task
 
     def preview_move(self, q, what: str, allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
         return self.arm.preview(q, what, allowed_contacts)
@@ -72,8 +75,8 @@ class Moves:
         space over ``steps`` steps (IK from the current joints), with the goal's joints near a limit named."""
         if self.task is None:
             raise CalibrationError("choose a task location first")
-        robot = self.robot
-        start = np.array(self.joints_deg, dtype=float)
+        robot = self.cell.robot
+        start = np.array(self.arm.joints_deg, dtype=float)
         goal = solve_ik(robot, self.task.approach2base, start).q_deg
         margin = np.minimum(goal - robot.lower_limits_deg, robot.upper_limits_deg - goal)
         near = [f"joint {robot.joint_names[i]} within {m:.1f} {robot.joint_units[i]} of its limit" for i, m in enumerate(margin) if m < NEAR_LIMIT_DEG]

@@ -1,6 +1,7 @@
-"""The paper's *Point* and *Accept* on frames bound to the robot state they were captured in.
+"""The paper's *Point*, *Accept* and *Calibrate* on frames bound to the robot state they were captured in.
 
-A mixin of :class:`~calib_core.operator.core.OperatorCore`. Frames arrive through
+A part of :class:`~calib_core.operator.core.OperatorCore` (``core.picking``), given the cell, the session, the
+frames (:class:`~calib_core.operator.observations.Observations`), the arm and the log it writes to. Frames arrive through
 :meth:`Picking.observe_frame` (live, or from a recording being replayed); the first image pick of
 a set holds the newest frame, only when the robot had settled before it; every image pick
 carries that frame's :class:`~calib_core.calibration.view_stamp.ViewStamp`; pairs of two robot
@@ -11,17 +12,69 @@ from __future__ import annotations
 
 import time
 
-from calib_core.calibration.session import CalibrationError
+import numpy as np
+from psygnal import Signal
+
+from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
 from calib_core.link.joint_history import JointHistory
-from calib_core.operator.observations import HeldFrame, NotSettledError
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
+from calib_core.operator.observations import HeldFrame, NotSettledError, Observations
+from calib_core.operator.operator_log import OperatorLog
 from calib_core.vision.corner_pick import refine_corner_pick
 
 
 class Picking:
-    """Frames, the held still and the pair being made."""
+    """Frames, the held still, the pair being made (``current_pair``) and the solve of the pairs.
+    Event: ``solved()`` after :meth:`calibrate`."""
+
+    solved = Signal()
+
+    def __init__(self, cell: Cell, session: CalibrationSession, observations: Observations, arm: Arm, log: OperatorLog):
+        self.cell, self.session, self.observations, self.arm, self.log = cell, session, observations, arm, log
+        self.current_pair: int | None = None
+        """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
+        session.pairs.changed.connect(self.release_unused_still)
+
+    @property
+    def workcell(self):
+        return self.cell.workcell
+
+    @property
+    def robot(self):
+        return self.cell.robot
+
+    @property
+    def intrinsics(self):
+        return self.cell.intrinsics
+
+    def let_go(self) -> None:
+        """No pair is being made any more (after an undo, a solve): the next image click starts none."""
+        self.current_pair = None
+
+    def calibrate(self):
+        """*Calibrate*: solve the usable pairs (all from one robot pose) for the camera's pose, hence the
+        tool's; the result is shown through an undoable command. Emits ``solved``."""
+        target = self.session.target
+        if target is None:
+            raise CalibrationError("choose the target object first")
+        obj2world = self.workcell.component(target).item2world
+        use = self.session.pairs.usable()
+        unbound = [p.number for p in use if p.view is None]
+        if unbound:
+            raise CalibrationError(
+                f"pair{'s' if len(unbound) > 1 else ''} {', '.join(map(str, unbound))} {'carry' if len(unbound) > 1 else 'carries'} no robot pose "
+                "(picked outside the program's frames, or saved by an older videocal): pick the image point again, on a frame of this pose"
+            )
+        self.check_same_state(use)
+        joints = np.array(use[0].view.joints_deg) if use else self.arm.joints_deg
+        self.current_pair = None
+        result = self.session.calibrate(self.intrinsics, obj2world, self.robot.fk(joints, "camera"), self.robot.fk(joints, "tcp"), joints)
+        self.solved.emit()
+        return result
 
     def pick_model_point(self, component: str, feature: str | None, point_world_mm) -> int:
         """*Point*, first half: a point on the target's model (3,) mm in base. A new model pick
@@ -30,7 +83,7 @@ class Picking:
         if pending is not None:
             self.session.delete(pending.number)
         self.current_pair = self.session.pick_3d(component, feature, point_world_mm)
-        self.message.emit(f"pair {self.current_pair}: now pick {feature or 'the point'} on the camera image")
+        self.log.say(f"pair {self.current_pair}: now pick {feature or 'the point'} on the camera image")
         return self.current_pair
 
     def pick_image_point(self, pixel, *, refine: bool = False) -> int:
@@ -69,15 +122,13 @@ class Picking:
         if refine and shown is not None:
             pixel = refine_corner_pick(shown.image, pixel)
         self.session.move_2d(number, pixel, view)
-        self.record_event("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
+        self.log.record("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
 
     def _pick_pose(self):
         """The target's pose in the camera for the frame being picked on: ``(obj2cam (4, 4), basis)``, from
         the complete pairs on that frame when there are three or more, else from the model's camera."""
-        import numpy as np
-
         held = self.observations.still
-        joints = np.asarray(held.stamp.joints_deg if held is not None else self.joints_deg, dtype=float)
+        joints = np.asarray(held.stamp.joints_deg if held is not None else self.arm.joints_deg, dtype=float)
         obj2world = self.workcell.component(self.session.target).item2world
         obj2cam = concat(obj2world, invert(self.robot.fk(joints, "camera")))
         done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
@@ -97,8 +148,6 @@ class Picking:
     def expected_pixel(self):
         """Where the pair waiting for its image point should lie on the frame being picked on: ``(uv (2,)
         px, basis)`` (see :meth:`_pick_pose`); ``None`` when no pair waits."""
-        import numpy as np
-
         from calib_core.camera.projection import project_points
 
         pending = self.session.pairs.pending()
@@ -121,8 +170,6 @@ class Picking:
         """A click on a round feature (the waiting pair's feature is a circle in the workcell) moved to the
         rim's centre: the rim the model predicts, placed at the click, fitted to the image's edges within
         4 px, corrected for perspective. ``None`` when the feature is no circle or no rim was found."""
-        import numpy as np
-
         from calib_core.camera.projection import project_points
         from calib_core.vision.feature_detectors import Detection, detect_circle
         from calib_core.vision.target_detectors import as_grey, circle_rim
@@ -175,7 +222,7 @@ class Picking:
     def hold_frame(self) -> HeldFrame:
         """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
         held = self.observations.hold()
-        self.record_event("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
+        self.log.record("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
         return held
 
     def frame_to_capture(self) -> tuple:
@@ -186,9 +233,10 @@ class Picking:
         frame = self.observations.newest_usable()
         if frame is None:
             raise OperatorError("no camera frame yet: start the camera (Execute > Live) or open a recording")
-        if not self.replaying and self.last_move_sent_s is not None and frame.t_host_s <= self.last_move_sent_s:
-            raise NotSettledError(f"frame {frame.index} was taken before the last move ({self.motion.what}) was sent: wait for a frame from where the robot stands now")
-        has_robot = self.replaying or self.link is not None
+        sent_s = self.arm.last_move_sent_s
+        if not self.replaying and sent_s is not None and frame.t_host_s <= sent_s:
+            raise NotSettledError(f"frame {frame.index} was taken before the last move ({self.arm.state.what}) was sent: wait for a frame from where the robot stands now")
+        has_robot = self.replaying or self.arm.link is not None
         return frame, (self.observations.stamp(frame) if has_robot else None)
 
     def stamp_frame(self, frame) -> ViewStamp:
@@ -199,7 +247,8 @@ class Picking:
         """Back to the live image for picking (the pairs keep their stamps)."""
         self.observations.release()
 
-    def _release_unused_still(self, *_) -> None:
+    def release_unused_still(self, *_) -> None:
+        """Back to the live image when no complete pair is picked on the held frame."""
         if self.observations.still is not None and not any(p.complete for p in self.session.pairs):
             self.release_frame()
 
@@ -219,7 +268,7 @@ class Picking:
         if self.current_pair is None:
             raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
         number, self.current_pair = self.current_pair, None
-        self.record_event("pair_accepted", number=number)
+        self.log.record("pair_accepted", number=number)
         return number
 
     def delete_pair(self, number: int | None = None) -> int:

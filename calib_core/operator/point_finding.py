@@ -1,5 +1,6 @@
 """*Find points*: the target's features located in the held frame and proposed as pairs, accepted
-in one undoable step. A mixin of :class:`~calib_core.operator.core.OperatorCore`.
+in one undoable step. A part of :class:`~calib_core.operator.core.OperatorCore` (``core.finder``), given the
+cell, the session, the picking (its held frame and its rule of one robot pose) and the log.
 
 The frame is held as for a pick (refused while the robot moves), so the proposals carry its
 :class:`~calib_core.calibration.view_stamp.ViewStamp`; the modelled camera pose is the robot model's
@@ -12,12 +13,16 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from psygnal import Signal
 
 from calib_core.calibration.commands import AddPairs
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
+from calib_core.operator.cell import Cell
+from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.picking import Picking
 
 if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
     from calib_core.vision.find_points import FoundPoints
@@ -32,8 +37,29 @@ class FoundOnFrame:
 
 
 class PointFinding:
-    found: FoundOnFrame | None = None
-    _model_view = None
+    """Events: ``points_found(found)`` (a :class:`FoundOnFrame`; ``None``: the proposals withdrawn),
+    ``solved()`` after :meth:`calibrate_on_edges`."""
+
+    points_found = Signal(object)
+    solved = Signal()
+
+    def __init__(self, cell: Cell, session: CalibrationSession, picking: Picking, log: OperatorLog):
+        self.cell, self.session, self.picking, self.log = cell, session, picking, log
+        self.found: FoundOnFrame | None = None
+        """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or dismissed)."""
+        self._model_view = None
+
+    @property
+    def workcell(self):
+        return self.cell.workcell
+
+    @property
+    def robot(self):
+        return self.cell.robot
+
+    @property
+    def intrinsics(self):
+        return self.cell.intrinsics
 
     def find_points(self) -> FoundOnFrame:
         """Locate the target's features in the held frame (holding the newest one first). Emits
@@ -41,7 +67,7 @@ class PointFinding:
         target = self.session.target
         if target is None:
             raise CalibrationError("choose the target object first")
-        held = self.observations.still or self.hold_frame()
+        held = self.picking.observations.still or self.picking.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.workcell.component(target)
         obj2cam_model = concat(item.item2world, invert(self.robot.fk(q, "camera")))
@@ -49,10 +75,10 @@ class PointFinding:
 
         result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))
         self.found = FoundOnFrame(result, held.stamp)
-        self.record_event("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
+        self.log.record("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
                           missed={m.feature: m.reason for m in result.missed}, seconds=round(result.seconds, 3))
         self.points_found.emit(self.found)
-        self.message.emit(result.message)
+        self.log.say(result.message)
         return self.found
 
     def dismiss_found_points(self) -> None:
@@ -69,7 +95,7 @@ class PointFinding:
             if self._model_view is not None:
                 self._model_view.close()
             self._model_view = ModelView(self.intrinsics)
-        return self._model_view.of_cell(self.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.scene_extras))
+        return self._model_view.of_cell(self.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.cell.extras))
 
     def calibrate_on_edges(self):
         """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's
@@ -90,7 +116,7 @@ class PointFinding:
         inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.intrinsics, prior=concat(item.item2world, invert(cam2world_model)))
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.session.last_solve_inputs = inputs
-        self.current_pair = None
+        self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
         estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.intrinsics,
                                           view_sources=(found.view.source,), label="Calibrate on edges")
@@ -115,12 +141,12 @@ class PointFinding:
         fresh = [p for p in chosen if p.feature not in paired]
         if not fresh:
             raise OperatorError(f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})")
-        self.check_same_state([p for p in session.pairs if p.complete], found.view)
+        self.picking.check_same_state([p for p in session.pairs if p.complete], found.view)
         item = self.workcell.component(found.result.component)
         spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]
         command = AddPairs(session.pairs, spec, found.view)
         session.undo.push(command)
         numbers = [pair.number for pair in command.added]
-        self.record_event("found_points_accepted", numbers=numbers, features=[p.feature for p in fresh])
+        self.log.record("found_points_accepted", numbers=numbers, features=[p.feature for p in fresh])
         self.found = None
         return numbers

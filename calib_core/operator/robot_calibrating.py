@@ -1,5 +1,10 @@
 """The operator core's robot calibration: plan the poses, run them (:class:`CalibrationRun`),
-identify, apply the result to the cell's robot (and take it back), save it."""
+identify, apply the result to the cell's robot (and take it back), save it. The one owner of the changes
+made to the cell's robot in place: a calibration applied, a measured tool (:mod:`~calib_core.operator.tool_measuring`
+measures it, this puts it in), and Revert, which takes both back.
+
+A part of :class:`~calib_core.operator.core.OperatorCore` (``core.robot_calibration``), given the cell, the
+session (the look to fuse), the arm (where the robot stands, the moves of a run) and the log."""
 
 from __future__ import annotations
 
@@ -9,14 +14,38 @@ from pathlib import Path
 
 import numpy as np
 
+from calib_core.calibration.session import CalibrationSession
 from calib_core.errors import OperatorError
 from calib_core.frames import concat, invert
+from calib_core.operator.arm import Arm
 from calib_core.operator.calibration_run import VIA
+from calib_core.operator.cell import Cell
+from calib_core.operator.operator_log import OperatorLog
 from calib_core.robot.model import _to_mm, _to_se3
 
 
 class RobotCalibrating:
-    """Mixed into :class:`~calib_core.operator.core.OperatorCore`."""
+    """``applied_robot_calibration`` (the result in use, or ``None``), ``measured_tool`` (a
+    :class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool` in use, or ``None``)."""
+
+    def __init__(self, cell: Cell, session: CalibrationSession, arm: Arm, log: OperatorLog):
+        self.cell, self.session, self.arm, self.log = cell, session, arm, log
+        self.applied_robot_calibration = None
+        self.measured_tool = None
+        self._robot_before_calibration = None
+        self._intrinsics_before_calibration = None
+
+    @property
+    def workcell(self):
+        return self.cell.workcell
+
+    @property
+    def robot(self):
+        return self.cell.robot
+
+    @property
+    def intrinsics(self):
+        return self.cell.intrinsics
 
     def plan_robot_calibration(self, spec, n: int = 40, *, cell_views_per_target: int = 3):
         """A :class:`~calib_core.robot_calibration.pose_planner.PosePlan` of ``n`` poses seeing the
@@ -27,9 +56,12 @@ class RobotCalibrating:
         from calib_core.robot_calibration.cell_views import cell_view_joints
         from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 
-        world = self.collision_world()
-        plan = plan_poses(self.robot, self.intrinsics, spec, self.board_placement(spec), n, start_deg=self.joints_deg, collisions=world, candidates=max(60, 3 * n))
-        kept, q = [], np.asarray(self.joints_deg, dtype=float)
+        from calib_core.vision.board_placement import board_in_cell
+
+        world = self.cell.collision_world()
+        start = np.asarray(self.arm.joints_deg, dtype=float)
+        plan = plan_poses(self.robot, self.intrinsics, spec, board_in_cell(spec, self.workcell, self.robot), n, start_deg=start, collisions=world, candidates=max(60, 3 * n))
+        kept, q = [], start
         for goal in plan.joints_deg:
             if not any(world.check(p) for p in joint_path(q, goal)):
                 kept.append(goal)
@@ -58,7 +90,7 @@ class RobotCalibrating:
         components' ``cell_views`` ((component, joints deg)), not started."""
         from calib_core.operator.calibration_run import CalibrationRun
 
-        return CalibrationRun(self, spec, plan, cell_views)
+        return CalibrationRun(self.arm, self.log, spec, plan, cell_views)
 
     def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False, progress=None):
         """Identify the robot from a :class:`~calib_core.vision.capture.BoardCapture`'s views with
@@ -75,10 +107,10 @@ class RobotCalibrating:
             raise OperatorError(f"{len(posed)} views with a robot pose, at least 6 needed (run the calibration plan)")
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
-        done = identify_robot(self.robot, self.intrinsics, self.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.scene_extras,
+        done = identify_robot(self.robot, self.intrinsics, self.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.cell.extras,
                               with_intrinsics=with_intrinsics, progress=progress)
         result = done.result
-        self.record_event("robot_calibrated", views=done.board_views, component_views=done.cell_views, rms_px=result.rms_px, identified=len(result.observability.identified))
+        self.log.record("robot_calibrated", views=done.board_views, component_views=done.cell_views, rms_px=result.rms_px, identified=len(result.observability.identified))
         return result
 
     def apply_robot_calibration(self, result) -> None:
@@ -92,13 +124,12 @@ class RobotCalibrating:
         self.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
         self.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
         if result.intrinsics != self.intrinsics:  # refined with the robot: the camera as the same fit saw it
-            if getattr(self, "_intrinsics_before_calibration", None) is None:
+            if self._intrinsics_before_calibration is None:
                 self._intrinsics_before_calibration = self.intrinsics
-            self.use_intrinsics(result.intrinsics)
-        self.record_event("robot_calibration_applied", rms_px=result.rms_px)
-        self.camera_model_changed.emit()
-        self.scene_changed.emit()
-        self.message.emit(f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)")
+            self.cell.use_intrinsics(result.intrinsics)
+        self.log.record("robot_calibration_applied", rms_px=result.rms_px)
+        self.cell.robot_edited()
+        self.log.say(f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)")
 
     def look_fused_with_robot(self, look):
         """The look (an :class:`~calib_core.calibration.end_effector.EndEffectorEstimate` at its
@@ -106,7 +137,7 @@ class RobotCalibrating:
         (:func:`~calib_core.calibration.look_fusion.fuse_look`: the model's TCP covariance there, the
         component placed to the survey's sigma); ``None`` without an applied robot calibration or a
         look without covariance."""
-        result = getattr(self, "applied_robot_calibration", None)
+        result = self.applied_robot_calibration
         context = self.session.context
         if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
             return None
@@ -117,7 +148,7 @@ class RobotCalibrating:
         cam2base = self.robot.fk(q, "camera")
         model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, concat(self.robot.fk(q, "tcp"), invert(cam2base)))
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
-        tool = getattr(self, "measured_tool", None)
+        tool = self.measured_tool
         tool_covariance = tool.covariance_in_base(cam2base) if tool is not None else None
         if tool_covariance is None:
             return fused
@@ -126,11 +157,16 @@ class RobotCalibrating:
 
     def keep_robot_before_calibration(self) -> None:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
-        if getattr(self, "_robot_before_calibration", None) is None:
+        if self._robot_before_calibration is None:
             self._robot_before_calibration = ([_to_mm(p) for p in self.robot.model.jointPlacements], self.robot.frame_placement("camera"), self.robot.frame_placement("tcp"))
 
+    @property
+    def can_revert(self) -> bool:
+        """Whether the robot in use differs from the one loaded (a calibration applied, a tool measured)."""
+        return self._robot_before_calibration is not None
+
     def revert_robot_calibration(self) -> None:
-        before = getattr(self, "_robot_before_calibration", None)
+        before = self._robot_before_calibration
         if before is None:
             raise OperatorError("no robot calibration is applied")
         placements, camera, tcp = before
@@ -141,13 +177,22 @@ class RobotCalibrating:
         self._robot_before_calibration = None
         self.applied_robot_calibration = None
         self.measured_tool = None
-        if getattr(self, "_intrinsics_before_calibration", None) is not None:
-            self.use_intrinsics(self._intrinsics_before_calibration)
+        if self._intrinsics_before_calibration is not None:
+            self.cell.use_intrinsics(self._intrinsics_before_calibration)
             self._intrinsics_before_calibration = None
-        self.record_event("robot_calibration_reverted")
-        self.camera_model_changed.emit()
-        self.scene_changed.emit()
-        self.message.emit("the robot's model as loaded is in use again")
+        self.log.record("robot_calibration_reverted")
+        self.cell.robot_edited()
+        self.log.say("the robot's model as loaded is in use again")
+
+    def use_tool(self, tool) -> None:
+        """Put a measured tool (:class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool`) into the
+        robot's TCP frame; Revert takes it back."""
+        from calib_core.robot_calibration.camera_to_tool import with_tool
+
+        self.keep_robot_before_calibration()
+        self.measured_tool = tool
+        self.robot.set_frame_placement("tcp", with_tool(self.robot, tool.tcp2cam).frame_placement("tcp"))
+        self.cell.robot_edited()
 
     def save_robot_calibration(self, folder, result, tool=None) -> tuple[Path, Path]:
         """``robot_calibration.yaml`` and the calibrated URDF into ``folder``; with ``tool`` (from
@@ -158,5 +203,5 @@ class RobotCalibrating:
         Path(folder).mkdir(parents=True, exist_ok=True)
         robot = with_tool(result.robot, tool.tcp2cam) if tool is not None else None
         paths = save_robot_calibration(folder, result, result.nominal, robot=robot, tool=tool)
-        self.message.emit(f"robot calibration saved to {paths[0]} and {paths[1]}")
+        self.log.say(f"robot calibration saved to {paths[0]} and {paths[1]}")
         return paths

@@ -9,6 +9,10 @@ frame (:mod:`calib_core.robot_calibration.grasp_view`: neither the fixture's sur
 calibration enters); :meth:`ToolMeasuring.measure_tool` gives the TCP in the camera frame from all of them
 through the robot as it is now (calibrated first, or the camera's errors go into the tool) and puts it
 into the robot's TCP frame, undone by Revert like a robot calibration.
+
+A part of :class:`~calib_core.operator.core.OperatorCore` (``core.tool``), given the cell, the task choice, the
+arm, the picking (the frame held for a grasp), Find points (the modelled view a grasp is checked against), the
+robot calibration (which puts the tool in) and the log.
 """
 
 from __future__ import annotations
@@ -16,17 +20,30 @@ from __future__ import annotations
 import numpy as np
 
 from calib_core.errors import OperatorError
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
 from calib_core.operator.motion import Motion
+from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.picking import Picking
+from calib_core.operator.point_finding import PointFinding
+from calib_core.operator.robot_calibrating import RobotCalibrating
+from calib_core.operator.task_choice import TaskChoice
 
 
 class ToolMeasuring:
-    """Mixed into :class:`~calib_core.operator.core.OperatorCore`."""
+    """``grasps``: the :class:`~calib_core.robot_calibration.camera_to_tool.Grasp` recorded so far."""
+
+    def __init__(self, cell: Cell, tasks: TaskChoice, arm: Arm, picking: Picking, finder: PointFinding, robot_calibration: RobotCalibrating, log: OperatorLog):
+        self.cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log = cell, tasks, arm, picking, finder, robot_calibration, log
+        self.grasps: list = []
 
     @property
-    def grasps(self) -> list:
-        if not hasattr(self, "_grasps"):
-            self._grasps = []
-        return self._grasps
+    def task(self):
+        return self.tasks.task
+
+    @property
+    def robot(self):
+        return self.cell.robot
 
     def record_grasp(self):
         """A :class:`~calib_core.robot_calibration.camera_to_tool.Grasp` at the current task
@@ -37,52 +54,48 @@ class ToolMeasuring:
 
         if self.task is None:
             raise OperatorError("choose a task location: the grasp puts the TCP on its fixture pin")
-        if not self.link_up:
+        if not self.arm.link_up:
             raise OperatorError("the controller link is down: a grasp needs the joints the controller reports")
-        if self.motion.motion in (Motion.MOVING, Motion.UNKNOWN):
-            raise OperatorError(f"the robot is {self.motion.motion.value}: record the grasp once it stands with the gripper closed on the pin")
-        q = np.array(self.joints_deg, dtype=float)
+        if self.arm.state.motion in (Motion.MOVING, Motion.UNKNOWN):
+            raise OperatorError(f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed on the pin")
+        q = np.array(self.arm.joints_deg, dtype=float)
         seen, how = None, "no camera frame: taken through the robot and the fixture's survey"
-        if self.observations.latest is not None:
-            held = self.hold_frame()  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
+        if self.picking.observations.latest is not None:
+            held = self.picking.hold_frame()  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
             q = np.asarray(held.stamp.joints_deg, dtype=float)
-            item = self.workcell.component(self.task.component) if self.task.component else None
+            workcell = self.cell.workcell
+            item = workcell.component(self.task.component) if self.task.component else None
             try:
-                seen = see_grasp(held.frame.image, self.intrinsics, self.robot, self.workcell, self.task, q,
-                                 expected=self.modelled_view(q, item) if item is not None else None)
+                seen = see_grasp(held.frame.image, self.cell.intrinsics, self.robot, workcell, self.task, q,
+                                 expected=self.finder.modelled_view(q, item) if item is not None else None)
                 how = f"seen on frame {held.stamp.frame_index} ({seen.edge_samples} edge samples of {seen.component})"
             except GraspNotSeenError as e:
                 how = f"not seen ({e}): taken through the robot and the fixture's survey"
-            self._release_unused_still()
+            self.picking.release_unused_still()
         grasp = Grasp(f"{self.task.name} #{sum(g.name.startswith(self.task.name + ' #') for g in self.grasps) + 1}", q, self.task.tcp2base.copy(), seen)
         self.grasps.append(grasp)
-        self.record_event("grasp_recorded", task=self.task.name, joints_deg=[float(v) for v in grasp.joints_deg], seen=seen is not None)
-        self.message.emit(f"grasp recorded at {self.task.name} ({len(self.grasps)} in all): {how}")
+        self.log.record("grasp_recorded", task=self.task.name, joints_deg=[float(v) for v in grasp.joints_deg], seen=seen is not None)
+        self.log.say(f"grasp recorded at {self.task.name} ({len(self.grasps)} in all): {how}")
         return grasp
 
     def clear_grasps(self) -> None:
         self.grasps.clear()
-        self.message.emit("grasps cleared")
+        self.log.say("grasps cleared")
 
     def measure_tool(self):
         """The TCP in the camera frame from the recorded grasps
         (:class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool`), put into the robot's TCP
         frame; Revert takes it back."""
-        from calib_core.robot_calibration.camera_to_tool import camera_to_tool, with_tool
+        from calib_core.robot_calibration.camera_to_tool import camera_to_tool
 
         if not self.grasps:
             raise OperatorError("record a grasp first: close the gripper on a task location's pin in compliance, then Record grasp")
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
-        calibration = getattr(self, "applied_robot_calibration", None)
+        calibration = self.robot_calibration.applied_robot_calibration
         tool = camera_to_tool(self.robot, self.grasps, placement_sigma_mm=SURVEY_SIGMA_MM,
                               camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None)
-        self.measured_tool = tool
-        placed = with_tool(self.robot, tool.tcp2cam)
-        self.keep_robot_before_calibration()
-        self.robot.set_frame_placement("tcp", placed.frame_placement("tcp"))
-        self.record_event("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
-        self.camera_model_changed.emit()
-        self.scene_changed.emit()
-        self.message.emit(f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
+        self.robot_calibration.use_tool(tool)
+        self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
+        self.log.say(f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
         return tool

@@ -241,8 +241,8 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     win.files.start_recording(tmp_path / "session.mcap")
     assert win.files.record_action.isChecked()
     wait_for_settled_frame(qtbot, win)  # a pick holds the newest frame: one taken with the robot settled
-    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
-    wb.pick_image_point((100.0, 120.0))
+    wb.picking.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.picking.pick_image_point((100.0, 120.0))
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
     qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
 
@@ -374,11 +374,11 @@ def test_a_refused_move_is_shown_and_ctrl_q_stops_the_simulator(qtbot, window):
     win, wb = window, window.workbench
     q = wb.joints_deg.copy()
     q[5] = wb.robot.upper_limits_deg[5] + 10.0
-    win.report(lambda: wb.move_joints(q, "a pose past the wrist's limit"))()
+    win.report(lambda: wb.moves.move_joints(q, "a pose past the wrist's limit"))()
     assert "outside its limits" in win.results.status.text()  # the core refuses it: nothing is sent
     # A model whose limits are wider than the controller's: the controller refuses the move, and the window says so.
     wb.robot.model.upperPositionLimit[5] += np.radians(20.0)
-    win.move(lambda confirmed: wb.move_joints(q, "a pose past the wrist's limit", confirmed=confirmed))
+    win.actions.move(lambda confirmed: wb.moves.move_joints(q, "a pose past the wrist's limit", confirmed=confirmed))
     confirm_move_if_asked(qtbot, win)
     qtbot.waitUntil(lambda: "LIMIT" in win.results.status.text(), timeout=10_000)
     assert "move to a pose past the wrist's limit failed" in win.results.status.text()

@@ -42,10 +42,10 @@ def test_a_component_is_added_placed_by_numbers_and_undone_in_one_step(qtbot, wi
     assert np.allclose(T[:3, 3], [1200.0, -150.0, 400.0]) and np.degrees(np.arctan2(T[1, 0], T[0, 0])) == pytest.approx(30.0)
     qtbot.waitUntil(lambda: win.virtual.renders > renders, timeout=5_000)  # the views follow
     assert wb.session.undo.undo_label == "Place crate"
-    win._undo()  # every placement of the crate at once
+    win.actions.undo()  # every placement of the crate at once
     assert np.allclose(wb.workcell.component("crate").item2world[:3, 3], [1000.0, 0.0, 0.0])
     assert panel.xyz[0].value() == pytest.approx(1000.0)
-    win._undo()
+    win.actions.undo()
     assert "crate" not in [c.name for c in wb.workcell.components] and win.commands.target.findText("crate") < 0
 
 

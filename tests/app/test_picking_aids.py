@@ -38,7 +38,7 @@ def test_the_expected_position_is_drawn_and_sharpens_after_three_pairs(qtbot, wi
         misses.append(float(np.linalg.norm(mark - uv_true)))
         texts.append(win.camera.view.overlay.text)
         _click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
-        wb.accept_pair()
+        wb.picking.accept_pair()
         assert _expected_mark(win) is None  # nothing waits: nothing expected
     # the first marks come from the model (the robot's error: many pixels off); the fourth from the pose
     # of the three pairs already made: within a couple of pixels
@@ -71,7 +71,7 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
         p_world = apply(fixture.item2world, fixture.features[name])
         _pick_on_model(qtbot, win, model_cam, p_world)
         _click_image(qtbot, win.camera.view, *project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0])
-        wb.accept_pair()
+        wb.picking.accept_pair()
     view = win.camera.view
     before = np.array(wb.session.pairs.get(2).pixel)
     x, y = view.image_to_widget(*before)
@@ -116,8 +116,8 @@ def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
         _pick_on_model(qtbot, win, model_cam, p_world)
         uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
         _click_image(qtbot, win.camera.view, *(uv_true + (2.5, -2.0)), zoom=4.0)  # a hand 3 px off
-        errors.append(float(np.linalg.norm(np.array(wb.session.pairs.get(wb.current_pair).pixel) - uv_true)))
-        wb.accept_pair()
+        errors.append(float(np.linalg.norm(np.array(wb.session.pairs.get(wb.picking.current_pair).pixel) - uv_true)))
+        wb.picking.accept_pair()
     # The hand was 3.2 px off. The boss's rim puts it within 0.1-1.1 px (by the frame's noise). The knob's
     # end-face rim lies within 2 px of its silhouette, and since the simulated camera integrates its pixels
     # (session 10) the two edges blend at 640 px: the rim found is 0.9-2.1 px from the truth, by frame.

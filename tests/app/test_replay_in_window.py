@@ -50,7 +50,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     before = _digest(recording)
     win.files.open_recording(recording)
     bar = win.replay
-    assert bar.isVisible() and wb.replaying and not win.commands.live.isChecked()
+    assert bar.isVisible() and wb.picking.replaying and not win.commands.live.isChecked()
     assert "replaying session.mcap" in win.statusBar().currentMessage()
 
     # Scrub to the middle of the pick sequence: that frame, those joints, those pairs, no result yet.
@@ -88,7 +88,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
 
     # Closing without an edit gives the live session back, pair and all.
     qtbot.mouseClick(bar.close_button, Qt.MouseButton.LeftButton)
-    assert not bar.isVisible() and not wb.replaying and win.commands.live.isChecked()
+    assert not bar.isVisible() and not wb.picking.replaying and win.commands.live.isChecked()
     assert [p.number for p in wb.session.pairs] == [live_pair]
     assert _digest(recording) == before
 
@@ -122,7 +122,7 @@ def test_bad_and_cut_off_recordings(qtbot, window, tmp_path, recording):
     junk.write_bytes(b"not a recording")
     win.files.open_recording(junk)
     assert "not an MCAP recording" in win.results.status.text() and "junk.mcap" in win.results.status.text()
-    assert not win.replay.isVisible() and not wb.replaying
+    assert not win.replay.isVisible() and not wb.picking.replaying
     # A recording cut off by a crash opens with what it holds and offers recovery.
     data = recording.read_bytes()
     cut = tmp_path / "cut.mcap"
@@ -185,7 +185,7 @@ def test_a_branchs_new_pair_is_numbered_after_the_recorded_ones_and_undo_stays_i
     recorded = wb.session.pairs.pairs()
     assert recorded and min(p.number for p in recorded) == 1
     fixture = wb.workcell.component("oru_1_fixture")
-    number = wb.pick_model_point("oru_1_fixture", "pin_tip", tuple(fixture.item2world[:3, 3]))
+    number = wb.picking.pick_model_point("oru_1_fixture", "pin_tip", tuple(fixture.item2world[:3, 3]))
     assert win.replay.branched_at_s is not None
     assert number == max(p.number for p in recorded) + 1
     win.camera.subpixel.setChecked(False)

@@ -87,7 +87,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     pins = {}
 
     def move(q, what, allowed=frozenset()):  # awaited until the reported joints are there: the next preview starts from them
-        handle = wb.move_joints(q, what, confirmed=True, allowed_contacts=allowed)
+        handle = wb.moves.move_joints(q, what, confirmed=True, allowed_contacts=allowed)
         qtbot.waitUntil(lambda: handle.finished and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=60_000)
 
     home = np.asarray(wb.cell.home_joints, dtype=float)
@@ -102,7 +102,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
         qtbot.mouseClick(tool.record_button, Qt.MouseButton.LeftButton)
         pins[task.name] = (q_pin, task.tcp2base)
         move(q_approach, f"{task.name} approach", frozenset({task.component}))  # back out of the fixture
-    assert len(wb.grasps) == 2 and "2 grasps" in tool.text.text(), win.statusBar().currentMessage()
+    assert len(wb.tool.grasps) == 2 and "2 grasps" in tool.text.text(), win.statusBar().currentMessage()
     before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
     assert tool.tool is not None and "TCP from 2 grasps (2 seen by the camera), spread" in tool.text.text()
@@ -130,11 +130,11 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     move(solve_ik(wb.robot, task.approach2base, home).q_deg, f"{task.name} approach")
     move(q_look, f"{task.name} task", frozenset({task.component}))
     wait_for_settled_frame(qtbot, win)
-    found = wb.find_points()
+    found = wb.finder.find_points()
     edges = found.result.edges
     assert edges is not None and edges.settled, (edges.converged, edges.rms_px, edges.inlier_share) if edges else "no edges"
-    look = wb.calibrate_on_edges()
-    fused = wb.look_fused_with_robot(look)
+    look = wb.finder.calibrate_on_edges()
+    fused = wb.robot_calibration.look_fused_with_robot(look)
     assert wb.session.verdict.ok and fused is not None and fused.agree, (wb.session.verdict, fused and fused.message)
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     stored = wb.session.corrections.latest(task.name)

@@ -42,7 +42,7 @@ def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale
 
     # The robot goes home; the still is let go (untick Hold): the picks and the result are of another pose.
     win.camera.freeze.setChecked(False)
-    wb.move_joints(wb.cell.home_joints, "home", confirmed=True)
+    wb.moves.move_joints(wb.cell.home_joints, "home", confirmed=True)
     qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
     wait_for_settled_frame(qtbot, win)
     overlay = win.camera.view.overlay
@@ -89,7 +89,7 @@ def test_a_click_while_the_robot_moves_picks_nothing(qtbot, window):
     qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 1.0, timeout=10_000)
     qtbot.waitUntil(lambda: not wb.observations.stillness(win.camera.last_frame_received).settled, timeout=5_000)
     fixture = wb.workcell.component("oru_1_fixture")
-    wb.pick_model_point("oru_1_fixture", "pin_tip", apply(fixture.item2world, fixture.features["pin_tip"]))
+    wb.picking.pick_model_point("oru_1_fixture", "pin_tip", apply(fixture.item2world, fixture.features["pin_tip"]))
     qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(200, 150))
     assert "nothing picked" in win.results.status.text() and "deg/s" in win.results.status.text()
     assert wb.session.pairs.pending() is not None and win.camera.held is None
@@ -134,7 +134,7 @@ def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_p
     qtbot.waitUntil(lambda: wb.recorder.messages > done + 20, timeout=10_000)
     win.files.stop_recording()
     win.camera.freeze.setChecked(False)
-    wb.move_joints(wb.cell.home_joints, "home", confirmed=True)
+    wb.moves.move_joints(wb.cell.home_joints, "home", confirmed=True)
     qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)
     win.files.open_recording(tmp_path / "s.mcap")
     assert win.replay.playback is not None, win.results.status.text()
@@ -147,7 +147,7 @@ def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_p
 def test_quit_with_unsaved_work_asks(qtbot, window):
     win, wb = window, window.workbench
     win.settings.setValue("window/ask_unsaved", True)
-    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.picking.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
     asked = _answer(qtbot, "Cancel")
     win.close()
     assert asked and "not saved" in asked[0] and win.isVisible()
@@ -194,7 +194,7 @@ def test_a_quit_by_signal_asks_nothing_and_keeps_the_unsaved_work(qtbot, window)
     and the unsaved session stays in the recovery file (offered at the next start)."""
     win, wb = window, window.workbench
     win.settings.setValue("window/ask_unsaved", True)
-    wb.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.picking.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
     app = QApplication.instance()
     app.setProperty("videocal_quit_by_signal", True)
     try:
@@ -209,7 +209,7 @@ def test_stop_halts_a_running_move_from_the_overview(qtbot, window):
     win, wb = window, window.workbench
     q = np.array(wb.joints_deg)
     q[0] += 120.0
-    win.move(lambda confirmed: wb.move_joints(q, "a turn of the base", confirmed=confirmed))
+    win.actions.move(lambda confirmed: wb.moves.move_joints(q, "a turn of the base", confirmed=confirmed))
     assert confirm_move_if_asked(qtbot, win)  # 120 deg: it waited for Move
     qtbot.waitUntil(lambda: abs(wb.joints_deg[0] - q[0]) < 118.0, timeout=10_000)
     assert wb.motion.motion.value == "moving"

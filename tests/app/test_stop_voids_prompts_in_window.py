@@ -18,7 +18,7 @@ def _far_joints(wb):
 def test_esc_withdraws_a_waiting_move_prompt(qtbot, window):
     win, wb = window, window.workbench
     q, before = _far_joints(wb), np.array(wb.joints_deg)
-    win.move(lambda confirmed: wb.move_joints(q, "far", confirmed=confirmed))
+    win.actions.move(lambda confirmed: wb.moves.move_joints(q, "far", confirmed=confirmed))
     assert win.overview.move_button.isVisible() and "waiting for your confirmation" in win.overview.preview_text.text()
     qtbot.keyClick(win, Qt.Key.Key_Escape)
     assert "stop sent" in win.statusBar().currentMessage() or "stop sent" in win.results.status.text()
@@ -26,7 +26,7 @@ def test_esc_withdraws_a_waiting_move_prompt(qtbot, window):
     qtbot.mouseClick(win.overview.move_button, Qt.MouseButton.LeftButton)  # hidden: the click goes nowhere
     assert wb.motion.motion.value != "moving" and np.max(np.abs(wb.joints_deg - before)) < 1e-6
     # Asked again, Move sends it.
-    win.move(lambda confirmed: wb.move_joints(q, "far", confirmed=confirmed))
+    win.actions.move(lambda confirmed: wb.moves.move_joints(q, "far", confirmed=confirmed))
     qtbot.mouseClick(win.overview.move_button, Qt.MouseButton.LeftButton)
     # arrived (the controller's DON) and the joints there: on a loaded machine the last sample may follow the DON
     qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived" and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=30_000)
@@ -36,12 +36,12 @@ def test_a_confirmation_given_before_a_stop_moves_nothing(qtbot, window):
     wb = window.workbench
     q = _far_joints(wb)
     with pytest.raises(MoveNeedsConfirmation) as asked:
-        wb.move_joints(q, "far")
-    wb.stop_robot()
+        wb.moves.move_joints(q, "far")
+    wb.moves.stop_robot()
     with pytest.raises(CalibrationError, match="stopped after this move was asked for"):
-        wb.move_joints(q, "far", confirmed=asked.value.confirmation)
+        wb.moves.move_joints(q, "far", confirmed=asked.value.confirmation)
     assert wb.motion.motion.value != "moving"
     with pytest.raises(MoveNeedsConfirmation) as again:  # asked again, answered: it goes
-        wb.move_joints(q, "far")
-    wb.move_joints(q, "far", confirmed=again.value.confirmation)
+        wb.moves.move_joints(q, "far")
+    wb.moves.move_joints(q, "far", confirmed=again.value.confirmation)
     qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived", timeout=30_000)

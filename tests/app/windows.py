@@ -29,9 +29,9 @@ def wait_for_settled_frame(qtbot, win, timeout_ms: int = 15_000) -> None:
 
 def pick_pair(wb, component: str, feature, point_world_mm, pixel) -> int:
     """One pair through the core, as the panes' clicks make it (the image point on the held frame)."""
-    wb.pick_model_point(component, feature, point_world_mm)
-    wb.pick_image_point(pixel)
-    return wb.accept_pair()
+    wb.picking.pick_model_point(component, feature, point_world_mm)
+    wb.picking.pick_image_point(pixel)
+    return wb.picking.accept_pair()
 
 
 def confirm_move_if_asked(qtbot, win) -> bool:

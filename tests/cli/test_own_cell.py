@@ -130,7 +130,7 @@ def test_the_controller_order_and_zero_offsets_apply_at_the_link(cells, tmp_path
         goal = home + np.array([5.0, 4.0, -3.0, 2.0, -6.0, 10.0])
         ended = []
         core.arm.move_finished.connect(lambda what, error: ended.append(error))
-        core.move_joints(goal, "a test pose").wait(15)
+        core.moves.move_joints(goal, "a test pose").wait(15)
         assert core.link.wait_for_samples(core.link.stats.samples + 2, 2.0)
         assert np.allclose(core.joints_deg, goal, atol=1e-3)
         assert ended == [""]

@@ -42,6 +42,6 @@ def test_the_example_connector_drives_the_core_and_moves_nothing(installed, tmp_
             time.sleep(0.01)
         assert np.allclose(core.joints_deg, last)
         with pytest.raises(Exception, match="plays back a file"):
-            core.move_joints(core.joints_deg + 1.0, "a test", confirmed=True)
+            core.moves.move_joints(core.joints_deg + 1.0, "a test", confirmed=True)
     finally:
         core.close()

@@ -14,6 +14,6 @@ def pick_all(core, bed, q, features=FEATURES) -> None:
         if name not in fixture.features:
             continue
         p = apply(fixture.item2world, fixture.features[name])
-        core.pick_model_point(fixture.name, name, p)
-        core.pick_image_point(project(apply(invert(true_cam), p[None]), core.intrinsics)[0])
-        core.accept_pair()
+        core.picking.pick_model_point(fixture.name, name, p)
+        core.picking.pick_image_point(project(apply(invert(true_cam), p[None]), core.intrinsics)[0])
+        core.picking.accept_pair()

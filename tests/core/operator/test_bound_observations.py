@@ -47,25 +47,25 @@ def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_a
     stamps = {p.view for p in core.session.pairs}
     assert len(stamps) == 1 and next(iter(stamps)).frame_index == 7  # one still for the whole set
     np.testing.assert_allclose(next(iter(stamps)).joints_deg, q_task, atol=1e-9)
-    at_task = core.calibrate()
+    at_task = core.picking.calibrate()
     assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
     # The truth scores the estimate (nothing above read it): the measured camera pose is the real one.
     true_cam = site.bed.true_cam2world(q_task)
     assert np.linalg.norm(at_task.cam2world_measured[:3, 3] - true_cam[:3, 3]) < 0.01
-    core.save_workspace(tmp_path / "w.json")
+    core.files.save_workspace(tmp_path / "w.json")
     # Quit, start again with the robot at home, restore, Calibrate: the same answer, not a 432 mm one.
     again = OperatorCore(cell, site)
     still_for(again, joints_deg=cell.home_joints)
-    again.open_workspace(tmp_path / "w.json")
-    restored = again.calibrate()
+    again.files.open_workspace(tmp_path / "w.json")
+    restored = again.picking.calibrate()
     np.testing.assert_allclose(restored.displacement_mm, at_task.displacement_mm, atol=1e-9)
     np.testing.assert_allclose(again.session.context.joints_deg, q_task, atol=1e-9)
     assert np.linalg.norm(restored.displacement_mm) < 25.0
     # A new pick on a frame of the home pose joins pairs of the task pose: refused, naming them.
     frame_now(again, index=8)
-    again.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
+    again.picking.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
     with pytest.raises(CalibrationError, match=r"pairs 1, 2, .* another pose"):
-        again.pick_image_point((10.0, 10.0))
+        again.picking.pick_image_point((10.0, 10.0))
     assert again.session.pairs.pending() is not None  # nothing was picked
 
 
@@ -80,14 +80,14 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
     verdict = core.session.verdict
     assert verdict.verdict is Verdict.IMPLAUSIBLE and "beyond the cell's stated model error of 25 mm" in verdict.text
     with pytest.raises(LookNotAtTask, match="from .*'s pose"):  # the home joints are not the task location's pose
-        core.store_correction()
+        core.desk.store_correction()
     converted = "converted by a test: the look is the task's"
     with pytest.raises(ConfirmationNeeded) as refused:
-        core.store_correction(convert=converted)
+        core.desk.store_correction(convert=converted)
     assert refused.value.reasons == verdict.reasons and core.session.corrections.latest(core.task.name) is None
     events = []
     core.event.connect(lambda kind, detail: events.append((kind, detail)))
-    stored = core.store_correction(convert=converted, confirmation="confirmed by a test: the cell was moved")
+    stored = core.desk.store_correction(convert=converted, confirmation="confirmed by a test: the cell was moved")
     assert stored.verdict == "implausible" and stored.confirmation == "confirmed by a test: the cell was moved"
     assert ("correction_confirmed", {"task": core.task.name, "verdict": "implausible", "confirmation": stored.confirmation}) in events
 
@@ -95,12 +95,12 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
 def test_a_result_whose_pairs_changed_is_stale_and_cannot_be_stored(cell_and_site):
     cell, site = cell_and_site
     core, _ = _picked_at_task(cell, site)
-    core.calibrate()
+    core.picking.calibrate()
     assert core.session.stale_reason is None
-    core.delete_pair(2)
+    core.picking.delete_pair(2)
     assert "pair 2 is no longer used" in core.session.stale_reason
     with pytest.raises(CalibrationError, match="from an earlier state"):
-        core.store_correction()
+        core.desk.store_correction()
     core.undo()  # the pair is back as it was: the result is current again
     assert core.session.stale_reason is None
     core.session.clear()
@@ -117,14 +117,14 @@ def test_a_frame_taken_while_the_robot_moves_is_refused_with_the_reason(cell_and
         q[1] += 0.2
         sample(core, q, t + 0.02 * k)
     frame_now(core, t_s=t + 0.2)
-    core.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
+    core.picking.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
     with pytest.raises(NotSettledError, match=rf"moving when the frame was taken \({core.robot.joint_names[1]} at 10.00 deg/s"):
-        core.pick_image_point((10.0, 10.0))
+        core.picking.pick_image_point((10.0, 10.0))
     assert core.observations.still is None and core.session.pairs.pending() is not None
     # Still again for the settle time: the next frame is usable.
     end = still_for(core, seconds=0.4, joints_deg=q, start_s=t + 0.22)
     frame_now(core, t_s=end)
-    core.pick_image_point((10.0, 10.0))
+    core.picking.pick_image_point((10.0, 10.0))
     np.testing.assert_allclose(core.session.pairs.pairs()[0].view.joints_deg, q, atol=1e-9)
 
 
@@ -134,13 +134,13 @@ def test_a_link_that_drops_leaves_the_pose_unknown_until_a_fresh_sample(cell_and
     still_for(core)
     core.arm._on_link_state("down", "device lost")
     frame_now(core)
-    assert not core.robot_settled().settled and "pose is unknown" in core.robot_settled().reason
-    core.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
+    assert not core.picking.robot_settled().settled and "pose is unknown" in core.picking.robot_settled().reason
+    core.picking.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
     with pytest.raises(NotSettledError, match="link dropped"):
-        core.pick_image_point((10.0, 10.0))
+        core.picking.pick_image_point((10.0, 10.0))
     still_for(core, seconds=0.5)
     frame_now(core)
-    core.pick_image_point((10.0, 10.0))
+    core.picking.pick_image_point((10.0, 10.0))
     assert core.session.pairs.pairs()[0].view is not None
 
 
@@ -151,7 +151,7 @@ def test_pairs_without_a_robot_pose_are_not_solved(cell_and_site):
         core.session.pick_3d(core.task.component, name, (float(k), 0.0, 0.0))
         core.session.pick_2d((10.0 * k, 5.0))  # a script's picks, outside the core's frames
     with pytest.raises(CalibrationError, match="pairs 1, 2, 3, 4 carry no robot pose"):
-        core.calibrate()
+        core.picking.calibrate()
 
 
 def test_a_pick_on_a_frame_newer_than_the_joint_stream_holds_the_frame_before_it(cell_and_site):
@@ -166,10 +166,10 @@ def test_a_pick_on_a_frame_newer_than_the_joint_stream_holds_the_frame_before_it
     frame_now(core, index=2, t_s=t_last + 0.010)  # its joint samples are still on the way
     fixture = core.workcell.component(core.task.component)
     p = apply(fixture.item2world, fixture.features["pin_tip"])
-    core.pick_model_point(fixture.name, "pin_tip", p)
-    core.pick_image_point((320.0, 240.0))
+    core.picking.pick_model_point(fixture.name, "pin_tip", p)
+    core.picking.pick_image_point((320.0, 240.0))
     assert core.observations.still.frame is before
-    assert np.allclose(core.session.pairs.get(core.current_pair).view.joints_deg, q, atol=1e-6)
+    assert np.allclose(core.session.pairs.get(core.picking.current_pair).view.joints_deg, q, atol=1e-6)
     core.close()
     # moving: the newest frame is judged (the robot moved before it), and refused with the reason
     core = OperatorCore(cell, site)
@@ -178,7 +178,7 @@ def test_a_pick_on_a_frame_newer_than_the_joint_stream_holds_the_frame_before_it
         sample(core, q + 0.5 * k, t0 + 0.02 * k)
     frame_now(core, index=1, t_s=t0 + 0.30)
     frame_now(core, index=2, t_s=t0 + 0.38)
-    core.pick_model_point(fixture.name, "pin_tip", p)
+    core.picking.pick_model_point(fixture.name, "pin_tip", p)
     with pytest.raises(NotSettledError, match="frame 2"):
-        core.pick_image_point((320.0, 240.0))
+        core.picking.pick_image_point((320.0, 240.0))
     core.close()

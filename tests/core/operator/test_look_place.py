@@ -28,7 +28,7 @@ def _look(cell, site, joints_of):
     still_for(core, joints_deg=q)
     frame_now(core)
     _pick_all(core, site.bed, q)
-    core.calibrate()
+    core.picking.calibrate()
     return core, q
 
 
@@ -42,17 +42,17 @@ def _at_task(core):
 
 def test_a_look_from_the_approach_is_refused_as_the_tasks_correction(cell_and_site):
     core, _ = _look(*cell_and_site, _at_approach)
-    place = core.look_place()
+    place = core.desk.look_place()
     assert place.at == "elsewhere" and place.offset_mm == pytest.approx(core.task.approach_mm, abs=0.5)
     with pytest.raises(LookNotAtTask, match=r"200\.0 mm .* from .*'s pose") as refused:
-        core.store_correction()
+        core.desk.store_correction()
     assert refused.value.change_mm > 0.1  # the window shows how far the commanded target would move
     assert core.session.corrections.history(core.task.name) == []
 
 
 def test_kept_as_a_measurement_it_moves_nothing(cell_and_site):
     core, q = _look(*cell_and_site, _at_approach)
-    kept = core.store_measurement()
+    kept = core.desk.store_measurement()
     table = core.session.corrections
     assert kept.kind == "measurement" and table.history(core.task.name) == [kept]
     assert table.latest(core.task.name) is None
@@ -64,10 +64,10 @@ def test_kept_as_a_measurement_it_moves_nothing(cell_and_site):
 def test_converted_explicitly_it_becomes_the_correction_with_what_the_operator_said(cell_and_site):
     core, _ = _look(*cell_and_site, _at_approach)
     with pytest.raises(LookNotAtTask) as refused:
-        core.store_correction()
+        core.desk.store_correction()
     events = []
     core.event.connect(lambda kind, detail: events.append((kind, detail)))
-    c = core.store_correction(convert="converted by a test")
+    c = core.desk.store_correction(convert="converted by a test")
     assert c.kind == "correction" and core.session.corrections.latest(core.task.name) is c
     assert "converted: the look was made 200" in c.source and "converted by a test" in c.source
     assert [k for k, _ in events] == ["look_converted"]
@@ -79,17 +79,17 @@ def test_converted_explicitly_it_becomes_the_correction_with_what_the_operator_s
 def test_looks_at_the_task_and_at_its_corrected_pose_count(cell_and_site):
     cell, site = cell_and_site
     core, _ = _look(cell, site, _at_task)
-    assert core.look_place().at == "task"
-    first = core.store_correction()
+    assert core.desk.look_place().at == "task"
+    first = core.desk.store_correction()
     corrected = core.session.corrections.corrected_target(core.task.name, core.task.tcp2base)
     q_corrected = solve_ik(core.robot, corrected, core.cell.home_joints).q_deg
     core.session.clear()
     still_for(core, joints_deg=q_corrected)
     frame_now(core, index=1)
     _pick_all(core, site.bed, q_corrected)
-    core.calibrate()
-    assert core.look_place().at == "corrected"
-    second = core.store_correction()
+    core.picking.calibrate()
+    assert core.desk.look_place().at == "corrected"
+    second = core.desk.store_correction()
     assert core.session.corrections.history(core.task.name) == [first, second]
 
 
@@ -98,15 +98,15 @@ def test_a_look_on_a_recording_is_not_the_live_tasks_correction(cell_and_site):
     core = OperatorCore(cell, site)
     q = _at_task(core)
     times = np.arange(0.0, 1.0, 0.02)  # a still robot on the recording's time axis, then a frame of it
-    core.begin_replay(JointHistory.from_arrays(times, np.tile(q, (len(times), 1)), core.workcell.safety.settle_rule), "sample_session.mcap")
-    core.observe_frame(Frame(np.zeros((480, 640, 3), np.uint8), 3, float(times[-1])), replayed=True)
+    core.picking.begin_replay(JointHistory.from_arrays(times, np.tile(q, (len(times), 1)), core.workcell.safety.settle_rule), "sample_session.mcap")
+    core.picking.observe_frame(Frame(np.zeros((480, 640, 3), np.uint8), 3, float(times[-1])), replayed=True)
     _pick_all(core, site.bed, q)
-    core.calibrate()
-    core.end_replay()  # "Close replay": the branched session stays open
-    place = core.look_place()
+    core.picking.calibrate()
+    core.picking.end_replay()  # "Close replay": the branched session stays open
+    place = core.desk.look_place()
     assert place.at == "recording" and place.source == "sample_session.mcap"
     with pytest.raises(LookNotAtTask, match="on the recording sample_session.mcap"):
-        core.store_correction()
+        core.desk.store_correction()
     assert core.session.corrections.latest(core.task.name) is None
 
 
@@ -140,9 +140,9 @@ def test_the_stored_correction_exports_as_a_krl_data_list_named_after_its_file_w
 
     cell, site = cell_and_site
     core, _ = _look(cell, site, _at_task)
-    core.store_correction()
+    core.desk.store_correction()
     path = tmp_path / "cell_targets.dat"
-    core.export_corrections(path, "krl")
+    core.files.export_corrections(path, "krl")
     text = path.read_text()
     assert text.startswith("DEFDAT cell_targets PUBLIC")
     tool = concat(core.robot.fk(core.joints_deg, "tcp"), invert(core.robot.fk(core.joints_deg, "flange")))

@@ -21,25 +21,25 @@ def test_point_then_accept_and_a_second_click_moves_the_image_point(core):
     core.event.connect(lambda kind, detail: events.append((kind, detail)))
     fixture = core.workcell.component("oru_1_fixture")
     with pytest.raises(OperatorError, match="nothing to accept"):
-        core.accept_pair()
-    n = core.pick_model_point("oru_1_fixture", "pin_tip", fixture.item2world[:3, 3])
+        core.picking.accept_pair()
+    n = core.picking.pick_model_point("oru_1_fixture", "pin_tip", fixture.item2world[:3, 3])
     with pytest.raises(OperatorError, match=f"pair {n} \\(pin_tip\\) has no point on the camera image"):
-        core.accept_pair()
+        core.picking.accept_pair()
     still_for(core)
     frame_now(core)
-    core.pick_image_point((100.0, 200.0))
-    core.pick_image_point((101.5, 199.0))  # not accepted yet: the click moves it
+    core.picking.pick_image_point((100.0, 200.0))
+    core.picking.pick_image_point((101.5, 199.0))  # not accepted yet: the click moves it
     assert core.session.pairs.get(n).pixel == (101.5, 199.0) and len(core.session.pairs) == 1
-    assert core.accept_pair() == n and core.current_pair is None
+    assert core.picking.accept_pair() == n and core.picking.current_pair is None
     assert [e for e in events if e[0] != "frame_held"] == [("pair_accepted", {"number": n})]
     # After Accept a click on the image starts nothing: the model point comes first.
     with pytest.raises(OperatorError, match="pick the point on the model"):
-        core.pick_image_point((5.0, 5.0))
+        core.picking.pick_image_point((5.0, 5.0))
     # A new model pick replaces one still waiting for its image point.
-    m = core.pick_model_point("oru_1_fixture", "plate_top_left", fixture.item2world[:3, 3])
-    core.pick_model_point("oru_1_fixture", "plate_top_right", fixture.item2world[:3, 3])
+    m = core.picking.pick_model_point("oru_1_fixture", "plate_top_left", fixture.item2world[:3, 3])
+    core.picking.pick_model_point("oru_1_fixture", "plate_top_right", fixture.item2world[:3, 3])
     assert m not in [p.number for p in core.session.pairs] and len(core.session.pairs) == 2
-    assert core.undo() is not None and core.current_pair is None
+    assert core.undo() is not None and core.picking.current_pair is None
 
 
 def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
@@ -65,11 +65,11 @@ def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
 
 def test_a_workspace_opens_on_its_own_cell_only(core, tmp_path):
     path = tmp_path / "w.json"
-    core.save_workspace(path)
+    core.files.save_workspace(path)
     assert load_workspace(path).cell == core.cell.identity.to_dict()
     other = OperatorCore(Cell.open())
     other.editor.add_feature("oru_1", "extra", [1, 2, 3])  # now another cell
     with pytest.raises(CellMismatchError, match="belongs to the cell 'space station robotic test bed'"):
-        other.open_workspace(path)
+        other.files.open_workspace(path)
     other.undo()
-    other.open_workspace(path)  # the same cell again
+    other.files.open_workspace(path)  # the same cell again

@@ -31,15 +31,15 @@ def picked():
     frame_now(core)
     fixture = core.workcell.component(core.task.component)
     for _ in range(3):  # pairs 1 to 3 made and deleted: the set starts at 4
-        core.pick_model_point(fixture.name, "pin_tip", apply(fixture.item2world, fixture.features["pin_tip"]))
-        core.delete_pair()
+        core.picking.pick_model_point(fixture.name, "pin_tip", apply(fixture.item2world, fixture.features["pin_tip"]))
+        core.picking.delete_pair()
     true_cam = site.bed.true_cam2world(q)
     for k, name in enumerate(FEATURES):
         p = apply(fixture.item2world, fixture.features[name])
         uv = project(apply(invert(true_cam), p[None]), core.intrinsics)[0] + (np.array([15.0, -12.0]) if k == 3 else 0.0)  # pair 7 mis-clicked
-        core.pick_model_point(fixture.name, name, p)
-        core.pick_image_point(uv)
-        core.accept_pair()
+        core.picking.pick_model_point(fixture.name, name, p)
+        core.picking.pick_image_point(uv)
+        core.picking.accept_pair()
     return core
 
 
@@ -47,8 +47,8 @@ def test_a_failed_solve_names_the_mis_clicked_pair_by_its_table_number(picked):
     core = picked
     assert [p.number for p in core.session.pairs] == [4, 5, 6, 7, 8, 9]
     core.session.robust = False
-    estimate = core.calibrate()
+    estimate = core.picking.calibrate()
     assert estimate.solution.status.value == "failed" and "pair 7 fits worst" in estimate.solution.reason, estimate.solution.reason
     core.session.robust = True
-    estimate = core.calibrate()
+    estimate = core.picking.calibrate()
     assert any("pair 7 rejected as outliers" in w for w in estimate.solution.warnings), estimate.solution.warnings

@@ -23,7 +23,7 @@ def found_core():
     frame_now(core, index=3, image=camera.read().image)
     events = []
     core.points_found.connect(events.append)
-    found = core.find_points()
+    found = core.finder.find_points()
     yield core, site, q, found, events
     camera.close()
 
@@ -32,13 +32,13 @@ def test_found_points_are_accepted_in_one_step_and_solve_like_picks(found_core):
     core, site, q, found, events = found_core
     assert events == [found] and found.result.found and found.view.frame_index == 3
     proposed = [p.feature for p in found.result.proposals]
-    numbers = core.accept_found_points()
+    numbers = core.finder.accept_found_points()
     pairs = list(core.session.pairs)
     assert [p.number for p in pairs] == numbers and [p.feature for p in pairs] == proposed
     assert all(p.complete and p.view == found.view for p in pairs)
     assert core.session.undo.undo() == f"Accept {len(numbers)} found points" and len(core.session.pairs) == 0
     core.session.undo.redo()
-    estimate = core.calibrate()
+    estimate = core.picking.calibrate()
     assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
     # The truth scores: the found points put the camera far nearer the true one than the model does.
     # (About 1 mm today against 8 mm: the detectors carry 0.2-0.8 px of bias that the solve's noise
@@ -52,20 +52,20 @@ def test_found_points_are_accepted_in_one_step_and_solve_like_picks(found_core):
 def test_nothing_to_accept_twice(found_core):
     core, *_ = found_core
     with pytest.raises(OperatorError, match="Find points"):
-        core.accept_found_points()
-    core.find_points()
+        core.finder.accept_found_points()
+    core.finder.find_points()
     with pytest.raises(OperatorError, match="already paired"):
-        core.accept_found_points()
+        core.finder.accept_found_points()
     with pytest.raises(OperatorError, match="not among the proposals: nose"):
-        core.accept_found_points(["nose"])
+        core.finder.accept_found_points(["nose"])
 
 
 def test_calibrate_on_edges_puts_the_tcp_within_a_tenth_of_a_millimetre(found_core):
     core, site, q, found, events = found_core
-    core.find_points()
+    core.finder.find_points()
     solved = []
     core.solved.connect(lambda: solved.append(True))
-    estimate = core.calibrate_on_edges()
+    estimate = core.finder.calibrate_on_edges()
     assert solved and estimate.solution.method == "edges" and estimate.solution.status.value == "ok"
     assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
     assert core.session.last_solve_inputs["method"] == "edges" and core.session.last_solve_inputs["frame_index"] == 3

@@ -42,7 +42,7 @@ def recorded(tmp_path_factory):
     still_for(core, 2.5, joints_deg=q, start_s=t + 0.24)
     frame_now(core, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 90, np.uint8))
     _pick_all(core, site.bed, q)
-    core.calibrate()
+    core.picking.calibrate()
     solution = core.session.result.solution
     points_obj, _, numbers = core.session.pairs.arrays()
     obj2world = core.workcell.component(core.session.target).item2world

@@ -67,9 +67,9 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     for k in range(3):
         frame_now(core, k, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 60 + 40 * k, np.uint8))
     _pick_all(core, site.bed, q)
-    assert not core.find_points().result.found  # a flat grey frame: recorded all the same
-    core.calibrate()
-    core.store_correction(convert="a test: the approach's look stands for the task", confirmation="test")
+    assert not core.finder.find_points().result.found  # a flat grey frame: recorded all the same
+    core.picking.calibrate()
+    core.desk.store_correction(convert="a test: the approach's look stands for the task", confirmation="test")
     core.stop_recording()
     (result,) = _read_indexed(path)
     _agrees_with_ours(result, path)

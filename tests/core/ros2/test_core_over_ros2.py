@@ -27,7 +27,7 @@ def test_go_to_task_over_ros2_and_pose_unknown_when_the_states_stop(domain):
     try:
         assert core.start_controller() == "ros2:///joint_states?stale_after_s=0.3"
         assert wait_until(lambda: core.link_up and np.allclose(core.joints_deg, start, atol=1e-6))
-        handle = core.go_to_task(approach=True, wait=True, confirmed=True)
+        handle = core.moves.go_to_task(approach=True, wait=True, confirmed=True)
         assert handle.error is None and core.motion.motion is Motion.ARRIVED
         # The trajectory carried the model's joints by URDF name: the arm stands where the core aimed.
         assert np.allclose(arm.position(time.monotonic()), handle.joints_deg, atol=1e-6)
