@@ -1,4 +1,4 @@
-"""The replay timeline: a recording played back in the window.
+"""The replay timeline: a recording, or a ROS 2 bag, played back in the window.
 
 The camera pane shows the recorded frames, the CAD views follow the recorded joints, and the point
 pairs and the last solve appear as they stood at the timeline's position. The first edit the
@@ -18,12 +18,14 @@ import numpy as np
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QSlider, QStyle, QToolButton, QWidget
 
+from calib_core.bags.bag_playback import BagPlayback, is_bag
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import FileFormatError
 from calib_core.link.joint_history import JointHistory
 from calib_core.recording.playback import RecordedSolve, RecordingPlayback
 from calib_core.recording.reader import read_recording, recover
 from calib_core.recording.replay import solve_from_inputs
+from calib_core.ros2.joint_units import user_per_si
 from calib_core.video.frame import Frame
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0)
@@ -95,16 +97,25 @@ class ReplayBar(QWidget):
         """Open a recording at its start. Raises ``FileFormatError`` (the window says why) and changes
         nothing when the file is not a readable recording."""
         path = Path(path)
-        contents = read_recording(path)
-        if not contents.messages:
-            raise FileFormatError(path, "the recording holds no messages")
-        playback = RecordingPlayback(contents)
+        if is_bag(path):  # a ROS 2 bag: its frames, with the arm's joints at each frame's stamp
+            robot = self.workbench.robot
+            playback, complete, problem = BagPlayback(path, robot.joint_names, user_per_si(robot.joint_units)), True, None
+            if not len(playback.frames):
+                playback.close()
+                raise FileFormatError(path, f"no image on {playback.frames.topic}")
+        else:
+            contents = read_recording(path)
+            if not contents.messages:
+                raise FileFormatError(path, "the recording holds no messages")
+            playback, complete, problem = RecordingPlayback(contents), contents.complete, contents.problem
         recorded_intrinsics = None
         if playback.setup.get("intrinsics"):
             try:
                 recorded_intrinsics = Intrinsics.from_dict(playback.setup["intrinsics"])
             except (KeyError, TypeError, ValueError) as exc:
+                getattr(playback, "close", lambda: None)()
                 raise FileFormatError(path, f"its intrinsics cannot be read ({exc})", "/videocal/setup") from None
+        self._close_playback()
         if self.playback is None:
             s = self.workbench.session
             self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.workbench.intrinsics)
@@ -125,10 +136,13 @@ class ReplayBar(QWidget):
         self.slider.setRange(0, max(1, int(round(playback.duration_s * 1000))))
         self.slider.setValue(0)
         self.slider.blockSignals(False)
-        self.recover_button.setVisible(not contents.complete)
+        self.recover_button.setVisible(not complete)
         self.show()
         self.seek(0.0)
-        note = "" if contents.complete else f" - cut off: {contents.problem}; Recover... writes a complete copy"
+        note = "" if complete else f" - cut off: {problem}; Recover... writes a complete copy"
+        if isinstance(playback, BagPlayback):
+            joints = f"joints from {playback.joint_topic}" if playback.joint_topic else "no joint states: a camera alone, nothing robot-bound"
+            note = f" (ROS 2 bag, {playback.frames.topic}; {joints})"
         self.workbench.message.emit(f"replaying {path.name}: {playback.duration_s:.1f} s, {len(playback.frames)} frames, {len(playback.solves)} solves{note}")
 
     def close_replay(self) -> None:
@@ -148,11 +162,17 @@ class ReplayBar(QWidget):
                 s.undo.clear()
             finally:
                 self._applying = False
+        self._close_playback()
         self.playback = self.path = self._live_state = None
         self.workbench.picking.end_replay()
         self.hide()
         self.workbench.message.emit("replay closed: " + ("the branched session stays open" if branched else "the live session is back as it was"))
         self.closed.emit()
+
+    def _close_playback(self) -> None:
+        close = getattr(self.playback, "close", None)  # a bag keeps its file open while it is replayed
+        if close is not None:
+            close()
 
     def _recover(self) -> None:
         if self.path is None:
@@ -252,8 +272,6 @@ class ReplayBar(QWidget):
         solution = solve_from_inputs(solve.inputs)  # deterministic: the same answer as recorded
         numbers = [p.number for p in self.workbench.session.pairs.usable()]
         obj2world, cam_model, tcp_model = (np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model"))
-        from calib_core.camera.intrinsics import Intrinsics
-
         self.workbench.session.show_result(solution, obj2world, cam_model, tcp_model, c.get("joints_deg"), numbers,
                                            points_obj_mm=solve.inputs.get("points_3d"), intrinsics=Intrinsics.from_dict(solve.inputs["intrinsics"]))
 

@@ -104,7 +104,7 @@ def read_recording(path: str | Path) -> RecordingContents:
     path = Path(path)
     if path.is_dir():
         what = "a ROS bag folder" if (path / "metadata.yaml").is_file() else "a folder"
-        raise FileFormatError(path, f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics and calibrate-hand-eye")
+        raise FileFormatError(path, f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)")
     try:
         handle = open(path, "rb")
     except FileNotFoundError:
@@ -145,7 +145,7 @@ def read_recording(path: str | Path) -> RecordingContents:
         # Another program's MCAP (a ROS 2 bag) or an empty one: replaying it would show "0 frames" and succeed.
         topics = sorted({f"{c.topic} ({c.message_encoding})" for c in channels.values()})
         held = f"its topics: {', '.join(topics[:8])}{' ...' if len(topics) > 8 else ''}" if topics else "it holds no messages"
-        hint = "; a ROS 2 bag is read by calibrate-intrinsics and calibrate-hand-eye" if any("cdr" in t or "ros" in t for t in topics) else ""
+        hint = "; a ROS 2 bag is read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)" if any("cdr" in t or "ros" in t for t in topics) else ""
         raise FileFormatError(path, f"not a videocal recording: no videocal message ({held}){hint}")
     if bad_messages:
         problems.append(f"{bad_messages} message{'s' if bad_messages > 1 else ''} could not be decoded: skipped")
