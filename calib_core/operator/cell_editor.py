@@ -32,10 +32,6 @@ class CellEditor:
         self.cell, self.session, self.tasks, self.arm, self.log = cell, session, tasks, arm, log
         self.dirty = False
 
-    @property
-    def workcell(self):
-        return self.cell.workcell
-
     def _edited(self, kind: str, name: str) -> None:
         self.cell.refresh_identity()
         self.dirty = True
@@ -48,7 +44,7 @@ class CellEditor:
         """A task location at ``tcp2base`` (4, 4) mm in base (default: the current TCP pose), for
         ``component`` (default: the current target). Undoable."""
         task = TaskLocation(str(name).strip(), self.cell.robot.fk(self.arm.joints_deg, "tcp") if tcp2base is None else np.asarray(tcp2base, dtype=float), float(approach_mm), component or self.session.target)
-        self.session.undo.push(AddTaskLocation(self.workcell, task, self._edited))
+        self.session.undo.push(AddTaskLocation(self.cell.workcell, task, self._edited))
         return task
 
     def add_component(self, mesh_file, name: str, *, kind: str = "component", units: str = "mm", color=(0.7, 0.7, 0.7), item2world: np.ndarray | None = None) -> None:
@@ -59,24 +55,24 @@ class CellEditor:
         mesh = load_component_mesh(mesh_file, units)
         placement = np.array(item2world, dtype=float) if item2world is not None else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
         item = SceneItem(name, mesh, placement, tuple(float(c) for c in color), kind, {})
-        self.session.undo.push(AddComponent(self.workcell, item, mesh_file, units, self._edited))
+        self.session.undo.push(AddComponent(self.cell.workcell, item, mesh_file, units, self._edited))
 
     def place_component(self, name: str, xyz_mm, rpy_deg) -> None:
         """Place a component by numbers (its surveyed placement: mm, deg, in base). Successive
         placements of one component are one undo step."""
-        self.session.undo.push(PlaceComponent(self.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._edited))
+        self.session.undo.push(PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._edited))
 
     def snap_feature(self, component: str, point_component_mm, radius_mm: float) -> Snap:
         """Where a click on ``component`` defines a feature (circle centre, corner, vertex or the surface point)."""
-        return snap_point(self.workcell.component(component).mesh, point_component_mm, radius_mm)
+        return snap_point(self.cell.workcell.component(component).mesh, point_component_mm, radius_mm)
 
     def add_feature(self, component: str, name: str, point_component_mm) -> None:
         """A named feature ``point_component_mm`` (3,) in the component's frame. Undoable."""
-        self.session.undo.push(AddFeature(self.workcell, component, name, point_component_mm, self._edited))
+        self.session.undo.push(AddFeature(self.cell.workcell, component, name, point_component_mm, self._edited))
 
     def save(self, path=None):
         """Write the edited cell back into its workcell YAML (comments and untouched entries kept)."""
-        written = save_workcell(self.workcell, path)
+        written = save_workcell(self.cell.workcell, path)
         self.dirty = False
         self.log.say(f"cell saved to {written}")
         return written

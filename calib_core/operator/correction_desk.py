@@ -38,10 +38,6 @@ class CorrectionDesk:
     def task(self):
         return self.tasks.task
 
-    @property
-    def robot(self):
-        return self.cell.robot
-
     def look_place(self) -> LookPlace | None:
         """Where the last result's look was made against the chosen task location (``None`` before a
         solve, without a task location or for a look that carries no robot pose)."""
@@ -51,7 +47,7 @@ class CorrectionDesk:
         corrected = None
         if self.session.corrections.latest(self.task.name) is not None:
             corrected = self.session.corrections.corrected_target(self.task.name, self.task.tcp2base)
-        return place_of_look(self.task, self.robot.fk(context.joints_deg, "tcp"), corrected, context.view_sources)
+        return place_of_look(self.task, self.cell.robot.fk(context.joints_deg, "tcp"), corrected, context.view_sources)
 
     def store_correction(self, *, confirmation: str = "", convert: str = ""):
         """Store the last result as the task location's correction. Only a look made live at the task's
@@ -74,7 +70,7 @@ class CorrectionDesk:
         tool, context = self.robot_calibration.measured_tool, self.session.context
         tool_covariance = None
         if tool is not None and context.joints_deg is not None:
-            tool_covariance = tool.covariance_in_base(self.robot.fk(context.joints_deg, "camera"))
+            tool_covariance = tool.covariance_in_base(self.cell.robot.fk(context.joints_deg, "camera"))
         source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
         if source:
             source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source

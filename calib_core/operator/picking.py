@@ -39,18 +39,6 @@ class Picking:
         """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
         session.pairs.changed.connect(self.release_unused_still)
 
-    @property
-    def workcell(self):
-        return self.cell.workcell
-
-    @property
-    def robot(self):
-        return self.cell.robot
-
-    @property
-    def intrinsics(self):
-        return self.cell.intrinsics
-
     def let_go(self) -> None:
         """No pair is being made any more (after an undo, a solve): the next image click starts none."""
         self.current_pair = None
@@ -61,7 +49,7 @@ class Picking:
         target = self.session.target
         if target is None:
             raise CalibrationError("choose the target object first")
-        obj2world = self.workcell.component(target).item2world
+        obj2world = self.cell.workcell.component(target).item2world
         use = self.session.pairs.usable()
         unbound = [p.number for p in use if p.view is None]
         if unbound:
@@ -72,7 +60,7 @@ class Picking:
         self.check_same_state(use)
         joints = np.array(use[0].view.joints_deg) if use else self.arm.joints_deg
         self.current_pair = None
-        result = self.session.calibrate(self.intrinsics, obj2world, self.robot.fk(joints, "camera"), self.robot.fk(joints, "tcp"), joints)
+        result = self.session.calibrate(self.cell.intrinsics, obj2world, self.cell.robot.fk(joints, "camera"), self.cell.robot.fk(joints, "tcp"), joints)
         self.solved.emit()
         return result
 
@@ -129,8 +117,8 @@ class Picking:
         the complete pairs on that frame when there are three or more, else from the model's camera."""
         held = self.observations.still
         joints = np.asarray(held.stamp.joints_deg if held is not None else self.arm.joints_deg, dtype=float)
-        obj2world = self.workcell.component(self.session.target).item2world
-        obj2cam = concat(obj2world, invert(self.robot.fk(joints, "camera")))
+        obj2world = self.cell.workcell.component(self.session.target).item2world
+        obj2cam = concat(obj2world, invert(self.cell.robot.fk(joints, "camera")))
         done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
         if len(done) >= 3:
             from calib_core.solver import solve_pose
@@ -138,7 +126,7 @@ class Picking:
 
             points = apply(invert(obj2world), np.array([p.point_world_mm for p in done]))
             try:
-                solution = solve_pose(points, np.array([p.pixel for p in done]), self.intrinsics, prior=obj2cam)
+                solution = solve_pose(points, np.array([p.pixel for p in done]), self.cell.intrinsics, prior=obj2cam)
             except SolverInputError:
                 solution = None
             if solution is not None and solution.status.value != "failed":
@@ -154,8 +142,8 @@ class Picking:
         if pending is None or self.session.target is None:
             return None
         obj2cam, basis = self._pick_pose()
-        obj2world = self.workcell.component(self.session.target).item2world
-        uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.intrinsics)[0]
+        obj2world = self.cell.workcell.component(self.session.target).item2world
+        uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.cell.intrinsics)[0]
         return (uv, basis) if np.all(np.isfinite(uv)) else None
 
     def refine_pick(self, image, pixel) -> tuple[float, float]:
@@ -178,14 +166,14 @@ class Picking:
         target = self.session.target
         if pending is None or target is None or pending.feature is None:
             return None
-        item = self.workcell.component(target)
+        item = self.cell.workcell.component(target)
         kind = item.feature_kinds.get(pending.feature)
         if kind is None or kind.kind != "circle":
             return None
         obj2cam, _ = self._pick_pose()
         point = np.asarray(item.features[pending.feature], dtype=float)
-        rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
-        centre = project_points(point[None], obj2cam, self.intrinsics)[0]
+        rim, offset = circle_rim(point, kind, obj2cam, self.cell.intrinsics)
+        centre = project_points(point[None], obj2cam, self.cell.intrinsics)[0]
         grey = as_grey(image)
         found = detect_circle(grey, rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
         if not isinstance(found, Detection):

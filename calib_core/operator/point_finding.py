@@ -49,18 +49,6 @@ class PointFinding:
         """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or dismissed)."""
         self._model_view = None
 
-    @property
-    def workcell(self):
-        return self.cell.workcell
-
-    @property
-    def robot(self):
-        return self.cell.robot
-
-    @property
-    def intrinsics(self):
-        return self.cell.intrinsics
-
     def find_points(self) -> FoundOnFrame:
         """Locate the target's features in the held frame (holding the newest one first). Emits
         ``points_found``; the proposals wait for :meth:`accept_found_points`."""
@@ -69,11 +57,11 @@ class PointFinding:
             raise CalibrationError("choose the target object first")
         held = self.picking.observations.still or self.picking.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
-        item = self.workcell.component(target)
-        obj2cam_model = concat(item.item2world, invert(self.robot.fk(q, "camera")))
+        item = self.cell.workcell.component(target)
+        obj2cam_model = concat(item.item2world, invert(self.cell.robot.fk(q, "camera")))
         from calib_core.vision.find_points import find_points
 
-        result = find_points(held.frame.image, self.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))
+        result = find_points(held.frame.image, self.cell.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))
         self.found = FoundOnFrame(result, held.stamp)
         self.log.record("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
                           missed={m.feature: m.reason for m in result.missed}, seconds=round(result.seconds, 3))
@@ -89,13 +77,13 @@ class PointFinding:
     def modelled_view(self, q_deg, item):
         """What the modelled camera at joints ``q_deg`` sees of ``item`` (the modelled cell, the robot
         and what is put up in it), for Find points' checks against the image."""
-        if self._model_view is None or self._model_view.intrinsics != self.intrinsics:
+        if self._model_view is None or self._model_view.intrinsics != self.cell.intrinsics:
             from calib_core.render.model_view import ModelView  # VTK loads on the first Find points, not at start-up
 
             if self._model_view is not None:
                 self._model_view.close()
-            self._model_view = ModelView(self.intrinsics)
-        return self._model_view.of_cell(self.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.cell.extras))
+            self._model_view = ModelView(self.cell.intrinsics)
+        return self._model_view.of_cell(self.cell.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.cell.extras))
 
     def calibrate_on_edges(self):
         """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's
@@ -109,16 +97,16 @@ class PointFinding:
         from calib_core.recording.replay import solve_inputs
         from calib_core.vision.edge_solution import edge_solution
 
-        solution = edge_solution(found.result.edges, self.intrinsics)
-        item = self.workcell.component(found.result.component)
+        solution = edge_solution(found.result.edges, self.cell.intrinsics)
+        item = self.cell.workcell.component(found.result.component)
         q = np.asarray(found.view.joints_deg, dtype=float)
-        cam2world_model = self.robot.fk(q, "camera")
-        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.intrinsics, prior=concat(item.item2world, invert(cam2world_model)))
+        cam2world_model = self.cell.robot.fk(q, "camera")
+        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.cell.intrinsics, prior=concat(item.item2world, invert(cam2world_model)))
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.session.last_solve_inputs = inputs
         self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
-        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.intrinsics,
+        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.cell.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.cell.intrinsics,
                                           view_sources=(found.view.source,), label="Calibrate on edges")
         self.solved.emit()
         return estimate
@@ -142,7 +130,7 @@ class PointFinding:
         if not fresh:
             raise OperatorError(f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})")
         self.picking.check_same_state([p for p in session.pairs if p.complete], found.view)
-        item = self.workcell.component(found.result.component)
+        item = self.cell.workcell.component(found.result.component)
         spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]
         command = AddPairs(session.pairs, spec, found.view)
         session.undo.push(command)

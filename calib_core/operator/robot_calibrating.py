@@ -35,18 +35,6 @@ class RobotCalibrating:
         self._robot_before_calibration = None
         self._intrinsics_before_calibration = None
 
-    @property
-    def workcell(self):
-        return self.cell.workcell
-
-    @property
-    def robot(self):
-        return self.cell.robot
-
-    @property
-    def intrinsics(self):
-        return self.cell.intrinsics
-
     def plan_robot_calibration(self, spec, n: int = 40, *, cell_views_per_target: int = 3):
         """A :class:`~calib_core.robot_calibration.pose_planner.PosePlan` of ``n`` poses seeing the
         board where the cell puts it, then ``cell_views_per_target`` poses seeing each surveyed
@@ -60,7 +48,7 @@ class RobotCalibrating:
 
         world = self.cell.collision_world()
         start = np.asarray(self.arm.joints_deg, dtype=float)
-        plan = plan_poses(self.robot, self.intrinsics, spec, board_in_cell(spec, self.workcell, self.robot), n, start_deg=start, collisions=world, candidates=max(60, 3 * n))
+        plan = plan_poses(self.cell.robot, self.cell.intrinsics, spec, board_in_cell(spec, self.cell.workcell, self.cell.robot), n, start_deg=start, collisions=world, candidates=max(60, 3 * n))
         kept, q = [], start
         for goal in plan.joints_deg:
             if not any(world.check(p) for p in joint_path(q, goal)):
@@ -74,7 +62,7 @@ class RobotCalibrating:
         def free(a, b):
             return not any(world.check(p) for p in joint_path(a, b))
 
-        for component, goal in cell_view_joints(self.robot, self.workcell, self.intrinsics, cell_views_per_target, collisions=world) if cell_views_per_target else []:
+        for component, goal in cell_view_joints(self.cell.robot, self.cell.workcell, self.cell.intrinsics, cell_views_per_target, collisions=world) if cell_views_per_target else []:
             if free(q, goal):
                 cell.append((component, goal))
             elif free(q, home) and free(home, goal):  # round the cell's obstacles through home
@@ -107,7 +95,7 @@ class RobotCalibrating:
             raise OperatorError(f"{len(posed)} views with a robot pose, at least 6 needed (run the calibration plan)")
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
-        done = identify_robot(self.robot, self.intrinsics, self.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.cell.extras,
+        done = identify_robot(self.cell.robot, self.cell.intrinsics, self.cell.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.cell.extras,
                               with_intrinsics=with_intrinsics, progress=progress)
         result = done.result
         self.log.record("robot_calibrated", views=done.board_views, component_views=done.cell_views, rms_px=result.rms_px, identified=len(result.observability.identified))
@@ -119,13 +107,13 @@ class RobotCalibrating:
         follows); :meth:`revert_robot_calibration` takes it back."""
         self.keep_robot_before_calibration()
         self.applied_robot_calibration = result
-        for j in range(1, self.robot.model.njoints):
-            self.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
-        self.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
-        self.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
-        if result.intrinsics != self.intrinsics:  # refined with the robot: the camera as the same fit saw it
+        for j in range(1, self.cell.robot.model.njoints):
+            self.cell.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
+        self.cell.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
+        self.cell.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
+        if result.intrinsics != self.cell.intrinsics:  # refined with the robot: the camera as the same fit saw it
             if self._intrinsics_before_calibration is None:
-                self._intrinsics_before_calibration = self.intrinsics
+                self._intrinsics_before_calibration = self.cell.intrinsics
             self.cell.use_intrinsics(result.intrinsics)
         self.log.record("robot_calibration_applied", rms_px=result.rms_px)
         self.cell.robot_edited()
@@ -145,8 +133,8 @@ class RobotCalibrating:
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
         q = context.joints_deg
-        cam2base = self.robot.fk(q, "camera")
-        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, concat(self.robot.fk(q, "tcp"), invert(cam2base)))
+        cam2base = self.cell.robot.fk(q, "camera")
+        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base)))
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
         tool = self.measured_tool
         tool_covariance = tool.covariance_in_base(cam2base) if tool is not None else None
@@ -158,7 +146,7 @@ class RobotCalibrating:
     def keep_robot_before_calibration(self) -> None:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
         if self._robot_before_calibration is None:
-            self._robot_before_calibration = ([_to_mm(p) for p in self.robot.model.jointPlacements], self.robot.frame_placement("camera"), self.robot.frame_placement("tcp"))
+            self._robot_before_calibration = ([_to_mm(p) for p in self.cell.robot.model.jointPlacements], self.cell.robot.frame_placement("camera"), self.cell.robot.frame_placement("tcp"))
 
     @property
     def can_revert(self) -> bool:
@@ -170,10 +158,10 @@ class RobotCalibrating:
         if before is None:
             raise OperatorError("no robot calibration is applied")
         placements, camera, tcp = before
-        for j in range(1, self.robot.model.njoints):
-            self.robot.model.jointPlacements[j] = _to_se3(placements[j])
-        self.robot.set_frame_placement("camera", camera)
-        self.robot.set_frame_placement("tcp", tcp)
+        for j in range(1, self.cell.robot.model.njoints):
+            self.cell.robot.model.jointPlacements[j] = _to_se3(placements[j])
+        self.cell.robot.set_frame_placement("camera", camera)
+        self.cell.robot.set_frame_placement("tcp", tcp)
         self._robot_before_calibration = None
         self.applied_robot_calibration = None
         self.measured_tool = None
@@ -191,7 +179,7 @@ class RobotCalibrating:
 
         self.keep_robot_before_calibration()
         self.measured_tool = tool
-        self.robot.set_frame_placement("tcp", with_tool(self.robot, tool.tcp2cam).frame_placement("tcp"))
+        self.cell.robot.set_frame_placement("tcp", with_tool(self.cell.robot, tool.tcp2cam).frame_placement("tcp"))
         self.cell.robot_edited()
 
     def save_robot_calibration(self, folder, result, tool=None) -> tuple[Path, Path]:

@@ -15,14 +15,10 @@ class SessionFiles:
     def __init__(self, cell: Cell, session: CalibrationSession, log: OperatorLog):
         self.cell, self.session, self.log = cell, session, log
 
-    @property
-    def workcell(self):
-        return self.cell.workcell
-
     def workspace(self):
         from calib_core.workspace.workspace import Workspace
 
-        return Workspace(str(self.workcell.path), self.cell.intrinsics, dict(self.workcell.task_locations), self.session.target, self.session.pairs.pairs(), self.session.corrections, cell=self.cell.identity.to_dict())
+        return Workspace(str(self.cell.workcell.path), self.cell.intrinsics, dict(self.cell.workcell.task_locations), self.session.target, self.session.pairs.pairs(), self.session.corrections, cell=self.cell.identity.to_dict())
 
     def save_workspace(self, path) -> None:
         from calib_core.workspace.workspace import save_workspace
@@ -37,9 +33,9 @@ class SessionFiles:
 
         ws = load_workspace(path)  # raises before anything is changed
         self.cell.check_identity(ws.cell, f"workspace {path}")
-        if ws.target and ws.target not in {c.name for c in self.workcell.components}:
+        if ws.target and ws.target not in {c.name for c in self.cell.workcell.components}:
             raise CalibrationError(f"workspace {path}: target {ws.target!r} is not a component of the open cell {self.cell.name!r}")
-        self.workcell.task_locations.update(ws.task_locations)
+        self.cell.workcell.task_locations.update(ws.task_locations)
         if ws.target:
             self.session.set_target(ws.target)
         self.session.pairs.replace_all(ws.pairs)
@@ -55,5 +51,5 @@ class SessionFiles:
 
         if not self.session.corrections.tasks():
             raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
-        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.workcell.task_locations, Path(path).name.split(".")[0], self.cell.robot))
+        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.cell.workcell.task_locations, Path(path).name.split(".")[0], self.cell.robot))
         self.log.say(f"corrections exported to {path} ({fmt})")

@@ -41,10 +41,6 @@ class ToolMeasuring:
     def task(self):
         return self.tasks.task
 
-    @property
-    def robot(self):
-        return self.cell.robot
-
     def record_grasp(self):
         """A :class:`~calib_core.robot_calibration.camera_to_tool.Grasp` at the current task
         location from the joints the controller reports now, seen on the newest frame when its
@@ -66,7 +62,7 @@ class ToolMeasuring:
             workcell = self.cell.workcell
             item = workcell.component(self.task.component) if self.task.component else None
             try:
-                seen = see_grasp(held.frame.image, self.cell.intrinsics, self.robot, workcell, self.task, q,
+                seen = see_grasp(held.frame.image, self.cell.intrinsics, self.cell.robot, workcell, self.task, q,
                                  expected=self.finder.modelled_view(q, item) if item is not None else None)
                 how = f"seen on frame {held.stamp.frame_index} ({seen.edge_samples} edge samples of {seen.component})"
             except GraspNotSeenError as e:
@@ -93,7 +89,7 @@ class ToolMeasuring:
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
         calibration = self.robot_calibration.applied_robot_calibration
-        tool = camera_to_tool(self.robot, self.grasps, placement_sigma_mm=SURVEY_SIGMA_MM,
+        tool = camera_to_tool(self.cell.robot, self.grasps, placement_sigma_mm=SURVEY_SIGMA_MM,
                               camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None)
         self.robot_calibration.use_tool(tool)
         self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
