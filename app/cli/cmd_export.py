@@ -46,8 +46,8 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.workspace.workspace import load_workspace
 
     ws = load_workspace(args.workspace)
-    robot = _robot(args.workcell or ws.workcell_path) if args.format not in ("csv", "json") else None
-    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None, robot)
+    robot, joint_map = _robot(args.workcell or ws.workcell_path) if args.format not in ("csv", "json") else (None, None)
+    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None, robot, joint_map)
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")
@@ -57,11 +57,15 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _robot(workcell: str | Path | None):
-    """The workcell's robot, for the tool data of a listing; ``None`` (the listing then has no tool data, and says
-    nothing wrong) when the workspace names no workcell or it is not there."""
+    """The workcell's robot and its joint map (model joints to controller axes), for the tool data and the arm's
+    configurations of a listing; ``(None, None)`` (the listing then has neither, and says so) when the workspace names
+    no workcell or it is not there."""
     if not workcell or not Path(workcell).is_file():
-        print(f"note: no tool data in the listing: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
-        return None
+        print(f"note: no tool data or arm configurations in the listing: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
+        return None, None
+    from calib_core.link.joint_map import JointMap
     from calib_core.workcell import load_workcell
 
-    return load_workcell(workcell).load_robot()
+    cell = load_workcell(workcell)
+    robot = cell.load_robot()
+    return robot, JointMap.for_robot(robot.joint_names, cell.robot_spec.controller)

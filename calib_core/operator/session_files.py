@@ -51,5 +51,5 @@ class SessionFiles:
 
         if not self.session.corrections.tasks():
             raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
-        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.cell.workcell.task_locations, Path(path).name.split(".")[0], self.cell.robot))
+        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.cell.workcell.task_locations, Path(path).name.split(".")[0], self.cell.robot, self.cell.joint_map))
         self.log.say(f"corrections exported to {path} ({fmt})")

@@ -10,8 +10,11 @@ language declares a Cartesian target:
 - FANUC TP: a position ``(X, Y, Z, W, P, R)``, mm and degrees, ``R = Rz(R) Ry(P) Rx(W)``;
 - COMAU PDL2: ``POS(x, y, z, e1, e2, e3, '')``, mm and Euler ZYZ degrees.
 
-A pose alone does not fix the arm's configuration (ABB ``confdata``, FANUC ``CONFIG``, KUKA
-``S``/``T``): the listings say so, and leave it to be taught on the controller.
+A pose alone does not fix the arm's configuration. Given the cell's robot, each target carries the one the arm takes
+there (:mod:`calib_core.workspace.arm_configuration`: IK from the joints the look was made at): ABB ``confdata``,
+KUKA ``S``/``T`` (a ``POS`` in place of a ``FRAME``), and for a UR the joints to pass as ``qnear`` to the controller's
+own ``get_inverse_kin``; a target near a configuration boundary says so. FANUC's ``CONFIG`` is left to be taught
+(docs/decisions.md says why), as is every configuration without the robot.
 Variable names are made unique within a listing after the vendor's length limit. The listing's own name (RAPID's
 ``MODULE``, KRL's ``DEFDAT``, FANUC's ``/PROG``) is the file's, as the controllers require (a KRL data list whose
 ``DEFDAT`` differs from its file name is refused when loaded; a FANUC ``.ls`` is loaded under its ``/PROG`` name).
@@ -23,11 +26,14 @@ import re
 import time
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from calib_core.calibration.corrections import CorrectionTable
+from calib_core.workspace.arm_configuration import ArmConfiguration, NotASixAxisArmError, abb_confdata, arm_configuration, kuka_status_turn
+from calib_core.errors import VideocalError
 from calib_core.names import InvalidNameError, check_name
 from calib_core.workcell.model import TaskLocation
 
@@ -75,8 +81,8 @@ def rapid_pose(T: np.ndarray) -> str:
     return f"[[{x:.3f},{y:.3f},{z:.3f}],[{qw:.8f},{qx:.8f},{qy:.8f},{qz:.8f}]]"
 
 
-def rapid_robtarget(T: np.ndarray) -> str:
-    return f"[{rapid_pose(T)[1:-1]},[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]]"
+def rapid_robtarget(T: np.ndarray, confdata: tuple[int, int, int, int] = (0, 0, 0, 0)) -> str:
+    return f"[{rapid_pose(T)[1:-1]},[{','.join(str(int(v)) for v in confdata)}],[9E9,9E9,9E9,9E9,9E9,9E9]]"
 
 
 def rapid_tooldata(tcp2flange: np.ndarray) -> str:
@@ -85,13 +91,15 @@ def rapid_tooldata(tcp2flange: np.ndarray) -> str:
     return f"[TRUE,{rapid_pose(tcp2flange)},[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]"
 
 
-def krl_frame(T: np.ndarray) -> str:
+def krl_frame(T: np.ndarray, status_turn: tuple[int, int] | None = None) -> str:
+    """KRL's ``FRAME`` ``{X, Y, Z, A, B, C}``; with ``status_turn`` a ``POS`` (``..., S s, T t}``)."""
     x, y, z = T[:3, 3]
     with warnings.catch_warnings():
         # B = +-90 deg (a tool turned square): A and C are not unique; scipy's choice gives the same rotation
         warnings.simplefilter("ignore", UserWarning)
         a, b, c = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
-    return f"{{X {x:.3f},Y {y:.3f},Z {z:.3f},A {a:.4f},B {b:.4f},C {c:.4f}}}"
+    st = "" if status_turn is None else f",S {status_turn[0]},T {status_turn[1]}"
+    return f"{{X {x:.3f},Y {y:.3f},Z {z:.3f},A {a:.4f},B {b:.4f},C {c:.4f}{st}}}"
 
 
 def fanuc_position(T: np.ndarray) -> tuple[float, ...]:
@@ -112,8 +120,21 @@ def pdl2_pos(T: np.ndarray) -> str:
     return f"POS({x:.3f}, {y:.3f}, {z:.3f}, {e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f}, '')"
 
 
-Entry = tuple[str, np.ndarray, str]
-"""(variable name, target pose (4, 4) mm in base, a remark)."""
+@dataclass(frozen=True)
+class Entry:
+    """``ident``: the variable's name; ``pose`` (4, 4) mm in base: the target to command; ``note``: a remark;
+    ``arm``: the arm's configuration there (``None`` without the robot; a string: why it is not known)."""
+
+    ident: str
+    pose: np.ndarray
+    note: str
+    arm: ArmConfiguration | str | None = None
+
+    def arm_note(self, vendor_terms: str) -> str:
+        """What a listing says of the configuration beside the target."""
+        if isinstance(self.arm, ArmConfiguration):
+            return f"{vendor_terms} from the arm at this target (IK from the look's joints)" + (f"; near a boundary: {'; '.join(self.arm.near)}: check it" if self.arm.near else "")
+        return f"{vendor_terms} must be taught" + (f" ({self.arm})" if self.arm else " (no robot given)")
 
 DEFAULT_NAME = "videocal_corrections"
 
@@ -137,30 +158,38 @@ def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: n
              "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location"]
     if tool is not None:
         lines += ["# the tool (TCP) the targets are for, on the flange: set it before moving to them", f"set_tcp({urscript_pose(tool)})"]
-    for ident, T, note in entries:
-        lines += [f"# {note}", f"global {ident} = {urscript_pose(T)}"]
+    for e in entries:
+        lines += [f"# {e.note}", f"global {e.ident} = {urscript_pose(e.pose)}"]
+        if isinstance(e.arm, ArmConfiguration):
+            q = ", ".join(f"{v:.6f}" for v in np.radians(e.arm.axes_deg[:6]))
+            lines += [f"# the joints (rad) near which the arm stands there: movej(get_inverse_kin({e.ident}, qnear={e.ident}_qnear))" + (f"; near: {'; '.join(e.arm.near)}" if e.arm.near else ""),
+                      f"global {e.ident}_qnear = [{q}]"]
     return lines
 
 
 def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"MODULE {name}", f"  ! videocal corrected task locations, {when}",
-             "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0); confdata [0,0,0,0] must be taught"]
+             "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0), confdata [cf1, cf4, cf6, cfx]"]
     if tool is not None:
         lines += ["  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and centre of gravity",
                   f"  PERS tooldata videocal_tool := {rapid_tooldata(tool)};"]
-    for ident, T, note in entries:
-        lines += [f"  ! {note}", f"  CONST robtarget {ident} := {rapid_robtarget(T)};"]
+    for e in entries:
+        conf = abb_confdata(e.arm) if isinstance(e.arm, ArmConfiguration) else (0, 0, 0, 0)
+        lines += [f"  ! {e.note}; {e.arm_note('confdata')}", f"  CONST robtarget {e.ident} := {rapid_robtarget(e.pose, conf)};"]
     return lines + ["ENDMODULE"]
 
 
 def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"DEFDAT {name} PUBLIC", f"; videocal corrected task locations, {when}",
-             "; FRAME {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; S and T are taught"]
+             "; {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; a POS carries S and T"]
     if tool is not None:
         lines += ["; the tool (TCP) the targets are for, on the flange: TOOL_DATA[n]=videocal_tool, then $TOOL=TOOL_DATA[n]",
                   f"DECL GLOBAL FRAME videocal_tool={krl_frame(tool)}"]
-    for ident, T, note in entries:
-        lines += [f"; {note}", f"DECL GLOBAL FRAME {ident}={krl_frame(T)}"]
+    for e in entries:
+        if isinstance(e.arm, ArmConfiguration):
+            lines += [f"; {e.note}; {e.arm_note('S and T')}", f"DECL GLOBAL POS {e.ident}={krl_frame(e.pose, kuka_status_turn(e.arm))}"]
+        else:
+            lines += [f"; {e.note}; {e.arm_note('S and T')}", f"DECL GLOBAL FRAME {e.ident}={krl_frame(e.pose)}"]
     return lines + ["ENDDAT"]
 
 
@@ -179,12 +208,12 @@ def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), to
     if tool is not None:
         x, y, z, w, p, r = fanuc_position(tool)
         notes += ["the tool frame (UTOOL 1) the targets are for, on the faceplate:", f"X {x:.3f} Y {y:.3f} Z {z:.3f} W {w:.3f} P {p:.3f} R {r:.3f}"]
-    notes += [f"P[{k}] {ident}: {note}" for k, (ident, _, note) in enumerate(entries, start=1)]
+    notes += [f"P[{k}] {e.ident}: {e.note}" for k, e in enumerate(entries, start=1)]
     lines = [f"/PROG  {name}"] + _fanuc_attr(len(notes), when) + ["/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
-    for k, (ident, T, _) in enumerate(entries, start=1):
-        x, y, z, w, p, r = fanuc_position(T)
+    for k, e in enumerate(entries, start=1):
+        x, y, z, w, p, r = fanuc_position(e.pose)
         lines += [
-            f'P[{k}:"{ident}"]{{', "   GP1:", "\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',",
+            f'P[{k}:"{e.ident}"]{{', "   GP1:", "\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',",
             f"\tX = {x:10.3f}  mm,\tY = {y:10.3f}  mm,\tZ = {z:10.3f}  mm,",
             f"\tW = {w:10.3f} deg,\tP = {p:10.3f} deg,\tR = {r:10.3f} deg", "};",
         ]
@@ -194,8 +223,8 @@ def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), to
 def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [f"-- videocal corrected task locations, {when}",
              "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
-    lines += [f"  {ident} : POSITION  -- {note}" for ident, _, note in entries]
-    body = [f"  {ident} := {pdl2_pos(T)}" for ident, T, _ in entries]
+    lines += [f"  {e.ident} : POSITION  -- {e.note}" for e in entries]
+    body = [f"  {e.ident} := {pdl2_pos(e.pose)}" for e in entries]
     if tool is not None:
         body = ["  $TOOL := " + pdl2_pos(tool) + "  -- the tool (TCP) the targets are for, on the flange"] + body
     return lines + ["BEGIN"] + body + ["END"]
@@ -213,10 +242,38 @@ def corrected_targets(table: CorrectionTable, tasks: dict[str, TaskLocation]) ->
     return {name: table.corrected_target(name, tasks[name].tcp2base) for name in table.tasks() if name in tasks}
 
 
-def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, tool: np.ndarray | None = None) -> str:
+REFERENCE_POSES = {"rapid": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "krl": (0.0, -90.0, 90.0, 0.0, 0.0, 0.0)}
+"""Each vendor's pose (controller axes, deg) whose elbow is the normal one: ABB's zero (cfx's "in front of the lower
+arm"), KUKA's home (Status bit 1 set: A3 past the stretched arm's angle)."""
+
+
+def _arm_at(fmt: str, robot, joint_map, target: np.ndarray, look_joints) -> ArmConfiguration | str | None:
+    """The arm's configuration at ``target`` for ``fmt`` (``None``: the language has none here, or no robot)."""
+    if robot is None or fmt not in ("rapid", "krl", "urscript"):
+        return None
+    from calib_core.link.joint_map import JointMap
+    from calib_core.robot import solve_ik
+
+    joint_map = joint_map or JointMap.identity(robot.n_joints)
+    try:
+        q = solve_ik(robot, target, np.asarray(look_joints, dtype=float)).q_deg
+    except VideocalError as exc:
+        return f"no IK at this target from the look's joints: {str(exc).splitlines()[0]}"
+    if fmt == "urscript":
+        return ArmConfiguration(np.asarray(joint_map.to_controller(q), dtype=float), 0.0, 0.0, ())
+    try:
+        return arm_configuration(robot, joint_map, q, REFERENCE_POSES[fmt])
+    except NotASixAxisArmError as exc:
+        return str(exc)
+
+
+def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, tool: np.ndarray | None = None,
+                       robot=None, joint_map=None) -> str:
     """The corrected targets as a ``fmt`` listing (:data:`FORMATS`), one variable per task location,
     each with its measured displacement as a remark; named after the file it goes to (``file_stem``); with ``tool``
-    (``tcp2flange`` (4, 4) mm), the tool data the targets are for, in the language's own form."""
+    (``tcp2flange`` (4, 4) mm), the tool data the targets are for, in the language's own form; with ``robot`` (the
+    cell's :class:`~calib_core.robot.model.RobotModel`) and ``joint_map`` (model joints to controller axes; default
+    the same), the arm's configuration at each target."""
     writer, max_name = LISTINGS[fmt]
     listing = listing_name(fmt, file_stem)
     targets = corrected_targets(table, tasks)
@@ -229,5 +286,6 @@ def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLo
     entries = []
     for name, T in targets.items():
         c = table.latest(name)
-        entries.append((idents[name], T, f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"))
+        note = f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"
+        entries.append(Entry(idents[name], T, note, _arm_at(fmt, robot, joint_map, T, c.joints_deg)))
     return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S"), listing, tool) + [""])

@@ -72,15 +72,16 @@ def corrections_pdl2(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> 
     return controller_listing("pdl2", table, tasks)
 
 
-def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, robot=None) -> str:
+def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, robot=None, joint_map=None) -> str:
     """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`); a controller listing is named after the file it
     goes to (``file_stem``, the name without its suffixes), as the controller requires, and with ``robot`` (the cell's
-    :class:`~calib_core.robot.model.RobotModel`) carries the tool data the targets are for."""
+    :class:`~calib_core.robot.model.RobotModel`) carries the tool data the targets are for and the arm's
+    configuration at each (``joint_map``: the cell's model joints to controller axes)."""
     if fmt == "json":
         return corrections_json(table, tasks)
     if fmt == "csv":
         return corrections_csv(table, tasks)
-    return controller_listing(fmt, table, tasks, file_stem, None if robot is None else tool_on_flange(robot))
+    return controller_listing(fmt, table, tasks, file_stem, None if robot is None else tool_on_flange(robot), robot, joint_map)
 
 
 def tool_on_flange(robot) -> np.ndarray:
