@@ -79,7 +79,7 @@ class CameraPublisher:
             stamp = msg.Time.of_ns(time.time_ns() - int((time.monotonic() - frame.t_host_s) * 1e9))
             header = msg.Header(stamp, "camera")
             images.write(msg.Image(header, h, w, "rgb8", 0, w * 3, frame.image.tobytes()))
-            infos.write(msg.CameraInfo(header, h, w, "plumb_bob", [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
+            infos.write(msg.CameraInfo(header, h, w, i.model, [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
                                        [i.fu, 0.0, i.cx, 0.0, 0.0, i.fv, i.cy, 0.0, 0.0, 0.0, 1.0, 0.0]))
             self.published += 1
         self.source.close()

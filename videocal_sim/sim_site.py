@@ -58,13 +58,14 @@ class SimulatedSite:
 
 
 def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: RobotErrors | None = None, image_scale: float = 1.0,
-                   process: SimulatorProcess | None = None, camera_fps: float = 15.0) -> tuple[Cell, SimulatedSite]:
+                   process: SimulatorProcess | None = None, camera_fps: float = 15.0, intrinsics: Intrinsics | None = None) -> tuple[Cell, SimulatedSite]:
     """The cell at ``workcell_path`` and a simulated site for it: the true robot has ``errors``
-    (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels)."""
+    (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels); ``intrinsics``: another
+    camera than the workcell's (its lens, a fisheye), the same for the simulated camera and the cell's model."""
     workcell = load_workcell(workcell_path)
-    if workcell.intrinsics_path is None:
+    if workcell.intrinsics_path is None and intrinsics is None:
         raise VideocalError(f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated camera needs one")
-    nominal: Intrinsics = load_intrinsics(workcell.intrinsics_path)
+    nominal: Intrinsics = intrinsics or load_intrinsics(workcell.intrinsics_path)
     if image_scale != 1.0:
         nominal = nominal.scaled(image_scale)
     bed = TestBed.create(workcell, errors=errors, intrinsics=nominal)

@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
         for name in ("fu", "fv", "cx", "cy"):
             t = f"   (truth {getattr(truth, name):.2f})" if truth is not None else ""
             print(f"  {name} = {getattr(i, name):9.2f} +- {result.std[name]:.2f} px{t}")
-        print("  distortion k1 k2 p1 p2 k3 = " + " ".join(f"{v:+.5f}" for v in i.distortion))
+        print(f"  distortion ({i.model}) {' '.join(i.distortion_names)} = " + " ".join(f"{v:+.5f}" for v in i.distortion))
         for line in result.advice:
             print(f"advice: {line}")
         print(f"wrote {args.out}")

@@ -199,7 +199,7 @@ class VisionPanel(QWidget):
             f"<b>Intrinsics</b> from {len(r.used)} views, RMS {r.rms_px:.3f} px",
             f"fu {i.fu:.2f} &plusmn; {s['fu']:.2f}, fv {i.fv:.2f} &plusmn; {s['fv']:.2f} px",
             f"cx {i.cx:.2f} &plusmn; {s['cx']:.2f}, cy {i.cy:.2f} &plusmn; {s['cy']:.2f} px",
-            "k1 k2 p1 p2 k3: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
+            f"{' '.join(i.distortion_names)}: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
         ]
         lines += [f"&bull; {a}" for a in r.advice]
         lines += [f"<span style='color:#e0a030'>check: {p}</span>" for p in intrinsics_problems(r, self.workbench.intrinsics)]

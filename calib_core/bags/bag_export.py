@@ -115,7 +115,7 @@ def _write_camera_info(writer, ts, T, intrinsics: dict, t_ns: int, camera_frame:
     connection = writer.add_connection(INFO_TOPIC, kind, typestore=ts)
     roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
     info = T[kind](header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=camera_frame), height=int(intrinsics["height"]), width=int(intrinsics["width"]),
-                   distortion_model="plumb_bob", d=np.array(d, float), k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
+                   distortion_model=str(intrinsics.get("distortion_model", "plumb_bob")), d=np.array(d, float), k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
                    p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float), binning_x=0, binning_y=0, roi=roi)
     writer.write(connection, t_ns, ts.serialize_cdr(info, kind))
     return 1

@@ -35,6 +35,10 @@ def distortion_map(intrinsics: Intrinsics) -> DistortionMap:
     if not intrinsics.has_distortion:
         return DistortionMap(intrinsics, u.astype(np.float32), v.astype(np.float32))
     ideal_px = project(unproject(pixels, intrinsics, undistort=True), intrinsics, distort=False)
+    # A wide (fisheye) lens sees rays whose ideal pinhole pixels lie far out (infinitely at 90 deg): the canvas stops
+    # one image beyond each edge, and the few pixels of the real image beyond it sample its border.
+    reach = np.array([w, h], dtype=float)
+    ideal_px = np.clip(np.nan_to_num(ideal_px, nan=0.0, posinf=1e9, neginf=-1e9), -reach, 2 * reach)
     lo = np.floor(ideal_px.min(axis=0)) - 2
     hi = np.ceil(ideal_px.max(axis=0)) + 2
     left, top = max(0.0, -lo[0]), max(0.0, -lo[1])

@@ -7,6 +7,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 DISTORTION_NAMES = ("k1", "k2", "p1", "p2", "k3")
+DISTORTION_MODELS = {
+    "plumb_bob": ("k1", "k2", "p1", "p2", "k3"),
+    "rational_polynomial": ("k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"),
+    "equidistant": ("k1", "k2", "k3", "k4"),
+}
+"""The lens models, by ROS's ``distortion_model`` names, with their coefficients in OpenCV's order: OpenCV's
+5-parameter model, its 8-parameter rational model, and its fisheye (equidistant, Kannala-Brandt) model."""
 
 
 MAX_IMAGE_SIDE_PX = 20000
@@ -15,11 +22,13 @@ MAX_IMAGE_SIDE_PX = 20000
 
 @dataclass(frozen=True)
 class Intrinsics:
-    """A pinhole camera with OpenCV's 5-parameter lens distortion.
+    """A camera: a pinhole with lens distortion.
 
     ``fu``, ``fv``: focal lengths, px. ``cx``, ``cy``: principal point, px, with the
     centre of the top-left pixel at (0, 0) as in OpenCV. ``width``, ``height``: image
-    size, px. ``distortion``: ``(k1, k2, p1, p2, k3)``, dimensionless, OpenCV's model.
+    size, px. ``distortion``: the coefficients of ``model`` (:data:`DISTORTION_MODELS`), dimensionless:
+    ``(k1, k2, p1, p2, k3)`` for ``plumb_bob`` (the default), eight for ``rational_polynomial``,
+    ``(k1, k2, k3, k4)`` for ``equidistant`` (OpenCV's fisheye model).
     """
 
     fu: float
@@ -28,7 +37,8 @@ class Intrinsics:
     cy: float
     width: int
     height: int
-    distortion: tuple[float, float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0, 0.0))
+    distortion: tuple[float, ...] = field(default=(0.0, 0.0, 0.0, 0.0, 0.0))
+    model: str = "plumb_bob"
 
     def __post_init__(self) -> None:
         for name in ("fu", "fv", "cx", "cy"):
@@ -45,9 +55,12 @@ class Intrinsics:
             if int(v) > MAX_IMAGE_SIDE_PX:
                 raise ValueError(f"intrinsics: {name} is {v} pixels; videocal takes images up to {MAX_IMAGE_SIDE_PX} pixels a side")
             object.__setattr__(self, name, int(v))
+        if self.model not in DISTORTION_MODELS:
+            raise ValueError(f"intrinsics: unknown distortion model {self.model!r}; videocal knows {', '.join(DISTORTION_MODELS)}")
+        names = DISTORTION_MODELS[self.model]
         d = tuple(float(x) for x in np.asarray(self.distortion, dtype=float).ravel())
-        if len(d) != 5:
-            raise ValueError(f"intrinsics: distortion needs 5 values (k1, k2, p1, p2, k3), got {len(d)}")
+        if len(d) != len(names):
+            raise ValueError(f"intrinsics: {self.model} distortion needs {len(names)} values ({', '.join(names)}), got {len(d)}")
         if not all(np.isfinite(d)):
             raise ValueError("intrinsics: distortion contains NaN or infinite values")
         object.__setattr__(self, "distortion", d)
@@ -59,8 +72,12 @@ class Intrinsics:
 
     @property
     def dist_coeffs(self) -> np.ndarray:
-        """Distortion as OpenCV wants it: array (5,) ``k1 k2 p1 p2 k3``."""
+        """Distortion as OpenCV wants it: array (5,), (8,) or, for ``equidistant`` (``cv2.fisheye``), (4,)."""
         return np.asarray(self.distortion, dtype=float)
+
+    @property
+    def distortion_names(self) -> tuple[str, ...]:
+        return DISTORTION_MODELS[self.model]
 
     @property
     def has_distortion(self) -> bool:
@@ -72,7 +89,8 @@ class Intrinsics:
         return (self.width, self.height)
 
     def without_distortion(self) -> Intrinsics:
-        return replace(self, distortion=(0.0, 0.0, 0.0, 0.0, 0.0))
+        """The ideal pinhole camera of the same focal lengths and principal point."""
+        return replace(self, distortion=(0.0, 0.0, 0.0, 0.0, 0.0), model="plumb_bob")
 
     def with_focal(self, fu: float, fv: float) -> Intrinsics:
         return replace(self, fu=fu, fv=fv)
@@ -101,7 +119,7 @@ class Intrinsics:
         )
 
     def to_dict(self) -> dict:
-        return {
+        out = {
             "fu": self.fu,
             "fv": self.fv,
             "cx": self.cx,
@@ -110,6 +128,9 @@ class Intrinsics:
             "height": self.height,
             "distortion": list(self.distortion),
         }
+        if self.model != "plumb_bob":  # files of the default model stay as older videocal wrote them
+            out["distortion_model"] = self.model
+        return out
 
     @classmethod
     def from_dict(cls, data: dict) -> Intrinsics:
@@ -122,7 +143,7 @@ class Intrinsics:
         missing = [k for k in ("fu", "fv", "cx", "cy", "width", "height") if k not in data]
         if missing:
             raise ValueError(f"intrinsics: missing field(s) {', '.join(missing)}")
-        unknown = set(data) - {"fu", "fv", "cx", "cy", "width", "height", "distortion"}
+        unknown = set(data) - {"fu", "fv", "cx", "cy", "width", "height", "distortion", "distortion_model"}
         if unknown:
             raise ValueError(f"intrinsics: unknown field(s) {', '.join(sorted(unknown))}")
         kwargs = {}
@@ -133,4 +154,6 @@ class Intrinsics:
             kwargs[k] = v
         if "distortion" in data:
             kwargs["distortion"] = tuple(data["distortion"])
+        if "distortion_model" in data:
+            kwargs["model"] = str(data["distortion_model"])
         return cls(**kwargs)

@@ -14,7 +14,7 @@ import numpy as np
 import yaml
 
 from calib_core.atomic_file import atomic_path, atomic_write_text
-from calib_core.camera.intrinsics import MAX_IMAGE_SIDE_PX, Intrinsics
+from calib_core.camera.intrinsics import DISTORTION_MODELS, MAX_IMAGE_SIDE_PX, Intrinsics
 from calib_core.documents import parse_yaml, read_text
 from calib_core.errors import FileFormatError
 
@@ -63,7 +63,9 @@ def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv
             fs.write("image_width", intrinsics.width)
             fs.write("image_height", intrinsics.height)
             fs.write("camera_matrix", intrinsics.K)
-            fs.write("distortion_coefficients", intrinsics.dist_coeffs.reshape(1, 5))
+            fs.write("distortion_coefficients", intrinsics.dist_coeffs.reshape(1, -1))
+            if intrinsics.model != "plumb_bob":
+                fs.write("distortion_model", intrinsics.model)
             fs.release()
     else:
         atomic_write_text(path, yaml.safe_dump(_ros_dict(intrinsics, camera_name), sort_keys=False))
@@ -86,11 +88,13 @@ def _load_opencv(path: Path, image_size: tuple[int, int] | None = None) -> Intri
             dist = _fs_matrix(fs, path, "distortion_coefficients", None).ravel()
         width = _fs_int(fs, path, "image_width", image_size[0] if image_size else None)
         height = _fs_int(fs, path, "image_height", image_size[1] if image_size else None)
+        model_node = fs.getNode("distortion_model")
+        model = model_node.string() if not model_node.empty() and model_node.isString() else None
     except cv2.error as exc:  # a node of another shape than the file's kind says (OpenCV asserts)
         raise FileFormatError(path, f"not an OpenCV intrinsics file ({_first_line(exc).split('error: ')[-1]})") from None
     finally:
         fs.release()
-    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")
+    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients", model)
 
 
 def _fs_matrix(fs: cv2.FileStorage, path: Path, key: str, shape: tuple[int, int] | None) -> np.ndarray:
@@ -139,12 +143,10 @@ def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None)
         raise FileFormatError(path, f"unknown key(s) for a ROS camera_info file: {', '.join(unknown)}")
     width = _image_side(path, "image_width", data.get("image_width"), image_size[0] if image_size else None)
     height = _image_side(path, "image_height", data.get("image_height"), image_size[1] if image_size else None)
-    model = data.get("distortion_model", "plumb_bob")
-    if model not in ("plumb_bob", "rational_polynomial"):
-        raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
+    model = _model_field(path, data.get("distortion_model") or "plumb_bob")
     K = _ros_matrix(path, data, "camera_matrix", 9).reshape(3, 3)
-    dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(5)
-    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients")
+    dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(0)
+    return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients", model)
 
 
 def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
@@ -158,20 +160,16 @@ def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int
         raise FileFormatError(path, f"unknown key(s) for a CameraInfo message: {', '.join(unknown)}")
     width = _image_side(path, "width", data.get("width") or None, image_size[0] if image_size else None)
     height = _image_side(path, "height", data.get("height") or None, image_size[1] if image_size else None)
-    model = data.get("distortion_model") or "plumb_bob"
-    if model not in ("plumb_bob", "rational_polynomial"):
-        raise FileFormatError(path, f"unsupported distortion model {model!r} (videocal uses plumb_bob)", "distortion_model")
+    model = _model_field(path, data.get("distortion_model") or "plumb_bob")
     values = {}
     for name, size in (("k", 9), ("d", None)):
         v = field(name)
         if v is None and name == "d":
-            v = [0.0] * 5
+            v = []
         if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v) or (size and len(v) != size):
             raise FileFormatError(path, f"must be a list of {size or 'the distortion'} numbers, got {v!r}", name)
         values[name] = np.asarray(v, dtype=float)
-    if not values["d"].size:
-        values["d"] = np.zeros(5)
-    return _build(path, values["k"].reshape(3, 3), values["d"], width, height, "k", "d")
+    return _build(path, values["k"].reshape(3, 3), values["d"], width, height, "k", "d", model)
 
 
 def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarray:
@@ -192,20 +190,39 @@ def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarra
     return np.asarray(values, dtype=float)
 
 
-def _build(path: Path, K: np.ndarray, dist: np.ndarray, width: int, height: int, k_field: str, d_field: str) -> Intrinsics:
+def _model_field(path: Path, model) -> str:
+    if model not in DISTORTION_MODELS:
+        raise FileFormatError(path, f"unsupported distortion model {model!r}; videocal reads {', '.join(DISTORTION_MODELS)}", "distortion_model")
+    return str(model)
+
+
+def _coefficients(path: Path, dist: np.ndarray, model: str | None, d_field: str) -> tuple[str, tuple[float, ...]]:
+    """``(model, coefficients)`` of a file's distortion: as its ``model`` says (``plumb_bob`` takes 4 or 5 values, and
+    an all-zero list of any length; ``rational_polynomial`` 8; ``equidistant`` 4); a file naming no model (OpenCV's)
+    is ``plumb_bob`` with 4 or 5 values, ``rational_polynomial`` with 8 (``plumb_bob`` when k4..k6 are zero)."""
+    n = dist.size
+    if not np.all(np.isfinite(dist)):
+        raise FileFormatError(path, "the distortion contains NaN or infinite values", d_field)
+    if model is None:
+        model = "rational_polynomial" if n == 8 and np.any(dist[5:] != 0) else "plumb_bob"
+    if not np.any(dist) and model != "equidistant":  # no distortion, however many zeros were written
+        return model, (0.0,) * len(DISTORTION_MODELS[model])
+    names = DISTORTION_MODELS[model]
+    if model == "plumb_bob" and n in (4, 5, 8) and not np.any(dist[5:]):
+        return model, tuple(np.r_[dist[:5], np.zeros(5 - min(n, 5))])
+    if n != len(names):
+        raise FileFormatError(path, f"a {model} lens has {len(names)} coefficients ({' '.join(names)}), the file gives {n}", d_field)
+    return model, tuple(float(v) for v in dist)
+
+
+def _build(path: Path, K: np.ndarray, dist: np.ndarray, width: int, height: int, k_field: str, d_field: str, model: str | None = None) -> Intrinsics:
     if not np.all(np.isfinite(K)):
         raise FileFormatError(path, "contains NaN or infinite values", k_field)
     if abs(K[0, 1]) > 1e-9 or np.any(np.abs(K[2] - [0, 0, 1]) > 1e-9) or abs(K[1, 0]) > 1e-9:
         raise FileFormatError(path, "not a pinhole camera matrix [[fu,0,cx],[0,fv,cy],[0,0,1]] (skew is not supported)", k_field)
-    dist = np.asarray(dist, dtype=float).ravel()
-    if dist.size not in (4, 5, 8) or not np.all(np.isfinite(dist)):
-        raise FileFormatError(path, f"expected 4 or 5 finite coefficients k1 k2 p1 p2 [k3], got {dist.size}", d_field)
-    if dist.size == 8 and np.any(dist[5:] != 0):
-        raise FileFormatError(path, "rational distortion (k4..k6) is not supported", d_field)
-    dist5 = np.zeros(5)
-    dist5[: min(5, dist.size)] = dist[:5]
+    model, coefficients = _coefficients(path, np.asarray(dist, dtype=float).ravel(), model, d_field)
     try:
-        return Intrinsics(K[0, 0], K[1, 1], K[0, 2], K[1, 2], width, height, tuple(dist5))
+        return Intrinsics(K[0, 0], K[1, 1], K[0, 2], K[1, 2], width, height, coefficients, model)
     except ValueError as exc:
         raise FileFormatError(path, str(exc).removeprefix("intrinsics: "), k_field) from None
 
@@ -218,8 +235,8 @@ def _ros_dict(intr: Intrinsics, camera_name: str) -> dict:
         "image_height": intr.height,
         "camera_name": camera_name,
         "camera_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in intr.K.ravel()]},
-        "distortion_model": "plumb_bob",
-        "distortion_coefficients": {"rows": 1, "cols": 5, "data": [float(v) for v in intr.distortion]},
+        "distortion_model": intr.model,
+        "distortion_coefficients": {"rows": 1, "cols": len(intr.distortion), "data": [float(v) for v in intr.distortion]},
         "rectification_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in np.eye(3).ravel()]},
         "projection_matrix": {"rows": 3, "cols": 4, "data": [float(v) for v in P.ravel()]},
     }

@@ -59,13 +59,13 @@ def _pose(target, T_mm: np.ndarray) -> None:
 
 
 def camera_calibration(intrinsics: Intrinsics, frame_id: str, t_ns: int):
-    """``foxglove.CameraCalibration``: K, D (OpenCV order), R = I, P = [K | 0], size; the model
-    is ``plumb_bob`` for up to 5 coefficients and ``rational_polynomial`` for 8."""
+    """``foxglove.CameraCalibration``: K, D (OpenCV order), R = I, P = [K | 0], size; the model is ``plumb_bob``,
+    ``rational_polynomial`` or, for a fisheye (``equidistant``) lens, Foxglove's name for the same model,
+    ``kannala_brandt`` (k1..k4)."""
     from foxglove_schemas_protobuf.CameraCalibration_pb2 import CameraCalibration
 
     d = [float(v) for v in intrinsics.distortion]
-    model = "rational_polynomial" if len(d) > 5 else "plumb_bob"
-    d = d + [0.0] * ((8 if len(d) > 5 else 5) - len(d))
+    model = {"equidistant": "kannala_brandt"}.get(intrinsics.model, intrinsics.model)
     fu, fv, cx, cy = map(float, (intrinsics.fu, intrinsics.fv, intrinsics.cx, intrinsics.cy))
     message = CameraCalibration(
         frame_id=frame_id, width=int(intrinsics.width), height=int(intrinsics.height), distortion_model=model, D=d,

@@ -21,7 +21,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.camera.projection import project
+from calib_core.camera.projection import as_pinhole, project
 from calib_core.errors import VideocalError
 from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.robot.model import RobotModel
@@ -193,7 +193,8 @@ def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[Po
     for v in views:
         if v.target != BOARD or len(v.points_mm) < 4:
             continue
-        ok, rvec, tvec = cv2.solvePnP(v.points_mm, v.pixels, intrinsics.K, intrinsics.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
+        pixels, camera = as_pinhole(v.pixels, intrinsics)  # OpenCV's PnP knows no fisheye lens
+        ok, rvec, tvec = cv2.solvePnP(v.points_mm, pixels, camera.K, camera.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
         if ok:
             placements.append(concat(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()), robot.fk(v.joints_deg, camera_frame)))
     if not placements:

@@ -14,7 +14,7 @@ the views determine. Intrinsics corrections (fu fv cx cy px, k1 k2 p1 p2 in thou
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -37,8 +37,8 @@ def delta_transform(v: np.ndarray) -> np.ndarray:
 def corrected_intrinsics(nominal: Intrinsics, d: np.ndarray) -> Intrinsics:
     """``nominal`` with the corrections ``d`` (8,) in the units of :data:`INTRINSICS` applied."""
     dist = np.asarray(nominal.distortion, dtype=float).copy()
-    dist[:4] += np.asarray(d[4:8], dtype=float) / 1000.0
-    return Intrinsics(nominal.fu + d[0], nominal.fv + d[1], nominal.cx + d[2], nominal.cy + d[3], nominal.width, nominal.height, tuple(dist))
+    dist[:4] += np.asarray(d[4:8], dtype=float) / 1000.0  # the first four of any model: k1 k2 p1 p2, or a fisheye's k1..k4
+    return replace(nominal, fu=nominal.fu + d[0], fv=nominal.fv + d[1], cx=nominal.cx + d[2], cy=nominal.cy + d[3], distortion=tuple(dist))
 
 
 def delta_of(T: np.ndarray) -> np.ndarray:

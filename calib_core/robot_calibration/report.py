@@ -92,7 +92,7 @@ def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_f
             "correlations_over_0_9": [[a, b, r] for a, b, r in result.observability.correlations],
         },
         "camera_on_parent": _xyz_rpy(result.robot.frame_placement(camera_frame)),
-        "intrinsics": {"fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion)},
+        "intrinsics": {"fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion), "distortion_model": i.model},
         "board2base": None if result.board2base is None else _xyz_rpy(result.board2base),
         "rms_px": round(result.rms_px, 4), "start_rms_px": round(result.start_rms_px, 4), "noise_px": round(result.noise_px, 4),
         "noise_by_target_px": {k: round(v, 4) for k, v in result.noise_by_target_px.items()},

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import as_pinhole
 from calib_core.solver.errors import MismatchedPointsError, NonFiniteInputError, TooFewPointsError
 from calib_core.solver.initialisation import normalized_coordinates, sqpnp_seed
 from calib_core.solver.kernels.dlt import dlt_pose_batch
@@ -83,6 +84,9 @@ def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Int
     check_intrinsics(intrinsics)
     P, uv = _check_batch(points_3d, points_2d, estimate_focal)
     b, n, _ = P.shape
+    if intrinsics.model != "plumb_bob":  # the kernel knows OpenCV's 5-parameter lens: the ideal pinhole sees the same rays
+        flat, intrinsics = as_pinhole(uv.reshape(-1, 2), intrinsics)
+        uv = np.ascontiguousarray(flat.reshape(b, n, 2))
     if starts is not None:
         S = np.asarray(starts, dtype=float)
         if S.shape != (b, 4, 4):

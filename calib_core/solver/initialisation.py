@@ -45,7 +45,7 @@ def normalized_coordinates(points_2d: np.ndarray, intrinsics: Intrinsics, fu: fl
     xy[..., 0] = (points_2d[..., 0] - intrinsics.cx) / fu
     xy[..., 1] = (points_2d[..., 1] - intrinsics.cy) / fv
     if intrinsics.has_distortion:
-        xy = undistort_normalized(xy.reshape(-1, 2), intrinsics.distortion).reshape(points_2d.shape)
+        xy = undistort_normalized(xy.reshape(-1, 2), intrinsics.distortion, intrinsics.model).reshape(points_2d.shape)
     return xy
 
 

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import as_pinhole
 from scipy.spatial import cKDTree
 
 from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, NON_FINITE_3D, check_pairs, close_pairs
@@ -112,7 +113,10 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
     if n_off_image:
         u, v = p2[:, 0], p2[:, 1]
         off_image = tuple(int(k) for k in np.flatnonzero((u < -0.5) | (v < -0.5) | (u > intrinsics.width - 0.5) | (v > intrinsics.height - 0.5)))
-    return PoseProblem(p3, p2, intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image, repeated)
+    # The kernels know OpenCV's 5-parameter lens; a rational or fisheye lens is solved on the ideal pinhole's pixels,
+    # which see the same rays (the pose is the same; residuals are in the ideal image's pixels).
+    p2, intrinsics = as_pinhole(p2, intrinsics)
+    return PoseProblem(p3, np.ascontiguousarray(p2), intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image, repeated)
 
 
 def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tuple[int, int], ...]:

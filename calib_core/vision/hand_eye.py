@@ -24,7 +24,7 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.camera.projection import project
+from calib_core.camera.projection import as_pinhole, project
 from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError
 
@@ -90,7 +90,8 @@ def board_pose(view: BoardView, spec, intrinsics: Intrinsics) -> np.ndarray:
 def board_pose_fit(view: BoardView, spec, intrinsics: Intrinsics) -> tuple[np.ndarray, float]:
     """``board2cam`` (4, 4) mm of one view and the RMS distance (px) of its corners from their reprojection."""
     obj = spec.corners_mm()[view.ids]
-    ok, rvec, tvec = cv2.solvePnP(obj, view.corners_px, intrinsics.K, intrinsics.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
+    pixels, camera = as_pinhole(view.corners_px, intrinsics)  # OpenCV's PnP knows no fisheye lens
+    ok, rvec, tvec = cv2.solvePnP(obj, pixels, camera.K, camera.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
     if not ok:
         raise CalibrationInputError(f"view {view.name}: the board's pose could not be found")
     pose = make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())

@@ -10,6 +10,7 @@ import cv2
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import as_pinhole, project_points
 from calib_core.frames import make_transform
 
 
@@ -21,12 +22,13 @@ def pose_derivatives(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Int
     pts = np.asarray(points_mm, dtype=np.float64).reshape(-1, 3)
     rvec0 = cv2.Rodrigues(obj2cam[:3, :3])[0]
     tvec0 = obj2cam[:3, 3].reshape(3, 1).astype(np.float64)
-    pixels = cv2.projectPoints(pts, rvec0, tvec0, intrinsics.K, intrinsics.dist_coeffs)[0].reshape(-1, 2)
+    pixels = project_points(pts, obj2cam, intrinsics)
     columns = []
     for change in changes:
         moved = []
         for sign in (1.0, -1.0):
             uv, camera = change(sign * step, pixels.copy())
+            uv, camera = as_pinhole(uv, camera)  # OpenCV's PnP knows no fisheye lens
             _, rvec, tvec = cv2.solvePnP(pts, uv, camera.K, camera.dist_coeffs, rvec0.copy(), tvec0.copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
             moved.append(difference(obj2cam, make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())))
         columns.append((moved[0] - moved[1]) / (2.0 * step))
