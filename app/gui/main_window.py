@@ -202,6 +202,7 @@ class MainWindow(QMainWindow):
         self.files.autosave.finish()  # unsaved work stays recoverable; a closed window writes nothing more
         self.status_line.timer.stop()
         self.replay.pause()
+        self.replay.release_file()  # a bag stays open while it is replayed
         if self.worker is not None:
             self.worker.stop()
         self.virtual.close_renderer()

@@ -174,6 +174,10 @@ class ReplayBar(QWidget):
         if close is not None:
             close()
 
+    def release_file(self) -> None:
+        """Let go of the file being replayed (the window closes); nothing else changes."""
+        self._close_playback()
+
     def _recover(self) -> None:
         if self.path is None:
             return

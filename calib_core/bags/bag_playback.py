@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from calib_core.bags.bag_source import bag_intrinsics, choose_image_topic, open_bag
+from calib_core.bags.bag_source import bag_intrinsics, choose_image_topic, open_reader
 from calib_core.bags.joint_track import JOINT_STATE, read_joint_track
 from calib_core.errors import FileFormatError
 
@@ -78,8 +78,7 @@ class BagPlayback:
         self.path = Path(path)
         self.solves: list = []
         chosen = choose_image_topic(self.path, topic)  # an error lists the image topics, or says what the bag holds
-        self._bag = open_bag(self.path)
-        reader = self._bag.__enter__()
+        self._reader = reader = open_reader(self.path)
         try:
             self.frames = BagFrames(self.path, chosen.name, reader)
             n = len(list(joint_names))
@@ -102,9 +101,9 @@ class BagPlayback:
         self.duration_s = float(self.frames.times_s[-1]) if len(self.frames) else 0.0
 
     def close(self) -> None:
-        if self._bag is not None:
-            self._bag.__exit__(None, None, None)
-            self._bag = None
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None
 
     def __enter__(self):
         return self

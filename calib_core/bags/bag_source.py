@@ -44,9 +44,9 @@ def _bag_paths(path: Path) -> list[Path]:
     return [path]
 
 
-@contextmanager
-def open_bag(path: str | Path):
-    """The ``rosbags`` reader, open; :class:`FileFormatError` naming the file when it is not a readable bag."""
+def open_reader(path: str | Path):
+    """The ``rosbags`` reader of ``path``, open (the caller closes it); :class:`FileFormatError` naming the file when
+    it is not a readable bag."""
     from rosbags.highlevel import AnyReader
 
     path = Path(path)
@@ -57,6 +57,13 @@ def open_bag(path: str | Path):
         reader.open()
     except Exception as exc:  # rosbags raises its own errors per storage and profile
         raise FileFormatError(path, f"not a ROS bag rosbags can read: {str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}") from None
+    return reader
+
+
+@contextmanager
+def open_bag(path: str | Path):
+    """:func:`open_reader` for a ``with`` block."""
+    reader = open_reader(path)
     try:
         yield reader
     finally:

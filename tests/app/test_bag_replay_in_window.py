@@ -12,10 +12,13 @@ from PySide6.QtCore import Qt
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
 from calib_core.bags.bag_playback import BagPlayback, is_bag
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert
+from calib_core.robot import solve_ik
 from calib_core.ros2.joint_units import user_per_si
 from tests.app.windows import window_settings
 from tests.core.bags.bag_writing import hold_and_move, write_arm_bag
-from tests.core.operator.perfect_operator import pick_all
+from tests.core.operator.perfect_operator import FEATURES, pick_all
 from videocal_sim.sim_site import simulated_cell
 from videocal_sim.test_bed import TestBed
 
@@ -25,9 +28,10 @@ T0 = 1_760_000_000_000_000_000  # the robot's clock, ns
 @pytest.fixture(scope="module")
 def arm_bag(tmp_path_factory):
     bed = TestBed.create()
-    home = np.array(bed.workcell.home_joints_deg, float)
-    turned = home + np.r_[2.0, -1.5, 1.0, 0.0, 1.0, 0.0][: len(home)]
-    track, shots, moving = hold_and_move([home, turned], T0)
+    task = next(iter(bed.workcell.task_locations.values()))
+    look = solve_ik(bed.model_robot, task.approach2base, np.array(bed.workcell.home_joints_deg, float)).q_deg  # the camera on the fixture
+    turned = look + np.r_[0.5, 0.0, 0.0, 0.0, -1.5, 0.0][: len(look)]
+    track, shots, moving = hold_and_move([look, turned], T0)
     camera = bed.camera()
     rendered = [(t, camera.render(q)[0]) for t, q in shots]
     bag = write_arm_bag(tmp_path_factory.mktemp("bag") / "look_bag", bed.intrinsics, bed.model_robot, rendered, track)
@@ -81,6 +85,9 @@ def test_a_bag_replays_in_the_window_and_a_look_is_solved_on_it(qtbot, window, a
 
     # Picks on that frame carry the joints of its stamp; the solve uses them and finds the true camera pose (the
     # tool beyond it is the model's mounting: what one look can measure is the camera).
+    fixture = wb.workcell.component(wb.task.component)
+    corners = apply(invert(bed.true_cam2world(joints[2])), apply(fixture.item2world, np.array([fixture.features[f] for f in FEATURES if f in fixture.features])))
+    assert wb.intrinsics.contains(project(corners, wb.intrinsics)).all()  # the features are on the frame, where they are picked
     pick_all(wb, bed, joints[2])
     assert all(np.allclose(p.view.joints_deg, joints[2], atol=0.05) for p in wb.session.pairs)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
