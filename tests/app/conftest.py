@@ -45,3 +45,15 @@ def window(live_window):
 def launcher(tmp_path):
     """Opens windows as `videocal gui` does on the simulated site: each cell with its own simulator."""
     return CellLauncher(lambda workcell, process=None: simulated_cell(workcell, process=process), settings=window_settings(tmp_path, "launcher"))
+
+
+@pytest.fixture
+def offline_window(qtbot, tmp_path):
+    """A window on the simulated cell with no controller and no camera started: for replays, which need neither."""
+    wb = Workbench(*simulated_cell())
+    win = MainWindow(wb, settings=window_settings(tmp_path))
+    qtbot.addWidget(win)
+    win.resize(1500, 950)
+    win.show()
+    yield win
+    win.close()

@@ -9,17 +9,13 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from app.gui.main_window import MainWindow
-from app.gui.workbench import Workbench
 from calib_core.bags.bag_playback import BagPlayback, is_bag
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.robot import solve_ik
 from calib_core.ros2.joint_units import user_per_si
-from tests.app.windows import window_settings
 from tests.core.bags.bag_writing import hold_and_move, write_arm_bag
 from tests.core.operator.perfect_operator import FEATURES, pick_all
-from videocal_sim.sim_site import simulated_cell
 from videocal_sim.test_bed import TestBed
 
 T0 = 1_760_000_000_000_000_000  # the robot's clock, ns
@@ -43,14 +39,8 @@ def _digest(folder) -> str:
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
-    wb = Workbench(*simulated_cell())
-    win = MainWindow(wb, settings=window_settings(tmp_path))
-    qtbot.addWidget(win)
-    win.resize(1500, 950)
-    win.show()
-    yield win
-    win.close()
+def window(offline_window):
+    return offline_window
 
 
 def test_the_bag_reads_as_a_timeline(arm_bag):

@@ -9,27 +9,17 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
 
-from app.gui.main_window import MainWindow
-from tests.app.windows import window_settings
-from app.gui.workbench import Workbench
 from tests.app.windows import confirm_move_if_asked
 from calib_core.recording.playback import RecordingPlayback
 from calib_core.recording.reader import read_recording
-from videocal_sim.sim_site import simulated_cell
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "recordings" / "sample_session.mcap"
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
 
 @pytest.fixture
-def window(qtbot, tmp_path):
-    wb = Workbench(*simulated_cell())
-    win = MainWindow(wb, settings=window_settings(tmp_path))
-    qtbot.addWidget(win)
-    win.resize(1500, 950)
-    win.show()
-    yield win
-    win.close()
+def window(offline_window):
+    return offline_window
 
 
 @pytest.fixture
