@@ -26,7 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     rate.add_argument("--stream", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="ask the controller to stream at this rate (default 20)")
     parser.add_argument("--count", type=bounded_int(1, 10**12), help="stop after this many samples")
     parser.add_argument("--timeout", type=bounded_float(0.0, 86400.0, exclusive_low=True), default=5.0, help="give up after this many seconds without a sample (default 5)")
-    parser.add_argument("--json", action="store_true", help="one JSON object per line: seq, t_ms, joints_deg")
+    parser.add_argument("--json", action="store_true", help="one JSON object per line: seq, t_ms (ms since the epoch), t_controller_ms (the controller's own stamp), joints_deg")
     parser.add_argument("--baud", type=bounded_int(50, 20_000_000), help="serial baud rate (videocal's protocol; default 115200)")
     parser.add_argument("--parity", choices=("N", "E", "O"), help="serial parity (videocal's protocol; default N)")
 
@@ -83,6 +83,7 @@ def run(args: argparse.Namespace) -> int:
         expected = version.n_joints
     skipped = 0
     to_model = link.joint_map.to_model if context.n_joints else None
+    epoch_ms = EpochStamps()
     printed = 0
     code = 0
     last = started = time.monotonic()
@@ -121,10 +122,11 @@ def run(args: argparse.Namespace) -> int:
                     continue
                 if to_model is not None:
                     q = tuple(float(v) for v in to_model(q))
+                t_ms = epoch_ms(s)
                 if args.json:
-                    print(json.dumps({"seq": s.sample.seq, "t_ms": s.sample.t_ms, "joints_deg": list(q)}), flush=True)
+                    print(json.dumps({"seq": s.sample.seq, "t_ms": t_ms, "t_controller_ms": s.sample.t_ms, "joints_deg": list(q)}), flush=True)
                 else:
-                    print(f"{s.sample.seq:>8} {s.sample.t_ms:>10} ms  " + " ".join(f"{v:9.4f}" for v in q), flush=True)
+                    print(f"{s.sample.seq:>8} {t_ms:>14} ms  " + " ".join(f"{v:9.4f}" for v in q), flush=True)
                 printed += 1
     except KeyboardInterrupt:
         pass
@@ -133,3 +135,28 @@ def run(args: argparse.Namespace) -> int:
         stats = link.stats_snapshot()
         print("link statistics: " + ", ".join(f"{k} {v}" for k, v in stats.items()), file=sys.stderr)
     return code
+
+
+EPOCH_FLOOR_MS = 1_000_000_000_000
+"""A stamp past this (2001-09-09) counts from the Unix epoch (a ROS 2 header); a controller's own clock (since its
+start: videocal's protocol, UR's RTDE) would need 31 years of uptime to reach it."""
+
+
+class EpochStamps:
+    """A sample's stamp in ms since the Unix epoch. A ROS 2 header's is one already. A controller's own clock (since its
+    start) is put on the epoch by the first sample's arrival: each later stamp keeps its distance from the first as the
+    controller stamped it (the steps are the controller's, never reordered), and the whole run sits late by the first
+    sample's transit (a millisecond on a near link, the link's one-way delay on a far one). A controller clock that
+    goes back (a restart) is anchored again on that sample."""
+
+    def __init__(self):
+        self._anchor: tuple[int, float] | None = None  # (controller ms, host epoch s) of the anchoring sample
+
+    def __call__(self, timed) -> int:
+        t_ms = int(timed.sample.t_ms)
+        if t_ms >= EPOCH_FLOOR_MS:
+            return t_ms
+        if self._anchor is None or t_ms < self._anchor[0]:
+            self._anchor = (t_ms, time.time() - (time.monotonic() - timed.t_host_s))
+        first_ms, first_epoch_s = self._anchor
+        return int(round(first_epoch_s * 1000.0)) + (t_ms - first_ms)

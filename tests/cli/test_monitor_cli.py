@@ -3,6 +3,9 @@
 import json
 import subprocess
 import sys
+import time
+
+import numpy as np
 
 from tests.core.link.sim_process import SimProcess
 
@@ -14,11 +17,18 @@ def _videocal(*args, timeout=60):
 def test_monitor_prints_count_samples_as_json(tmp_path):
     sim = SimProcess("--pty", "--joints", "1,2,3,4,5,6", link=tmp_path / "ctl")
     try:
+        before_ms = time.time() * 1000
         run = _videocal("monitor", sim.url, "--stream", "100", "--count", "7", "--json")
         assert run.returncode == 0, run.stderr
         lines = [json.loads(line) for line in run.stdout.splitlines()]
         assert len(lines) == 7
         assert lines[0]["joints_deg"] == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+        # t_ms counts from the epoch (the controller's own clock, since its start, put on it by the first sample's
+        # arrival), apart by the controller's own steps (10 ms at 100 Hz)
+        assert all(before_ms - 1000 < x["t_ms"] < time.time() * 1000 + 1000 for x in lines)
+        assert all(x["t_controller_ms"] < 1_000_000_000_000 for x in lines)
+        steps = np.diff([x["t_ms"] for x in lines])
+        assert np.array_equal(steps, np.diff([x["t_controller_ms"] for x in lines])) and np.all(steps > 0)
         assert [x["seq"] for x in lines] == list(range(lines[0]["seq"], lines[0]["seq"] + 7))
         assert "link statistics: sentences" in run.stderr
         poll = _videocal("monitor", sim.url, "--poll", "30", "--count", "3")
@@ -56,7 +66,6 @@ def test_monitor_does_not_show_a_sample_of_another_joint_count(tmp_path):
     controller here is the test itself on a pty: it answers nothing but streams samples, one of them short."""
     import os
     import threading
-    import time
     import tty
 
     from calib_core.link.protocol import JointSample, encode
@@ -95,7 +104,6 @@ def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch):
     """``sim-ros2`` (a ros2_control arm on Cyclone DDS) and ``monitor ros2://`` as two processes: the
     samples come in the workcell's joint order, stamped by the arm's clock (ms since the epoch)."""
     import os
-    import time
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
