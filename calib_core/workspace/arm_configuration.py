@@ -53,6 +53,12 @@ class ArmConfiguration:
     elbow_mm: float
     near: tuple[str, ...]
 
+    @classmethod
+    def of_axes(cls, axes_deg) -> ArmConfiguration:
+        """The axes alone, for a controller that names the configuration by its joints (a UR's ``qnear``): no wrist
+        centre is measured (NaN)."""
+        return cls(np.asarray(axes_deg, dtype=float), float("nan"), float("nan"), ())
+
 
 def _quadrant(angle_deg: float) -> int:
     return math.floor(angle_deg / 90.0)

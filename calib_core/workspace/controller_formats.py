@@ -260,7 +260,7 @@ def _arm_at(fmt: str, robot, joint_map, target: np.ndarray, look_joints) -> ArmC
     except VideocalError as exc:
         return f"no IK at this target from the look's joints: {str(exc).splitlines()[0]}"
     if fmt == "urscript":
-        return ArmConfiguration(np.asarray(joint_map.to_controller(q), dtype=float), 0.0, 0.0, ())
+        return ArmConfiguration.of_axes(joint_map.to_controller(q))
     try:
         return arm_configuration(robot, joint_map, q, REFERENCE_POSES[fmt])
     except NotASixAxisArmError as exc:

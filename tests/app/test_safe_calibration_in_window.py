@@ -9,8 +9,7 @@ import trimesh
 from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QApplication
 
-from calib_core.camera.projection import project
-from calib_core.frames import apply, invert
+from calib_core.frames import apply
 from tests.app.windows import answer_next_question as _answer, answer_questions, confirm_move_if_asked, go_and_settle, pick_features, wait_for_settled_frame
 
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]

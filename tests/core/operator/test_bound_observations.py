@@ -7,8 +7,7 @@ import pytest
 from calib_core.calibration.look_place import LookNotAtTask
 from calib_core.calibration.session import CalibrationError, ConfirmationNeeded
 from calib_core.calibration.verdict import Verdict
-from calib_core.camera.projection import project
-from calib_core.frames import apply, invert
+from calib_core.frames import apply
 from calib_core.operator.core import OperatorCore
 from calib_core.operator.observations import NotSettledError
 from calib_core.robot import solve_ik

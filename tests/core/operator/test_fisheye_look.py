@@ -38,7 +38,7 @@ def _camera_error(core, site, q, estimate) -> tuple[float, float]:
             float(np.linalg.norm(estimate.cam2world_model[:3, 3] - true_cam[:3, 3])))
 
 
-def test_the_image_is_a_fisheyes(fisheye_look):
+def test_the_lens_moves_a_feature_by_pixels_and_the_cell_uses_it(fisheye_look):
     core, site, q, frame = fisheye_look
     fixture = core.workcell.component(core.task.component)
     corner = apply(invert(site.bed.true_cam2world(q)), apply(fixture.item2world, fixture.features["plate_top_left"])[None])
