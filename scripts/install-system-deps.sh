@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the system libraries videocal needs: OSMesa/EGL/GL for offscreen VTK rendering,
-# what Qt's xcb platform plugin needs to open a window on a desktop, and Aravis for GenICam cameras.
+# what Qt's xcb platform plugin needs to open a window on a desktop, Aravis for GenICam cameras, and iproute2.
 # As root it runs apt-get; otherwise it prints the exact command and stops.
 set -euo pipefail
 
@@ -11,6 +11,8 @@ PACKAGES=(
   libxcb-xfixes0 libxcb-xkb1 libx11-xcb1 libxrender1 libxi6
   # GenICam cameras: Aravis and its GObject introspection data; PyGObject is built against these
   libaravis-0.8-0 gir1.2-aravis-0.8 libgirepository1.0-dev libcairo2-dev pkg-config gcc python3-dev
+  # a far ROS 2 link (videocal_sim/far_network.py): network namespaces and TUN devices are set up with ip
+  iproute2
 )
 
 missing=()

@@ -29,8 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "served as a GigE Vision camera on the loopback interface, read through Aravis); or ur (the robot a simulated Universal "
                              "Robots controller: RTDE through ur_rtde, moves as URScript)")
     parser.add_argument("--link-delay-ms", type=bounded_float(0.0, 5000.0), default=0.0, metavar="MS",
-                        help="put the controller far away: videocal's link through a delay line of this one-way delay, +-30 %% jitter, 1 %% lost "
-                             "(the frames follow the link's samples, as a gripper camera's would); with --site sim")
+                        help="put the controller far away: this one-way delay, +-30 %% jitter, 1 %% lost, on videocal's link (--site sim: a TCP "
+                             "delay line) or ROS 2's (--site ros2: the arm in a network namespace of its own, every DDS packet delayed; "
+                             "needs root); the frames follow the link's samples, as a gripper camera's would")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
                         help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 

@@ -105,10 +105,17 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     n_joints = load_workcell(workcell).load_robot().n_joints
     typical = RobotErrors.typical(0, n_joints=n_joints)
     cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale)
+    weather = None
+    if link_delay_ms:  # the same cell far away, with the issue's weather
+        from videocal_sim.delay_line import LinkWeather
+
+        weather = LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01)
+        if site_kind not in ("sim", "ros2"):
+            raise ValueError(f"--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site {site_kind}")
     if site_kind == "ros2":  # the same simulated cell, its robot and camera reached through ROS 2
         from videocal_sim.ros2_site import Ros2SimulatedSite
 
-        site = Ros2SimulatedSite(site)
+        site = Ros2SimulatedSite(site, weather=weather)
     elif site_kind == "gige":  # the same cell, its camera served over GigE Vision and read through Aravis
         from videocal_sim.gige_site import GigESimulatedSite
 
@@ -117,13 +124,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         from videocal_sim.ur_site import URSimulatedSite
 
         site = URSimulatedSite(site)
-    if link_delay_ms:  # the same cell far away: the link through a delay line with the issue's weather
-        from videocal_sim.delay_line import LinkWeather
+    if weather is not None and site_kind == "sim":  # videocal's own link through a delay line
         from videocal_sim.far_site import FarSimulatedSite
 
-        if site_kind != "sim":
-            raise ValueError("--link-delay-ms puts the delay line on videocal's own link: use it with --site sim")
-        site = FarSimulatedSite(site, LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01))
+        site = FarSimulatedSite(site, weather)
     bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
     wb = Workbench(cell, site)
     if location is not None:
@@ -211,7 +215,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
             _click(win.commands.find_points, 10, 10)
-            _wait(app, lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), 30, "the points found")
+            if win.finder.dialog is None or not win.finder.dialog.isVisible():  # Find points runs in the click: it showed why not
+                raise OperatorError(f"demo ({round_name} look): Find points proposed nothing: {win.statusBar().currentMessage() or win.results.status.text()}")
             dialog = win.finder.dialog
             shot(f"{round_name}_points_found")
             shot(f"{round_name}_points_found_list", dialog)  # the proposals and what was missed, with the reasons

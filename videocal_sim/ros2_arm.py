@@ -5,7 +5,8 @@ at ``rate_hz`` with ROS 2's default QoS, as ``joint_state_broadcaster`` does, an
 ``trajectory_msgs/JointTrajectory`` messages on ``/<controller>/joint_trajectory`` as
 ``joint_trajectory_controller``'s topic interface does: a new trajectory replaces the running one and starts
 from where the joints are, its points interpolated in time; a trajectory naming other joints, a point past a
-joint limit or a non-increasing ``time_from_start`` is rejected (and logged), leaving the arm where it is.
+joint limit, a non-increasing ``time_from_start`` or no point at all (the controller says "Empty trajectory
+received.") is rejected (and logged), leaving the arm doing what it did.
 It reads no truth: it is the controller, not the world.
 """
 
@@ -86,6 +87,8 @@ class SimulatedRos2Arm:
         names = list(message.joint_names)
         if sorted(names) != sorted(self.joint_names) or len(set(names)) != len(names):
             return f"joint names {names} are not this controller's {self.joint_names}"
+        if not message.points:
+            return "Empty trajectory received."
         order = [names.index(n) for n in self.joint_names]
         points, times = [], []
         for i, point in enumerate(message.points):
@@ -100,10 +103,6 @@ class SimulatedRos2Arm:
             points.append(q)
             times.append(t)
         current = self.position(now)
-        if not points:  # an empty trajectory: hold where the arm is
-            with self._lock:
-                self.q, self._plan = current, None
-            return None
         with self._lock:
             if times[0] <= 0.0:  # a first point at 0 s: reached at once
                 times[0] = 1e-3

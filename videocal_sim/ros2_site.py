@@ -5,10 +5,16 @@ the operator core reaches both only through its ROS 2 connectors (``ros2:///join
 
 The camera publisher runs here (it renders the test bed's true view, which is the truth and stays in
 ``videocal_sim``); it poses the camera from the joint states the core receives, as the simulated site does.
+
+Far away (``weather``): the arm runs in a network namespace of its own behind :class:`~videocal_sim.far_network.FarNetwork`,
+every DDS packet between it and the workstation delayed, jittered and some dropped; the camera publisher stays on the
+workstation's side and follows the joint states as they arrive, so its frames are as late as the link's samples (as
+:mod:`videocal_sim.far_site` does for videocal's own link).
 """
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import tempfile
@@ -24,13 +30,18 @@ from videocal_sim.sim_site import SimulatedSite
 class Ros2ArmProcess:
     """``videocal sim-ros2`` for a cell, a child that dies with us; :meth:`wait_ready` waits for its ``ready``."""
 
-    def __init__(self, workcell_path: Path, joints_deg, domain: int, rate_hz: float = 100.0):
+    def __init__(self, workcell_path: Path, joints_deg, domain: int, rate_hz: float = 100.0, *, network=None):
         self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-ros2-")
         self._stderr_path = Path(self._folder.name) / "stderr.txt"
         cmd = [sys.executable, "-m", "app.cli.main", "sim-ros2", "--workcell", str(Path(workcell_path).resolve()), "--domain", str(domain),
                "--rate", f"{rate_hz:g}", "--joints", ",".join(f"{v:.6f}" for v in joints_deg)]
+        env = None
+        if network is not None:  # on the far side of the link, with its own address and the workstation as its peer
+            cmd = network.far_command(cmd)
+            env = dict(os.environ, CYCLONEDDS_URI=network.cyclone_config("far"))
         with open(self._stderr_path, "w") as err:
-            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), preexec_fn=_die_with_parent)
+            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), env=env,
+                                            preexec_fn=_die_with_parent)
         self._ready = False
 
     def wait_ready(self) -> None:
@@ -47,12 +58,13 @@ class Ros2ArmProcess:
 
 
 class CameraPublisher:
-    """Publishes ``source``'s frames on ``/camera/image_raw`` (rgb8, stamped at exposure on the epoch clock)
-    and ``intrinsics`` (the cell's camera file, as a driver publishes its calibration file) on
-    ``/camera/camera_info``, until :meth:`stop`."""
+    """Publishes ``source``'s frames on ``/camera/image_raw`` (rgb8) and ``intrinsics`` (the cell's camera file, as
+    a driver publishes its calibration file) on ``/camera/camera_info``, until :meth:`stop`. Each frame is stamped
+    ``stamp_ns()`` (epoch ns): the stamp of the joint state it was rendered at, so the picture and its stamp agree
+    however late the joint states came (a far link's)."""
 
-    def __init__(self, source, intrinsics, domain: int):
-        self.source, self.intrinsics, self.domain = source, intrinsics, domain
+    def __init__(self, source, intrinsics, domain: int, stamp_ns):
+        self.source, self.intrinsics, self.domain, self.stamp_ns = source, intrinsics, domain, stamp_ns
         self.published = 0
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="sim ros2 camera", daemon=True)
@@ -76,7 +88,7 @@ class CameraPublisher:
             if frame is None:
                 break
             h, w = frame.image.shape[:2]
-            stamp = msg.Time.of_ns(time.time_ns() - int((time.monotonic() - frame.t_host_s) * 1e9))
+            stamp = msg.Time.of_ns(self.stamp_ns())
             header = msg.Header(stamp, "camera")
             images.write(msg.Image(header, h, w, "rgb8", 0, w * 3, frame.image.tobytes()))
             infos.write(msg.CameraInfo(header, h, w, i.model, [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
@@ -92,7 +104,7 @@ class CameraPublisher:
 class Ros2SimulatedSite(SimulatedSite):
     """A :class:`SimulatedSite` whose robot and camera are reached through ROS 2 (domain ``ROS_DOMAIN_ID``)."""
 
-    def __init__(self, site: SimulatedSite, domain: int | None = None):
+    def __init__(self, site: SimulatedSite, domain: int | None = None, weather=None, seed: int = 0):
         super().__init__(site.bed, camera_fps=site.camera_fps, camera_seed=site.camera_seed)
         from calib_core.ros2.wire import domain_id
 
@@ -100,16 +112,38 @@ class Ros2SimulatedSite(SimulatedSite):
         self.description = f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain})"
         self.arm: Ros2ArmProcess | None = None
         self.publisher: CameraPublisher | None = None
+        self.network = None
+        self._pose = (self.bed.joints_deg.copy(), time.time_ns())  # until the first joint state
+        self._rendered_stamp_ns = self._pose[1]
+        if weather is not None:
+            from calib_core.ros2.participant import configure
+            from videocal_sim.far_network import FarNetwork
+
+            self.network = FarNetwork(weather, seed=seed)
+            configure(self.domain, self.network.cyclone_config("near"))
+            self.description += (f", {1000 * weather.one_way_s:.0f} ms away (+-{100 * weather.jitter:.0f} %, "
+                                 f"{100 * weather.loss:g} % of the packets lost)")
+
+    def _follow(self, sample) -> None:
+        # The robot is where its joint states say, at their stamp (the controller's epoch clock): one pair, so a frame
+        # rendered from them is stamped with their time.
+        self._pose = (self._link_joint_map.to_model(sample.joints_deg), int(sample.sample.t_ms) * 1_000_000)
+        self.bed.joints_deg = self._pose[0]
+
+    def _rendered_joints(self):
+        joints, self._rendered_stamp_ns = self._pose
+        return joints.copy()
 
     def start_controller(self) -> str:
         if self.arm is None:
-            self.arm = Ros2ArmProcess(self.bed.workcell.path, self.bed.joints_deg, self.domain)
+            self.arm = Ros2ArmProcess(self.bed.workcell.path, self.bed.joints_deg, self.domain, network=self.network)
         self.arm.wait_ready()
         return f"ros2:///joint_states?domain={self.domain}"
 
     def camera_factory(self, fps: float | None = None) -> Callable:
         if self.publisher is None:
-            self.publisher = CameraPublisher(self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True), self.bed.intrinsics, self.domain)
+            camera = self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True, joints=self._rendered_joints)
+            self.publisher = CameraPublisher(camera, self.bed.intrinsics, self.domain, lambda: self._rendered_stamp_ns)
         from calib_core.connectors.registry import open_camera
 
         spec = f"ros2:///camera/image_raw?domain={self.domain}"
@@ -120,3 +154,8 @@ class Ros2SimulatedSite(SimulatedSite):
             self.publisher.stop()
         if self.arm is not None:
             self.arm.stop()
+        if self.network is not None:
+            from calib_core.ros2.participant import release
+
+            release(self.domain)
+            self.network.close()

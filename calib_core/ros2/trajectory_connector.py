@@ -17,8 +17,15 @@ the workstation. The commanded point only moves forward along the line, so a lat
 arm back. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
 once when no trajectory controller subscribes to the topic; *stopped* by Stop, which sends a trajectory that
 holds the current position. No joint states for ``stale_after_s``: the link is ``stale``, the robot's pose
-unknown, and the move is not renewed. On a link slower than ``horizon_s`` a round trip the arm moves in steps
-(it reaches each point before the next arrives): set ``horizon_s`` above the round trip.
+unknown, and the move is not renewed.
+
+A far link (a satellite's seconds): the joint states' delay is measured from their stamps (:attr:`delay_s`, clocks in
+step as ROS 2 assumes), and what waits on the link follows it. The horizon given is ``horizon_s`` plus the round trip
+(twice the delay) and its spread, so the arm does not stop at each point waiting for the next, and after a lost
+link it stops within that much motion, still on the line; ``stale_after_s`` is lengthened by the delay's spread,
+so a late burst of samples is not taken for a lost robot. Each point's time is counted from where the last joint
+states put the arm, which is behind where it is: the arm never goes faster than ``speed_deg_s``, and across a
+round trip of seconds it goes about half as fast.
 """
 
 from __future__ import annotations
@@ -33,6 +40,7 @@ import numpy as np
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
+from calib_core.link.arrival_delay import ArrivalDelay
 from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.protocol import JointSample
@@ -91,6 +99,7 @@ class Ros2TrajectoryController(ConnectorEvents):
         self._ids = itertools.count(1)
         self._latest: TimedSample | None = None
         self._last_sample_s: float | None = None
+        self._arrival = ArrivalDelay()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._reader = self._writer = None
@@ -136,6 +145,17 @@ class Ros2TrajectoryController(ConnectorEvents):
     @property
     def latest(self) -> TimedSample | None:
         return self._latest
+
+    @property
+    def delay_s(self) -> float | None:
+        """The joint states' one-way delay (s): arrival minus header stamp, the median of the recent ones."""
+        return self._arrival.one_way_s()
+
+    @property
+    def horizon_now_s(self) -> float:
+        """How much of a move's motion the controller is given beyond the measured joints (s): ``horizon_s``, plus
+        the round trip and its spread on a far link."""
+        return self.horizon_s + 2.0 * (self._arrival.one_way_s() or 0.0) + self._arrival.spread_s
 
     def stats_snapshot(self) -> dict[str, int]:
         with self._lock:
@@ -198,7 +218,7 @@ class Ros2TrajectoryController(ConnectorEvents):
         line = target - start
         length2 = float(line @ line)
         s_measured = 0.0 if length2 == 0.0 or latest is None else float(np.clip((np.asarray(latest.joints_deg) - start) @ line / length2, 0.0, 1.0))
-        s_next = min(1.0, max(self._s_commanded, s_measured + self.horizon_s / duration_s))
+        s_next = min(1.0, max(self._s_commanded, s_measured + self.horizon_now_s / duration_s))
         self._publish(start + s_next * line, max((s_next - s_measured) * duration_s, 0.05))
         self._s_commanded, self._renewed_s = s_next, now
 
@@ -239,7 +259,7 @@ class Ros2TrajectoryController(ConnectorEvents):
 
     def _watch(self, now: float) -> None:
         last = self._last_sample_s
-        if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s:
+        if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s + self._arrival.spread_s:
             self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
         move = self._moves.current
         if move is not None and now > move.deadline_s:
@@ -263,6 +283,7 @@ class Ros2TrajectoryController(ConnectorEvents):
         q = q_si * self._per_si
         t_ns = message.header.stamp.ns()
         sample = TimedSample(JointSample(next(self._seq), t_ns // 1_000_000, tuple(float(v) for v in q)), time.monotonic())
+        self._arrival.add(t_ns / 1e9, time.time())
         with self._lock:
             if not self._order.admit(sample.sample):
                 return

@@ -222,3 +222,15 @@ def test_wrong_urls_and_options_are_named(domain):
         open_controller("ros2:///joint_states?speed_deg_s=fast", _context())
     with pytest.raises(LinkError, match="give the cell"):
         open_controller("ros2:///joint_states", ControllerContext((), (), JointMap.identity(0)))
+
+
+def test_the_simulated_arm_refuses_an_empty_trajectory_as_the_controller_does():
+    """ros2_controllers' joint_trajectory_controller logs "Empty trajectory received." and keeps its trajectory; a
+    Stop must therefore be a trajectory that holds, which is what the connector sends."""
+    from calib_core.ros2 import messages as msg
+
+    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 5 + [1000.0], [-360.0] * 5 + [0.0], [360.0] * 5 + [500.0], [0, -30, 60, 0, 45, 100])
+    point = msg.JointTrajectoryPoint(positions=[0.1, 0, 0, 0, 0, 0.1], time_from_start=msg.Duration.of_s(1.0))
+    assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), [point]), 0.0) is None
+    assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), []), 0.5) == "Empty trajectory received."
+    assert np.allclose(arm.position(1.0), [math.degrees(0.1), 0, 0, 0, 0, 100.0])  # the first one ran on to its end
