@@ -83,7 +83,11 @@ class CameraPublisher:
         infos = DataWriter(dp, Topic(dp, "rt/camera/camera_info", msg.CameraInfo), qos=default_qos(1))
         i = self.intrinsics
         k = [i.fu, 0.0, i.cx, 0.0, i.fv, i.cy, 0.0, 0.0, 1.0]
+        period = 1.0 / self.source.fps if self.source.fps else 0.0
+        next_s = time.monotonic()
         while not self._stop.is_set():
+            next_s = max(next_s + period, time.monotonic() - period)  # at the camera's rate (behind: no burst to catch up)
+            self._stop.wait(max(0.0, next_s - time.monotonic()))
             frame = self.source.read()
             if frame is None:
                 break

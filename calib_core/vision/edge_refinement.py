@@ -70,8 +70,9 @@ class EdgeFit:
     """The largest RMS at which this fit may count as settled (what the caller asked of its images)."""
     min_share: float = 0.5
     """The least share of the samples on their edges at which a fit within 0.5 px counts as settled. Find points,
-    which proposes pairs from the fit, asks three quarters: a wrong minimum can settle within 0.3 px holding about
-    half of them (the demo's frame 12: 55 %, 1.6 mm off, where the right pose holds 90 %)."""
+    which proposes pairs from the fit, asks 60 %: a wrong minimum can settle within 0.3 px holding about half of them
+    (the demo's frame 12: 52-56 %, 1.6-1.9 mm off, where the right pose holds 90 %; the least right fit of the
+    Find points bench held 65 %)."""
 
     @property
     def settled(self) -> bool:

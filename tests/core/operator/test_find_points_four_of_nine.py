@@ -4,7 +4,7 @@ was judged OK while the camera was 1.6 mm from the true one. The image's noise h
 edge fit first; each settled 1.6-1.9 mm off with about half of its samples on their edges, the first was kept, and
 the features that agreed with it were proposed, so the pairs agreed with one another and no mis-pick test could see
 it. The right start ranked fourth; the search now goes on while no fit settles with three quarters of its samples on
-their edges. The truth only scores."""
+their edges, and a fit with fewer than 60 % is not settled at all. The truth only scores."""
 
 from pathlib import Path
 
@@ -50,7 +50,7 @@ def test_a_fit_on_half_its_edges_proposes_nothing_and_offers_no_edge_calibration
     frame_now(core, index=12, image=cv2.cvtColor(cv2.imread(str(FRAME)), cv2.COLOR_BGR2RGB))
     found = core.finder.find_points().result
     assert not found.found and not found.proposals
-    assert 0.5 < found.edges.inlier_share < 0.75 and not found.edges.settled
+    assert 0.5 < found.edges.inlier_share < 0.6 and not found.edges.settled
     assert "did not settle" in found.message and "pick the points by hand" in found.message
     with pytest.raises(OperatorError, match="did not settle"):
         core.finder.calibrate_on_edges()
