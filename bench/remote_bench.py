@@ -97,6 +97,21 @@ def window_demo(one_way_s: float, site: str = "sim") -> dict:
             "error_mm": report["corrected_tcp_error_mm"], "status": report["status"]}
 
 
+def _demo_table(demos: list[dict]) -> list[str]:
+    """The window demos' table, ratios against the first row (0 s)."""
+    lines = ["| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
+             "|---|---|---|---|---|---|---|"]
+    near = np.median(demos[0].get("looks") or [np.nan])
+    for d in demos:
+        if "failed" in d:
+            lines.append(f"| {d['one_way']:g} s | FAILED: {d['failed']} | | | | | |")
+            continue
+        median = np.median(d["looks"])
+        lines.append(f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
+                     f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |")
+    return lines
+
+
 def main() -> str:
     rows = [one_delay(d) for d in DELAYS_S]
     demos = [window_demo(d) for d in DELAYS_S]
@@ -122,21 +137,12 @@ def main() -> str:
         measured = "-" if r["delay_s"] is None else f"{r['delay_s']:.2f} s"
         lines.append(f"| {r['one_way']:g} s | {r['handshake_s']:.1f} s{'' if r['ready'] else ' (FAILED)'} | {measured} | {look:.2f} s ({len(r['looks'])}/{LOOKS}) | "
                      f"{look / peer:.1f} | {r['sent']} / {r['seen']} | {r['duplicates']} | {r['stops']} | {r['late']} |")
-    near = np.median(demos[0].get("looks") or [np.nan])
     lines += ["", "## Through the window", "",
               "`videocal demo --offscreen --scale 0.5 --link-delay-ms MS` (the same delay line on the controller link; the simulated "
               "camera follows the joints the link delivers, so its frames come as late as the samples, as a gripper camera's "
               "would). A look: Go pressed -> a frame the core accepts for picks (the settle rule widened by the link's spread of "
               "delays). The corrected tool's error is scored against the simulator's truth.", "",
-              "| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
-              "|---|---|---|---|---|---|---|"]
-    for d in demos:
-        if "failed" in d:
-            lines.append(f"| {d['one_way']:g} s | FAILED: {d['failed']} | | | | | |")
-            continue
-        median = np.median(d["looks"])
-        lines.append(f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
-                     f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |")
+              *_demo_table(demos)]
     lines += ["", "## ROS 2 through the window", ""]
     if no_far_network:
         lines.append(f"Not measured on this machine: {no_far_network}.")
@@ -146,16 +152,7 @@ def main() -> str:
                   "order) and 1 % dropped; the camera's frames follow the joint states as they arrive and carry their stamps. At 0 s there "
                   "is no relay: DDS on the loopback (the peer). The measured one-way delay is the joint states' arrival minus their "
                   "stamps (a FIFO path with +-30 % jitter delivers near its upper end).", "",
-                  "| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
-                  "|---|---|---|---|---|---|---|"]
-        near_ros2 = np.median(ros2[0].get("looks") or [np.nan])
-        for d in ros2:
-            if "failed" in d:
-                lines.append(f"| {d['one_way']:g} s | FAILED: {d['failed']} | | | | | |")
-                continue
-            median = np.median(d["looks"])
-            lines.append(f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near_ros2:.1f} | "
-                         f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |")
+                  *_demo_table(ros2)]
     lines += ["", "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored against "
               "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is judged "
               "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a round "
