@@ -8,8 +8,8 @@ The camera publisher runs here (it renders the test bed's true view, which is th
 
 Far away (``weather``): the arm runs in a network namespace of its own behind :class:`~videocal_sim.far_network.FarNetwork`,
 every DDS packet between it and the workstation delayed, jittered and some dropped; the camera publisher stays on the
-workstation's side and follows the joint states as they arrive, so its frames are as late as the link's samples (as
-:mod:`videocal_sim.far_site` does for videocal's own link).
+workstation's side and renders where the joint states put the robot as they arrive, each frame stamped with the
+stamp of the joint state it shows (so the picture and its stamp agree however late the states came).
 """
 
 from __future__ import annotations
@@ -20,8 +20,11 @@ import sys
 import tempfile
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
+
+import numpy as np
 
 from videocal_sim.sim_process import _PROJECT, SiteError, _die_with_parent, stop_child
 from videocal_sim.sim_site import SimulatedSite
@@ -60,8 +63,8 @@ class Ros2ArmProcess:
 class CameraPublisher:
     """Publishes ``source``'s frames on ``/camera/image_raw`` (rgb8) and ``intrinsics`` (the cell's camera file, as
     a driver publishes its calibration file) on ``/camera/camera_info``, until :meth:`stop`. Each frame is stamped
-    ``stamp_ns()`` (epoch ns): the stamp of the joint state it was rendered at, so the picture and its stamp agree
-    however late the joint states came (a far link's)."""
+    ``stamp_ns(q)`` (epoch ns) of the joints ``q`` it was rendered at (``source.last_truth``): the stamp of that joint
+    state, so the picture and its stamp agree however late the joint states came (a far link's)."""
 
     def __init__(self, source, intrinsics, domain: int, stamp_ns):
         self.source, self.intrinsics, self.domain, self.stamp_ns = source, intrinsics, domain, stamp_ns
@@ -92,7 +95,7 @@ class CameraPublisher:
             if frame is None:
                 break
             h, w = frame.image.shape[:2]
-            stamp = msg.Time.of_ns(self.stamp_ns())
+            stamp = msg.Time.of_ns(self.stamp_ns(self.source.last_truth.q_commanded_deg))
             header = msg.Header(stamp, "camera")
             images.write(msg.Image(header, h, w, "rgb8", 0, w * 3, frame.image.tobytes()))
             infos.write(msg.CameraInfo(header, h, w, i.model, [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
@@ -117,8 +120,7 @@ class Ros2SimulatedSite(SimulatedSite):
         self.arm: Ros2ArmProcess | None = None
         self.publisher: CameraPublisher | None = None
         self.network = None
-        self._pose = (self.bed.joints_deg.copy(), time.time_ns())  # until the first joint state
-        self._rendered_stamp_ns = self._pose[1]
+        self._poses: deque[tuple[np.ndarray, int]] = deque([(self.bed.joints_deg.copy(), time.time_ns())], maxlen=256)  # (joints, stamp ns)
         if weather is not None:
             from calib_core.ros2.participant import configure
             from videocal_sim.far_network import FarNetwork
@@ -129,14 +131,18 @@ class Ros2SimulatedSite(SimulatedSite):
                                  f"{100 * weather.loss:g} % of the packets lost)")
 
     def _follow(self, sample) -> None:
-        # The robot is where its joint states say, at their stamp (the controller's epoch clock): one pair, so a frame
-        # rendered from them is stamped with their time.
-        self._pose = (self._link_joint_map.to_model(sample.joints_deg), int(sample.sample.t_ms) * 1_000_000)
-        self.bed.joints_deg = self._pose[0]
+        # The robot is where its joint states say, at their stamp (the controller's epoch clock), kept as a pair so
+        # that a frame rendered from those joints is stamped with their time.
+        joints = self._link_joint_map.to_model(sample.joints_deg)
+        self._poses.append((joints, int(sample.sample.t_ms) * 1_000_000))
+        self.bed.joints_deg = joints
 
-    def _rendered_joints(self):
-        joints, self._rendered_stamp_ns = self._pose
-        return joints.copy()
+    def _stamp_of(self, q_deg) -> int:
+        """The stamp (epoch ns) of the newest joint state at exactly ``q_deg``: the one the frame was rendered from."""
+        for joints, stamp_ns in reversed(list(self._poses)):
+            if np.array_equal(joints, q_deg):
+                return stamp_ns
+        return self._poses[-1][1]
 
     def start_controller(self) -> str:
         if self.arm is None:
@@ -146,8 +152,8 @@ class Ros2SimulatedSite(SimulatedSite):
 
     def camera_factory(self, fps: float | None = None) -> Callable:
         if self.publisher is None:
-            camera = self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True, joints=self._rendered_joints)
-            self.publisher = CameraPublisher(camera, self.bed.intrinsics, self.domain, lambda: self._rendered_stamp_ns)
+            camera = self.bed.camera(fps=fps or self.camera_fps, seed=self.camera_seed, live=True)
+            self.publisher = CameraPublisher(camera, self.bed.intrinsics, self.domain, self._stamp_of)
         from calib_core.connectors.registry import open_camera
 
         spec = f"ros2:///camera/image_raw?domain={self.domain}"

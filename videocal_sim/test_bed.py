@@ -74,10 +74,8 @@ class TestBed:
     def model_cam2world(self, q_commanded_deg: ArrayLike) -> np.ndarray:
         return self.model_robot.fk(q_commanded_deg, "camera")
 
-    def camera(self, *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0, intrinsics: Intrinsics | None = None, live: bool = False,
-               joints=None) -> SimulatedCamera:
-        """The test bed's camera, following ``joints_deg`` (or ``joints()``, the commanded joints (n,) deg/mm each
-        frame is rendered at); ``live``: video for the window (frames of a moving robot point-sampled,
-        :attr:`SimulatedCamera.coarse_while_moving`)."""
-        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, joints or (lambda: self.joints_deg.copy()), fps=fps,
-                               look=look, seed=seed, coarse_while_moving=live)
+    def camera(self, *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0, intrinsics: Intrinsics | None = None, live: bool = False) -> SimulatedCamera:
+        """The test bed's camera, following ``joints_deg``; ``live``: video for the window (frames of
+        a moving robot point-sampled, :attr:`SimulatedCamera.coarse_while_moving`)."""
+        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, lambda: self.joints_deg.copy(), fps=fps, look=look, seed=seed,
+                               coarse_while_moving=live)
