@@ -158,7 +158,10 @@ class FarNetwork:
         cmd = [sys.executable, "-m", "videocal_sim.far_network", "--one-way-ms", f"{1000 * weather.one_way_s:g}",
                "--jitter", f"{weather.jitter:g}", "--loss", f"{weather.loss:g}", "--seed", str(seed)]
         project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-        self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True, cwd=project)
+        from videocal_sim.sim_process import _die_with_parent  # the relay ends with the program that made it (SIGTERM)
+
+        self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True, cwd=project,
+                                        preexec_fn=_die_with_parent)
         line = self.process.stdout.readline().split()
         if len(line) != 4 or line[0] != "ready":
             self.process.kill()
