@@ -1,5 +1,5 @@
 """A far network for connectors that speak UDP (ROS 2 on DDS): a second network namespace, the simulated
-robot's side, joined to this one by two TUN devices whose IP packets cross a user-space relay that holds each
+robot's side, joined to this one by two TAP devices whose Ethernet frames cross a user-space relay that holds each
 for a one-way delay, varies it (jitter) and drops some (loss), as a satellite link between the operator's
 workstation and the cell would.
 
@@ -9,14 +9,15 @@ so a relay on another port is never used; Cyclone's ``ExternalNetworkAddress`` r
 machine. With two namespaces each side has its own address and its own route, and every packet between them
 passes through here, whatever the protocol says.
 
-One process (``python -m videocal_sim.far_network``, root: namespaces and TUN devices need CAP_NET_ADMIN)
-makes the near TUN device in its own namespace, then moves into a new namespace of its own and makes the far
-one there (a TUN device stays in the namespace it was made in). Programs of the far side join it with
+One process (``python -m videocal_sim.far_network``, root: namespaces and TAP devices need CAP_NET_ADMIN)
+makes the near TAP device in its own namespace, then moves into a new namespace of its own and makes the far
+one there (a TAP device stays in the namespace it was made in). Each side has a /24 address with a broadcast (a
+GigE Vision camera is found by broadcast) and the other's MAC set outright (ARP would give up across seconds). Programs of the far side join it with
 ``nsenter --net=/proc/PID/ns/net`` (:meth:`FarNetwork.far_command`). Nothing is left behind: the namespace
-lives while the relay or a far program runs in it, the TUN devices while the relay holds them open.
+lives while the relay or a far program runs in it, the TAP devices while the relay holds them open.
 
-Loss here is a missing packet (UDP), not a late one (TCP's, :mod:`videocal_sim.delay_line`); the order of the
-packets is kept (a packet is never due before the one ahead of it), as a single path keeps it.
+Loss here is a missing frame (UDP's packet), not a late one (TCP's, :mod:`videocal_sim.delay_line`); the order of
+the frames is kept (a packet is never due before the one ahead of it), as a single path keeps it.
 """
 
 from __future__ import annotations
@@ -40,19 +41,19 @@ from calib_core.errors import VideocalError
 from videocal_sim.delay_line import LinkWeather
 
 _TUNSETIFF = 0x400454CA
-_IFF_TUN, _IFF_NO_PI = 0x0001, 0x1000
+_IFF_TAP, _IFF_NO_PI = 0x0002, 0x1000
 _CLONE_NEWNET = 0x40000000
 _MTU = 1500
 
 
 class FarNetworkError(VideocalError, RuntimeError):
-    """The far network cannot be made here (not root, no TUN device, no ``ip``), said with what is missing."""
+    """The far network cannot be made here (not root, no TUN/TAP device, no ``ip``), said with what is missing."""
 
 
 def why_not_available() -> str | None:
     """What keeps this machine from making a far network, or ``None``."""
     if os.geteuid() != 0:
-        return "network namespaces and TUN devices need root (CAP_NET_ADMIN)"
+        return "network namespaces and TAP devices need root (CAP_NET_ADMIN)"
     if not os.path.exists("/dev/net/tun"):
         return "there is no /dev/net/tun"
     for tool in ("ip", "nsenter"):
@@ -61,10 +62,18 @@ def why_not_available() -> str | None:
     return None
 
 
-def _tun(name: str) -> int:
+def _tap(name: str) -> int:
+    """A TAP device (Ethernet frames, broadcast like a NIC: GigE Vision's discovery needs it) held by the fd."""
     fd = os.open("/dev/net/tun", os.O_RDWR)
-    fcntl.ioctl(fd, _TUNSETIFF, struct.pack("16sH", name.encode(), _IFF_TUN | _IFF_NO_PI))
+    fcntl.ioctl(fd, _TUNSETIFF, struct.pack("16sH", name.encode(), _IFF_TAP | _IFF_NO_PI))
     return fd
+
+
+def _bring_up(name: str, mac: str, own_ip: str, peer_ip: str, peer_mac: str) -> None:
+    """Address the device and name the peer's MAC outright: ARP across seconds of delay would give up first."""
+    _ip("link", "set", name, "address", mac, "mtu", str(_MTU), "up")
+    _ip("addr", "add", f"{own_ip}/24", "brd", "+", "dev", name)
+    _ip("neigh", "replace", peer_ip, "lladdr", peer_mac, "nud", "permanent", "dev", name)
 
 
 def _ip(*args: str) -> None:
@@ -91,7 +100,7 @@ class RelayStats:
 
 
 class PacketRelay:
-    """Moves IP packets between two TUN file descriptors through ``weather`` (delay, jitter, loss)."""
+    """Moves Ethernet frames between two TAP file descriptors through ``weather`` (delay, jitter, loss)."""
 
     def __init__(self, near_fd: int, far_fd: int, weather: LinkWeather, seed: int = 0):
         self.weather = weather
@@ -199,7 +208,7 @@ class FarNetwork:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Makes the two namespaces' TUN devices, prints ``ready NETNS_PATH NEAR_IP FAR_IP``, relays until SIGTERM."""
+    """Makes the two namespaces' TAP devices, prints ``ready NETNS_PATH NEAR_IP FAR_IP``, relays until SIGTERM."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="python -m videocal_sim.far_network", description=main.__doc__)
@@ -216,16 +225,15 @@ def main(argv: list[str] | None = None) -> int:
     k = _free_subnet()
     near_ip, far_ip = f"10.77.{k}.1", f"10.77.{k}.2"
     near_name = f"vcfar{os.getpid() % 100000}"
+    near_mac, far_mac = f"02:77:00:00:{k:02x}:01", f"02:77:00:00:{k:02x}:02"
     try:
-        near_fd = _tun(near_name)
-        _ip("addr", "add", near_ip, "peer", far_ip, "dev", near_name)
-        _ip("link", "set", near_name, "mtu", str(_MTU), "up")
+        near_fd = _tap(near_name)
+        _bring_up(near_name, near_mac, near_ip, far_ip, far_mac)
         if ctypes.CDLL(None, use_errno=True).unshare(_CLONE_NEWNET) != 0:
             raise FarNetworkError(f"unshare(CLONE_NEWNET): {os.strerror(ctypes.get_errno())}")
-        far_fd = _tun("vcfar0")
+        far_fd = _tap("vcfar0")
         _ip("link", "set", "lo", "up")
-        _ip("addr", "add", far_ip, "peer", near_ip, "dev", "vcfar0")
-        _ip("link", "set", "vcfar0", "mtu", str(_MTU), "up")
+        _bring_up("vcfar0", far_mac, far_ip, near_ip, near_mac)
     except (OSError, FarNetworkError) as exc:
         print(f"error: cannot make the far network: {exc}", file=sys.stderr)
         return 2
