@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import ctypes
 import fcntl
+import functools
 import heapq
 import os
 import random
@@ -59,6 +60,20 @@ def why_not_available() -> str | None:
     for tool in ("ip", "nsenter"):
         if shutil.which(tool) is None:
             return f"the '{tool}' command is missing (Debian: {'iproute2' if tool == 'ip' else 'util-linux'})"
+    return _probe()
+
+
+@functools.lru_cache(maxsize=1)
+def _probe() -> str | None:
+    """Make the two devices and the namespace once, and take them down (a container may refuse either)."""
+    try:
+        done = subprocess.run([sys.executable, "-m", "videocal_sim.far_network", "--probe"], capture_output=True, text=True, timeout=20,
+                              cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    except subprocess.TimeoutExpired:
+        return "making the far network took over 20 s"
+    if done.returncode != 0:
+        why = done.stderr.strip().splitlines()
+        return why[-1].removeprefix("error: ") if why else f"making the far network failed (exit {done.returncode})"
     return None
 
 
@@ -216,8 +231,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jitter", type=float, default=0.0, help="fraction of the delay (0.3: +-30 %%)")
     parser.add_argument("--loss", type=float, default=0.0, help="fraction of packets dropped (0.01)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--probe", action="store_true", help="make the devices and the namespace, then end at once (exit 0: it can be done here)")
     args = parser.parse_args(argv)
-    why = why_not_available()
+    why = "network namespaces and TAP devices need root (CAP_NET_ADMIN)" if os.geteuid() != 0 else None
     if why is not None:
         print(f"error: cannot make a far network here: {why}", file=sys.stderr)
         return 2
@@ -237,6 +253,8 @@ def main(argv: list[str] | None = None) -> int:
     except (OSError, FarNetworkError) as exc:
         print(f"error: cannot make the far network: {exc}", file=sys.stderr)
         return 2
+    if args.probe:
+        return 0
     relay = PacketRelay(near_fd, far_fd, weather, seed=args.seed).start()
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
