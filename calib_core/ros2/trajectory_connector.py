@@ -17,7 +17,7 @@ the workstation. The commanded point only moves forward along the line, so a lat
 arm back. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
 once when no trajectory controller subscribes to the topic; *stopped* by Stop, which sends a trajectory that
 holds the current position. No joint states for ``stale_after_s``: the link is ``stale``, the robot's pose
-unknown, and the move is not renewed.
+unknown, and a move under way ends with that error (it is not renewed: the arm stops within its horizon).
 
 A far link (a satellite's seconds): the joint states' delay is measured from their stamps (:attr:`delay_s`, clocks in
 step as ROS 2 assumes), and what waits on the link follows it. The horizon given is ``horizon_s`` plus the round trip
@@ -261,6 +261,8 @@ class Ros2TrajectoryController(ConnectorEvents):
         last = self._last_sample_s
         if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s + self._arrival.spread_s:
             self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
+            # A move under way cannot be followed any more: it ends now, not at its deadline (it is not renewed either).
+            self._moves.finish(MoveError(f"the joint states stopped ({now - last:.1f} s): the robot's pose is unknown"))
         move = self._moves.current
         if move is not None and now > move.deadline_s:
             from calib_core.link.link_types import MoveTimeout

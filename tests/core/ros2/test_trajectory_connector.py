@@ -234,3 +234,19 @@ def test_the_simulated_arm_refuses_an_empty_trajectory_as_the_controller_does():
     assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), [point]), 0.0) is None
     assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), []), 0.5) == "Empty trajectory received."
     assert np.allclose(arm.position(1.0), [math.degrees(0.1), 0, 0, 0, 0, 100.0])  # the first one ran on to its end
+
+
+def test_a_move_ends_when_the_joint_states_stop_not_at_its_deadline(arm):
+    """The arm's driver gone mid-move (measured through the 1.5 s far network before this: the move ran on to its
+    60 s deadline while the link said stale)."""
+    link = _connected(speed_deg_s=10)
+    try:
+        handle = link.move_joints([60, -30, 60, 0, 45, 100], timeout_s=60.0)
+        assert wait_until(lambda: link.latest.joints_deg[0] > 1.0)
+        arm.close()  # the driver gone: no joint states, no controller
+        with pytest.raises(MoveError, match="the joint states stopped"):
+            handle.wait(5.0)
+        assert link.state is LinkState.STALE
+        assert not link.move_joints([0, -30, 60, 0, 45, 100]).sent
+    finally:
+        link.close()
