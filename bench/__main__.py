@@ -1,4 +1,4 @@
-"""Run every ``bench/*_bench.py`` (or the ones named on the command line).
+"""Run every ``bench/*_bench.py`` and ``bench/real_photos.py`` (or the ones named on the command line).
 
 Each bench module has ``main() -> str``: it measures, writes its Markdown report to
 ``docs/benchmarks/<name>.md`` and returns the report's path. Timings never go in tests.
@@ -14,7 +14,7 @@ HERE = Path(__file__).resolve().parent
 
 
 def main(argv: list[str]) -> int:
-    names = argv or sorted(p.stem for p in HERE.glob("*_bench.py"))
+    names = argv or sorted(p.stem for p in HERE.glob("*_bench.py")) + ["real_photos"]
     failed = []
     for name in names:
         mod = importlib.import_module(f"bench.{name.removesuffix('.py')}")

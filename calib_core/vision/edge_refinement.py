@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
@@ -21,6 +22,7 @@ from calib_core.camera.projection import project, project_points
 from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
+from calib_core.vision.outline import outline_samples
 
 _SAMPLE_STEP_PX = 4.0
 _MIN_STRENGTH = 12.0
@@ -152,11 +154,40 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
 
 def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """3D samples (m, 3) on the visible crease and silhouette edges, their edges' far ends (m, 3),
-    their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With
+    """3D samples (m, 3) on the visible crease and silhouette edges and on the occluding contour, their edges'
+    far ends (m, 3), their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With
     ``expected_magnitude`` (h, w: the :func:`gradient_magnitude` of the cell rendered at ``obj2cam``)
     only where that view shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
-    (:func:`_clearance`)."""
+    (:func:`_clearance`). The contour (:mod:`calib_core.vision.outline`) fills in where the mesh's own edges
+    are too short to hold a sample: a scanned object's facets, a fine rim."""
+    return edge_model(mesh, obj2cam, intrinsics, expected_magnitude)[:4]
+
+
+def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None):
+    """:func:`edge_points` and how many of its samples (the last ones) came from the occluding contour alone:
+    those belong to the pose they were taken at (a smooth surface's rim moves with it)."""
+    pts, far, clearance, chain = _crease_points(mesh, obj2cam, intrinsics, expected_magnitude)
+    outline = outline_samples(mesh, obj2cam, intrinsics, _SAMPLE_STEP_PX)
+    if len(outline) == 0:
+        return pts, far, clearance, chain, 0
+    uv = project_points(outline.points_mm, obj2cam, intrinsics)
+    if len(pts):
+        # where a crease or silhouette sample lies within a step, the contour adds nothing (a CAD part's outline)
+        covered = cKDTree(project_points(pts, obj2cam, intrinsics)).query(uv)[0] <= _SAMPLE_STEP_PX + 0.5
+    else:
+        covered = np.zeros(len(uv), dtype=bool)
+    keep = ~covered
+    if expected_magnitude is not None:
+        keep &= model_shows_edge(expected_magnitude, uv)
+    if not keep.any():
+        return pts, far, clearance, chain, 0
+    first_chain = int(chain.max()) + 1 if len(chain) else 0
+    return (np.concatenate([pts, outline.points_mm[keep]]), np.concatenate([far, outline.along_mm[keep]]),
+            np.concatenate([clearance, np.full(int(keep.sum()), np.inf)]), np.concatenate([chain, first_chain + outline.chain[keep]]), int(keep.sum()))
+
+
+def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None):
+    """:func:`edge_points` along the mesh's own crease and silhouette edges."""
     seg = visible_segments(mesh, obj2cam)
     if len(seg) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
@@ -219,6 +250,17 @@ def model_shows_edge(magnitude: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return inside & (magnitude[v, u] >= _MIN_STRENGTH)
 
 
+_RESAMPLE = (0.5, 1.0)
+"""(deg, mm): a fit with contour samples takes them again once it has turned or moved this far from where they
+were taken."""
+
+
+def _moved_beyond(a: np.ndarray, b: np.ndarray, bound: tuple[float, float]) -> bool:
+    """Whether pose ``b`` (4, 4, mm) has turned ``bound[0]`` deg or moved ``bound[1]`` mm from ``a``."""
+    turn = np.degrees(np.linalg.norm(Rotation.from_matrix(a[:3, :3] @ b[:3, :3].T).as_rotvec()))
+    return bool(turn > bound[0] or np.linalg.norm(a[:3, 3] - b[:3, 3]) > bound[1])
+
+
 def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
     out = obj2cam.copy()
     out[:3, :3] = Rotation.from_rotvec(xi[:3]).as_matrix() @ obj2cam[:3, :3]
@@ -250,8 +292,9 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     ``obj2cam``, to leave out edges without contrast; ``rms_bound_px`` the fit's settle bound (:attr:`EdgeFit.settled`);
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    pts, far, clearance, chain = edge_points(mesh, obj2cam, intrinsics, expected_magnitude)
+    pts, far, clearance, chain, from_outline = edge_model(mesh, obj2cam, intrinsics, expected_magnitude)
     pose = obj2cam.copy()
+    sampled_at = pose
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False
     H = np.eye(6)
@@ -259,6 +302,10 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     share = 0.0
     previous_xi, damping = None, 1.0
     for it in range(iterations):
+        if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
+            # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
+            pts, far, clearance, chain, from_outline = edge_model(mesh, pose, intrinsics, expected_magnitude)
+            sampled_at = pose
         if len(pts) < 12:
             break
         uv = project_points(pts, pose, intrinsics)

@@ -1,0 +1,168 @@
+"""The occluding contour of any mesh at a pose: where the object meets its background in the image.
+
+A CAD part's outline runs along long crease edges, each of which holds many samples; a scanned object (a
+smooth mesh of 10-25 thousand facets, as BOP's and YCB's models are) has no crease, and its outline is made of
+facet edges a fraction of a pixel long, none long enough to hold a sample. Here the outline is taken from the
+object's own silhouette: the mesh's faces are filled into a mask at the pose, the mask's outer boundary is
+walked every few pixels, and each boundary sample takes the 3D point of the nearest rim edge (an edge between a
+face turned to the camera and one turned away). The image point is that 3D point's projection, so the sample
+sits on the geometric rim, not on the mask's pixel grid. A rim moves over a smooth surface as the pose changes:
+the samples are for the pose they were taken at, and a fit takes them again as it moves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.spatial import cKDTree
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project_points
+
+NEAR_MM = 1.0
+"""Faces with a vertex nearer the camera than this (or behind it) are not filled in."""
+_RIM_STEP_PX = 1.0
+_MATCH_PX = 2.5
+_BORDER_PX = 3.0
+CHAIN_SAMPLES = 12
+"""Consecutive outline samples taken as one edge chain (what the image does to a stretch of outline, its
+background and its shading, is shared by its neighbours): about 50 px of outline at the default step."""
+
+
+@dataclass(frozen=True)
+class Outline:
+    """Samples on the occluding contour: ``points_mm`` (m, 3) and ``along_mm`` (m, 3), a point a little
+    further along the contour (the edge's direction, as a crease sample's far end gives it), both in the
+    mesh's frame; ``chain`` (m,) the stretch of contour each belongs to."""
+
+    points_mm: np.ndarray
+    along_mm: np.ndarray
+    chain: np.ndarray
+
+    @staticmethod
+    def empty() -> "Outline":
+        return Outline(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=int))
+
+    def __len__(self) -> int:
+        return len(self.points_mm)
+
+
+def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, tuple[int, int]]:
+    """The mesh's faces turned to the camera, filled: a uint8 mask over the part of the image the object
+    covers (255 inside) and its top-left pixel (u0, v0). Faces reaching behind :data:`NEAR_MM` are left out."""
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    faces = np.asarray(mesh.faces)
+    z = vertices @ obj2cam[2, :3] + obj2cam[2, 3]
+    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+    normals = np.asarray(mesh.face_normals)
+    toward = np.einsum("fi,fi->f", normals, centre - vertices[faces[:, 0]]) > 0
+    keep = toward & (z[faces] > NEAR_MM).all(axis=1)
+    if not keep.any():
+        return np.zeros((0, 0), np.uint8), (0, 0)
+    uv = project_points(vertices, obj2cam, intrinsics)
+    tri = uv[faces[keep]]  # (F, 3, 2)
+    tri = tri[np.isfinite(tri).all(axis=(1, 2))]
+    if not len(tri):
+        return np.zeros((0, 0), np.uint8), (0, 0)
+    lo = np.floor(np.clip(tri.reshape(-1, 2).min(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) - 2
+    hi = np.ceil(np.clip(tri.reshape(-1, 2).max(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) + 3
+    lo = np.maximum(lo, 0)
+    hi = np.minimum(hi, [intrinsics.width, intrinsics.height])
+    mask = np.zeros((max(hi[1] - lo[1], 1), max(hi[0] - lo[0], 1)), np.uint8)
+    # one convex fill a face: a single fillPoly of many polygons fills by the even-odd rule, and overlapping
+    # facets would cancel out; sub-pixel vertices (4 fractional bits) keep thin facets
+    fixed = np.round((tri - lo) * 16.0).astype(np.int32)
+    for f in fixed:
+        cv2.fillConvexPoly(mask, f, 255, lineType=cv2.LINE_8, shift=4)
+    return mask, (int(lo[0]), int(lo[1]))
+
+
+def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+    """Points (k, 3) mm along the rim edges, about a pixel apart in the image, and their pixels (k, 2)."""
+    from calib_core.vision.edge_refinement import silhouette_segments
+
+    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+    seg = silhouette_segments(mesh, centre)
+    if not len(seg):
+        return np.zeros((0, 3)), np.zeros((0, 2))
+    z = seg @ obj2cam[2, :3] + obj2cam[2, 3]
+    seg = seg[(z > NEAR_MM).all(axis=1)]
+    if not len(seg):
+        return np.zeros((0, 3)), np.zeros((0, 2))
+    ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
+    counts = np.clip(np.ceil(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / _RIM_STEP_PX).astype(int), 1, 4000) + 1
+    which = np.repeat(np.arange(len(seg)), counts)
+    s = np.concatenate([np.linspace(0.0, 1.0, c) for c in counts])
+    points = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]
+    return points, project_points(points, obj2cam, intrinsics)
+
+
+def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0) -> Outline:
+    """Samples every ``step_px`` along the outer boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
+    mesh's frame to the camera's, mm), each on the rim edge nearest its boundary pixel (within 2.5 px); none
+    where the image's border cuts the silhouette (the border is not the object's edge)."""
+    mask, (u0, v0) = silhouette_mask(mesh, obj2cam, intrinsics)
+    if mask.size == 0 or not mask.any():
+        return Outline.empty()
+    rim, rim_px = _rim_points(mesh, obj2cam, intrinsics)
+    if not len(rim):
+        return Outline.empty()
+    tree = cKDTree(rim_px)
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    points, along, chain = [], [], []
+    next_chain = 0
+    for contour in contours:
+        c = contour[:, 0, :].astype(float) + [u0, v0]
+        if len(c) < 8:
+            continue
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
+        picks = np.searchsorted(arc, np.arange(0.0, arc[-1], step_px))
+        picks = picks[picks < len(c)]
+        px = c[picks]
+        inside = ((px[:, 0] > _BORDER_PX) & (px[:, 0] < intrinsics.width - 1 - _BORDER_PX)
+                  & (px[:, 1] > _BORDER_PX) & (px[:, 1] < intrinsics.height - 1 - _BORDER_PX))
+        distance, nearest = tree.query(px)
+        good = inside & (distance <= _MATCH_PX)
+        # runs of good samples, each walked in order: a sample's direction is toward its neighbour
+        n = len(px)
+        for run in _runs(good, closed=True):
+            if len(run) < 3:
+                continue
+            p = rim[nearest[run]]
+            ahead = np.roll(p, -1, axis=0)
+            closed_loop = len(run) == n
+            if not closed_loop:
+                ahead[-1] = p[-1] + (p[-1] - p[-2])
+            points.append(p)
+            along.append(ahead)
+            chain.append(next_chain + np.arange(len(run)) // CHAIN_SAMPLES)
+            next_chain = int(chain[-1].max()) + 1
+    if not points:
+        return Outline.empty()
+    points, along, chain = np.concatenate(points), np.concatenate(along), np.concatenate(chain)
+    # two neighbours on one rim point give no direction
+    moved = np.linalg.norm(along - points, axis=1) > 1e-9
+    return Outline(points[moved], along[moved], chain[moved])
+
+
+def _runs(good: np.ndarray, closed: bool) -> list[np.ndarray]:
+    """Index runs (in order) where ``good`` holds; on a closed contour a run may wrap past the end."""
+    n = len(good)
+    if good.all():
+        return [np.arange(n)]
+    if not good.any():
+        return []
+    start = int(np.flatnonzero(~good)[0]) + 1 if closed else 0
+    order = (np.arange(n) + start) % n if closed else np.arange(n)
+    runs, current = [], []
+    for i in order:
+        if good[i]:
+            current.append(i)
+        elif current:
+            runs.append(np.array(current))
+            current = []
+    if current:
+        runs.append(np.array(current))
+    return runs
