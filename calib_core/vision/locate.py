@@ -44,7 +44,9 @@ class LocatedFeature:
 @dataclass(frozen=True)
 class Located:
     """``status``: ``ok`` (the edges settled: converged, within their RMS bound, at least half the samples on
-    their edges), else ``not found`` with ``message`` saying why. ``obj2cam`` (4, 4) mm: the edge fit's pose
+    their edges, and every other start that settled put the object within a few pixels of it in the image),
+    ``uncertain`` (settled, but another start settled elsewhere in the image: the message says how far), else
+    ``not found`` with ``message`` saying why. ``obj2cam`` (4, 4) mm: the edge fit's pose
     (``None`` when not found); ``std_rotation_deg`` (3,) and ``std_translation_mm`` (3,): its 1-sigma, about the
     camera's axes; ``features`` found and ``missed`` (name, reason); ``features_obj2cam`` the pose of the features
     alone (four or more, else ``None``) and ``features_vs_edges_mm`` how far its origin is from the edges' (the two
@@ -85,6 +87,7 @@ class Located:
                 "origin_from_edges_mm": self.features_vs_edges_mm},
             "moved_from_prior": None if self.prior_moved_mm is None else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
             "starts_apart_mm": self.extra.get("starts_apart_mm"),
+            "starts_apart_px": self.extra.get("starts_apart_px"),
             "seconds": round(self.seconds, 3),
         }
 
@@ -125,12 +128,62 @@ def locate(image: np.ndarray, intrinsics: Intrinsics, mesh, prior_obj2cam: np.nd
     # affine (a 250 px box at 1450 px focal) the outline fits as well 4 % nearer or further, turned to match, and
     # the edge fit's own covariance does not show it (2 mm in depth where starts ended 40 mm apart). The spread of
     # the starts that settle is added to the 1-sigma, and a start that ends beyond it is said.
+    #
+    # Then two starts from the answer itself, 4 % nearer and further: the outline scaled by 4 % each way. On a part
+    # with printed or inner edges (the tutorial box's printed frame lies 10-15 px inside its outline) a fit that
+    # took an inner edge for the outline, or the outline for an inner edge, finds the other one from there.
     ends = [located.obj2cam]
-    for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0):
+    for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(located.obj2cam, RIVAL_DEPTH_SHARE):
         other = _report(look(start), intrinsics, start, reach_mm, reach_deg)
         if other.status == "ok":
             ends.append(other.obj2cam)
-    return _with_spread(located, ends)
+    return _verdict(_with_spread(located, ends), ends, mesh, intrinsics)
+
+
+RIVAL_DEPTH_SHARE = 0.04
+"""How far nearer and further (a share of the distance) the answer is moved to look for a rival fit."""
+AGREE_PX = 2.0
+"""Settled fits whose outlines lie within this many pixels of each other (or within twice the edges' RMS) are one
+answer: apart further, the photo holds two explanations and the answer is ``uncertain``."""
+
+
+def _depth_starts(obj2cam: np.ndarray, share: float) -> list[np.ndarray]:
+    out = []
+    for sign in (-1.0, 1.0):
+        start = obj2cam.copy()
+        start[:3, 3] = obj2cam[:3, 3] * (1.0 + sign * share)
+        out.append(start)
+    return out
+
+
+def image_distance_px(a: np.ndarray, b: np.ndarray, mesh, intrinsics: Intrinsics) -> float:
+    """How far apart, px, poses ``a`` and ``b`` (both 4 x 4 obj2cam, mm) put what the camera sees of the mesh: the
+    largest distance between the edge samples seen at ``a`` (its outline and creases) projected at each. Hidden
+    points are left out: on a nearly affine view a turn traded for depth moves a hidden back corner 15 px while
+    every seen edge stays within 3."""
+    from calib_core.camera.projection import project_points
+    from calib_core.vision.edge_refinement import edge_points
+
+    seen = edge_points(mesh, a, intrinsics)[0]
+    if not len(seen):
+        seen = np.asarray(mesh.vertices, dtype=float)[:: max(1, len(mesh.vertices) // 2000)]
+    return float(np.max(np.linalg.norm(project_points(seen, a, intrinsics) - project_points(seen, b, intrinsics), axis=1)))
+
+
+def _verdict(located: Located, ends: list[np.ndarray], mesh, intrinsics: Intrinsics) -> Located:
+    """``located`` as it is when every settled fit puts the object where it does in the image (within
+    :data:`AGREE_PX` or twice the edges' RMS); otherwise ``uncertain``, saying how far apart the fits are. Starts
+    that agree in the image but not in depth (a nearly affine view) are one answer: their spread is in the 1-sigma."""
+    from dataclasses import replace as with_fields
+
+    apart = max((image_distance_px(e, ends[0], mesh, intrinsics) for e in ends[1:]), default=0.0)
+    bound = max(AGREE_PX, 2.0 * (located.edge_rms_px or 0.0))
+    extra = {**located.extra, "starts_apart_px": round(apart, 2)}
+    if apart <= bound:
+        return with_fields(located, extra=extra)
+    return with_fields(located, status="uncertain", extra=extra,
+                       message=f"uncertain: another start settled with the object {apart:.1f} px away in the image (more than {bound:.1f} px): "
+                               "an inner, printed or neighbouring edge explains the outline as well; " + located.message)
 
 
 def _starts_round(prior: np.ndarray, mm: float, deg: float) -> list[np.ndarray]:
@@ -157,14 +210,14 @@ def _with_spread(located: Located, ends: list[np.ndarray]) -> Located:
     from scipy.spatial.transform import Rotation
 
     if len(ends) < 2:
-        return with_fields(located, message=located.message + "; 1 of 3 starts settled: the 1-sigma is the edge fit's own")
+        return with_fields(located, message=located.message + "; 1 of 5 starts settled: the 1-sigma is the edge fit's own")
     t = np.array([e[:3, 3] for e in ends])
     turn = np.array([Rotation.from_matrix(e[:3, :3] @ ends[0][:3, :3].T).as_rotvec() for e in ends])
     spread_t, spread_r = t.std(axis=0, ddof=1), np.degrees(turn.std(axis=0, ddof=1))
     std_t = np.hypot(located.std_translation_mm, spread_t)
     std_r = np.hypot(located.std_rotation_deg, spread_r)
     apart = float(np.max(np.linalg.norm(t - t[0], axis=1)))
-    note = f"; {len(ends)} of 3 starts settled, within {apart:.1f} mm of one another"
+    note = f"; {len(ends)} of 5 starts settled, within {apart:.1f} mm of one another"
     if np.any(np.abs(t - t[0]).max(axis=0) > 3.0 * np.maximum(located.std_translation_mm, 1e-6)):
         note += " (more than the edges' own 1-sigma allows: the photo fixes the pose less well than one fit says; the 1-sigma includes the starts' spread)"
     return with_fields(located, message=located.message + note, std_translation_mm=std_t, std_rotation_deg=std_r,

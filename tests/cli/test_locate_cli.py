@@ -51,13 +51,18 @@ def _moved(pose: dict, mm: float, deg: float, rng) -> dict:
     return {"R_obj2cam": R.tolist(), "t_obj2cam_mm": (np.array(pose["t_obj2cam_mm"]) + mm * d / np.linalg.norm(d)).tolist()}
 
 
-def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_files):
+def test_the_tutorial_box_is_located_by_its_edges_but_its_print_leaves_it_uncertain(photo_files):
+    """The box is printed all over (a frame of lines 10-15 px inside its outline, pictures, lettering): from the
+    answer moved 4 % nearer or further the edges settle on the print, over 3 px away on the image, with every sample
+    on an edge. One outline fit cannot tell the box's edge from its print here, so the answer is ``uncertain``
+    (exit 3) with the reason, never ``ok``; the pose and its 1-sigma are still reported."""
     overlay = photo_files / "located.png"
     run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"),
                     "--prior", str(_prior(photo_files, "prior.json", HAND_PRIOR)), "--overlay", str(overlay), "--indent", "0")
-    assert run.returncode == 0, run.stderr
+    assert run.returncode == 3, run.stderr
     out = json.loads(run.stdout)
-    assert out["status"] == "ok", out["message"]
+    assert out["status"] == "uncertain" and "another start settled" in out["message"], out["message"]
+    assert out["starts_apart_px"] > 3.0
     # every outline sample on its edge; a real box's rounded, printed edges fit to about a pixel and a quarter
     assert out["edges"]["share_on_edges"] > 0.9 and out["edges"]["rms_px"] < 1.5 and out["edges"]["samples"] > 300
     assert len(out["features"]) >= 6  # of the 7 corners in view
@@ -76,7 +81,7 @@ def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_fi
 
 
 def test_starts_around_the_prior_end_at_one_pose(photo_files):
-    """Four starts 8 mm and 0.7 deg from the hand prior: across the line of sight the located poses agree within their
+    """Four starts 8 mm and 0.7 deg from the hand prior (each answer uncertain, as above, but reported): across the line of sight the located poses agree within their
     own 1-sigma (x3); in depth within 5 % (on this nearly affine view, 250 px of box at 1450 px focal, depth trades
     against the turn: one start ends 40 mm further with every sample on its edges; docs/find-points.md)."""
     rng = np.random.default_rng(4)
@@ -84,8 +89,9 @@ def test_starts_around_the_prior_end_at_one_pose(photo_files):
     for k in range(4):
         prior = _prior(photo_files, f"prior{k}.json", _moved(HAND_PRIOR, 8.0, 0.7, rng))
         run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(prior), "--indent", "0")
-        assert run.returncode == 0, run.stderr + run.stdout
+        assert run.returncode in (0, 3), run.stderr + run.stdout
         out = json.loads(run.stdout)
+        assert out["status"] in ("ok", "uncertain"), out["message"]
         poses.append(np.array(out["t_obj2cam_mm"]))
         stds.append(np.array(out["std"]["translation_mm"]))
     spread = np.max(np.abs(np.array(poses) - np.mean(poses, axis=0)), axis=0)
