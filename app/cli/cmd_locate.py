@@ -7,7 +7,8 @@ the photo. The prior is JSON: ``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as
 ``obj2cam`` (4 x 4, mm). ``--features`` is YAML: ``name: [x, y, z]`` in the mesh's units, corners of the object
 (default: the vertices of a mesh of at most 64, a box's eight).
 
-Exit codes: 0 located (``ok``), 2 bad input (one ``error:`` line), 3 not located (the JSON says why).
+Exit codes: 0 located (``ok``), 2 bad input (one ``error:`` line), 3 not located or ``uncertain`` (another start
+settled elsewhere on the image; the JSON says why and still gives the pose).
 """
 
 from __future__ import annotations
