@@ -22,7 +22,8 @@ from calib_core.camera.projection import project, project_points
 from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
-from calib_core.vision.outline import outline_samples
+from calib_core.vision.outline import outline_samples, silhouette_mask
+from calib_core.vision.region_model import MIN_CONTRAST, RegionModel
 
 _SAMPLE_STEP_PX = 4.0
 _MIN_STRENGTH = 12.0
@@ -160,30 +161,75 @@ def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magn
     only where that view shows an edge and no other edge it shows passes within :data:`_CROWDED_PX`
     (:func:`_clearance`). The contour (:mod:`calib_core.vision.outline`) fills in where the mesh's own edges
     are too short to hold a sample: a scanned object's facets, a fine rim."""
-    return edge_model(mesh, obj2cam, intrinsics, expected_magnitude)[:4]
+    samples = edge_model(mesh, obj2cam, intrinsics, expected_magnitude)
+    return samples.points, samples.far, samples.clearance, samples.chain
 
 
-def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None):
-    """:func:`edge_points` and how many of its samples (the last ones) came from the occluding contour alone:
-    those belong to the pose they were taken at (a smooth surface's rim moves with it)."""
+@dataclass(frozen=True)
+class EdgeSamples:
+    """What :func:`edge_model` gives: the samples ``points`` (m, 3, mm, the mesh's frame), their edges' ``far``
+    ends (m, 3), ``clearance`` (m,) px, ``chain`` (m,); ``outward`` (m,): +1 or -1 where the sample lies on the
+    object's outline (the side the normal from ``points`` to ``far``, turned a quarter left in the image, must
+    be multiplied by to point away from the object), 0 on an edge with the object on both sides; ``from_outline``
+    how many samples (the last ones) came from the occluding contour alone (they belong to this pose: a smooth
+    surface's rim moves with it); ``silhouette``: the object's mask at this pose and its top-left pixel."""
+
+    points: np.ndarray
+    far: np.ndarray
+    clearance: np.ndarray
+    chain: np.ndarray
+    outward: np.ndarray
+    from_outline: int
+    silhouette: tuple[np.ndarray, tuple[int, int]]
+
+
+def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None) -> EdgeSamples:
+    """The samples of :func:`edge_points`, with which of them lie on the outline (:class:`EdgeSamples`)."""
     pts, far, clearance, chain = _crease_points(mesh, obj2cam, intrinsics, expected_magnitude)
-    outline = outline_samples(mesh, obj2cam, intrinsics, _SAMPLE_STEP_PX)
-    if len(outline) == 0:
-        return pts, far, clearance, chain, 0
-    uv = project_points(outline.points_mm, obj2cam, intrinsics)
-    if len(pts):
-        # where a crease or silhouette sample lies within a step, the contour adds nothing (a CAD part's outline)
-        covered = cKDTree(project_points(pts, obj2cam, intrinsics)).query(uv)[0] <= _SAMPLE_STEP_PX + 0.5
-    else:
-        covered = np.zeros(len(uv), dtype=bool)
-    keep = ~covered
-    if expected_magnitude is not None:
-        keep &= model_shows_edge(expected_magnitude, uv)
-    if not keep.any():
-        return pts, far, clearance, chain, 0
-    first_chain = int(chain.max()) + 1 if len(chain) else 0
-    return (np.concatenate([pts, outline.points_mm[keep]]), np.concatenate([far, outline.along_mm[keep]]),
-            np.concatenate([clearance, np.full(int(keep.sum()), np.inf)]), np.concatenate([chain, first_chain + outline.chain[keep]]), int(keep.sum()))
+    silhouette = silhouette_mask(mesh, obj2cam, intrinsics)
+    outline = outline_samples(mesh, obj2cam, intrinsics, _SAMPLE_STEP_PX, silhouette=silhouette)
+    added = 0
+    if len(outline):
+        uv = project_points(outline.points_mm, obj2cam, intrinsics)
+        if len(pts):
+            # where a crease or silhouette sample lies within a step, the contour adds nothing (a CAD part's outline)
+            keep = cKDTree(project_points(pts, obj2cam, intrinsics)).query(uv)[0] > _SAMPLE_STEP_PX + 0.5
+        else:
+            keep = np.ones(len(uv), dtype=bool)
+        if expected_magnitude is not None:
+            keep &= model_shows_edge(expected_magnitude, uv)
+        if keep.any():
+            first_chain = int(chain.max()) + 1 if len(chain) else 0
+            pts, far = np.concatenate([pts, outline.points_mm[keep]]), np.concatenate([far, outline.along_mm[keep]])
+            clearance = np.concatenate([clearance, np.full(int(keep.sum()), np.inf)])
+            chain = np.concatenate([chain, first_chain + outline.chain[keep]])
+            added = int(keep.sum())
+    return EdgeSamples(pts, far, clearance, chain, _outward(pts, far, obj2cam, intrinsics, silhouette), added, silhouette)
+
+
+_SIDE_PX = 3.0
+
+
+def _outward(pts: np.ndarray, far: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, silhouette) -> np.ndarray:
+    """+1 or -1 (m,) where the object lies on one side of a sample only (3 px across), 0 where on both or neither."""
+    mask, (u0, v0) = silhouette
+    if not len(pts) or mask.size == 0:
+        return np.zeros(len(pts), dtype=int)
+    uv = project_points(pts, obj2cam, intrinsics)
+    d = project_points(far, obj2cam, intrinsics) - uv
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9)
+    normals = np.column_stack([-d[:, 1], d[:, 0]])
+
+    def on_object(points):
+        u = np.rint(points[:, 0] - u0).astype(int)
+        v = np.rint(points[:, 1] - v0).astype(int)
+        within = (u >= 0) & (u < mask.shape[1]) & (v >= 0) & (v < mask.shape[0])
+        out = np.zeros(len(points), dtype=bool)
+        out[within] = mask[v[within], u[within]] > 0
+        return out
+
+    plus, minus = on_object(uv + _SIDE_PX * normals), on_object(uv - _SIDE_PX * normals)
+    return np.where(minus & ~plus, 1, np.where(plus & ~minus, -1, 0))
 
 
 def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None):
@@ -250,6 +296,13 @@ def model_shows_edge(magnitude: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return inside & (magnitude[v, u] >= _MIN_STRENGTH)
 
 
+CREASES_JOIN_PX = 2.0
+"""With the outline found by colour, the creases join the fit once its search window is this narrow, px."""
+CREASES_AGREE_PX = 0.75
+"""... and only when their median offset from where the outline puts them is at most this, px."""
+MIN_REGION_SEPARATION = 0.2
+"""The least :attr:`~calib_core.vision.region_model.RegionModel.separation` at which the outline is found by
+colour: below it the object's colours are too much its surroundings' to tell the two apart."""
 _RESAMPLE = (0.5, 1.0)
 """(deg, mm): a fit with contour samples takes them again once it has turned or moved this far from where they
 were taken."""
@@ -286,13 +339,22 @@ def normal_jacobian(points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndar
 
 
 def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected_magnitude: np.ndarray | None = None, search_px: float = 8.0,
-                    iterations: int = 30, magnitude: np.ndarray | None = None, rms_bound_px: float = SETTLED_RMS_PX) -> EdgeFit:
+                    iterations: int = 30, magnitude: np.ndarray | None = None, rms_bound_px: float = SETTLED_RMS_PX, colour: np.ndarray | None = None) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
     ``obj2cam``, to leave out edges without contrast; ``rms_bound_px`` the fit's settle bound (:attr:`EdgeFit.settled`);
-    ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it."""
+    ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it. ``colour``: the image in RGB
+    (h, w, 3) uint8; given, the outline's samples are found where the object's colours end
+    (:mod:`calib_core.vision.region_model`) when its colours tell it from its surroundings, not at the strongest
+    gradient (print, texture and clutter have gradients too)."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    pts, far, clearance, chain, from_outline = edge_model(mesh, obj2cam, intrinsics, expected_magnitude)
+    model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude)
+    pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
+    regions = None
+    if colour is not None and colour.ndim == 3:
+        regions = RegionModel.from_image(colour, *model.silhouette)
+        if regions is not None and regions.separation < MIN_REGION_SEPARATION:
+            regions = None  # the object's colours are its surroundings' too: the gradients are all there is
     pose = obj2cam.copy()
     sampled_at = pose
     window = search_px
@@ -301,10 +363,12 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     edges, offsets, vectors = np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2))
     share = 0.0
     previous_xi, damping = None, 1.0
+    creases_join = None
     for it in range(iterations):
         if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
             # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
-            pts, far, clearance, chain, from_outline = edge_model(mesh, pose, intrinsics, expected_magnitude)
+            model = edge_model(mesh, pose, intrinsics, expected_magnitude)
+            pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
             sampled_at = pose
         if len(pts) < 12:
             break
@@ -314,6 +378,25 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         normals = np.column_stack([-d[:, 1], d[:, 0]])
         found, strength, inside = search_normals(magnitude, uv, normals, window)
         ok = inside & (strength >= _MIN_STRENGTH)
+        counted = np.ones(len(uv), dtype=bool)  # the samples the fit's share on its edges is of
+        if regions is not None and outward.any():
+            on_outline = outward != 0
+            step, contrast, step_inside = regions.step_edges(uv[on_outline], normals[on_outline] * outward[on_outline, None], window)
+            found[on_outline] = step
+            # The outline alone brings the pose near, as the region-based trackers fit: a crease between two of the
+            # object's faces has its colours on both sides, and on a printed part the strongest gradient within a
+            # wide window is as often the print's (a frame 12 mm inside a box's edges pulled the pose 3 deg off its
+            # outline). The creases join once the window is at its finest, where the print cannot reach them; they
+            # sharpen the turn (a fixture on the simulated camera: 0.12 deg off by its outline alone, 0.01 with them).
+            creases = ok & ~on_outline
+            if creases_join is None and window <= CREASES_JOIN_PX and creases.any():
+                # decided once: only creases that agree with where the outline has put the pose (a crease whose
+                # nearest gradient is the print's lies px off all along it; the fixture's lie within a few tenths)
+                r_creases = np.einsum("ij,ij->i", found[creases] - uv[creases], normals[creases])
+                creases_join = bool(np.median(np.abs(r_creases)) <= CREASES_AGREE_PX)
+            ok = creases & bool(creases_join)
+            ok[on_outline] = step_inside & (contrast >= MIN_CONTRAST)
+            counted = on_outline
         # while the window is wide, only the samples with no other edge inside it (a few, far apart,
         # bring the pose near; the crowded ones join as it shrinks)
         clear = ok & (clearance > window)
@@ -342,7 +425,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         pose = _perturbed(pose, xi)
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
-        share = float(np.mean(wts > 0))
+        share = float(np.mean(wts[counted] > 0)) if counted.any() else 0.0
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
         at_finest = window <= 2.0
         window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks

@@ -134,7 +134,8 @@ def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Int
 
 
 def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2cam_model: np.ndarray, *, kinds: dict[str, FeatureKind] | None = None,
-                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None, edge_rms_px: float = SETTLED_RMS_PX) -> FoundPoints:
+                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None, edge_rms_px: float = SETTLED_RMS_PX,
+                by_colour: bool = False) -> FoundPoints:
     """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
     ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
     the item's own, corner when absent). ``expected(obj2cam, box_px) -> image``: the cell rendered as this
@@ -142,7 +143,9 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     (u0, v0, u1, v1) px need be, :meth:`~calib_core.render.model_view.ModelView.render`): edges it shows no
     contrast on are not searched for. ``reach_mm`` and ``reach_deg``: how far the true camera may be
     from the modelled one (the robot's error), which bounds the search. ``edge_rms_px``: the edge fit's settle bound
-    (:data:`~calib_core.vision.edge_refinement.SETTLED_RMS_PX` for the cell's camera; coarser for a photo)."""
+    (:data:`~calib_core.vision.edge_refinement.SETTLED_RMS_PX` for the cell's camera; coarser for a photo).
+    ``by_colour``: the outline found where the target's colours end (:mod:`~calib_core.vision.region_model`),
+    not at the strongest gradient, on a colour image where the target's colours tell it from its surroundings."""
     t0 = time.perf_counter()
     kinds = item.feature_kinds if kinds is None else kinds
     names = list(item.features)
@@ -176,9 +179,11 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     ranked = rank_starts(edge_distance_map(image, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg, keep=_STARTS)
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
+    colour = image if by_colour and image.ndim == 3 else None
+
     def refined(start_pose: np.ndarray) -> EdgeFit:
         fit = refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected_magnitude=detectors.expected_magnitude(start_pose) if expected is not None else None,
-                              magnitude=detectors.magnitude, rms_bound_px=edge_rms_px)
+                              magnitude=detectors.magnitude, rms_bound_px=edge_rms_px, colour=colour)
         return replace(fit, min_share=_FIT_SHARE)  # settled only on more than half its edges: proposals follow from it
 
     best = None
@@ -232,7 +237,8 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
         across = replace(refine_to_edges(grey, intrinsics, item.mesh, pose, expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
-                                         magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX, rms_bound_px=edge_rms_px), min_share=_FIT_SHARE)
+                                         magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX, rms_bound_px=edge_rms_px, colour=colour),
+                         min_share=_FIT_SHARE)
         if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
             edge_fit = across
         edge_seconds += time.perf_counter() - t_across

@@ -99,11 +99,12 @@ def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.n
     return points, project_points(points, obj2cam, intrinsics)
 
 
-def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0) -> Outline:
+def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0, silhouette=None) -> Outline:
     """Samples every ``step_px`` along the outer boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
     mesh's frame to the camera's, mm), each on the rim edge nearest its boundary pixel (within 2.5 px); none
-    where the image's border cuts the silhouette (the border is not the object's edge)."""
-    mask, (u0, v0) = silhouette_mask(mesh, obj2cam, intrinsics)
+    where the image's border cuts the silhouette (the border is not the object's edge). ``silhouette``: the
+    :func:`silhouette_mask` at that pose, when the caller has it."""
+    mask, (u0, v0) = silhouette_mask(mesh, obj2cam, intrinsics) if silhouette is None else silhouette
     if mask.size == 0 or not mask.any():
         return Outline.empty()
     rim, rim_px = _rim_points(mesh, obj2cam, intrinsics)

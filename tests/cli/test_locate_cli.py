@@ -51,20 +51,18 @@ def _moved(pose: dict, mm: float, deg: float, rng) -> dict:
     return {"R_obj2cam": R.tolist(), "t_obj2cam_mm": (np.array(pose["t_obj2cam_mm"]) + mm * d / np.linalg.norm(d)).tolist()}
 
 
-def test_the_tutorial_box_is_located_by_its_edges_but_its_print_leaves_it_uncertain(photo_files):
-    """The box is printed all over (a frame of lines 10-15 px inside its outline, pictures, lettering): from the
-    answer moved 4 % nearer or further the edges settle on the print, over 3 px away on the image, with every sample
-    on an edge. One outline fit cannot tell the box's edge from its print here, so the answer is ``uncertain``
-    (exit 3) with the reason, never ``ok``; the pose and its 1-sigma are still reported."""
+def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_files):
     overlay = photo_files / "located.png"
     run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"),
                     "--prior", str(_prior(photo_files, "prior.json", HAND_PRIOR)), "--overlay", str(overlay), "--indent", "0")
-    assert run.returncode == 3, run.stderr
+    assert run.returncode == 0, run.stderr
     out = json.loads(run.stdout)
-    assert out["status"] == "uncertain" and "another start settled" in out["message"], out["message"]
-    assert out["starts_apart_px"] > 3.0
-    # every outline sample on its edge; a real box's rounded, printed edges fit to about a pixel and a quarter
-    assert out["edges"]["share_on_edges"] > 0.9 and out["edges"]["rms_px"] < 1.5 and out["edges"]["samples"] > 300
+    assert out["status"] == "ok", out["message"]
+    # every outline sample on its edge (found where the box's colours end, not at the print's strongest gradient);
+    # a real box's rounded edges fit to about a pixel and a quarter
+    assert out["edges"]["share_on_edges"] > 0.9 and out["edges"]["rms_px"] < 1.5 and out["edges"]["samples"] > 250
+    # every other start put the box's seen edges within three times that of this answer
+    assert out["starts_apart_px"] < 3.0 * out["edges"]["rms_px"]
     assert len(out["features"]) >= 6  # of the 7 corners in view
     std = np.array(out["std"]["translation_mm"])
     assert np.all(std > 0.2) and np.all(std < 12.0)  # widened by the starts' spread (a nearly affine view: docs/find-points.md)
@@ -81,17 +79,19 @@ def test_the_tutorial_box_is_located_by_its_edges_but_its_print_leaves_it_uncert
 
 
 def test_starts_around_the_prior_end_at_one_pose(photo_files):
-    """Four starts 8 mm and 0.7 deg from the hand prior (each answer uncertain, as above, but reported): across the line of sight the located poses agree within their
-    own 1-sigma (x3); in depth within 5 % (on this nearly affine view, 250 px of box at 1450 px focal, depth trades
-    against the turn: one start ends 40 mm further with every sample on its edges; docs/find-points.md)."""
+    """Four starts 8 mm and 0.7 deg from the hand prior (searching 3 deg round it: the hand prior, from six corners
+    picked to about 4 px, is itself 3 deg off the box's outline): each answer ``ok``, across the line of sight within
+    their own 1-sigma (x3) of one another; in depth within 5 % (on this nearly affine view, 250 px of box at 1450 px
+    focal, depth trades against the turn; docs/find-points.md)."""
     rng = np.random.default_rng(4)
     poses, stds = [], []
     for k in range(4):
         prior = _prior(photo_files, f"prior{k}.json", _moved(HAND_PRIOR, 8.0, 0.7, rng))
-        run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(prior), "--indent", "0")
-        assert run.returncode in (0, 3), run.stderr + run.stdout
+        run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(prior), "--indent", "0",
+                        "--reach-deg", "3")
+        assert run.returncode == 0, run.stderr + run.stdout
         out = json.loads(run.stdout)
-        assert out["status"] in ("ok", "uncertain"), out["message"]
+        assert out["status"] == "ok", out["message"]
         poses.append(np.array(out["t_obj2cam_mm"]))
         stds.append(np.array(out["std"]["translation_mm"]))
     spread = np.max(np.abs(np.array(poses) - np.mean(poses, axis=0)), axis=0)

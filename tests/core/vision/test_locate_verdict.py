@@ -1,7 +1,9 @@
 """``locate``'s verdict on a real photograph nobody on the team took (OpenCV's pose tutorial: a cookie box printed
-all over, on a wooden table): from priors 10-120 mm off, none of the answers is called ``ok``. Before the verdict
-compared the settled starts in the image, every one of these was ``ok``, two of them 20 mm / 6.7 deg and 71 mm from
-the answer the hand-picked prior gives (their outline on the box's printed frame)."""
+all over, on a wooden table): from priors 10-120 mm off, every answer called ``ok`` puts the box's seen edges where
+the answer from the hand-picked prior does (the photo's truth is not known: agreement is the check). Before the
+verdict compared the settled starts in the image, all seven were ``ok``, two of them 20 mm / 6.7 deg and 71 mm from
+the hand prior's answer (their outline on the box's printed frame); and before the outline was found by colour the
+hand prior's own answer lay on the print."""
 
 from __future__ import annotations
 
@@ -21,11 +23,13 @@ def _hand_prior() -> np.ndarray:
     return T
 
 
-def test_no_prior_from_10_to_120_mm_off_gives_an_ok_on_the_printed_box():
+def test_every_ok_from_priors_10_to_120_mm_off_agrees_with_the_hand_prior_s_answer():
     image = np.ascontiguousarray(cv2.imread(str(PHOTO))[:, :, ::-1])
     mesh = load_mesh(BOX, units="cm")
+    reference = locate(image, TUTORIAL_CAMERA, mesh, _hand_prior(), reach_deg=3.0)
+    assert reference.status == "ok", reference.message
     rng = np.random.default_rng(7)
-    statuses = []
+    statuses, apart = [], []
     for mm in (10, 20, 40, 60, 80, 100, 120):
         prior = _hand_prior()
         d, axis = rng.normal(size=3), rng.normal(size=3)
@@ -35,8 +39,10 @@ def test_no_prior_from_10_to_120_mm_off_gives_an_ok_on_the_printed_box():
         statuses.append(located.status)
         if located.status == "uncertain":
             assert located.extra["starts_apart_px"] > 2.0 and "px away in the image" in located.message
-    assert "ok" not in statuses, statuses
-    assert statuses.count("uncertain") >= 5, statuses
+        if located.status == "ok":
+            apart.append(image_distance_px(reference.obj2cam, located.obj2cam, mesh, TUTORIAL_CAMERA))
+    assert statuses.count("ok") >= 3, statuses  # the box is found from most priors, not merely refused
+    assert max(apart) < 3.0 * reference.edge_rms_px, (statuses, apart)
 
 
 def test_two_poses_apart_only_in_a_hidden_corner_are_close_in_the_image():
