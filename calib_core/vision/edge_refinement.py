@@ -104,14 +104,15 @@ def _segment_keys(seg: np.ndarray) -> list[bytes]:
     return [(e[::-1] if f else e).tobytes() for e, f in zip(ends, flip)]
 
 
-def visible_segments(mesh, obj2cam: np.ndarray) -> np.ndarray:
+def visible_segments(mesh, obj2cam: np.ndarray, silhouette: np.ndarray | None = None) -> np.ndarray:
     """The crease edges with a face turned to the camera and the silhouette, each once: (E, 2, 3) mm
-    (a crease on the occluding contour is both; sampled twice, its samples would count double)."""
+    (a crease on the occluding contour is both; sampled twice, its samples would count double).
+    ``silhouette``: :func:`silhouette_segments` from this pose's camera, when the caller has them."""
     seg, normals = crease_segments(mesh)
     centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
     facing = np.einsum("eij,ej->ei", normals, centre - seg.mean(axis=1)) > 0
     seg = seg[facing.any(axis=1)]
-    silhouette = silhouette_segments(mesh, centre)
+    silhouette = silhouette_segments(mesh, centre) if silhouette is None else silhouette
     if len(silhouette):
         known = set(_segment_keys(seg)) if len(seg) else set()
         new = np.array([k not in known for k in _segment_keys(silhouette)], dtype=bool)
@@ -185,9 +186,10 @@ class EdgeSamples:
 
 def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None) -> EdgeSamples:
     """The samples of :func:`edge_points`, with which of them lie on the outline (:class:`EdgeSamples`)."""
-    pts, far, clearance, chain = _crease_points(mesh, obj2cam, intrinsics, expected_magnitude)
+    rims = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3])
+    pts, far, clearance, chain = _crease_points(mesh, obj2cam, intrinsics, expected_magnitude, rims)
     silhouette = silhouette_mask(mesh, obj2cam, intrinsics)
-    outline = outline_samples(mesh, obj2cam, intrinsics, _SAMPLE_STEP_PX, silhouette=silhouette)
+    outline = outline_samples(mesh, obj2cam, intrinsics, _SAMPLE_STEP_PX, silhouette=silhouette, rims=rims)
     added = 0
     if len(outline):
         uv = project_points(outline.points_mm, obj2cam, intrinsics)
@@ -232,9 +234,9 @@ def _outward(pts: np.ndarray, far: np.ndarray, obj2cam: np.ndarray, intrinsics: 
     return np.where(minus & ~plus, 1, np.where(plus & ~minus, -1, 0))
 
 
-def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None):
-    """:func:`edge_points` along the mesh's own crease and silhouette edges."""
-    seg = visible_segments(mesh, obj2cam)
+def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None, rims: np.ndarray | None = None):
+    """:func:`edge_points` along the mesh's own crease and silhouette edges (``rims``: the silhouette's, when known)."""
+    seg = visible_segments(mesh, obj2cam, rims)
     if len(seg) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
@@ -303,7 +305,7 @@ CREASES_AGREE_PX = 0.75
 MIN_REGION_SEPARATION = 0.2
 """The least :attr:`~calib_core.vision.region_model.RegionModel.separation` at which the outline is found by
 colour: below it the object's colours are too much its surroundings' to tell the two apart."""
-_RESAMPLE = (0.5, 1.0)
+_RESAMPLE = (1.0, 2.0)
 """(deg, mm): a fit with contour samples takes them again once it has turned or moved this far from where they
 were taken."""
 

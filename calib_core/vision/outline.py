@@ -24,6 +24,7 @@ from calib_core.camera.projection import project_points
 NEAR_MM = 1.0
 """Faces with a vertex nearer the camera than this (or behind it) are not filled in."""
 _RIM_STEP_PX = 1.0
+_SMALL_FACE_PX2 = 2.0
 _MATCH_PX = 2.5
 _BORDER_PX = 3.0
 CHAIN_SAMPLES = 12
@@ -71,20 +72,29 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
     lo = np.maximum(lo, 0)
     hi = np.minimum(hi, [intrinsics.width, intrinsics.height])
     mask = np.zeros((max(hi[1] - lo[1], 1), max(hi[0] - lo[0], 1)), np.uint8)
-    # one convex fill a face: a single fillPoly of many polygons fills by the even-odd rule, and overlapping
-    # facets would cancel out; sub-pixel vertices (4 fractional bits) keep thin facets
-    fixed = np.round((tri - lo) * 16.0).astype(np.int32)
-    for f in fixed:
+    # One convex fill a face (a single fillPoly of many polygons fills by the even-odd rule, and overlapping facets
+    # would cancel out), with sub-pixel vertices (4 fractional bits) to keep thin facets. A scanned mesh's facets
+    # are mostly under a pixel: those are set as their corners' pixels and the gaps closed (3 x 3), 20 ms less a
+    # mask for a 20k-face mesh; the outline's samples take their places from the rim edges, not from the mask.
+    edge_a, edge_b = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = 0.5 * np.abs(edge_a[:, 0] * edge_b[:, 1] - edge_a[:, 1] * edge_b[:, 0])
+    large = area >= _SMALL_FACE_PX2
+    for f in np.round((tri[large] - lo) * 16.0).astype(np.int32):
         cv2.fillConvexPoly(mask, f, 255, lineType=cv2.LINE_8, shift=4)
+    if not large.all():
+        corners = np.rint(tri[~large].reshape(-1, 2) - lo).astype(int)
+        corners = corners[(corners[:, 0] >= 0) & (corners[:, 0] < mask.shape[1]) & (corners[:, 1] >= 0) & (corners[:, 1] < mask.shape[0])]
+        mask[corners[:, 1], corners[:, 0]] = 255
+        mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
     return mask, (int(lo[0]), int(lo[1]))
 
 
-def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
-    """Points (k, 3) mm along the rim edges, about a pixel apart in the image, and their pixels (k, 2)."""
+def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Points (k, 3) mm along the rim edges (``rims`` (E, 2, 3) when the caller has them), about a pixel apart in
+    the image, and their pixels (k, 2)."""
     from calib_core.vision.edge_refinement import silhouette_segments
 
-    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
-    seg = silhouette_segments(mesh, centre)
+    seg = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3]) if rims is None else rims
     if not len(seg):
         return np.zeros((0, 3)), np.zeros((0, 2))
     z = seg @ obj2cam[2, :3] + obj2cam[2, 3]
@@ -99,15 +109,15 @@ def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.n
     return points, project_points(points, obj2cam, intrinsics)
 
 
-def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0, silhouette=None) -> Outline:
+def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0, silhouette=None, rims: np.ndarray | None = None) -> Outline:
     """Samples every ``step_px`` along the outer boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
     mesh's frame to the camera's, mm), each on the rim edge nearest its boundary pixel (within 2.5 px); none
     where the image's border cuts the silhouette (the border is not the object's edge). ``silhouette``: the
-    :func:`silhouette_mask` at that pose, when the caller has it."""
+    :func:`silhouette_mask` at that pose, and ``rims`` its rim edges (E, 2, 3), when the caller has them."""
     mask, (u0, v0) = silhouette_mask(mesh, obj2cam, intrinsics) if silhouette is None else silhouette
     if mask.size == 0 or not mask.any():
         return Outline.empty()
-    rim, rim_px = _rim_points(mesh, obj2cam, intrinsics)
+    rim, rim_px = _rim_points(mesh, obj2cam, intrinsics, rims)
     if not len(rim):
         return Outline.empty()
     tree = cKDTree(rim_px)
