@@ -93,7 +93,7 @@ def second_writer_handshake() -> dict:
             with ControllerLink(sim.url, rate_hz=50) as link:
                 link.wait_for_samples(3, 5.0)
                 intruder = serial.serial_for_url(sim.url, timeout=0.05)
-                intruder.write(encode("HEL,0123456789abcdef"))
+                intruder.write(encode("HEL,0123456789abcdef," + "0" * 32))  # a hello without the key
                 intruder.write(encode("AUT," + "0" * 32))
                 time.sleep(0.3)
                 intruder.close()

@@ -39,6 +39,10 @@ from calib_core.link.protocol import (
 )
 
 MAX_STREAM_HZ = 250.0
+REFUSALS_PER_S = 10
+"""Refusals answered a second at most; the rest are counted (``refusals_unanswered``) and not answered."""
+SEEN_HELLOS = 16
+"""How many of the workstation's latest hello nonces are remembered: a hello seen again is a replay, not answered."""
 
 
 class ControllerLogic:
@@ -48,11 +52,12 @@ class ControllerLogic:
     ``report_joints`` maps the true joint state to what the encoders report (identity by
     default; the test bed reports commanded joints, which is what a real controller does).
 
-    ``key`` (32 bytes): the link's pre-shared key. With one, the controller speaks protocol 4 and
-    obeys a motion sentence and a heartbeat only when sealed in the current session
-    (:mod:`calib_core.link.auth`);
-    every refusal is answered ``ERR,AUTH`` and kept in ``auth_refusals`` (and passed to ``on_refusal``).
-    Without one it is a protocol-3 controller: any client's ``MVJ`` moves it.
+    ``key`` (32 bytes): the link's pre-shared key. With one, the controller speaks protocol 6 and
+    obeys a motion sentence and a heartbeat only when sealed in the current session and sealed recently
+    (:mod:`calib_core.link.auth`); it answers only hellos from the key's holder, and the dead-man counts by the
+    heartbeats' sealed times. Every refusal is kept in ``auth_refusals`` (and passed to ``on_refusal``) and answered
+    ``ERR,AUTH``, at most :data:`REFUSALS_PER_S` a second (a flood of forged sentences must not fill the line the
+    workstation's replies travel on). Without a key it is a protocol-3 controller: any client's ``MVJ`` moves it.
     """
 
     def __init__(self, joint_model: JointModel | None = None, initial_deg=None, clock: Callable[[], float] = time.monotonic, seq_start: int = 0,
@@ -74,6 +79,9 @@ class ControllerLogic:
         self.key = key
         self.on_refusal = on_refusal
         self.auth_refusals: list[str] = []
+        self.refusals_unanswered = 0
+        self._refusal_window = (0.0, 0)  # (start s, refusals answered in it)
+        self._seen_hellos: list[str] = []
         self.end_session()
 
     @property
@@ -83,12 +91,18 @@ class ControllerLogic:
 
     def end_session(self) -> None:
         """Forget the authenticated session (the workstation went away or opened a new one)."""
-        self._hello: tuple[str, str] | None = None  # (workstation nonce, controller nonce) offered
+        self._hello: tuple[str, str, float] | None = None  # (workstation nonce, controller nonce, when) offered
         self._session: bytes | None = None
         self._last_counter = 0
+        self.fresh_ms = auth.FRESH_MIN_MS
+        self._seal_t_ms: int | None = None
+
+    def clock_ms(self, t: float | None = None) -> int:
+        """The controller's clock, ms since start-up (what its samples and the seals are stamped with)."""
+        return int(round(((self.clock() if t is None else t) - self.t_start) * 1000.0))
 
     def _sample(self) -> JointSample:
-        sample = JointSample(self.seq, int(round((self.clock() - self.t_start) * 1000.0)), tuple(float(q) for q in self.joints_deg))
+        sample = JointSample(self.seq, self.clock_ms(), tuple(float(q) for q in self.joints_deg))
         self.seq = (self.seq + 1) % SEQ_MODULUS
         return sample
 
@@ -134,9 +148,9 @@ class ControllerLogic:
         elif isinstance(msg, RequestVersion):
             out.append(VersionReport(PROTOCOL_VERSION if self.key is not None else 3, len(self.joints_deg)))
         elif isinstance(msg, Hello | Authenticate) and self.key is not None:
-            out.append(self._handshake(msg))
-        elif isinstance(msg, MoveJoints) and self.key is not None and (why := self._seal_problem(inner, sealed)):
-            out.append(self._refuse(f"move {msg.id}: not obeyed: {why}"))
+            out += self._handshake(msg, now)
+        elif isinstance(msg, MoveJoints) and self.key is not None and (why := self._seal_problem(inner, sealed, now)):
+            out += self._refuse(f"move {msg.id}: not obeyed: {why}", now)
         elif isinstance(msg, MoveJoints):
             goal = np.asarray(msg.joints_deg, dtype=float)
             lo, hi = np.asarray(self.model.lower_limits_deg), np.asarray(self.model.upper_limits_deg)
@@ -157,12 +171,14 @@ class ControllerLogic:
         elif isinstance(msg, Stop):
             out += self._halt(now, "STOPPED", "stopped by the workstation")
             out.append(Ack("STP", "-"))
-        elif isinstance(msg, Heartbeat) and self.key is not None and (why := self._seal_problem(inner, sealed)):
+        elif isinstance(msg, Heartbeat) and self.key is not None and (why := self._seal_problem(inner, sealed, now)):
             # only the authenticated workstation keeps a move running or disarms the dead-man
-            out.append(self._refuse(f"heartbeat: not obeyed: {why}"))
+            out += self._refuse(f"heartbeat: not obeyed: {why}", now)
         elif isinstance(msg, Heartbeat):
             self.deadman_s = msg.timeout_ms / 1000.0
-            self._last_heartbeat_t = now
+            # the dead-man counts from when the heartbeat was sealed, not from when it arrived: one held back on the
+            # way feeds it only for what is left of its time
+            self._last_heartbeat_t = now if self.key is None else min(now, self.t_start + self._seal_t_ms / 1000.0)
         elif isinstance(msg, RequestState):
             state = "MOVING" if self.move is not None else "IDLE"
             out.append(StateReport(state, f"stream {self.stream_hz:g} Hz"))
@@ -172,31 +188,46 @@ class ControllerLogic:
             out.append(ErrorReply("UNEXPECTED", f"{type(msg).__name__} is sent by a controller; not accepted"))
         return out
 
-    def _refuse(self, text: str) -> ErrorReply:
+    def _refuse(self, text: str, now: float) -> list[ErrorReply]:
+        """The refusal's reply, or none past :data:`REFUSALS_PER_S` this second (it is still counted)."""
         self.auth_refusals.append(text)
         if self.on_refusal is not None:
             self.on_refusal(text)
-        return ErrorReply("AUTH", text)
+        start, answered = self._refusal_window
+        if now - start >= 1.0:
+            start, answered = now, 0
+        if answered >= REFUSALS_PER_S:
+            self.refusals_unanswered += 1
+            self._refusal_window = (start, answered)
+            return []
+        self._refusal_window = (start, answered + 1)
+        return [ErrorReply("AUTH", text)]
 
-    def _handshake(self, msg) -> HelloReply | Ack | ErrorReply:
+    def _handshake(self, msg, now: float) -> list:
         if isinstance(msg, Hello):
-            # The session in force stays until a new handshake completes: a hello from a process
-            # without the key (a second writer on the line) cannot end the workstation's session.
-            controller_nonce = auth.new_nonce()
-            self._hello = (msg.nonce, controller_nonce)
-            return HelloReply(controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce))
+            if not auth.proof_is_valid(auth.hello_request(self.key, msg.nonce), msg.request):
+                # not from the key's holder: answered (rate-limited) and forgotten; the offer in force stays
+                return self._refuse(f"hello {msg.nonce}: wrong request: the workstation does not hold this controller's link key", now)
+            if msg.nonce in self._seen_hellos:
+                return []  # a hello of the key's holder seen before: replayed from a capture
+            self._seen_hellos = (self._seen_hellos + [msg.nonce])[-SEEN_HELLOS:]
+            # The session in force stays until a new handshake completes.
+            controller_nonce, clock_ms = auth.new_nonce(), self.clock_ms(now)
+            self._hello = (msg.nonce, controller_nonce, now)
+            return [HelloReply(controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce, clock_ms), clock_ms)]
         if self._hello is None:
-            return self._refuse("auth: AUT without a HEL first")
-        ws_nonce, controller_nonce = self._hello
+            return self._refuse("auth: AUT without a HEL first", now)
+        ws_nonce, controller_nonce, offered = self._hello
         self._hello = None  # one try per hello
         if not auth.proof_is_valid(auth.workstation_proof(self.key, ws_nonce, controller_nonce), msg.proof):
-            return self._refuse("auth: wrong proof: the workstation does not hold this controller's link key")
+            return self._refuse("auth: wrong proof: the workstation does not hold this controller's link key", now)
         self._session = auth.session_key(self.key, ws_nonce, controller_nonce)
         self._last_counter = 0
-        return Ack("AUT", "-")
+        self.fresh_ms = auth.freshness_bound_ms(1000.0 * (now - offered))
+        return [Ack("AUT", "-")]
 
-    def _seal_problem(self, inner: str, sealed: auth.Seal | None) -> str | None:
-        """Why a motion sentence is not to be obeyed (``None``: it is sealed in this session)."""
+    def _seal_problem(self, inner: str, sealed: auth.Seal | None, now: float) -> str | None:
+        """Why a motion sentence is not to be obeyed (``None``: it is sealed in this session, recently)."""
         if self._session is None:
             return "no authenticated session (send HEL and AUT first)"
         if sealed is None:
@@ -205,7 +236,10 @@ class ControllerLogic:
             return "wrong seal (altered, or sealed in another session)"
         if sealed.counter <= self._last_counter:
             return f"counter {sealed.counter} not above {self._last_counter} (a replayed sentence)"
+        if (stale := auth.staleness(sealed, self.clock_ms(now), self.fresh_ms)) is not None:
+            return stale
         self._last_counter = sealed.counter
+        self._seal_t_ms = sealed.t_ms
         return None
 
     def tick(self) -> list:

@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-PROTOCOL_VERSION = 5
+PROTOCOL_VERSION = 6
 # Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences; version 4
-# adds a 45-byte seal to motion sentences (16 joints of 1e6 still fit).
+# adds a seal to motion sentences, 56 bytes with version 6's time (16 joints of 1e6 still fit).
 MAX_SENTENCE_BYTES = 320
 MAX_JOINTS = 16
 SEQ_MODULUS = 2**32
@@ -163,23 +163,27 @@ class Heartbeat:
 
 @dataclass(frozen=True)
 class Hello:
-    """``$HEL,<nonce>``: the workstation opens an authenticated session (protocol 4)."""
+    """``$HEL,<nonce>,<request>``: the workstation opens an authenticated session; ``request`` proves it holds the
+    key (protocol 6; :func:`calib_core.link.auth.hello_request`)."""
 
     nonce: str
+    request: str
 
     def body(self) -> str:
-        return f"HEL,{self.nonce}"
+        return f"HEL,{self.nonce},{self.request}"
 
 
 @dataclass(frozen=True)
 class HelloReply:
-    """``$HEL,<nonce>,<proof>``: the controller's nonce and its proof that it holds the key."""
+    """``$HEL,<nonce>,<proof>,<clock_ms>``: the controller's nonce, its clock (ms) and its proof that it holds the
+    key (protocol 6)."""
 
     nonce: str
     proof: str
+    clock_ms: int
 
     def body(self) -> str:
-        return f"HEL,{self.nonce},{self.proof}"
+        return f"HEL,{self.nonce},{self.proof},{self.clock_ms}"
 
 
 @dataclass(frozen=True)
@@ -257,6 +261,12 @@ def _hex(text: str, what: str) -> str:
     return text
 
 
+def _clock_ms(text: str) -> int:
+    if not 1 <= len(text) <= 10 or not text.isdigit():
+        raise ProtocolError("malformed", f"HEL clock: not 1 to 10 decimal digits: {text!r}")
+    return int(text)
+
+
 def parse_body(body: str) -> Message:
     """The message of a sentence body (checksum already verified); :class:`ProtocolError` if invalid."""
     fields = body.split(",")
@@ -283,10 +293,10 @@ def parse_body(body: str) -> Message:
         return RequestVersion()
     if kind == "VER" and n == 3:
         return VersionReport(_integer(fields[1], "VER version"), _integer(fields[2], "VER n_joints"))
-    if kind == "HEL" and n == 2:
-        return Hello(_hex(fields[1], "HEL nonce"))
     if kind == "HEL" and n == 3:
-        return HelloReply(_hex(fields[1], "HEL nonce"), _hex(fields[2], "HEL proof"))
+        return Hello(_hex(fields[1], "HEL nonce"), _hex(fields[2], "HEL request"))
+    if kind == "HEL" and n == 4:
+        return HelloReply(_hex(fields[1], "HEL nonce"), _hex(fields[2], "HEL proof"), _clock_ms(fields[3]))
     if kind == "AUT" and n == 2:
         return Authenticate(_hex(fields[1], "AUT proof"))
     if kind == "RQJ" and n == 1:

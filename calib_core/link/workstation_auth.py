@@ -1,8 +1,9 @@
-"""The workstation's side of the link's session authentication (protocol 4, :mod:`calib_core.link.auth`).
+"""The workstation's side of the link's session authentication (protocol 6, :mod:`calib_core.link.auth`).
 
 The driver calls :meth:`WorkstationAuth.hello` on every (re)connection, hands it the controller's
-``HEL``, ``ACK,AUT`` and ``ERR`` replies, and seals motion sentences with :meth:`seal`. The state says
-whether the robot may be moved now, and :attr:`failure` why not.
+``HEL``, ``ACK,AUT`` and ``ERR`` replies, and seals motion sentences with :meth:`seal`, each with the time it was
+sealed on the controller's clock (read at the handshake). The state says whether the robot may be moved now, and
+:attr:`failure` why not.
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ class WorkstationAuth:
         self.state = AuthState.OFF if key is None else AuthState.PENDING
         self.failure: str | None = None
         self.sessions = 0
+        self.forged_replies = 0
+        """Hello replies whose proof held for no hello of ours (another writer's, or forged): ignored."""
         self._nonce: str | None = None
         self._session: bytes | None = None
         self._counter = 0
@@ -63,6 +66,7 @@ class WorkstationAuth:
         self._attempts = 0
         self._earlier: dict[str, float] = {}  # the nonces of this series' earlier hellos: when each was sent
         self._aut_sent_s: float | None = None
+        self._clock_offset_ms = 0.0  # the controller's clock minus this host's monotonic clock, ms
 
     def _set(self, state: AuthState, failure: str | None = None) -> None:
         with self._changed:
@@ -82,25 +86,30 @@ class WorkstationAuth:
         self._sent_s = time.monotonic()
         self._aut_sent_s = None
         self._set(AuthState.PENDING)
-        return Hello(self._nonce).body()
+        return Hello(self._nonce, auth.hello_request(self._key, self._nonce)).body()
 
     def on_hello_reply(self, msg: HelloReply) -> str | None:
-        """The ``AUT`` body answering the controller's ``HEL`` (``None``: the controller is not to be trusted)."""
+        """The ``AUT`` body answering the controller's ``HEL`` (``None``: not an answer to this hello). A reply whose
+        proof does not hold for this hello is ignored, not a failure: anyone on the line can send one (a controller
+        with another key refuses the hello itself, and :meth:`on_error` says so)."""
         if self._key is None or self.state is not AuthState.PENDING or self._nonce is None:
             return None
         now = time.monotonic()
-        if auth.is_nonce(msg.nonce):
-            for nonce, sent_s in self._earlier.items():
-                if auth.proof_is_valid(auth.controller_proof(self._key, nonce, msg.nonce), msg.proof):
-                    # A late answer to an earlier hello: the controller holds the key and is far away; the
-                    # newest hello is the one it will take an AUT for. Wait for that answer a round trip longer.
-                    self.round_trip.add(now - sent_s)
-                    return None
-        if not auth.is_nonce(msg.nonce) or not auth.proof_is_valid(auth.controller_proof(self._key, self._nonce, msg.nonce), msg.proof):
-            self._set(AuthState.FAILED, f"the controller does not hold {self._key_name}: its proof is wrong (another key installed?); the robot is not moved")
+        if not auth.is_nonce(msg.nonce):
+            return None
+        for nonce, sent_s in self._earlier.items():
+            if auth.proof_is_valid(auth.controller_proof(self._key, nonce, msg.nonce, msg.clock_ms), msg.proof):
+                # A late answer to an earlier hello: the controller holds the key and is far away; the
+                # newest hello is the one it will take an AUT for. Wait for that answer a round trip longer.
+                self.round_trip.add(now - sent_s)
+                return None
+        if not auth.proof_is_valid(auth.controller_proof(self._key, self._nonce, msg.nonce, msg.clock_ms), msg.proof):
+            self.forged_replies += 1
             return None
         if not self._earlier:  # Karn's rule: the answer to a hello sent once times the round trip
             self.round_trip.add(now - self._sent_s)
+        # the controller read its clock between our hello and this answer: at their midpoint, to within half the trip
+        self._clock_offset_ms = msg.clock_ms - 500.0 * (self._sent_s + now)
         self._session = auth.session_key(self._key, self._nonce, msg.nonce)
         self._aut_sent_s = now
         return Authenticate(auth.workstation_proof(self._key, self._nonce, msg.nonce)).body()
@@ -117,19 +126,29 @@ class WorkstationAuth:
         """An ``ERR`` about the handshake (True: it was one)."""
         if self._key is None:
             return False
+        if msg.code == "AUTH" and msg.text.startswith("hello "):
+            # the controller refused a hello: ours only if it names our nonce (a flood of others' is not our failure)
+            if self.state is AuthState.PENDING and self._nonce is not None and msg.text.startswith(f"hello {self._nonce}:"):
+                self._set(AuthState.FAILED, f"the controller does not hold {self._key_name}: it refused our hello (another key installed?); "
+                                            "the robot is not moved")
+            return True
         if msg.code == "AUTH" and msg.text.startswith("auth:") and self.state is AuthState.PENDING:
             # (in a session, an "auth:" refusal answers another writer's handshake on the line, not ours)
             self._set(AuthState.FAILED, f"the controller refused {self._key_name} ({msg.text}); the robot is not moved")
             return True
         if self.state is AuthState.PENDING and not msg.text.startswith("move ") and ("HEL" in msg.text or "AUT" in msg.text):
-            self._set(AuthState.FAILED, f"the controller does not authenticate (it answered {msg.code}: {msg.text}): videocal moves only a controller that "
-                                        "holds the link key; install the controller program (resources/controller/videocal_link.pdl) with `videocal link-key`'s key")
+            self._set(AuthState.FAILED, f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): videocal moves only a "
+                                        "controller that holds the link key; install the controller program (resources/controller/videocal_link.pdl, protocol 6) "
+                                        "with `videocal link-key`'s key")
             return True
         return False
 
     def lost_session(self, msg: ErrorReply) -> bool:
-        """A move refused for want of a session (the controller restarted): time for a new hello."""
-        return self._key is not None and msg.code == "AUTH" and "no authenticated session" in msg.text
+        """A move refused for want of a session (the controller restarted), or for its time (the clocks have drifted
+        apart, or the link held it back): time for a new hello, which reads the controller's clock again. The move
+        itself is not sent again."""
+        return self._key is not None and msg.code == "AUTH" and ("no authenticated session" in msg.text or "stale:" in msg.text
+                                                                 or "ahead of the controller clock" in msg.text)
 
     def _try_wait_s(self) -> float:
         """How long the current try waits for its answer (s): doubling per try, at least the round trip's
@@ -160,7 +179,11 @@ class WorkstationAuth:
         if self._session is None:
             raise RuntimeError("no session to seal in")
         self._counter += 1
-        return auth.seal(self._session, self._counter, body)
+        return auth.seal(self._session, self._counter, self.controller_clock_ms(), body)
+
+    def controller_clock_ms(self, now_s: float | None = None) -> int:
+        """Now on the controller's clock (ms), as read at the handshake."""
+        return max(0, int(round(1000.0 * (time.monotonic() if now_s is None else now_s) + self._clock_offset_ms)))
 
     @property
     def why_not(self) -> str:

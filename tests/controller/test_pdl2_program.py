@@ -197,12 +197,22 @@ class _ProgramBySentence:
         return [parse_body(s[1:s.index("*")]) for s in self.sent]
 
 
-def _session(program: _ProgramBySentence):
+def _session(program: _ProgramBySentence, round_trip_ms: int = 0):
+    """A session opened by the key's holder (its answer ``round_trip_ms`` after the hello); a function that seals a
+    body at the program's clock now (or at ``t_ms``) and hands it over."""
     nonce = auth.new_nonce()
-    (reply,) = program.handle(f"HEL,{nonce}")
+    (reply,) = program.handle(f"HEL,{nonce},{auth.hello_request(KEY, nonce)}")
+    assert reply.proof == auth.controller_proof(KEY, nonce, reply.nonce, reply.clock_ms) and reply.clock_ms == program.t_ms
+    program.t_ms += round_trip_ms
     assert program.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}")[0].body() == "ACK,AUT,-"
     counter = iter(range(1, 10**6))
-    return lambda body: program.handle(auth.seal(auth.session_key(KEY, nonce, reply.nonce), next(counter), body))
+    session = auth.session_key(KEY, nonce, reply.nonce)
+
+    def sealed(body: str, t_ms: int | None = None, deliver: bool = True):
+        text = auth.seal(session, next(counter), program.t_ms if t_ms is None else t_ms, body)
+        return program.handle(text) if deliver else text
+
+    return sealed
 
 
 def test_it_believes_only_the_workstations_sealed_heartbeat():
@@ -222,6 +232,50 @@ def test_it_believes_only_the_workstations_sealed_heartbeat():
 def test_a_hello_without_the_key_leaves_the_session_in_force():
     p = _ProgramBySentence()
     sealed = _session(p)
-    p.handle(f"HEL,{auth.new_nonce()}")  # a second writer
-    assert p.handle("AUT," + "0" * 32)[0].text.startswith("auth: wrong proof")
+    stranger = auth.new_nonce()
+    (refused,) = p.handle(f"HEL,{stranger},{'0' * 32}")  # a second writer, without the key
+    assert refused.code == "AUTH" and refused.text.startswith(f"hello {stranger}: wrong request")
+    assert p.handle("AUT," + "0" * 32)[0].text.startswith("auth: AUT without a HEL first")
+    assert sealed("MVJ,a.1,10,0,0,0,0,0")[0].body() == "ACK,MVJ,a.1"
+
+
+def test_it_refuses_a_move_held_back_and_released_after_the_workstation_died():
+    """As the simulator (tests/core/link/test_link_attacks.py): seals carry the time; the program's bound is twice
+    the handshake's round trip and half a second, at least 1 s."""
+    for held_ms, round_trip_ms, obeyed in ((8000, 0, False), (20000, 0, False), (900, 0, True), (3000, 2000, True), (5000, 2000, False)):
+        p = _ProgramBySentence()
+        sealed = _session(p, round_trip_ms)
+        assert sealed("HBT,60000") == []
+        move = sealed("MVJ,a.1,90,0,0,0,0,0", deliver=False)
+        p.t_ms += held_ms
+        replies = p.handle(move)
+        if obeyed:
+            assert replies[0].body() == "ACK,MVJ,a.1", (held_ms, round_trip_ms, replies)
+        else:
+            assert replies[0].code == "AUTH" and "stale: sealed" in replies[0].text and not p.moving, (held_ms, replies)
+
+
+def test_its_dead_man_counts_from_when_the_heartbeat_was_sealed():
+    p = _ProgramBySentence()
+    sealed = _session(p)
+    assert sealed("HBT,1000") == []
+    assert sealed("MVJ,a.1,160,0,0,0,0,0")[0].body() == "ACK,MVJ,a.1"
+    late = sealed("HBT,1000", deliver=False)
+    p.t_ms += 800
+    assert p.handle(late) == []  # sealed 0.8 s ago: it feeds the dead-man for 0.2 s
+    p.t_ms += 250
+    (halted,) = p.tick()
+    assert halted.code == "DEADMAN" and not p.moving
+
+
+def test_it_answers_a_flood_of_forged_sentences_at_most_ten_times_a_second_and_a_replayed_hello_never():
+    p = _ProgramBySentence()
+    sealed = _session(p)
+    answered = sum(len(p.handle("HBT,60000")) for _ in range(200))  # 200 within the same millisecond
+    assert answered == 10
+    p.t_ms += 1000
+    assert len(p.handle("HBT,60000")) == 1  # a new second
+    nonce = auth.new_nonce()
+    hello = f"HEL,{nonce},{auth.hello_request(KEY, nonce)}"
+    assert len(p.handle(hello)) == 1 and p.handle(hello) == []
     assert sealed("MVJ,a.1,10,0,0,0,0,0")[0].body() == "ACK,MVJ,a.1"

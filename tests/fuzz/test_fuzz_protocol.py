@@ -20,13 +20,14 @@ bodies = st.one_of(
     st.builds(lambda k, rest: k + rest, st.sampled_from(KINDS), st.text(BODY_CHARS, max_size=200)),
     st.builds(lambda k, fields: ",".join([k, *fields]), st.sampled_from(KINDS),
               st.lists(st.one_of(st.text(BODY_CHARS.filter(lambda c: c != ","), max_size=40), st.floats().map(str),
-                                 st.integers().map(str), st.from_regex(r"#[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True)), max_size=20)),
+                                 st.integers().map(str), st.from_regex(r"#[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True),
+                                 st.from_regex(r"#[0-9]{1,11}:[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True)), max_size=20)),
 )
 
 
 def _session(logic: ControllerLogic) -> bytes:
     wn = auth.new_nonce()
-    (reply,) = logic.handle(f"HEL,{wn}")
+    (reply,) = logic.handle(f"HEL,{wn},{auth.hello_request(KEY, wn)}")
     logic.handle(f"AUT,{auth.workstation_proof(KEY, wn, reply.nonce)}")
     return auth.session_key(KEY, wn, reply.nonce)
 
@@ -47,7 +48,7 @@ def test_no_unsealed_body_moves_a_keyed_controller(sequence):
 def test_any_altered_character_of_a_sealed_move_is_refused(position, char):
     logic = ControllerLogic(key=KEY)
     session = _session(logic)
-    sealed = auth.seal(session, 1, "MVJ,m1.1,10.0000,-20.0000,30.0000,0.0000,5.5000,-1.0000")
+    sealed = auth.seal(session, 1, logic.clock_ms(), "MVJ,m1.1,10.0000,-20.0000,30.0000,0.0000,5.5000,-1.0000")
     i = position % len(sealed)
     altered = sealed[:i] + char + sealed[i + 1:]
     replies = logic.handle(altered)

@@ -42,13 +42,18 @@ class _Workstation:
     def __init__(self, controller: ControllerLogic):
         self.c = controller
         nonce = auth.new_nonce()
-        (reply,) = controller.handle(f"HEL,{nonce}")
+        (reply,) = controller.handle(f"HEL,{nonce},{auth.hello_request(KEY, nonce)}")
+        assert reply.proof == auth.controller_proof(KEY, nonce, reply.nonce, reply.clock_ms)
         assert controller.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}") == [Ack("AUT", "-")]
         self.session, self.counter = auth.session_key(KEY, nonce, reply.nonce), 0
 
-    def sealed(self, body: str) -> list:
+    def seal(self, body: str, t_ms: int | None = None) -> str:
+        """``body`` sealed now on the controller's clock (or at ``t_ms``)."""
         self.counter += 1
-        return self.c.handle(auth.seal(self.session, self.counter, body))
+        return auth.seal(self.session, self.counter, self.c.clock_ms() if t_ms is None else t_ms, body)
+
+    def sealed(self, body: str) -> list:
+        return self.c.handle(self.seal(body))
 
 
 def test_an_unsealed_heartbeat_neither_keeps_a_move_running_nor_disarms_the_dead_man():
@@ -73,9 +78,10 @@ def test_an_unsealed_heartbeat_neither_keeps_a_move_running_nor_disarms_the_dead
 def test_a_hello_without_the_key_does_not_end_the_workstations_session():
     c = ControllerLogic(clock=_Clock(), key=KEY)
     ws = _Workstation(c)
-    (reply,) = c.handle(f"HEL,{auth.new_nonce()}")  # a second writer on the line
-    assert reply.nonce and c.session_open
-    assert c.handle("AUT," + "0" * 32)[0].text.startswith("auth: wrong proof")
+    stranger = auth.new_nonce()
+    (reply,) = c.handle(f"HEL,{stranger},{'0' * 32}")  # a second writer on the line, without the key
+    assert reply.code == "AUTH" and reply.text.startswith(f"hello {stranger}: wrong request") and c.session_open
+    assert c.handle("AUT," + "0" * 32)[0].text.startswith("auth: AUT without a HEL first")  # no offer was made to it
     assert c.session_open and ws.sealed("MVJ,a.1,10,0,0,0,0,0") == [Ack("MVJ", "a.1")]
     ws2 = _Workstation(c)  # a complete handshake (the workstation again, after a restart) replaces it
     assert ws.sealed("STP")[-1] == Ack("STP", "-")
@@ -181,3 +187,155 @@ def test_a_keyless_tcp_client_does_not_lock_the_workstation_out(sim):  # noqa: F
             assert workstation.state is LinkState.UP
         squatter.settimeout(1.0)
         assert squatter.recv(4096) == b""  # it was let go when the workstation came
+
+
+def test_a_sealed_move_held_back_by_a_relay_and_released_after_the_workstation_died_is_refused():
+    """A keyless relay between the two passed heartbeats on late, withheld the first sealed move with the heartbeat
+    before it, and released both after the workstation had died (8 s, then 20 s). Version 5 obeyed: joint 1 moved
+    0 to 90 deg with nobody at the workstation. The seals now carry the time they were made."""
+    for held_s in (8.0, 20.0):
+        clock = _Clock()
+        c = ControllerLogic(clock=clock, key=KEY)
+        ws = _Workstation(c)
+        assert ws.sealed("HBT,1000") == []
+        heartbeat, move = ws.seal("HBT,1000"), ws.seal("MVJ,a.1,90,0,0,0,0,0")  # withheld by the relay
+        clock.t += 3.0 + held_s  # the workstation is killed 3 s later; the relay waits, then releases them
+        (late_heartbeat,) = c.handle(heartbeat)
+        assert late_heartbeat.code == "AUTH" and "stale: sealed" in late_heartbeat.text
+        (late_move,) = c.handle(move)
+        assert late_move.code == "AUTH" and "stale: sealed" in late_move.text and c.move is None
+        assert c.joints_deg[0] == 0.0
+        assert parse_body(late_move.body()) == late_move  # the refusal crosses the line whole (one ERR text field)
+
+
+def test_the_dead_man_counts_from_when_a_heartbeat_was_sealed_not_when_it_arrived():
+    clock = _Clock()
+    c = ControllerLogic(clock=clock, key=KEY)
+    ws = _Workstation(c)
+    assert ws.sealed("HBT,1000") == []
+    assert ws.sealed("MVJ,a.1,160,0,0,0,0,0") == [Ack("MVJ", "a.1")]
+    held = ws.seal("HBT,1000")  # sealed now, delivered 0.8 s late: it feeds the dead-man for 0.2 s, not 1 s
+    clock.t += 0.8
+    assert c.handle(held) == []
+    clock.t += 0.25
+    out = c.tick()
+    assert out and out[0].code == "DEADMAN" and c.move is None
+
+
+def test_a_move_released_after_the_dead_man_ran_out_is_refused_even_when_fresh_enough():
+    """A session whose handshake took 4 s (a far link) allows seals 8.5 s old; a move held back 3 s is within that,
+    but the last heartbeat's time has run out: the workstation is not there to stop it, and it is not started."""
+    clock = _Clock()
+    c = ControllerLogic(clock=clock, key=KEY)
+    nonce = auth.new_nonce()
+    (reply,) = c.handle(f"HEL,{nonce},{auth.hello_request(KEY, nonce)}")
+    clock.t += 4.0
+    assert c.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}") == [Ack("AUT", "-")] and c.fresh_ms == 8500
+    session = auth.session_key(KEY, nonce, reply.nonce)
+    assert c.handle(auth.seal(session, 1, c.clock_ms(), "HBT,1000")) == []
+    move = auth.seal(session, 2, c.clock_ms(), "MVJ,a.1,90,0,0,0,0,0")
+    clock.t += 3.0
+    (refused,) = c.handle(move)
+    assert refused.code == "DEADMAN" and c.move is None
+
+
+def test_a_flood_of_keyless_hellos_leaves_the_workstation_s_handshake_alone_and_is_answered_sparingly():
+    """A writer without the key sends a hello every 20 ms while the workstation connects (version 5 answered each,
+    and the workstation's answer to its own hello no longer matched: 3 of 6 connects failed). Now only the key's
+    holder is answered, the refusals at most 10 a second."""
+    from calib_core.link.controller_sim import REFUSALS_PER_S
+    from calib_core.link.workstation_auth import WorkstationAuth
+
+    clock = _Clock()
+    c = ControllerLogic(clock=clock, key=KEY)
+    ws = WorkstationAuth(KEY)
+    ours = ws.hello()
+    answers = []
+    for k in range(100):  # 2 s of flood, our hello in the middle of it
+        clock.t += 0.02
+        answers += c.handle(f"HEL,{auth.new_nonce()},{'0' * 32}")
+        if k == 50:
+            (reply,) = [r for r in c.handle(ours)]
+            aut = ws.on_hello_reply(reply)
+    assert all(isinstance(a, ErrorReply) and a.text.startswith("hello ") for a in answers)
+    assert len(answers) <= 3 * REFUSALS_PER_S and c.refusals_unanswered >= 100 - 3 * REFUSALS_PER_S
+    for a in answers:
+        assert ws.on_error(a) and ws.state is AuthState.PENDING  # others' refusals: not ours
+    assert c.handle(aut) == [Ack("AUT", "-")]
+    ws.on_accepted()
+    assert ws.state is AuthState.READY and c.session_open
+
+
+def test_a_replayed_hello_of_the_workstation_is_not_answered_again():
+    c = ControllerLogic(clock=_Clock(), key=KEY)
+    nonce = auth.new_nonce()
+    hello = f"HEL,{nonce},{auth.hello_request(KEY, nonce)}"
+    assert len(c.handle(hello)) == 1
+    assert c.handle(hello) == []  # from a capture: it opens nothing
+
+
+def test_a_flood_of_unsealed_heartbeats_is_counted_not_answered_beyond_ten_a_second():
+    clock = _Clock()
+    c = ControllerLogic(clock=clock, key=KEY)
+    ws = _Workstation(c)
+    replies = []
+    for _ in range(1000):  # 1 s of forged heartbeats every millisecond
+        clock.t += 0.001
+        replies += c.handle("HBT,60000")
+    assert 1 <= len(replies) <= 11 and len(c.auth_refusals) == 1000
+    assert ws.sealed("MVJ,a.1,10,0,0,0,0,0") == [Ack("MVJ", "a.1")]  # the workstation's move is obeyed at once
+
+
+_WORKSTATION_BEHIND_RELAY = textwrap.dedent("""
+    import sys
+    from calib_core.link.driver import ControllerLink
+    link = ControllerLink(sys.argv[1], rate_hz=20, deadman_ms=1000).start(wait_open=True)
+    assert link.wait_for_samples(3, 10.0), "no samples"
+    print("auth", link.auth_state.value, flush=True)
+    link.move_joints((90.0, 0, 0, 0, 0, 0), timeout_s=60)
+    print("sent", flush=True)
+    import time
+    time.sleep(60)
+""")
+
+
+@pytest.mark.parametrize("released_after_s", [8.0])
+def test_a_relay_releasing_a_withheld_move_after_the_workstation_died_moves_nothing(sim, released_after_s):  # noqa: F811
+    """Through the real simulator and the real driver (in a process of its own, killed): the relay passes heartbeats
+    200 ms late, withholds the first sealed move with the heartbeat before it, drops the rest; the workstation is
+    killed 3 s later and the relay releases the two 8 s after that."""
+    from tests.core.link.withholding_relay import WithholdingRelay
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    sim("--tcp", str(port), "--joints", "0,0,0,0,0,0", link=False)
+    relay = WithholdingRelay(port)
+    ws = subprocess.Popen([sys.executable, "-c", _WORKSTATION_BEHIND_RELAY, f"socket://127.0.0.1:{relay.port}"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert ws.stdout.readline().strip() == "auth ready"
+        assert ws.stdout.readline().strip() == "sent"
+        deadline = time.monotonic() + 10
+        while not relay.withheld and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert [b.split(",")[0] for b in relay.withheld] == ["HBT", "MVJ"]
+        time.sleep(3.0)
+        os.kill(ws.pid, signal.SIGKILL)
+        ws.wait(5)
+        time.sleep(released_after_s)
+        seen = len(relay.from_controller)
+        relay.release()
+        for _ in range(20):  # 2 s of asking for the joints
+            relay.ask("RQJ")
+            time.sleep(0.1)
+        replies = [parse_body(b) for b in relay.from_controller[seen:]]
+    finally:
+        if ws.poll() is None:
+            ws.kill()
+        ws.stdout.close()
+        relay.close()
+    refusals = [r for r in replies if isinstance(r, ErrorReply)]
+    assert any(r.code == "AUTH" and "stale: sealed" in r.text and r.text.startswith("move ") for r in refusals), refusals
+    assert not any(isinstance(r, Ack) and r.cmd == "MVJ" for r in replies)
+    samples = [r for r in replies if isinstance(r, JointSample)]
+    assert len(samples) >= 10 and all(abs(s.joints_deg[0]) < 1e-6 for s in samples)  # joint 1 never left 0 deg

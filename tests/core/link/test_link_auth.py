@@ -1,5 +1,6 @@
-"""Protocol 4: the session handshake on the pre-shared key and the seal on motion sentences, at the
-controller's logic, through the real simulator process, and the key file itself."""
+"""The session handshake on the pre-shared key and the seal on motion sentences (protocol 6: the hello proves the
+key, the controller's answer carries its clock, seals carry the time they were made), at the controller's logic,
+through the real simulator process, and the key file itself."""
 
 from __future__ import annotations
 
@@ -34,27 +35,43 @@ def _hmac_by_hand(key: bytes, text: str) -> str:
 
 def test_proofs_and_seals_are_rfc2104_hmacs_of_the_documented_texts():
     wn, cn = "0123456789abcdef", "fedcba9876543210"
-    assert auth.controller_proof(KEY, wn, cn) == _hmac_by_hand(KEY, f"videocal-hello|{wn}|{cn}")[:32]
+    assert auth.hello_request(KEY, wn) == _hmac_by_hand(KEY, f"videocal-request|{wn}")[:32]
+    assert auth.controller_proof(KEY, wn, cn, 123456) == _hmac_by_hand(KEY, f"videocal-hello|{wn}|{cn}|123456")[:32]
     assert auth.workstation_proof(KEY, wn, cn) == _hmac_by_hand(KEY, f"videocal-auth|{cn}|{wn}")[:32]
     session = auth.session_key(KEY, wn, cn)
     assert session.hex() == _hmac_by_hand(KEY, f"videocal-session|{wn}|{cn}")
     body = "MVJ,mab12.1,10.0000,0.0000,-5.2500"
-    sealed = auth.seal(session, 7, body)
-    assert sealed == f"{body},#7:{_hmac_by_hand(session, f'7|{body}')[:32]}"
+    sealed = auth.seal(session, 7, 98765, body)
+    assert sealed == f"{body},#7:98765:{_hmac_by_hand(session, f'7|98765|{body}')[:32]}"
     inner, s = auth.split_seal(sealed)
-    assert inner == body and s.counter == 7 and auth.seal_is_valid(session, inner, s)
+    assert inner == body and s.counter == 7 and s.t_ms == 98765 and auth.seal_is_valid(session, inner, s)
     assert not auth.seal_is_valid(session, body.replace("10.0000", "90.0000"), s)
+    assert not auth.seal_is_valid(session, inner, auth.Seal(7, 98766, s.mac))  # the time is sealed too
     assert auth.split_seal(body) == (body, None)
-    assert len(encode(auth.seal(session, 4_000_000_000, "MVJ,mffff.99999," + ",".join(["-999999.9999"] * 16)))) <= 320
+    assert len(encode(auth.seal(session, 4_000_000_000, 9_999_999_999, "MVJ,mffff.99999," + ",".join(["-999999.9999"] * 16)))) <= 320
 
 
-def _handshake(logic: ControllerLogic, key: bytes = KEY) -> bytes:
+@pytest.mark.parametrize("round_trip_ms, bound_ms", [(0, 1000), (10, 1000), (400, 1300), (3700, 7900), (9000, 15000)])
+def test_the_freshness_bound_follows_the_handshake_s_round_trip(round_trip_ms, bound_ms):
+    assert auth.freshness_bound_ms(round_trip_ms) == bound_ms
+
+
+def _handshake(logic: ControllerLogic, key: bytes = KEY) -> bytes | None:
+    """A session opened by the holder of ``key`` (None when the controller refuses its hello: another key)."""
     wn = auth.new_nonce()
-    (reply,) = logic.handle(f"HEL,{wn}")
-    assert isinstance(reply, HelloReply) and reply.proof == auth.controller_proof(KEY, wn, reply.nonce)
+    (reply,) = logic.handle(f"HEL,{wn},{auth.hello_request(key, wn)}")
+    if key != KEY:
+        assert reply.code == "AUTH" and reply.text.startswith(f"hello {wn}: wrong request")
+        return None
+    assert isinstance(reply, HelloReply) and reply.proof == auth.controller_proof(KEY, wn, reply.nonce, reply.clock_ms)
+    assert abs(reply.clock_ms - logic.clock_ms()) <= 1
     (ack,) = logic.handle(f"AUT,{auth.workstation_proof(key, wn, reply.nonce)}")
-    assert ack == Ack("AUT", "-") or key != KEY
+    assert ack == Ack("AUT", "-")
     return auth.session_key(key, wn, reply.nonce)
+
+
+def _sealed(logic: ControllerLogic, session: bytes, counter: int, body: str) -> str:
+    return auth.seal(session, counter, logic.clock_ms(), body)
 
 
 def _moved(replies) -> bool:
@@ -69,35 +86,36 @@ def test_a_keyed_controller_obeys_only_sealed_moves_of_its_session():
     session = _handshake(logic)
     (refused,) = logic.handle(move)  # a session, but the sentence is not sealed
     assert refused.code == "AUTH" and "no seal" in refused.text
-    sealed = auth.seal(session, 1, move)
+    sealed = _sealed(logic, session, 1, move)
     assert _moved(logic.handle(sealed))
     logic.handle("STP")
     assert logic.handle(sealed)[0].code == "AUTH"  # replayed: same counter
     tampered = sealed.replace("MVJ,m1.1,10,", "MVJ,m1.1,90,")
     assert "wrong seal" in logic.handle(tampered)[0].text
-    assert _moved(logic.handle(auth.seal(session, 5, "MVJ,m1.2,20,0,0,0,0,0")))  # counters may skip, never go back
+    assert _moved(logic.handle(_sealed(logic, session, 5, "MVJ,m1.2,20,0,0,0,0,0")))  # counters may skip, never go back
     _handshake(logic)  # a new session: the old one's seals are worthless
-    assert "wrong seal" in logic.handle(auth.seal(session, 9, "MVJ,m1.3,0,0,0,0,0,0"))[0].text
+    assert "wrong seal" in logic.handle(_sealed(logic, session, 9, "MVJ,m1.3,0,0,0,0,0,0"))[0].text
     assert len(logic.auth_refusals) == 5
 
 
 def test_stop_needs_no_session_and_a_wrong_key_gets_none():
     logic = ControllerLogic(key=KEY)
     session = _handshake(logic)
-    assert _moved(logic.handle(auth.seal(session, 1, "MVJ,m1.1,150,0,0,0,0,0")))
+    assert _moved(logic.handle(_sealed(logic, session, 1, "MVJ,m1.1,150,0,0,0,0,0")))
     logic.end_session()  # the workstation went away
     stop = logic.handle("STP")
     assert stop[0].code == "STOPPED" and stop[-1] == Ack("STP", "-") and logic.move is None
-    wrong = _handshake(logic, key=bytes(32))
-    assert logic.auth_refusals[-1].startswith("auth: wrong proof")
-    assert logic.handle(auth.seal(wrong, 1, "MVJ,m1.2,1,0,0,0,0,0"))[0].code == "AUTH"
+    assert _handshake(logic, key=bytes(32)) is None and logic.auth_refusals[-1].startswith("hello ")
+    guessed = auth.session_key(bytes(32), auth.new_nonce(), auth.new_nonce())
+    assert logic.handle(_sealed(logic, guessed, 1, "MVJ,m1.2,1,0,0,0,0,0"))[0].code == "AUTH"
     (refused,) = logic.handle("AUT," + "0" * 32)
     assert refused.code == "AUTH" and "without a HEL" in refused.text
 
 
 def test_a_protocol_3_controller_answers_hello_as_unknown():
     logic = ControllerLogic()
-    (reply,) = logic.handle(f"HEL,{auth.new_nonce()}")
+    wn = auth.new_nonce()
+    (reply,) = logic.handle(f"HEL,{wn},{auth.hello_request(KEY, wn)}")
     assert reply.code == "UNKNOWN" and "HEL" in reply.text
     assert _moved(logic.handle("MVJ,m1.1,1,0,0,0,0,0"))
 
@@ -206,7 +224,7 @@ def test_an_unanswered_hello_is_sent_again_before_the_handshake_fails():
     assert not ws.check_timeout(t3 + 12.1) and ws.state is AuthState.FAILED and "4 tries in" in ws.failure
     # the reply to the latest hello is what counts; a late reply to the failed one is not believed
     nonce = ws._nonce
-    reply = HelloReply("0123456789abcdef", auth.controller_proof(KEY, nonce, "0123456789abcdef"))
+    reply = HelloReply("0123456789abcdef", auth.controller_proof(KEY, nonce, "0123456789abcdef", 5), 5)
     assert ws.on_hello_reply(reply) is None
 
 
@@ -233,12 +251,29 @@ def test_a_late_answer_to_an_earlier_hello_times_the_round_trip_and_the_newest_o
     assert ws.state is AuthState.READY
 
 
-def test_answers_under_the_wrong_key_fail_whichever_hello_they_claim_to_answer():
+def test_a_controller_with_another_key_refuses_our_hello_and_we_say_so():
     controller = ControllerLogic(key=bytes(32))
     ws = WorkstationAuth(KEY)
     first = ws.hello()
     ws._sent_s -= 2.0
     assert ws.check_timeout(time.monotonic())
-    ws.hello()
-    reply = controller.handle(first)[0]
-    assert ws.on_hello_reply(reply) is None and ws.state is AuthState.FAILED and "proof is wrong" in ws.failure
+    second = ws.hello()
+    # its refusal of the earlier hello is not about the newest one; of the newest, it is
+    assert ws.on_error(controller.handle(first)[0]) and ws.state is AuthState.PENDING
+    assert ws.on_error(controller.handle(second)[0]) and ws.state is AuthState.FAILED and "refused our hello" in ws.failure
+
+
+def test_forged_hello_replies_and_refusals_of_others_hellos_do_not_fail_the_handshake():
+    """Anyone on the line can send a HEL reply or an ERR,AUTH naming a hello: neither ends ours. The answer to
+    our own hello, proven with the key, opens the session."""
+    controller = ControllerLogic(key=KEY)
+    ws = WorkstationAuth(KEY)
+    ours = ws.hello()
+    assert ws.on_hello_reply(HelloReply("0123456789abcdef", "0" * 32, 1000)) is None and ws.forged_replies == 1
+    stranger = auth.new_nonce()
+    assert ws.on_error(controller.handle(f"HEL,{stranger},{'1' * 32}")[0]) and ws.state is AuthState.PENDING
+    (reply,) = controller.handle(ours)
+    aut = ws.on_hello_reply(reply)
+    assert controller.handle(aut) == [Ack("AUT", "-")]
+    ws.on_accepted()
+    assert ws.state is AuthState.READY
