@@ -107,7 +107,7 @@ class ReplayBar(QWidget):
             contents = read_recording(path)
             if not contents.messages:
                 raise FileFormatError(path, "the recording holds no messages")
-            playback, complete, problem = RecordingPlayback(contents), contents.complete, contents.problem
+            playback, complete, problem = RecordingPlayback(contents, path.name), contents.complete, contents.problem
         recorded_intrinsics = None
         if playback.setup.get("intrinsics"):
             try:

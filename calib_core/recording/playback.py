@@ -32,10 +32,12 @@ class RecordedSolve:
 
 
 class RecordingPlayback:
-    """Everything in a recording, indexed by time."""
+    """Everything in a recording, indexed by time. ``name``: the recording's, which every pair it gives back carries
+    as its frame's source (a look rebuilt from a recording is never taken for a live one)."""
 
-    def __init__(self, contents: RecordingContents):
+    def __init__(self, contents: RecordingContents, name: str = "a recording"):
         self.contents = contents
+        self.name = name
         self._t0 = contents.messages[0].log_time_ns if contents.messages else 0
         self.frames = FrameTrack(contents)
         joints = contents.topic(JOINTS_TOPIC)
@@ -68,7 +70,8 @@ class RecordingPlayback:
         return None if i < 0 else self.joints_deg[i].copy()
 
     def pairs_at(self, t_s: float) -> list[Correspondence]:
-        """The point pairs as they stood at ``t_s``, rebuilt from the recorded edits."""
+        """The point pairs as they stood at ``t_s``, rebuilt from the recorded edits; each image point's view
+        carries this recording as its source (recorded live, it is not live now)."""
         pairs: dict[int, Correspondence] = {}
         for m in self._events[: bisect.bisect_right(self._event_times, t_s)]:
             kind, d = m.payload["kind"], m.payload.get("detail", {})
@@ -81,7 +84,12 @@ class RecordingPlayback:
                 pairs.pop(int(d["number"]), None)
             elif kind == "pair_reset":
                 pairs = {int(p["number"]): pair_from_dict(p) for p in d.get("pairs", [])}
-        return list(pairs.values())
+        return [self._recorded(p) for p in pairs.values()]
+
+    def _recorded(self, pair: Correspondence) -> Correspondence:
+        if pair.view is None or pair.view.source == self.name:
+            return pair
+        return replace(pair, view=replace(pair.view, source=self.name))
 
     def _view_at(self, t_s: float) -> ViewStamp | None:
         """For a pair recorded without its frame stamp (older recordings): the frame shown and the
@@ -91,7 +99,7 @@ class RecordingPlayback:
             return None
         i = bisect.bisect_right(self.joint_times_s, t_s) - 1
         k = self.frame_index_at(t_s)
-        return ViewStamp(-1 if k is None else int(k), float(t_s), tuple(float(v) for v in q), float(t_s - self.joint_times_s[i]), f"{t_s:.3f} s into the recording", "recording (joints at the pick)")
+        return ViewStamp(-1 if k is None else int(k), float(t_s), tuple(float(v) for v in q), float(t_s - self.joint_times_s[i]), f"{t_s:.3f} s into the recording", self.name)
 
     def solve_at(self, t_s: float) -> RecordedSolve | None:
         """The last solve at or before ``t_s``."""

@@ -189,3 +189,30 @@ def test_a_branchs_new_pair_is_numbered_after_the_recorded_ones_and_undo_stays_i
     wb.redo()
     numbers = [p.number for p in wb.session.pairs]
     assert len(numbers) == len(set(numbers)) == len(recorded) + 1
+
+
+def test_a_look_from_the_recording_is_never_stored_as_the_task_s_correction_by_itself(qtbot, window, recording):
+    """Open a recording, seek past its recorded solve (made live at the task), Store correction: the window asks,
+    naming the recording, and Cancel stores nothing. The same after branching (a pair deleted, Calibrate again):
+    the remaining pairs still come from the recording."""
+    from tests.app.windows import answer_questions
+
+    win, wb = window, window.workbench
+    truth = RecordingPlayback(read_recording(recording))
+    win.files.open_recording(recording)
+    bar = win.replay
+    bar.seek(truth.duration_s)
+    assert wb.session.result is not None
+    assert all(p.view is None or p.view.source == "session.mcap" for p in wb.session.pairs)
+    asked = answer_questions(qtbot, ["Cancel"])
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    assert asked and "recording session.mcap" in asked[0], asked
+    assert wb.session.corrections.history(wb.task.name) == []
+    win.table.selectRow(0)
+    qtbot.mouseClick(win.commands.delete, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    assert bar.branched_at_s is not None and wb.session.result is not None
+    asked = answer_questions(qtbot, ["Cancel"])
+    qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
+    assert asked and "recording session.mcap" in asked[0], asked
+    assert wb.session.corrections.history(wb.task.name) == []
