@@ -31,13 +31,21 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out.exists() and not args.out.is_dir():
         raise VideocalError(f"{args.out}: --out names a file; grab writes PNG files and frames.csv into a folder")
+    blocking = next((parent for parent in args.out.parents if parent.exists() and not parent.is_dir()), None)
+    if blocking is not None:
+        raise VideocalError(f"{args.out}: cannot make the folder: {blocking} is a file")
     if (args.out / "frames.csv").exists():
         raise VideocalError(f"{args.out / 'frames.csv'} exists: grab into an empty folder (nothing was overwritten)")
-    args.out.mkdir(parents=True, exist_ok=True)
+    camera = open_camera(args.spec)  # before anything is made: a camera that does not open leaves nothing behind
+    made = [d for d in (args.out, *args.out.parents) if not d.exists()]
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        camera.close()
+        raise VideocalError(f"{args.out}: cannot make the folder ({exc.strerror or exc})") from None
     rows = ["file,t_device_ns,t_host_s"]
     code = 0
     silent_since = None
-    camera = open_camera(args.spec)
     try:
         while len(rows) - 1 < args.count:
             try:
@@ -67,7 +75,14 @@ def run(args: argparse.Namespace) -> int:
             rows.append(f"{name},{'' if frame.t_device_ns is None else frame.t_device_ns},{frame.t_host_s:.6f}")
     finally:
         camera.close()
-        atomic_write_text(args.out / "frames.csv", "\n".join(rows) + "\n")
+        if len(rows) > 1:
+            atomic_write_text(args.out / "frames.csv", "\n".join(rows) + "\n")
+        else:  # not one frame: nothing is left behind, not even the folders grab made
+            for folder in made:
+                try:
+                    folder.rmdir()
+                except OSError:
+                    break
     if code == 0:
         print(f"{args.count} frames and frames.csv in {args.out}")
     return code

@@ -56,9 +56,23 @@ class IntrinsicsCalibration:
     advice: list[str] = field(default_factory=list)
 
 
+MIN_SIDE_PX = 32
+"""An image with a side shorter than this (px) cannot hold a board's corners: it is rejected, not handed to OpenCV
+(whose adaptive threshold fails an assertion on a 1 x 1 picture)."""
+MAX_ASPECT = 5.0
+"""The longest side of a view at most this many times its shortest."""
+
+
 def detect_view(name: str, image: np.ndarray, spec, detector=None) -> BoardView | RejectedView:
     """Find the target's points in one image (RGB or grey); ``detector`` from ``spec.detector(settings)``
     (made once for many images), else one with the default settings."""
+    h, w = image.shape[:2]
+    if min(h, w) < MIN_SIDE_PX:
+        return RejectedView(name, f"the image is {w} x {h} px: too small to hold a board")
+    if max(h, w) > MAX_ASPECT * min(h, w):
+        # no camera takes such a picture (a damaged file decodes so: 640 x 14304), and OpenCV's detectors allocate
+        # past 2 GB on one
+        return RejectedView(name, f"the image is {w} x {h} px: not a camera's picture (sides more than {MAX_ASPECT:g} to 1; a damaged file?)")
     grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
     found = (detector or spec.detector())(grey)
     size = (grey.shape[1], grey.shape[0])

@@ -186,3 +186,25 @@ def test_a_full_disk_is_an_error_not_a_traceback(tmp_path):
     run = _videocal("render", "--out", out, "--scale", "0.5", preexec=small_files)
     _refused(run, "r.png")
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
+
+
+def test_board_views_too_small_or_of_no_camera_s_shape_are_rejected_by_name(tmp_path):
+    """A 1 x 1 PNG failed OpenCV's adaptive threshold with a traceback; a damaged JPEG that decodes as 640 x 14304
+    made the board detector allocate past 2 GB. Each is now a rejected view, named with its size."""
+    import cv2
+    import numpy as np
+
+    folder = tmp_path / "views"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "one.png"), np.zeros((1, 1), np.uint8))
+    cv2.imwrite(str(folder / "tall.jpg"), np.random.default_rng(0).integers(0, 255, (14304, 640), dtype=np.uint8))
+    line = _refused(_videocal("calibrate-intrinsics", folder, "--board", "chessboard:9x6:25", "--out", tmp_path / "camera.yaml"),
+                    "one.png: the image is 1 x 1 px: too small", "tall.jpg: the image is 640 x 14304 px: not a camera's picture")
+    assert "0 usable board views" in line and not (tmp_path / "camera.yaml").exists()
+
+
+def test_grab_into_a_folder_under_a_file_or_from_no_camera_leaves_nothing(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    _refused(_videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file")
+    _refused(_videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"), "missing.mp4")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]  # no folder made for a camera that did not open
