@@ -57,14 +57,14 @@ class BagFrames:
 
     def image(self, k: int) -> np.ndarray:
         """Frame ``k`` as RGB (h, w, 3) uint8, read from the bag at its record time."""
-        from calib_core.bags.bag_source import _rgb
+        from calib_core.bags.bag_source import _rgb, deserialize
 
         if not 0 <= k < len(self):
             raise IndexError(f"frame {k} of a bag topic with {len(self)} images")
         log_ns = int(self.log_ns[k])
         for connection, _, raw in self._reader.messages(connections=self._connections, start=log_ns, stop=log_ns + 1):
             if _header_stamp_ns(raw, log_ns) == self.stamps_ns[k]:
-                message = self._reader.deserialize(raw, connection.msgtype)
+                message = deserialize(self._reader, raw, connection, f"{self.path} {self.topic} image {k}")
                 return _rgb(message, connection.msgtype, f"{self.path} {self.topic} image {k}")
         raise FileFormatError(self.path, f"{self.topic}: image {k} (recorded at {log_ns} ns) could not be read again")
 

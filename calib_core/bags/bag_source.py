@@ -60,6 +60,16 @@ def open_reader(path: str | Path):
     return reader
 
 
+def deserialize(reader, raw: bytes, connection, where: str):
+    """``raw`` read as the connection's message type; :class:`FileFormatError` naming ``where`` (the bag, topic and
+    message) when its bytes are not that message in CDR (a bag written by another serializer, or damaged)."""
+    try:
+        return reader.deserialize(raw, connection.msgtype)
+    except Exception as exc:  # rosbags' own serde errors (and struct/index errors on truncated bytes)
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise FileFormatError(Path(where.split(" ")[0]), f"{where}: not a {connection.msgtype} in CDR ({text})") from None
+
+
 @contextmanager
 def open_bag(path: str | Path):
     """:func:`open_reader` for a ``with`` block."""
@@ -118,7 +128,7 @@ def bag_stamped_images(path: str | Path, topic: str | None = None, every: int = 
         for k, (connection, log_ns, raw) in enumerate(reader.messages(connections=connections)):
             if k % every:
                 continue
-            message = reader.deserialize(raw, connection.msgtype)
+            message = deserialize(reader, raw, connection, f"{path} {chosen.name} message {k}")
             stamp = message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec or log_ns
             yield stamp, f"t_{stamp}", _rgb(message, connection.msgtype, f"{path} {chosen.name} message {k}")
 
@@ -142,5 +152,5 @@ def bag_camera_info(path: str | Path):
     with open_bag(path) as reader:
         connections = [c for c in reader.connections if c.msgtype == CAMERA_INFO]
         for connection, _, raw in reader.messages(connections=connections):
-            return connection.topic, reader.deserialize(raw, connection.msgtype)
+            return connection.topic, deserialize(reader, raw, connection, f"{path} {connection.topic}")
     return None

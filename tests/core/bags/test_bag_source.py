@@ -77,3 +77,26 @@ def test_a_bag_given_as_a_recording_is_refused_naming_what_it_holds(tmp_path):
         assert run.returncode == 2 and expected in run.stderr and "Traceback" not in run.stderr, run.stderr
     recover = subprocess.run([sys.executable, "-m", "app.cli.main", "recover", str(header_only), str(tmp_path / "copy.mcap")], capture_output=True, text=True, timeout=120)
     assert recover.returncode == 2 and not (tmp_path / "copy.mcap").exists()  # issue 33: no empty copy
+
+
+def test_a_bag_whose_messages_are_not_cdr_is_one_error_naming_the_topic_and_message(tmp_path):
+    """rosbags' own error escaped as a traceback from calibrate-intrinsics on such a bag."""
+    import subprocess
+    import sys
+
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from calib_core.bags.bag_source import bag_images
+    from calib_core.errors import FileFormatError
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    folder = tmp_path / "garbage_bag"
+    with Writer(folder, version=9) as writer:
+        connection = writer.add_connection("/camera/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        writer.write(connection, 1_700_000_000_000_000_000, b"\x00\x01 not a CDR image at all")
+    with pytest.raises(FileFormatError, match=r"/camera/image_raw message 0: not a sensor_msgs/msg/Image in CDR"):
+        list(bag_images(folder))
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-intrinsics", str(folder), "--board", "chessboard:9x6:25",
+                          "--out", str(tmp_path / "camera.yaml")], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 2 and "Traceback" not in run.stderr and "not a sensor_msgs/msg/Image in CDR" in run.stderr, run.stderr[-2000:]
