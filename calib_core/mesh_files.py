@@ -60,7 +60,8 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # trimesh's own warnings on a broken file: the checks below say what is wrong
-            mesh = trimesh.load(path, force="mesh")
+            # unprocessed first: trimesh's processing drops faces with non-finite vertices without a word
+            mesh = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
         raise FileFormatError(path, f"cannot read the mesh: {exc}", field) from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
@@ -69,7 +70,9 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
         raise FileFormatError(path, f"a mesh of {len(mesh.faces)} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing", field)
     vertices = np.asarray(mesh.vertices) * MESH_SCALE[units]
     if not np.all(np.isfinite(vertices)):
-        raise FileFormatError(path, "the mesh has coordinates that are not finite numbers", field)
+        bad = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
+        raise FileFormatError(path, f"the mesh has coordinates that are not finite numbers (vertex {bad}: {vertices[bad].tolist()})", field)
+    mesh.process()  # vertices shared by their faces (an STL repeats them per triangle): the edges' neighbours
     if np.abs(vertices).max() > MAX_COORDINATE_MM:
         raise FileFormatError(path, f"the mesh reaches {np.abs(vertices).max():.3g} mm from its origin, beyond {MAX_COORDINATE_MM:g} mm: "
                                     "are its units right (mesh_units)?", field)

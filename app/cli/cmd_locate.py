@@ -104,6 +104,10 @@ def run(args: argparse.Namespace) -> int:
     mesh = load_mesh(args.mesh, args.units)
     features = read_features(args.features, MESH_SCALE[args.units]) if args.features else None
     prior = read_prior(args.prior)
+    centre = prior[:3, :3] @ np.asarray(mesh.bounding_box.centroid, dtype=float) + prior[:3, 3]
+    if not centre[2] > 0.0:
+        raise FileFormatError(args.prior, f"the prior puts the object's centre {centre[2]:.1f} mm in front of the camera: behind it, or in its "
+                                          "plane; the camera looks along +z (OpenCV's axes)")
     view = ModelView(intrinsics)
     try:
         from calib_core.scene import SceneItem

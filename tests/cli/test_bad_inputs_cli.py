@@ -208,3 +208,28 @@ def test_grab_into_a_folder_under_a_file_or_from_no_camera_leaves_nothing(tmp_pa
     _refused(_videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file")
     _refused(_videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"), "missing.mp4")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]  # no folder made for a camera that did not open
+
+
+def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_camera(tmp_path):
+    """A NaN vertex was dropped by trimesh's processing without a word (and locate then said "give a prior nearer the
+    object"); a prior behind the camera ended in "cannot convert float NaN to integer"."""
+    import cv2
+    import numpy as np
+    import trimesh
+
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.camera.intrinsics_io import save_intrinsics
+
+    box = trimesh.creation.box([100.0, 80.0, 60.0])
+    vertices = box.vertices.copy()
+    vertices[3] = [np.nan, 0.0, 0.0]
+    trimesh.Trimesh(vertices, box.faces, process=False).export(tmp_path / "nan.stl")
+    box.export(tmp_path / "box.stl")
+    cv2.imwrite(str(tmp_path / "photo.png"), np.zeros((480, 640, 3), np.uint8))
+    save_intrinsics(tmp_path / "camera.yaml", Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480))
+    (tmp_path / "ahead.json").write_text(json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 500], [0, 0, 0, 1]]}))
+    (tmp_path / "behind.json").write_text(json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -500], [0, 0, 0, 1]]}))
+    _refused(_videocal("locate", tmp_path / "photo.png", "--mesh", tmp_path / "nan.stl", "--intrinsics", tmp_path / "camera.yaml", "--prior", tmp_path / "ahead.json"),
+             "nan.stl", "not finite")
+    _refused(_videocal("locate", tmp_path / "photo.png", "--mesh", tmp_path / "box.stl", "--intrinsics", tmp_path / "camera.yaml", "--prior", tmp_path / "behind.json"),
+             "behind.json", "behind it")
