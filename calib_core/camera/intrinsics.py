@@ -20,6 +20,11 @@ MAX_IMAGE_SIDE_PX = 20000
 """Larger than any camera's sensor; a bigger number is a typo that would allocate gigabytes."""
 
 
+MAX_DISTORTION = 1e4
+"""The largest distortion coefficient taken (in size): a real lens's are under 10 (a rational model's a few hundred);
+-1e308 is a damaged file, which would send every projection to infinity."""
+
+
 @dataclass(frozen=True)
 class Intrinsics:
     """A camera: a pinhole with lens distortion.
@@ -63,6 +68,9 @@ class Intrinsics:
             raise ValueError(f"intrinsics: {self.model} distortion needs {len(names)} values ({', '.join(names)}), got {len(d)}")
         if not all(np.isfinite(d)):
             raise ValueError("intrinsics: distortion contains NaN or infinite values")
+        if max((abs(x) for x in d), default=0.0) > MAX_DISTORTION:
+            k = max(range(len(d)), key=lambda i: abs(d[i]))
+            raise ValueError(f"intrinsics: distortion {names[k]} = {d[k]:g} is no lens's (at most {MAX_DISTORTION:g} in size)")
         object.__setattr__(self, "distortion", d)
 
     @property

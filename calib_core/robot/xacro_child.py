@@ -17,6 +17,9 @@ def main() -> int:
     request = json.loads(sys.stdin.read())
     limit = int(request["memory_mb"]) * 1024 * 1024
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    if "cpu_s" in request:  # a runaway expression stops on its own even when nobody waits for it any more
+        cpu = int(request["cpu_s"])
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu))
     import xacro
     import xacro.substitution_args as substitution
 

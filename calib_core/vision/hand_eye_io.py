@@ -49,12 +49,24 @@ def load_mounting(path: str | Path) -> tuple[np.ndarray, str | None]:
     from calib_core.ros2.mounting_in import is_launch_file, read_static_transform
 
     if not is_launch_file(path):
-        return load_cam2flange(path), None
+        return _plausible(load_cam2flange(path), path, "cam2flange.xyz"), None
     found = read_static_transform(path)
     if "optical" not in found.child.lower():
         raise FileFormatError(path, f"the camera frame {found.child!r} is not an optical frame (z along the view, x right, y down): "
                                     "give the transform to the camera's *_optical_frame", "arguments")
-    return found.child2parent_mm, found.parent
+    return _plausible(found.child2parent_mm, path, "arguments"), found.parent
+
+
+MAX_MOUNTING_MM = 3000.0
+"""The farthest a camera on the robot may be from the frame it is mounted on (mm): an arm's reach."""
+
+
+def _plausible(cam2frame: np.ndarray, path, field: str) -> np.ndarray:
+    distance = float(np.linalg.norm(cam2frame[:3, 3]))
+    if distance > MAX_MOUNTING_MM:
+        raise FileFormatError(path, f"the camera would be {distance:.0f} mm from the frame it is mounted on, beyond {MAX_MOUNTING_MM:g} mm: "
+                                    "a camera on the robot is within an arm's reach of its flange (are the units mm?)", field)
+    return cam2frame
 
 
 def load_cam2flange(path: str | Path) -> np.ndarray:

@@ -133,12 +133,22 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
 _FEATURE_KEYS = {"at", "kind", "radius_mm", "normal"}
 
 
+def _feature_point(reader, value, field: str) -> np.ndarray:
+    from calib_core.mesh_files import MAX_COORDINATE_MM
+
+    point = reader.vector(value, 3, field)
+    if np.abs(point).max() > MAX_COORDINATE_MM:
+        raise reader.fail(field, f"lies {np.abs(point).max():.3g} mm from its component's origin, beyond {MAX_COORDINATE_MM:g} mm: "
+                                 "features are in mm in the component's frame")
+    return point
+
+
 def _feature(reader, value, field: str) -> tuple[np.ndarray, FeatureKind]:
     """A feature's point (3,) mm and its kind: ``[x, y, z]`` (a corner) or ``{at, kind, radius_mm, normal}``."""
     if not isinstance(value, dict):
-        return reader.vector(value, 3, field), CORNER
+        return _feature_point(reader, value, field), CORNER
     entry = reader.mapping(value, field, _FEATURE_KEYS, {"at"})
-    point = reader.vector(entry["at"], 3, f"{field}.at")
+    point = _feature_point(reader, entry["at"], f"{field}.at")
     kind = reader.choice(entry.get("kind", "corner"), f"{field}.kind", set(KINDS))
     if kind != "circle":
         for key in ("radius_mm", "normal"):

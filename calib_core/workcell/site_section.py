@@ -40,6 +40,8 @@ def read_site_section(reader, raw, folder: Path) -> SiteSection:
         value = raw.get(key)
         if value is not None and (not isinstance(value, str) or not value.strip() or len(value) > 1000):
             raise reader.fail(f"site.{key}", f"must be a URL or path (a non-empty string), got {value!r}")
+        if value is not None and any(ord(c) < 32 or ord(c) == 127 for c in value):
+            raise reader.fail(f"site.{key}", f"holds a control character (a newline, a tab, a NUL): {value!r}")
         values[key] = value
     camera = values["camera"]
     if camera is not None and url_scheme(camera) is None and not camera.strip().isdigit():

@@ -215,23 +215,23 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
 
     rel = lambda p: os.path.relpath(p, folder.resolve())  # noqa: E731 - paths relative to the workcell file
     lines = [
-        f"# A starting cell for {urdf.name}, written by videocal new-cell. Schema: docs/workcell.md.",
+        f"# A starting cell for {json.dumps(urdf.name)}, written by videocal new-cell. Schema: docs/workcell.md.",
         "# Replace the example target by your components (placements as surveyed, in the robot's base frame).",
         "schema_version: 2",
-        f"name: {name or urdf.stem + ' cell'}",
+        f"name: {json.dumps(name or urdf.stem + ' cell')}",  # JSON's strings are YAML's: a newline or '#' stays in the value
         "units: {length: mm, angle: deg}",
         "",
         "robot:",
-        f"  urdf: {rel(urdf)}",
+        f"  urdf: {json.dumps(rel(urdf))}",
     ]
     if package_paths:
-        lines.append("  package_paths: [" + ", ".join(rel(p) for p in package_paths) + "]")
+        lines.append("  package_paths: [" + ", ".join(json.dumps(rel(p)) for p in package_paths) + "]")
     if xacro_args:
         lines.append("  xacro_args: {" + ", ".join(f"{k}: {json.dumps(v)}" for k, v in xacro_args.items()) + "}")
     lines += [
         "  frames:",
-        f"    base: {base if base else '~'}" + ("" if base else "                # the URDF's root link"),
-        f"    flange: {flange}",
+        f"    base: {json.dumps(base) if base else '~'}" + ("" if base else "                # the URDF's root link"),
+        f"    flange: {json.dumps(flange)}",
         f"    tcp: {_frame_yaml(flange, frames['tcp'].frame2parent)}",
         f"    camera: {_frame_yaml(flange, frames['camera'].frame2parent)}   # OpenCV axes",
         "  home_joints_deg: [" + ", ".join(f"{v:.3f}" for v in home) + "]",

@@ -100,6 +100,12 @@ def save_workspace(path: str | Path, ws: Workspace) -> None:
     atomic_write_text(path, json.dumps(workspace_to_dict(ws), indent=1))
 
 
+MAX_MAGNITUDE = 1e7
+"""The largest coordinate a workspace may hold (mm, px): 10 km."""
+MAX_SIGMA = 1e6
+"""The largest 1-sigma a workspace may hold (mm, deg): a 1 km uncertainty is no measurement."""
+
+
 class _Fields:
     def __init__(self, path: Path):
         self.path = path
@@ -125,13 +131,17 @@ class _Fields:
             raise self.fail(f"{where}.{key}" if where else key, f"the name {value[:60]!r} {why}")
         return value
 
-    def vector(self, value, n: int, where: str) -> np.ndarray:
+    def vector(self, value, n: int, where: str, bound: float = MAX_MAGNITUDE) -> np.ndarray:
+        """``n`` finite numbers, each at most ``bound`` in size (mm, px: a cell is metres across, an image thousands
+        of pixels; -1e308 is a damaged file, and an export would carry it to a controller)."""
         try:
             arr = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise self.fail(where, f"must be {n} finite numbers, got {value!r}") from None
         if arr.shape != (n,) or not np.all(np.isfinite(arr)):
             raise self.fail(where, f"must be {n} finite numbers, got {value!r}")
+        if np.abs(arr).max() > bound:
+            raise self.fail(where, f"must be {n} numbers within +-{bound:g}, got {value!r}")
         return arr
 
     def sigmas(self, value, n: int, where: str) -> np.ndarray:
@@ -139,8 +149,8 @@ class _Fields:
         if not isinstance(value, list) or len(value) != n or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in value):
             raise self.fail(where, f"must be {n} numbers (null for an unknown one), got {value!r}")
         arr = np.array([np.nan if v is None else v for v in value], dtype=float)
-        if np.any(arr < 0) or np.any(np.isinf(arr)):
-            raise self.fail(where, f"must be {n} non-negative finite numbers, got {value!r}")
+        if np.any(arr < 0) or np.any(np.isinf(arr)) or np.any(arr > MAX_SIGMA):
+            raise self.fail(where, f"must be {n} non-negative finite numbers up to {MAX_SIGMA:g}, got {value!r}")
         return arr
 
     def number(self, value, where: str, low: float = -np.inf, high: float = np.inf, allow_nan: bool = False) -> float:

@@ -233,3 +233,60 @@ def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_cam
              "nan.stl", "not finite")
     _refused(_videocal("locate", tmp_path / "photo.png", "--mesh", tmp_path / "box.stl", "--intrinsics", tmp_path / "camera.yaml", "--prior", tmp_path / "behind.json"),
              "behind.json", "behind it")
+
+
+# --- numbers that parse but mean nothing --------------------------------------------------------------
+def test_a_feature_at_1e23_mm_and_a_distortion_of_minus_1e308_are_refused_by_field(cell):
+    def far_feature(d):
+        component = next(c for c in d["components"] if c.get("features"))
+        name = next(iter(component["features"]))
+        component["features"][name] = [1e23, 0.0, 0.0]
+
+    _refused(_render(cell(far_feature), cell.folder), "edited.yaml", "features", "beyond")
+    ros = yaml.safe_load((cell.folder / "camera" / "gripper_camera_ros.yaml").read_text())
+    ros["distortion_coefficients"]["data"][1] = -1e308
+    _refused(_render(_camera_file(cell, yaml.safe_dump(ros)), cell.folder), "bad.yaml", "k2", "no lens")
+
+
+def test_a_camera_mounting_10_km_from_the_flange_is_refused(tmp_path):
+    from calib_core.errors import FileFormatError
+    from calib_core.vision.hand_eye_io import load_mounting
+
+    path = tmp_path / "hand_eye.yaml"
+    path.write_text(yaml.safe_dump({"cam2flange": {"xyz": [1e7, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}}))
+    with pytest.raises(FileFormatError, match=r"hand_eye.yaml: field 'cam2flange.xyz': the camera would be 10000000 mm from"):
+        load_mounting(path)
+
+
+def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_path):
+    import numpy as np
+
+    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.calibration.correspondences import Correspondence
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.workcell import load_workcell
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    cell = load_workcell()
+    table = CorrectionTable()
+    measured = np.eye(4)
+    measured[0, 3] = 1.0
+    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, 0, 0]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    pair = Correspondence(1, "oru_1_fixture", None, (100.0, 0.0, 0.0), None)
+    path = tmp_path / "w.json"
+    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [pair], table))
+    assert _videocal("export", path).returncode == 0
+    original = json.loads(path.read_text())
+    data = json.loads(json.dumps(original))
+    data["pairs"][0]["point_world_mm"] = [-1e308, 0.0, 0.0]
+    path.write_text(json.dumps(data))
+    _refused(_videocal("export", path), "w.json", "point_world_mm", "within")
+    data = json.loads(json.dumps(original))
+    data["corrections"][0]["std_displacement_mm"] = [9e18, 0.1, 0.1]
+    path.write_text(json.dumps(data))
+    _refused(_videocal("export", path), "w.json", "std_displacement_mm", "up to")
+
+
+def test_a_site_url_with_a_newline_or_a_nul_is_refused_by_field(cell):
+    for url in ("socket://robot:30002\nmore", "ros2:///joint_states\x00"):
+        _refused(_render(cell(lambda d: d.update(site={"controller": url})), cell.folder), "edited.yaml", "site.controller", "control character")

@@ -64,3 +64,17 @@ def test_new_cell_on_the_jaco2_says_which_flange_and_puts_the_tool_out_of_the_ha
     # the TCP lies beyond the hand along the way out (it went 150 mm sideways), and its z points that way
     assert np.linalg.norm(along - (along @ out) * out) < 1.0 and along @ out > 100.0
     assert tcp[:3, 2] @ out > 0.999
+
+
+def test_a_cell_name_and_a_urdf_file_name_with_a_newline_and_a_hash_are_written_as_yaml_strings(tmp_path):
+    """new-cell wrote the URDF's file name into workcell.yaml as it was: a newline in it made another YAML key."""
+    import shutil
+
+    odd = tmp_path / "ur5 #1\nrobot.urdf"
+    shutil.copyfile(require(UR5), odd)
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "new-cell", str(tmp_path / "cell"), "--urdf", str(odd), "--package-path", str(SHARE),
+                          "--name", "line one\nname: injected # not a comment"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    cell = load_workcell(tmp_path / "cell" / "workcell.yaml")
+    assert cell.name == "line one\nname: injected # not a comment"
+    assert cell.robot_spec.urdf.resolve() == odd.resolve()

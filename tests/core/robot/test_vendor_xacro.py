@@ -3,6 +3,7 @@
 xacro arguments; runaway expressions bounded in time and memory."""
 
 import math
+import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -128,3 +129,35 @@ def test_a_calibrated_kr6_keeps_its_package_meshes_and_its_corrected_joint(tmp_p
     q = np.array([10.0, -20.0, 30.0, 5.0, 40.0, -15.0])  # deg
     np.testing.assert_allclose(again.fk(q, "tool0"), calibrated.fk(q, "tool0"), atol=1e-6)
     assert not np.allclose(again.fk(q, "tool0"), nominal.fk(q, "tool0"), atol=1e-3)
+
+
+def test_the_xacro_child_ends_with_its_parent(tmp_path):
+    """A runaway expansion went on computing after the command that started it was killed."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    slow = tmp_path / "slow.xacro"
+    slow.write_text('<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>')
+    parent = subprocess.Popen([sys.executable, "-c", "import sys; from pathlib import Path; from calib_core.robot.xacro_expand import expand_xacro; "
+                               "print('expanding', flush=True); expand_xacro(Path(sys.argv[1]), [], timeout_s=120)", str(slow)],
+                              stdout=subprocess.PIPE, text=True)
+    assert parent.stdout.readline().strip() == "expanding"
+
+    def children() -> list[str]:
+        found = subprocess.run(["pgrep", "-P", str(parent.pid), "-f", "xacro_child"], capture_output=True, text=True).stdout.split()
+        return found
+
+    deadline = time.monotonic() + 20
+    while not children() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    child = children()
+    assert child, "the child never started"
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait(5)
+    parent.stdout.close()
+    deadline = time.monotonic() + 10
+    while os.path.exists(f"/proc/{child[0]}") and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not os.path.exists(f"/proc/{child[0]}") or open(f"/proc/{child[0]}/stat").read().split()[2] == "Z"
