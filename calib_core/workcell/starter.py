@@ -11,13 +11,14 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
-from calib_core.errors import VideocalError
+from calib_core.errors import FileWriteError, VideocalError
 from calib_core.frames import concat, make_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.flange_choice import choose_flange, tool_alignment
 from calib_core.robot import UnreachableTargetError, solve_ik
@@ -200,7 +201,49 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     target2base = make_transform(np.column_stack([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]), tcp[:3, 3] + [GRASP_STANDOFF_MM, 0.0, 0.0])
     reach, _ = reach_of(robot)
 
-    folder.mkdir(parents=True, exist_ok=True)
+    made_parents = [d for d in folder.parents if not d.exists()]
+    try:
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        # Written into a folder beside the target and moved into place whole: a full disk, a read-only folder or an
+        # error half-way leaves nothing behind
+        staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=folder.parent))
+    except OSError as exc:
+        raise FileWriteError(folder, f"cannot make the cell's folder ({exc.strerror or exc})") from None
+    try:
+        _write_files(staging, folder, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach)
+        _move_into(staging, folder)
+    except OSError as exc:
+        raise FileWriteError(folder, f"cannot write the cell ({exc.strerror or exc}); nothing was left behind") from None
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+        if not (folder / "workcell.yaml").exists():
+            for d in made_parents:
+                try:
+                    d.rmdir()
+                except OSError:
+                    break
+    from calib_core.workcell.loader import load_workcell
+
+    load_workcell(folder / "workcell.yaml")  # what was written must load
+    return StarterCell(folder / "workcell.yaml", flange, base, held, home, tcp, target2base, choice.why, axis_warning)
+
+
+def _move_into(staging: Path, folder: Path) -> None:
+    """Everything in ``staging`` into ``folder``: renamed whole when ``folder`` is new, else file by file."""
+    if not folder.exists():
+        os.rename(staging, folder)
+        staging.mkdir()  # for the caller's clean-up
+        return
+    for item in sorted(staging.rglob("*"), key=lambda q: len(q.parts)):
+        target = folder / item.relative_to(staging)
+        if item.is_dir():
+            target.mkdir(exist_ok=True)
+        else:
+            os.replace(item, target)
+
+
+def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach) -> None:
+    """The cell's files into ``folder`` (paths in them relative to ``final``, a sibling: the same relative paths)."""
     meshes = folder / "meshes"
     meshes.mkdir(exist_ok=True)
     floor = trimesh.creation.box(extents=(3.0 * reach, 3.0 * reach, 10.0))
@@ -213,7 +256,7 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     trimesh.util.concatenate([target, post]).export(meshes / "target.stl")
     shutil.copyfile(BUNDLED_CAMERA, folder / "camera.yaml")
 
-    rel = lambda p: os.path.relpath(p, folder.resolve())  # noqa: E731 - paths relative to the workcell file
+    rel = lambda p: os.path.relpath(p, final.resolve())  # noqa: E731 - paths relative to the workcell file
     lines = [
         f"# A starting cell for {json.dumps(urdf.name)}, written by videocal new-cell. Schema: docs/workcell.md.",
         "# Replace the example target by your components (placements as surveyed, in the robot's base frame).",
@@ -266,9 +309,4 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
         f"    approach_mm: {APPROACH_MM:g}",
         "",
     ]
-    path = folder / "workcell.yaml"
-    path.write_text("\n".join(lines), encoding="utf-8")
-    from calib_core.workcell.loader import load_workcell
-
-    load_workcell(path)  # what was written must load
-    return StarterCell(path, flange, base, held, home, tcp, target2base, choice.why, axis_warning)
+    (folder / "workcell.yaml").write_text("\n".join(lines), encoding="utf-8")

@@ -290,3 +290,31 @@ def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_
 def test_a_site_url_with_a_newline_or_a_nul_is_refused_by_field(cell):
     for url in ("socket://robot:30002\nmore", "ros2:///joint_states\x00"):
         _refused(_render(cell(lambda d: d.update(site={"controller": url})), cell.folder), "edited.yaml", "site.controller", "control character")
+
+
+def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothing(tmp_path):
+    """new-cell wrote its meshes, then failed on a full disk with a traceback and a half-made folder."""
+    import stat
+
+    from tests.vendor_robots import SHARE, UR5, require
+
+    def small_files() -> None:
+        import signal
+
+        _limits()
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1500, 1500))  # the workcell file and the target's STL are larger
+
+    urdf = require(UR5)
+    run = _videocal("new-cell", tmp_path / "deep" / "cell", "--urdf", urdf, "--package-path", SHARE, preexec=small_files, timeout=300)
+    _refused(run, "cell", "nothing was left behind")
+    assert list(tmp_path.iterdir()) == []
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(stat.S_IRUSR | stat.S_IXUSR)
+    try:
+        if os.geteuid() != 0:  # root writes anywhere: the read-only case is a user's
+            _refused(_videocal("new-cell", locked / "cell", "--urdf", urdf, "--package-path", SHARE, timeout=300), "cell")
+            assert list(locked.iterdir()) == []
+    finally:
+        locked.chmod(stat.S_IRWXU)
