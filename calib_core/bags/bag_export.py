@@ -17,7 +17,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from calib_core.errors import FileFormatError
+from calib_core.errors import FileFormatError, FileWriteError
 
 IMAGE_TOPIC = "/camera/image_raw/compressed"
 JOINT_TOPIC = "/joint_states"
@@ -63,8 +63,11 @@ def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: lis
     counts = {IMAGE_TOPIC: 0, JOINT_TOPIC: 0, INFO_TOPIC: 0}
     try:
         _write(Writer(out, version=9, storage_plugin=StoragePlugin.MCAP), ts, T, track, joints, names, joint_units, intrinsics, camera_frame, counts)
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(out, ignore_errors=True)  # no half-written bag left behind
+        if isinstance(exc, OSError) or type(exc).__name__ == "WriterError":  # a full disk, a read-only folder
+            cause = exc.__cause__ if isinstance(exc.__cause__, OSError) else exc
+            raise FileWriteError(out, f"cannot write the bag ({getattr(cause, 'strerror', None) or cause}); nothing was left behind") from None
         raise
     return counts
 

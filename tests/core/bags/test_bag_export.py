@@ -73,3 +73,20 @@ def test_a_bad_export_says_why_and_leaves_nothing(tmp_path):
         bag_export._units_from_workcell(SAMPLE, str(Path(__file__).resolve().parents[2] / "data" / "nope.yaml"), 6)
     run = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(SAMPLE), "--format", "ros2-bag"], capture_output=True, text=True, timeout=120)
     assert run.returncode == 2 and "give --out FOLDER" in run.stderr and "Traceback" not in run.stderr
+
+
+def test_a_full_disk_is_one_error_line_and_no_half_written_bag(tmp_path):
+    """A file-size limit as a full disk: export --format ros2-bag ended in rosbags' traceback."""
+    import resource
+    import signal
+
+    def small_files() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))  # the sample's frames are more
+
+    out = tmp_path / "bag"
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(SAMPLE), "--format", "ros2-bag", "--out", str(out)],
+                         capture_output=True, text=True, timeout=300, preexec_fn=small_files)
+    assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr[-2000:]
+    assert "cannot write the bag" in run.stderr and "nothing was left behind" in run.stderr
+    assert not out.exists()
