@@ -103,7 +103,7 @@ class FileMenu:
         """Open a workspace file. ``restored``: an autosave, which is no file of the operator's: it joins
         no recent list and *Save* asks where (it once wrote into the recovery folder, offered again at
         the next start as an unsaved autosave)."""
-        if not attempt(self.window.show_error, self.window.workbench.files.open_workspace, path):
+        if not attempt(self.window.show_error, lambda: self.window.workbench.files.open_workspace(path, hold=not restored)):
             return False
         if restored:
             self.workspace_path = None
@@ -204,7 +204,7 @@ class FileMenu:
         """Autosave every minute when the session changed. Sessions that ended without saving left their
         autosave: offer each (File > Restore autosave of ...) rather than load one unasked."""
         wb = self.window.workbench
-        self.autosave = Autosave(self.window.settings, lambda: wb.revision, wb.files.save_workspace, self._status, self.window)
+        self.autosave = Autosave(self.window.settings, lambda: wb.revision, lambda path: wb.files.save_workspace(path, hold=False), self._status, self.window)
         self.restore_actions: dict[str, QAction] = {}
         for path in self.autosave.orphans():
             stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))

@@ -364,5 +364,6 @@ class OperatorCore:
         if rec is not None:
             rec.wait_finished(5.0)  # a file finishing in the background is not cut off by the exit
         self.arm.close()
+        self.files.release()  # the workspace file is free for another window
         if self.site is not None:
             self.site.close()

@@ -52,6 +52,7 @@ def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_a
     true_cam = site.bed.true_cam2world(q_task)
     assert np.linalg.norm(at_task.cam2world_measured[:3, 3] - true_cam[:3, 3]) < 0.01
     core.files.save_workspace(tmp_path / "w.json")
+    core.files.release()  # quit (its window lets go of the file)
     # Quit, start again with the robot at home, restore, Calibrate: the same answer, not a 432 mm one.
     again = OperatorCore(cell, site)
     still_for(again, joints_deg=cell.home_joints)

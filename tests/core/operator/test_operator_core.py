@@ -67,6 +67,7 @@ def test_a_workspace_opens_on_its_own_cell_only(core, tmp_path):
     path = tmp_path / "w.json"
     core.files.save_workspace(path)
     assert load_workspace(path).cell == core.cell.identity.to_dict()
+    core.close()  # one window at a time on a workspace file
     other = OperatorCore(Cell.open())
     other.editor.add_feature("oru_1", "extra", [1, 2, 3])  # now another cell
     with pytest.raises(CellMismatchError, match="belongs to the cell 'space station robotic test bed'"):
