@@ -78,7 +78,9 @@ def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
             sys.stderr.flush()
             os._exit(128 + signum)
         app.setProperty("videocal_quit_by_signal", True)  # closing asks nothing; unsaved work stays in the autosave
-        app.quit()
+        # queued, not called: between ``running = True`` and the loop taking its first event, quit() does nothing
+        # and the signal would be lost
+        QTimer.singleShot(0, app.quit)
 
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, quit_by_signal)
