@@ -37,6 +37,10 @@ class ConnectorEvents:
         self._state = state
         self._emit(self.state_changed, state, reason)
 
+    def _restate(self, reason: str) -> None:
+        """The state as it is, with a new reason: what the user needs to know has changed, the state has not."""
+        self._emit(self.state_changed, self._state, reason)
+
     def _emit(self, signal, *args) -> None:
         try:
             signal.emit(*args)

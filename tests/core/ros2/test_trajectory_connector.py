@@ -250,3 +250,36 @@ def test_a_move_ends_when_the_joint_states_stop_not_at_its_deadline(arm):
         assert not link.move_joints([0, -30, 60, 0, 45, 100]).sent
     finally:
         link.close()
+
+
+def test_joint_states_of_other_names_say_which_came_and_which_renaming_fits(domain):
+    """`monitor` said "waiting for /joint_states" while hundreds of messages arrived whose names the cell's robot does
+    not have (only the statistics counted them). The link's state now names what came and what is missing, and the
+    renaming when the names are this robot's with a prefix."""
+    dp = DomainParticipant(domain)
+    qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10))
+    writer = DataWriter(dp, Topic(dp, "rt/joint_states", Joints), qos=qos)
+    link = open_controller("ros2:///joint_states", _context())
+    states = []
+    link.state_changed.connect(lambda state, why: states.append((state, why)))
+    link.start()
+    try:
+        assert wait_until(lambda: writer.get_publication_matched_status().current_count > 0)
+        prefixed = [f"ur10e_{n}" for n in NAMES]
+        writer.write(Joints(Hdr(Stamp(1_700_000_000, 0), "base"), prefixed, [0.0] * 6, [], []))
+        assert wait_until(lambda: any("arrives without this cell's joints" in why for _, why in states))
+        why = states[-1][1]
+        assert link.state is LinkState.CONNECTING and "ur10e_shoulder_pan" in why and "missing shoulder_pan" in why
+        assert "shoulder_pan -> ur10e_shoulder_pan" in why
+        writer.write(Joints(Hdr(Stamp(1_700_000_001, 0), "base"), ["finger_a", "finger_b"], [0.0, 0.0], [], []))
+        assert wait_until(lambda: link.stats_snapshot()["wrong_joint_count"] == 2)
+    finally:
+        link.close()
+
+
+def test_a_renaming_is_suggested_only_when_it_is_one_to_one():
+    from calib_core.ros2.trajectory_connector import suggest_joint_names
+
+    assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "left_b_joint"]) == {"a_joint": "left_a_joint", "b_joint": "left_b_joint"}
+    assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "right_a_joint", "left_b_joint"]) is None
+    assert suggest_joint_names(["a_joint"], ["finger"]) is None
