@@ -203,8 +203,14 @@ def _fanuc_attr(line_count: int, when: str) -> list[str]:
             "      ABORT_REQUEST\t= 0,", "      PAUSE_REQUEST\t= 0;", "DEFAULT_GROUP\t= 1,*,*,*,*;", "CONTROL_CODE\t= 00000000 00000000;"]
 
 
+FANUC_UNTAUGHT = "TEACH ME"
+"""What a FANUC position's CONFIG says until taught: not a configuration (those are 'F|N U|D T|B, t1, t4, t6'), so the
+controller refuses the listing rather than loading a guessed one (docs/decisions.md says why none is derived)."""
+
+
 def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), tool: np.ndarray | None = None) -> list[str]:
-    notes = [f"videocal corrected task locations, {when}", "X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W)) in the robot's world frame; CONFIG must be taught"]
+    notes = [f"videocal corrected task locations, {when}", "positions in the robot's world frame: X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W))",
+             f"CONFIG is not known: each P[n] says '{FANUC_UNTAUGHT}', which the controller refuses: teach it (TOUCHUP) before use"]
     if tool is not None:
         x, y, z, w, p, r = fanuc_position(tool)
         notes += ["the tool frame (UTOOL 1) the targets are for, on the faceplate:", f"X {x:.3f} Y {y:.3f} Z {z:.3f} W {w:.3f} P {p:.3f} R {r:.3f}"]
@@ -213,7 +219,7 @@ def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), to
     for k, e in enumerate(entries, start=1):
         x, y, z, w, p, r = fanuc_position(e.pose)
         lines += [
-            f'P[{k}:"{e.ident}"]{{', "   GP1:", "\tUF : 0, UT : 1,\t\tCONFIG : 'N U T, 0, 0, 0',",
+            f'P[{k}:"{e.ident}"]{{', "   GP1:", f"\tUF : 0, UT : 1,\t\tCONFIG : '{FANUC_UNTAUGHT}',",
             f"\tX = {x:10.3f}  mm,\tY = {y:10.3f}  mm,\tZ = {z:10.3f}  mm,",
             f"\tW = {w:10.3f} deg,\tP = {p:10.3f} deg,\tR = {r:10.3f} deg", "};",
         ]

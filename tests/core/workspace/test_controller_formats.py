@@ -154,3 +154,19 @@ def test_each_listing_carries_the_tool_its_targets_are_for(table):
     assert np.allclose(values[:3], tool[:3, 3], atol=1e-3) and np.allclose(Rotation.from_euler("xyz", values[3:], degrees=True).as_matrix(), tool[:3, :3], atol=1e-5)
     assert "$TOOL := POS(12.500, -3.000, 187.250," in controller_listing("pdl2", t, tasks, tool=tool)
     assert "videocal_tool" not in controller_listing("krl", t, tasks)  # no robot given: no tool data, nothing made up
+
+
+def test_a_fanuc_listing_carries_no_configuration_a_controller_would_load(table):
+    """It carried CONFIG : 'N U T, 0, 0, 0', which a controller loads as it is: a guess at the arm's configuration.
+    Each position now says it is not known, in a form the controller refuses, and the remarks say to teach it."""
+    import re
+
+    from calib_core.workspace.controller_formats import FANUC_UNTAUGHT
+
+    t, tasks = table
+    listing = controller_listing("fanuc", t, tasks, "cell_targets")
+    configs = re.findall(r"CONFIG : '([^']*)'", listing)
+    assert configs and set(configs) == {FANUC_UNTAUGHT}
+    # FANUC's form: a flip, an up/down and a top/bottom letter, then three turn numbers; this is none
+    assert not re.fullmatch(r"[FN] [UD] [TB], -?\d, -?\d, -?\d", FANUC_UNTAUGHT)
+    assert "teach it (TOUCHUP) before use" in listing
