@@ -5,7 +5,7 @@ the Foxglove MCAP the recorder writes. Written with ``rosbags`` (MCAP storage, R
   recording (the H.264 track decoded frame by frame);
 - ``/joint_states``: ``sensor_msgs/JointState`` in the robot's URDF joint names, **radians and metres** (a recording
   holds degrees and mm: the workcell's robot says which joint is prismatic);
-- ``/camera/camera_info``: ``sensor_msgs/CameraInfo`` from the recording's camera (plumb_bob), once.
+- ``/camera/camera_info``: ``sensor_msgs/CameraInfo`` from the recording's camera, with every image at its stamp.
 """
 
 from __future__ import annotations
@@ -76,6 +76,8 @@ def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_
     with writer:
         if len(track):
             images = writer.add_connection(IMAGE_TOPIC, "sensor_msgs/msg/CompressedImage", typestore=ts)
+            info = _camera_info(T, intrinsics, camera_frame) if intrinsics else None
+            infos = writer.add_connection(INFO_TOPIC, "sensor_msgs/msg/CameraInfo", typestore=ts) if info is not None else None
             for k, message in enumerate(track.messages):
                 rgb = track.image(k)
                 if rgb is None:
@@ -85,8 +87,11 @@ def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_
                 msg = T["sensor_msgs/msg/CompressedImage"](header=header, format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
                 writer.write(images, message.log_time_ns, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
                 counts[IMAGE_TOPIC] += 1
-            if intrinsics:
-                counts[INFO_TOPIC] = _write_camera_info(writer, ts, T, intrinsics, track.messages[0].log_time_ns, camera_frame)
+                if info is not None:
+                    # one CameraInfo with every image, at its stamp: image_proc and most consumers pair them by stamp
+                    info.header = header
+                    writer.write(infos, message.log_time_ns, ts.serialize_cdr(info, "sensor_msgs/msg/CameraInfo"))
+                    counts[INFO_TOPIC] += 1
         if joints:
             connection = writer.add_connection(JOINT_TOPIC, "sensor_msgs/msg/JointState", typestore=ts)
             per_si = np.array([math.pi / 180.0 if u == "deg" else 1e-3 for u in joint_units])
@@ -111,14 +116,13 @@ def _units_from_workcell(recording: Path, workcell: str | None, n: int) -> list[
     return units
 
 
-def _write_camera_info(writer, ts, T, intrinsics: dict, t_ns: int, camera_frame: str) -> int:
+def _camera_info(T, intrinsics: dict, camera_frame: str):
+    """The recording's camera as a ``sensor_msgs/CameraInfo`` (its header set per image)."""
     fu, fv, cx, cy = (float(intrinsics[k]) for k in ("fu", "fv", "cx", "cy"))
     d = [float(v) for v in intrinsics.get("distortion", [0.0] * 5)]
-    kind = "sensor_msgs/msg/CameraInfo"
-    connection = writer.add_connection(INFO_TOPIC, kind, typestore=ts)
     roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
-    info = T[kind](header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=camera_frame), height=int(intrinsics["height"]), width=int(intrinsics["width"]),
-                   distortion_model=str(intrinsics.get("distortion_model", "plumb_bob")), d=np.array(d, float), k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
-                   p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float), binning_x=0, binning_y=0, roi=roi)
-    writer.write(connection, t_ns, ts.serialize_cdr(info, kind))
-    return 1
+    header = T["std_msgs/msg/Header"](stamp=_stamp(T, 0), frame_id=camera_frame)
+    return T["sensor_msgs/msg/CameraInfo"](header=header, height=int(intrinsics["height"]), width=int(intrinsics["width"]),
+                                           distortion_model=str(intrinsics.get("distortion_model", "plumb_bob")), d=np.array(d, float),
+                                           k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
+                                           p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float), binning_x=0, binning_y=0, roi=roi)

@@ -31,13 +31,18 @@ def test_the_sample_session_reads_back_as_ros_messages(tmp_path):
     track = FrameTrack(contents)
     samples = contents.topic(JOINTS_TOPIC)
     setup = contents.topic(SETUP_TOPIC)[-1].payload
-    assert counts[JOINT_TOPIC] == len(samples) and counts[INFO_TOPIC] == 1 and 0 < counts[IMAGE_TOPIC] <= len(track)
+    assert counts[JOINT_TOPIC] == len(samples) and 0 < counts[IMAGE_TOPIC] <= len(track)
+    assert counts[INFO_TOPIC] == counts[IMAGE_TOPIC]  # a CameraInfo with every image (it had one for 139 images)
     with AnyReader([out], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
         topics = {c.topic: c.msgtype for c in reader.connections}
         assert topics == {IMAGE_TOPIC: "sensor_msgs/msg/CompressedImage", JOINT_TOPIC: "sensor_msgs/msg/JointState", INFO_TOPIC: "sensor_msgs/msg/CameraInfo"}
         states = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == JOINT_TOPIC])]
         images = [(t, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages([c for c in reader.connections if c.topic == IMAGE_TOPIC])]
-        info = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == INFO_TOPIC])][0]
+        infos = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == INFO_TOPIC])]
+        info = infos[0]
+    # each image's CameraInfo has its stamp and frame, as image_proc pairs them
+    assert [(m.header.stamp.sec, m.header.stamp.nanosec, m.header.frame_id) for m in infos] == \
+        [(m.header.stamp.sec, m.header.stamp.nanosec, m.header.frame_id) for _, m in images]
     assert list(states[0].name) == list(setup["joint_names"])
     np.testing.assert_allclose(states[5].position, np.radians(samples[5].payload["joints_deg"]), atol=1e-12)  # deg -> rad
     assert states[5].header.stamp.sec * 10**9 + states[5].header.stamp.nanosec == samples[5].log_time_ns
