@@ -108,15 +108,30 @@ class CameraPublisher:
         self._thread.join(timeout=3.0)
 
 
+PRIVATE_DOMAINS = (170, 229)
+"""The DDS domains a simulated arm takes when none is named: away from ROS 2's default (0) and the ones people pick,
+so a demo never commands, or is commanded by, a real robot on the workstation's own domain."""
+
+
+def private_domain() -> int:
+    """A domain for this process's simulated cell: within :data:`PRIVATE_DOMAINS`, by the process id (two demos at
+    once take two domains)."""
+    low, high = PRIVATE_DOMAINS
+    return low + os.getpid() % (high - low + 1)
+
+
 class Ros2SimulatedSite(SimulatedSite):
-    """A :class:`SimulatedSite` whose robot and camera are reached through ROS 2 (domain ``ROS_DOMAIN_ID``)."""
+    """A :class:`SimulatedSite` whose robot and camera are reached through ROS 2: on ``domain``, else on
+    ``ROS_DOMAIN_ID`` when the user set it, else on a private domain (:func:`private_domain`)."""
 
     def __init__(self, site: SimulatedSite, domain: int | None = None, weather=None, seed: int = 0):
         super().__init__(site.bed, camera_fps=site.camera_fps, camera_seed=site.camera_seed)
         from calib_core.ros2.wire import domain_id
 
-        self.domain = domain_id(domain)
-        self.description = f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain})"
+        private = domain is None and "ROS_DOMAIN_ID" not in os.environ
+        self.domain = private_domain() if private else domain_id(domain)
+        self.description = (f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain}"
+                            + (", a private one: set ROS_DOMAIN_ID to choose" if private else "") + ")")
         self.arm: Ros2ArmProcess | None = None
         self.publisher: CameraPublisher | None = None
         self.network = None
