@@ -14,7 +14,7 @@ from calib_core.vision.edge_refinement import refine_to_edges
 from calib_core.vision.locate import locate
 from calib_core.vision.region_model import RegionModel
 from calib_core.vision.outline import silhouette_mask
-from tests.core.vision.printed_box_scene import CAMERA, TRUTH, printed_box, render
+from videocal_sim.printed_box_scene import CAMERA, TRUTH, printed_box, render
 
 IDENTITY = np.eye(4)[None]
 

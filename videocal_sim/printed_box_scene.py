@@ -1,4 +1,4 @@
-"""A printed box on a wood-grained table, rendered by videocal's renderer with its truth known: the difficulties
+"""A printed box on a wood-grained table, rendered by videocal's renderer with its truth known (for tests and the real-photo bench): the difficulties
 of OpenCV's photographed cookie box (a frame printed 12 mm inside every face's edge, lettering, a table with
 grain and a shadow-dark patch) where the truth can score. A render, not a photograph."""
 
@@ -62,15 +62,18 @@ TRUTH[:3, :3] = Rotation.from_euler("zyx", [35.0, 0.0, -130.0], degrees=True).as
 TRUTH[:3, 3] = [-20.0, 10.0, 1100.0]
 
 
-def render(noise_seed: int = 0) -> np.ndarray:
-    """The photo (h, w, 3) uint8 RGB of the printed box at :data:`TRUTH` on the table, with sensor noise."""
+def render(noise_seed: int = 0, printed: bool = True) -> np.ndarray:
+    """The photo (h, w, 3) uint8 RGB of the printed box (or, ``printed`` False, a plain yellow one) at :data:`TRUTH` on
+    the table, with sensor noise."""
     from calib_core.render.renderer import RenderOptions, SceneRenderer
     from calib_core.scene import SceneItem
 
     mesh, texture, uv = printed_box()
     renderer = SceneRenderer(CAMERA.width, CAMERA.height)
     try:
-        renderer.set_items([SceneItem("box", mesh, TRUTH, color=(1.0, 1.0, 1.0), texture=texture, texture_coords=uv)])
+        item = (SceneItem("box", mesh, TRUTH, color=(1.0, 1.0, 1.0), texture=texture, texture_coords=uv) if printed
+                else SceneItem("box", mesh, TRUTH, color=(0.9, 0.75, 0.2)))
+        renderer.set_items([item])
         rgba = renderer.render_view(CAMERA, np.eye(4), RenderOptions(transparent_background=True, show_edges=False))
     finally:
         renderer.close()
@@ -78,3 +81,12 @@ def render(noise_seed: int = 0) -> np.ndarray:
     image = rgba[:, :, :3] * alpha + wood_table() * (1 - alpha)
     image = cv2.GaussianBlur(image.astype(np.float32), (0, 0), 0.7) + np.random.default_rng(noise_seed).normal(0, 2.5, image.shape)
     return np.clip(image, 0, 255).astype(np.uint8)
+
+
+def silhouette_centre_px() -> tuple[float, float]:
+    """The box's centre in the image at :data:`TRUTH` (px)."""
+    from calib_core.camera.projection import project_points
+
+    mesh, _, _ = printed_box()
+    u, v = project_points(np.asarray(mesh.vertices).mean(axis=0)[None], TRUTH, CAMERA)[0]
+    return float(u), float(v)
