@@ -3,6 +3,9 @@ the simulated camera on its worker thread, images at 640 x 480 (the same workflo
 rendering cost). ``window`` has the robot's typical kinematic errors and the modelled camera mounting;
 ``live_window`` makes one with other errors."""
 
+import os
+import time
+
 import pytest
 
 from app.gui.cell_launcher import CellLauncher
@@ -57,3 +60,43 @@ def offline_window(qtbot, tmp_path):
     win.show()
     yield win
     win.close()
+
+
+MODAL_LIMIT_S = float(os.environ.get("VIDEOCAL_TEST_MODAL_LIMIT_S", "60"))
+"""A modal dialog nobody answers for this long is closed and its test failed: the dialog's own event loop keeps
+Python's timeout handler from ever running, and a test stuck there would hold up the whole run."""
+
+
+@pytest.fixture(autouse=True)
+def unanswered_dialogs():
+    """Watches for a modal dialog left open (a question a test did not expect): closes it after
+    :data:`MODAL_LIMIT_S` and fails the test, naming the dialog."""
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
+
+    if QApplication.instance() is None:
+        yield
+        return
+    seen: dict = {"widget": None, "since": 0.0}
+    stuck: list[str] = []
+
+    def check():
+        widget = QApplication.activeModalWidget()
+        if widget is None or widget is not seen["widget"]:
+            seen["widget"], seen["since"] = widget, time.monotonic()
+            return
+        if time.monotonic() - seen["since"] > MODAL_LIMIT_S:
+            text = getattr(widget, "text", lambda: "")()
+            stuck.append(f"{type(widget).__name__} {widget.windowTitle()!r}: {text!r}")
+            widget.close()
+            if hasattr(widget, "reject"):
+                widget.reject()
+            seen["widget"] = None
+
+    timer = QTimer()
+    timer.timeout.connect(check)
+    timer.start(500)
+    yield
+    timer.stop()
+    if stuck:
+        pytest.fail(f"a modal dialog waited {MODAL_LIMIT_S:g} s for an answer and was closed: {stuck[0]}")
