@@ -56,12 +56,12 @@ def run(args: argparse.Namespace) -> int:
                     silent_since = now
                     print(f"waiting: {exc}", file=sys.stderr, flush=True)
                 if now - silent_since > args.wait:
-                    print(f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); {len(rows) - 1} of {args.count} frames kept in {args.out}", file=sys.stderr)
+                    print(f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); {_kept(rows, args)}", file=sys.stderr)
                     code = EXIT_SILENT
                     break
                 continue
             if frame is None:
-                print(f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames (kept in {args.out})", file=sys.stderr)
+                print(f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames ({_kept(rows, args)})", file=sys.stderr)
                 code = EXIT_SILENT
                 break
             if silent_since is not None:
@@ -86,3 +86,9 @@ def run(args: argparse.Namespace) -> int:
     if code == 0:
         print(f"{args.count} frames and frames.csv in {args.out}")
     return code
+
+
+def _kept(rows: list[str], args) -> str:
+    """What a grab that ended early leaves: the frames it got, or nothing at all."""
+    got = len(rows) - 1
+    return f"{got} of {args.count} frames kept in {args.out}" if got else f"0 of {args.count} frames: nothing was left behind"

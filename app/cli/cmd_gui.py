@@ -36,10 +36,16 @@ def run(args: argparse.Namespace) -> int:
         # Start the controller simulator first: its start-up then overlaps the window's imports. It dies with us.
         simulator = site_kind.start_early(args.workcell)
     try:
-        return _run_window(args, site_kind, simulator)
+        code = _run_window(args, site_kind, simulator)
     finally:
         if simulator is not None:
             simulator.stop()
+    # Everything is closed and written (the windows' close: autosave, recording, link). Leave without the interpreter's
+    # final clean-up: tearing down Qt, VTK, numba and DDS with their threads still in native code aborted the process
+    # about one exit in three ("FATAL: exception not rethrown", exit -6) after a clean close.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 def _is_real(args: argparse.Namespace) -> bool:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from calib_core.bags.bag_source import bag_intrinsics, choose_image_topic, open_reader
+from calib_core.bags.bag_source import bag_intrinsics, choose_image_topic, messages, open_reader
 from calib_core.bags.joint_track import JOINT_STATE, read_joint_track
 from calib_core.errors import FileFormatError
 
@@ -39,7 +39,7 @@ class BagFrames:
         self.path, self.topic, self._reader = path, topic, reader
         self._connections = [c for c in reader.connections if c.topic == topic]
         log, stamps = [], []
-        for _, log_ns, raw in reader.messages(connections=self._connections):
+        for _, log_ns, raw in messages(reader, self.path, connections=self._connections):
             log.append(log_ns)
             stamps.append(_header_stamp_ns(raw, log_ns))
         order = np.argsort(np.asarray(stamps, dtype=np.int64), kind="stable")
@@ -62,7 +62,7 @@ class BagFrames:
         if not 0 <= k < len(self):
             raise IndexError(f"frame {k} of a bag topic with {len(self)} images")
         log_ns = int(self.log_ns[k])
-        for connection, _, raw in self._reader.messages(connections=self._connections, start=log_ns, stop=log_ns + 1):
+        for connection, _, raw in messages(self._reader, self.path, connections=self._connections, start=log_ns, stop=log_ns + 1):
             if _header_stamp_ns(raw, log_ns) == self.stamps_ns[k]:
                 message = deserialize(self._reader, raw, connection, f"{self.path} {self.topic} image {k}")
                 return _rgb(message, connection.msgtype, f"{self.path} {self.topic} image {k}")

@@ -60,6 +60,21 @@ def open_reader(path: str | Path):
     return reader
 
 
+def messages(reader, path, **selection):
+    """``reader.messages(**selection)``, each (connection, log time ns, raw bytes); :class:`FileFormatError` naming the
+    bag when its storage turns out damaged on the way (a chunk whose checksum fails, a record cut short)."""
+    iterator = reader.messages(**selection)
+    while True:
+        try:
+            item = next(iterator)
+        except StopIteration:
+            return
+        except Exception as exc:  # rosbags' reader errors, and struct/zstd errors on damaged chunks
+            text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+            raise FileFormatError(Path(path), f"the bag is damaged: {text}") from None
+        yield item
+
+
 def deserialize(reader, raw: bytes, connection, where: str):
     """``raw`` read as the connection's message type; :class:`FileFormatError` naming ``where`` (the bag, topic and
     message) when its bytes are not that message in CDR (a bag written by another serializer, or damaged)."""
@@ -125,7 +140,7 @@ def bag_stamped_images(path: str | Path, topic: str | None = None, every: int = 
     chosen = choose_image_topic(path, topic)
     with open_bag(path) as reader:
         connections = [c for c in reader.connections if c.topic == chosen.name]
-        for k, (connection, log_ns, raw) in enumerate(reader.messages(connections=connections)):
+        for k, (connection, log_ns, raw) in enumerate(messages(reader, path, connections=connections)):
             if k % every:
                 continue
             message = deserialize(reader, raw, connection, f"{path} {chosen.name} message {k}")
@@ -151,6 +166,6 @@ def bag_camera_info(path: str | Path):
     """The first ``CameraInfo`` of the bag as ``(topic, message)``, or None."""
     with open_bag(path) as reader:
         connections = [c for c in reader.connections if c.msgtype == CAMERA_INFO]
-        for connection, _, raw in reader.messages(connections=connections):
+        for connection, _, raw in messages(reader, path, connections=connections):
             return connection.topic, deserialize(reader, raw, connection, f"{path} {connection.topic}")
     return None

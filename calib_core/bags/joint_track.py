@@ -77,7 +77,7 @@ def read_joint_track(path: str | Path, joint_names, per_si, topic: str | None = 
     """The arm's joints from a bag's JointState topic (``topic``, else the only one, else ``/joint_states``).
     ``per_si`` (n,): deg per rad or mm per m for each joint. :class:`FileFormatError` names the bag for no such topic,
     or no message with all of the arm's joints (and says which names it had)."""
-    from calib_core.bags.bag_source import deserialize, open_bag
+    from calib_core.bags.bag_source import deserialize, messages, open_bag
 
     names = list(joint_names)
     per_si = np.asarray(per_si, dtype=float)
@@ -96,7 +96,7 @@ def read_joint_track(path: str | Path, joint_names, per_si, topic: str | None = 
                 raise FileFormatError(path, f"several JointState topics: choose one with --joint-topic: {', '.join(topics)}")
             candidates = [c for c in candidates if c.topic == chosen]
         stamps, rows, seen_names = [], [], set()
-        for connection, log_ns, raw in reader.messages(connections=candidates):
+        for connection, log_ns, raw in messages(reader, path, connections=candidates):
             message = deserialize(reader, raw, connection, f"{path} {connection.topic}")
             listed = list(message.name)
             seen_names.update(listed)

@@ -110,14 +110,14 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
 
     path = Path(path)
     samples: dict[str, tuple[str, list]] = {}  # child -> (parent, [(stamp, xyz, quat)])
-    from calib_core.bags.bag_source import deserialize
+    from calib_core.bags.bag_source import deserialize, messages
 
     with open_bag(path) as reader:
         connections = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
         if not connections:
             held = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})) or "no messages"
             raise FileFormatError(path, f"no /tf in this bag (it holds {held}): the flange poses come from the transforms")
-        for connection, log_ns, raw in reader.messages(connections=connections):
+        for connection, log_ns, raw in messages(reader, path, connections=connections):
             for tf in deserialize(reader, raw, connection, f"{path} {connection.topic}").transforms:
                 parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
                 stamp = tf.header.stamp.sec * 1_000_000_000 + tf.header.stamp.nanosec or log_ns

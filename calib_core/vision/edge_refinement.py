@@ -184,8 +184,11 @@ class EdgeSamples:
     silhouette: tuple[np.ndarray, tuple[int, int]]
 
 
-def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None) -> EdgeSamples:
-    """The samples of :func:`edge_points`, with which of them lie on the outline (:class:`EdgeSamples`)."""
+def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None, *,
+               whole_outline: bool = False) -> EdgeSamples:
+    """The samples of :func:`edge_points`, with which of them lie on the outline (:class:`EdgeSamples`).
+    ``whole_outline``: the contour's samples fill every gap the mesh's own edges leave (for a fit of the outline by
+    colour); else only on a mesh whose own edges hold little of its outline (:data:`OUTLINE_ONLY_WHEN_UNCOVERED`)."""
     rims = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3])
     pts, far, clearance, chain = _crease_points(mesh, obj2cam, intrinsics, expected_magnitude, rims)
     silhouette = silhouette_mask(mesh, obj2cam, intrinsics)
@@ -194,8 +197,12 @@ def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magni
     if len(outline):
         uv = project_points(outline.points_mm, obj2cam, intrinsics)
         if len(pts):
-            # where a crease or silhouette sample lies within a step, the contour adds nothing (a CAD part's outline)
+            # where a crease or silhouette sample lies within a step, the contour adds nothing; and where the mesh's
+            # own edges hold most of its outline (a CAD part), the contour adds nothing at all: its few uncovered
+            # samples are corners and short facets, and the CAD fit is kept as it was
             keep = cKDTree(project_points(pts, obj2cam, intrinsics)).query(uv)[0] > _SAMPLE_STEP_PX + 0.5
+            if not whole_outline and keep.mean() < OUTLINE_ONLY_WHEN_UNCOVERED:
+                keep[:] = False
         else:
             keep = np.ones(len(uv), dtype=bool)
         if expected_magnitude is not None:
@@ -298,6 +305,9 @@ def model_shows_edge(magnitude: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return inside & (magnitude[v, u] >= _MIN_STRENGTH)
 
 
+OUTLINE_ONLY_WHEN_UNCOVERED = 0.5
+"""The contour's samples join the mesh's own edge samples only when more than this share of them lies away from
+any (a scanned mesh's outline: none of its facet edges holds a sample)."""
 CREASES_JOIN_PX = 2.0
 """With the outline found by colour, the creases join the fit once its search window is this narrow, px."""
 CREASES_AGREE_PX = 0.75
@@ -350,7 +360,8 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     (:mod:`calib_core.vision.region_model`) when its colours tell it from its surroundings, not at the strongest
     gradient (print, texture and clutter have gradients too)."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
-    model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude)
+    by_colour = colour is not None and colour.ndim == 3
+    model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude, whole_outline=by_colour)
     pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
     regions = None
     if colour is not None and colour.ndim == 3:
@@ -369,7 +380,7 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     for it in range(iterations):
         if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
             # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
-            model = edge_model(mesh, pose, intrinsics, expected_magnitude)
+            model = edge_model(mesh, pose, intrinsics, expected_magnitude, whole_outline=by_colour)
             pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
             sampled_at = pose
         if len(pts) < 12:

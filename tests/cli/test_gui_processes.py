@@ -70,7 +70,7 @@ def test_sigterm_closes_the_window_and_the_simulator(cell_copy, tmp_path):
         assert len(_simulators_for(cell_copy)) == 1
         gui.send_signal(signal.SIGTERM)
         gui.wait(timeout=30)
-        assert gui.returncode == 0
+        assert gui.returncode == 0, gui.communicate()[1][-1500:]
         assert _wait_gone(cell_copy) == []
     finally:
         if gui.poll() is None:

@@ -183,7 +183,24 @@ def loaders(folder: Path) -> dict:
         path.write_text(json.dumps(doc))
         return path
 
+    bag_folder, bag_mcap = _small_bag(out)
+    launch_xml = ('<launch>\n  <node pkg="tf2_ros" exec="static_transform_publisher" name="mounting" args="--x 0.081 --y -0.001 --z 0.088 '
+                  '--roll -1.745 --pitch 0.0 --yaw -1.571 --frame-id tool0 --child-frame-id camera_color_optical_frame"/>\n</launch>\n')
+    xacro_text = ('<robot name="fuzz" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <xacro:property name="l" value="0.3"/>\n'
+                  '  <xacro:macro name="link" params="n"><link name="${n}"/></xacro:macro>\n  <xacro:link n="base"/>\n  <xacro:link n="tip"/>\n'
+                  '  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 ${l}"/><axis xyz="0 0 1"/>'
+                  '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n</robot>\n')
+    url_texts = st.one_of(
+        st.builds(lambda scheme, rest: scheme + rest, st.sampled_from(["ros2://", "ros2:///", "socket://", "rfc2217://", "loop://", "ur-rtde://", "aravis://", ""]),
+                  st.text(max_size=60)),
+        st.from_regex(r"ros2:///[a-z_/]{1,20}\?[a-z_]{1,12}=[-0-9.a-z\x00\n]{0,12}(&[a-z_]{1,12}=[-0-9.a-z]{0,8}){0,3}", fullmatch=True),
+    )
+
     return {
+        "ros2_bag": (mutated_bytes(bag_mcap), lambda b: _read_bag(bag_folder, b)),
+        "launch_file": (mutated_text(launch_xml), lambda t: _load_mounting(yaml_file("mounting.launch.xml", text=t))),
+        "xacro": (mutated_text(xacro_text), lambda t: _expand(yaml_file("fuzz.urdf.xacro", text=t))),
+        "connector_url": (url_texts, _open_url),
         "workcell": (st.one_of(mutated(workcell_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(workcell_doc, sort_keys=False)).map(lambda t: ("text", t))),
                      lambda v: load_workcell(yaml_file("fuzz.yaml", v[1]) if v[0] == "doc" else yaml_file("fuzz.yaml", text=v[1]))),
         "intrinsics_ros": (st.one_of(mutated(ros_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(ros_doc)).map(lambda t: ("text", t))),
@@ -207,6 +224,54 @@ def loaders(folder: Path) -> dict:
         "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"(charuco|aruco):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}(:legacy)?", fullmatch=True),
                         st.from_regex(r"(chessboard|circles):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}(:asymmetric)?", fullmatch=True)), parse_board),
     }
+
+
+def _small_bag(out: Path) -> tuple[Path, bytes]:
+    """A ROS 2 bag of two images, a CameraInfo and a JointState written by rosbags; its folder and its MCAP's bytes."""
+    import shutil as _shutil
+
+    from tests.core.bags.bag_writing import write_bag
+
+    folder = out / "fuzz_bag"
+    _shutil.rmtree(folder, ignore_errors=True)
+    image = np.tile(np.arange(640, dtype=np.uint16).astype(np.uint8), (480, 1))  # the size its CameraInfo says
+    write_bag(folder, "mcap", {"/camera/image_raw": [image, image[::-1].copy()]})
+    mcap = next(folder.glob("*.mcap"))
+    return folder, mcap.read_bytes()
+
+
+def _read_bag(folder: Path, data: bytes):
+    from calib_core.bags.bag_source import bag_intrinsics, bag_stamped_images
+
+    next(folder.glob("*.mcap")).write_bytes(data)
+    images = list(bag_stamped_images(folder))
+    if images:
+        bag_intrinsics(folder, (images[0][2].shape[1], images[0][2].shape[0]))
+    return images
+
+
+def _load_mounting(path: Path):
+    from calib_core.vision.hand_eye_io import load_mounting
+
+    return load_mounting(path)
+
+
+def _expand(path: Path):
+    from calib_core.robot.xacro_expand import expand_xacro
+
+    return expand_xacro(path, [], timeout_s=5.0, memory_mb=512)
+
+
+def _open_url(url: str):
+    """A controller connector made (not started) and a camera spec checked, as a workcell's site: section is taken."""
+    from calib_core.connectors.controller import ControllerContext
+    from calib_core.connectors.registry import check_camera_spec, open_controller
+    from calib_core.link.joint_map import JointMap
+
+    scheme = url.split(":", 1)[0].lower()
+    if scheme in ("ros2", "socket", "rfc2217", "loop"):  # made without a connection (ur-rtde connects when made)
+        open_controller(url, ControllerContext(("a", "b"), ("deg", "deg"), JointMap.identity(2), 50.0, {}))
+    check_camera_spec(url)
 
 
 def _workspace_doc(folder: Path) -> dict:

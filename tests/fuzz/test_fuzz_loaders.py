@@ -14,7 +14,7 @@ import pytest
 from tests.fuzz.run_loader import ROOT
 
 LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec", "detector_settings", "cal_data", "pose_csv",
-           "robot_urdf", "recording", "mesh_ply", "locate_prior", "locate_features"]
+           "robot_urdf", "recording", "mesh_ply", "locate_prior", "locate_features", "ros2_bag", "launch_file", "xacro", "connector_url"]
 EXAMPLES = int(os.environ.get("VIDEOCAL_FUZZ_EXAMPLES", "150"))
 
 
