@@ -32,7 +32,8 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.solver.errors import SolverInputError
 from calib_core.vision.edge_alignment import edge_distance_map, edge_samples_px, matched_share
-from calib_core.vision.edge_refinement import SETTLED_RMS_PX, EdgeFit, edge_points, refine_to_edges
+from calib_core.vision.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
+from calib_core.vision.edge_samples import edge_points
 from calib_core.vision.feature_detectors import Detection, NotDetected
 from calib_core.vision.target_detectors import TargetDetectors, as_grey
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts

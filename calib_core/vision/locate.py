@@ -169,7 +169,7 @@ def image_distance_px(a: np.ndarray, b: np.ndarray, mesh, intrinsics: Intrinsics
     points are left out: on a nearly affine view a turn traded for depth moves a hidden back corner 15 px while
     every seen edge stays within 3."""
     from calib_core.camera.projection import project_points
-    from calib_core.vision.edge_refinement import edge_points
+    from calib_core.vision.edge_samples import edge_points
 
     seen = edge_points(mesh, a, intrinsics)[0]
     if not len(seen):

@@ -92,7 +92,7 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
 def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Points (k, 3) mm along the rim edges (``rims`` (E, 2, 3) when the caller has them), about a pixel apart in
     the image, and their pixels (k, 2)."""
-    from calib_core.vision.edge_refinement import silhouette_segments
+    from calib_core.vision.edge_samples import silhouette_segments
 
     seg = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3]) if rims is None else rims
     if not len(seg):

@@ -14,7 +14,7 @@ from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.vision.corner_against_model import detect_corner_against_model
 from calib_core.vision.edge_alignment import crease_segments
-from calib_core.vision.edge_refinement import model_shows_edge
+from calib_core.vision.edge_samples import model_shows_edge
 from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_circle_against_model, detect_corner, detect_corner_from_edges, gradient_magnitude
 from calib_core.workcell.feature_kinds import FeatureKind
 

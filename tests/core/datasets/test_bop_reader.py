@@ -17,7 +17,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.datasets.bop import BopDataset
 from calib_core.datasets.pose_errors import mspd
 from calib_core.errors import FileFormatError
-from calib_core.vision.edge_refinement import edge_points
+from calib_core.vision.edge_samples import edge_points
 from calib_core.vision.locate import locate
 
 K = Intrinsics(572.4, 573.6, 325.3, 242.0, 640, 480)

@@ -5,7 +5,7 @@ import trimesh
 
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.solver.clustered_covariance import clustered_scatter
-from calib_core.vision.edge_refinement import edge_chains
+from calib_core.vision.edge_samples import edge_chains
 
 
 def test_a_box_has_twelve_chains_and_a_cylinder_s_rims_one_each():

@@ -6,7 +6,7 @@ import numpy as np
 import trimesh
 
 from calib_core.frames import make_transform
-from calib_core.vision.edge_refinement import _clearance, _segment_keys, visible_segments
+from calib_core.vision.edge_samples import _clearance, _segment_keys, visible_segments
 
 
 def test_a_crease_on_the_silhouette_is_sampled_once():
