@@ -15,7 +15,7 @@ from scipy.spatial import cKDTree
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.vision.edge_alignment import crease_segments
-from calib_core.vision.outline import outline_samples, silhouette_mask
+from calib_core.vision.outline import outline_samples, silhouette_mask, silhouette_segments
 
 SAMPLE_STEP_PX = 4.0
 """A sample every this many pixels along an edge."""
@@ -26,17 +26,6 @@ _CROWDED_PX = 3.0
 OUTLINE_ONLY_WHEN_UNCOVERED = 0.5
 """The contour's samples join the mesh's own edge samples only when more than this share of them lies away from
 any (a scanned mesh's outline: none of its facet edges holds a sample)."""
-
-def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:
-    """The occluding contour seen from ``centre_mm`` (3,) (mesh frame): edges between a face turned to the
-    camera and one turned away, whatever their angle (a pin's round side has no crease). (E, 2, 3) mm."""
-    pairs = mesh.face_adjacency
-    normals = mesh.face_normals[pairs]  # (E, 2, 3)
-    mid = mesh.vertices[mesh.face_adjacency_edges].mean(axis=1)
-    toward = np.einsum("eij,ej->ei", normals, centre_mm - mid) > 0
-    contour = toward[:, 0] != toward[:, 1]
-    return mesh.vertices[mesh.face_adjacency_edges[contour]]
-
 
 def _segment_keys(seg: np.ndarray) -> list[bytes]:
     """One key per segment (E, 2, 3), the same for both directions (to 1 um)."""

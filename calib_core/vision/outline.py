@@ -50,6 +50,17 @@ class Outline:
         return len(self.points_mm)
 
 
+def silhouette_segments(mesh, centre_mm: np.ndarray) -> np.ndarray:
+    """The occluding contour seen from ``centre_mm`` (3,) (mesh frame): edges between a face turned to the
+    camera and one turned away, whatever their angle (a pin's round side has no crease). (E, 2, 3) mm."""
+    pairs = mesh.face_adjacency
+    normals = mesh.face_normals[pairs]  # (E, 2, 3)
+    mid = mesh.vertices[mesh.face_adjacency_edges].mean(axis=1)
+    toward = np.einsum("eij,ej->ei", normals, centre_mm - mid) > 0
+    contour = toward[:, 0] != toward[:, 1]
+    return mesh.vertices[mesh.face_adjacency_edges[contour]]
+
+
 def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, tuple[int, int]]:
     """The mesh's faces turned to the camera, filled: a uint8 mask over the part of the image the object
     covers (255 inside) and its top-left pixel (u0, v0). Faces reaching behind :data:`NEAR_MM` are left out."""
@@ -92,8 +103,6 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
 def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Points (k, 3) mm along the rim edges (``rims`` (E, 2, 3) when the caller has them), about a pixel apart in
     the image, and their pixels (k, 2)."""
-    from calib_core.vision.edge_samples import silhouette_segments
-
     seg = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3]) if rims is None else rims
     if not len(seg):
         return np.zeros((0, 3)), np.zeros((0, 2))
