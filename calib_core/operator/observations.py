@@ -24,7 +24,10 @@ from calib_core.video.frame import Frame
 
 
 RECENT_FRAMES = 16
-"""The frames kept to fall back on while the newest wait for their joint samples (at 15 fps, about a second)."""
+"""The frames always kept to fall back on while the newest wait for their joint samples (at 15 fps, about a second)."""
+RECENT_BYTES = 256 * 2**20
+"""Beyond :data:`RECENT_FRAMES`, older frames are kept while they are younger than the joint stream can lag
+(twice the link's spread of delays, plus half a second) and their pixels take no more than this (bytes)."""
 
 
 class NotSettledError(OperatorError):
@@ -62,7 +65,8 @@ class Observations:
         """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread."""
         self.source = "live"
         self.latest: Frame | None = None
-        self._recent: deque[Frame] = deque(maxlen=RECENT_FRAMES)
+        self._recent: deque[Frame] = deque()
+        self._recent_bytes = 0
         self.still: HeldFrame | None = None
 
     @property
@@ -72,8 +76,21 @@ class Observations:
     def observe(self, frame: Frame) -> None:
         """A frame of the current source arrived: ``frame_observed``."""
         self.latest = frame
-        self._recent.append(frame)
+        self._keep(frame)
         self.frame_observed.emit(frame)
+
+    def _keep(self, frame: Frame) -> None:
+        # By time, not by count: on a far link the joint samples of a frame arrive up to the link's spread later
+        # than the frame, and a fixed count of frames at a high rate would all be waiting at once.
+        self._recent.append(frame)
+        self._recent_bytes += frame.image.nbytes
+        window_s = 2.0 * self.margin_s() + 0.5
+        while len(self._recent) > RECENT_FRAMES:
+            oldest = self._recent[0]
+            if frame.t_host_s - oldest.t_host_s <= window_s and self._recent_bytes <= RECENT_BYTES:
+                break
+            self._recent.popleft()
+            self._recent_bytes -= oldest.image.nbytes
 
     def replay(self, history: JointHistory, name: str) -> None:
         """A recording ``name`` stands in for the live source: its frames, stamped by its ``history``
@@ -90,6 +107,7 @@ class Observations:
         self.history, self.source, self.margin_s = history, source, margin_s
         self.latest = None
         self._recent.clear()
+        self._recent_bytes = 0
         self.source_changed.emit(source)
 
     def stillness(self, frame: Frame) -> Stillness:
@@ -118,9 +136,11 @@ class Observations:
         """The newest frame whose joint samples have arrived: the joint stream lags the frames by up to a sample
         period (20 ms at 50 Hz) on a near link, and by the link's spread of delays on a far one (most of a second at
         1.5 s +-30 %), so the newest frames may not be judged yet. The newest of all when none can be."""
-        for frame in reversed(self._recent):
-            if not self.stillness(frame).pending:
-                return frame
+        newest_sample_s = self.history.latest_s
+        if newest_sample_s is not None:
+            for frame in reversed(self._recent):
+                if frame.t_host_s <= newest_sample_s:
+                    return frame
         return self.latest
 
     def hold(self, frame: Frame | None = None) -> HeldFrame:
