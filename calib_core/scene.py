@@ -40,3 +40,6 @@ class SceneItem:
     texture_coords: np.ndarray | None = None
     opacity: float = 1.0
     """Below 1: drawn see-through (a ghost robot of a previewed move)."""
+    form_tolerance_mm: float = 0.0
+    """How far the real part's features may lie from their CAD positions: 1-sigma per axis, mm (0: the part is its
+    CAD). A look at the part carries it in its uncertainty (:mod:`calib_core.calibration.form_error`)."""

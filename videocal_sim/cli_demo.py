@@ -33,6 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="put the controller far away: this one-way delay, +-30 %% jitter, 1 %% lost, on videocal's link (--site sim: a TCP "
                              "delay line) or ROS 2's (--site ros2: the arm in a network namespace of its own, every DDS packet delayed; "
                              "needs root); the frames follow the link's samples, as a gripper camera's would")
+    parser.add_argument("--look", choices=("plain", "workshop"), default="plain",
+                        help="how the simulated camera's images look: plain (the parts as their CAD, one key light; default) or workshop "
+                             "(the parts printed and up to a millimetre off their CAD, three lamps casting shadows, highlights, a noisier and "
+                             "softer camera: what a real camera shows)")
     parser.add_argument("--method", choices=("find-points", "picks", "edges"), default="find-points",
                         help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges")
 
@@ -48,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method, site_kind=args.site, link_delay_ms=args.link_delay_ms)
-    print(json.dumps({k: report[k] for k in ("site", "status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
+    report = run_demo(args.out, scale=args.scale, workcell=args.workcell or DEFAULT_WORKCELL, location=args.location, method=args.method, site_kind=args.site, link_delay_ms=args.link_delay_ms, look=args.look)
+    print(json.dumps({k: report[k] for k in ("site", "camera_look", "status", "pairs", "rms_px", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "uncorrected_tcp_error_mm")}, indent=2))
     print(f"screenshots and report.json in {args.out}")
     # The window, its link and its camera are closed and report.json is written: leave without the interpreter's final
     # clean-up, which tore down Qt and the connectors' native threads in any order (a good run once ended with exit 134,

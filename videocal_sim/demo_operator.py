@@ -92,7 +92,7 @@ METHODS = ("find-points", "picks", "edges")
 
 
 def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points", site_kind: str = "sim",
-             link_delay_ms: float = 0.0) -> dict:
+             link_delay_ms: float = 0.0, look: str = "plain") -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
@@ -104,7 +104,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     # as exact): the demo's true robot has typical joint, link and base errors and the modelled camera mounting.
     n_joints = load_workcell(workcell).load_robot().n_joints
     typical = RobotErrors.typical(0, n_joints=n_joints)
-    cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale)
+    cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale,
+                                less_kind=look == "workshop")
     weather = None
     if link_delay_ms:  # the same cell far away, with the weather
         from videocal_sim.delay_line import LinkWeather
@@ -315,6 +316,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "task_location": task.name,
             "method": method,
             "site": site.description,
+            "camera_look": look,
             "link": {"one_way_ms": link_delay_ms, "measured_one_way_s": getattr(wb.link, "delay_s", None), "go_to_settled_frame_s": [round(v, 2) for v in looks_s]},
             "connectors": {"controller": wb.link.url, "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(site_kind, "the simulated camera (in process)")},
             "target": wb.session.target,

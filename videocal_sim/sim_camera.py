@@ -17,6 +17,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.render import RenderOptions, SceneRenderer
+from calib_core.render.studio import Studio
 from calib_core.scene import SceneItem
 from calib_core.camera.distortion_map import distortion_map
 from calib_core.video.frame import Frame, FrameSource
@@ -35,6 +36,9 @@ class CameraLook:
     light_direction: tuple[float, float, float] = (-0.5, 0.4, 0.8)
     light_intensity: float = 0.8
     background: tuple[float, float, float] = (0.30, 0.31, 0.33)
+    studio: Studio | None = None
+    """Lamps that cast shadows and glossy surfaces (:func:`videocal_sim.real_look.real_camera_look`) instead of the
+    key light; ``None``: the key light (``light_direction``, ``light_intensity``)."""
     supersample: int | None = None
     """Samples per pixel side (``None``: enough for a render at least :data:`FINE_WIDTH_PX` wide, at
     most 8). A sensor integrates the light over each pixel, a renderer samples the pixel's centre:
@@ -149,7 +153,10 @@ class SimulatedCamera(FrameSource):
         renderer = self._renderers.get(samples)
         if renderer is None:  # one per sample count: a coarse and a fine one while live
             renderer = self._renderers[samples] = SceneRenderer(fine.width, fine.height)
-            renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
+            if self.look.studio is not None:
+                renderer.set_studio(self.look.studio)
+            else:
+                renderer.set_lighting(self.look.light_intensity, self.look.light_direction)
         renderer.set_items(items)
         ideal = renderer.render_view(fine, cam2world, RenderOptions(background=self.look.background, show_edges=False))
         if samples > 1:  # an exact box filter for an integer factor

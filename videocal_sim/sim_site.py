@@ -58,7 +58,8 @@ class SimulatedSite:
 
 
 def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: RobotErrors | None = None, image_scale: float = 1.0,
-                   process: SimulatorProcess | None = None, camera_fps: float = 15.0, intrinsics: Intrinsics | None = None) -> tuple[Cell, SimulatedSite]:
+                   process: SimulatorProcess | None = None, camera_fps: float = 15.0, intrinsics: Intrinsics | None = None,
+                   less_kind: bool = False) -> tuple[Cell, SimulatedSite]:
     """The cell at ``workcell_path`` and a simulated site for it: the true robot has ``errors``
     (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels); ``intrinsics``: another
     camera than the workcell's (its lens, a fisheye), the same for the simulated camera and the cell's model."""
@@ -69,6 +70,13 @@ def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: Robo
     if image_scale != 1.0:
         nominal = nominal.scaled(image_scale)
     bed = TestBed.create(workcell, errors=errors, intrinsics=nominal)
+    if less_kind:
+        from videocal_sim.real_look import WORKSHOP_FORM_TOLERANCE_MM, make_less_kind
+
+        make_less_kind(bed)
+        for component in workcell.components:  # what the cell's drawings state of such parts (the truth's field stays unread)
+            if component.kind == "component":
+                component.form_tolerance_mm = WORKSHOP_FORM_TOLERANCE_MM
     cell = Cell.from_workcell(workcell, intrinsics=nominal)
     bed.joints_deg = np.array(cell.home_joints, dtype=float)
     return cell, SimulatedSite(bed, process=process, camera_fps=camera_fps)

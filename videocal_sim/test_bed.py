@@ -37,6 +37,9 @@ class TestBed:
     true_components: list[SceneItem] | None = None
     """Where the cell's components really are (``None``: where the workcell file says; the cold cell
     moves each by its survey error)."""
+    camera_look: CameraLook | None = None
+    """How the camera's images look when :meth:`camera` is not told (``None``: :class:`CameraLook`'s defaults;
+    :func:`videocal_sim.real_look.make_less_kind`: a workshop's)."""
     _model_visuals: RobotVisuals | None = field(default=None, repr=False)
 
     __test__ = False  # not a pytest test class despite its name
@@ -77,5 +80,5 @@ class TestBed:
     def camera(self, *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0, intrinsics: Intrinsics | None = None, live: bool = False) -> SimulatedCamera:
         """The test bed's camera, following ``joints_deg``; ``live``: video for the window (frames of
         a moving robot point-sampled, :attr:`SimulatedCamera.coarse_while_moving`)."""
-        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, lambda: self.joints_deg.copy(), fps=fps, look=look, seed=seed,
+        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, lambda: self.joints_deg.copy(), fps=fps, look=look or self.camera_look, seed=seed,
                                coarse_while_moving=live)

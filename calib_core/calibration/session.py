@@ -16,6 +16,7 @@ from calib_core.calibration.commands import AddPoint3D, ClearPairs, DeletePair, 
 from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.calibration.correspondences import CorrespondenceSet
 from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution, shared_shift_covariance
+from calib_core.calibration.form_error import form_error_covariance
 from calib_core.calibration.undo import Command, UndoStack
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
@@ -59,14 +60,18 @@ class SolveContext:
     view_sources: tuple[str, ...] = ("live",)
     """Where the frames of the look came from: ``live``, or a recording's name (see
     :class:`~calib_core.calibration.view_stamp.ViewStamp`)."""
+    form_tolerance_mm: float = 0.0
+    """The target's features about their CAD positions (1-sigma per axis, mm): :attr:`SceneItem.form_tolerance_mm`."""
 
 
 def _shared(context: SolveContext | None, obj2cam):
-    """The result's covariance (6, 6) from the image points' shared error, or None when the solve's
-    points or camera are not known."""
+    """The result's covariance (6, 6) from what the residuals cannot show: the image points' shared error and the
+    target's form tolerance (its features off their CAD positions); None when the solve's points or camera are not
+    known."""
     if context is None or context.points_obj_mm is None or context.intrinsics is None:
         return None
-    return shared_shift_covariance(obj2cam, context.points_obj_mm, context.intrinsics)
+    return (shared_shift_covariance(obj2cam, context.points_obj_mm, context.intrinsics)
+            + form_error_covariance(obj2cam, context.points_obj_mm, context.intrinsics, context.form_tolerance_mm))
 
 
 class _ShowResult(Command):
@@ -189,9 +194,11 @@ class CalibrationSession:
         self.undo.push(ClearPairs(self.pairs))
 
     # --- solve ---------------------------------------------------------------------------------
-    def calibrate(self, intrinsics: Intrinsics, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg=None) -> EndEffectorEstimate:
+    def calibrate(self, intrinsics: Intrinsics, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg=None, *,
+                  form_tolerance_mm: float = 0.0) -> EndEffectorEstimate:
         """``Calibrate``: solve the camera pose from the usable pairs (in the target's frame) with
-        the modelled camera pose as the prior, and the real end-effector location from it."""
+        the modelled camera pose as the prior, and the real end-effector location from it; its uncertainty carries the
+        target's ``form_tolerance_mm`` (1-sigma of its features about their CAD positions)."""
         if self.target is None:
             raise CalibrationError("choose the target object first")
         use = self.pairs.usable()
@@ -207,24 +214,25 @@ class CalibrationSession:
             solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
         return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics,
-                                label=f"Calibrate ({len(numbers)} pairs)")
+                                label=f"Calibrate ({len(numbers)} pairs)", form_tolerance_mm=form_tolerance_mm)
 
     def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int], *,
                     points_obj_mm=None, intrinsics: Intrinsics | None = None, view_sources: tuple[str, ...] | None = None,
-                    label: str | None = None) -> EndEffectorEstimate:
+                    label: str | None = None, form_tolerance_mm: float = 0.0) -> EndEffectorEstimate:
         """Make ``solution`` this session's result. With a ``label`` it is an operator's solve: one
         command on the undo stack (undo brings the previous result back); without, a solve shown from
         elsewhere (a recording being replayed), which is not an edit. With the solve's
         ``points_obj_mm`` (m, 3, the target's frame) and ``intrinsics`` the result's covariance
         carries the image points' shared error
-        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`). ``view_sources``:
+        (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`) and the target's
+        ``form_tolerance_mm`` (:func:`~calib_core.calibration.form_error.form_error_covariance`). ``view_sources``:
         where the look's frames came from (default: the used pairs' stamps)."""
         used = [p for p in self.pairs if p.number in set(numbers)]
         points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
         if view_sources is None:
             view_sources = tuple(sorted({p.view.source for p in used if p.view is not None})) or ("live",)
         context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
-                               points, intrinsics, tuple(view_sources))
+                               points, intrinsics, tuple(view_sources), float(form_tolerance_mm))
         result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=_shared(context, solution.obj2cam))
         solved = (result, context, 0)  # the verdict is judged where it is shown (restore_result)
         if label is None:

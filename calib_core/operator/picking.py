@@ -49,7 +49,8 @@ class Picking:
         target = self.session.target
         if target is None:
             raise CalibrationError("choose the target object first")
-        obj2world = self.cell.workcell.component(target).item2world
+        item = self.cell.workcell.component(target)
+        obj2world = item.item2world
         use = self.session.pairs.usable()
         unbound = [p.number for p in use if p.view is None]
         if unbound:
@@ -60,7 +61,8 @@ class Picking:
         self.check_same_state(use)
         joints = np.array(use[0].view.joints_deg) if use else self.arm.joints_deg
         self.current_pair = None
-        result = self.session.calibrate(self.cell.intrinsics, obj2world, self.cell.robot.fk(joints, "camera"), self.cell.robot.fk(joints, "tcp"), joints)
+        result = self.session.calibrate(self.cell.intrinsics, obj2world, self.cell.robot.fk(joints, "camera"), self.cell.robot.fk(joints, "tcp"), joints,
+                                        form_tolerance_mm=item.form_tolerance_mm)
         self.solved.emit()
         return result
 

@@ -107,7 +107,8 @@ class PointFinding:
         self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
         estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.cell.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.cell.intrinsics,
-                                          view_sources=(found.view.source,), label="Calibrate on edges")
+                                          view_sources=(found.view.source,), label="Calibrate on edges",
+                                          form_tolerance_mm=item.form_tolerance_mm)
         self.solved.emit()
         return estimate
 

@@ -17,6 +17,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.render.virtual_camera import depth_from_zbuffer, set_vtk_camera
+from calib_core.render.studio import Studio, light_with
 from calib_core.render.vtk_scene import ItemActor
 from calib_core.scene import SceneItem
 
@@ -79,6 +80,7 @@ class SceneRenderer:
         self._actors: dict[str, ItemActor] = {}
         self._overlay_actors: list[vtk.vtkProp] = []
         self._last: tuple[Intrinsics, np.ndarray] | None = None
+        self._material = (0.25, 0.75, 0.15, 1.0)  # ambient, diffuse, specular, specular power
         self._lights()
 
     # --- scene -------------------------------------------------------------------------
@@ -120,6 +122,11 @@ class SceneRenderer:
         """Change the lights (the simulated camera uses other light than the CAD views)."""
         self._lights(intensity, key_direction)
 
+    def set_studio(self, studio: Studio) -> None:
+        """Light the scene by ``studio``'s lamps, with their shadows and glossy surfaces (a workshop, not a CAD view)."""
+        light_with(self.renderer, studio)
+        self._material = (studio.ambient, 1.0 - studio.ambient, studio.specular, studio.specular_power)
+
     # --- drawing -----------------------------------------------------------------------
     def _style(self, options: RenderOptions) -> None:
         if options.style not in STYLES:
@@ -142,9 +149,11 @@ class SceneRenderer:
             prop = a.GetProperty()
             prop.SetColor(*color)
             prop.SetOpacity(actor.item.opacity)
-            prop.SetAmbient(0.25)
-            prop.SetDiffuse(0.75)
-            prop.SetSpecular(0.15)
+            ambient, diffuse, specular, power = self._material
+            prop.SetAmbient(ambient)
+            prop.SetDiffuse(diffuse)
+            prop.SetSpecular(specular)
+            prop.SetSpecularPower(power)
             if options.style == "wireframe":
                 prop.SetRepresentationToWireframe()
             else:

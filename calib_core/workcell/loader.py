@@ -32,7 +32,9 @@ SCHEMA_VERSION = 2
 # Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
 _READABLE_VERSIONS = (1, 2)
 _TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board", "safety", "site"}
-_COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features"}
+_COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features", "form_tolerance_mm"}
+FORM_TOLERANCE_LIMIT_MM = 20.0
+"""A part further from its CAD than this is not the part the CAD describes: model it anew."""
 _TASK_KEYS = {"name", "component", "tcp2base", "approach_mm", "tolerance_mm"}
 _KINDS = {"component", "fixture"}
 
@@ -127,7 +129,11 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         features[str(k)], feature_kind = _feature(reader, v, f"{f}.features.{k}")
         if feature_kind.kind != "corner":
             kinds[str(k)] = feature_kind
-    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features, feature_kinds=kinds)
+    form = reader.number(raw.get("form_tolerance_mm", 0.0), f"{f}.form_tolerance_mm")
+    if not 0.0 <= form <= FORM_TOLERANCE_LIMIT_MM:
+        raise reader.fail(f"{f}.form_tolerance_mm", f"must lie in [0, {FORM_TOLERANCE_LIMIT_MM:g}] mm (1-sigma of the part's features about their CAD positions), got {form:g}")
+    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features, feature_kinds=kinds,
+                     form_tolerance_mm=form)
 
 
 _FEATURE_KEYS = {"at", "kind", "radius_mm", "normal"}

@@ -51,6 +51,8 @@ def _component_entry(item, source: tuple[Path, str], folder: Path) -> CommentedM
     ])
     if item.features:
         entry["features"] = CommentedMap((k, _feature_entry(item, k)) for k in item.features)
+    if item.form_tolerance_mm > 0:
+        entry["form_tolerance_mm"] = float(item.form_tolerance_mm)
     return entry
 
 

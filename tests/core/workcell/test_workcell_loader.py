@@ -57,6 +57,8 @@ def _write(path: Path, data) -> Path:
         (lambda d: d.update(schema_version=7), "schema_version", "versions 1, 2"),
         (lambda d: d["task_locations"][0].update(component="oru_9"), "task_locations[0].component", "no component called 'oru_9'"),
         (lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]), "components[2].features.pin_tip", "list of 3 numbers"),
+        (lambda d: d["components"][2].update(form_tolerance_mm=-0.5), "components[2].form_tolerance_mm", "must lie in [0, 20] mm"),
+        (lambda d: d["components"][2].update(form_tolerance_mm="1 mm"), "components[2].form_tolerance_mm", "finite number"),
         (lambda d: d["robot"]["frames"].update(flange="tool0"), "robot.frames.flange", "the URDF has no frame 'tool0'"),
         (lambda d: d["robot"]["frames"].update(tcp={"parent": "wrist", "xyz": [0, 0, 1], "rpy": [0, 0, 0]}), "robot.frames.tcp.parent", "no frame 'wrist'"),
         (lambda d: d["robot"]["frames"].update(tool="flange"), "robot.frames", "unknown key(s) tool"),
@@ -158,3 +160,15 @@ def test_a_bad_feature_kind_names_its_field(tmp_path, entry, message):
         assert message in str(info.value)
     finally:
         path.unlink()
+
+
+def test_a_parts_form_tolerance_is_read_and_new_components_write_it(cell_copy, tmp_path):
+    """``form_tolerance_mm``: how far the part's features may lie from their CAD (1-sigma, mm); 0 when not stated."""
+    from calib_core.workcell.writer import _component_entry
+
+    path, data = cell_copy
+    data["components"][2]["form_tolerance_mm"] = 0.4
+    cell = load_workcell(_write(path, data))
+    assert cell.components[2].form_tolerance_mm == 0.4 and cell.components[1].form_tolerance_mm == 0.0
+    entry = _component_entry(cell.components[2], (path.parent / "meshes" / "rack.stl", "mm"), path.parent)
+    assert entry["form_tolerance_mm"] == 0.4 and "form_tolerance_mm" not in _component_entry(cell.components[1], (path.parent / "meshes" / "rack.stl", "mm"), path.parent)
