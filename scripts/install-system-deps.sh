@@ -11,6 +11,8 @@ PACKAGES=(
   libxcb-xfixes0 libxcb-xkb1 libx11-xcb1 libxrender1 libxi6
   # GenICam cameras: Aravis and its GObject introspection data; PyGObject is built against these
   libaravis-0.8-0 gir1.2-aravis-0.8 libgirepository1.0-dev libcairo2-dev pkg-config gcc python3-dev
+  # arv-tool-0.8, which docs/real-cell.md and docs/connectors.md use to list the cameras and their ids
+  aravis-tools-cli
   # a far ROS 2 link (videocal_sim/far_network.py): network namespaces and TUN devices are set up with ip
   iproute2
 )

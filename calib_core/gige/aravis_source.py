@@ -11,6 +11,7 @@ host's time at the frame (``t_host_s``, from Aravis's system timestamp). A camer
 
 from __future__ import annotations
 
+import ipaddress
 import time
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -20,6 +21,14 @@ from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSource
 
 _OPTIONS = {"exposure_us", "gain_db", "pixel_format", "width", "height", "timeout_s", "reopen_after_s", "fake"}
 _BUFFERS = 8
+
+
+def _is_address(device: str) -> bool:
+    try:
+        ipaddress.ip_address(device)
+        return True
+    except ValueError:
+        return False
 
 
 def _device_id(spec: str) -> str:
@@ -59,6 +68,7 @@ class AravisSource(FrameSource):
     # --- the device ----------------------------------------------------------------------------
     def _open(self) -> None:
         Aravis = self._Aravis
+        self._find_device()
         try:
             camera = Aravis.Camera.new(self.device)
         except Exception as exc:  # GLib.Error: the device is not there (yet)
@@ -78,9 +88,32 @@ class AravisSource(FrameSource):
         self.exposure_us = camera.get_exposure_time() if camera.is_exposure_time_available() else None
         self.gain_db = camera.get_gain() if camera.is_gain_available() else None
 
+    def _find_device(self) -> None:
+        """Look the camera up on every interface first: a camera named by its device id is found only in Aravis's
+        device list (opened without it, a GigE Vision camera answered but never streamed). A name on no list is an
+        error that says which cameras are there."""
+        if _is_address(self.device):
+            return  # a GigE Vision camera by its IP address is reached directly
+        Aravis = self._Aravis
+        Aravis.update_device_list()
+        found = [Aravis.get_device_id(i) for i in range(Aravis.get_n_devices())]
+        if self.device not in found:
+            seen = ", ".join(f"{d} ({Aravis.get_device_address(i) or Aravis.get_device_protocol(i)})" for i, d in enumerate(found)) or "none"
+            raise VideoSourceError(f"{self.description}: no camera with that id; cameras found: {seen} (an id is Vendor-Model-Serial, as `arv-tool-0.8` lists them)")
+
     def _configure(self, camera) -> None:
-        """The options, each set and read back; a refusal names the setting and what the camera allows."""
+        """The options, each checked against the range the camera offers, set, and read back: a refusal, or a value
+        the camera clamped or rounded, is an error naming the setting, the value asked and what the camera offers."""
         o = self.options
+
+        def number(name: str) -> float:
+            try:
+                value = float(o[name])
+            except (TypeError, ValueError):
+                raise VideoSourceError(f"{self.description}: {name}={o[name]!r} is not a number") from None
+            if value != value or value in (float("inf"), float("-inf")):
+                raise VideoSourceError(f"{self.description}: {name}={o[name]!r} is not a finite number")
+            return value
 
         def setting(name: str, apply) -> None:
             try:
@@ -88,18 +121,49 @@ class AravisSource(FrameSource):
             except Exception as exc:
                 raise VideoSourceError(f"{self.description}: it refuses {name}={o[name]!r}: {getattr(exc, 'message', exc)}") from None
 
+        def within(name: str, value: float, bounds, unit: str) -> None:
+            low, high = float(bounds[0]), float(bounds[1])
+            if not low <= value <= high:
+                raise VideoSourceError(f"{self.description}: it refuses {name}={o[name]!r}: it offers {low:.10g}-{high:.10g} {unit}")
+
+        def read_back(name: str, asked: float, got: float, tolerance: float, unit: str) -> None:
+            if abs(got - asked) > tolerance:
+                raise VideoSourceError(f"{self.description}: {name}={o[name]!r} was not taken: the camera reports {got:g} {unit}")
+
         if "pixel_format" in o:
             allowed = list(camera.dup_available_pixel_formats_as_strings() or [])
             if o["pixel_format"] not in allowed:
                 raise VideoSourceError(f"{self.description}: it refuses pixel_format={o['pixel_format']!r}; it offers {', '.join(allowed)}")
             setting("pixel_format", lambda: camera.set_pixel_format_from_string(str(o["pixel_format"])))
+            got = camera.get_pixel_format_as_string()
+            if got != o["pixel_format"]:
+                raise VideoSourceError(f"{self.description}: pixel_format={o['pixel_format']!r} was not taken: the camera reports {got}")
         if "width" in o or "height" in o:
             x, y, w, h = camera.get_region()
-            setting("width", lambda: camera.set_region(0, 0, int(o.get("width", w)), int(o.get("height", h))))
+            width = number("width") if "width" in o else float(w)
+            height = number("height") if "height" in o else float(h)
+            if "width" in o:
+                within("width", width, camera.get_width_bounds(), "px")
+            if "height" in o:
+                within("height", height, camera.get_height_bounds(), "px")
+            setting("width" if "width" in o else "height", lambda: camera.set_region(0, 0, int(width), int(height)))
+            _, _, w, h = camera.get_region()
+            if "width" in o:
+                read_back("width", int(width), w, 0, "px (its width step?)")
+            if "height" in o:
+                read_back("height", int(height), h, 0, "px (its height step?)")
         if "exposure_us" in o:
-            setting("exposure_us", lambda: camera.set_exposure_time(float(o["exposure_us"])))
+            exposure = number("exposure_us")
+            if camera.is_exposure_time_available():
+                within("exposure_us", exposure, camera.get_exposure_time_bounds(), "us")
+            setting("exposure_us", lambda: camera.set_exposure_time(exposure))
+            read_back("exposure_us", exposure, camera.get_exposure_time(), max(1.0, 0.01 * exposure), "us")
         if "gain_db" in o:
-            setting("gain_db", lambda: camera.set_gain(float(o["gain_db"])))
+            gain = number("gain_db")
+            if camera.is_gain_available():
+                within("gain_db", gain, camera.get_gain_bounds(), "dB")
+            setting("gain_db", lambda: camera.set_gain(gain))
+            read_back("gain_db", gain, camera.get_gain(), 0.05, "dB")
 
     def _close_device(self) -> None:
         if self._camera is not None:
