@@ -50,6 +50,8 @@ class URRtdeController(ConnectorEvents):
         parts = urlsplit(url)
         if not parts.hostname:
             raise LinkError(f"{url!r}: a UR controller is ur-rtde://HOST (its IP address or name)")
+        if context.n_joints == 0:  # no cell (``monitor`` without --workcell): the UR's own six joints, in its order
+            context = ControllerContext(tuple(f"joint_{k + 1}" for k in range(6)), ("deg",) * 6, JointMap.identity(6), context.rate_hz, context.options)
         if context.n_joints != 6 or any(u != "deg" for u in context.joint_units):
             raise LinkError(f"{url}: a UR robot has 6 revolute joints; the cell's robot has {context.n_joints} ({', '.join(context.joint_units)})")
         options = dict(context.options or {})

@@ -92,6 +92,18 @@ def test_a_move_then_a_stop_on_the_way(link):
     assert link.latest.joints_deg[0] == pytest.approx(held, abs=1e-6)
 
 
+def test_monitor_without_a_workcell_prints_the_ur_s_own_six_joints(sim):
+    """``videocal monitor ur-rtde://HOST`` with no cell: the UR's six joints in its order (the cell's robot had 0
+    joints and the connector refused: "the cell's robot has 0 ()")."""
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", f"ur-rtde://{sim.host}", "--count", "2", "--json"], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    import json
+
+    samples = [json.loads(line) for line in run.stdout.splitlines() if line.startswith("{")]
+    # six joints in degrees, within the robot's range (earlier tests moved it from HOME)
+    assert len(samples) == 2 and all(len(s["joints_deg"]) == 6 and np.all(np.abs(s["joints_deg"]) <= 360.0) for s in samples)
+
+
 def test_protective_stop_and_local_control_refuse_moves_and_say_so(sim, link):
     sim.command("protective-stop")
     assert wait_until(lambda: link.protective_stop)
