@@ -65,6 +65,10 @@ def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
     return topic, options
 
 
+TYPE_CHECK_S = 1.0
+"""While nothing has come, how often the topic's publishers' types are looked at (s)."""
+
+
 class Ros2TrajectoryController(ConnectorEvents):
     """See the module. ``context.joint_names`` are the joints looked for in each JointState message.
     (``auth_changed`` is never emitted: ROS 2 has no session.)"""
@@ -119,6 +123,7 @@ class Ros2TrajectoryController(ConnectorEvents):
         from calib_core.ros2 import messages as msg
         from calib_core.ros2.participant import participant
         from calib_core.ros2.taker import Taker
+        from calib_core.ros2.topic_types import TopicTypes
         from calib_core.ros2.wire import default_qos, sensor_qos
 
         if self._thread is not None:
@@ -128,6 +133,8 @@ class Ros2TrajectoryController(ConnectorEvents):
         self._reader = DataReader(dp, Topic(dp, self.joint_states_topic, msg.JointState), qos=reader_qos)
         self._writer = DataWriter(dp, Topic(dp, self.trajectory_topic, msg.JointTrajectory), qos=default_qos(1))
         self._taker = Taker(self._reader)
+        self._types = TopicTypes(dp)
+        self._started_s = self._types_checked_s = time.monotonic()
         self._set_state(LinkState.CONNECTING, f"waiting for {self.joint_states_topic[2:]} on ROS domain {self.domain}")
         self._thread = threading.Thread(target=self._run, name=f"ros2 {self.url}", daemon=True)
         self._thread.start()
@@ -258,6 +265,8 @@ class Ros2TrajectoryController(ConnectorEvents):
             self._keep_moving(now)
 
     def _watch(self, now: float) -> None:
+        if self._state is LinkState.CONNECTING and now - self._types_checked_s >= TYPE_CHECK_S:
+            self._say_foreign_types(now)
         last = self._last_sample_s
         if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s + self._arrival.spread_s:
             self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
@@ -268,6 +277,17 @@ class Ros2TrajectoryController(ConnectorEvents):
             from calib_core.link.link_types import MoveTimeout
 
             self._moves.finish(MoveTimeout("the joints did not reach the target in time"))
+
+    def _say_foreign_types(self, now: float) -> None:
+        """Nothing has come yet: a publisher of another message type on the topic is said, not waited for."""
+        self._types_checked_s = now
+        from calib_core.ros2 import messages as msg
+
+        foreign = self._types.foreign(self.joint_states_topic, msg.JointState.__idl_typename__)
+        if foreign:
+            self.last_error = (f"{self.joint_states_topic[2:]} on ROS domain {self.domain} carries {', '.join(foreign)}, not sensor_msgs/msg/JointState: "
+                               "name the topic of the arm's joint states (ros2:///TOPIC)")
+            self._restate(self.last_error)
 
     def _on_joint_state(self, message) -> None:
         names = list(message.name)

@@ -277,6 +277,35 @@ def test_joint_states_of_other_names_say_which_came_and_which_renaming_fits(doma
         link.close()
 
 
+@dataclass
+class Text(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    data: str
+
+
+def test_a_topic_of_another_message_type_is_said_not_waited_for(domain):
+    """A publisher of std_msgs/String on /joint_states: a JointState reader never matches it, so the topic looked
+    silent ("waiting for /joint_states"); DDS discovery tells the type, and the link's state says it."""
+    dp = DomainParticipant(domain)
+    writer = DataWriter(dp, Topic(dp, "rt/joint_states", Text))
+    link = open_controller("ros2:///joint_states", _context())
+    states = []
+    link.state_changed.connect(lambda state, why: states.append((state, why)))
+    link.start()
+    try:
+        writer.write(Text("hello"))
+        assert wait_until(lambda: any("carries std_msgs/msg/String, not sensor_msgs/msg/JointState" in why for _, why in states), timeout_s=10)
+        assert link.state is LinkState.CONNECTING and f"joint_states on ROS domain {domain}" in states[-1][1]
+    finally:
+        link.close()
+
+
+def test_dds_type_names_read_as_ros_names():
+    from calib_core.ros2.topic_types import ros_type_name
+
+    assert ros_type_name("sensor_msgs::msg::dds_::JointState_") == "sensor_msgs/msg/JointState"
+    assert ros_type_name("my::Thing") == "my::Thing"
+
+
 def test_a_renaming_is_suggested_only_when_it_is_one_to_one():
     from calib_core.ros2.trajectory_connector import suggest_joint_names
 
