@@ -43,7 +43,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "1-sigma); .launch.py a ROS 2 launch file running tf2_ros's static_transform_publisher; .urdf or .xacro a "
                              "fixed-joint snippet for the robot's description")
     parser.add_argument("--parent-frame", help="the ROS frame the camera hangs from in the .launch.py and .urdf outputs (default: the workcell's "
-                                               "robot flange link, else tool0; the base link for --static-camera)")
+                                               "site.camera_parent_frame, else its robot's flange link, else tool0; the base link for --static-camera)")
+    parser.add_argument("--camera-frame", help="the camera's ROS frame in those outputs: the camera driver's optical frame (default: the workcell's "
+                                               "site.camera_frame, else videocal_camera_optical_frame)")
     parser.add_argument("--robot-errors", action="store_true", help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
@@ -81,18 +83,18 @@ def _write_outputs(args, result) -> list[Path]:
     from calib_core.ros2.mounting_out import mounting_text_for
     from calib_core.vision.hand_eye_io import save_hand_eye
 
-    parent = args.parent_frame
-    if parent is None:
-        frames = {}
-        if args.workcell is not None:
-            from calib_core.workcell import load_workcell
+    from calib_core.ros2.frame_names import camera_frames
 
-            frames = load_workcell(args.workcell).robot_spec.frames or {}
-        key, fallback = ("base", "base_link") if result.static_camera else ("flange", "tool0")
-        parent = str(frames.get(key) or fallback)
+    workcell = None
+    if args.workcell is not None:
+        from calib_core.workcell import load_workcell
+
+        workcell = load_workcell(args.workcell)
+    parent, child = camera_frames(workcell, static_camera=result.static_camera)
+    parent, child = args.parent_frame or parent, args.camera_frame or child
     note = f"{result.views} poses, RMS {result.rms_px:.3f} px, 1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)} mm"
     for path in args.out:
-        text = mounting_text_for(path, result.camera2mount, parent, note=note)
+        text = mounting_text_for(path, result.camera2mount, parent, child=child, note=note)
         if text is None:
             save_hand_eye(path, result)
         else:

@@ -34,12 +34,7 @@ def run(args: argparse.Namespace) -> int:
 
         if args.out is None:
             raise VideocalError("--format ros2-bag writes a bag folder: give --out FOLDER")
-        units = None
-        if args.workcell is not None:
-            from calib_core.workcell import load_workcell
-
-            units = list(load_workcell(args.workcell).load_robot().joint_units)
-        counts = recording_to_bag(args.workspace, args.out, joint_units=units)
+        counts = recording_to_bag(args.workspace, args.out, **_bag_cell(args))
         print(f"wrote {args.out}: " + ", ".join(f"{n} on {topic}" for topic, n in counts.items()))
         return 0
     from calib_core.workspace.exports import export_corrections
@@ -54,6 +49,26 @@ def run(args: argparse.Namespace) -> int:
     else:
         sys.stdout.write(text)
     return 0
+
+
+def _bag_cell(args) -> dict:
+    """What the cell gives a bag: each joint's unit and the camera's mounting on /tf_static, from ``--workcell`` or the
+    recording's own workcell when it is still there (without either the units are asked for and no mounting is
+    written)."""
+    from calib_core.bags.bag_export import cell_mounting
+    from calib_core.recording.reader import read_recording
+    from calib_core.recording.schemas import SETUP_TOPIC
+    from calib_core.workcell import load_workcell
+
+    path = args.workcell
+    if path is None:
+        setups = read_recording(args.workspace).topic(SETUP_TOPIC)
+        named = setups[-1].payload.get("workcell") if setups else None
+        path = Path(named) if named and Path(named).is_file() else None
+    if path is None:
+        return {}
+    workcell = load_workcell(path)
+    return {"joint_units": list(workcell.load_robot().joint_units), "mounting": cell_mounting(workcell)}
 
 
 def _robot(workcell: str | Path | None):

@@ -5,7 +5,9 @@ the Foxglove MCAP the recorder writes. Written with ``rosbags`` (MCAP storage, R
   recording (the H.264 track decoded frame by frame);
 - ``/joint_states``: ``sensor_msgs/JointState`` in the robot's URDF joint names, **radians and metres** (a recording
   holds degrees and mm: the workcell's robot says which joint is prismatic);
-- ``/camera/camera_info``: ``sensor_msgs/CameraInfo`` from the recording's camera, with every image at its stamp.
+- ``/camera/camera_info``: ``sensor_msgs/CameraInfo`` from the recording's camera, with every image at its stamp;
+- ``/tf_static``: the camera's mounting (``tf2_msgs/TFMessage``, transient local as tf2's static broadcaster offers it),
+  the camera's frame the one the images and camera_info are stamped with (:mod:`calib_core.ros2.frame_names`).
 """
 
 from __future__ import annotations
@@ -22,15 +24,30 @@ from calib_core.errors import FileFormatError, FileWriteError
 IMAGE_TOPIC = "/camera/image_raw/compressed"
 JOINT_TOPIC = "/joint_states"
 INFO_TOPIC = "/camera/camera_info"
+TF_STATIC_TOPIC = "/tf_static"
+
+
+def cell_mounting(workcell) -> tuple[str, str, np.ndarray]:
+    """``(parent, child, camera2parent)`` (4, 4) mm: the camera's mounting in ``workcell`` (a loaded workcell), named
+    as every ROS output names it (:func:`~calib_core.ros2.frame_names.camera_frames`)."""
+    from calib_core.frames import concat, invert
+    from calib_core.ros2.frame_names import camera_frames
+
+    robot = workcell.load_robot()
+    parent, child = camera_frames(workcell, flange_frame=robot.roles.get("flange"))
+    q = np.array(workcell.home_joints_deg, dtype=float)
+    return parent, child, concat(invert(robot.fk(q, parent)), robot.fk(q, "camera"))
 
 
 def _stamp(T, t_ns: int):
     return T["builtin_interfaces/msg/Time"](sec=t_ns // 10**9, nanosec=t_ns % 10**9)
 
 
-def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: list[str] | None = None, camera_frame: str = "videocal_camera_optical_frame") -> dict:
+def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: list[str] | None = None, mounting: tuple[str, str, np.ndarray] | None = None) -> dict:
     """Write the recording at ``recording`` as a ROS 2 bag folder ``out`` (which must not exist). ``joint_units``: each
     joint's unit (``deg``/``mm``) in the recording's joint order (default: the recording's workcell's robot).
+    ``mounting``: ``(parent, child, camera2parent)`` (:func:`cell_mounting`) put on ``/tf_static``, its ``child`` the
+    images' frame (default: none on /tf_static, the images in ``videocal_camera_optical_frame``).
     Returns what was written per topic. :class:`FileFormatError` names the file: no recording, no frames and no
     joints, joints whose units cannot be told, or an ``out`` that exists."""
     from rosbags.rosbag2 import StoragePlugin, Writer
@@ -61,8 +78,13 @@ def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: lis
     ts = get_typestore(Stores.ROS2_HUMBLE)
     T = ts.types
     counts = {IMAGE_TOPIC: 0, JOINT_TOPIC: 0, INFO_TOPIC: 0}
+    from calib_core.ros2.frame_names import DEFAULT_CAMERA_FRAME
+
+    camera_frame = DEFAULT_CAMERA_FRAME if mounting is None else mounting[1]
+    first_ns = min([m.log_time_ns for m in track.messages[:1]] + [m.log_time_ns for m in joints[:1]])
     try:
-        _write(Writer(out, version=9, storage_plugin=StoragePlugin.MCAP), ts, T, track, joints, names, joint_units, intrinsics, camera_frame, counts)
+        _write(Writer(out, version=9, storage_plugin=StoragePlugin.MCAP), ts, T, track, joints, names, joint_units, intrinsics, camera_frame, counts,
+               mounting, first_ns)
     except BaseException as exc:
         shutil.rmtree(out, ignore_errors=True)  # no half-written bag left behind
         if isinstance(exc, OSError) or type(exc).__name__ == "WriterError":  # a full disk, a read-only folder
@@ -72,8 +94,11 @@ def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: lis
     return counts
 
 
-def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_frame: str, counts: dict) -> None:
+def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_frame: str, counts: dict, mounting, first_ns: int) -> None:
     with writer:
+        if mounting is not None:
+            _write_mounting(writer, ts, T, mounting, first_ns)
+            counts[TF_STATIC_TOPIC] = 1
         if len(track):
             images = writer.add_connection(IMAGE_TOPIC, "sensor_msgs/msg/CompressedImage", typestore=ts)
             info = _camera_info(T, intrinsics, camera_frame) if intrinsics else None
@@ -101,6 +126,25 @@ def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_
                 js = T["sensor_msgs/msg/JointState"](header=header, name=names, position=q, velocity=np.array([], float), effort=np.array([], float))
                 writer.write(connection, message.log_time_ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
                 counts[JOINT_TOPIC] += 1
+
+
+def _write_mounting(writer, ts, T, mounting, t_ns: int) -> None:
+    """The camera's mounting on /tf_static at the bag's first stamp, offered transient local (tf2's static
+    broadcaster's QoS: a player hands it to subscribers that join later)."""
+    from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
+    from scipy.spatial.transform import Rotation
+
+    parent, child, camera2parent = mounting
+    never = QosTime(0x7FFFFFFF, 0xFFFFFFFF)
+    qos = Qos(QosHistory.KEEP_LAST, 1, QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL, never, never, QosLiveliness.AUTOMATIC, never, False)
+    connection = writer.add_connection(TF_STATIC_TOPIC, "tf2_msgs/msg/TFMessage", typestore=ts, offered_qos_profiles=[qos])
+    x, y, z = (float(v) / 1000.0 for v in camera2parent[:3, 3])
+    qx, qy, qz, qw = Rotation.from_matrix(camera2parent[:3, :3]).as_quat()
+    transform = T["geometry_msgs/msg/Transform"](translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
+                                                rotation=T["geometry_msgs/msg/Quaternion"](x=float(qx), y=float(qy), z=float(qz), w=float(qw)))
+    stamped = T["geometry_msgs/msg/TransformStamped"](header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=parent), child_frame_id=child, transform=transform)
+    message = T["tf2_msgs/msg/TFMessage"](transforms=[stamped])
+    writer.write(connection, t_ns, ts.serialize_cdr(message, "tf2_msgs/msg/TFMessage"))
 
 
 def _units_from_workcell(recording: Path, workcell: str | None, n: int) -> list[str]:

@@ -202,12 +202,17 @@ class OperatorCore:
 
     def static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
         """What the cell's ROS side is told: ``(parent, child, child2parent_mm)`` for the camera mounting in use
-        (``videocal_camera`` on the flange; z along the optical axis, x right, y down: ROS's optical frame) and
-        each task's corrected target (``videocal/<task>`` in the base frame; the correction, or the plan if none)."""
+        (the site's ``camera_frame`` on its ``camera_parent_frame``, :func:`~calib_core.ros2.frame_names.camera_frames`:
+        by default ``videocal_camera_optical_frame`` on the flange; z along the optical axis, x right, y down: ROS's
+        optical frame) and each task's corrected target (``videocal/<task>`` in the base frame; the correction, or the
+        plan if none)."""
+        from calib_core.ros2.frame_names import camera_frames
+
         frames = self.workcell.robot_spec.frames
-        flange, base = str(frames.get("flange") or "flange"), str(frames.get("base") or "base_link")
+        base = str(frames.get("base") or "base_link")
+        parent, child = camera_frames(self.workcell, flange_frame=self.robot.roles.get("flange"))
         q = self.joints_deg
-        out = [(flange, "videocal_camera", concat(self.robot.fk(q, "camera"), invert(self.robot.fk(q, "flange"))))]
+        out = [(parent, child, concat(self.robot.fk(q, "camera"), invert(self.robot.fk(q, parent))))]
         for name, task in self.workcell.task_locations.items():
             out.append((base, f"videocal/{name}", self.session.corrections.corrected_target(name, task.tcp2base)))
         return out

@@ -1,7 +1,7 @@
 """The measured camera mounting in the two forms a ROS 2 system takes it (issue 31): a launch file that runs
-``tf2_ros``'s ``static_transform_publisher`` (ROS 2 Humble's named arguments: metres and a quaternion), and a
-URDF/xacro snippet with a fixed joint from the mount's link to the camera's (metres, URDF's fixed-axis
-roll-pitch-yaw in radians). Plain text: no ROS needed to write them. The camera frame is videocal's (z along
+``tf2_ros``'s ``static_transform_publisher`` (ROS 2 Humble's named arguments: metres and a quaternion), and a URDF (a document a
+parser reads alone) or a xacro macro to include, with a fixed joint from the mount's link to the camera's (metres,
+URDF's fixed-axis roll-pitch-yaw in radians). Plain text: no ROS needed to write them. The camera frame is videocal's (z along
 the optical axis, x right, y down), which is ROS's optical frame convention (REP 103: ``*_optical_frame``).
 """
 
@@ -13,8 +13,11 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from calib_core.ros2.frame_names import DEFAULT_CAMERA_FRAME
+
 LAUNCH_SUFFIXES = (".launch.py",)
-URDF_SUFFIXES = (".urdf", ".xacro", ".urdf.xacro")
+URDF_SUFFIXES = (".urdf",)
+XACRO_SUFFIXES = (".xacro",)
 
 
 def _clean(camera2mount_mm) -> tuple[np.ndarray, np.ndarray]:
@@ -28,7 +31,7 @@ def _clean(camera2mount_mm) -> tuple[np.ndarray, np.ndarray]:
     return T[:3, 3] / 1000.0, R
 
 
-def static_transform_launch(camera2mount_mm, parent: str, child: str = "videocal_camera_optical_frame", note: str = "") -> str:
+def static_transform_launch(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:
     """A ROS 2 Python launch file publishing ``child`` in ``parent`` on ``/tf_static``."""
     xyz, R = _clean(camera2mount_mm)
     qx, qy, qz, qw = Rotation.from_matrix(R).as_quat()
@@ -46,28 +49,57 @@ def static_transform_launch(camera2mount_mm, parent: str, child: str = "videocal
             "    ])\n")
 
 
-def urdf_snippet(camera2mount_mm, parent: str, child: str = "videocal_camera_optical_frame", note: str = "") -> str:
-    """A URDF (or xacro) fragment: ``<link name=child/>`` and the fixed joint placing it on ``parent``; paste it into
-    the robot's description (or include it in a xacro) to have the camera's frame in the robot's tf tree."""
+def _origin(camera2mount_mm) -> str:
     xyz, R = _clean(camera2mount_mm)
     rpy = Rotation.from_matrix(R).as_euler("xyz")  # URDF's rpy: roll about x, pitch about y, yaw about z, fixed axes
     fmt = lambda v: " ".join(f"{x:.9g}" for x in v)
-    return (f"<!-- Written by videocal on {date.today().isoformat()}: the camera mounting{': ' + note if note else ''}. "
-            f"Metres and radians. -->\n"
-            f'<link name="{child}"/>\n'
-            f'<joint name="{child}_joint" type="fixed">\n'
-            f'  <parent link="{parent}"/>\n'
-            f'  <child link="{child}"/>\n'
-            f'  <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-            "</joint>\n")
+    return f'<origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>'
 
 
-def mounting_text_for(path: str | Path, camera2mount_mm, parent: str, note: str = "") -> str | None:
-    """The text ``path``'s suffix asks for (``.launch.py``: the launch file; ``.urdf``/``.xacro``: the snippet), or
-    ``None`` for any other suffix (videocal's own YAML)."""
+def _header(note: str) -> str:
+    return f"<!-- Written by videocal on {date.today().isoformat()}: the camera mounting{': ' + note if note else ''}. Metres and radians. -->\n"
+
+
+def urdf_document(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:
+    """A URDF that any parser reads alone: the ``parent`` link, the camera's ``child`` link and the fixed joint between
+    them (check_urdf, urdf_parser_py, Pinocchio). Its joint and child link are what a robot's description takes."""
+    return ('<?xml version="1.0"?>\n' + _header(note) +
+            '<robot name="videocal_camera_mounting">\n'
+            f'  <link name="{parent}"/>\n'
+            f'  <link name="{child}"/>\n'
+            f'  <joint name="{child}_joint" type="fixed">\n'
+            f'    <parent link="{parent}"/>\n'
+            f'    <child link="{child}"/>\n'
+            f'    {_origin(camera2mount_mm)}\n'
+            "  </joint>\n"
+            "</robot>\n")
+
+
+def xacro_macro(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:
+    """A xacro file defining the macro ``videocal_camera_mounting`` (parameters ``parent`` and ``child``, defaulting to
+    these frames): ``<xacro:include filename="...">`` it in the robot's description and call
+    ``<xacro:videocal_camera_mounting/>`` to add the camera's link and its fixed joint."""
+    return ('<?xml version="1.0"?>\n' + _header(note) +
+            '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+            f'  <xacro:macro name="videocal_camera_mounting" params="parent:={parent} child:={child}">\n'
+            '    <link name="${child}"/>\n'
+            '    <joint name="${child}_joint" type="fixed">\n'
+            '      <parent link="${parent}"/>\n'
+            '      <child link="${child}"/>\n'
+            f'      {_origin(camera2mount_mm)}\n'
+            "    </joint>\n"
+            "  </xacro:macro>\n"
+            "</robot>\n")
+
+
+def mounting_text_for(path: str | Path, camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str | None:
+    """The text ``path``'s suffix asks for (``.launch.py``: the launch file; ``.urdf``: a URDF read alone; ``.xacro``:
+    the xacro macro), or ``None`` for any other suffix (videocal's own YAML)."""
     name = Path(path).name.lower()
     if name.endswith(LAUNCH_SUFFIXES):
-        return static_transform_launch(camera2mount_mm, parent, note=note)
+        return static_transform_launch(camera2mount_mm, parent, child, note=note)
+    if name.endswith(XACRO_SUFFIXES):
+        return xacro_macro(camera2mount_mm, parent, child, note=note)
     if name.endswith(URDF_SUFFIXES):
-        return urdf_snippet(camera2mount_mm, parent, note=note)
+        return urdf_document(camera2mount_mm, parent, child, note=note)
     return None

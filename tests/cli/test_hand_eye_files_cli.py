@@ -33,17 +33,17 @@ def test_ros_industrial_static_camera_set_gives_the_camera_in_the_base(tmp_path)
     """The file says static_camera, the board and the intrinsics (no image size: the images give it).
     ROS-Industrial's own starting guess for this set puts the camera at (-19.6, 1278.4, 284.0) mm."""
     out = tmp_path / "he.yaml"
-    run = _videocal("calibrate-hand-eye", ROSI / "cal_data.yaml", "--out", out, "--out", tmp_path / "camera.launch.py", "--out", tmp_path / "camera.urdf.xacro", "--json")
+    run = _videocal("calibrate-hand-eye", ROSI / "cal_data.yaml", "--out", out, "--out", tmp_path / "camera.launch.py", "--out", tmp_path / "camera.urdf", "--json")
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
-    # The same mounting for ROS 2: a static_transform_publisher launch file and a URDF snippet on the base link.
+    # The same mounting for ROS 2: a static_transform_publisher launch file and a URDF (read alone) on the base link.
     import pinocchio as pin
 
     cam2base = transform_from_xyz_rpy(doc["cam2base"]["xyz"], doc["cam2base"]["rpy"])
     launch = (tmp_path / "camera.launch.py").read_text()
     assert '"--frame-id", "base_link"' in launch and "static_transform_publisher" in launch
     compile(launch, "camera.launch.py", "exec")
-    model = pin.buildModelFromXML(f'<robot name="r"><link name="base_link"/>{(tmp_path / "camera.urdf.xacro").read_text()}</robot>')
+    model = pin.buildModelFromXML((tmp_path / "camera.urdf").read_text())
     data = model.createData()
     pin.framesForwardKinematics(model, data, np.zeros(model.nq))
     placed = data.oMf[model.getFrameId("videocal_camera_optical_frame")]

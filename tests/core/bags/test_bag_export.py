@@ -95,3 +95,35 @@ def test_a_full_disk_is_one_error_line_and_no_half_written_bag(tmp_path):
     assert run.returncode == 2 and "Traceback" not in run.stderr, run.stderr[-2000:]
     assert "cannot write the bag" in run.stderr and "nothing was left behind" in run.stderr
     assert not out.exists()
+
+
+def test_the_cli_bag_carries_the_mounting_on_tf_static_in_the_frame_its_images_are_stamped_with(tmp_path):
+    """``export --format ros2-bag --workcell F``: the camera's mounting on /tf_static (transient local, as tf2's
+    static broadcaster offers it) under the name the images and camera_info carry."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.interfaces import QosDurability
+    from rosbags.typesys import Stores, get_typestore
+    from scipy.spatial.transform import Rotation
+
+    from calib_core.bags.bag_export import TF_STATIC_TOPIC
+    from calib_core.frames import concat, invert
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+
+    out = tmp_path / "bag"
+    run = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(SAMPLE), "--format", "ros2-bag", "--out", str(out), "--workcell", str(DEFAULT_WORKCELL)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    cell = load_workcell(DEFAULT_WORKCELL)
+    robot = cell.load_robot()
+    q = np.array(cell.home_joints_deg, float)
+    camera2flange = concat(invert(robot.fk(q, "flange")), robot.fk(q, "camera"))  # the mounting, another way
+    with AnyReader([out], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+        tf = next(c for c in reader.connections if c.topic == TF_STATIC_TOPIC)
+        assert tf.msgtype == "tf2_msgs/msg/TFMessage" and tf.ext.offered_qos_profiles[0].durability is QosDurability.TRANSIENT_LOCAL
+        (message,) = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([tf])]
+        image = next(reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages([c for c in reader.connections if c.topic == IMAGE_TOPIC]))
+    (stamped,) = message.transforms
+    assert stamped.child_frame_id == image.header.frame_id == "videocal_camera_optical_frame" and stamped.header.frame_id == robot.roles["flange"]
+    t, r = stamped.transform.translation, stamped.transform.rotation
+    np.testing.assert_allclose(np.array([t.x, t.y, t.z]) * 1000.0, camera2flange[:3, 3], atol=1e-6)
+    np.testing.assert_allclose(Rotation.from_quat([r.x, r.y, r.z, r.w]).as_matrix(), camera2flange[:3, :3], atol=1e-9)

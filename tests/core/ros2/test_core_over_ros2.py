@@ -68,7 +68,7 @@ def test_the_camera_mounting_and_targets_on_tf_static_for_a_late_subscriber(doma
         got = []
         assert wait_until(lambda: got.extend(reader.take()) or got, 10.0)
         by_child = {t.child_frame_id: t for t in got[-1].transforms}
-        camera = by_child["videocal_camera"]
+        camera = by_child["videocal_camera_optical_frame"]  # the name the launch file, URDF and bag use too
         assert camera.header.frame_id == "flange"
         t = camera.transform.translation
         assert np.allclose([t.x, t.y, t.z], moved[:3, 3] / 1000.0, atol=1e-9)
