@@ -1,4 +1,4 @@
-"""Reading a user's ROS 2 bag (issue 31): time to the first frame, the joint track, and peak memory, for a 1-minute
+"""Reading a user's ROS 2 bag: time to the first frame, the joint track, and peak memory, for a 1-minute
 and a 10-minute bag of 1280 x 960 JPEG at 15 fps with 500 Hz joint states, against rosbags read by hand (the peer:
 the library videocal reads through, with OpenCV decoding the JPEG). Writes docs/benchmarks/bag.md.
 

@@ -1,4 +1,4 @@
-"""Connectors (issue 30), each beside a bare client of the same library in the same run. Writes
+"""Connectors, each beside a bare client of the same library in the same run. Writes
 docs/benchmarks/connectors.md.
 
 - ROS 2 joint states at 500 Hz from ``videocal sim-ros2`` (another process): samples per second delivered by the
@@ -191,7 +191,7 @@ def main() -> str:
     c, b = ros["connector"], ros["bare"]
     g = gige["connector"]
     lines = [
-        "# Connectors (issue 30)",
+        "# Connectors",
         "",
         f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}; the other side in another process on the same "
         f"machine; {SECONDS:g} s per figure. Each connector beside a bare client of the same library in the same run.",

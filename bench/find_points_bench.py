@@ -1,4 +1,4 @@
-"""Find points and the edge refinement (issue 15's targets), on the test bed's simulated camera.
+"""Find points and the edge refinement, on the test bed's simulated camera.
 
 At the paper's task location and at 20 random poses around it that see the target, with the typical
 robot errors and with twice them. The truth only scores: a feature is visible when the true camera

@@ -1,4 +1,4 @@
-"""Window targets (issue #5), measured offscreen (Qt offscreen platform, VTK through OSMesa/llvmpipe on the CPU).
+"""Window targets, measured offscreen (Qt offscreen platform, VTK through OSMesa/llvmpipe on the CPU).
 Writes docs/benchmarks/gui.md. On a desktop with a GPU the rendering figures are far higher."""
 
 from __future__ import annotations
@@ -221,7 +221,7 @@ def main() -> str:
         "",
         "## The whole calibration (`videocal demo`, full size: two looks, each stored)",
         "",
-        "TCP error after the stored correction against the test bed's truth (target <= 0.1 mm and 0.1 deg; issue 15: Find points and Accept all "
+        "TCP error after the stored correction against the test bed's truth (target <= 0.1 mm and 0.1 deg; Find points and Accept all "
         "no worse than picks by hand). `uncorrected`: the plain model's.",
         "",
         "| cell | look made by | pairs or edge samples | TCP error after | uncorrected | estimate within 3 sigma (RMS px) |",

@@ -1,4 +1,4 @@
-"""The link attacks of issue 32 against the real simulator process, timed: a dead workstation's move
+"""The link attacks against the real simulator process, timed: a dead workstation's move
 fed by someone else's heartbeats, a second writer's handshake, a keyless TCP squatter, oversize fields.
 Used by bench/reliability_bench.py."""
 

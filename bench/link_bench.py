@@ -1,4 +1,4 @@
-"""Controller-link targets (issue #4). Writes docs/benchmarks/link.md.
+"""Controller-link targets. Writes docs/benchmarks/link.md.
 
 - parse rate from a pty (sentences per second through the driver, 2 cores);
 - latency from a sentence's last byte written to its sample callback (median, 99th percentile);

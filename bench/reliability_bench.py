@@ -181,7 +181,7 @@ def main() -> str:
     lines.append(f"| the simulator killed mid-move: the core's motion state says the pose is unknown | {1000 * lost_s:.0f} ms | <= 1 s |")
     lines += [
         "",
-        "| link attack (issue 32, the real simulator process) | answer | time | target |",
+        "| link attack (the real simulator process) | answer | time | target |",
         "|---|---|---|---|",
         f"| workstation SIGKILLed mid-move (dead-man 1000 ms), then `HBT,60000` unsealed every 100 ms from another process | "
         f"{heartbeats['refused']} heartbeats refused; the robot at rest at {heartbeats['stopped_deg']:.1f} of 160 deg | {heartbeats['stopped_s']:.2f} s from the kill | "

@@ -1,4 +1,4 @@
-"""A far controller (issue 30, deliverable 7): the operator's time per look through a delay line of 0, 0.3 and
+"""A far controller: the operator's time per look through a delay line of 0, 0.3 and
 1.5 s one way (+-30 % jitter, 1 % of the chunks lost once), videocal's own protocol to the controller simulator in
 another process. Writes docs/benchmarks/remote.md.
 
@@ -157,7 +157,7 @@ def main() -> str:
     gige = [] if no_far_network else [gige_far(d) for d in DELAYS_S]
     peer = np.median(rows[0]["looks"]) if rows[0]["looks"] else float("nan")
     lines = [
-        "# A far controller (issue 30)",
+        "# A far controller",
         "",
         f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}. videocal's own protocol through "
         "`videocal_sim/delay_line.py` (one-way delay, +-30 % jitter, 1 % of the chunks lost once and delivered a round trip "

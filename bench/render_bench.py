@@ -1,4 +1,4 @@
-"""CAD-side targets (issue #3): rendering, picking, kinematics, memory. Writes docs/benchmarks/render.md."""
+"""CAD-side targets: rendering, picking, kinematics, memory. Writes docs/benchmarks/render.md."""
 
 from __future__ import annotations
 

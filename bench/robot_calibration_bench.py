@@ -1,4 +1,4 @@
-"""Robot calibration on the cold cell (issue 16): 40 planned views of a board, the intrinsics from
+"""Robot calibration on the cold cell: 40 planned views of a board, the intrinsics from
 the same views, the robot identified, scored at 20 planned poses not used. Five cold cells (seeds).
 Writes docs/benchmarks/robot_calibration.md."""
 
@@ -87,22 +87,22 @@ def main() -> str:
         "(left at nominal), the survey (taken as exact to its stated 0.05 mm 1-sigma), each grasp's place on its fixture (the workcell file) and the "
         "fingers' centring on the pin (0.01 mm 1-sigma).",
         "",
-        "Against the issue's targets (TCP at held-out poses <= 0.1 mm and 0.02 deg from <= 40 views; estimate within 3 sigma; mounting within "
+        "Against the targets (TCP at held-out poses <= 0.1 mm and 0.02 deg from <= 40 views; estimate within 3 sigma; mounting within "
         "0.2 mm and 0.05 deg; identification <= 10 s for 40 views):",
         "",
-        "- TCP in the base frame: the column above (from 5-6 mm), both targets met on every cell. Session 8 had 0.17-0.35 mm; four changes "
+        "- TCP in the base frame: the column above (from 5-6 mm), both targets met on every cell. Without four changes it was 0.17-0.35 mm; they "
         "made the difference, each measured on the components' poses against the truth: the planned views reached only the image's middle, so "
         "the lens's distortion at its edges (where the components are seen) was a guess, and with k3 free the fit made k2 0.37 against a true "
         "0.08, putting a component 0.5-2 mm off in depth; views turned off the board's centre and k3 held at zero brought that to 0.05 mm. Then the "
         "two task fixtures stand one above the other, so the base's turn about that line rested on edge-fit orientations: viewing a component off "
         "that line (collision-checked, along the arm's reach) fixes it by positions. The components' own orientations carried a bias of a few "
         "tenths of a milliradian the same way across views (2-17 of the fit's sigmas) while their positions were right to 0.03 mm: their "
-        "covariance gets a 1 mrad turn about their own origin (session 10 found the bias was the simulated camera's point-sampled pixels, "
+        "covariance gets a 1 mrad turn about their own origin (the bias was the simulated camera's point-sampled pixels, "
         "now integrated: the 1 mrad still measures better than 0.2, 0.036-0.068 mm against 0.042-0.093 mm at held-out poses). Last, the intrinsics are fitted with the robot and each component's pose carried "
         "over to them. A view whose pose disagrees with the others is left out by name (none here).",
         "- within 3 sigma: the share of held-out camera poses inside their propagated 3-sigma ellipsoid (chi-square, 6 degrees of freedom). "
         "Fitting the intrinsics with the robot puts their uncertainty into the covariance; without it (`--fixed-intrinsics`) it was 0 % on cells 0-2. "
-        "The parameters' RMS error over sigma is 0.8-1.2 since session 13 takes each view's residuals as one measurement where they share an error "
+        "The parameters' RMS error over sigma is 0.8-1.2 now that the fit takes each view's residuals as one measurement where they share an error "
         "(calib_core/solver/clustered_covariance.py); with the residuals as independent it was 1.3-1.8.",
         "- parameters within 3 sigma: the identified parameters against the truth written in the model's own parameters "
         "(exactly: tests/core/robot_calibration/test_truth_mapping.py) and mapped into the identified subset (to first order, the "
@@ -113,7 +113,7 @@ def main() -> str:
         "",
         "## One look at the paper's task location on the calibrated model (target: <= 0.05 mm and 0.05 deg, estimate within 3 sigma)",
         "",
-        "As `videocal demo --cold` makes it: the tool measured by grasps at the other fixtures, each seen by the camera (session 12's tool went through "
+        "As `videocal demo --cold` makes it: the tool measured by grasps at the other fixtures, each seen by the camera (a tool that went through "
         "the calibrated robot and the fixture's survey: 0.017-0.056 mm after the look, the survey's error whole in the tool; seen, the look and the tool "
         "see the same kind of fixture from the same place through the same camera, and a principal point's error turns both alike); Find points' edge fit (Calibrate on edges) from the "
         "task location itself (as the paper and `videocal demo` look) and from its approach (about 350 mm from the fixture). Errors of the true "

@@ -1,4 +1,4 @@
-"""Session targets (issue #6): recording cost, replay speed, opening a long recording. Writes docs/benchmarks/session.md."""
+"""Session targets: recording cost, replay speed, opening a long recording. Writes docs/benchmarks/session.md."""
 
 from __future__ import annotations
 

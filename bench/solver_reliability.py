@@ -1,4 +1,4 @@
-"""How often a robust solve is wrong but called ``ok``, and how often a mis-pick is caught (issue 33), against
+"""How often a robust solve is wrong but called ``ok``, and how often a mis-pick is caught, against
 PoseLib and OpenCV on the same scenes. Sections of ``docs/benchmarks/solver.md`` (bench/solver_bench.py).
 
 A pose is *right* when its translation is within 5 sigma + 0.5 mm of the truth, sigma being the translation

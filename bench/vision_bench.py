@@ -1,4 +1,4 @@
-"""Vision-system targets (issue #7): intrinsics from 15 simulated ChArUco views at 1280 x 960, with and
+"""Vision-system targets: intrinsics from 15 simulated ChArUco views at 1280 x 960, with and
 without lens distortion modelled. Writes docs/benchmarks/vision.md."""
 
 from __future__ import annotations

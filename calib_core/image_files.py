@@ -1,4 +1,4 @@
-"""Reading an image file with its limits checked first (issue 33): a PNG that claims 100000 x 100000 pixels would
+"""Reading an image file with its limits checked first: a PNG that claims 100000 x 100000 pixels would
 make OpenCV allocate 30 GB (or fail with an assertion and a traceback); its size is read from the header before
 anything is decoded, and a file that is no image, or too large, is an error naming the file and the limit.
 """

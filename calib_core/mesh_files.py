@@ -1,4 +1,4 @@
-"""A component's mesh from a file, with its limits checked (issue 33): the one reader of the workcell's meshes and of
+"""A component's mesh from a file, with its limits checked: the one reader of the workcell's meshes and of
 *Add component*. A binary STL says its triangle count in its header, so a 5-million-triangle file is refused before
 it is read; any mesh is refused when its file or its triangle count is over the limit, when a coordinate is not
 finite or absurd, or when it encloses no area (every triangle degenerate). Each error names the file and the limit.

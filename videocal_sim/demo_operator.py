@@ -107,7 +107,7 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale,
                                 less_kind=look == "workshop")
     weather = None
-    if link_delay_ms:  # the same cell far away, with the weather
+    if link_delay_ms:  # the same cell far away, with a far link's weather
         from videocal_sim.delay_line import LinkWeather
 
         weather = LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01)

@@ -1,4 +1,4 @@
-"""*File > Open camera...*: any camera a connector handles, chosen while the window runs (issue 30: the camera was
+"""*File > Open camera...*: any camera a connector handles, chosen while the window runs (the camera was
 chosen only at launch). The spec is what ``--camera`` takes: a device number, a video file, a folder of images,
 ``rtsp://``/``http://`` streams, ``aravis://ID``, ``ros2:///topic``... A scheme nobody handles is refused before the
 running camera is stopped; a camera that then fails to open says why in the results panel, and the window stays up.

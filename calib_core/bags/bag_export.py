@@ -1,4 +1,4 @@
-"""A videocal recording as a ROS 2 bag (issue 31): what ``ros2 bag info``/``play`` and rosbags-based tools read, beside
+"""A videocal recording as a ROS 2 bag: what ``ros2 bag info``/``play`` and rosbags-based tools read, beside
 the Foxglove MCAP the recorder writes. Written with ``rosbags`` (MCAP storage, ROS 2 Humble's message definitions):
 
 - ``/camera/image_raw/compressed``: ``sensor_msgs/CompressedImage`` (JPEG), each frame stamped with its time in the

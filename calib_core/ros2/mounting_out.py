@@ -1,4 +1,4 @@
-"""The measured camera mounting in the two forms a ROS 2 system takes it (issue 31): a launch file that runs
+"""The measured camera mounting in the two forms a ROS 2 system takes it: a launch file that runs
 ``tf2_ros``'s ``static_transform_publisher`` (ROS 2 Humble's named arguments: metres and a quaternion), and a URDF (a document a
 parser reads alone) or a xacro macro to include, with a fixed joint from the mount's link to the camera's (metres,
 URDF's fixed-axis roll-pitch-yaw in radians). Plain text: no ROS needed to write them. The camera frame is videocal's (z along

@@ -96,6 +96,21 @@ RIVAL_CHECK_POINTS = 10
 _CONSISTENT_QUANTILE = 0.999
 
 
+def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
+    """The least-squares pose of the pairs of ``sub`` alone, seeded by P3P over its triplets (compiled), or None."""
+    from calib_core.solver.kernels.fast_path import p3p_newton_summary
+    from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
+
+    if sub.n_points < 4 or sub.coplanar:
+        return None
+    intr = sub.intrinsics
+    out = p3p_newton_summary(sub.points_3d, sub.points_2d, chosen.fu, chosen.fv, intr.cx, intr.cy, sub.distortion, 100, -1.0, DEFAULT_SIGMA_PX,
+                             1e9, -1.0, 1.0, 0.0)
+    if out is None:
+        return None
+    return refine_seed(sub, out[0], out[1], chosen.fu, chosen.fv, None)
+
+
 def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) -> list[RefinedPose]:
     """Other poses that explain as many pairs as ``chosen`` does, each pair within the noise: ``chosen``'s
     inliers with one of them swapped for one it rejected, fitted by least squares and consistent (squared
@@ -119,6 +134,10 @@ def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) 
             idx = np.flatnonzero(subset)
             sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
             fit = refine_seed(sub, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv, None)
+            if fit is None or not fit.converged or fit.cost > limit:
+                # from the chosen pose the swapped set's own minimum may be out of reach (a rival tens of mm away):
+                # its triplets' P3P roots find it
+                fit = _own_minimum(sub, chosen)
             if fit is None or not fit.converged or fit.cost > limit:
                 continue
             r, J, _ = residuals_and_jacobian(problem, fit.newton.R, fit.newton.t, fit.fu, fit.fv)

@@ -81,12 +81,12 @@ def admissible(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_
     scale = float(np.sqrt(np.sum(residuals[used] ** 2) / dof)) if dof >= OWN_SCALE_MIN_DOF else 0.0
     sigma = max(float(noise_px), scale)
     tested = len(residuals)
-    limit = 2.0 * _fisher_quantile(tested, dof) if scale > noise_px else threshold(tested)
+    limit = 2.0 * fisher_quantile(tested, dof) if scale > noise_px else threshold(tested)
     return np.where(finite, statistics, np.inf) / sigma**2 <= limit
 
 
 @lru_cache(maxsize=4096)
-def _fisher_quantile(n_tested: int, dof: int) -> float:
+def fisher_quantile(n_tested: int, dof: int) -> float:
     """F(2, dof) at the quantile leaving one false flag per thousand solves among ``n_tested`` pairs."""
     from scipy.stats import f as fisher
 
@@ -115,6 +115,6 @@ def flag_misfits(statistics: np.ndarray, residuals: np.ndarray, used: np.ndarray
     sigma = np.maximum(noise_px, np.sqrt(others))
     # Where the scale is the picks' own estimate, the statistic over it is 2 F(2, dof), not chi-square: the
     # heavier tail of an estimated scale (12 degrees of freedom for 10 pairs) must not flag coarse good picks.
-    limits = np.where(np.sqrt(others) > noise_px, 2.0 * _fisher_quantile(int(finite.sum()), dof), limit)
+    limits = np.where(np.sqrt(others) > noise_px, 2.0 * fisher_quantile(int(finite.sum()), dof), limit)
     with np.errstate(invalid="ignore"):
         return np.nan_to_num(statistics / sigma**2, nan=0.0) > limits, sigma, limit

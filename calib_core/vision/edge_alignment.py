@@ -2,7 +2,7 @@
 over 30 deg) and open boundary, samples along those a camera sees (a face beside them faces it), the
 distance transform of the image's Canny edges, and the share of samples that lie on an image edge.
 
-Until session 12 this module also slid the projected edges over the image as a 2D shift (chamfer
+This module once also slid the projected edges over the image as a 2D shift (chamfer
 matching) to find the target; close to it a robot's error is no shift (parallax), and
 :mod:`calib_core.vision.pose_hypotheses` searches camera poses instead.
 """

@@ -1,4 +1,4 @@
-"""A user's ROS 2 bag on the window's replay timeline (issue 31): the frames of its image topic, the arm's joints at
+"""A user's ROS 2 bag on the window's replay timeline: the frames of its image topic, the arm's joints at
 each frame's header stamp (from ``/joint_states`` through the cell's joint names), its CameraInfo as the camera in
 use; points picked on a frame and solved as on a recording. The bag is written by ``rosbags`` from the simulated
 test bed (the true robot, rendered by the true camera); the truth only scores."""

@@ -333,7 +333,7 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         assert "Restore" in win.files.restore_action.text()
         win.files.restore_action.trigger()
         assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
-        # Issue 32: Save after a restore wrote into the recovery folder without a dialog, and the next
+        # Save after a restore wrote into the recovery folder without a dialog, and the next
         # start offered that file again. A restored session has no file yet: Save asks where.
         assert win.files.workspace_path is None
         chosen = tmp_path / "mine.json"

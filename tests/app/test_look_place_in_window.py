@@ -1,4 +1,4 @@
-"""Issue 32's first hole through the real window: Go to approach, pick, Calibrate (OK), Store
+"""The first hole through the real window: Go to approach, pick, Calibrate (OK), Store
 correction. The look was made 200 mm from the task location: the window says so and offers to keep it
 as a measurement; kept so, *Go to task, corrected* has no correction to execute and moves nothing."""
 

@@ -1,4 +1,4 @@
-"""Issue 33: one pick 12 px off among nine good ones was solved 'ok' (RMS 0.92 px) and stored. Through the
+"""One pick 12 px off among nine good ones was solved 'ok' (RMS 0.92 px) and stored. Through the
 window: the solve fails naming the pair, the pairs table marks it, and nothing can be stored."""
 
 from PySide6.QtCore import Qt

@@ -120,7 +120,7 @@ def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
         wb.picking.accept_pair()
     # The hand was 3.2 px off. The boss's rim puts it within 0.1-1.1 px (by the frame's noise). The knob's
     # end-face rim lies within 2 px of its silhouette, and since the simulated camera integrates its pixels
-    # (session 10) the two edges blend at 640 px: the rim found is 0.9-2.1 px from the truth, by frame.
+    # the two edges blend at 640 px: the rim found is 0.9-2.1 px from the truth, by frame.
     # A known limit (docs/find-points.md); the pick must still be better than the hand.
     assert errors[1] < 1.5, errors
     assert errors[0] < 2.5, errors

@@ -167,7 +167,7 @@ def test_a_recording_from_another_camera_mode_replays_with_its_own_intrinsics(qt
 
 
 def test_a_branchs_new_pair_is_numbered_after_the_recorded_ones_and_undo_stays_in_the_branch(qtbot, window, recording):
-    """Issue 32: a new pair took number 1 beside recorded pair 1; the camera click meant for it moved the
+    """A new pair took number 1 beside recorded pair 1; the camera click meant for it moved the
     recorded pair, Undo twice deleted the recorded pair and Redo left two rows numbered 1."""
     win, wb = window, window.workbench
     win.files.open_recording(recording)

@@ -1,4 +1,4 @@
-"""Issue 32: Esc said "stop sent to the controller" but the Move prompt stayed armed, and *Move* then
+"""Esc said "stop sent to the controller" but the Move prompt stayed armed, and *Move* then
 moved the robot. A Stop now voids every prompt waiting; a confirmation given before it moves nothing."""
 
 import numpy as np

@@ -191,7 +191,7 @@ def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, 
 
 
 def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
-    """Issue 32: four captures while the robot moved to the next board pose were all accepted, each a copy
+    """Four captures while the robot moved to the next board pose were all accepted, each a copy
     of the frame from before the move (the still held for picking); coverage stayed while the count rose."""
     win, wb = window, window.workbench
     vision = win.vision

@@ -1,4 +1,4 @@
-"""Which frame new-cell mounts the tool on (issue 31): the JACO2 of example-robot-data got a finger tip
+"""Which frame new-cell mounts the tool on: the JACO2 of example-robot-data got a finger tip
 (``j2s6s200_link_finger_tip_2``): tool and camera 150 mm sideways, and the demo still said ok. The flange is now
 the last link of the arm before any gripper, said with its reason, and a flange whose z does not point out of
 the wrist (JACO2's end effector: 90 deg across) has the tool placed along the way out."""

@@ -132,7 +132,7 @@ def test_a_signal_during_start_up_ends_it_and_leaves_no_simulator(cell_copy, tmp
 
 
 def test_a_relative_workcell_path_opens_the_window(cell_copy, tmp_path):
-    """Issue 29/31: the simulator child ran in the project's folder with the path as given."""
+    """The simulator child ran in the project's folder with the path as given."""
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
     done = subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--workcell", os.path.relpath(cell_copy, tmp_path), "--screenshot", "shot.png"],
                           cwd=tmp_path, capture_output=True, text=True, env=env, timeout=180)

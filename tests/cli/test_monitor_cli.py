@@ -62,7 +62,7 @@ def test_sim_controller_bad_options_exit_2():
 
 
 def test_monitor_does_not_show_a_sample_of_another_joint_count(tmp_path):
-    """Issue 33: a 3-joint sample in the middle of a 6-joint stream was printed as if it were valid. The
+    """A 3-joint sample in the middle of a 6-joint stream was printed as if it were valid. The
     controller here is the test itself on a pty: it answers nothing but streams samples, one of them short."""
     import os
     import threading

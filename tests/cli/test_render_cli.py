@@ -49,7 +49,7 @@ def test_bad_arguments_exit_2(tmp_path, args, message):
 
 
 def test_at_task_renders_from_the_task_pose_itself(tmp_path):
-    """``--location`` shows the approach; the first look is made at the task location itself (issue 31: a cell
+    """``--location`` shows the approach; the first look is made at the task location itself (a cell
     whose approach render looked fine failed its first look there). ``--at-task`` shows that view."""
     from calib_core.workcell import load_workcell
 

@@ -63,7 +63,7 @@ def test_a_mesh_path_no_file_system_takes(folder, name):
 
 
 def test_a_detector_parameter_past_a_c_int_is_refused_naming_it(tmp_path):
-    """The reliability bench's fuzzing (session 15): ``integer won't fit into a C int`` escaped as a ValueError."""
+    """The reliability bench's fuzzing: ``integer won't fit into a C int`` escaped as a ValueError."""
     from calib_core.vision.target_detection import load_detector_settings
 
     path = tmp_path / "detector.yaml"
@@ -82,7 +82,7 @@ def test_a_file_name_with_a_nul_byte_in_a_data_file_is_refused(tmp_path):
 
 
 def test_a_huge_integer_for_a_detector_number_is_taken_as_a_float_or_refused_naming_it(tmp_path):
-    """``ufunc 'isfinite' not supported`` for an integer past 2^63 escaped as a TypeError (reliability bench, session 15)."""
+    """``ufunc 'isfinite' not supported`` for an integer past 2^63 escaped as a TypeError (reliability bench)."""
     from calib_core.vision.target_detection import load_detector_settings
 
     path = tmp_path / "detector.yaml"

@@ -1,4 +1,4 @@
-"""Issue 33: a workcell that is a FIFO blocked the load forever. A pipe or a device is refused by name."""
+"""A workcell that is a FIFO blocked the load forever. A pipe or a device is refused by name."""
 
 import os
 import subprocess

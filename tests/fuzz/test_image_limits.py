@@ -1,4 +1,4 @@
-"""Image files beyond their limits (issue 33): each is refused by name, before decoding, with the limit; none gives
+"""Image files beyond their limits: each is refused by name, before decoding, with the limit; none gives
 a traceback or allocates gigabytes. The cases are the held-out fuzzing's findings."""
 
 from __future__ import annotations

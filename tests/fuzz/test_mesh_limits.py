@@ -1,4 +1,4 @@
-"""Meshes beyond their limits (issue 33): a 5-million-triangle STL refused from its header before it is read, a mesh
+"""Meshes beyond their limits: a 5-million-triangle STL refused from its header before it is read, a mesh
 with coordinates of 3e38 or no area refused, each error naming the file; through the workcell, the error names the
 workcell's field too."""
 

@@ -119,3 +119,44 @@ def fit_summary(J, r, w, R, t, sigma_given, default_sigma, cov, cov_centre, loo,
         for b in range(3):
             cov_centre[a, b] *= s2
     return rms, sigma, source, condition
+
+
+@njit(cache=True)
+def flags_a_misfit(J, r, cov_unit, noise, fisher_limit, own_scale_min_dof, false_flag_per_solve):
+    """Whether :func:`calib_core.solver.misfit.flag_misfits` would flag a pair of this fit (every pair used), compiled
+    for the fast path: ``T_i = r_i^T (I - H_ii)^-1 r_i`` from the hat matrix's 2 x 2 blocks (``cov_unit`` (p, p) =
+    ``(J^T J)^-1``), each against the noise or the other pairs' own scale. ``fisher_limit``: ``2 F(2, dof)`` at the
+    false-flag quantile for ``n`` pairs. Returns 1 (a pair flagged), 0 (none), -1 (a pair the fit cannot judge: the
+    full test decides)."""
+    n, _, p = J.shape
+    dof = 2 * n - p - 2
+    if n < 3 or dof <= 0:
+        return 0
+    T = np.empty(n)
+    rss = 0.0
+    for i in range(n):
+        h00 = 0.0
+        h01 = 0.0
+        h11 = 0.0
+        for a in range(p):
+            for b in range(p):
+                c = cov_unit[a, b]
+                h00 += J[i, 0, a] * c * J[i, 0, b]
+                h01 += J[i, 0, a] * c * J[i, 1, b]
+                h11 += J[i, 1, a] * c * J[i, 1, b]
+        m00 = 1.0 - h00
+        m11 = 1.0 - h11
+        det = m00 * m11 - h01 * h01
+        if not det > 1e-9:
+            return -1
+        T[i] = (m11 * r[i, 0] * r[i, 0] + 2.0 * h01 * r[i, 0] * r[i, 1] + m00 * r[i, 1] * r[i, 1]) / det
+        rss += r[i, 0] * r[i, 0] + r[i, 1] * r[i, 1]
+    chi2_limit = -2.0 * np.log(false_flag_per_solve / n)
+    for i in range(n):
+        others = max(rss - T[i], 0.0) / dof if dof >= own_scale_min_dof else 0.0
+        scale = np.sqrt(others)
+        sigma = max(noise, scale)
+        limit = fisher_limit if scale > noise else chi2_limit
+        if T[i] / (sigma * sigma) > limit:
+            return 1
+    return 0

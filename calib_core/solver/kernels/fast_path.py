@@ -44,7 +44,7 @@ def seed_coordinates(uv, fu, fv, cx, cy, dist):
 @njit(cache=True)
 def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma):
     """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else
-    ``(R, t, residuals, covariance (6, 6), centre covariance (3, 3), leave-one-out (n,),
+    ``(R, t, residuals, Jacobian (n, 2, 6), covariance (6, 6), centre covariance (3, 3), leave-one-out (n,),
     scalars)`` with ``scalars`` = ``iterations, outcome, rms px, sigma px, sigma source,
     condition`` (all arrays allocated here: one call, few interpreter round trips)."""
     n = P.shape[0]
@@ -62,7 +62,7 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     lengths = np.empty(n)
     rms, sigma, source, condition = fit_summary(J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
     scalars = np.array([iterations, outcome, rms, sigma, source, condition], dtype=np.float64)
-    return R, t, r, cov, cov_centre, loo, scalars
+    return R, t, r, J, cov, cov_centre, loo, scalars
 
 
 @njit(cache=True)
@@ -165,6 +165,7 @@ def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     cov_centre = np.empty((3, 3))
     loo = np.empty(n)
     lengths = np.empty(n)
-    rms, sigma, source, condition = fit_summary(Js[best], r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
+    J = Js[best].copy()
+    rms, sigma, source, condition = fit_summary(J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
     scalars = np.array([its[best], outcomes[best], rms, sigma, source, condition], dtype=np.float64)
-    return R, t, r, cov, cov_centre, loo, scalars
+    return R, t, r, J, cov, cov_centre, loo, scalars

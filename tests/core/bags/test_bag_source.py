@@ -60,7 +60,7 @@ def test_calibrate_intrinsics_from_a_bag_matches_the_photos_folder(tmp_path):
 
 
 def test_a_bag_given_as_a_recording_is_refused_naming_what_it_holds(tmp_path):
-    """Issue 31: `replay bag.mcap` said '0 solves' with exit 0; a bag folder said 'Is a directory'."""
+    """`replay bag.mcap` said '0 solves' with exit 0; a bag folder said 'Is a directory'."""
     from mcap.writer import Writer
 
     bag = write_bag(tmp_path / "bag", "mcap", {"/camera/image_raw": chessboard_photos()[:1]})
@@ -76,7 +76,7 @@ def test_a_bag_given_as_a_recording_is_refused_naming_what_it_holds(tmp_path):
         run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(source)], capture_output=True, text=True, timeout=120)
         assert run.returncode == 2 and expected in run.stderr and "Traceback" not in run.stderr, run.stderr
     recover = subprocess.run([sys.executable, "-m", "app.cli.main", "recover", str(header_only), str(tmp_path / "copy.mcap")], capture_output=True, text=True, timeout=120)
-    assert recover.returncode == 2 and not (tmp_path / "copy.mcap").exists()  # issue 33: no empty copy
+    assert recover.returncode == 2 and not (tmp_path / "copy.mcap").exists()  # no empty copy
 
 
 def test_a_bag_whose_messages_are_not_cdr_is_one_error_naming_the_topic_and_message(tmp_path):

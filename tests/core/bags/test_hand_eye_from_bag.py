@@ -1,4 +1,4 @@
-"""The camera's mounting from a user's ROS 2 bag with no conversion (issue 31): board images, ``/joint_states`` and
+"""The camera's mounting from a user's ROS 2 bag with no conversion: board images, ``/joint_states`` and
 CameraInfo as a ROS 2 system records them (written by ``rosbags``), from the simulated test bed: the arm holds still
 at each pose and moves between them, and the camera keeps taking frames all along. The flange pose at each image's
 stamp comes from the joint states through the cell's robot, only where the arm stood still; the intrinsics from the

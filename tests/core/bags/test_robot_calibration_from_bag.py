@@ -1,4 +1,4 @@
-"""``videocal calibrate-robot BAG`` (issue 31): the robot's geometry identified from a user's ROS 2 bag with no
+"""``videocal calibrate-robot BAG``: the robot's geometry identified from a user's ROS 2 bag with no
 conversion: board images on a compressed topic, ``/joint_states`` (SI units, a gripper joint beside the arm's)
 and the camera driver's CameraInfo, recorded while the arm held still at planned poses and moved between them.
 Frames taken mid-move are left out; the joints of the others come from the joint states at each image's stamp.

@@ -18,7 +18,7 @@ FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bot
 @pytest.fixture(scope="module")
 def bed():
     errors = RobotErrors.typical(0)
-    # No hand-eye error here: with the modelled mounting the camera tells the TCP exactly (issue #7 calibrates it).
+    # No hand-eye error here: with the modelled mounting the camera tells the TCP exactly (the hand-eye calibration measures it).
     errors = RobotErrors(errors.joint_offsets_deg, errors.link_errors_mm, errors.base_xyz_mm, errors.base_rpy_deg)
     return TestBed.create(errors=errors)
 

@@ -1,4 +1,4 @@
-"""*Verify* judges two looks against the task's tolerance as well as their 1-sigma (issue 32: 1.61 mm
+"""*Verify* judges two looks against the task's tolerance as well as their 1-sigma (1.61 mm
 apart with a 1.68 mm 3-sigma was called "agree" for a task that needs 1 mm)."""
 
 import numpy as np

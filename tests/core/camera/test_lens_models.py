@@ -1,4 +1,4 @@
-"""OpenCV's rational (8-coefficient) and fisheye (equidistant) lenses beside its 5-coefficient one (issue 31): projection
+"""OpenCV's rational (8-coefficient) and fisheye (equidistant) lenses beside its 5-coefficient one: projection
 against OpenCV's own ``projectPoints`` and ``fisheye.projectPoints``, back-projection as its inverse, the files ROS and
 OpenCV write, and a pose solved through each lens."""
 

@@ -1,4 +1,4 @@
-"""A controller seconds away (issue 30, deliverable 7): videocal's own protocol through a delay line of
+"""A controller seconds away: videocal's own protocol through a delay line of
 1.5 s one way, +-30 % jitter and 1 % of the chunks lost once (late by a round trip, as TCP delivers them),
 between the workstation's driver and the controller simulator in its own process.
 

@@ -1,4 +1,4 @@
-"""Issue 32's link attacks: a heartbeat from anyone kept a move running after the workstation died, a
+"""The link attacks: a heartbeat from anyone kept a move running after the workstation died, a
 keyless HEL ended the workstation's session, a keyless TCP client locked it out, and long refusals made
 the simulator exit. Each at the controller's logic and through the real simulator process."""
 

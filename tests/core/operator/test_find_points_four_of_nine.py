@@ -1,4 +1,4 @@
-"""A defect reproduced and fixed (session 22's closing note): on this frame (the demo's first look, frame 12, held by
+"""A defect reproduced and fixed: on this frame (the demo's first look, frame 12, held by
 the window in about half of the demo's runs) Find points proposed 4 or 5 of the fixture's 9 features, and their solve
 was judged OK while the camera was 1.6 mm from the true one. The image's noise had ranked three wrong starts of the
 edge fit first; each settled 1.6-1.9 mm off with about half of its samples on their edges, the first was kept, and

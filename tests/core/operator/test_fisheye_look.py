@@ -1,4 +1,4 @@
-"""A look through a fisheye (equidistant) lens, the whole chain (issue 31): the simulated camera renders through it,
+"""A look through a fisheye (equidistant) lens, the whole chain: the simulated camera renders through it,
 picks are made on its image, Find points and its edge fit work on it, and the solve measures the camera as through
 the bundled lens. The lens is the bundled camera's focal length and principal point with OpenCV's fisheye model
 (its corners 175 px from where a pinhole would put them). The truth only scores."""

@@ -1,4 +1,4 @@
-"""A correction is bound to where its look was made (issue 32): a look from the approach pose or from a
+"""A correction is bound to where its look was made: a look from the approach pose or from a
 recording is a measurement at its own pose, never the task's correction unless converted explicitly."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""The core's events say what changed and only when it did (issue 29): joints on a change, not on every
+"""The core's events say what changed and only when it did: joints on a change, not on every
 sample; solve options through the undo stack with their own event."""
 
 import numpy as np

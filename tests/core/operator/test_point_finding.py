@@ -70,7 +70,7 @@ def test_calibrate_on_edges_puts_the_tcp_within_a_tenth_of_a_millimetre(found_co
     assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
     assert core.session.last_solve_inputs["method"] == "edges" and core.session.last_solve_inputs["frame_index"] == 3
     # The camera is what a look measures (the TCP follows through the camera's mounting, which this cell
-    # has with its typical error: issue 16's business): within a tenth of a millimetre of the true one.
+    # has with its typical error: the robot calibration's business): within a tenth of a millimetre of the true one.
     true_cam = site.bed.true_cam2world(q)
     error = np.linalg.norm(estimate.cam2world_measured[:3, 3] - true_cam[:3, 3])
     model_error = np.linalg.norm(estimate.cam2world_model[:3, 3] - true_cam[:3, 3])

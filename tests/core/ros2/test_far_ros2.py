@@ -1,4 +1,4 @@
-"""ROS 2 seconds away (issue 30, deliverable 7): the simulated ros2_control arm in a network namespace of its own,
+"""ROS 2 seconds away: the simulated ros2_control arm in a network namespace of its own,
 every DDS packet between it and this process delayed 1.5 s one way (+-30 %), 1 % of them dropped, by
 :class:`videocal_sim.far_network.FarNetwork`. The connector must come up, measure the delay from the stamps,
 take no burst of late samples for a lost robot, and move the arm once along its line to the target."""

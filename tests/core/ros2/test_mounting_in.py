@@ -1,4 +1,4 @@
-"""A camera mounting read from the launch file another tool wrote for ``static_transform_publisher`` (issue 31):
+"""A camera mounting read from the launch file another tool wrote for ``static_transform_publisher``:
 MoveIt 2's hand-eye calibration (a Python launch file, named arguments, quaternion or roll/pitch/yaw), an XML
 launch (positional arguments, ROS 1's MoveIt Calibration and hand-written setups), and videocal's own output read
 back. The Python file is parsed, never run."""

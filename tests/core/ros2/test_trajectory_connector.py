@@ -185,7 +185,7 @@ time.sleep(60)
 
 
 def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm):
-    """The dead-man (issue 30): a one-point trajectory ran on to the target whatever became of the workstation.
+    """The dead-man: a one-point trajectory ran on to the target whatever became of the workstation.
     A real process, killed with SIGKILL mid-move (no Stop, no goodbye): the arm stops within the horizon's
     motion (0.5 s at 20 deg/s: 10 deg) of where it was, on the way, and stays there."""
     import signal

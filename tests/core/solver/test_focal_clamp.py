@@ -1,4 +1,4 @@
-"""Issue 33: with focal lengths estimated, a solve resting on the focal search range said 'point 2 fits worst
+"""With focal lengths estimated, a solve resting on the focal search range said 'point 2 fits worst
 (check that pick)': the picks were fine, the range was the cause. The reason now says so."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Mis-picks found in plain mode too (issue 33): one pick 12 px off among 9 good ones passed with RMS 0.92 px
+"""Mis-picks found in plain mode too: one pick 12 px off among 9 good ones passed with RMS 0.92 px
 and a 0.108 deg tilt. Each pair's leave-one-out miss is tested against the noise model."""
 
 from __future__ import annotations

@@ -76,7 +76,7 @@ def test_robust_finds_the_pose_through_a_third_of_wrong_pairs(pairs):
 
 
 def test_robust_on_seven_coarse_picks_of_the_photo_gives_the_plain_answer(pairs):
-    """Issue 33: robust mode on 7 clean hand picks of the tutorial's photo (about 2 px) failed where the plain
+    """Robust mode on 7 clean hand picks of the tutorial's photo (about 2 px) failed where the plain
     solve was fine. Seven of the photo's registered pairs spread over the box, moved by 2 px as a hand would."""
     P, uv = pairs
     rng = np.random.default_rng(12)

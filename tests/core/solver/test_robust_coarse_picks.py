@@ -1,7 +1,7 @@
-"""The robust mode with hand picks coarser than the noise model, and with few pairs (issue 33).
+"""The robust mode with hand picks coarser than the noise model, and with few pairs.
 
 Robust mode judged every pair against 0.5 px: 7 clean pairs picked at 2 px had good pairs rejected in 182 of
-200 scenes (the pose up to 84 mm from the plain solve's), and the issue's 7 hand picks on a photo failed. It now
+200 scenes (the pose up to 84 mm from the plain solve's), and 7 hand picks on a photo failed. It now
 measures the picks' scale when the pairs allow it, admits a left-out pair by the same test the misfit check
 uses, and with few pairs calls the answer ambiguous when a different pair could be the mis-pick."""
 

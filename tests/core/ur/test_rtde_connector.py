@@ -180,7 +180,7 @@ def test_a_ur_1_5_s_away_connects_measures_its_delay_and_completes_a_move():
 
 def test_an_unreachable_controller_is_one_error_line_without_the_library_s_noise():
     """``ur_rtde`` printed "connect: Connection refused" on stderr at every retry (C++, whatever its verbose flag),
-    ahead of videocal's one error line (issue 33)."""
+    ahead of videocal's one error line."""
     import subprocess
     import sys
     from pathlib import Path

@@ -1,4 +1,4 @@
-"""A board capture refuses a frame it has captured already (issue 32: four captures of one frame were
+"""A board capture refuses a frame it has captured already (four captures of one frame were
 four views)."""
 
 import numpy as np

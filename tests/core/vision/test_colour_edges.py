@@ -1,4 +1,4 @@
-"""Find points sees what the eye sees (issue 33): a target whose colour differs from what is behind it while its
+"""Find points sees what the eye sees: a target whose colour differs from what is behind it while its
 grey level does not. The test bed's cell with the fixture painted orange and the unit behind it tan, of one grey
 (OpenCV's luma 0.635 both), seen from the task location where the fixture's face fills the view: in grey its
 outline is gone (the grey path: "its edges did not settle"); in colour every feature is found. The truth only

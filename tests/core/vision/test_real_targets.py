@@ -66,7 +66,7 @@ def test_marker_refinement_recovers_the_corners_a_first_pass_loses():
     assert all(r >= p for _, r, p in counts)
     assert sum(r == 24 for _, r, _ in counts) >= 15
     by_name = {name: (r, p) for name, r, p in counts}
-    assert by_name["2"][0] == 24 and by_name["2"][1] <= 8  # the "4 of 24"
+    assert by_name["2"][0] == 24 and by_name["2"][1] <= 8  # "4 of 24", as first reported
     assert sum(p < 24 for _, _, p in counts) >= 8
 
 

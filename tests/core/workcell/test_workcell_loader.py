@@ -70,7 +70,7 @@ def _write(path: Path, data) -> Path:
         (lambda d: d["robot"].update(controller={"joints": ["joint_1", "joint_2"]}), "robot.controller.joints", "must name each driven joint once"),
         (lambda d: d["robot"].update(controller={"joints": ["joint_1"], "zero_offsets": [1, 2]}), "robot.controller.zero_offsets", "one value per controller joint"),
         (lambda d: d.update(hand_eye_board={"xyz": [1, 2]}), "hand_eye_board", "missing key(s) rpy"),
-        # names become controller code and YAML keys: no control characters (issue 32)
+        # names become controller code and YAML keys: no control characters
         (lambda d: d["task_locations"][0].update(name="oru_1\n  x := 0; END; DELETE"), "task_locations[0].name", "control character U+000A"),
         (lambda d: d["components"][1].update(name="rack\u202e1"), "components[1].name", "control character U+202E"),
         (lambda d: d["components"][2]["features"].update({"pin\ttip": [1, 2, 3]}), "components[2].features.'pin\\ttip'", "control character U+0009"),

@@ -1,4 +1,4 @@
-"""Names from the user never become controller code (issue 32: a task name with a newline exported
+"""Names from the user never become controller code (a task name with a newline exported
 ``:= 0; END; DELETE`` as PDL2 statements between VAR and BEGIN, exit 0)."""
 
 import json
