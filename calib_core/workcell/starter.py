@@ -195,6 +195,7 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, turn @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])), "camera": NewFrame(flange, turn @ _camera_frame(offset))}
     robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held, xacro_args=xacro_args))
     home = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
+    floor_z = _floor_z_mm(robot, home)
     tcp, q_approach = _find_task(robot, home)
     home = q_approach  # start where the camera already sees the target from the approach
     # The target's face centre sits GRASP_STANDOFF_MM beyond the TCP, facing the robot (its x toward -x base).
@@ -210,7 +211,7 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     except OSError as exc:
         raise FileWriteError(folder, f"cannot make the cell's folder ({exc.strerror or exc})") from None
     try:
-        _write_files(staging, folder, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach)
+        _write_files(staging, folder, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach, floor_z)
         _move_into(staging, folder)
     except OSError as exc:
         raise FileWriteError(folder, f"cannot write the cell ({exc.strerror or exc}); nothing was left behind") from None
@@ -242,15 +243,28 @@ def _move_into(staging: Path, folder: Path) -> None:
             os.replace(item, target)
 
 
-def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach) -> None:
-    """The cell's files into ``folder`` (paths in them relative to ``final``, a sibling: the same relative paths)."""
+def _floor_z_mm(robot: RobotModel, q_deg) -> float:
+    """The height (mm, base frame z) of the floor's top: under the robot's fixed links (the mounting that moves with
+    no joint), which on FANUC's and Yaskawa's packages reach 330 mm below their ``base`` frame; 0 when they stand
+    on or above it, or have no geometry."""
+    from calib_core.robot.visuals import RobotVisuals
+
+    visuals = RobotVisuals.from_robot(robot)
+    lows = [float(trimesh.transform_points(trimesh.bounds.corners(mesh.bounds), pose)[:, 2].min()) if len(mesh.vertices) else 0.0
+            for g, mesh, pose in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q_deg)) if g.parentJoint == 0]
+    return min(0.0, min(lows, default=0.0))
+
+
+def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach, floor_z=0.0) -> None:
+    """The cell's files into ``folder`` (paths in them relative to ``final``, a sibling: the same relative paths);
+    the floor's top at ``floor_z`` (mm, base frame)."""
     meshes = folder / "meshes"
     meshes.mkdir(exist_ok=True)
     floor = trimesh.creation.box(extents=(3.0 * reach, 3.0 * reach, 10.0))
     floor.apply_translation([0.0, 0.0, -5.0])
     floor.export(meshes / "floor.stl")
     target = _target_mesh()
-    post_height = max(target2base[2, 3] - PLATE[2] / 2, 1.0)
+    post_height = max(target2base[2, 3] - floor_z - PLATE[2] / 2, 1.0)
     post = trimesh.creation.box(extents=(20.0, 20.0, post_height))  # from the plate's back down to the floor
     post.apply_translation([-PLATE[0] - 10.0, 0.0, -PLATE[2] / 2 - post_height / 2 + 20.0])
     trimesh.util.concatenate([target, post]).export(meshes / "target.stl")
@@ -292,7 +306,7 @@ def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_arg
         "    mesh: meshes/floor.stl",
         "    mesh_units: mm",
         "    color: [0.55, 0.56, 0.58]",
-        "    placement: {xyz: [0, 0, 0], rpy: [0, 0, 0]}",
+        f"    placement: {{xyz: [0, 0, {floor_z:.2f}], rpy: [0, 0, 0]}}" + ("   # under the robot's base link" if floor_z < 0 else ""),
         "  - name: target",
         "    kind: component",
         "    mesh: meshes/target.stl",
