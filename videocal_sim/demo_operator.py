@@ -24,7 +24,7 @@ from PySide6.QtCore import QEventLoop, QPointF, QSettings, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
-from calib_core.errors import OperatorError
+from calib_core.errors import OperatorError, VideocalError
 from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
@@ -57,13 +57,17 @@ def _visible_features(component, cam2world: np.ndarray, intrinsics) -> list[str]
     return names
 
 
+class DemoTimeoutError(VideocalError, TimeoutError):
+    """The scripted operator waited too long for something: one ``error:`` line naming it, not a traceback."""
+
+
 def _wait(app: QApplication, condition, timeout_s: float, what: str, state=None) -> None:
-    """Process events until ``condition()``; after ``timeout_s`` a TimeoutError naming ``what`` and,
+    """Process events until ``condition()``; after ``timeout_s`` a :class:`DemoTimeoutError` naming ``what`` and,
     when given, ``state()`` (what the window and the robot say then)."""
     deadline = time.monotonic() + timeout_s
     while not condition():
         if time.monotonic() > deadline:
-            raise TimeoutError(f"demo: timed out waiting for {what}" + (f" ({state()})" if state is not None else ""))
+            raise DemoTimeoutError(f"demo: waited {timeout_s:g} s for {what}" + (f" ({state()})" if state is not None else ""))
         app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 20)
         time.sleep(0.01)
 
@@ -163,7 +167,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     wb.arm.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
     try:
-        _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 30, "the controller link and the camera")
+        # (60 s: a loaded machine starts the simulator, the camera's process and the link slowly)
+        _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 60, "the controller link and the camera",
+              lambda: f"link {'up' if wb.link_up else 'not up'}; camera {'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
+                      f"status: {win.results.status.text()!r}")
         shot("start")
         task = wb.task
 
