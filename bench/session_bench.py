@@ -13,7 +13,8 @@ import numpy as np
 from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.reader import read_recording
 from calib_core.recording.recorder import SessionRecorder
-from calib_core.recording.replay import replay, solve_inputs
+from calib_core.recording.replay import replay
+from calib_core.solver.solve_inputs import solve_inputs
 from calib_core.solver import solve_pose
 from videocal_sim.test_bed import TestBed
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from calib_core.calibration.correspondences import Correspondence, CorrespondenceSet, with_pixel
-from calib_core.calibration.undo import Command
+from calib_core.undo import Command
 from calib_core.errors import OperatorError
 
 

@@ -17,12 +17,12 @@ from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.calibration.correspondences import CorrespondenceSet
 from calib_core.calibration.end_effector import EndEffectorEstimate, end_effector_from_solution, shared_shift_covariance
 from calib_core.calibration.form_error import form_error_covariance
-from calib_core.calibration.undo import Command, UndoStack
+from calib_core.undo import Command, UndoStack
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
-from calib_core.recording.replay import solve_inputs
+from calib_core.solver.solve_inputs import solve_inputs
 from calib_core.solver.solution import SolveStatus
 
 

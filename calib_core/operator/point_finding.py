@@ -94,7 +94,7 @@ class PointFinding:
             raise OperatorError("Find points (F6) first: the edges are fitted on its frame")
         if not found.result.edges.settled:
             raise OperatorError(f"the target's edges did not settle on this frame (RMS {found.result.edges.rms_px:.2f} px): pick the points by hand")
-        from calib_core.recording.replay import solve_inputs
+        from calib_core.solver.solve_inputs import solve_inputs
         from calib_core.vision.edge_solution import edge_solution
 
         solution = edge_solution(found.result.edges, self.cell.intrinsics)

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 from calib_core.frames import concat, invert, make_transform
 from calib_core.robot import UnreachableTargetError, solve_ik
 from calib_core.robot.model import RobotModel
+from calib_core.robot.reach import reach_of
 from calib_core.vision.board import BoardSpec
 
 VIEW_DISTANCE_MM = (420.0, 600.0)
@@ -26,16 +27,6 @@ def board_from_centre(spec: BoardSpec, centre2base: np.ndarray) -> np.ndarray:
     w, h = spec.size_mm
     R = centre2base[:3, :3]
     return make_transform(R, centre2base[:3, 3] - R @ np.array([w / 2, h / 2, 0.0]))
-
-
-def reach_of(robot: RobotModel, samples: int = 400, seed: int = 0) -> tuple[float, float]:
-    """The flange's horizontal reach (mm, the 90th percentile over random joints within the limits)
-    and its median height (mm) in the base frame."""
-    rng = np.random.default_rng(seed)
-    lo = np.maximum(robot.lower_limits_deg, -180.0)
-    hi = np.minimum(robot.upper_limits_deg, 180.0)
-    points = np.array([robot.fk(rng.uniform(lo, hi), "flange")[:3, 3] for _ in range(samples)])
-    return float(np.percentile(np.hypot(points[:, 0], points[:, 1]), 90)), float(np.median(points[:, 2]))
 
 
 def board_in_front_of_robot(spec: BoardSpec, robot: RobotModel, home_deg=None) -> np.ndarray:

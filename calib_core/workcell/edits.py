@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from calib_core.calibration.undo import Command
+from calib_core.undo import Command
 from calib_core.names import check_typed_name
 from calib_core.errors import OperatorError
 from calib_core.frames import check_transform

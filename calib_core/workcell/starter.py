@@ -24,7 +24,7 @@ from calib_core.workcell.flange_choice import choose_flange, tool_alignment
 from calib_core.robot import UnreachableTargetError, solve_ik
 from calib_core.robot.model import RobotModel, load_robot
 from calib_core.robot.spec import NewFrame, RobotSpec
-from calib_core.vision.board_placement import reach_of
+from calib_core.robot.reach import reach_of
 
 BUNDLED_CAMERA = Path(__file__).resolve().parents[2] / "resources" / "camera" / "gripper_camera.yaml"
 TCP_MM = 150.0

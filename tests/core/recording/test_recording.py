@@ -12,7 +12,8 @@ import pytest
 from calib_core.errors import FileFormatError
 from calib_core.recording.reader import decode_frame, read_recording, recover
 from calib_core.recording.recorder import SessionRecorder
-from calib_core.recording.replay import replay, solve_inputs
+from calib_core.recording.replay import replay
+from calib_core.solver.solve_inputs import solve_inputs
 from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
 from calib_core.solver import solve_pose
