@@ -149,7 +149,7 @@ def test_the_simulated_camera_s_frame_is_located_where_the_truth_is(tmp_path):
     cv2.imwrite(str(tmp_path / "frame.png"), cv2.cvtColor(frame.image, cv2.COLOR_RGB2BGR))
     item.mesh.export(tmp_path / "fixture.stl")
     save_intrinsics(tmp_path / "camera.yaml", bed.intrinsics)
-    prior = _prior(tmp_path, "prior.json", {"R_obj2cam": model[:3, :3].tolist(), "t_obj2cam_mm": model[:3, 3].tolist()})
+    _prior(tmp_path, "prior.json", {"R_obj2cam": model[:3, :3].tolist(), "t_obj2cam_mm": model[:3, 3].tolist()})
     # relative paths from the folder, as a user types them
     run = _videocal("locate", "frame.png", "--mesh", "fixture.stl", "--intrinsics", "camera.yaml", "--prior", "prior.json", "--indent", "0", cwd=tmp_path)
     assert run.returncode == 0, run.stderr + run.stdout

@@ -5,7 +5,7 @@ import numpy as np
 import trimesh
 
 from calib_core.scene import SceneItem
-from videocal_sim.real_look import PRINT_TEXELS, TEXEL_MM, form_error, printed, real_components, workshop_studio
+from videocal_sim.real_look import PRINT_TEXELS, TEXEL_MM, form_error, printed, workshop_studio
 from videocal_sim.test_bed import TestBed
 from videocal_sim.real_look import make_less_kind
 

@@ -3,7 +3,6 @@ frames, the joint states in radians in the URDF's names, the camera_info; a bad 
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 from pathlib import Path

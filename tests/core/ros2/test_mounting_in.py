@@ -5,7 +5,6 @@ back. The Python file is parsed, never run."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -87,7 +87,7 @@ def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(dom
 
 
 def test_no_joint_states_is_stale_and_the_reason_says_where(domain):
-    link = open_controller(f"ros2:///arm/joint_states?stale_after_s=0.2", _context())
+    link = open_controller("ros2:///arm/joint_states?stale_after_s=0.2", _context())
     states = []
     link.state_changed.connect(lambda state, why: states.append((state, why)))
     link.start()

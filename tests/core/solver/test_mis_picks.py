@@ -61,7 +61,6 @@ def test_the_statistic_matches_a_real_leave_one_out_solve():
     T, P, uv = _scene(rng, 8, 0.5)
     uv[3] += [4.0, -3.0]
     full = solve_pose(P, uv, CAM)
-    from calib_core.solver.finish import residuals_and_jacobian  # the same residuals the solver reports
     from calib_core.solver.problem import PoseProblem  # noqa: F401 (documents where the problem comes from)
 
     for i in range(8):
