@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.workspace.workspace import load_workspace
 
     ws = load_workspace(args.workspace)
-    robot, joint_map = _robot(args.workcell or ws.workcell_path) if args.format not in ("csv", "json") else (None, None)
+    robot, joint_map = _robot(args.workcell or ws.workcell_path)
     text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None, robot, joint_map)
     if args.out:
         atomic_write_text(args.out, text)
@@ -76,7 +76,7 @@ def _robot(workcell: str | Path | None):
     configurations of a listing; ``(None, None)`` (the listing then has neither, and says so) when the workspace names
     no workcell or it is not there."""
     if not workcell or not Path(workcell).is_file():
-        print(f"note: no tool data or arm configurations in the listing: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
+        print(f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
         return None, None
     from calib_core.link.joint_map import JointMap
     from calib_core.workcell import load_workcell

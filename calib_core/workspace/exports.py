@@ -19,7 +19,9 @@ from calib_core.workspace.workspace import _correction_dict, _pose
 CSV_COLUMNS = (
     "task", "time_s", "dx_mm", "dy_mm", "dz_mm", "rx_deg", "ry_deg", "rz_deg", "sd_dx_mm", "sd_dy_mm", "sd_dz_mm", "sd_rx_deg", "sd_ry_deg", "sd_rz_deg",
     "target_x_mm", "target_y_mm", "target_z_mm", "target_roll_deg", "target_pitch_deg", "target_yaw_deg", "rms_px", "pairs", "source",
+    "tool_x_mm", "tool_y_mm", "tool_z_mm", "tool_roll_deg", "tool_pitch_deg", "tool_yaw_deg",
 )
+"""The ``tool_*`` columns: the TCP on the flange the targets are for (empty without the cell's robot)."""
 EXPORT_FORMATS = ("json", "csv") + FORMATS
 
 
@@ -31,8 +33,9 @@ def _target(c: Correction, tasks: dict[str, TaskLocation]):
     return concat(task.tcp2base, invert(c.delta_base))
 
 
-def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:
-    """Every correction; with ``tasks``, each also with ``target_to_command`` ({xyz mm, rpy deg} in base)."""
+def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None) -> str:
+    """Every correction; with ``tasks``, each also with ``target_to_command`` ({xyz mm, rpy deg} in base); with
+    ``tool`` (``tcp2flange`` (4, 4) mm), ``tool_on_flange``: the TCP the targets are for."""
     rows = []
     for t in table.tasks():
         for c in table.history(t):
@@ -41,7 +44,10 @@ def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | No
             if target is not None:
                 row["target_to_command"] = _pose(target)
             rows.append(row)
-    return json.dumps({"frame": "base", "units": {"length": "mm", "angle": "deg", "rpy": "fixed axes x, y, z"}, "corrections": rows}, indent=1)
+    doc = {"frame": "base", "units": {"length": "mm", "angle": "deg", "rpy": "fixed axes x, y, z"}, "corrections": rows}
+    if tool is not None:
+        doc["tool_on_flange"] = _pose(tool)
+    return json.dumps(doc, indent=1)
 
 
 def _cell(text: str) -> str:
@@ -49,9 +55,14 @@ def _cell(text: str) -> str:
     return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
 
 
-def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None) -> str:
+def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None) -> str:
     """Every stored correction (history included), one row each, mm and degrees; the target columns
-    are empty for a task location the workspace does not know."""
+    are empty for a task location the workspace does not know, the tool columns without ``tool``
+    (``tcp2flange`` (4, 4) mm: the TCP the targets are for)."""
+    tool_cells = [""] * 6
+    if tool is not None:
+        xyz, rpy = xyz_rpy_from_transform(tool)
+        tool_cells = [f"{v + 0.0:.4f}" for v in xyz] + [f"{v + 0.0:.5f}" for v in rpy]  # (+ 0.0: no "-0.00000")
     out = io.StringIO()
     w = csv.writer(out)
     w.writerow(CSV_COLUMNS)
@@ -63,7 +74,7 @@ def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | Non
                 xyz, rpy = xyz_rpy_from_transform(target)
                 pose = [f"{v:.4f}" for v in xyz] + [f"{v:.5f}" for v in rpy]
             w.writerow([_cell(c.task), f"{c.time_s:.3f}", *(f"{v:.4f}" for v in c.displacement_mm), *(f"{v:.5f}" for v in c.rotation_deg), *(f"{v:.4f}" for v in c.std_displacement_mm),
-                        *(f"{v:.5f}" for v in c.std_rotation_deg), *pose, f"{c.rms_px:.3f}", c.pairs, _cell(c.source)])
+                        *(f"{v:.5f}" for v in c.std_rotation_deg), *pose, f"{c.rms_px:.3f}", c.pairs, _cell(c.source), *tool_cells])
     return out.getvalue()
 
 
@@ -77,11 +88,12 @@ def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLo
     goes to (``file_stem``, the name without its suffixes), as the controller requires, and with ``robot`` (the cell's
     :class:`~calib_core.robot.model.RobotModel`) carries the tool data the targets are for and the arm's
     configuration at each (``joint_map``: the cell's model joints to controller axes)."""
+    tool = None if robot is None else tool_on_flange(robot)
     if fmt == "json":
-        return corrections_json(table, tasks)
+        return corrections_json(table, tasks, tool)
     if fmt == "csv":
-        return corrections_csv(table, tasks)
-    return controller_listing(fmt, table, tasks, file_stem, None if robot is None else tool_on_flange(robot), robot, joint_map)
+        return corrections_csv(table, tasks, tool)
+    return controller_listing(fmt, table, tasks, file_stem, tool, robot, joint_map)
 
 
 def tool_on_flange(robot) -> np.ndarray:

@@ -107,6 +107,24 @@ def test_csv_and_json_hold_the_target_to_command(table):
     assert row["source"].startswith("'=")  # a spreadsheet must not run it
     data = json.loads(corrections_json(t, tasks))
     assert data["frame"] == "base" and np.allclose(data["corrections"][0]["target_to_command"]["xyz"], target[:3, 3])
+    assert row["tool_x_mm"] == "" and "tool_on_flange" not in data  # without the robot: no tool, and said so by nothing made up
+
+
+def test_csv_and_json_carry_the_tool_the_targets_are_for(table):
+    """A target to command is for one TCP: the CSV's tool columns and the JSON's tool_on_flange give it (mm, deg),
+    as the cell's robot has it on its flange."""
+    from calib_core.frames import transform_from_xyz_rpy
+    from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
+    from calib_core.workspace.exports import tool_on_flange
+
+    t, tasks = table
+    tool = tool_on_flange(load_workcell(DEFAULT_WORKCELL).load_robot())
+    rows = list(csv.reader(io.StringIO(corrections_csv(t, tasks, tool))))
+    row = dict(zip(rows[0], rows[1]))
+    written = transform_from_xyz_rpy([float(row[f"tool_{a}_mm"]) for a in "xyz"], [float(row[f"tool_{a}_deg"]) for a in ("roll", "pitch", "yaw")])
+    np.testing.assert_allclose(written, tool, atol=1e-3)
+    data = json.loads(corrections_json(t, tasks, tool))
+    np.testing.assert_allclose(transform_from_xyz_rpy(data["tool_on_flange"]["xyz"], data["tool_on_flange"]["rpy"]), tool, atol=1e-6)
 
 
 def test_each_listing_is_named_after_its_file_as_the_controller_requires(table):
