@@ -21,6 +21,8 @@ from calib_core.workcell import DEFAULT_WORKCELL
 from app.cli.options import bounded_float
 
 VIEWS = ("virtual", "overview", "true")
+OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG = -130.0, 32.0
+"""The overview's direction, the window's own at start."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -91,11 +93,15 @@ def run(args: argparse.Namespace) -> int:
         image = load_plugin(SITES, "sim").true_view(cell, q, intr)
     else:
         renderer = SceneRenderer()
-        renderer.set_items(cell.components + RobotVisuals.from_robot(robot).scene_items(q))
+        items = cell.components + RobotVisuals.from_robot(robot).scene_items(q)
+        renderer.set_items(items)
         if args.view == "virtual":
             image = renderer.render_view(intr.without_distortion(), robot.fk(q, "camera"), options)
         else:
-            image = renderer.render_overview(options=options)
+            from calib_core.scene_framing import cell_framing, eye_at
+
+            target, distance = cell_framing(items)  # the whole cell, as the window's overview frames it
+            image = renderer.render_overview(eye_at(target, distance, OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG), target, options=options)
         renderer.close()
     ok, png = cv2.imencode(".png", np.ascontiguousarray(image[:, :, ::-1]))
     if not ok:

@@ -12,23 +12,13 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWi
 
 from app.gui.image_view import ImageView
 from app.gui.workbench import Workbench
+from calib_core.scene_framing import cell_framing, eye_at
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.render.frustum import frustum_polyline
 from calib_core.scene import SceneItem
 
 MODEL_FRUSTUM = (0.35, 0.6, 1.0)
 MEASURED_FRUSTUM = (0.2, 1.0, 0.4)
-
-
-def _world_corners(item) -> np.ndarray:
-    lo, hi = item.mesh.bounds
-    box = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    return (item.item2world @ box.T).T[:, :3]
-
-
-def _is_slab(item) -> bool:
-    extents = np.sort(item.mesh.extents)
-    return extents[0] < 0.05 * extents[2]
 
 
 class _OrbitView(ImageView):
@@ -208,12 +198,7 @@ class OverviewPane(QWidget):
         """Frame the cell: its components and the robot where it stands (a floor or a wall, far wider
         than it is thick, does not count), seen from the current direction."""
         wb = self.workbench
-        items = [c for c in wb.workcell.components if not _is_slab(c)] + wb.cell.model_visuals().scene_items(wb.joints_deg)
-        corners = np.concatenate([_world_corners(item) for item in items]) if items else np.zeros((1, 3))
-        lo, hi = corners.min(axis=0), corners.max(axis=0)
-        self.target = (lo + hi) / 2.0
-        radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 200.0)
-        self.distance_mm = float(np.clip(1.1 * radius / np.sin(np.radians(20.0)), 800.0, 15000.0))
+        self.target, self.distance_mm = cell_framing(list(wb.workcell.components) + wb.cell.model_visuals().scene_items(wb.joints_deg))
         self.mark_dirty()
 
     def play_path(self, joints_deg: list[np.ndarray], interval_ms: int = 40) -> None:
@@ -234,8 +219,7 @@ class OverviewPane(QWidget):
         self._dirty = True
 
     def eye(self) -> np.ndarray:
-        a, e = np.radians(self.azimuth_deg), np.radians(self.elevation_deg)
-        return self.target + self.distance_mm * np.array([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)])
+        return eye_at(self.target, self.distance_mm, self.azimuth_deg, self.elevation_deg)
 
     def refresh(self) -> None:
         """Redraw only when something changed (joints, a solve, the view)."""
