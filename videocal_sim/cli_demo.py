@@ -26,7 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cold", action="store_true", help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)")
     parser.add_argument("--site", choices=("sim", "ros2", "gige", "ur"), default="sim",
                         help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default); ROS 2 "
-                             "(a simulated ros2_control arm and a camera topic on Cyclone DDS, on ROS_DOMAIN_ID when set, else a private domain 170-229); or gige (the camera "
+                             "(a simulated ros2_control arm and a camera topic on Cyclone DDS, on ROS_DOMAIN_ID when set, else a private domain 71-100); or gige (the camera "
                              "served as a GigE Vision camera on the loopback interface, read through Aravis); or ur (the robot a simulated Universal "
                              "Robots controller: RTDE through ur_rtde, moves as URScript)")
     parser.add_argument("--link-delay-ms", type=bounded_float(0.0, 5000.0), default=0.0, metavar="MS",

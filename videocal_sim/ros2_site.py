@@ -108,9 +108,10 @@ class CameraPublisher:
         self._thread.join(timeout=3.0)
 
 
-PRIVATE_DOMAINS = (170, 229)
-"""The DDS domains a simulated arm takes when none is named: away from ROS 2's default (0) and the ones people pick,
-so a demo never commands, or is commanded by, a real robot on the workstation's own domain."""
+PRIVATE_DOMAINS = (71, 100)
+"""The DDS domains a simulated arm takes when none is named: away from ROS 2's default (0) and the small ones people
+pick, so a demo never commands, or is commanded by, a real robot on the workstation's own domain; and within ROS 2's
+safe range (0-101 on Linux: a higher domain's ports fall in the ephemeral range, where another socket may hold one)."""
 
 
 def private_domain() -> int:

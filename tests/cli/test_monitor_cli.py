@@ -107,7 +107,7 @@ def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch):
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    env = {**os.environ, "ROS_DOMAIN_ID": str(150 + os.getpid() % 50)}
+    env = {**os.environ, "ROS_DOMAIN_ID": str(64 + os.getpid() % 6)}
     arm = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-ros2", "--rate", "200", "--joints", "10,-20,30,-40,50,-60"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
