@@ -16,8 +16,7 @@ import trimesh
 from calib_core.errors import FileFormatError
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
-MESH_SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
-"""A mesh's units -> mm."""
+from calib_core.mesh_units import MESH_SCALE  # noqa: E402,F401 (the readers' units, named where --help can read them)
 MAX_TRIANGLES = 2_000_000
 _WINDING_FIX_TRIANGLES = 200_000  # trimesh's winding repair walks the face graph (networkx): bounded in time
 """The most triangles a component may have: a cell's CAD part decimated for viewing has tens of thousands."""

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from app.cli.options import resolved_path
-from calib_core.workspace.exports import EXPORT_FORMATS
+from calib_core.workspace.export_formats import EXPORT_FORMATS
 
 BAG_FORMAT = "ros2-bag"
 

@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from app.cli.options import resolved_path
-from calib_core.workcell import DEFAULT_WORKCELL
+from calib_core.bundled import DEFAULT_WORKCELL
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -22,15 +22,14 @@ import numpy as np
 
 from calib_core.documents import read_json, read_text, parse_yaml
 from calib_core.errors import FileFormatError
-from calib_core.frames import check_transform, make_transform
-from calib_core.mesh_files import MESH_SCALE, load_mesh
+from calib_core.mesh_units import MESH_SCALE
 
 EXIT_NOT_LOCATED = 3
 MAX_FEATURES = 1000
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from calib_core.vision.find_points import REACH_DEG, REACH_MM
+    from calib_core.vision.search_reach import REACH_DEG, REACH_MM
 
     parser.add_argument("photo", type=Path, help="the photo (PNG, JPEG, ...) of the object")
     parser.add_argument("--mesh", type=Path, required=True, help="the object's mesh (STL, OBJ, PLY, DAE, glTF)")
@@ -46,6 +45,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def read_prior(path: Path) -> np.ndarray:
     """The prior pose (4, 4) mm from JSON: ``R_obj2cam`` + ``t_obj2cam_mm``, or ``obj2cam``; the error names the field."""
+    from calib_core.frames import check_transform, make_transform  # scipy: loaded for a run, not for --help
+
     data = read_json(path, "prior pose file")
     if not isinstance(data, dict):
         raise FileFormatError(path, "the top level must be a JSON object with R_obj2cam and t_obj2cam_mm (or obj2cam)")
@@ -101,6 +102,8 @@ def run(args: argparse.Namespace) -> int:
     intrinsics = load_intrinsics(args.intrinsics, image_size=(image.shape[1], image.shape[0]))
     if (intrinsics.width, intrinsics.height) != (image.shape[1], image.shape[0]):
         raise FileFormatError(args.photo, f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x {intrinsics.height} px")
+    from calib_core.mesh_files import load_mesh  # trimesh: loaded for a run, not for --help
+
     mesh = load_mesh(args.mesh, args.units)
     features = read_features(args.features, MESH_SCALE[args.units]) if args.features else None
     prior = read_prior(args.prior)

@@ -12,12 +12,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from calib_core.atomic_file import atomic_write_bytes
 from calib_core.errors import VideocalError
-from calib_core.workcell import DEFAULT_WORKCELL
+from calib_core.bundled import DEFAULT_WORKCELL
 from app.cli.options import bounded_float
 
 VIEWS = ("virtual", "overview", "true")
@@ -103,6 +102,8 @@ def run(args: argparse.Namespace) -> int:
             target, distance = cell_framing(items)  # the whole cell, as the window's overview frames it
             image = renderer.render_overview(eye_at(target, distance, OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG), target, options=options)
         renderer.close()
+    import cv2
+
     ok, png = cv2.imencode(".png", np.ascontiguousarray(image[:, :, ::-1]))
     if not ok:
         raise VideocalError("could not encode the image as PNG")

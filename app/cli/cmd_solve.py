@@ -13,11 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from calib_core.camera.intrinsics import Intrinsics
 from calib_core.documents import read_json
 from calib_core.errors import FileFormatError
-from calib_core.frames import make_transform
-from calib_core.solver import SolveStatus, solve_pose
 
 EXIT_FAILED = 3
 _KNOWN_FIELDS = {"intrinsics", "points_3d", "points_2d", "prior", "estimate_focal", "model", "sigma_px", "robust"}
@@ -45,7 +42,10 @@ def _points(data: dict, name: str, dim: int, path: Path) -> np.ndarray:
     return points
 
 
-def _intrinsics(data: dict, path: Path) -> Intrinsics:
+def _intrinsics(data: dict, path: Path):
+    """The ``intrinsics`` field as an :class:`~calib_core.camera.intrinsics.Intrinsics`."""
+    from calib_core.camera.intrinsics import Intrinsics  # (with the camera package, scipy: not for --help)
+
     raw = _field(data, "intrinsics", path)
     if not isinstance(raw, dict):
         raise FileFormatError(path, "must be an object with fu, fv, cx, cy, width, height", "intrinsics")
@@ -65,6 +65,8 @@ def _intrinsics(data: dict, path: Path) -> Intrinsics:
 
 
 def _prior(data: dict, path: Path) -> np.ndarray | None:
+    from calib_core.frames import make_transform  # (scipy: not for --help)
+
     raw = data.get("prior")
     if raw is None:
         return None
@@ -113,6 +115,8 @@ def read_solve_inputs(path: Path) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from calib_core.solver import SolveStatus, solve_pose  # the solver's kernels load with it: not for --help
+
     inputs = read_solve_inputs(args.input)
     solution = solve_pose(inputs.pop("points_3d"), inputs.pop("points_2d"), inputs.pop("intrinsics"), **inputs)
     json.dump(solution.to_dict(), sys.stdout, indent=args.indent or None)

@@ -10,7 +10,6 @@ import argparse
 import json
 import sys
 
-from calib_core.solver.paper_table1 import run_table1
 
 _COLUMNS = ("d_x", "d_y", "d_z", "phi_x", "phi_y", "phi_z")
 
@@ -26,6 +25,8 @@ def _format_row(label: str, values) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from calib_core.solver.paper_table1 import run_table1  # the solver's kernels load with it: not for --help
+
     if args.as_printed and args.model != "paper":
         raise ValueError("--as-printed applies to the paper's model: add --model paper")
     rows = run_table1(args.model, as_printed=args.as_printed)

@@ -39,10 +39,7 @@ from calib_core.vision.target_detectors import TargetDetectors, as_grey
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
-REACH_MM = 20.0
-"""How far the camera's centre may be from where the model puts it: a typical robot's error (8 mm), twice, and some."""
-REACH_DEG = 1.5
-"""How far the camera may be turned from where the model puts it: a typical robot's error (0.7 deg), twice."""
+from calib_core.vision.search_reach import REACH_DEG, REACH_MM  # noqa: E402 (named apart: a command's --help reads them)
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
 _FIT_SHARE = 0.6  # a fit settles (is proposed from) with this share of its samples on their edges: wrong minima seen held 52-56 %, the least right one 65 % (the bench)

@@ -27,7 +27,7 @@ from calib_core.workcell.robot_section import check_against_robot, read_robot_se
 from calib_core.workcell.site_section import read_site_section
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SAFETY_KEYS, SafetyLimits
 
-DEFAULT_WORKCELL = Path(__file__).resolve().parents[2] / "resources" / "workcell" / "workcell.yaml"
+from calib_core.bundled import DEFAULT_WORKCELL  # noqa: E402 (re-exported: the package's name for it)
 SCHEMA_VERSION = 2
 # Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
 _READABLE_VERSIONS = (1, 2)

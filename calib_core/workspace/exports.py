@@ -22,7 +22,9 @@ CSV_COLUMNS = (
     "tool_x_mm", "tool_y_mm", "tool_z_mm", "tool_roll_deg", "tool_pitch_deg", "tool_yaw_deg",
 )
 """The ``tool_*`` columns: the TCP on the flange the targets are for (empty without the cell's robot)."""
-EXPORT_FORMATS = ("json", "csv") + FORMATS
+from calib_core.workspace.export_formats import EXPORT_FORMATS, LISTING_FORMATS  # noqa: E402,F401 (EXPORT_FORMATS: the formats by name, for those who import them from here)
+
+assert FORMATS == LISTING_FORMATS, "the listings' names in export_formats.py follow controller_formats.LISTINGS"
 
 
 def _target(c: Correction, tasks: dict[str, TaskLocation]):
