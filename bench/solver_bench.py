@@ -239,77 +239,6 @@ def _time_per_call(fn, reps):
     return best
 
 
-SPEED_SCENES = 300
-
-
-def _mean_per_solve(fn, problems) -> float:
-    """Mean time (s) of ``fn(P, uv)`` over ``problems``, best of 3 passes (each pass every problem once)."""
-    best = np.inf
-    for _ in range(3):
-        t0 = time.perf_counter()
-        for P, uv in problems:
-            fn(P, uv)
-        best = min(best, (time.perf_counter() - t0) / len(problems))
-    return best
-
-
-def _poselib_plain(P, uv):
-    import poselib
-
-    camera = {"model": "PINHOLE", "width": CAM.width, "height": CAM.height, "params": [CAM.fu, CAM.fv, CAM.cx, CAM.cy]}
-    return poselib.estimate_absolute_pose(uv, P, camera, {"max_reproj_error": INLIER_SIGMAS * NOISE_PX, "min_iterations": 0}, {})
-
-
-def speed_section(rng) -> list[str]:
-    lines = [
-        f"## Speed ({SPEED_SCENES} different scenes a row at {NOISE_PX} px noise, no prior; mean per solve, best of 3 passes; a whole solve: "
-        "checks, seeds, refinement, covariance, leave-one-out and the mis-pick test)",
-        "",
-        "Every solver sees the same problems after a warm-up (videocal's compiled kernels loaded, the full search run once). PoseLib runs "
-        "`estimate_absolute_pose` (P3P/LO-RANSAC and its bundle adjustment) with `min_iterations` 0, so that a clean set ends after its first "
-        "hypotheses: its fastest use for a plain solve. `full search` counts videocal's solves that left the compiled fast path.",
-        "",
-        "| problem | videocal solve_pose | full search | OpenCV SQPnP + RefineLM | PoseLib | videocal / OpenCV (target <= 1.0) | videocal / PoseLib (target <= 2.0) |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    import calib_core.solver.solve as solve_module
-
-    for n in (4, 5, 6, 8, 20):
-        problems = [(P, uv + rng.normal(0, NOISE_PX, uv.shape)) for _, P, uv in (_scene(rng, n) for _ in range(SPEED_SCENES))]
-        slow = []
-        fast = solve_module.fast_solve
-        solve_module.fast_solve = lambda *a, **k: slow.append(1) if (out := fast(*a, **k)) is None else out
-        try:
-            for P, uv in problems:
-                solve_pose(P, uv, CAM)
-        finally:
-            solve_module.fast_solve = fast
-        for P, uv in problems[:10]:  # warm-up
-            _opencv("sqpnp+lm", P, uv)
-            _poselib_plain(P, uv)
-        ours = _mean_per_solve(lambda P, uv: solve_pose(P, uv, CAM), problems)
-        cv = _mean_per_solve(lambda P, uv: _opencv("sqpnp+lm", P, uv), problems)
-        pl = _mean_per_solve(_poselib_plain, problems)
-        lines.append(f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us | {ours / cv:.2f} | {ours / pl:.2f} |")
-    scenes = [_scene(rng, 6) for _ in range(1000)]
-    P = np.stack([s[1] for s in scenes])
-    uv = np.stack([s[2] + rng.normal(0, NOISE_PX, (6, 2)) for s in scenes])
-    starts = np.stack([_displaced(rng, s[0], 20, 5) for s in scenes])
-    batch_seeded = _time_per_call(lambda: solve_pose_batch(P, uv, CAM, starts=starts), 1) / 1000
-    batch_free = _time_per_call(lambda: solve_pose_batch(P, uv, CAM), 1) / 1000
-    cv_loop = _time_per_call(lambda: [_opencv("sqpnp+lm", P[i], uv[i]) for i in range(1000)], 1) / 1000
-    lines += [
-        "",
-        "| batch of 1000 problems, N = 6 | per problem | target |",
-        "|---|---|---|",
-        f"| solve_pose_batch from starts (20 mm / 5 deg off) | {batch_seeded * 1e6:.1f} us | <= 20 us |",
-        f"| solve_pose_batch without starts (batched DLT seeds) | {batch_free * 1e6:.1f} us | |",
-        f"| OpenCV SQPnP + RefineLM in a Python loop | {cv_loop * 1e6:.1f} us | |",
-        "",
-    ]
-    return lines
-
-
 def _with_outliers(rng, n, share):
     T, P, uv = _scene(rng, n)
     noisy = uv + rng.normal(0, NOISE_PX, uv.shape)
@@ -402,6 +331,8 @@ def robust_section(rng) -> list[str]:
 def main() -> str:
     rng = np.random.default_rng(20261122)
     t0 = time.time()
+    from bench.solver_speed import speed_section  # (it imports this module's scenes and peers)
+
     # (the speed section draws from a generator of its own: the other sections keep their scenes whatever it times)
     body = table1_section() + convergence_section(rng) + accuracy_section(rng) + speed_section(np.random.default_rng(20261205)) + robust_section(rng)
     body += robust_reliability_section(rng) + mis_pick_section(rng)
