@@ -9,6 +9,23 @@ from calib_core.solver.kernels.small_linalg import spd_inverse, symmetric_eigenv
 
 
 @njit(cache=True)
+def hat_block(J, i, cov_unit):
+    """``(h00, h01, h11)``: pair ``i``'s 2 x 2 block of the hat matrix ``J_i cov_unit J_i^T`` (symmetric), from the
+    Jacobian ``J`` (n, 2, p) and ``cov_unit`` (p, p) = ``(J^T W J)^-1``."""
+    p = J.shape[2]
+    h00 = 0.0
+    h01 = 0.0
+    h11 = 0.0
+    for a in range(p):
+        for b in range(p):
+            c = cov_unit[a, b]
+            h00 += J[i, 0, a] * c * J[i, 0, b]
+            h01 += J[i, 0, a] * c * J[i, 1, b]
+            h11 += J[i, 1, a] * c * J[i, 1, b]
+    return h00, h01, h11
+
+
+@njit(cache=True)
 def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
     """Fill ``cov_unit`` (p, p) with ``(J^T W J)^-1`` (the covariance for unit pixel noise),
     ``cov_centre_unit`` (3, 3) with the covariance of the camera centre ``c = -R^T t`` in the
@@ -62,15 +79,7 @@ def information_diagnostics(J, r, w, R, t, cov_unit, cov_centre_unit, loo):
                     acc += Ac[a, k] * cov_unit[k, m] * Ac[b, m]
             cov_centre_unit[a, b] = acc
     for i in range(n):
-        h00 = 0.0
-        h01 = 0.0
-        h11 = 0.0
-        for a in range(p):
-            for b in range(p):
-                c = cov_unit[a, b]
-                h00 += J[i, 0, a] * c * J[i, 0, b]
-                h01 += J[i, 0, a] * c * J[i, 1, b]
-                h11 += J[i, 1, a] * c * J[i, 1, b]
+        h00, h01, h11 = hat_block(J, i, cov_unit)
         m00 = 1.0 - w[i] * h00
         m01 = -w[i] * h01
         m11 = 1.0 - w[i] * h11
@@ -135,15 +144,7 @@ def flags_a_misfit(J, r, cov_unit, noise, fisher_limit, own_scale_min_dof, false
     T = np.empty(n)
     rss = 0.0
     for i in range(n):
-        h00 = 0.0
-        h01 = 0.0
-        h11 = 0.0
-        for a in range(p):
-            for b in range(p):
-                c = cov_unit[a, b]
-                h00 += J[i, 0, a] * c * J[i, 0, b]
-                h01 += J[i, 0, a] * c * J[i, 1, b]
-                h11 += J[i, 1, a] * c * J[i, 1, b]
+        h00, h01, h11 = hat_block(J, i, cov_unit)
         m00 = 1.0 - h00
         m11 = 1.0 - h11
         det = m00 * m11 - h01 * h01
