@@ -25,6 +25,7 @@ from calib_core.robot import UnreachableTargetError, solve_ik
 from calib_core.robot.model import RobotModel, load_robot
 from calib_core.robot.spec import NewFrame, RobotSpec
 from calib_core.robot.reach import reach_of
+from calib_core.workcell.task_pose import find_task
 
 BUNDLED_CAMERA = Path(__file__).resolve().parents[2] / "resources" / "camera" / "gripper_camera.yaml"
 TCP_MM = 150.0
@@ -142,13 +143,18 @@ def _camera_frame(offset_mm: float) -> np.ndarray:
     return transform_from_xyz_rpy([0.0, -offset_mm, CAMERA_OUT_MM], [tilt, 0.0, 0.0])
 
 
-def _find_task(robot: RobotModel, home: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A reachable grasp (tcp2base) facing +x in front of the robot, and the joints that reach it and
-    its approach. Tries distances and heights from the middle of the workspace outward."""
+def _find_task(robot: RobotModel, home: np.ndarray, camera_yaw_deg: float, floor_z_mm: float) -> tuple[np.ndarray, np.ndarray]:
+    """A reachable grasp (tcp2base) facing +x in front of the robot, and the joints that reach its approach: unfolded
+    where the arm's joints are read (:mod:`calib_core.workcell.task_pose`), else the first reached, from the middle
+    of the workspace outward."""
+    # The camera's side of the tool (OpenCV axes, turned camera_yaw_deg about the tool from the TCP's -y) up, the tool
+    # along base +x (toward the target): the camera looks from above with the image upright.
+    upright = np.column_stack([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+    R = upright @ transform_from_xyz_rpy([0, 0, 0], [0, 0, -camera_yaw_deg])[:3, :3]
+    unfolded = find_task(robot, R, home, APPROACH_MM, max(150.0, floor_z_mm + 150.0))
+    if unfolded is not None:
+        return unfolded
     reach, height = reach_of(robot)
-    # Tool z along base +x (toward the target), y down, x to the right: the camera (OpenCV axes, on
-    # flange -y) looks from above with the image upright.
-    R = np.column_stack([[0.0, -1.0, 0.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
     for fraction in (0.55, 0.45, 0.65, 0.35, 0.75):
         for z in (height, 0.8 * height, 1.2 * height, 0.5 * reach):
             tcp = make_transform(R, [fraction * reach, 0.0, max(z, 150.0)])
@@ -192,11 +198,14 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     robot = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": base}, None, held, xacro_args=xacro_args))
     yaw, offset = _tool_side(robot, flange, align)
     turn = concat(transform_from_xyz_rpy([0, 0, 0], [0, 0, yaw]), align)  # (in the flange's frame: aligned, then turned about the tool)
-    frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, turn @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])), "camera": NewFrame(flange, turn @ _camera_frame(offset))}
+    # The TCP is the flange moved along its z, not turned (the tool data a controller takes is a pure offset, for every
+    # vendor's flange); the camera goes on the side the hand leaves room, turned about the tool from the TCP's -y.
+    frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, align @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])),
+              "camera": NewFrame(flange, turn @ _camera_frame(offset))}
     robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held, xacro_args=xacro_args))
     home = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
     floor_z = _floor_z_mm(robot, home)
-    tcp, q_approach = _find_task(robot, home)
+    tcp, q_approach = _find_task(robot, home, yaw, floor_z)
     home = q_approach  # start where the camera already sees the target from the approach
     # The target's face centre sits GRASP_STANDOFF_MM beyond the TCP, facing the robot (its x toward -x base).
     target2base = make_transform(np.column_stack([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]), tcp[:3, 3] + [GRASP_STANDOFF_MM, 0.0, 0.0])
