@@ -6,7 +6,8 @@ at ``rate_hz`` with ROS 2's default QoS, as ``joint_state_broadcaster`` does, an
 ``joint_trajectory_controller``'s topic interface does: a new trajectory replaces the running one and starts
 from where the joints are, its points interpolated in time; a trajectory naming other joints, a point past a
 joint limit, a non-increasing ``time_from_start`` or no point at all (the controller says "Empty trajectory
-received.") is rejected (and logged), leaving the arm doing what it did.
+received.") is rejected (and logged), leaving the arm doing what it did. It serves the controller's
+``FollowJointTrajectory`` action as well (:mod:`videocal_sim.ros2_action_server`), unless ``action=False``.
 It reads no truth: it is the controller, not the world.
 """
 
@@ -24,7 +25,8 @@ class SimulatedRos2Arm:
     ``initial_deg`` (n,). ``log``: where rejections are said."""
 
     def __init__(self, joint_names, per_si, lower_deg, upper_deg, initial_deg, *, rate_hz: float = 100.0, domain: int = 0,
-                 controller: str = "joint_trajectory_controller", joint_states: str = "/joint_states", log=sys.stderr):
+                 controller: str = "joint_trajectory_controller", joint_states: str = "/joint_states", log=sys.stderr,
+                 action: bool = True):
         self.joint_names = list(joint_names)
         self.per_si = np.asarray(per_si, float)
         self.lower, self.upper = np.asarray(lower_deg, float), np.asarray(upper_deg, float)
@@ -37,6 +39,10 @@ class SimulatedRos2Arm:
         self.published = 0
         self.trajectories = 0
         self.rejected = 0
+        self.plan_number = 0
+        """Counts the trajectories taken (from the topic or the action): a goal knows whether its own still runs."""
+        self.action = None
+        self._serve_action = action
         self._plan: tuple[float, np.ndarray, np.ndarray] | None = None  # (t0 s, times (k+1,), points (k+1, n))
         self._lock = threading.Lock()
         self._stop = threading.Event()
@@ -60,9 +66,15 @@ class SimulatedRos2Arm:
             thread = threading.Thread(target=target, name=f"sim ros2 {name}", daemon=True)
             thread.start()
             self._threads.append(thread)
+        if self._serve_action:
+            from videocal_sim.ros2_action_server import FollowJointTrajectoryServer
+
+            self.action = FollowJointTrajectoryServer(self).start()
         return self
 
     def close(self) -> None:
+        if self.action is not None:
+            self.action.close()
         self._stop.set()
         for thread in self._threads:
             thread.join(timeout=1.0)
@@ -107,7 +119,25 @@ class SimulatedRos2Arm:
             if times[0] <= 0.0:  # a first point at 0 s: reached at once
                 times[0] = 1e-3
             self._plan = (now, np.array([0.0] + times), np.array([current] + points))
+            self.plan_number += 1
         return None
+
+    def plan_done(self, now: float) -> bool:
+        """The trajectory taken last has run out (the arm stands at its last point)."""
+        self.position(now)
+        with self._lock:
+            return self._plan is None
+
+    def plan_end(self) -> np.ndarray:
+        """Where the running trajectory ends (deg, mm), or where the arm stands."""
+        with self._lock:
+            return self._plan[2][-1].copy() if self._plan is not None else self.q.copy()
+
+    def hold(self, now: float) -> None:
+        """Stop where the arm is (a cancelled goal: the controller holds its position)."""
+        q = self.position(now)
+        with self._lock:
+            self.q, self._plan = q, None
 
     def _listen_loop(self) -> None:
         while not self._stop.is_set():

@@ -6,15 +6,18 @@ URL ``ros2:///joint_states`` (the joint states topic; ``?controller=NAME&domain=
 robot), so the connector's axes are the model's (:meth:`JointMap.identity`); ROS's rad and m become deg and
 mm. A sample's time is its header stamp (the controller's clock), never its arrival.
 
-Moves: ``trajectory_msgs/JointTrajectory`` on ``/<controller>/joint_trajectory`` (the controller's topic
-interface: no goal handshake to lose on a slow link), streamed as a dead-man: the move is a straight line in
+Moves: through the controller's ``FollowJointTrajectory`` action (``/<controller>/follow_joint_trajectory``) when it
+serves one, else as ``trajectory_msgs/JointTrajectory`` on ``/<controller>/joint_trajectory`` (its topic interface;
+``?interface=action`` or ``topic`` insists on one), streamed either way as a dead-man: the move is a straight line in
 joint space at ``speed_deg_s``, and the controller is only ever given the next ``horizon_s`` of it (one point,
 ``horizon_s`` of motion beyond where the joint states put the arm), renewed every third of that. Each message
 replaces the last (what the controller does with a new trajectory), so while they arrive the arm moves without
 a pause; when they stop (the workstation gone, the network cut, the joint states stale) the arm stops within
 ``horizon_s`` of motion, on the line. A one-point trajectory to the target did run on to it whatever became of
 the workstation. The commanded point only moves forward along the line, so a late joint state never turns the
-arm back. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
+arm back. Through the action each renewal is a goal that preempts the last
+(:mod:`calib_core.ros2.trajectory_goals`): a refused or aborted goal ends the move with the controller's reason, and
+Stop cancels the running goal. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
 once when no trajectory controller subscribes to the topic; *stopped* by Stop, which sends a trajectory that
 holds the current position. No joint states for ``stale_after_s``: the link is ``stale``, the robot's pose
 unknown, and a move under way ends with that error (it is not renewed: the arm stops within its horizon).
@@ -48,7 +51,8 @@ from calib_core.link.sample_order import SampleOrder
 from calib_core.ros2.joint_units import user_per_si
 
 DEFAULT_CONTROLLER = "joint_trajectory_controller"
-_OPTIONS = {"controller", "domain", "qos", "speed_deg_s", "done_tolerance_deg", "stale_after_s", "horizon_s"}
+_OPTIONS = {"controller", "domain", "qos", "interface", "speed_deg_s", "done_tolerance_deg", "stale_after_s", "horizon_s"}
+INTERFACES = ("auto", "action", "topic")
 
 
 def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
@@ -85,12 +89,18 @@ class Ros2TrajectoryController(ConnectorEvents):
         self._qos_name = str(options.get("qos", "default"))
         if self._qos_name not in ("default", "sensor"):
             raise LinkError(f"ros2 option qos: 'default' or 'sensor', got {self._qos_name!r}")
+        self.interface = str(options.get("interface", "auto"))
+        if self.interface not in INTERFACES:
+            raise LinkError(f"ros2 option interface: one of {', '.join(INTERFACES)}, got {self.interface!r}")
         self.speed_deg_s = number_option(options, "speed_deg_s", 20.0, 0.1, 1000.0, "ros2")
         self.done_tolerance_deg = number_option(options, "done_tolerance_deg", 0.05, 1e-4, 10.0, "ros2")
         self.stale_after_s = number_option(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0, "ros2")
         self.horizon_s = number_option(options, "horizon_s", 0.5, 0.1, 30.0, "ros2")
         self.joint_states_topic = dds_topic(topic)
         self.trajectory_topic = dds_topic(f"/{self.controller}/joint_trajectory")
+        self.action_name = f"/{self.controller}/follow_joint_trajectory"
+        self._goals = None  # the action's goals (GoalStream), when the controller serves it
+        self._through_action = False  # the move under way goes through the action
         self.joint_names = list(context.joint_names)
         self.n_joints = context.n_joints
         self.joint_map = JointMap.identity(self.n_joints)
@@ -132,6 +142,11 @@ class Ros2TrajectoryController(ConnectorEvents):
         reader_qos = sensor_qos(100) if self._qos_name == "sensor" else default_qos(100)
         self._reader = DataReader(dp, Topic(dp, self.joint_states_topic, msg.JointState), qos=reader_qos)
         self._writer = DataWriter(dp, Topic(dp, self.trajectory_topic, msg.JointTrajectory), qos=default_qos(1))
+        if self.interface != "topic":
+            from calib_core.ros2.action_client import FollowJointTrajectoryClient
+            from calib_core.ros2.trajectory_goals import GoalStream
+
+            self._goals = GoalStream(FollowJointTrajectoryClient(self.domain, self.action_name))
         self._taker = Taker(self._reader)
         self._types = TopicTypes(dp)
         self._started_s = self._types_checked_s = time.monotonic()
@@ -180,13 +195,14 @@ class Ros2TrajectoryController(ConnectorEvents):
             handle.sent = False
             handle._finish(MoveError(f"move {handle.id}: not sent: {reason}"))
             return handle
+        self._through_action = self._goals is not None and self._goals.client.server_ready()
         start = np.asarray(latest.joints_deg, dtype=float)
         duration_s = max(float(np.max(np.abs(q - start))) / self.speed_deg_s, 0.5)
         self._moves.begin(handle)
         with self._path_lock:
             self._path, self._s_commanded = (start, q, duration_s), 0.0
             self._renew(time.monotonic())
-        handle.acked = True  # the controller's topic takes it as given: reliable delivery, no reply
+        handle.acked = True  # reliable delivery; a goal the controller refuses ends the move when its answer comes
         return handle
 
     def stop(self) -> bool:
@@ -196,7 +212,8 @@ class Ros2TrajectoryController(ConnectorEvents):
             return False
         with self._path_lock:
             self._path = None
-        self._publish(np.asarray(latest.joints_deg), 0.1)
+        if not (self._through_action and self._goals.cancel()):
+            self._publish(np.asarray(latest.joints_deg), 0.1)
         self._moves.finish(MoveError("ERR,STOPPED: stopped by the operator"))
         return True
 
@@ -213,8 +230,12 @@ class Ros2TrajectoryController(ConnectorEvents):
             return "the connector is not started"
         if self._state is not LinkState.UP or latest is None:
             return f"the link is {self._state.value} (no fresh joint states on {self.joint_states_topic[2:]})"
-        if self._writer.get_publication_matched_status().current_count == 0:
-            return f"no trajectory controller subscribes to /{self.trajectory_topic[3:]} (is '{self.controller}' loaded and active?)"
+        if self.interface == "action":
+            if not self._goals.client.server_ready():
+                return f"no FollowJointTrajectory action server at {self.action_name} (is '{self.controller}' loaded and active?)"
+        elif self._writer.get_publication_matched_status().current_count == 0 and not (self._goals and self._goals.client.server_ready()):
+            where = f"/{self.trajectory_topic[3:]}" + (f" and no action server at {self.action_name}" if self._goals else "")
+            return f"no trajectory controller subscribes to {where} (is '{self.controller}' loaded and active?)"
         return None
 
     def _renew(self, now: float) -> None:
@@ -248,7 +269,11 @@ class Ros2TrajectoryController(ConnectorEvents):
 
         point = msg.JointTrajectoryPoint(positions=[float(v) for v in q_user / self._per_si], time_from_start=msg.Duration.of_s(duration_s))
         # An empty stamp: the controller starts the trajectory on receipt (its own clock, not ours).
-        self._writer.write(msg.JointTrajectory(msg.Header(), list(self.joint_names), [point]))
+        trajectory = msg.JointTrajectory(msg.Header(), list(self.joint_names), [point])
+        if self._through_action:
+            self._goals.send(trajectory)
+        else:
+            self._writer.write(trajectory)
 
     # --- the reader thread ---------------------------------------------------------------------
     def _run(self) -> None:
@@ -263,6 +288,22 @@ class Ros2TrajectoryController(ConnectorEvents):
             now = time.monotonic()
             self._watch(now)
             self._keep_moving(now)
+            self._hear_the_controller()
+
+    def _hear_the_controller(self) -> None:
+        """The action's answers: a refused or aborted goal of the move under way ends it with the controller's reason."""
+        if self._goals is None or not self._through_action:
+            return
+        try:
+            reason = self._goals.poll()
+        except Exception as exc:  # a DDS hiccup must not end the thread
+            self.stats.errors += 1
+            self.last_error = f"reading {self.action_name}: {exc!r}"
+            return
+        if reason is not None:
+            with self._path_lock:
+                self._path = None
+            self._moves.finish(MoveError(reason))
 
     def _watch(self, now: float) -> None:
         if self._state is LinkState.CONNECTING and now - self._types_checked_s >= TYPE_CHECK_S:

@@ -107,14 +107,21 @@ def arm(domain):
     arm.close()
 
 
-def _connected(**options):
-    link = open_controller("ros2:///joint_states", _context(controller="arm_controller", **options)).start()
-    assert wait_until(lambda: link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0)
+@pytest.fixture(params=["topic", "action"])
+def interface(request):
+    """Each move test through the controller's topic and through its FollowJointTrajectory action."""
+    return request.param
+
+
+def _connected(interface="topic", **options):
+    link = open_controller("ros2:///joint_states", _context(controller="arm_controller", interface=interface, **options)).start()
+    ready = (lambda: link._goals.client.server_ready()) if interface == "action" else (lambda: link._writer.get_publication_matched_status().current_count > 0)
+    assert wait_until(lambda: link.state is LinkState.UP and ready())
     return link
 
 
-def test_a_move_through_the_trajectory_controller_ends_at_its_target(arm):
-    link = _connected(speed_deg_s=100)
+def test_a_move_through_the_trajectory_controller_ends_at_its_target(arm, interface):
+    link = _connected(interface, speed_deg_s=100)
     try:
         target = [10.0, -20.0, 50.0, 5.0, 40.0, 150.0]
         handle = link.move_joints(target, timeout_s=20)
@@ -122,12 +129,16 @@ def test_a_move_through_the_trajectory_controller_ends_at_its_target(arm):
         handle.wait(20)
         assert np.allclose(link.latest.joints_deg, target, atol=0.05)
         assert np.allclose(arm.position(time.monotonic()), target, atol=1e-6)
+        if interface == "action":
+            assert arm.action.accepted >= 1 and arm.trajectories == 0  # goals, none on the topic
+        else:
+            assert arm.trajectories >= 1 and arm.action.accepted == 0
     finally:
         link.close()
 
 
-def test_stop_holds_the_arm_where_it_stands(arm):
-    link = _connected(speed_deg_s=20)
+def test_stop_holds_the_arm_where_it_stands(arm, interface):
+    link = _connected(interface, speed_deg_s=20)
     try:
         handle = link.move_joints([60.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=20)
         assert wait_until(lambda: link.latest.joints_deg[0] > 5.0)
@@ -140,6 +151,8 @@ def test_stop_holds_the_arm_where_it_stands(arm):
         held = arm.position(time.monotonic())[0]
         assert 5.0 < held < 30.0  # stopped on the way, far from 60
         assert wait_until(lambda: abs(link.latest.joints_deg[0] - held) < 1e-6, 2.0)
+        if interface == "action":
+            assert wait_until(lambda: arm.action.cancelled == 1)  # Stop is the goal's cancel
     finally:
         link.close()
 
@@ -156,13 +169,15 @@ def test_a_move_with_no_controller_listening_is_not_sent(arm):
         link.close()
 
 
-def test_the_arm_rejects_a_trajectory_past_its_limits(arm):
-    link = _connected(speed_deg_s=1000)  # the first half second of the move already crosses the limit
+def test_the_arm_rejects_a_trajectory_past_its_limits(arm, interface):
+    link = _connected(interface, speed_deg_s=1000)  # the first half second of the move already crosses the limit
     try:
         handle = link.move_joints([0, -30, 60, 0, 45, 900.0], timeout_s=1.0)  # slide limit 500 mm
-        with pytest.raises(MoveError):
+        # through the action the controller's refusal ends the move at once, with its words
+        with pytest.raises(MoveError, match="refused the goal" if interface == "action" else None):
             handle.wait(3)
-        assert arm.rejected >= 1 and np.allclose(arm.position(time.monotonic()), [0, -30, 60, 0, 45, 100])
+        refused = arm.action.refused if interface == "action" else arm.rejected
+        assert refused >= 1 and np.allclose(arm.position(time.monotonic()), [0, -30, 60, 0, 45, 100])
     finally:
         link.close()
 
@@ -175,8 +190,8 @@ from calib_core.link.joint_map import JointMap
 from calib_core.link.link_types import LinkState
 names = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "slide")
 link = open_controller("ros2:///joint_states", ControllerContext(names, ("deg",) * 5 + ("mm",), JointMap.identity(6), 100.0,
-                       {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5})).start()
-while not (link.state is LinkState.UP and link._writer.get_publication_matched_status().current_count > 0):
+                       {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5, "interface": sys.argv[1]})).start()
+while not (link.state is LinkState.UP and (link._goals.client.server_ready() if sys.argv[1] == "action" else link._writer.get_publication_matched_status().current_count > 0)):
     time.sleep(0.01)
 handle = link.move_joints([80.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=30)
 print("moving", flush=True)
@@ -184,7 +199,7 @@ time.sleep(60)
 """
 
 
-def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm):
+def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm, interface):
     """The dead-man: a one-point trajectory ran on to the target whatever became of the workstation.
     A real process, killed with SIGKILL mid-move (no Stop, no goodbye): the arm stops within the horizon's
     motion (0.5 s at 20 deg/s: 10 deg) of where it was, on the way, and stays there."""
@@ -194,7 +209,7 @@ def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm):
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[3]
-    station = subprocess.Popen([sys.executable, "-c", _WORKSTATION], cwd=root, stdout=subprocess.PIPE, text=True)
+    station = subprocess.Popen([sys.executable, "-c", _WORKSTATION, interface], cwd=root, stdout=subprocess.PIPE, text=True)
     try:
         assert station.stdout.readline().strip() == "moving"
         assert wait_until(lambda: arm.position(time.monotonic())[0] > 20.0, 10.0)
@@ -205,7 +220,7 @@ def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm):
         held = arm.position(time.monotonic())[0]
         assert at_kill <= held <= at_kill + 10.0 + 0.5  # 10 deg of motion at most (and a sample's worth)
         assert held < 60.0  # far from the 80 deg target it would have run on to
-        assert arm.rejected == 0 and arm.trajectories >= 3  # streamed: renewed while it moved
+        assert arm.rejected == 0 and arm.plan_number >= 3  # streamed: renewed while it moved (topic messages or goals)
     finally:
         if station.poll() is None:
             station.kill()
