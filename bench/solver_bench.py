@@ -27,63 +27,17 @@ from calib_core.solver.problem import make_problem
 from calib_core.solver.refine import run_newton
 from calib_core.solver.sampler import INLIER_SIGMAS
 from bench.solver_reliability import mis_pick_section, robust_reliability_section
+from bench.solver_scenes import CAM, NOISE_PX, _cv_pose, _displaced, _opencv, _scene, _time_per_call
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "solver.md"
-CAM = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
-K = CAM.K
 TRIALS = 1000
-NOISE_PX = 0.5
+
 SUCCESS_MM, SUCCESS_DEG = 1e-3, 1e-3  # "converged to the truth" on exact pixels
-
-
-def _scene(rng: np.random.Generator, n: int, planar: bool = False):
-    """A random pose (object ~500 mm away, all points inside the image) and its points (n, 3) mm."""
-    while True:
-        R = Rotation.from_rotvec(rng.normal(0, 0.35, 3)).as_matrix()
-        t = np.array([rng.uniform(-60, 60), rng.uniform(-50, 50), rng.uniform(400, 600)])
-        P = rng.uniform(-75, 75, (n, 3))
-        if planar:
-            P[:, 2] = 0.0
-        T = make_transform(R, t)
-        uv = project_points(P, T, CAM)
-        if CAM.contains(uv, margin_px=20).all():
-            return T, P, uv
 
 
 def _errors(T: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
     dt = float(np.linalg.norm(T[:3, 3] - truth[:3, 3]))
     return dt, float(np.degrees(Rotation.from_matrix(T[:3, :3] @ truth[:3, :3].T).magnitude()))
-
-
-def _displaced(rng, truth, dist_mm, angle_deg):
-    """``truth`` moved by ``dist_mm`` along a random direction and turned by ``angle_deg`` about a random axis."""
-    d = rng.normal(size=3)
-    a = rng.normal(size=3)
-    R = Rotation.from_rotvec(np.radians(angle_deg) * a / np.linalg.norm(a)).as_matrix() @ truth[:3, :3]
-    return make_transform(R, truth[:3, 3] + dist_mm * d / np.linalg.norm(d))
-
-
-def _cv_pose(rvec, tvec):
-    return make_transform(cv2.Rodrigues(np.asarray(rvec, float).reshape(3))[0], np.asarray(tvec, float).reshape(3))
-
-
-def _opencv(method, P, uv, start=None):
-    try:
-        if method == "iterative+guess":
-            rvec = cv2.Rodrigues(start[:3, :3])[0]
-            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, rvec, start[:3, 3].reshape(3, 1).copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
-        elif method == "sqpnp+lm":
-            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_SQPNP)
-            rvec, tvec = cv2.solvePnPRefineLM(P, uv, K, None, rvec, tvec)
-        elif method == "epnp":
-            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_EPNP)
-        elif method == "iterative":
-            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_ITERATIVE)
-        else:
-            raise ValueError(method)
-    except cv2.error:
-        return None
-    return _cv_pose(rvec, tvec) if ok else None
 
 
 # --- Table 1 -----------------------------------------------------------------------------------
@@ -228,17 +182,6 @@ def accuracy_section(rng) -> list[str]:
 
 
 # --- Speed ---------------------------------------------------------------------------------------
-def _time_per_call(fn, reps):
-    fn()
-    best = np.inf
-    for _ in range(5):
-        t0 = time.perf_counter()
-        for _ in range(reps):
-            fn()
-        best = min(best, (time.perf_counter() - t0) / reps)
-    return best
-
-
 def _with_outliers(rng, n, share):
     T, P, uv = _scene(rng, n)
     noisy = uv + rng.normal(0, NOISE_PX, uv.shape)
@@ -331,7 +274,7 @@ def robust_section(rng) -> list[str]:
 def main() -> str:
     rng = np.random.default_rng(20261122)
     t0 = time.time()
-    from bench.solver_speed import speed_section  # (it imports this module's scenes and peers)
+    from bench.solver_speed import speed_section
 
     # (the speed section draws from a generator of its own: the other sections keep their scenes whatever it times)
     body = table1_section() + convergence_section(rng) + accuracy_section(rng) + speed_section(np.random.default_rng(20261205)) + robust_section(rng)

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from bench.solver_bench import CAM, NOISE_PX, _displaced, _opencv, _scene, _time_per_call
+from bench.solver_scenes import CAM, NOISE_PX, _displaced, _opencv, _scene, _time_per_call
 from calib_core.solver import solve_pose, solve_pose_batch
 from calib_core.solver.sampler import INLIER_SIGMAS
 

@@ -29,7 +29,6 @@ def _register(name: str, module: str, help_text: str) -> None:
 _register("gui", "app.cli.cmd_gui", "open the operator's window (the bundled workcell with simulated robot and camera by default)")
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
-_register("sim-controller", "app.cli.cmd_sim_controller", "run a simulated robot controller on a pty or a TCP port")
 _register("link-key", "app.cli.cmd_link_key", "name, show or renew the controller link's pre-shared key")
 _register("monitor", "app.cli.cmd_monitor", "print the joint samples of any controller connector")
 _register("grab", "app.cli.cmd_grab", "save N frames of any camera connector as PNG files and frames.csv")

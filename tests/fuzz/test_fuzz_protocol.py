@@ -8,7 +8,7 @@ import time
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from calib_core.link import auth
-from calib_core.link.controller_sim import ControllerLogic
+from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.protocol import encode
 

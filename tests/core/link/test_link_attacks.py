@@ -18,7 +18,7 @@ import serial
 
 from calib_core.link import auth
 from calib_core.link.assembler import SentenceAssembler
-from calib_core.link.controller_sim import ControllerLogic
+from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_types import LinkState
 from calib_core.link.protocol import MAX_SENTENCE_BYTES, Ack, ErrorReply, JointSample, encode, parse_body
@@ -243,7 +243,7 @@ def test_a_flood_of_keyless_hellos_leaves_the_workstation_s_handshake_alone_and_
     """A writer without the key sends a hello every 20 ms while the workstation connects (version 5 answered each,
     and the workstation's answer to its own hello no longer matched: 3 of 6 connects failed). Now only the key's
     holder is answered, the refusals at most 10 a second."""
-    from calib_core.link.controller_sim import REFUSALS_PER_S
+    from videocal_sim.controller_sim import REFUSALS_PER_S
     from calib_core.link.workstation_auth import WorkstationAuth
 
     clock = _Clock()

@@ -13,7 +13,7 @@ import time
 import pytest
 
 from calib_core.link import auth
-from calib_core.link.controller_sim import ControllerLogic
+from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_key import LinkKeyError, default_key_path, read_key, user_key, write_new_key
 from calib_core.link.link_types import MoveError

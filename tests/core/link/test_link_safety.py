@@ -7,7 +7,7 @@ import time
 import numpy as np
 import pytest
 
-from calib_core.link.controller_sim import ControllerLogic
+from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_types import LinkState, MoveError
 from calib_core.link.protocol import Ack, Done, ErrorReply, JointSample, encode

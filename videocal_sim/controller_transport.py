@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from calib_core.link.assembler import SentenceAssembler
-from calib_core.link.controller_sim import ControllerLogic
-from calib_core.link.faults import FaultInjector
+from videocal_sim.controller_sim import ControllerLogic
+from videocal_sim.wire_faults import FaultInjector
 from calib_core.link.protocol import ErrorReply, encode
 
 

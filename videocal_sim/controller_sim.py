@@ -3,7 +3,7 @@ of the original system, moves with trapezoidal profiles and streams joint sample
 
 Transport-free: :meth:`ControllerLogic.handle` turns incoming sentence bodies into replies
 and :meth:`ControllerLogic.tick` produces the due stream samples and move completions; the
-transports in :mod:`calib_core.link.sim_transport` carry the bytes.
+transports in :mod:`videocal_sim.controller_transport` carry the bytes.
 """
 
 from __future__ import annotations

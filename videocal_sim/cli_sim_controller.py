@@ -12,6 +12,8 @@ import numpy as np
 
 from calib_core.errors import VideocalError
 
+HELP = "run a simulated robot controller on a pty or a TCP port"
+
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     where = parser.add_mutually_exclusive_group(required=True)
@@ -33,11 +35,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.link.controller_sim import ControllerLogic
-    from calib_core.link.faults import FaultInjector
+    from videocal_sim.controller_sim import ControllerLogic
+    from videocal_sim.wire_faults import FaultInjector
     from calib_core.link.joint_motion import PlainJointModel
     from calib_core.link.link_key import read_key, user_key
-    from calib_core.link.sim_transport import SimOptions, serve
+    from videocal_sim.controller_transport import SimOptions, serve
 
     if args.link is not None and not args.pty:
         raise VideocalError("--link applies to --pty")
