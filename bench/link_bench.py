@@ -21,7 +21,7 @@ import numpy as np
 
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.link_types import LinkState
 from calib_core.link.protocol import JointSample, encode
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "link.md"

@@ -18,12 +18,12 @@ import numpy as np
 from calib_core.calibration.session import ConfirmationNeeded
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
-from calib_core.link.link_types import TimedSample
+from calib_core.connectors.link_types import TimedSample
 from calib_core.link.protocol import JointSample
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
 from videocal_sim.sim_site import simulated_cell
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 OUT = Path(__file__).resolve().parents[1] / "resources" / "recordings" / "sample_session.mcap"
 FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left"]

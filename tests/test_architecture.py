@@ -73,36 +73,61 @@ def test_headless_commands_do_not_load_qt():
     assert out.stdout.strip().endswith("False")
 
 
-_POSE_CALLS = {"invert", "inv", "fk", "frame_placement", "make_transform", "delta_transform", "transform_from_xyz_rpy", "concat"}
+_POSE_CALLS = {"invert", "fk", "frame_placement", "make_transform", "delta_transform", "transform_from_xyz_rpy", "concat"}
 
 
-def _is_pose(node: ast.AST) -> bool:
-    """A 4 x 4 pose by its name (``a2b``, ``item.item2world``) or by the function that makes one."""
+def _is_pose(node: ast.AST, known: frozenset[str] = frozenset()) -> bool:
+    """A 4 x 4 pose by its name (``a2b``, ``item.item2world``), by the function that makes one, or by a name
+    assigned one in the same function (``known``: ``T = make_transform(...)`` makes ``T`` a pose)."""
     import re
 
     if isinstance(node, ast.Name | ast.Attribute):
         name = node.id if isinstance(node, ast.Name) else node.attr
-        return re.fullmatch(r"[a-z_]*[a-z]2[a-z][a-z_]*", name) is not None
+        return (isinstance(node, ast.Name) and name in known) or re.fullmatch(r"[a-z_]*[a-z]2[a-z][a-z_]*", name) is not None
     if isinstance(node, ast.Call):
         f = node.func
         return (f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else "") in _POSE_CALLS
     if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult):
-        return _is_pose(node.left) or _is_pose(node.right)
+        return _is_pose(node.left, known) or _is_pose(node.right, known)
     return False
+
+
+def _poses_by_call(scope: ast.AST) -> frozenset[str]:
+    """Names a function assigns a pose to (by a pose call or another pose), followed to a fixed point."""
+    known: set[str] = set()
+    while True:
+        found = {t.id for node in ast.walk(scope) if isinstance(node, ast.Assign) and _is_pose(node.value, frozenset(known))
+                 for t in node.targets if isinstance(t, ast.Name)}
+        if found <= known:
+            return frozenset(known)
+        known |= found
+
+
+def _is_inverse_by_hand(node: ast.AST, known: frozenset[str]) -> bool:
+    """``np.linalg.inv(pose)``: a rigid pose is inverted by ``invert`` (its transpose, exact), not a general inverse."""
+    return (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "inv" and len(node.args) == 1
+            and _is_pose(node.args[0], known))
 
 
 def _bare_compositions(source: str, filename: str) -> list[str]:
     tree = ast.parse(source, filename=filename)
-    return [
-        f"{filename}:{node.lineno}: {ast.unparse(node)}"
-        for node in ast.walk(tree)
-        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult) and _is_pose(node.left) and _is_pose(node.right)
-    ]
+    hits = set()
+    for scope in [tree] + [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef)]:
+        known = _poses_by_call(scope) if scope is not tree else frozenset()
+        for node in ast.walk(scope):
+            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult) and _is_pose(node.left, known) and _is_pose(node.right, known):
+                hits.add((node.lineno, ast.unparse(node)))
+            elif _is_inverse_by_hand(node, known):
+                hits.add((node.lineno, ast.unparse(node)))
+    return [f"{filename}:{line}: {text}" for line, text in sorted(hits)]
 
 
 def test_poses_are_composed_with_concat_and_invert():
     # concat(a2b, b2c) reads in the order the frames chain; ``b2c @ a2b`` reads backwards, and a wrong order still runs.
     assert len(_bare_compositions("x = invert(cam2world) @ obj2world\ny = concat(obj2world, invert(cam2world)) @ p", "probe")) == 1
+    # by call: a name given a pose in the function, and a pose inverted by hand
+    assert len(_bare_compositions("def f(q):\n    T = robot.fk(q, 'tcp')\n    S = T\n    return S @ make_transform(R, t)", "probe")) == 1
+    assert len(_bare_compositions("r = np.linalg.inv(base2root)\nc = np.linalg.inv(J.T @ J)", "probe")) == 1
     offenders = [
         hit
         for package in ("calib_core", "app", "videocal_sim")

@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         raise VideocalError("--open and --key-file exclude each other")
     key = None if args.open else (read_key(args.key_file) if args.key_file is not None else user_key())
     if args.robot == "cell":
-        from calib_core.link.joint_map import ControllerJointModel, JointMap
+        from calib_core.connectors.joint_map import ControllerJointModel, JointMap
         from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
         cell = load_workcell(args.workcell or DEFAULT_WORKCELL)

@@ -157,7 +157,7 @@ def truth_in_model_parameters(bed) -> np.ndarray:
     nominal, true = bed.model_robot, bed.true_robot
     layout = CorrectedRobot(nominal).layout
     p = np.zeros(layout.size)
-    root2base = np.linalg.inv(nominal.base2root)
+    root2base = invert(nominal.base2root)
     # Each joint's zero offset is its motion at q = offset after the placement: liMi at the offsets.
     data = nominal.model.createData()
     pin.forwardKinematics(nominal.model, data, nominal.configuration(true.joint_offsets))

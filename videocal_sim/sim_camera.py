@@ -20,7 +20,7 @@ from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.render.studio import Studio
 from calib_core.scene import SceneItem
 from calib_core.camera.distortion_map import distortion_map
-from calib_core.video.frame import Frame, FrameSource
+from calib_core.connectors.frame import Frame, FrameSource
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.errors import VideocalError
-from calib_core.link.joint_map import JointMap
+from calib_core.connectors.joint_map import JointMap
 from calib_core.operator.cell import Cell
 from calib_core.scene import SceneItem
 from videocal_sim.sim_process import SimulatorProcess

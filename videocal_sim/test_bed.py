@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.errors import VideocalError
+from calib_core.frames import concat
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
 from calib_core.scene import SceneItem
@@ -61,7 +62,7 @@ class TestBed:
         base = self.true_robot.base_true2base_model
         links = self.visuals.scene_items(q_true)
         for item in links:
-            item.item2world = base @ item.item2world
+            item.item2world = concat(item.item2world, base)
         components = self.workcell.components if self.true_components is None else self.true_components
         return list(components) + links + list(self.extra_items)
 

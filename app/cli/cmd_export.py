@@ -78,7 +78,7 @@ def _robot(workcell: str | Path | None):
     if not workcell or not Path(workcell).is_file():
         print(f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
         return None, None
-    from calib_core.link.joint_map import JointMap
+    from calib_core.connectors.joint_map import JointMap
     from calib_core.workcell import load_workcell
 
     cell = load_workcell(workcell)

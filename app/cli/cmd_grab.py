@@ -27,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.atomic_file import atomic_write_bytes, atomic_write_text
     from calib_core.connectors.registry import open_camera
     from calib_core.errors import VideocalError
-    from calib_core.video.frame import FrameTimeout
+    from calib_core.connectors.frame import FrameTimeout
 
     if args.out.exists() and not args.out.is_dir():
         raise VideocalError(f"{args.out}: --out names a file; grab writes PNG files and frames.csv into a folder")

@@ -34,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _context(args: argparse.Namespace, rate_hz: float, options: dict):
     """The connector's context: the workcell's robot, or none (any joint count, the controller's order)."""
     from calib_core.connectors.controller import ControllerContext
-    from calib_core.link.joint_map import JointMap
+    from calib_core.connectors.joint_map import JointMap
 
     if args.workcell is None:
         return ControllerContext((), (), JointMap.identity(0), rate_hz, options)

@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from PySide6.QtCore import QThread, Signal
 
-from calib_core.video.frame import FrameSource, FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import FrameSource, FrameTimeout, VideoSourceError
 
 
 class FrameWorker(QThread):

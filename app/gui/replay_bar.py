@@ -26,7 +26,7 @@ from calib_core.recording.playback import RecordedSolve, RecordingPlayback
 from calib_core.recording.reader import read_recording, recover
 from calib_core.recording.replay import solve_from_inputs
 from calib_core.ros2.joint_units import user_per_si
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0)
 

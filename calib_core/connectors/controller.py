@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkState, MoveHandle, TimedSample  # noqa: F401 (the types a connector speaks)
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkState, MoveHandle, TimedSample  # noqa: F401 (the types a connector speaks)
 
 
 @dataclass(frozen=True)
@@ -70,3 +70,7 @@ class ControllerConnector(Protocol):
 
     def stats_snapshot(self) -> dict[str, int]:
         """Counters (samples delivered, gaps, errors...) since the start."""
+
+    publishes_transforms: bool
+    """Declared by the connector (False in :class:`~calib_core.connectors.events.ConnectorEvents`): it takes the
+    results through ``publish_static_transforms(transforms)``."""

@@ -7,7 +7,7 @@ import threading
 
 from psygnal import Signal
 
-from calib_core.link.link_types import LinkState, LinkStats, MoveError, MoveHandle
+from calib_core.connectors.link_types import LinkState, LinkStats, MoveError, MoveHandle
 
 
 class ConnectorEvents:
@@ -21,6 +21,14 @@ class ConnectorEvents:
     stats: LinkStats
     last_error: str | None = None
     _state: LinkState = LinkState.CLOSED
+
+    publishes_transforms: bool = False
+    """The connector can put the calibration's results where the robot's software reads them
+    (:meth:`publish_static_transforms`: ROS 2's ``/tf_static``); the core publishes to it only then."""
+
+    def publish_static_transforms(self, transforms: list) -> None:
+        """``(parent, child, child2parent (4, 4) mm)`` to the robot's side; only when :attr:`publishes_transforms`."""
+        raise NotImplementedError(f"{type(self).__name__} does not publish transforms")
 
     @property
     def state(self) -> LinkState:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from calib_core.link.link_types import LinkError
+from calib_core.connectors.link_types import LinkError
 
 
 def number_option(options: dict, key: str, default: float, low: float, high: float, scheme: str) -> float:

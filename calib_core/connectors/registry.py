@@ -12,7 +12,7 @@ from calib_core.connectors.controller import ControllerConnector, ControllerCont
 from calib_core.connectors.urls import camera_scheme, controller_scheme
 from calib_core.errors import VideocalError
 from calib_core.plugins import load_plugin, plugin_names
-from calib_core.video.frame import FrameSource
+from calib_core.connectors.frame import FrameSource
 
 CONTROLLERS = "videocal.controllers"
 CAMERAS = "videocal.cameras"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from calib_core.video.frame import VideoSourceError
+from calib_core.connectors.frame import VideoSourceError
 
 
 def aravis():

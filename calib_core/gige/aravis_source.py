@@ -5,7 +5,7 @@ Options (``?exposure_us=8000&gain_db=2&pixel_format=RGB8&width=1280&height=960``
 ``camera_options``): set on the camera when it opens and set again after a reconnect; a camera that refuses one
 is an error naming it. Frames carry the camera's own timestamp (``t_device_ns``: the device's clock, ns) and the
 host's time at the frame (``t_host_s``, from Aravis's system timestamp). A camera that stops sending gives
-:class:`~calib_core.video.frame.FrameTimeout`; after ``reopen_after_s`` of silence the device is opened again
+:class:`~calib_core.connectors.frame.FrameTimeout`; after ``reopen_after_s`` of silence the device is opened again
 (a GigE camera that was unplugged or rebooted comes back without restarting videocal).
 """
 
@@ -17,7 +17,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 from calib_core.gige.aravis_lib import aravis
 from calib_core.gige.pixel_formats import to_rgb
-from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 _OPTIONS = {"exposure_us", "gain_db", "pixel_format", "width", "height", "timeout_s", "reopen_after_s", "fake"}
 _BUFFERS = 8

@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from calib_core.video.frame import VideoSourceError
+from calib_core.connectors.frame import VideoSourceError
 
 # PFNC codes: Mono8, Mono16, RGB8, BGR8 and the 8-bit Bayer patterns.
 MONO8, MONO16, RGB8, BGR8 = 0x01080001, 0x01100007, 0x02180014, 0x02180015

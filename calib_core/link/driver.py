@@ -21,7 +21,7 @@ import serial
 from calib_core.connectors.events import ConnectorEvents
 from calib_core.link.assembler import SentenceAssembler
 from calib_core.link.link_key import default_key_path, user_key
-from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
+from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.move_book import MoveBook
 from calib_core.link.sample_order import SampleOrder
 from calib_core.link.protocol import (

@@ -7,7 +7,7 @@ import re
 import threading
 from collections import deque
 
-from calib_core.link.link_types import MoveError, MoveHandle, MoveTimeout
+from calib_core.connectors.link_types import MoveError, MoveHandle, MoveTimeout
 from calib_core.link.protocol import ErrorReply
 
 _MOVE_IN_ERROR = re.compile(r"move ([A-Za-z0-9_.-]+):")

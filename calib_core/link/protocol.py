@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from calib_core.connectors.link_types import JointSample as SharedJointSample
+
 PROTOCOL_VERSION = 6
 # Version 2 carries any number of joints (1 to MAX_JOINTS) and so allows longer sentences; version 4
 # adds a seal to motion sentences, 56 bytes with version 6's time (16 joints of 1e6 still fit).
@@ -51,13 +53,9 @@ def format_angle(deg: float) -> str:
 
 # --- messages from the controller ------------------------------------------------------------
 @dataclass(frozen=True)
-class JointSample:
-    """``$JNT,<seq>,<t_ms>,<q1>,...,<qn>``: a joint sample. ``seq`` counts up and wraps at 2^32;
-    ``t_ms`` is the controller's clock; ``joints_deg`` (n,) deg or mm, in the controller's axis order."""
-
-    seq: int
-    t_ms: int
-    joints_deg: tuple[float, ...]
+class JointSample(SharedJointSample):
+    """``$JNT,<seq>,<t_ms>,<q1>,...,<qn>``: a joint sample on the wire (the connectors' shared
+    :class:`~calib_core.connectors.link_types.JointSample`). ``seq`` wraps at 2^32."""
 
     def body(self) -> str:
         return ",".join(["JNT", str(self.seq % SEQ_MODULUS), str(self.t_ms)] + [format_angle(q) for q in self.joints_deg])

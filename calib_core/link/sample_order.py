@@ -7,7 +7,7 @@ controller, whose samples are fresh again (``restart``). Gaps in the sequence ar
 
 from __future__ import annotations
 
-from calib_core.link.link_types import LinkStats
+from calib_core.connectors.link_types import LinkStats
 from calib_core.link.protocol import SEQ_MODULUS, JointSample
 
 RESTART_BACK_MS = 1000  # a controller clock that goes back further than this has restarted ...

@@ -20,7 +20,7 @@ from calib_core.calibration.session import CalibrationError
 from calib_core.connectors.controller import ControllerConnector, ControllerContext
 from calib_core.connectors.registry import open_controller
 from calib_core.link.joint_history import ControllerClock
-from calib_core.link.link_types import LinkState, MoveHandle, TimedSample
+from calib_core.connectors.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.motion import Motion, MotionState, ended
 from calib_core.operator.move_preview import Confirmation, MoveNeedsConfirmation, MovePreview, MoveRefused, preview_move

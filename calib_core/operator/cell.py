@@ -19,7 +19,7 @@ from psygnal import Signal
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.errors import VideocalError
-from calib_core.link.joint_map import JointMap
+from calib_core.connectors.joint_map import JointMap
 from calib_core.robot.collision import CollisionWorld
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals

@@ -24,7 +24,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.link.joint_history import JointHistory
-from calib_core.link.link_types import TimedSample
+from calib_core.connectors.link_types import TimedSample
 from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
@@ -166,7 +166,7 @@ class OperatorCore:
             self.site.attach(link)
         link.start()
         self.log.say(f"controller link: {url}")
-        if hasattr(link, "publish_static_transforms"):  # a ROS 2 cell: the results on /tf_static too
+        if getattr(link, "publishes_transforms", False):  # declared by the connector (ROS 2: the results on /tf_static too)
             for signal in (self.camera_model_changed, self.correction_stored):
                 signal.connect(self._publish_static_transforms, unique=True)
             self._publish_static_transforms()
@@ -219,7 +219,7 @@ class OperatorCore:
 
     def _publish_static_transforms(self, *_) -> None:
         link = self.link
-        if link is None or not hasattr(link, "publish_static_transforms"):
+        if link is None or not getattr(link, "publishes_transforms", False):
             return
         try:
             link.publish_static_transforms(self.static_transforms())

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import Enum
 
-from calib_core.link.link_types import MoveTimeout
+from calib_core.connectors.link_types import MoveTimeout
 
 
 class Motion(str, Enum):

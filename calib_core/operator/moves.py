@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from calib_core.calibration.session import CalibrationError, CalibrationSession
-from calib_core.link.link_types import MoveHandle
+from calib_core.connectors.link_types import MoveHandle
 from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.move_preview import Confirmation, MovePreview

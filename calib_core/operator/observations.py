@@ -20,7 +20,7 @@ from psygnal import Signal
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.link.joint_history import JointHistory, Stillness
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 
 RECENT_FRAMES = 16

@@ -13,7 +13,7 @@ from typing import Protocol
 
 from calib_core.connectors.registry import open_camera
 from calib_core.scene import SceneItem
-from calib_core.video.frame import FrameSource
+from calib_core.connectors.frame import FrameSource
 
 
 class Site(Protocol):

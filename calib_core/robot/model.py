@@ -84,7 +84,7 @@ class RobotModel:
             kinds.append(kind)
         self.joint_kinds: list[str] = kinds
         self._internal_per_user = np.array([_INTERNAL_PER_USER[k] for k in kinds])
-        self._root2base = np.linalg.inv(self.base2root)
+        self._root2base = invert(self.base2root)
 
     # --- joints ----------------------------------------------------------------------------------
     @property

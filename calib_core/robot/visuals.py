@@ -19,7 +19,7 @@ from calib_core.errors import FileFormatError
 from calib_core.robot import mesh_cache
 from calib_core.robot.model import RobotModel, _to_mm
 from calib_core.scene import SceneItem
-from calib_core.frames import concat
+from calib_core.frames import concat, invert
 
 _CYLINDER_SECTIONS = 32
 _KINDS = {"visual": pin.GeometryType.VISUAL, "collision": pin.GeometryType.COLLISION}
@@ -120,7 +120,7 @@ class RobotVisuals:
         q = self.robot.configuration(q_deg)
         data = self.geometry_model.createData()
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geometry_model, data, q)
-        root2base = np.linalg.inv(self.robot.base2root)
+        root2base = invert(self.robot.base2root)
         return [concat(_to_mm(p), root2base) for p in data.oMg]
 
     def riding_with(self, frame: str) -> frozenset[str]:

@@ -7,7 +7,7 @@ is that instant on the host's monotonic clock (the stamp's age subtracted from t
 the arrival), so picks are bound to the joints when the image was taken, not when it arrived. The reader is best
 effort (it hears both best-effort and reliable publishers, as ``rclcpp``'s sensor-data subscriptions do) and keeps
 only the newest image: a slow window skips frames, it never queues them. A camera that goes quiet gives
-:class:`~calib_core.video.frame.FrameTimeout` (the pane keeps waiting and says so); when it comes back, so do frames.
+:class:`~calib_core.connectors.frame.FrameTimeout` (the pane keeps waiting and says so); when it comes back, so do frames.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import threading
 import time
 from urllib.parse import parse_qs, urlsplit
 
-from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 _OPTIONS = {"domain", "timeout_s"}
 

@@ -44,9 +44,9 @@ from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.link.arrival_delay import ArrivalDelay
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
-from calib_core.link.protocol import JointSample
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
+from calib_core.connectors.link_types import JointSample
 from calib_core.link.sample_order import SampleOrder
 from calib_core.ros2.joint_units import user_per_si
 
@@ -76,6 +76,8 @@ TYPE_CHECK_S = 1.0
 class Ros2TrajectoryController(ConnectorEvents):
     """See the module. ``context.joint_names`` are the joints looked for in each JointState message.
     (``auth_changed`` is never emitted: ROS 2 has no session.)"""
+
+    publishes_transforms = True
 
     def __init__(self, url: str, context: ControllerContext):
         from calib_core.ros2.wire import domain_id, dds_topic
@@ -315,7 +317,7 @@ class Ros2TrajectoryController(ConnectorEvents):
             self._moves.finish(MoveError(f"the joint states stopped ({now - last:.1f} s): the robot's pose is unknown"))
         move = self._moves.current
         if move is not None and now > move.deadline_s:
-            from calib_core.link.link_types import MoveTimeout
+            from calib_core.connectors.link_types import MoveTimeout
 
             self._moves.finish(MoveTimeout("the joints did not reach the target in time"))
 

@@ -29,9 +29,9 @@ from psygnal import Signal
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
-from calib_core.link.protocol import JointSample
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
+from calib_core.connectors.link_types import JointSample
 from calib_core.link.round_trip import RoundTrip
 
 SCRIPT_PORT, DASHBOARD_PORT = 30002, 29999

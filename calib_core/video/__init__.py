@@ -1,5 +1,5 @@
 """Video sources: OpenCV devices, files and URLs, image folders, recordings, the simulated camera."""
 
-from calib_core.video.frame import Frame, FrameSource, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, VideoSourceError
 
 __all__ = ["Frame", "FrameSource", "VideoSourceError"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from calib_core.video.frame import FrameSource, VideoSourceError
+from calib_core.connectors.frame import FrameSource, VideoSourceError
 
 
 def open_opencv(spec: str, options: dict) -> FrameSource:
@@ -37,7 +37,7 @@ def open_stream(spec: str, options: dict) -> FrameSource:
     unknown = set(options) - {"timeout_s", "reopen_every_s"}
     if unknown:
         raise VideoSourceError(f"camera {spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: reopen_every_s, timeout_s")
-    from calib_core.link.link_types import LinkError
+    from calib_core.connectors.link_types import LinkError
 
     try:
         timeout_s = number_option(options, "timeout_s", 5.0, 0.1, 600.0, spec)

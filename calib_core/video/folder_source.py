@@ -7,7 +7,7 @@ from pathlib import Path
 
 from calib_core.errors import FileFormatError
 from calib_core.image_files import read_image
-from calib_core.video.frame import Frame, FrameSource, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, VideoSourceError
 
 SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
 

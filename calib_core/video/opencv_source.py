@@ -6,7 +6,7 @@ import time
 
 import cv2
 
-from calib_core.video.frame import Frame, FrameSource, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, VideoSourceError
 
 
 class OpenCVSource(FrameSource):

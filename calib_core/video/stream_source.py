@@ -2,7 +2,7 @@
 
 An IP camera restarts, a switch reboots, a Wi-Fi bridge goes away for a few seconds: the stream ends, FFmpeg says
 so, and the camera usually comes back at the same URL. Until it does, :meth:`read` raises
-:class:`~calib_core.video.frame.FrameTimeout` (the reader keeps reading and the window says it is waiting), and
+:class:`~calib_core.connectors.frame.FrameTimeout` (the reader keeps reading and the window says it is waiting), and
 tries to open the stream again every ``reopen_every_s``. FFmpeg's own waits are bounded (``timeout_s``) so a
 stream that hangs instead of ending cannot freeze the reader.
 """
@@ -13,7 +13,7 @@ import time
 
 import cv2
 
-from calib_core.video.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 
 class StreamSource(FrameSource):

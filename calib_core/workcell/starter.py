@@ -19,7 +19,7 @@ import numpy as np
 import trimesh
 
 from calib_core.errors import FileWriteError, VideocalError
-from calib_core.frames import concat, make_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
+from calib_core.frames import concat, invert, make_transform, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.flange_choice import choose_flange, tool_alignment
 from calib_core.robot import UnreachableTargetError, solve_ik
 from calib_core.robot.model import RobotModel, load_robot
@@ -123,7 +123,7 @@ def _tool_side(robot: RobotModel, flange: str, align: np.ndarray | None = None) 
     points = []
     for g, mesh, pose in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q)):
         if g.parentJoint == last_joint:
-            p = np.linalg.inv(flange2base) @ pose @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T
+            p = concat(pose, invert(flange2base)) @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T
             points.append(p[:3].T)
     points = np.concatenate(points) if points else np.zeros((1, 3))
     points = points[(points[:, 2] > -20.0) & (points[:, 2] < TCP_MM)]
@@ -158,7 +158,7 @@ def _find_task(robot: RobotModel, home: np.ndarray, camera_yaw_deg: float, floor
     for fraction in (0.55, 0.45, 0.65, 0.35, 0.75):
         for z in (height, 0.8 * height, 1.2 * height, 0.5 * reach):
             tcp = make_transform(R, [fraction * reach, 0.0, max(z, 150.0)])
-            approach = tcp @ make_transform(np.eye(3), [0.0, 0.0, -APPROACH_MM])
+            approach = concat(make_transform(np.eye(3), [0.0, 0.0, -APPROACH_MM]), tcp)
             try:
                 q_approach = solve_ik(robot, approach, home, extra_seeds=16).q_deg
                 solve_ik(robot, tcp, q_approach, extra_seeds=4)

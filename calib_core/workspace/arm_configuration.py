@@ -137,7 +137,7 @@ def _elbow_side(axes: list[_Axis], centre: np.ndarray) -> float:
 
 def arm_configuration(robot, joint_map, q_model_deg, reference_axes_deg) -> ArmConfiguration:
     """The configuration of ``robot`` (a :class:`~calib_core.robot.model.RobotModel`) at ``q_model_deg`` (model joints),
-    ``joint_map`` (:class:`~calib_core.link.joint_map.JointMap`) giving the controller's axis values.
+    ``joint_map`` (:class:`~calib_core.connectors.joint_map.JointMap`) giving the controller's axis values.
     ``reference_axes_deg`` (6,) controller axes: the vendor's pose whose elbow side is the normal one (ABB: all zero;
     KUKA: A2 = -90, A3 = +90; only axes 2 and 3 matter). :class:`NotASixAxisArmError` for a robot that has none."""
     q = np.asarray(q_model_deg, dtype=float)

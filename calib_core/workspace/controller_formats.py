@@ -257,7 +257,7 @@ def _arm_at(fmt: str, robot, joint_map, target: np.ndarray, look_joints) -> ArmC
     """The arm's configuration at ``target`` for ``fmt`` (``None``: the language has none here, or no robot)."""
     if robot is None or fmt not in ("rapid", "krl", "urscript"):
         return None
-    from calib_core.link.joint_map import JointMap
+    from calib_core.connectors.joint_map import JointMap
     from calib_core.robot import solve_ik
 
     joint_map = joint_map or JointMap.identity(robot.n_joints)

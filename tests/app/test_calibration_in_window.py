@@ -121,7 +121,7 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     # An image click before any model pick.
     import time
 
-    from calib_core.video.frame import Frame
+    from calib_core.connectors.frame import Frame
 
     wait_for_settled_frame(qtbot, win)  # Hold holds only a frame taken with the robot settled
     win.camera.freeze.setChecked(True)  # the operator froze this (black) frame to pick on

@@ -23,7 +23,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.robot import solve_ik
 from videocal_sim.sim_site import simulated_cell
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 BASELINES = Path(__file__).resolve().parents[1] / "baselines"
 OUTPUT = Path(__file__).resolve().parents[1] / "output"

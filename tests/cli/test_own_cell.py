@@ -15,7 +15,7 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.link.driver import ControllerLink
 from calib_core.link.protocol import PROTOCOL_VERSION
-from calib_core.link.link_types import MoveError
+from calib_core.connectors.link_types import MoveError
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
 from videocal_sim.sim_process import SimulatorProcess

@@ -19,7 +19,7 @@ import pytest
 from calib_core.link import auth
 from calib_core.link.driver import ControllerLink
 from calib_core.link.joint_motion import TrapezoidMove
-from calib_core.link.link_types import MoveError
+from calib_core.connectors.link_types import MoveError
 from calib_core.link.protocol import PROTOCOL_VERSION, parse_body
 from calib_core.link.workstation_auth import AuthState
 

@@ -266,7 +266,7 @@ def _open_url(url: str):
     """A controller connector made (not started) and a camera spec checked, as a workcell's site: section is taken."""
     from calib_core.connectors.controller import ControllerContext
     from calib_core.connectors.registry import check_camera_spec, open_controller
-    from calib_core.link.joint_map import JointMap
+    from calib_core.connectors.joint_map import JointMap
 
     scheme = url.split(":", 1)[0].lower()
     if scheme in ("ros2", "socket", "rfc2217", "loop"):  # made without a connection (ur-rtde connects when made)

@@ -9,7 +9,7 @@ from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import ConnectorNotFoundError, open_camera, open_controller
 from calib_core.connectors.urls import camera_scheme, controller_scheme
 from calib_core.link.driver import ControllerLink
-from calib_core.link.joint_map import JointMap
+from calib_core.connectors.joint_map import JointMap
 
 
 def _context(n=6):

@@ -12,7 +12,7 @@ import pytest
 
 from calib_core.connectors.registry import open_camera
 from calib_core.gige.pixel_formats import BGR8, MONO8, MONO16, RGB8, to_rgb
-from calib_core.video.frame import FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import FrameTimeout, VideoSourceError
 from videocal_sim.gige_camera import SimulatedGigECamera
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.link_types import LinkState
 from calib_core.link.round_trip import RoundTrip
 from calib_core.link.workstation_auth import AuthState
 from videocal_sim.delay_line import DelayLine, LinkWeather

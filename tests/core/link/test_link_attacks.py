@@ -20,7 +20,7 @@ from calib_core.link import auth
 from calib_core.link.assembler import SentenceAssembler
 from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.link_types import LinkState
 from calib_core.link.protocol import MAX_SENTENCE_BYTES, Ack, ErrorReply, JointSample, encode, parse_body
 from calib_core.link.workstation_auth import AuthState
 from tests.core.link.test_link_with_simulator import sim  # noqa: F401 (the fixture)

@@ -16,7 +16,7 @@ from calib_core.link import auth
 from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
 from calib_core.link.link_key import LinkKeyError, default_key_path, read_key, user_key, write_new_key
-from calib_core.link.link_types import MoveError
+from calib_core.connectors.link_types import MoveError
 from calib_core.link.protocol import Ack, HelloReply, encode
 from calib_core.link.workstation_auth import AuthState, WorkstationAuth
 

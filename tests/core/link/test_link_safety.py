@@ -9,7 +9,7 @@ import pytest
 
 from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkState, MoveError
+from calib_core.connectors.link_types import LinkState, MoveError
 from calib_core.link.protocol import Ack, Done, ErrorReply, JointSample, encode
 
 
@@ -129,7 +129,7 @@ def test_a_second_workstation_cannot_take_the_robot_over(sim):  # noqa: F811
 
 
 def test_a_pending_move_times_out_while_the_link_is_down(sim):  # noqa: F811
-    from calib_core.link.link_types import MoveTimeout
+    from calib_core.connectors.link_types import MoveTimeout
 
     s = sim("--pty", "--joints", "0,0,0,0,0,0")
     with ControllerLink(s.url, rate_hz=50, deadman_ms=300) as link:

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from calib_core.link.driver import ControllerLink
-from calib_core.link.link_types import LinkError, LinkState, MoveError, MoveTimeout
+from calib_core.connectors.link_types import LinkError, LinkState, MoveError, MoveTimeout
 
 from tests.core.link.sim_process import SimProcess
 

@@ -4,9 +4,9 @@ import time
 
 import numpy as np
 
-from calib_core.link.link_types import TimedSample
+from calib_core.connectors.link_types import TimedSample
 from calib_core.link.protocol import JointSample
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 _seq = iter(range(10**9))
 

@@ -6,7 +6,7 @@ import numpy as np
 
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.observations import RECENT_FRAMES, Observations
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 
 
 def _frame(index: int, t_s: float) -> Frame:

@@ -9,7 +9,7 @@ from calib_core.frames import make_transform, pose_difference, transform_from_ro
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.core import OperatorCore
 from calib_core.robot import solve_ik
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 from calib_core.workcell.model import TaskLocation
 from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for

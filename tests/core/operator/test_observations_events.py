@@ -6,7 +6,7 @@ import numpy as np
 
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.core import OperatorCore
-from calib_core.video.frame import Frame
+from calib_core.connectors.frame import Frame
 from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for
 

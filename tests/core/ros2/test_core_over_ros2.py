@@ -5,7 +5,7 @@ import time
 
 import numpy as np
 
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.link_types import LinkState
 from calib_core.operator.cell import Cell
 from calib_core.operator.core import OperatorCore
 from calib_core.operator.motion import Motion

@@ -15,8 +15,8 @@ import pytest
 
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkState
 from calib_core.operator.cell import Cell
 from calib_core.ros2.participant import configure, release
 from calib_core.workcell import DEFAULT_WORKCELL

@@ -10,8 +10,8 @@ import pytest
 
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkState, MoveError
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkState, MoveError
 from calib_core.ros2 import action_types as at
 from calib_core.ros2 import messages as msg
 from calib_core.ros2.action_client import FollowJointTrajectoryClient

@@ -21,7 +21,7 @@ from calib_core.ros2.image_decoding import image_to_rgb
 from calib_core.ros2.image_source import Ros2ImageSource
 from calib_core.ros2.participant import participant
 from calib_core.ros2.wire import default_qos, sensor_qos
-from calib_core.video.frame import FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import FrameTimeout, VideoSourceError
 
 
 @dataclass

@@ -18,8 +18,8 @@ from cyclonedds.util import duration
 
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkState, MoveError
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkState, MoveError
 from calib_core.ros2.trajectory_connector import Ros2TrajectoryController
 from videocal_sim.ros2_arm import SimulatedRos2Arm
 from tests.waiting import wait_until
@@ -186,8 +186,8 @@ _WORKSTATION = """
 import sys, time
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkState
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkState
 names = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "slide")
 link = open_controller("ros2:///joint_states", ControllerContext(names, ("deg",) * 5 + ("mm",), JointMap.identity(6), 100.0,
                        {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5, "interface": sys.argv[1]})).start()
@@ -227,7 +227,7 @@ def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm, 
 
 
 def test_wrong_urls_and_options_are_named(domain):
-    from calib_core.link.link_types import LinkError
+    from calib_core.connectors.link_types import LinkError
 
     with pytest.raises(LinkError, match="has no host"):
         open_controller("ros2://robot/joint_states", _context())

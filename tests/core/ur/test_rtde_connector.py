@@ -11,8 +11,8 @@ import pytest
 
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkError, LinkState, MoveError
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkError, LinkState, MoveError
 from tests.waiting import wait_until
 
 NAMES = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")

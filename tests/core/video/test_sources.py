@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from calib_core.video.folder_source import ImageFolderSource
-from calib_core.video.frame import VideoSourceError
+from calib_core.connectors.frame import VideoSourceError
 from calib_core.video.opencv_source import OpenCVSource
 
 

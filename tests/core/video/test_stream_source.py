@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from calib_core.connectors.registry import open_camera
-from calib_core.video.frame import FrameTimeout, VideoSourceError
+from calib_core.connectors.frame import FrameTimeout, VideoSourceError
 
 
 class MjpegCamera:

@@ -15,7 +15,7 @@ import pytest
 
 from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.frames import transform_from_xyz_rpy
-from calib_core.link.joint_map import JointMap
+from calib_core.connectors.joint_map import JointMap
 from calib_core.robot.description import package_search_roots
 from calib_core.robot.model import load_robot
 from calib_core.robot.spec import RobotSpec

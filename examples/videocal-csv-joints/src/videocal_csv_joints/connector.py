@@ -15,8 +15,8 @@ from urllib.parse import unquote, urlsplit
 
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.events import ConnectorEvents
-from calib_core.link.joint_map import JointMap
-from calib_core.link.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
+from calib_core.connectors.joint_map import JointMap
+from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.link.protocol import JointSample
 
 

@@ -1,4 +1,6 @@
-"""What the controller link reports: its state, timestamped samples, statistics, move outcomes."""
+"""What every controller connector reports: its state, timestamped joint samples, statistics, move outcomes.
+
+The types a connector speaks, whatever its wire (videocal's own protocol, ROS 2, RTDE, a user's plug-in)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,16 @@ from dataclasses import dataclass
 from enum import Enum
 
 from calib_core.errors import VideocalError
-from calib_core.link.protocol import JointSample
+
+
+@dataclass(frozen=True)
+class JointSample:
+    """A joint sample: ``seq`` counts up (videocal's protocol wraps it at 2^32), ``t_ms`` the controller's clock (ms),
+    ``joints_deg`` (n,) deg or mm in the controller's axis order."""
+
+    seq: int
+    t_ms: int
+    joints_deg: tuple[float, ...]
 
 
 class LinkState(str, Enum):

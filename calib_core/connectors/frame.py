@@ -1,4 +1,4 @@
-"""The frame and the source protocol every video source follows."""
+"""What every camera connector delivers: the frame, and the source protocol every video source follows."""
 
 from __future__ import annotations
 
