@@ -52,7 +52,9 @@ def write_bag(folder: Path, seconds: float, jpeg: bytes) -> Path:
         for k in range(int(seconds * JOINT_HZ)):
             t = t0 + k * 1_000_000_000 // JOINT_HZ
             header = Header(stamp=Time(sec=t // 10**9, nanosec=t % 10**9), frame_id="")
-            msg = T["sensor_msgs/msg/JointState"](header=header, name=names, position=np.full(6, 0.001 * k), velocity=np.zeros(0), effort=np.zeros(0))
+            msg = T["sensor_msgs/msg/JointState"](
+                header=header, name=names, position=np.full(6, 0.001 * k), velocity=np.zeros(0), effort=np.zeros(0)
+            )
             writer.write(joints, t, ts.serialize_cdr(msg, "sensor_msgs/msg/JointState"))
             if k % frame_every == 0:
                 msg = T["sensor_msgs/msg/CompressedImage"](header=header, format="jpeg", data=data)
@@ -132,7 +134,9 @@ print(json.dumps({"seconds": seconds, "peak_mb": hwm_kb / 1024, "shape": list(sh
 
 
 def _probe(path: Path, what: str) -> dict:
-    run = subprocess.run([sys.executable, "-c", _PROBE, str(path), what], capture_output=True, text=True, cwd=ROOT, timeout=1800)
+    run = subprocess.run(
+        [sys.executable, "-c", _PROBE, str(path), what], capture_output=True, text=True, cwd=ROOT, timeout=1800
+    )
     if run.returncode != 0:
         raise RuntimeError(run.stderr[-2000:])
     return json.loads(run.stdout.strip().splitlines()[-1])
@@ -147,7 +151,17 @@ def main() -> str:
             bag = write_bag(Path(tmp) / f"bag_{minutes}min", minutes * 60.0, jpeg)
             size_mb = sum(p.stat().st_size for p in bag.rglob("*") if p.is_file()) / 1e6
             written_s = time.perf_counter() - began
-            result = {what: _probe(bag, what) for what in ("videocal_first_frame", "peer_first_frame", "videocal_joint_track", "peer_joint_track", "videocal_seek", "peer_seek")}
+            result = {
+                what: _probe(bag, what)
+                for what in (
+                    "videocal_first_frame",
+                    "peer_first_frame",
+                    "videocal_joint_track",
+                    "peer_joint_track",
+                    "videocal_seek",
+                    "peer_seek",
+                )
+            }
             rows.append((minutes, size_mb, written_s, result))
     lines = [
         "# Reading ROS 2 bags",
@@ -161,9 +175,16 @@ def main() -> str:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for minutes, size_mb, _, r in rows:
-        f, pf, j, pj = r["videocal_first_frame"], r["peer_first_frame"], r["videocal_joint_track"], r["peer_joint_track"]
-        lines.append(f"| {minutes} min | {size_mb:.0f} MB | {f['seconds']:.2f} s | {pf['seconds']:.2f} s | {f['seconds'] / pf['seconds']:.2f} | {f['peak_mb']:.0f} / {pf['peak_mb']:.0f} "
-                     f"| {j['seconds']:.1f} s | {pj['seconds']:.1f} s | {j['seconds'] / pj['seconds']:.2f} | {j['peak_mb']:.0f} / {pj['peak_mb']:.0f} |")
+        f, pf, j, pj = (
+            r["videocal_first_frame"],
+            r["peer_first_frame"],
+            r["videocal_joint_track"],
+            r["peer_joint_track"],
+        )
+        lines.append(
+            f"| {minutes} min | {size_mb:.0f} MB | {f['seconds']:.2f} s | {pf['seconds']:.2f} s | {f['seconds'] / pf['seconds']:.2f} | {f['peak_mb']:.0f} / {pf['peak_mb']:.0f} "
+            f"| {j['seconds']:.1f} s | {pj['seconds']:.1f} s | {j['seconds'] / pj['seconds']:.2f} | {j['peak_mb']:.0f} / {pj['peak_mb']:.0f} |"
+        )
     one, ten = rows[0][3], rows[1][3]
     lines += [
         "",
@@ -173,7 +194,7 @@ def main() -> str:
         f"its time grows with the bag's length, and so does its peak memory while it is read "
         f"({(ten['videocal_joint_track']['peak_mb'] - one['videocal_joint_track']['peak_mb']) * 1024 / (9 * 60 * JOINT_HZ):.2f} kB a sample: a row per message, "
         "as the peer's), the track kept after it 56 bytes a sample (6 doubles and a stamp). "
-        ""
+        "",
     ]
     lines += [
         "",
@@ -188,8 +209,10 @@ def main() -> str:
     ]
     for minutes, size_mb, _, r in rows:
         v, p = r["videocal_seek"], r["peer_seek"]
-        lines.append(f"| {minutes} min | {v['opened_s']:.1f} s | {p['opened_s']:.1f} s | {v['opened_s'] / p['opened_s']:.2f} | {v['seek_median_s'] * 1000:.0f} ms | "
-                     f"{p['seek_median_s'] * 1000:.0f} ms | {v['seek_median_s'] / p['seek_median_s']:.2f} | {v['seek_max_s'] * 1000:.0f} ms | {v['peak_mb']:.0f} / {p['peak_mb']:.0f} |")
+        lines.append(
+            f"| {minutes} min | {v['opened_s']:.1f} s | {p['opened_s']:.1f} s | {v['opened_s'] / p['opened_s']:.2f} | {v['seek_median_s'] * 1000:.0f} ms | "
+            f"{p['seek_median_s'] * 1000:.0f} ms | {v['seek_median_s'] / p['seek_median_s']:.2f} | {v['seek_max_s'] * 1000:.0f} ms | {v['peak_mb']:.0f} / {p['peak_mb']:.0f} |"
+        )
     lines += [
         "",
         f"A seek in the 10-minute bag takes {rows[-1][3]['videocal_seek']['seek_median_s'] * 1000:.0f} ms (target: under 0.2 s); the index is kept, not the images, so the "

@@ -28,8 +28,14 @@ SECONDS = 8.0
 
 
 def _start(args, env=None):
-    process = subprocess.Popen([sys.executable, "-m", "app.cli.main", *args], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                               text=True, env={**os.environ, **(env or {})})
+    process = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", *args],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env={**os.environ, **(env or {})},
+    )
     assert process.stdout.readline().strip() == "ready"
     return process
 
@@ -88,8 +94,12 @@ def ros2_joints() -> dict:
         stamps = np.array([t for _, t in rows])
         span_s = (stamps[-1] - stamps[0]) / 1000.0
         latency_ms = np.array([(arrival / 1e6) - t for arrival, t in rows])
-        return {"rate": (len(rows) - 1) / span_s, "lost": max(0, int(round(span_s * 500)) + 1 - len(rows)),
-                "p50": float(np.percentile(latency_ms, 50)), "p99": float(np.percentile(latency_ms, 99))}
+        return {
+            "rate": (len(rows) - 1) / span_s,
+            "lost": max(0, int(round(span_s * 500)) + 1 - len(rows)),
+            "p50": float(np.percentile(latency_ms, 50)),
+            "p99": float(np.percentile(latency_ms, 99)),
+        }
 
     return {"connector": figures(samples), "bare": figures(bare)}
 
@@ -118,13 +128,17 @@ def rtde_joints() -> dict:
 
 
 def _serve_gige():
-    code = ("import numpy as np, signal, threading\n"
-            "from videocal_sim.gige_camera import SimulatedGigECamera\n"
-            "image = np.random.default_rng(0).integers(0, 255, (960, 1280, 3), dtype=np.uint8)\n"
-            "camera = SimulatedGigECamera(lambda: image)\n"
-            "print('ready', flush=True)\n"
-            "done = threading.Event(); signal.signal(signal.SIGTERM, lambda *_: done.set()); done.wait()\n")
-    process = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    code = (
+        "import numpy as np, signal, threading\n"
+        "from videocal_sim.gige_camera import SimulatedGigECamera\n"
+        "image = np.random.default_rng(0).integers(0, 255, (960, 1280, 3), dtype=np.uint8)\n"
+        "camera = SimulatedGigECamera(lambda: image)\n"
+        "print('ready', flush=True)\n"
+        "done = threading.Event(); signal.signal(signal.SIGTERM, lambda *_: done.set()); done.wait()\n"
+    )
+    process = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True
+    )
     assert process.stdout.readline().strip() == "ready"
     return process
 
@@ -142,8 +156,13 @@ def gige_stream() -> dict:
             frame = camera.read()
             ages.append((time.monotonic() - frame.t_host_s) * 1000)
             count += 1
-        connector = {"fps": count / (time.monotonic() - start), "age_p50": float(np.median(ages)), "age_p99": float(np.percentile(ages, 99)),
-                     "camera_fps": camera.fps, "skipped": camera.skipped}
+        connector = {
+            "fps": count / (time.monotonic() - start),
+            "age_p50": float(np.median(ages)),
+            "age_p99": float(np.percentile(ages, 99)),
+            "camera_fps": camera.fps,
+            "skipped": camera.skipped,
+        }
         camera.close()
         Aravis = aravis()
         cam = Aravis.Camera.new("127.0.0.1")
@@ -175,14 +194,26 @@ def demo_through(site: str) -> dict:
 
     with tempfile.TemporaryDirectory() as out:
         began = time.monotonic()
-        run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", site, "--out", out],
-                             capture_output=True, text=True, timeout=1200, env={**os.environ, "QT_QPA_PLATFORM": "offscreen"})
+        run = subprocess.run(
+            [sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", site, "--out", out],
+            capture_output=True,
+            text=True,
+            timeout=1200,
+            env={**os.environ, "QT_QPA_PLATFORM": "offscreen"},
+        )
         seconds = time.monotonic() - began
         if run.returncode != 0:
             return {"site": site, "failed": (run.stderr.strip().splitlines() or ["no output"])[-1], "seconds": seconds}
         report = json.loads((Path(out) / "report.json").read_text())
-    return {"site": site, "seconds": seconds, "status": report.get("status"), "error_mm": report.get("corrected_tcp_error_mm"),
-            "error_deg": report.get("corrected_tcp_error_deg"), "before_mm": report.get("uncorrected_tcp_error_mm"), "via": report.get("site")}
+    return {
+        "site": site,
+        "seconds": seconds,
+        "status": report.get("status"),
+        "error_mm": report.get("corrected_tcp_error_mm"),
+        "error_deg": report.get("corrected_tcp_error_deg"),
+        "before_mm": report.get("uncorrected_tcp_error_mm"),
+        "via": report.get("site"),
+    }
 
 
 def main() -> str:
@@ -224,8 +255,10 @@ def main() -> str:
             lines.append(f"| `{d['site']}` | | FAILED: {d['failed']} | | | {d['seconds']:.0f} s | |")
             continue
         ratio = f"{d['seconds'] / base:.2f}" if base else ""
-        lines.append(f"| `{d['site']}` | {d['via']} | {d['status']} | {d['error_mm']:.3f} mm, {d['error_deg']:.3f} deg | {d['before_mm']:.2f} mm | "
-                     f"{d['seconds']:.0f} s | {ratio} |")
+        lines.append(
+            f"| `{d['site']}` | {d['via']} | {d['status']} | {d['error_mm']:.3f} mm, {d['error_deg']:.3f} deg | {d['before_mm']:.2f} mm | "
+            f"{d['seconds']:.0f} s | {ratio} |"
+        )
     lines.append("")
     OUT.write_text("\n".join(lines))
     return str(OUT)

@@ -35,7 +35,14 @@ N_RANDOM = 20
 
 def _errors(factor: float) -> RobotErrors:
     e = RobotErrors.typical(0, n_joints=6)
-    return RobotErrors(e.joint_offsets_deg * factor, e.link_errors_mm * factor, e.base_xyz_mm * factor, e.base_rpy_deg * factor, e.hand_eye_xyz_mm * factor, e.hand_eye_rpy_deg * factor)
+    return RobotErrors(
+        e.joint_offsets_deg * factor,
+        e.link_errors_mm * factor,
+        e.base_xyz_mm * factor,
+        e.base_rpy_deg * factor,
+        e.hand_eye_xyz_mm * factor,
+        e.hand_eye_rpy_deg * factor,
+    )
 
 
 PLACES = {"approach": 60.0, "task": 30.0}
@@ -105,7 +112,9 @@ def seen_features(bed: TestBed, q: np.ndarray, truth_cam2world: np.ndarray, rend
 
 def _run(factor: float, rng, place: str, *, workshop: bool = False, by_colour: bool = False) -> dict:
     bed = TestBed.create(errors=_errors(factor))
-    if workshop:  # printed parts, lamps with shadows, a noisier softer camera; no form error: the truth's features stay the CAD's
+    if (
+        workshop
+    ):  # printed parts, lamps with shadows, a noisier softer camera; no form error: the truth's features stay the CAD's
         make_less_kind(bed, form_error_mm=0.0)
     cell = bed.workcell
     item = cell.component(TARGET)
@@ -113,8 +122,21 @@ def _run(factor: float, rng, place: str, *, workshop: bool = False, by_colour: b
     view = ModelView(bed.intrinsics)
     depth_renderer = SceneRenderer(bed.intrinsics.width, bed.intrinsics.height)
     points = np.array(list(item.features.values()))
-    stats = {"hidden": 0, "visible": 0, "within_1px": 0, "proposed": 0, "wrong": 0, "found": 0, "poses": 0, "times": [], "edge_times": [], "edge_ratio": [], "edge_err_mm": [], "edge_ok": 0,
-             "paper": None}
+    stats = {
+        "hidden": 0,
+        "visible": 0,
+        "within_1px": 0,
+        "proposed": 0,
+        "wrong": 0,
+        "found": 0,
+        "poses": 0,
+        "times": [],
+        "edge_times": [],
+        "edge_ratio": [],
+        "edge_err_mm": [],
+        "edge_ok": 0,
+        "paper": None,
+    }
     for k, q in enumerate(_poses(bed, rng, place)):
         bed.joints_deg = q
         frame = camera.read()
@@ -160,19 +182,31 @@ def main() -> str:
     rng = np.random.default_rng(20261201)
     t0 = time.time()
     rows, edge_rows = [], []
-    runs = [(p, f, f"{p}: {t}", {}) for p in PLACES for f, t in ((1.0, "typical robot errors"), (2.0, "twice the typical errors"))]
-    runs += [(p, 1.0, f"workshop, {p}: typical, {how}", {"workshop": True, "by_colour": how == "outline by colour"}) for p in PLACES for how in ("edges by gradient", "outline by colour")]
+    runs = [
+        (p, f, f"{p}: {t}", {})
+        for p in PLACES
+        for f, t in ((1.0, "typical robot errors"), (2.0, "twice the typical errors"))
+    ]
+    runs += [
+        (p, 1.0, f"workshop, {p}: typical, {how}", {"workshop": True, "by_colour": how == "outline by colour"})
+        for p in PLACES
+        for how in ("edges by gradient", "outline by colour")
+    ]
     for place, factor, label, how in runs:
         s = _run(factor, rng, place, **how)
         t = np.array(s["times"])
         paper_visible, paper_ok, paper_worst = s["paper"]
-        rows.append(f"| {label} | {paper_ok}/{paper_visible} (worst {paper_worst:.2f} px) | {s['within_1px']}/{s['visible']} = {100 * s['within_1px'] / max(s['visible'], 1):.0f} % | {s['hidden']} "
-                    f"| {s['found']}/{s['poses']} | {s['wrong']} | {np.median(t):.2f} s / {t.max():.2f} s |")
+        rows.append(
+            f"| {label} | {paper_ok}/{paper_visible} (worst {paper_worst:.2f} px) | {s['within_1px']}/{s['visible']} = {100 * s['within_1px'] / max(s['visible'], 1):.0f} % | {s['hidden']} "
+            f"| {s['found']}/{s['poses']} | {s['wrong']} | {np.median(t):.2f} s / {t.max():.2f} s |"
+        )
         e = np.array(s["edge_err_mm"])
         r = np.array(s["edge_ratio"])
         te = np.array(s["edge_times"])
-        edge_rows.append(f"| {label} | {s['edge_ok']}/{s['poses']} = {100 * s['edge_ok'] / s['poses']:.0f} % | {np.median(e):.3f} mm / {e.max():.3f} mm "
-                         f"| {np.sqrt(np.mean(r ** 2)):.2f} | {np.median(te):.2f} s / {te.max():.2f} s |")
+        edge_rows.append(
+            f"| {label} | {s['edge_ok']}/{s['poses']} = {100 * s['edge_ok'] / s['poses']:.0f} % | {np.median(e):.3f} mm / {e.max():.3f} mm "
+            f"| {np.sqrt(np.mean(r**2)):.2f} | {np.median(te):.2f} s / {te.max():.2f} s |"
+        )
     lines = [
         "# Find points and the edge refinement",
         "",

@@ -20,13 +20,13 @@ import numpy as np
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "gui.md"
 
 
-
 def _settings(path):
     from PySide6.QtCore import QSettings
 
     settings = QSettings(str(path), QSettings.Format.IniFormat)
     settings.setValue("window/ask_unsaved", False)  # closing a bench window asks nothing
     return settings
+
 
 def _spin(app, seconds: float) -> None:
     end = time.monotonic() + seconds
@@ -49,10 +49,19 @@ def _launch(tmp: Path, tag: str, *args: str) -> tuple[float, float]:
     """Seconds from a fresh ``videocal gui`` process to the loading window, and to the full window."""
     shown_file = tmp / f"shown_{tag}.txt"
     t0 = time.monotonic()
-    subprocess.run([sys.executable, "-m", "app.cli.main", "gui", *args, "--screenshot", str(tmp / f"w_{tag}.png")], capture_output=True, text=True, timeout=180,
-                   env={**os.environ, "VIDEOCAL_REPORT_SHOWN": str(shown_file)})
+    subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "gui", *args, "--screenshot", str(tmp / f"w_{tag}.png")],
+        capture_output=True,
+        text=True,
+        timeout=180,
+        env={**os.environ, "VIDEOCAL_REPORT_SHOWN": str(shown_file)},
+    )
     shown = float(shown_file.read_text()) - t0 if shown_file.exists() else float("nan")
-    ready = float(shown_file.with_suffix(".ready").read_text()) - t0 if shown_file.with_suffix(".ready").exists() else float("nan")
+    ready = (
+        float(shown_file.with_suffix(".ready").read_text()) - t0
+        if shown_file.with_suffix(".ready").exists()
+        else float("nan")
+    )
     return shown, ready
 
 
@@ -100,8 +109,23 @@ def _preview_ms(workcell: Path | None) -> tuple[float, float, int]:
 
 def _demo(workcell: Path | None, tmp: Path, tag: str, method: str) -> dict | None:
     args = ["--workcell", str(workcell)] if workcell else []
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", *args, "--method", method, "--out", str(tmp / tag)], capture_output=True, text=True,
-                         timeout=900)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            *args,
+            "--method",
+            method,
+            "--out",
+            str(tmp / tag),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     return json.loads((tmp / tag / "report.json").read_text()) if run.returncode == 0 else {"failed": run.stderr[-300:]}
 
 
@@ -134,7 +158,9 @@ def main() -> str:
     win = MainWindow(wb, settings=_settings(tmp / "s.ini"))
     win.resize(1600, 1000)
     video = tmp / "clip.avi"
-    _video_file(video, seconds=20.0)  # frames until the picks at the end (a pick needs a frame newer than the settled robot)
+    _video_file(
+        video, seconds=20.0
+    )  # frames until the picks at the end (a pick needs a frame newer than the settled robot)
     win.start_camera(lambda: OpenCVSource(str(video)))
     win.show()
     warm_solver_in_background()  # as videocal gui does: the solves below do not wait for the kernels' loading
@@ -153,7 +179,17 @@ def main() -> str:
     lat = []
     for _ in range(10):
         t_arrive = time.monotonic()
-        wb.observe_sample(type("S", (), {"joints_deg": tuple(wb.joints_deg + 0.5), "sample": type("J", (), {"seq": 0, "t_ms": 0})(), "t_host_s": t_arrive})())
+        wb.observe_sample(
+            type(
+                "S",
+                (),
+                {
+                    "joints_deg": tuple(wb.joints_deg + 0.5),
+                    "sample": type("J", (), {"seq": 0, "t_ms": 0})(),
+                    "t_host_s": t_arrive,
+                },
+            )()
+        )
         before = win.overview.redraws
         while win.overview.redraws == before and time.monotonic() - t_arrive < 1.0:
             app.processEvents()
@@ -172,7 +208,14 @@ def main() -> str:
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     pick_ms, edges_ms = [], []
-    for name in ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip", "boss_top_left"):
+    for name in (
+        "plate_top_left",
+        "plate_top_right",
+        "plate_bottom_right",
+        "plate_bottom_left",
+        "pin_tip",
+        "boss_top_left",
+    ):
         p = apply(fixture.item2world, fixture.features[name])
         wb.picking.pick_model_point("oru_1_fixture", name, p)
         uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0]
@@ -193,9 +236,21 @@ def main() -> str:
     preview_bundled, preview_ur5 = _preview_ms(None), _preview_ms(ur5)
     # 5. Accuracy: the whole calibration through the window (videocal demo, full size) on the simulated cells,
     # each look made by Find points (the default), by picks by hand, and by Calibrate on edges.
-    cells = {"bundled (paper's task location)": None, "UR5 (videocal new-cell, 6 axes)": ur5, "Franka Panda (videocal new-cell, 7 axes)": panda}
-    demos = {(cell, method): _demo(path, tmp, f"demo_{i}_{method}", method) for i, (cell, path) in enumerate(cells.items()) for method in METHODS}
-    renderer = "OSMesa (llvmpipe, CPU)" if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW") == "vtkOSOpenGLRenderWindow" else "the default VTK window class"
+    cells = {
+        "bundled (paper's task location)": None,
+        "UR5 (videocal new-cell, 6 axes)": ur5,
+        "Franka Panda (videocal new-cell, 7 axes)": panda,
+    }
+    demos = {
+        (cell, method): _demo(path, tmp, f"demo_{i}_{method}", method)
+        for i, (cell, path) in enumerate(cells.items())
+        for method in METHODS
+    }
+    renderer = (
+        "OSMesa (llvmpipe, CPU)"
+        if os.environ.get("VTK_DEFAULT_OPENGL_WINDOW") == "vtkOSOpenGLRenderWindow"
+        else "the default VTK window class"
+    )
     lines = [
         "# Window benchmarks",
         "",
@@ -232,8 +287,10 @@ def main() -> str:
             lines += [f"| {cell} | {method} | the demo failed: {r['failed']!r} | | | |"]
             continue
         used = f"{r['pairs']} pairs" if r["pairs"] else f"{r['edge_samples']} edge samples"
-        lines += [f"| {cell} | {method} | {used} | {r['corrected_tcp_error_mm']:.3f} mm, {r['corrected_tcp_error_deg']:.3f} deg | {r['uncorrected_tcp_error_mm']:.2f} mm, "
-                  f"{r['uncorrected_tcp_error_deg']:.3f} deg | {r['estimate_within_3_sigma']} ({r['rms_px']:.2f}) |"]
+        lines += [
+            f"| {cell} | {method} | {used} | {r['corrected_tcp_error_mm']:.3f} mm, {r['corrected_tcp_error_deg']:.3f} deg | {r['uncorrected_tcp_error_mm']:.2f} mm, "
+            f"{r['uncorrected_tcp_error_deg']:.3f} deg | {r['estimate_within_3_sigma']} ({r['rms_px']:.2f}) |"
+        ]
     lines += [
         "",
         "The paper reached 1.07 mm and 0.64 deg. The demo's true robot has typical joint-offset, link-length and base "

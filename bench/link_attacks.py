@@ -35,8 +35,12 @@ _WORKSTATION = textwrap.dedent("""
 
 class _Simulator:
     def __init__(self, *args: str):
-        self.proc = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-controller", "--robot", "plain", *args],
-                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "app.cli.main", "sim-controller", "--robot", "plain", *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
         self.url = self.proc.stdout.readline().strip()
 
     def stop(self) -> None:

@@ -99,7 +99,12 @@ def fuzz() -> tuple[int, int, bool]:
 
 
 def _sim(*args):
-    proc = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-controller", "--robot", "plain", *args], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "sim-controller", "--robot", "plain", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
     proc.stdout.readline()
     return proc
 

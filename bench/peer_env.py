@@ -22,10 +22,21 @@ def peer_python() -> tuple[Path | None, str]:
         if made.returncode != 0:
             return None, f"could not make {PEERS}: {made.stderr.strip()[-200:]}"
     wanted = OPENCV_CONTRIB.split("==")[1].rsplit(".", 1)[0]  # 4.14.0.94 -> cv2.__version__ 4.14.0
-    check = subprocess.run([str(python), "-c", "import cv2; print(cv2.__version__, hasattr(cv2, 'rapid'))"], capture_output=True, text=True)
+    check = subprocess.run(
+        [str(python), "-c", "import cv2; print(cv2.__version__, hasattr(cv2, 'rapid'))"], capture_output=True, text=True
+    )
     if check.returncode != 0 or check.stdout.split() != [wanted, "True"]:
-        got = subprocess.run([str(python), "-m", "pip", "install", "--quiet", OPENCV_CONTRIB, "numpy"], capture_output=True, text=True, timeout=900)
+        got = subprocess.run(
+            [str(python), "-m", "pip", "install", "--quiet", OPENCV_CONTRIB, "numpy"],
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
         if got.returncode != 0:
             return None, f"pip could not install {OPENCV_CONTRIB}: {' '.join(got.stderr.split())[-300:]}"
-        check = subprocess.run([str(python), "-c", "import cv2; print(cv2.__version__, hasattr(cv2, 'rapid'))"], capture_output=True, text=True)
+        check = subprocess.run(
+            [str(python), "-c", "import cv2; print(cv2.__version__, hasattr(cv2, 'rapid'))"],
+            capture_output=True,
+            text=True,
+        )
     return python, f"OpenCV contrib {check.stdout.split()[0]} (cv2.rapid)"

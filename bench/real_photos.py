@@ -33,12 +33,21 @@ HELD_BACK = {"lmo"}
 HELD_BACK_SCENES = {("lm", 2)}
 SPLITS = ("test", "test_primesense", "val", "test_primesense_bop19")
 SEARCHED = (
-    ("T-LESS, ITODD, HOPE, YCB-V, LM (BOP's own releases)", "hosted on the BOP site and Hugging Face, which this machine cannot reach"),
+    (
+        "T-LESS, ITODD, HOPE, YCB-V, LM (BOP's own releases)",
+        "hosted on the BOP site and Hugging Face, which this machine cannot reach",
+    ),
     ("swtyree/hope-dataset (GitHub)", "50 HOPE preview photos, but no poses and no meshes: not scorable"),
-    ("fabianseiler/ZS6D, ahmedshahabaz/6D-Pose-Estimation (GitHub)", "YCB-V test scenes 48-59 with scene_gt.json, but no YCB-V meshes, "
-     "and each repository is over the 500 MiB a snapshot may have here (674 and 690 MB)"),
+    (
+        "fabianseiler/ZS6D, ahmedshahabaz/6D-Pose-Estimation (GitHub)",
+        "YCB-V test scenes 48-59 with scene_gt.json, but no YCB-V meshes, "
+        "and each repository is over the 500 MiB a snapshot may have here (674 and 690 MB)",
+    ),
     ("yufu-wang/6D_Pose (GitHub)", "LM-O, held back for the final check"),
-    ("lagadic/visp-images (GitHub)", "ViSP's tracking sequences: the ones with ground truth are simulated (Castle-simu)"),
+    (
+        "lagadic/visp-images (GitHub)",
+        "ViSP's tracking sequences: the ones with ground truth are simulated (Castle-simu)",
+    ),
 )
 
 
@@ -109,18 +118,51 @@ def run(views_per_set: int) -> tuple[list[Row], list[str]]:
             image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1]
             points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
             for mm, deg in PRIORS:
-                prior = moved_prior(view.obj2cam, mm, deg, np.random.default_rng(zlib.crc32(f"{view.key}/{mm:g}".encode())))
+                prior = moved_prior(
+                    view.obj2cam, mm, deg, np.random.default_rng(zlib.crc32(f"{view.key}/{mm:g}".encode()))
+                )
                 t0 = time.perf_counter()
-                located = locate(np.ascontiguousarray(image), view.intrinsics, mesh, prior, reach_mm=mm, reach_deg=deg, features={})
+                located = locate(
+                    np.ascontiguousarray(image), view.intrinsics, mesh, prior, reach_mm=mm, reach_deg=deg, features={}
+                )
                 seconds = time.perf_counter() - t0
                 pose = located.obj2cam
                 if pose is None:
-                    rows.append(Row(dataset.name, (mm, deg), view.key, located.status, np.inf, np.inf, np.inf, np.inf, info.diameter_mm, seconds, view.intrinsics.width))
+                    rows.append(
+                        Row(
+                            dataset.name,
+                            (mm, deg),
+                            view.key,
+                            located.status,
+                            np.inf,
+                            np.inf,
+                            np.inf,
+                            np.inf,
+                            info.diameter_mm,
+                            seconds,
+                            view.intrinsics.width,
+                        )
+                    )
                     continue
-                rows.append(Row(dataset.name, (mm, deg), view.key, located.status, mspd(pose, view.obj2cam, points, info.symmetries, view.intrinsics),
-                                mssd(pose, view.obj2cam, points, info.symmetries), translation_error_mm(pose, view.obj2cam),
-                                rotation_error_deg(pose, view.obj2cam), info.diameter_mm, seconds, view.intrinsics.width))
-            print(f"   {view.key}: " + ", ".join(f"{r.status} {r.mspd_px:.1f}px" for r in rows[-len(PRIORS):]), flush=True)
+                rows.append(
+                    Row(
+                        dataset.name,
+                        (mm, deg),
+                        view.key,
+                        located.status,
+                        mspd(pose, view.obj2cam, points, info.symmetries, view.intrinsics),
+                        mssd(pose, view.obj2cam, points, info.symmetries),
+                        translation_error_mm(pose, view.obj2cam),
+                        rotation_error_deg(pose, view.obj2cam),
+                        info.diameter_mm,
+                        seconds,
+                        view.intrinsics.width,
+                    )
+                )
+            print(
+                f"   {view.key}: " + ", ".join(f"{r.status} {r.mspd_px:.1f}px" for r in rows[-len(PRIORS) :]),
+                flush=True,
+            )
     return rows, sets
 
 
@@ -139,19 +181,29 @@ def box_photo_rows() -> list[str]:
     mesh = load_mesh(data / "box.ply", units="cm")
     camera = Intrinsics(718 * 45 / 22.3, 480 * 45 / 14.9, 359.0, 240.0, 718, 480)  # the tutorial's nominal lens
     hand = np.eye(4)
-    u, _, vt = np.linalg.svd(np.array([[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]]))
+    u, _, vt = np.linalg.svd(
+        np.array([[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]])
+    )
     hand[:3, :3], hand[:3, 3] = u @ vt, [-5.9, 110.7, 943.5]
     t0 = time.perf_counter()
     reference = locate(image, camera, mesh, hand, reach_deg=3.0)
-    rows = [f"From the hand prior: `{reference.status}`, {reference.edge_samples} samples, {100 * (reference.edge_share or 0):.0f} % on their edges, "
-            f"RMS {reference.edge_rms_px} px, {time.perf_counter() - t0:.1f} s.", "",
-            "| prior off by | status | seen edges from the hand prior's answer | s |", "|---|---|---|---|"]
+    rows = [
+        f"From the hand prior: `{reference.status}`, {reference.edge_samples} samples, {100 * (reference.edge_share or 0):.0f} % on their edges, "
+        f"RMS {reference.edge_rms_px} px, {time.perf_counter() - t0:.1f} s.",
+        "",
+        "| prior off by | status | seen edges from the hand prior's answer | s |",
+        "|---|---|---|---|",
+    ]
     rng = np.random.default_rng(7)
     for mm in (10, 20, 40, 60, 80, 100, 120):
         prior = moved_prior(hand, float(mm), 2.0, rng)
         t0 = time.perf_counter()
         located = locate(image, camera, mesh, prior, reach_mm=max(20.0, mm), reach_deg=3.0)
-        apart = "-" if located.obj2cam is None or reference.obj2cam is None else f"{image_distance_px(reference.obj2cam, located.obj2cam, mesh, camera):.1f} px"
+        apart = (
+            "-"
+            if located.obj2cam is None or reference.obj2cam is None
+            else f"{image_distance_px(reference.obj2cam, located.obj2cam, mesh, camera):.1f} px"
+        )
         rows.append(f"| {mm} mm, 2 deg | `{located.status}` | {apart} | {time.perf_counter() - t0:.1f} |")
     return rows
 
@@ -179,28 +231,53 @@ def peer_rows(n_priors: int = 5) -> list[str]:
     cu, cv = silhouette_centre_px()
     cv2.ellipse(occluded, (int(cu) - 150, int(cv) + 40), (70, 110), 20, 0, 360, (200, 150, 120), -1)
     identity = np.eye(4)[None]
-    rows = [f"Peer: {what if python else 'not run: ' + what}. Priors: the truth moved 10 mm and turned 3 deg (seeded), {n_priors} a scene; "
-            "each OpenCV tracker called as its documentation shows (200 control points, 15 px search) and iterated 10 times from the prior, "
-            "untuned; videocal's locate searching 10 mm / 3 deg. From the truth itself the OpenCV trackers end 12-15 px away even on the "
-            "plain box, so their rows say how they behave as called here, not the best their methods can do.", "",
-            "| scene (render, truth known) | method | within MSPD 5 px | median MSPD | median s |", "|---|---|---|---|---|"]
-    for label, image in (("plain box", render(printed=False)), ("printed box", base), ("printed box, a third of its outline hidden", occluded)):
+    rows = [
+        f"Peer: {what if python else 'not run: ' + what}. Priors: the truth moved 10 mm and turned 3 deg (seeded), {n_priors} a scene; "
+        "each OpenCV tracker called as its documentation shows (200 control points, 15 px search) and iterated 10 times from the prior, "
+        "untuned; videocal's locate searching 10 mm / 3 deg. From the truth itself the OpenCV trackers end 12-15 px away even on the "
+        "plain box, so their rows say how they behave as called here, not the best their methods can do.",
+        "",
+        "| scene (render, truth known) | method | within MSPD 5 px | median MSPD | median s |",
+        "|---|---|---|---|---|",
+    ]
+    for label, image in (
+        ("plain box", render(printed=False)),
+        ("printed box", base),
+        ("printed box, a third of its outline hidden", occluded),
+    ):
         priors = [moved_prior(TRUTH, 10.0, 3.0, np.random.default_rng(100 + k)) for k in range(n_priors)]
         results: dict[str, list[tuple[float, float]]] = {"videocal locate": []}
         for prior in priors:
             t0 = time.perf_counter()
             located = locate(image, CAMERA, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={})
-            error = np.inf if located.obj2cam is None else mspd(located.obj2cam, TRUTH, np.asarray(mesh.vertices), identity, CAMERA)
+            error = (
+                np.inf
+                if located.obj2cam is None
+                else mspd(located.obj2cam, TRUTH, np.asarray(mesh.vertices), identity, CAMERA)
+            )
             results["videocal locate"].append((error, time.perf_counter() - t0))
         if python is not None:
             with tempfile.TemporaryDirectory() as tmp:
                 png = Path(tmp) / "view.png"
                 cv2.imwrite(str(png), image[:, :, ::-1])
-                views = [{"rvec": cv2.Rodrigues(pr[:3, :3])[0].ravel().tolist(), "tvec": pr[:3, 3].tolist()} for pr in priors]
-                request = {"image": str(png), "K": CAMERA.K.tolist(), "vertices": np.asarray(mesh.vertices).tolist(), "faces": np.asarray(mesh.faces).tolist(),
-                           "views": views, "iterations": 10}
-                done = subprocess.run([str(python), str(Path(__file__).resolve().parent / "peers" / "opencv_trackers.py")], input=json.dumps(request),
-                                      capture_output=True, text=True, timeout=600)
+                views = [
+                    {"rvec": cv2.Rodrigues(pr[:3, :3])[0].ravel().tolist(), "tvec": pr[:3, 3].tolist()} for pr in priors
+                ]
+                request = {
+                    "image": str(png),
+                    "K": CAMERA.K.tolist(),
+                    "vertices": np.asarray(mesh.vertices).tolist(),
+                    "faces": np.asarray(mesh.faces).tolist(),
+                    "views": views,
+                    "iterations": 10,
+                }
+                done = subprocess.run(
+                    [str(python), str(Path(__file__).resolve().parent / "peers" / "opencv_trackers.py")],
+                    input=json.dumps(request),
+                    capture_output=True,
+                    text=True,
+                    timeout=600,
+                )
             if done.returncode == 0:
                 for name, outs in json.loads(done.stdout).items():
                     key = f"OpenCV {name.upper()}"
@@ -216,15 +293,19 @@ def peer_rows(n_priors: int = 5) -> list[str]:
                 rows.append(f"(the peer failed on {label}: {done.stderr.strip()[-200:]})")
         for method, rs in results.items():
             errors = np.array([e for e, _ in rs])
-            rows.append(f"| {label} | {method} | {int(np.sum(errors < 5.0))} of {len(rs)} | {np.median(errors):.1f} px | {np.median([t for _, t in rs]):.2f} |")
+            rows.append(
+                f"| {label} | {method} | {int(np.sum(errors < 5.0))} of {len(rs)} | {np.median(errors):.1f} px | {np.median([t for _, t in rs]):.2f} |"
+            )
     return rows
 
 
 def table(rows: list[Row]) -> list[str]:
     from calib_core.datasets.pose_errors import MSPD_THRESHOLDS_PX, MSSD_THRESHOLDS, average_recall
 
-    out = ["| data set | prior | views | ok | within MSPD 5 px | wrong ok | AR MSPD | AR MSSD | median t / r error (ok) | s a view (median, max) |",
-           "|---|---|---|---|---|---|---|---|---|---|"]
+    out = [
+        "| data set | prior | views | ok | within MSPD 5 px | wrong ok | AR MSPD | AR MSSD | median t / r error (ok) | s a view (median, max) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for name in sorted({r.dataset for r in rows}):
         for prior in PRIORS:
             rs = [r for r in rows if r.dataset == name and r.prior == prior]
@@ -238,9 +319,11 @@ def table(rows: list[Row]) -> list[str]:
             t = np.median([r.t_mm for r in ok]) if ok else float("nan")
             rdeg = np.median([r.r_deg for r in ok]) if ok else float("nan")
             secs = np.array([r.seconds for r in rs])
-            out.append(f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {len(rs)} | {len(ok)} | {100 * within:.0f} % | {wrong} | "
-                       f"{average_recall(mspd_all, MSPD_THRESHOLDS_PX):.2f} | {average_recall(mssd_all, MSSD_THRESHOLDS):.2f} | "
-                       f"{t:.1f} mm / {rdeg:.2f} deg | {np.median(secs):.1f}, {secs.max():.1f} |")
+            out.append(
+                f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {len(rs)} | {len(ok)} | {100 * within:.0f} % | {wrong} | "
+                f"{average_recall(mspd_all, MSPD_THRESHOLDS_PX):.2f} | {average_recall(mssd_all, MSSD_THRESHOLDS):.2f} | "
+                f"{t:.1f} mm / {rdeg:.2f} deg | {np.median(secs):.1f}, {secs.max():.1f} |"
+            )
     return out
 
 
@@ -249,32 +332,54 @@ def main(argv: list[str] | None = None) -> str:
     views = int(argv[argv.index("--views") + 1]) if "--views" in argv else 150
     rows, sets = run(views)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    lines = ["# Real photographs with ground truth", "",
-             f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, {os.cpu_count()} cores, one process (`python -m bench real_photos`).",
-             "Every figure here is from real camera images; the truth is the data set's own annotation and only scores.", "",
-             "Priors: the truth moved by the stated distance in a random direction and turned by the stated angle about a random "
-             "axis (seeded), `locate` searching that far. *Wrong ok*: an answer called `ok` whose MSPD is over 5 px at 640 px width. "
-             "AR: BOP's average recall (MSPD 5-50 px at 640 px width; MSSD 5-50 % of the diameter).", ""]
+    lines = [
+        "# Real photographs with ground truth",
+        "",
+        f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, {os.cpu_count()} cores, one process (`python -m bench real_photos`).",
+        "Every figure here is from real camera images; the truth is the data set's own annotation and only scores.",
+        "",
+        "Priors: the truth moved by the stated distance in a random direction and turned by the stated angle about a random "
+        "axis (seeded), `locate` searching that far. *Wrong ok*: an answer called `ok` whose MSPD is over 5 px at 640 px width. "
+        "AR: BOP's average recall (MSPD 5-50 px at 640 px width; MSSD 5-50 % of the diameter).",
+        "",
+    ]
     if rows:
-        lines += ["Data sets run: " + "; ".join(sets) + ".", ""] + table(rows) + ["", f"Peak memory of the process: {peak_mb:.0f} MB."]
+        lines += (
+            ["Data sets run: " + "; ".join(sets) + ".", ""]
+            + table(rows)
+            + ["", f"Peak memory of the process: {peak_mb:.0f} MB."]
+        )
     else:
-        lines += [f"**No real data set with ground truth was found on this machine** (looked in `{datasets_root()}`): nothing is "
-                  "measured here, and no figure elsewhere in videocal's docs comes from real photographs with ground truth."]
-    lines += ["", "## A real photograph without ground truth", "",
-              "OpenCV's real-time pose tutorial photo (a cookie box printed all over, on a wooden table; 718 x 480; the tutorial's "
-              "nominal camera, no calibration known). Its truth is not known: the check is that every answer called `ok` puts the "
-              "box where the others do.", ""] + box_photo_rows()
+        lines += [
+            f"**No real data set with ground truth was found on this machine** (looked in `{datasets_root()}`): nothing is "
+            "measured here, and no figure elsewhere in videocal's docs comes from real photographs with ground truth."
+        ]
+    lines += [
+        "",
+        "## A real photograph without ground truth",
+        "",
+        "OpenCV's real-time pose tutorial photo (a cookie box printed all over, on a wooden table; 718 x 480; the tutorial's "
+        "nominal camera, no calibration known). Its truth is not known: the check is that every answer called `ok` puts the "
+        "box where the others do.",
+        "",
+    ] + box_photo_rows()
     lines += ["", "## Beside a peer (renders)", ""] + peer_rows()
-    lines += ["", "## Where the data comes from", "",
-              "The bench reads BOP-format data sets (the BOP toolkit's layout: `models/models_info.json` and `obj_NNNNNN.ply` in mm, "
-              "`<split>/<scene>/scene_camera.json`, `scene_gt.json`, `scene_gt_info.json`, `rgb/` or `gray/`) from "
-              "`$VIDEOCAL_DATASETS`, one folder per data set named as BOP names it (`tless`, `itodd`, `hope`, `ycbv`, `lm`). "
-              "To run it: download a data set's base archive, models and test images from the BOP site "
-              "(bop.felk.cvut.cz/datasets, mirrored on Hugging Face as `bop-benchmark/<name>`), unpack them into "
-              "`$VIDEOCAL_DATASETS/<name>/`, and run `.venv/bin/python -m bench real_photos`. LM-O (`lmo`) and LM's scene 2 are "
-              "skipped: they are held back for a final check.", "",
-              "Searched for this run, from this machine (which reaches PyPI, Debian's and npm's registries and stored copies of "
-              "public GitHub repositories, not the web):", ""]
+    lines += [
+        "",
+        "## Where the data comes from",
+        "",
+        "The bench reads BOP-format data sets (the BOP toolkit's layout: `models/models_info.json` and `obj_NNNNNN.ply` in mm, "
+        "`<split>/<scene>/scene_camera.json`, `scene_gt.json`, `scene_gt_info.json`, `rgb/` or `gray/`) from "
+        "`$VIDEOCAL_DATASETS`, one folder per data set named as BOP names it (`tless`, `itodd`, `hope`, `ycbv`, `lm`). "
+        "To run it: download a data set's base archive, models and test images from the BOP site "
+        "(bop.felk.cvut.cz/datasets, mirrored on Hugging Face as `bop-benchmark/<name>`), unpack them into "
+        "`$VIDEOCAL_DATASETS/<name>/`, and run `.venv/bin/python -m bench real_photos`. LM-O (`lmo`) and LM's scene 2 are "
+        "skipped: they are held back for a final check.",
+        "",
+        "Searched for this run, from this machine (which reaches PyPI, Debian's and npm's registries and stored copies of "
+        "public GitHub repositories, not the web):",
+        "",
+    ]
     lines += [f"- {what}: {why}." for what, why in SEARCHED]
     OUT.write_text("\n".join(lines) + "\n")
     return str(OUT)

@@ -26,7 +26,14 @@ def _run(args, cwd=None) -> tuple[float, float, int, str]:
     """Wall time (s), peak RSS (MB) and exit code of ``videocal ARGS``, and its stderr."""
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
     started = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", "app.cli.main", *map(str, args)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=cwd, env=env)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", *map(str, args)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=cwd,
+        env=env,
+    )
     stderr = proc.stderr.read()
     _, status, usage = os.wait4(proc.pid, 0)
     proc.returncode = os.waitstatus_to_exitcode(status)
@@ -58,22 +65,63 @@ def bad_inputs(tmp: Path) -> list[tuple[str, float, float, int, bool]]:
     (tmp / "camera" / "huge.yaml").write_text(yaml.safe_dump({**ros, "image_width": 10**12}))
     render = ["render", "--out", tmp / "r.png", "--scale", "0.25", "--workcell"]
     cases = [
-        ("workcell nested 10 000 deep", render + [workcell("deep.yaml", text="name: " + "[" * 10000 + "]" * 10000 + "\n")]),
-        ("YAML alias bomb in the workcell's name", render + [workcell("bomb.yaml", text=cell.read_text().replace("name: space station robotic test bed", bomb + "name: *a8"))]),
+        (
+            "workcell nested 10 000 deep",
+            render + [workcell("deep.yaml", text="name: " + "[" * 10000 + "]" * 10000 + "\n")],
+        ),
+        (
+            "YAML alias bomb in the workcell's name",
+            render
+            + [
+                workcell(
+                    "bomb.yaml",
+                    text=cell.read_text().replace("name: space station robotic test bed", bomb + "name: *a8"),
+                )
+            ],
+        ),
         ("20 MB all-comment workcell", render + [comments]),
         ("workcell without a camera", render + [workcell("nocam.yaml", lambda d: d.pop("camera"))]),
-        ("task component given as a list", render + [workcell("list.yaml", lambda d: d["task_locations"][0].update(component=["a", "b"]))]),
-        ("intrinsics width 10^12", render + [workcell("huge.yaml", lambda d: d.update(camera={"intrinsics": "../camera/huge.yaml"}))]),
+        (
+            "task component given as a list",
+            render + [workcell("list.yaml", lambda d: d["task_locations"][0].update(component=["a", "b"]))],
+        ),
+        (
+            "intrinsics width 10^12",
+            render + [workcell("huge.yaml", lambda d: d.update(camera={"intrinsics": "../camera/huge.yaml"}))],
+        ),
         ("solve input nested 10 000 deep", ["solve", tmp / "deep.json"]),
-        ("board spec 100000 x 100000", ["calibrate-intrinsics", "sim", "--board", "charuco:100000x100000:30:22:DICT_5X5_100", "--out", tmp / "i.yaml"]),
-        ("calibrate-hand-eye --poses 1000000", ["calibrate-hand-eye", "sim", "--poses", "1000000", "--out", tmp / "h.yaml"]),
+        (
+            "board spec 100000 x 100000",
+            [
+                "calibrate-intrinsics",
+                "sim",
+                "--board",
+                "charuco:100000x100000:30:22:DICT_5X5_100",
+                "--out",
+                tmp / "i.yaml",
+            ],
+        ),
+        (
+            "calibrate-hand-eye --poses 1000000",
+            ["calibrate-hand-eye", "sim", "--poses", "1000000", "--out", tmp / "h.yaml"],
+        ),
         ("demo --scale 100", ["demo", "--offscreen", "--scale", "100", "--out", tmp / "demo"]),
         ("monitor --timeout inf", ["monitor", "loop://", "--timeout", "inf"]),
     ]
     out = []
     for name, args in cases:
         seconds, mb, code, stderr = _run(args)
-        out.append((name, seconds, mb, code, code == 2 and "Traceback" not in stderr and sum(line.startswith("error: ") for line in stderr.splitlines()) == 1))
+        out.append(
+            (
+                name,
+                seconds,
+                mb,
+                code,
+                code == 2
+                and "Traceback" not in stderr
+                and sum(line.startswith("error: ") for line in stderr.splitlines()) == 1,
+            )
+        )
     return out
 
 
@@ -156,8 +204,12 @@ def main() -> str:
     lost_s = link_lost_mid_move()
     from bench import link_attacks
 
-    heartbeats, hello, squatter, oversize = (link_attacks.dead_workstation_with_foreign_heartbeats(), link_attacks.second_writer_handshake(),
-                                             link_attacks.tcp_squatter(), link_attacks.oversize_fields())
+    heartbeats, hello, squatter, oversize = (
+        link_attacks.dead_workstation_with_foreign_heartbeats(),
+        link_attacks.second_writer_handshake(),
+        link_attacks.tcp_squatter(),
+        link_attacks.oversize_fields(),
+    )
     fuzzed = fuzz()
     lines = [
         "# Reliability benchmarks",
@@ -171,14 +223,26 @@ def main() -> str:
     ]
     for name, seconds, mb, code, clear in bad:
         answer = "one `error:` line, exit 2" if clear else f"exit {code}, NOT a clear error"
-        lines.append(f"| {name} | {answer} | {seconds:.2f} s ({seconds - idle_s:+.2f} s) | {mb:.0f} MB ({mb - idle_mb:+.0f} MB) | <= 2 s, <= 300 MB above idle |")
-    lines += ["", "| loader | generated documents | accepted | refused clearly | anything else | slowest document | peak memory of the run | target |", "|---|---|---|---|---|---|---|---|"]
+        lines.append(
+            f"| {name} | {answer} | {seconds:.2f} s ({seconds - idle_s:+.2f} s) | {mb:.0f} MB ({mb - idle_mb:+.0f} MB) | <= 2 s, <= 300 MB above idle |"
+        )
+    lines += [
+        "",
+        "| loader | generated documents | accepted | refused clearly | anything else | slowest document | peak memory of the run | target |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for s in fuzzed:
-        lines.append(f"| {s['loader']} | {s['examples']} | {s['accepted']} | {s['refused']} | {len(s['unexpected'])} | {s['slowest_s']:.2f} s | {s['peak_rss_mb']:.0f} MB ({s['peak_rss_mb'] - s['baseline_rss_mb']:+.0f} MB) | 0 tracebacks |")
+        lines.append(
+            f"| {s['loader']} | {s['examples']} | {s['accepted']} | {s['refused']} | {len(s['unexpected'])} | {s['slowest_s']:.2f} s | {s['peak_rss_mb']:.0f} MB ({s['peak_rss_mb'] - s['baseline_rss_mb']:+.0f} MB) | 0 tracebacks |"
+        )
     lines += ["", "| measure | result | target |", "|---|---|---|"]
     for what, (seconds, failure) in closes.items():
-        lines.append(f"| a failed recorder's close(), {what} (`{failure}`), 60 frames queued | {1000 * seconds:.0f} ms | <= 1 s |")
-    lines.append(f"| the simulator killed mid-move: the core's motion state says the pose is unknown | {1000 * lost_s:.0f} ms | <= 1 s |")
+        lines.append(
+            f"| a failed recorder's close(), {what} (`{failure}`), 60 frames queued | {1000 * seconds:.0f} ms | <= 1 s |"
+        )
+    lines.append(
+        f"| the simulator killed mid-move: the core's motion state says the pose is unknown | {1000 * lost_s:.0f} ms | <= 1 s |"
+    )
     lines += [
         "",
         "| link attack (the real simulator process) | answer | time | target |",

@@ -44,18 +44,37 @@ def one_delay(one_way_s: float) -> dict:
     from calib_core.link.workstation_auth import AuthState
     from videocal_sim.delay_line import DelayLine, LinkWeather
 
-    sim = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-controller", "--tcp", "0", "--robot", "plain", "--joints", "0,0,0,0,0,0"],
-                           stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    sim = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "sim-controller",
+            "--tcp",
+            "0",
+            "--robot",
+            "plain",
+            "--joints",
+            "0,0,0,0,0,0",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
     port = int(re.search(r":(\d+)", sim.stdout.readline()).group(1))
     seen: list[str] = []
-    tap = lambda direction, data: seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace"))) if direction == "up" else None
+    tap = lambda direction, data: (
+        seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace"))) if direction == "up" else None
+    )
     line = DelayLine(("127.0.0.1", 0), ("127.0.0.1", port), LinkWeather(one_way_s, 0.3, 0.01), seed=11, tap=tap).start()
     history, clock = JointHistory(), ControllerClock()
     looks, sent, stops = [], [], 0
     try:
         t0 = time.monotonic()
         link = ControllerLink(f"socket://127.0.0.1:{line.address[1]}", rate_hz=50, deadman_ms=1000)
-        link.sample_received.connect(lambda s: history.add(clock.stamp(s.t_host_s, s.sample.t_ms / 1000.0), np.asarray(s.joints_deg)))
+        link.sample_received.connect(
+            lambda s: history.add(clock.stamp(s.t_host_s, s.sample.t_ms / 1000.0), np.asarray(s.joints_deg))
+        )
         link.start()
         ready = link._auth.wait_settled(60.0) is AuthState.READY
         handshake_s = time.monotonic() - t0
@@ -77,8 +96,18 @@ def one_delay(one_way_s: float) -> dict:
         line.close()
         sim.terminate()
         sim.wait(10)
-    return {"one_way": one_way_s, "ready": ready, "handshake_s": handshake_s, "looks": looks, "delay_s": delay, "sent": len(sent), "seen": len(seen),
-            "duplicates": len(seen) - len(set(seen)), "stops": stops, "late": line.stats.late}
+    return {
+        "one_way": one_way_s,
+        "ready": ready,
+        "handshake_s": handshake_s,
+        "looks": looks,
+        "delay_s": delay,
+        "sent": len(sent),
+        "seen": len(seen),
+        "duplicates": len(seen) - len(set(seen)),
+        "stops": stops,
+        "late": line.stats.late,
+    }
 
 
 def window_demo(one_way_s: float, site: str = "sim") -> dict:
@@ -88,17 +117,42 @@ def window_demo(one_way_s: float, site: str = "sim") -> dict:
     import tempfile
 
     with tempfile.TemporaryDirectory(prefix="videocal-remote-bench-") as folder:
-        run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--scale", "0.5", "--out", folder, "--site", site,
-                              "--link-delay-ms", f"{1000 * one_way_s:g}"], capture_output=True, text=True, timeout=900)
+        run = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "app.cli.main",
+                "demo",
+                "--offscreen",
+                "--scale",
+                "0.5",
+                "--out",
+                folder,
+                "--site",
+                site,
+                "--link-delay-ms",
+                f"{1000 * one_way_s:g}",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
         if run.returncode != 0:
             return {"one_way": one_way_s, "failed": run.stderr.strip().splitlines()[-1]}
         report = json.loads((Path(folder) / "report.json").read_text())
-    return {"one_way": one_way_s, "looks": report["link"]["go_to_settled_frame_s"], "measured": report["link"]["measured_one_way_s"],
-            "error_mm": report["corrected_tcp_error_mm"], "status": report["status"]}
+    return {
+        "one_way": one_way_s,
+        "looks": report["link"]["go_to_settled_frame_s"],
+        "measured": report["link"]["measured_one_way_s"],
+        "error_mm": report["corrected_tcp_error_mm"],
+        "status": report["status"],
+    }
 
 
-_FAKE_CAMERA = ("import gi, time\ngi.require_version('Aravis', '0.8')\nfrom gi.repository import Aravis\n"
-                "camera = Aravis.GvFakeCamera.new('vcfar0', 'FAR01')\nprint('serving' if camera.is_running() else 'failed', flush=True)\ntime.sleep(900)\n")
+_FAKE_CAMERA = (
+    "import gi, time\ngi.require_version('Aravis', '0.8')\nfrom gi.repository import Aravis\n"
+    "camera = Aravis.GvFakeCamera.new('vcfar0', 'FAR01')\nprint('serving' if camera.is_running() else 'failed', flush=True)\ntime.sleep(900)\n"
+)
 
 
 def gige_far(one_way_s: float, seconds: float = 20.0) -> dict:
@@ -109,7 +163,9 @@ def gige_far(one_way_s: float, seconds: float = 20.0) -> dict:
     from videocal_sim.far_network import FarNetwork
 
     with FarNetwork(LinkWeather(one_way_s, 0.3, 0.01), seed=7) as net:
-        camera = subprocess.Popen(net.far_command([sys.executable, "-c", _FAKE_CAMERA]), stdout=subprocess.PIPE, text=True)
+        camera = subprocess.Popen(
+            net.far_command([sys.executable, "-c", _FAKE_CAMERA]), stdout=subprocess.PIPE, text=True
+        )
         try:
             if camera.stdout.readline().strip() != "serving":
                 return {"one_way": one_way_s, "failed": "the fake camera did not serve"}
@@ -134,16 +190,20 @@ def gige_far(one_way_s: float, seconds: float = 20.0) -> dict:
 
 def _demo_table(demos: list[dict]) -> list[str]:
     """The window demos' table, ratios against the first row (0 s)."""
-    lines = ["| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
+        "|---|---|---|---|---|---|---|",
+    ]
     near = np.median(demos[0].get("looks") or [np.nan])
     for d in demos:
         if "failed" in d:
             lines.append(f"| {d['one_way']:g} s | FAILED: {d['failed']} | | | | | |")
             continue
         median = np.median(d["looks"])
-        lines.append(f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
-                     f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |")
+        lines.append(
+            f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
+            f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |"
+        )
     return lines
 
 
@@ -171,51 +231,69 @@ def main() -> str:
     for r in rows:
         look = np.median(r["looks"]) if r["looks"] else float("nan")
         measured = "-" if r["delay_s"] is None else f"{r['delay_s']:.2f} s"
-        lines.append(f"| {r['one_way']:g} s | {r['handshake_s']:.1f} s{'' if r['ready'] else ' (FAILED)'} | {measured} | {look:.2f} s ({len(r['looks'])}/{LOOKS}) | "
-                     f"{look / peer:.1f} | {r['sent']} / {r['seen']} | {r['duplicates']} | {r['stops']} | {r['late']} |")
-    lines += ["", "## Through the window", "",
-              "`videocal demo --offscreen --scale 0.5 --link-delay-ms MS` (the same delay line on the controller link; the simulated "
-              "camera follows the joints the link delivers, so its frames come as late as the samples, as a gripper camera's "
-              "would). A look: Go pressed -> a frame the core accepts for picks (the settle rule widened by the link's spread of "
-              "delays). The corrected tool's error is scored against the simulator's truth.", "",
-              *_demo_table(demos)]
+        lines.append(
+            f"| {r['one_way']:g} s | {r['handshake_s']:.1f} s{'' if r['ready'] else ' (FAILED)'} | {measured} | {look:.2f} s ({len(r['looks'])}/{LOOKS}) | "
+            f"{look / peer:.1f} | {r['sent']} / {r['seen']} | {r['duplicates']} | {r['stops']} | {r['late']} |"
+        )
+    lines += [
+        "",
+        "## Through the window",
+        "",
+        "`videocal demo --offscreen --scale 0.5 --link-delay-ms MS` (the same delay line on the controller link; the simulated "
+        "camera follows the joints the link delivers, so its frames come as late as the samples, as a gripper camera's "
+        "would). A look: Go pressed -> a frame the core accepts for picks (the settle rule widened by the link's spread of "
+        "delays). The corrected tool's error is scored against the simulator's truth.",
+        "",
+        *_demo_table(demos),
+    ]
     lines += ["", "## ROS 2 through the window", ""]
     if no_far_network:
         lines.append(f"Not measured on this machine: {no_far_network}.")
     else:
-        lines += ["`videocal demo --offscreen --scale 0.5 --site ros2 --link-delay-ms MS`: the simulated ros2_control arm in a network "
-                  "namespace of its own behind `videocal_sim/far_network.py`, every DDS packet to and from it delayed (one way, +-30 %, in "
-                  "order) and 1 % dropped; the camera's frames follow the joint states as they arrive and carry their stamps. At 0 s there "
-                  "is no relay: DDS on the loopback (the peer). The measured one-way delay is the joint states' arrival minus their "
-                  "stamps (a FIFO path with +-30 % jitter delivers near its upper end).", "",
-                  *_demo_table(ros2)]
+        lines += [
+            "`videocal demo --offscreen --scale 0.5 --site ros2 --link-delay-ms MS`: the simulated ros2_control arm in a network "
+            "namespace of its own behind `videocal_sim/far_network.py`, every DDS packet to and from it delayed (one way, +-30 %, in "
+            "order) and 1 % dropped; the camera's frames follow the joint states as they arrive and carry their stamps. At 0 s there "
+            "is no relay: DDS on the loopback (the peer). The measured one-way delay is the joint states' arrival minus their "
+            "stamps (a FIFO path with +-30 % jitter delivers near its upper end).",
+            "",
+            *_demo_table(ros2),
+        ]
     lines += ["", "## A GigE Vision camera through the far network", ""]
     if no_far_network:
         lines.append(f"Not measured on this machine: {no_far_network}.")
     else:
-        lines += ["Aravis's own fake GigE Vision camera (its test pattern, 25 fps) on the robot's side of `videocal_sim/far_network.py` "
-                  "(one way, +-30 %, 1 % of the frames dropped), read through `aravis://` with Aravis 0.8 on this side. GigE Vision is a "
-                  "LAN protocol: Aravis waits a fixed time for each control answer (no setting for it in 0.8), so the camera opens "
-                  "slowly at 0.3 s and not at all when a round trip outlasts that wait. A frame counts only if all its packets arrive: "
-                  "the fake camera resent none of the 1 % lost here, so even at 0 s most frames are incomplete (a real camera "
-                  "resends on request). Far away, send the frames on from the robot's side (docs/real-cell.md).", "",
-                  "| one-way delay | opened after | frames/s after | |", "|---|---|---|---|"]
+        lines += [
+            "Aravis's own fake GigE Vision camera (its test pattern, 25 fps) on the robot's side of `videocal_sim/far_network.py` "
+            "(one way, +-30 %, 1 % of the frames dropped), read through `aravis://` with Aravis 0.8 on this side. GigE Vision is a "
+            "LAN protocol: Aravis waits a fixed time for each control answer (no setting for it in 0.8), so the camera opens "
+            "slowly at 0.3 s and not at all when a round trip outlasts that wait. A frame counts only if all its packets arrive: "
+            "the fake camera resent none of the 1 % lost here, so even at 0 s most frames are incomplete (a real camera "
+            "resends on request). Far away, send the frames on from the robot's side (docs/real-cell.md).",
+            "",
+            "| one-way delay | opened after | frames/s after | |",
+            "|---|---|---|---|",
+        ]
         for g in gige:
             if "failed" in g:
                 gave_up = f" (gave up after {g['after_s']:.1f} s)" if "after_s" in g else ""
                 lines.append(f"| {g['one_way']:g} s | not opened{gave_up} | | {g['failed']} |")
             else:
                 lines.append(f"| {g['one_way']:g} s | {g['opened_s']:.1f} s | {g['fps']:.1f} | |")
-    lines += ["", "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored against "
-              "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is judged "
-              "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a round "
-              "trip late every two seconds or so, so the spread stays near 4 s (1.5 s +-30 % plus a lost segment's 3.2 s) and a far "
-              "look waits about that twice, on top of the link-level look above. That is the price of never taking a frame whose "
-              "content may be from before the robot stopped. The measured one-way delay is half TCP's "
-              "smoothed round trip, which the lost segments' late answers raise above the mean delay. The move's own duration "
-              "(the simulator's trapezoid) and the hold are in every row; what the delay adds is about one round trip (the move "
-              "out, its DON and the samples of the hold back). The handshake is two round trips once the first hello's answer "
-              "is in; at 1.5 s the first try (1.5 s) is over before it, so a second hello goes out and its answer opens the session.", ""]
+    lines += [
+        "",
+        "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored against "
+        "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is judged "
+        "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a round "
+        "trip late every two seconds or so, so the spread stays near 4 s (1.5 s +-30 % plus a lost segment's 3.2 s) and a far "
+        "look waits about that twice, on top of the link-level look above. That is the price of never taking a frame whose "
+        "content may be from before the robot stopped. The measured one-way delay is half TCP's "
+        "smoothed round trip, which the lost segments' late answers raise above the mean delay. The move's own duration "
+        "(the simulator's trapezoid) and the hold are in every row; what the delay adds is about one round trip (the move "
+        "out, its DON and the samples of the hold back). The handshake is two round trips once the first hello's answer "
+        "is in; at 1.5 s the first try (1.5 s) is over before it, so a second hello goes out and its answer opens the session.",
+        "",
+    ]
     OUT.write_text("\n".join(lines))
     return str(OUT)
 

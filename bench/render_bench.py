@@ -50,7 +50,13 @@ def _memory_in_fresh_process() -> tuple[float, float]:
         "r.render_view(bed.intrinsics.without_distortion().scaled(0.5), bed.model_cam2world(q)); "
         "print(json.dumps([a, _rss_mb()]))"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=str(Path(__file__).resolve().parents[1]))
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=str(Path(__file__).resolve().parents[1]),
+    )
     libraries, loaded = json.loads(out.stdout.strip().splitlines()[-1])
     return libraries, loaded
 
@@ -73,7 +79,13 @@ def main() -> str:
     rows.append(("pick (ray cast + feature snap)", _median_ms(lambda: renderer.pick(intr.cx, intr.cy), 50), 10.0))
     rows.append(("forward kinematics (tcp)", _median_ms(lambda: bed.model_robot.fk(q), 2000), 0.05))
     target = cell.task("oru_1_grasp").tcp2base
-    rows.append(("inverse kinematics (from the approach joints)", _median_ms(lambda: solve_ik(bed.model_robot, target, q), 50), 10.0))
+    rows.append(
+        (
+            "inverse kinematics (from the approach joints)",
+            _median_ms(lambda: solve_ik(bed.model_robot, target, q), 50),
+            10.0,
+        )
+    )
     camera = bed.camera(intrinsics=bed.intrinsics.scaled(0.5))
     bed.joints_deg = q
     rows.append(("simulated camera frame 640 x 480 (render, distortion, noise)", _median_ms(camera.read, 20), None))

@@ -32,16 +32,28 @@ def _look_rows(seed: int) -> list[str]:
 
     rows = []
     for where in ("task", "approach"):
-        look = look_at_task(bed, run.robot, run.result.intrinsics, tasks[0], model_covariance=model_covariance, placement_sigma_mm=SURVEY_SIGMA_MM, from_where=where,
-                            tool=run.tool)
+        look = look_at_task(
+            bed,
+            run.robot,
+            run.result.intrinsics,
+            tasks[0],
+            model_covariance=model_covariance,
+            placement_sigma_mm=SURVEY_SIGMA_MM,
+            from_where=where,
+            tool=run.tool,
+        )
         model = look["calibrated_model_only_mm_deg"]
         if "after_look_mm_deg" not in look:
-            rows.append(f"| {seed} | {where} | {model[0]:.3f} mm, {model[1]:.4f} deg | not found: {look['message']} | | | |")
+            rows.append(
+                f"| {seed} | {where} | {model[0]:.3f} mm, {model[1]:.4f} deg | not found: {look['message']} | | | |"
+            )
             continue
         after, sigma, fused = look["after_look_mm_deg"], look["look_sigma_mm_deg"], look["fused"]
-        rows.append(f"| {seed} | {where} | {model[0]:.3f} mm, {model[1]:.4f} deg | {after[0]:.3f} mm, {after[1]:.4f} deg ({sigma[0]:.3f} mm, {sigma[1]:.4f} deg) | "
-                    f"{look['within_3_sigma']} | {fused['after_mm_deg'][0]:.3f} mm, {fused['after_mm_deg'][1]:.4f} deg ({fused['sigma_mm_deg'][0]:.3f} mm, "
-                    f"{fused['sigma_mm_deg'][1]:.4f} deg){'' if fused['agree'] else ': the look disagrees, not used'} | {fused['within_3_sigma']} |")
+        rows.append(
+            f"| {seed} | {where} | {model[0]:.3f} mm, {model[1]:.4f} deg | {after[0]:.3f} mm, {after[1]:.4f} deg ({sigma[0]:.3f} mm, {sigma[1]:.4f} deg) | "
+            f"{look['within_3_sigma']} | {fused['after_mm_deg'][0]:.3f} mm, {fused['after_mm_deg'][1]:.4f} deg ({fused['sigma_mm_deg'][0]:.3f} mm, "
+            f"{fused['sigma_mm_deg'][1]:.4f} deg){'' if fused['agree'] else ': the look disagrees, not used'} | {fused['within_3_sigma']} |"
+        )
     return rows
 
 
@@ -59,10 +71,12 @@ def main() -> str:
         tool = f"{run.tool.spread_mm:.3f} mm" if run.tool is not None else "-"
         par = s["parameters_against_truth"]
         left = f" ({len(r.left_out)} left out)" if r.left_out else ""
-        rows.append(f"| {seed} | {run.board_views} + {run.cell_views}{left} | {r.start_rms_px:.2f} -> {r.rms_px:.3f} | {len(r.observability.identified)} / {len(r.names)} "
-                    f"(cond {r.observability.condition:.0f}) | {cam_board[0]:.3f} mm, {cam_board[1]:.4f} deg | {cam_base[0]:.3f} mm, {cam_base[1]:.4f} deg | "
-                    f"{100 * s['camera_in_base_frame_within_3_sigma']:.0f} % | {100 * par['within_3_sigma']:.0f} % ({par['rms_error_over_sigma']:.1f}) | {tcp[0]:.3f} mm, {tcp[1]:.4f} deg | {tcp_nominal[0]:.2f} mm, {tcp_nominal[1]:.3f} deg | {tool} | "
-                    f"{e['fu']:+.2f} / {e['cx']:+.2f} / {e['cy']:+.2f} | {r.seconds:.1f} s | {total:.0f} s |")
+        rows.append(
+            f"| {seed} | {run.board_views} + {run.cell_views}{left} | {r.start_rms_px:.2f} -> {r.rms_px:.3f} | {len(r.observability.identified)} / {len(r.names)} "
+            f"(cond {r.observability.condition:.0f}) | {cam_board[0]:.3f} mm, {cam_board[1]:.4f} deg | {cam_base[0]:.3f} mm, {cam_base[1]:.4f} deg | "
+            f"{100 * s['camera_in_base_frame_within_3_sigma']:.0f} % | {100 * par['within_3_sigma']:.0f} % ({par['rms_error_over_sigma']:.1f}) | {tcp[0]:.3f} mm, {tcp[1]:.4f} deg | {tcp_nominal[0]:.2f} mm, {tcp_nominal[1]:.3f} deg | {tool} | "
+            f"{e['fu']:+.2f} / {e['cx']:+.2f} / {e['cy']:+.2f} | {r.seconds:.1f} s | {total:.0f} s |"
+        )
     lines = [
         "# Robot calibration benchmarks",
         "",

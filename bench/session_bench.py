@@ -44,7 +44,9 @@ def _tree_of_bundled_robot():
     return robot.frame_tree
 
 
-def record_minute(path: Path, frames: list[np.ndarray], seconds: float = 20.0, frame_format: str = "h264", moving_share: float = 1.0) -> dict:
+def record_minute(
+    path: Path, frames: list[np.ndarray], seconds: float = 20.0, frame_format: str = "h264", moving_share: float = 1.0
+) -> dict:
     """Record ``seconds`` of 15 fps frames and a 50 Hz joint stream, each from its own thread, in real
     time, with the frame tree on /tf as the tap writes it (every sample while the robot moves, which it
     does the first ``moving_share`` of the time, once a second while it stands)."""
@@ -97,7 +99,13 @@ def record_minute(path: Path, frames: list[np.ndarray], seconds: float = 20.0, f
         t.join()
     rec.close()
     size = path.stat().st_size
-    return {**written, "dropped": rec.frames_dropped, "stored": rec.frames_written, "mb_per_minute": size / 1e6 * 60.0 / seconds, **_index_share(path)}
+    return {
+        **written,
+        "dropped": rec.frames_dropped,
+        "stored": rec.frames_written,
+        "mb_per_minute": size / 1e6 * 60.0 / seconds,
+        **_index_share(path),
+    }
 
 
 def _index_share(path: Path) -> dict:
@@ -111,10 +119,17 @@ def _index_share(path: Path) -> dict:
         log_times = [m.log_time for _, _, m in reader.iter_messages(log_time_order=False)]
     # a ChunkIndex record: opcode and length, 4 times and offsets, the map of (channel, offset), the
     # message index length, the compression string, two sizes
-    chunk_index_bytes = sum(9 + 32 + 4 + 10 * len(c.message_index_offsets) + 8 + 4 + len(c.compression) + 16 for c in summary.chunk_indexes)
+    chunk_index_bytes = sum(
+        9 + 32 + 4 + 10 * len(c.message_index_offsets) + 8 + 4 + len(c.compression) + 16 for c in summary.chunk_indexes
+    )
     message_index_bytes = sum(c.message_index_length for c in summary.chunk_indexes)
     size = path.stat().st_size
-    return {"index_share": (message_index_bytes + chunk_index_bytes) / size, "chunks": len(summary.chunk_indexes), "ordered": log_times == sorted(log_times), "size": size}
+    return {
+        "index_share": (message_index_bytes + chunk_index_bytes) / size,
+        "chunks": len(summary.chunk_indexes),
+        "ordered": log_times == sorted(log_times),
+        "size": size,
+    }
 
 
 def write_hour(path: Path, frames: list[np.ndarray], hours: float = 1.0) -> dict:
@@ -159,7 +174,12 @@ def write_hour(path: Path, frames: list[np.ndarray], hours: float = 1.0) -> dict
         rec.write_raw(VIDEO_TOPIC, message.SerializeToString(), rec.unix_ns(t))
     clock.t = hours * 3600 + 1.0
     rec.close(timeout_s=None)
-    return {"frames": n_frames, "write_s": time.perf_counter() - started, "size": path.stat().st_size, **_index_share(path)}
+    return {
+        "frames": n_frames,
+        "write_s": time.perf_counter() - started,
+        "size": path.stat().st_size,
+        **_index_share(path),
+    }
 
 
 def open_and_seek_python(path: Path, n: int = 20) -> dict:
@@ -222,7 +242,9 @@ def main() -> str:
 
                 T = make_transform(np.eye(3), [rng.uniform(-20, 20), rng.uniform(-20, 20), 450.0])
                 uv = project_points(P, T, bed.intrinsics) + rng.normal(0, 0.3, (8, 2))
-                r.record_solve(solve_inputs(P, uv, bed.intrinsics, prior=T), solve_pose(P, uv, bed.intrinsics, prior=T).to_dict())
+                r.record_solve(
+                    solve_inputs(P, uv, bed.intrinsics, prior=T), solve_pose(P, uv, bed.intrinsics, prior=T).to_dict()
+                )
         t0 = time.perf_counter()
         results = replay(path)
         replay_s = time.perf_counter() - t0

@@ -42,21 +42,32 @@ def _errors(T: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
 
 # --- Table 1 -----------------------------------------------------------------------------------
 def table1_section() -> list[str]:
-    lines = ["## Table 1 (paper: final errors up to 1e-4)", "", "| model | worst final error (mm) | worst final error (deg) | iterations | converged |", "|---|---|---|---|---|"]
+    lines = [
+        "## Table 1 (paper: final errors up to 1e-4)",
+        "",
+        "| model | worst final error (mm) | worst final error (deg) | iterations | converged |",
+        "|---|---|---|---|---|",
+    ]
     for model, printed in (("pinhole", False), ("paper", False), ("paper", True)):
         rows = run_table1(model, as_printed=printed)
         conv = [r for r in rows if r.converged]
         worst_t = max((r.max_translation_error for r in conv), default=float("nan"))
         worst_r = max((r.max_rotation_error_deg for r in conv), default=float("nan"))
         label = f"{model}" + (" (derivatives as printed, undamped)" if printed else "")
-        lines.append(f"| {label} | {worst_t:.1e} | {worst_r:.1e} | {min(r.iterations for r in rows)}-{max(r.iterations for r in rows)} | {len(conv)}/10 |")
+        lines.append(
+            f"| {label} | {worst_t:.1e} | {worst_r:.1e} | {min(r.iterations for r in rows)}-{max(r.iterations for r in rows)} | {len(conv)}/10 |"
+        )
     # OpenCV on the same three points from the same starts: its iterative solver needs 4 points.
     from calib_core.solver.paper_table1 import CAMERA, FIXTURE_POINTS_MM, TRUE_OBJ2CAM, PAPER_STARTS
+
     uv = project_points(FIXTURE_POINTS_MM, TRUE_OBJ2CAM, CAMERA)
     ok = 0
     worst = 0.0
     for s in PAPER_STARTS:
-        start = make_transform(Rotation.from_rotvec(np.radians(s[3:])).as_matrix() @ TRUE_OBJ2CAM[:3, :3], TRUE_OBJ2CAM[:3, 3] + np.array(s[:3], float))
+        start = make_transform(
+            Rotation.from_rotvec(np.radians(s[3:])).as_matrix() @ TRUE_OBJ2CAM[:3, :3],
+            TRUE_OBJ2CAM[:3, 3] + np.array(s[:3], float),
+        )
         T = _opencv("iterative+guess", FIXTURE_POINTS_MM, uv, start)
         if T is not None:
             e = _errors(T, TRUE_OBJ2CAM)
@@ -74,7 +85,9 @@ def _paper_method_converges(P, uv, truth, start, focal):
     The pixels come from the paper's own model at the true pose, so the truth is its exact solution."""
     problem = make_problem(P, uv, CAM, estimate_focal=focal, model="paper")
     d0 = paper_shift_from_pose(start[:3, 3], CAM, CAM.fu * (1.03 if focal else 1.0), CAM.fv * (0.97 if focal else 1.0))
-    res = run_newton(problem, start[:3, :3], d0, CAM.fu * (1.03 if focal else 1.0), CAM.fv * (0.97 if focal else 1.0), damped=False)
+    res = run_newton(
+        problem, start[:3, :3], d0, CAM.fu * (1.03 if focal else 1.0), CAM.fv * (0.97 if focal else 1.0), damped=False
+    )
     t = pose_translation_from_paper_shift(res.t, CAM, res.fu, res.fv)
     return res.converged and _errors(make_transform(res.R, t), truth)[0] < SUCCESS_MM
 
@@ -83,7 +96,22 @@ def _paper_pixels(P, truth):
     d = paper_shift_from_pose(truth[:3, 3], CAM, CAM.fu, CAM.fv)
     r = np.empty((len(P), 2))
     J = np.empty((len(P), 2, 6))
-    evaluate(PAPER, P, np.zeros((len(P), 2)), truth[:3, :3], d, CAM.fu, CAM.fv, CAM.cx, CAM.cy, np.zeros(5), False, False, r, J)
+    evaluate(
+        PAPER,
+        P,
+        np.zeros((len(P), 2)),
+        truth[:3, :3],
+        d,
+        CAM.fu,
+        CAM.fv,
+        CAM.cx,
+        CAM.cy,
+        np.zeros(5),
+        False,
+        False,
+        r,
+        J,
+    )
     return -r
 
 
@@ -109,18 +137,32 @@ def convergence_section(rng) -> list[str]:
             uv = np.stack([s[2] for s in scenes])
             guess_cam = CAM.with_focal(CAM.fu * 1.03, CAM.fv * 0.97) if focal else CAM
             res = solve_pose_batch(P, uv, guess_cam, starts=starts, estimate_focal=focal)
-            ours = np.mean([res.converged[i] and _errors(res.obj2cam[i], scenes[i][0])[0] < SUCCESS_MM and _errors(res.obj2cam[i], scenes[i][0])[1] < SUCCESS_DEG for i in range(TRIALS)])
+            ours = np.mean(
+                [
+                    res.converged[i]
+                    and _errors(res.obj2cam[i], scenes[i][0])[0] < SUCCESS_MM
+                    and _errors(res.obj2cam[i], scenes[i][0])[1] < SUCCESS_DEG
+                    for i in range(TRIALS)
+                ]
+            )
             exact = np.mean(res.converged & (res.rms_px < 1e-6))
             full = [solve_pose(P[i], uv[i], guess_cam, prior=starts[i], estimate_focal=focal) for i in range(TRIALS)]
             full_truth = np.mean([_errors(f.obj2cam, scenes[i][0])[0] < SUCCESS_MM for i, f in enumerate(full)])
             ambiguous = np.mean([f.status.value == "ambiguous" for f in full])
-            paper = np.mean([_paper_method_converges(P[i], _paper_pixels(P[i], scenes[i][0]), scenes[i][0], starts[i], focal) for i in range(TRIALS)])
+            paper = np.mean(
+                [
+                    _paper_method_converges(P[i], _paper_pixels(P[i], scenes[i][0]), scenes[i][0], starts[i], focal)
+                    for i in range(TRIALS)
+                ]
+            )
             if focal:
                 cv_rate = "n/a (no focal estimation)"
             else:
                 ok = [(_opencv("iterative+guess", P[i], uv[i], starts[i])) for i in range(TRIALS)]
                 cv_rate = f"{100 * np.mean([T is not None and _errors(T, scenes[i][0])[0] < SUCCESS_MM for i, T in enumerate(ok)]):.1f} %"
-            lines.append(f"| {dist} mm / {ang} deg | {n} | {'estimated' if focal else 'known'} | {100 * ours:.1f} % | {100 * exact:.1f} % | {100 * full_truth:.1f} % | {100 * ambiguous:.1f} % | {100 * paper:.1f} % | {cv_rate} |")
+            lines.append(
+                f"| {dist} mm / {ang} deg | {n} | {'estimated' if focal else 'known'} | {100 * ours:.1f} % | {100 * exact:.1f} % | {100 * full_truth:.1f} % | {100 * ambiguous:.1f} % | {100 * paper:.1f} % | {cv_rate} |"
+            )
     lines.append("")
     return lines
 
@@ -159,7 +201,9 @@ def accuracy_section(rng) -> list[str]:
             sol = solve_pose(P, noisy, CAM, sigma_px=NOISE_PX, prior=_displaced(rng, truth, 5.0, 1.0))
             err2["ours"].append(_errors(sol.obj2cam, truth)[0] ** 2 if np.all(np.isfinite(sol.obj2cam)) else np.inf)
             bare = solve_pose(P, noisy, CAM, sigma_px=NOISE_PX)
-            err2["no prior"].append(_errors(bare.obj2cam, truth)[0] ** 2 if np.all(np.isfinite(bare.obj2cam)) else np.inf)
+            err2["no prior"].append(
+                _errors(bare.obj2cam, truth)[0] ** 2 if np.all(np.isfinite(bare.obj2cam)) else np.inf
+            )
             reported.append(float(np.sum(sol.uncertainty.std_t_obj2cam_mm**2)) if sol.uncertainty else np.nan)
             for m in ("sqpnp+lm", "epnp", "iterative"):
                 T = _opencv(m, P, noisy)
@@ -193,7 +237,16 @@ def _with_outliers(rng, n, share):
 def _opencv_ransac(P, uv, cam=CAM, noise_px=NOISE_PX):
     """OpenCV's solvePnPRansac as its documentation shows it, with the same inlier threshold as videocal."""
     Kc = np.array([[cam.fu, 0.0, cam.cx], [0.0, cam.fv, cam.cy], [0.0, 0.0, 1.0]])
-    ok, rvec, tvec, _ = cv2.solvePnPRansac(P, uv, Kc, None, reprojectionError=INLIER_SIGMAS * noise_px, confidence=0.9999, iterationsCount=10000, flags=cv2.SOLVEPNP_AP3P)
+    ok, rvec, tvec, _ = cv2.solvePnPRansac(
+        P,
+        uv,
+        Kc,
+        None,
+        reprojectionError=INLIER_SIGMAS * noise_px,
+        confidence=0.9999,
+        iterationsCount=10000,
+        flags=cv2.SOLVEPNP_AP3P,
+    )
     return _cv_pose(rvec, tvec) if ok else None
 
 
@@ -203,7 +256,14 @@ def _poselib(P, uv, cam=CAM, noise_px=NOISE_PX):
     return make_transform(np.asarray(pose.R), np.asarray(pose.t))
 
 
-TUTORIAL_PAIRS = Path(__file__).resolve().parent.parent / "tests" / "data" / "third_party" / "opencv_samples" / "cookies_ORB_pairs.yml"
+TUTORIAL_PAIRS = (
+    Path(__file__).resolve().parent.parent
+    / "tests"
+    / "data"
+    / "third_party"
+    / "opencv_samples"
+    / "cookies_ORB_pairs.yml"
+)
 TUTORIAL_CAM = Intrinsics(718 * 45 / 22.3, 480 * 45 / 14.9, 359.0, 240.0, 718, 480)
 TUTORIAL_NOISE_PX = 0.15  # the pairs' own RMS about their least-squares pose
 
@@ -217,7 +277,11 @@ def _robust_row(label: str, cases, cam, noise_px: float, tol: float, reps: int) 
     pl = _time_per_call(lambda: _poselib(P, uv, cam, noise_px), reps)
     ok = [0, 0, 0]
     for T, Pk, uvk in cases:
-        poses = (solve_pose(Pk, uvk, cam, robust=True, sigma_px=noise_px).obj2cam, _opencv_ransac(Pk, uvk, cam, noise_px), _poselib(Pk, uvk, cam, noise_px))
+        poses = (
+            solve_pose(Pk, uvk, cam, robust=True, sigma_px=noise_px).obj2cam,
+            _opencv_ransac(Pk, uvk, cam, noise_px),
+            _poselib(Pk, uvk, cam, noise_px),
+        )
         for k, pose in enumerate(poses):
             if pose is not None and np.all(np.isfinite(pose)):
                 dt, dr = _errors(pose, T)
@@ -262,12 +326,28 @@ def robust_section(rng) -> list[str]:
     for n, share, reps in ((20, 0.2, 200), (5000, 0.3, 5)):
         cases = [_with_outliers(rng, n, share)[:3] for _ in range(100 if n < 1000 else 10)]
         lines.append(_robust_row(f"N = {n}, {share:.0%} outliers", cases, CAM, NOISE_PX, 1.0, reps))
-    lines.append(_robust_row("OpenCV tutorial's 5914 real pairs, 30% replaced", _tutorial_cases(rng), TUTORIAL_CAM, TUTORIAL_NOISE_PX, 0.05, 5))
+    lines.append(
+        _robust_row(
+            "OpenCV tutorial's 5914 real pairs, 30% replaced",
+            _tutorial_cases(rng),
+            TUTORIAL_CAM,
+            TUTORIAL_NOISE_PX,
+            0.05,
+            5,
+        )
+    )
     clean_failures = 0
     for _ in range(200):
         _, P, uv = _scene(rng, 20)
-        clean_failures += solve_pose(P, uv + rng.normal(0, NOISE_PX, uv.shape), CAM, robust=True, sigma_px=NOISE_PX).status.value != "ok"
-    lines += ["", f"A clean set in robust mode (200 scenes, N = 20, 0.5 px noise): {clean_failures} not `ok` (target 0).", ""]
+        clean_failures += (
+            solve_pose(P, uv + rng.normal(0, NOISE_PX, uv.shape), CAM, robust=True, sigma_px=NOISE_PX).status.value
+            != "ok"
+        )
+    lines += [
+        "",
+        f"A clean set in robust mode (200 scenes, N = 20, 0.5 px noise): {clean_failures} not `ok` (target 0).",
+        "",
+    ]
     return lines
 
 
@@ -277,7 +357,13 @@ def main() -> str:
     from bench.solver_speed import speed_section
 
     # (the speed section draws from a generator of its own: the other sections keep their scenes whatever it times)
-    body = table1_section() + convergence_section(rng) + accuracy_section(rng) + speed_section(np.random.default_rng(20261205)) + robust_section(rng)
+    body = (
+        table1_section()
+        + convergence_section(rng)
+        + accuracy_section(rng)
+        + speed_section(np.random.default_rng(20261205))
+        + robust_section(rng)
+    )
     body += robust_reliability_section(rng) + mis_pick_section(rng)
     header = [
         "# Pose solver benchmarks",

@@ -33,12 +33,25 @@ def _scene(rng: np.random.Generator, n: int):
 
 
 def _right(pose, T, allowed_mm: float) -> bool:
-    return pose is not None and bool(np.all(np.isfinite(pose))) and float(np.linalg.norm(pose[:3, 3] - T[:3, 3])) <= allowed_mm
+    return (
+        pose is not None
+        and bool(np.all(np.isfinite(pose)))
+        and float(np.linalg.norm(pose[:3, 3] - T[:3, 3])) <= allowed_mm
+    )
 
 
 def _peers(P, uv):
     K = CAM.K
-    ok, rvec, tvec, _ = cv2.solvePnPRansac(P, uv, K, None, reprojectionError=INLIER_SIGMAS * NOISE_PX, confidence=0.9999, iterationsCount=10000, flags=cv2.SOLVEPNP_AP3P)
+    ok, rvec, tvec, _ = cv2.solvePnPRansac(
+        P,
+        uv,
+        K,
+        None,
+        reprojectionError=INLIER_SIGMAS * NOISE_PX,
+        confidence=0.9999,
+        iterationsCount=10000,
+        flags=cv2.SOLVEPNP_AP3P,
+    )
     opencv = make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()) if ok else None
     camera = {"model": "PINHOLE", "width": CAM.width, "height": CAM.height, "params": [CAM.fu, CAM.fv, CAM.cx, CAM.cy]}
     try:
@@ -70,7 +83,11 @@ def robust_reliability_section(rng: np.random.Generator) -> list[str]:
                 bad = rng.choice(n, k, replace=False)
                 good = np.setdiff1d(np.arange(n), bad)
                 oracle = solve_pose(P[good], uv[good], CAM, sigma_px=NOISE_PX) if len(good) >= 4 else None
-                allowed = 0.5 + 5.0 * (np.linalg.norm(oracle.uncertainty.std_t_obj2cam_mm) if oracle is not None and oracle.uncertainty else 0.0)
+                allowed = 0.5 + 5.0 * (
+                    np.linalg.norm(oracle.uncertainty.std_t_obj2cam_mm)
+                    if oracle is not None and oracle.uncertainty
+                    else 0.0
+                )
                 uv[bad] = rng.uniform([0, 0], [CAM.width, CAM.height], (k, 2))
                 s = solve_pose(P, uv, CAM, robust=True)
                 if s.status.value == "ok":
@@ -81,8 +98,10 @@ def robust_reliability_section(rng: np.random.Generator) -> list[str]:
                     if pose is not None:
                         counts[f"{name}_{'right' if _right(pose, T, allowed) else 'wrong'}"] += 1
             pct = {key: 100.0 * v / SCENES for key, v in counts.items()}
-            lines.append(f"| {n} | {k} ({share:.0%}) | {counts['wrong']} | {pct['right']:.0f} % | {pct['unsure']:.0f} % | "
-                         f"{pct['cv_wrong']:.0f} % / {pct['cv_right']:.0f} % | {pct['pl_wrong']:.0f} % / {pct['pl_right']:.0f} % |")
+            lines.append(
+                f"| {n} | {k} ({share:.0%}) | {counts['wrong']} | {pct['right']:.0f} % | {pct['unsure']:.0f} % | "
+                f"{pct['cv_wrong']:.0f} % / {pct['cv_right']:.0f} % | {pct['pl_wrong']:.0f} % / {pct['pl_right']:.0f} % |"
+            )
     return lines + [""]
 
 

@@ -48,7 +48,16 @@ def _opencv(method, P, uv, start=None):
     try:
         if method == "iterative+guess":
             rvec = cv2.Rodrigues(start[:3, :3])[0]
-            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, rvec, start[:3, 3].reshape(3, 1).copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
+            ok, rvec, tvec = cv2.solvePnP(
+                P,
+                uv,
+                K,
+                None,
+                rvec,
+                start[:3, 3].reshape(3, 1).copy(),
+                useExtrinsicGuess=True,
+                flags=cv2.SOLVEPNP_ITERATIVE,
+            )
         elif method == "sqpnp+lm":
             ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_SQPNP)
             rvec, tvec = cv2.solvePnPRefineLM(P, uv, K, None, rvec, tvec)

@@ -29,7 +29,9 @@ def _poselib_plain(P, uv):
     import poselib
 
     camera = {"model": "PINHOLE", "width": CAM.width, "height": CAM.height, "params": [CAM.fu, CAM.fv, CAM.cx, CAM.cy]}
-    return poselib.estimate_absolute_pose(uv, P, camera, {"max_reproj_error": INLIER_SIGMAS * NOISE_PX, "min_iterations": 0}, {})
+    return poselib.estimate_absolute_pose(
+        uv, P, camera, {"max_reproj_error": INLIER_SIGMAS * NOISE_PX, "min_iterations": 0}, {}
+    )
 
 
 def speed_section(rng) -> list[str]:
@@ -47,7 +49,9 @@ def speed_section(rng) -> list[str]:
     import calib_core.solver.solve as solve_module
 
     for n in (4, 5, 6, 8, 20):
-        problems = [(P, uv + rng.normal(0, NOISE_PX, uv.shape)) for _, P, uv in (_scene(rng, n) for _ in range(SPEED_SCENES))]
+        problems = [
+            (P, uv + rng.normal(0, NOISE_PX, uv.shape)) for _, P, uv in (_scene(rng, n) for _ in range(SPEED_SCENES))
+        ]
         slow = []
         fast = solve_module.fast_solve
         solve_module.fast_solve = lambda *a, **k: slow.append(1) if (out := fast(*a, **k)) is None else out
@@ -62,7 +66,9 @@ def speed_section(rng) -> list[str]:
         ours = _mean_per_solve(lambda P, uv: solve_pose(P, uv, CAM), problems)
         cv = _mean_per_solve(lambda P, uv: _opencv("sqpnp+lm", P, uv), problems)
         pl = _mean_per_solve(_poselib_plain, problems)
-        lines.append(f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us | {ours / cv:.2f} | {ours / pl:.2f} |")
+        lines.append(
+            f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us | {ours / cv:.2f} | {ours / pl:.2f} |"
+        )
     scenes = [_scene(rng, 6) for _ in range(1000)]
     P = np.stack([s[1] for s in scenes])
     uv = np.stack([s[2] + rng.normal(0, NOISE_PX, (6, 2)) for s in scenes])

@@ -29,19 +29,31 @@ def hand_eye_rows() -> list[str]:
     spec = BoardSpec()
     rows = ["| hand-eye from 10 poses | position error | rotation error | RMS | target |", "|---|---|---|---|---|"]
     typical = RobotErrors.typical(0)
-    for label, errors in (("mounting error only", RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)), ("with the robot's joint and link errors too", typical)):
+    for label, errors in (
+        (
+            "mounting error only",
+            RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg),
+        ),
+        ("with the robot's joint and link errors too", typical),
+    ):
         bed = TestBed.create(errors=errors)
         board2base = board_facing_robot(spec)
         views, flanges = [], []
-        for name, image, q in simulated_hand_eye_images(bed, spec, hand_eye_poses(bed, spec, board2base, 10), board2base):
+        for name, image, q in simulated_hand_eye_images(
+            bed, spec, hand_eye_poses(bed, spec, board2base, 10), board2base
+        ):
             v = detect_view(name, image, spec)
             if isinstance(v, BoardView):
                 views.append(v)
                 flanges.append(bed.model_robot.fk(q, "flange"))
         r = calibrate_hand_eye(views, flanges, spec, bed.intrinsics)
-        true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
+        true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement(
+            "camera"
+        )
         d, rot = pose_difference(r.cam2flange, true)
-        rows.append(f"| {label} | {np.linalg.norm(d):.3f} mm | {np.linalg.norm(rot):.4f} deg | {r.rms_px:.2f} px | <= 0.2 mm, 0.05 deg |")
+        rows.append(
+            f"| {label} | {np.linalg.norm(d):.3f} mm | {np.linalg.norm(rot):.4f} deg | {r.rms_px:.2f} px | <= 0.2 mm, 0.05 deg |"
+        )
     return rows
 
 
@@ -59,7 +71,9 @@ def main() -> str:
     rows = []
     for label, r in (("distortion modelled (videocal)", with_d), ("pinhole only (the paper's tool)", without)):
         i = r.intrinsics
-        rows.append(f"| {label} | {100 * (i.fu / truth.fu - 1):+.3f} % | {100 * (i.fv / truth.fv - 1):+.3f} % | {i.cx - truth.cx:+.2f} px | {i.cy - truth.cy:+.2f} px | {r.rms_px:.3f} px |")
+        rows.append(
+            f"| {label} | {100 * (i.fu / truth.fu - 1):+.3f} % | {100 * (i.fv / truth.fv - 1):+.3f} % | {i.cx - truth.cx:+.2f} px | {i.cy - truth.cy:+.2f} px | {r.rms_px:.3f} px |"
+        )
     lines = [
         "# Vision-system calibration benchmarks",
         "",

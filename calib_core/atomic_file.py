@@ -20,7 +20,9 @@ from calib_core.errors import FileWriteError
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | Path, check: Callable[[Path], None] | None = None, *, may_be_empty: bool = False) -> Iterator[Path]:
+def atomic_path(
+    path: str | Path, check: Callable[[Path], None] | None = None, *, may_be_empty: bool = False
+) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
 
     The caller writes the temporary file by any means (e.g. ``cv2.FileStorage``); ``check(tmp)``
@@ -29,7 +31,9 @@ def atomic_path(path: str | Path, check: Callable[[Path], None] | None = None, *
     """
     target = Path(os.path.realpath(path)) if Path(path).is_symlink() else Path(path)
     try:
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp" + target.suffix, dir=target.parent or ".")
+        fd, tmp_name = tempfile.mkstemp(
+            prefix=f".{target.name}.", suffix=".tmp" + target.suffix, dir=target.parent or "."
+        )
     except OSError as exc:
         raise FileWriteError(target, f"cannot write here: {exc.strerror or exc}") from None
     os.close(fd)
@@ -39,18 +43,25 @@ def atomic_path(path: str | Path, check: Callable[[Path], None] | None = None, *
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         if tmp.stat().st_size == 0 and not may_be_empty:
-            raise FileWriteError(target, "not written (the old file, if any, is unchanged): nothing reached the disk (is it full?)")
+            raise FileWriteError(
+                target, "not written (the old file, if any, is unchanged): nothing reached the disk (is it full?)"
+            )
         if check is not None:
             try:
                 check(tmp)
             except Exception as exc:  # whatever the reader raises, the file is not what was meant
-                raise FileWriteError(target, f"not written (the old file, if any, is unchanged): what reached the disk does not read back ({exc})") from None
+                raise FileWriteError(
+                    target,
+                    f"not written (the old file, if any, is unchanged): what reached the disk does not read back ({exc})",
+                ) from None
         _keep_mode(target, tmp)
         os.replace(tmp, target)
         _fsync_dir(target.parent)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
-        raise FileWriteError(target, f"not written (the old file, if any, is unchanged): {exc.strerror or exc}") from None
+        raise FileWriteError(
+            target, f"not written (the old file, if any, is unchanged): {exc.strerror or exc}"
+        ) from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

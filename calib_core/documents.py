@@ -72,13 +72,18 @@ def parse_yaml(text: str, path: str | Path, *, max_depth: int = MAX_DEPTH, max_a
             if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
                 depth += 1
                 if depth > max_depth:
-                    raise FileFormatError(path, f"nests deeper than {max_depth} levels (line {event.start_mark.line + 1})")
+                    raise FileFormatError(
+                        path, f"nests deeper than {max_depth} levels (line {event.start_mark.line + 1})"
+                    )
             elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
                 depth -= 1
             elif isinstance(event, yaml.AliasEvent):
                 aliases += 1
                 if aliases > max_aliases:
-                    raise FileFormatError(path, f"uses more than {max_aliases} YAML aliases (*name); write the values out (line {event.start_mark.line + 1})")
+                    raise FileFormatError(
+                        path,
+                        f"uses more than {max_aliases} YAML aliases (*name); write the values out (line {event.start_mark.line + 1})",
+                    )
         return yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as exc:
         if "flow level" in str(exc):  # libyaml's own nesting limit
@@ -133,7 +138,9 @@ def read_json(path: str | Path, what: str, **limits):
     return parse_json(read_text(path, what, limits.pop("max_bytes", MAX_DOCUMENT_BYTES)), path, **limits)
 
 
-def finite_number(value, path: str | Path, field: str, *, low: float = -math.inf, high: float = math.inf, exclusive_low: bool = False) -> float:
+def finite_number(
+    value, path: str | Path, field: str, *, low: float = -math.inf, high: float = math.inf, exclusive_low: bool = False
+) -> float:
     """``value`` as a finite float within [low, high] (``(low, high]`` with ``exclusive_low``), or a
     ``FileFormatError`` naming ``field``. Booleans are not numbers here."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -142,7 +149,11 @@ def finite_number(value, path: str | Path, field: str, *, low: float = -math.inf
     if not math.isfinite(v):
         raise FileFormatError(path, f"must be a finite number, got {value!r}", field)
     if v < low or (exclusive_low and v == low) or v > high:
-        bounds = f"{'above' if exclusive_low else 'at least'} {low:g}" if high == math.inf else f"between {low:g} and {high:g}"
+        bounds = (
+            f"{'above' if exclusive_low else 'at least'} {low:g}"
+            if high == math.inf
+            else f"between {low:g} and {high:g}"
+        )
         raise FileFormatError(path, f"must be {bounds}, got {value!r}", field)
     return v
 
@@ -166,7 +177,6 @@ def csv_numbers(cells: list[str], columns: list[str], path: str | Path, where: s
             raise FileFormatError(path, f"not a number: {cell.strip()!r}", f"{where}, {column}") from None
         values.append(finite_number(number, path, f"{where}, {column}"))
     return values
-
 
 
 def read_grey_image(image_path: str | Path, listed_in: str | Path, where: str) -> "np.ndarray":

@@ -36,7 +36,9 @@ def image_size(path: Path) -> tuple[int, int] | None:
             Image.MAX_IMAGE_PIXELS = before
 
 
-def read_image(path: str | Path, *, grey: bool = False, max_pixels: int = MAX_IMAGE_PIXELS, where: str | None = None) -> np.ndarray:
+def read_image(
+    path: str | Path, *, grey: bool = False, max_pixels: int = MAX_IMAGE_PIXELS, where: str | None = None
+) -> np.ndarray:
     """The image at ``path``: (h, w, 3) uint8 RGB, or (h, w) uint8 with ``grey``. :class:`FileFormatError` naming the
     file (and ``where``, a row of a list that named it) for a file that is missing, not a regular file, over
     ``max_pixels`` by its header, or not an image OpenCV can decode."""
@@ -47,11 +49,15 @@ def read_image(path: str | Path, *, grey: bool = False, max_pixels: int = MAX_IM
         raise FileFormatError(path, "no such image file (or not a regular file)", where)
     size = image_size(path)
     if size is not None and size[0] * size[1] > max_pixels:
-        raise FileFormatError(path, f"an image of {size[0]} x {size[1]} px is over the limit of {max_pixels / 1e6:g} megapixels", where)
+        raise FileFormatError(
+            path, f"an image of {size[0]} x {size[1]} px is over the limit of {max_pixels / 1e6:g} megapixels", where
+        )
     try:
         image = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE if grey else cv2.IMREAD_COLOR)
     except cv2.error as exc:  # OpenCV's own limits (a header Pillow could not read)
-        raise FileFormatError(path, f"not an image OpenCV can read: {str(exc).strip().splitlines()[-1]}", where) from None
+        raise FileFormatError(
+            path, f"not an image OpenCV can read: {str(exc).strip().splitlines()[-1]}", where
+        ) from None
     if image is None:
         raise FileFormatError(path, "not an image OpenCV can read", where)
     return image if grey else cv2.cvtColor(image, cv2.COLOR_BGR2RGB)

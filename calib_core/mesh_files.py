@@ -17,6 +17,7 @@ from calib_core.errors import FileFormatError
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
 from calib_core.mesh_units import MESH_SCALE  # noqa: E402,F401 (the readers' units, named where --help can read them)
+
 MAX_TRIANGLES = 2_000_000
 _WINDING_FIX_TRIANGLES = 200_000  # trimesh's winding repair walks the face graph (networkx): bounded in time
 """The most triangles a component may have: a cell's CAD part decimated for viewing has tens of thousands."""
@@ -44,21 +45,33 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
     file, no triangles, non-finite or absurd coordinates, or no area."""
     path = Path(path)
     if path.suffix.lower() not in MESH_SUFFIXES:
-        raise FileFormatError(path, f"unsupported mesh format {path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY", field)
+        raise FileFormatError(
+            path, f"unsupported mesh format {path.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY", field
+        )
     if units not in MESH_SCALE:
         raise FileFormatError(path, f"mesh units must be one of {', '.join(MESH_SCALE)}, got {units!r}", field)
     if not path.is_file():
         raise FileFormatError(path, "no such mesh file (or not a regular file)", field)
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
-        raise FileFormatError(path, f"a mesh file of {size / 1024**2:.0f} MB is over the limit of {MAX_FILE_BYTES / 1024**2:.0f} MB", field)
+        raise FileFormatError(
+            path,
+            f"a mesh file of {size / 1024**2:.0f} MB is over the limit of {MAX_FILE_BYTES / 1024**2:.0f} MB",
+            field,
+        )
     if path.suffix.lower() == ".stl":
         declared = _stl_header_triangles(path)
         if declared is not None and declared > MAX_TRIANGLES:
-            raise FileFormatError(path, f"a mesh of {declared} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing", field)
+            raise FileFormatError(
+                path,
+                f"a mesh of {declared} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing",
+                field,
+            )
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # trimesh's own warnings on a broken file: the checks below say what is wrong
+            warnings.simplefilter(
+                "ignore"
+            )  # trimesh's own warnings on a broken file: the checks below say what is wrong
             # unprocessed first: trimesh's processing drops faces with non-finite vertices without a word
             mesh = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
@@ -66,15 +79,27 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise FileFormatError(path, "the mesh has no triangles", field)
     if len(mesh.faces) > MAX_TRIANGLES:
-        raise FileFormatError(path, f"a mesh of {len(mesh.faces)} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing", field)
+        raise FileFormatError(
+            path,
+            f"a mesh of {len(mesh.faces)} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing",
+            field,
+        )
     vertices = np.asarray(mesh.vertices) * MESH_SCALE[units]
     if not np.all(np.isfinite(vertices)):
         bad = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
-        raise FileFormatError(path, f"the mesh has coordinates that are not finite numbers (vertex {bad}: {vertices[bad].tolist()})", field)
+        raise FileFormatError(
+            path,
+            f"the mesh has coordinates that are not finite numbers (vertex {bad}: {vertices[bad].tolist()})",
+            field,
+        )
     mesh.process()  # vertices shared by their faces (an STL repeats them per triangle): the edges' neighbours
     if np.abs(vertices).max() > MAX_COORDINATE_MM:
-        raise FileFormatError(path, f"the mesh reaches {np.abs(vertices).max():.3g} mm from its origin, beyond {MAX_COORDINATE_MM:g} mm: "
-                                    "are its units right (mesh_units)?", field)
+        raise FileFormatError(
+            path,
+            f"the mesh reaches {np.abs(vertices).max():.3g} mm from its origin, beyond {MAX_COORDINATE_MM:g} mm: "
+            "are its units right (mesh_units)?",
+            field,
+        )
     if not float(mesh.area) * MESH_SCALE[units] ** 2 > 0.0:
         raise FileFormatError(path, "the mesh has no area (every triangle is degenerate)", field)
     if len(mesh.faces) <= _WINDING_FIX_TRIANGLES and not mesh.is_winding_consistent:

@@ -36,7 +36,9 @@ def plugin_entry(group: str, name: str) -> EntryPoint:
         if ep.name == name:
             return ep
     installed = ", ".join(plugin_names(group)) or "none"
-    raise PluginNotFoundError(f"no {group.split('.')[-1][:-1]} plug-in named {name!r} is installed (installed: {installed})")
+    raise PluginNotFoundError(
+        f"no {group.split('.')[-1][:-1]} plug-in named {name!r} is installed (installed: {installed})"
+    )
 
 
 def load_plugin(group: str, name: str):
@@ -47,4 +49,6 @@ def load_plugin(group: str, name: str):
     try:
         return ep.load()
     except ImportError as exc:
-        raise PluginNotFoundError(f"the {group.split('.')[-1][:-1]} plug-in {name!r} is registered ({ep.value}) but cannot be loaded: {exc}") from None
+        raise PluginNotFoundError(
+            f"the {group.split('.')[-1][:-1]} plug-in {name!r} is registered ({ep.value}) but cannot be loaded: {exc}"
+        ) from None

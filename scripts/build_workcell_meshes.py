@@ -61,7 +61,9 @@ def grappling_fixture():
     plate = box((6, 160, 120), (-3, 0, 0))
     pin = cylinder(12, 40, (20, 0, 0), axis="x", sections=24)
     knob = cylinder(20, 10, (40, 0, 0), axis="x", sections=24)
-    bosses = [cylinder(10, 4, (2, y, z), axis="x", sections=20) for y, z in ((-55, 40), (55, 40), (-55, -40), (55, -40))]
+    bosses = [
+        cylinder(10, 4, (2, y, z), axis="x", sections=20) for y, z in ((-55, 40), (55, 40), (-55, -40), (55, -40))
+    ]
     return trimesh.util.concatenate([plate, pin, knob, *bosses])
 
 
@@ -83,12 +85,21 @@ def tool_station():
 
 def gripper_tool():
     """A spare two-finger gripper standing in its holder: frame at its mounting face centre."""
-    return trimesh.util.concatenate([cylinder(45, 20, (0, 0, 10)), box((100, 120, 80), (0, 0, 60)), box((16, 40, 80), (35, 0, 140)), box((16, 40, 80), (-35, 0, 140))])
+    return trimesh.util.concatenate(
+        [
+            cylinder(45, 20, (0, 0, 10)),
+            box((100, 120, 80), (0, 0, 60)),
+            box((16, 40, 80), (35, 0, 140)),
+            box((16, 40, 80), (-35, 0, 140)),
+        ]
+    )
 
 
 def screwdriver_tool():
     """A screwdriver tool in its holder: frame at its mounting face centre."""
-    return trimesh.util.concatenate([cylinder(45, 20, (0, 0, 10)), cylinder(35, 160, (0, 0, 100)), cylinder(6, 90, (0, 0, 225), sections=16)])
+    return trimesh.util.concatenate(
+        [cylinder(45, 20, (0, 0, 10)), cylinder(35, 160, (0, 0, 100)), cylinder(6, 90, (0, 0, 225), sections=16)]
+    )
 
 
 def floor():

@@ -61,7 +61,9 @@ def main() -> None:
         bed.joints_deg = q_home + (q_task - q_home) * (3 * s * s - 2 * s * s * s)  # smooth start and stop
         if clock.t_s == t_joint:
             q = cell.joint_map.to_controller(bed.joints_deg)
-            core.observe_sample(TimedSample(JointSample(n_joint, int(round(20 * n_joint)), tuple(float(v) for v in q)), clock.t_s))
+            core.observe_sample(
+                TimedSample(JointSample(n_joint, int(round(20 * n_joint)), tuple(float(v) for v in q)), clock.t_s)
+            )
             n_joint += 1
         elif clock.t_s == t_frame:
             image, _ = camera.render(bed.joints_deg)
@@ -89,7 +91,9 @@ def main() -> None:
     core.stop_recording()
     camera.close()
     duration = clock.t_s - start
-    print(f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, {n_joint} joint samples at {JOINT_HZ:g} Hz)")
+    print(
+        f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, {n_joint} joint samples at {JOINT_HZ:g} Hz)"
+    )
 
 
 if __name__ == "__main__":

@@ -73,7 +73,15 @@ def test_headless_commands_do_not_load_qt():
     assert out.stdout.strip().endswith("False")
 
 
-_POSE_CALLS = {"invert", "fk", "frame_placement", "make_transform", "delta_transform", "transform_from_xyz_rpy", "concat"}
+_POSE_CALLS = {
+    "invert",
+    "fk",
+    "frame_placement",
+    "make_transform",
+    "delta_transform",
+    "transform_from_xyz_rpy",
+    "concat",
+}
 
 
 def _is_pose(node: ast.AST, known: frozenset[str] = frozenset()) -> bool:
@@ -83,7 +91,9 @@ def _is_pose(node: ast.AST, known: frozenset[str] = frozenset()) -> bool:
 
     if isinstance(node, ast.Name | ast.Attribute):
         name = node.id if isinstance(node, ast.Name) else node.attr
-        return (isinstance(node, ast.Name) and name in known) or re.fullmatch(r"[a-z_]*[a-z]2[a-z][a-z_]*", name) is not None
+        return (isinstance(node, ast.Name) and name in known) or re.fullmatch(
+            r"[a-z_]*[a-z]2[a-z][a-z_]*", name
+        ) is not None
     if isinstance(node, ast.Call):
         f = node.func
         return (f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else "") in _POSE_CALLS
@@ -96,8 +106,13 @@ def _poses_by_call(scope: ast.AST) -> frozenset[str]:
     """Names a function assigns a pose to (by a pose call or another pose), followed to a fixed point."""
     known: set[str] = set()
     while True:
-        found = {t.id for node in ast.walk(scope) if isinstance(node, ast.Assign) and _is_pose(node.value, frozenset(known))
-                 for t in node.targets if isinstance(t, ast.Name)}
+        found = {
+            t.id
+            for node in ast.walk(scope)
+            if isinstance(node, ast.Assign) and _is_pose(node.value, frozenset(known))
+            for t in node.targets
+            if isinstance(t, ast.Name)
+        }
         if found <= known:
             return frozenset(known)
         known |= found
@@ -105,8 +120,13 @@ def _poses_by_call(scope: ast.AST) -> frozenset[str]:
 
 def _is_inverse_by_hand(node: ast.AST, known: frozenset[str]) -> bool:
     """``np.linalg.inv(pose)``: a rigid pose is inverted by ``invert`` (its transpose, exact), not a general inverse."""
-    return (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "inv" and len(node.args) == 1
-            and _is_pose(node.args[0], known))
+    return (
+        isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Attribute)
+        and node.func.attr == "inv"
+        and len(node.args) == 1
+        and _is_pose(node.args[0], known)
+    )
 
 
 def _bare_compositions(source: str, filename: str) -> list[str]:
@@ -115,7 +135,12 @@ def _bare_compositions(source: str, filename: str) -> list[str]:
     for scope in [tree] + [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef)]:
         known = _poses_by_call(scope) if scope is not tree else frozenset()
         for node in ast.walk(scope):
-            if isinstance(node, ast.BinOp) and isinstance(node.op, ast.MatMult) and _is_pose(node.left, known) and _is_pose(node.right, known):
+            if (
+                isinstance(node, ast.BinOp)
+                and isinstance(node.op, ast.MatMult)
+                and _is_pose(node.left, known)
+                and _is_pose(node.right, known)
+            ):
                 hits.add((node.lineno, ast.unparse(node)))
             elif _is_inverse_by_hand(node, known):
                 hits.add((node.lineno, ast.unparse(node)))
@@ -124,9 +149,23 @@ def _bare_compositions(source: str, filename: str) -> list[str]:
 
 def test_poses_are_composed_with_concat_and_invert():
     # concat(a2b, b2c) reads in the order the frames chain; ``b2c @ a2b`` reads backwards, and a wrong order still runs.
-    assert len(_bare_compositions("x = invert(cam2world) @ obj2world\ny = concat(obj2world, invert(cam2world)) @ p", "probe")) == 1
+    assert (
+        len(
+            _bare_compositions(
+                "x = invert(cam2world) @ obj2world\ny = concat(obj2world, invert(cam2world)) @ p", "probe"
+            )
+        )
+        == 1
+    )
     # by call: a name given a pose in the function, and a pose inverted by hand
-    assert len(_bare_compositions("def f(q):\n    T = robot.fk(q, 'tcp')\n    S = T\n    return S @ make_transform(R, t)", "probe")) == 1
+    assert (
+        len(
+            _bare_compositions(
+                "def f(q):\n    T = robot.fk(q, 'tcp')\n    S = T\n    return S @ make_transform(R, t)", "probe"
+            )
+        )
+        == 1
+    )
     assert len(_bare_compositions("r = np.linalg.inv(base2root)\nc = np.linalg.inv(J.T @ J)", "probe")) == 1
     offenders = [
         hit
@@ -143,7 +182,11 @@ def _parts_taking_the_core(source: str) -> list[str]:
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.ClassDef):
             for item in node.body:
-                if isinstance(item, ast.FunctionDef) and item.name == "__init__" and any(a.arg == "core" for a in item.args.args):
+                if (
+                    isinstance(item, ast.FunctionDef)
+                    and item.name == "__init__"
+                    and any(a.arg == "core" for a in item.args.args)
+                ):
                     found.append(node.name)
     return found
 
@@ -151,12 +194,18 @@ def _parts_taking_the_core(source: str) -> list[str]:
 def test_the_operator_parts_are_given_what_they_need():
     # Each part of the operator core is handed its dependencies (the cell, the session, the arm...), never the
     # core itself: no part shares the program's state by convention. The recording tap alone listens to every part.
-    assert _parts_taking_the_core("class Probe:\n    def __init__(self, core, log):\n        pass\n") == ["Probe"]  # the check sees one
+    assert _parts_taking_the_core("class Probe:\n    def __init__(self, core, log):\n        pass\n") == [
+        "Probe"
+    ]  # the check sees one
     offenders = {
         p.name: names
         for p in (ROOT / "calib_core" / "operator").glob("*.py")
         if p.name != "recording_tap.py" and (names := _parts_taking_the_core(p.read_text()))
     }
     assert offenders == {}
-    bases = [n for n in ast.walk(ast.parse((ROOT / "calib_core" / "operator" / "core.py").read_text())) if isinstance(n, ast.ClassDef) and n.name == "OperatorCore"]
+    bases = [
+        n
+        for n in ast.walk(ast.parse((ROOT / "calib_core" / "operator" / "core.py").read_text()))
+        if isinstance(n, ast.ClassDef) and n.name == "OperatorCore"
+    ]
     assert bases and bases[0].bases == []  # composed of its parts, not mixed from them

@@ -16,4 +16,9 @@ def assert_tool_on_the_pins(urdf, bed, grasps: dict, within_mm: float = 0.5) -> 
         pin = bed.workcell.task(name).tcp2base
         d, r = pose_difference(robot.fk(q, "tcp"), pin)
         nominal = np.linalg.norm(pose_difference(bed.model_robot.fk(q, "tcp"), pin)[0])
-        assert np.linalg.norm(d) < within_mm and np.linalg.norm(d) < nominal / 4 and np.linalg.norm(r) < 0.02, (name, d, r, nominal)
+        assert np.linalg.norm(d) < within_mm and np.linalg.norm(d) < nominal / 4 and np.linalg.norm(r) < 0.02, (
+            name,
+            d,
+            r,
+            nominal,
+        )

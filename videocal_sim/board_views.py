@@ -19,7 +19,9 @@ def board_view_poses(n: int, spec: BoardSpec, seed: int = 0) -> list[np.ndarray]
     centre = np.array([w / 2, h / 2, 0.0])
     poses = []
     for k in range(n):
-        tilt = Rotation.from_euler("xyz", [rng.uniform(-35, 35), rng.uniform(-35, 35), rng.uniform(-20, 20)], degrees=True)
+        tilt = Rotation.from_euler(
+            "xyz", [rng.uniform(-35, 35), rng.uniform(-35, 35), rng.uniform(-20, 20)], degrees=True
+        )
         distance = rng.uniform(350, 650)
         # Look at a point near the board centre, offset so the board lands in different image regions.
         aim = centre + np.array([rng.uniform(-0.5, 0.5) * w, rng.uniform(-0.5, 0.5) * h, 0.0])
@@ -29,12 +31,21 @@ def board_view_poses(n: int, spec: BoardSpec, seed: int = 0) -> list[np.ndarray]
     return poses
 
 
-def simulated_board_images(intrinsics: Intrinsics, spec: BoardSpec, n: int = 15, seed: int = 0, look: CameraLook | None = None) -> list[tuple[str, np.ndarray]]:
+def simulated_board_images(
+    intrinsics: Intrinsics, spec: BoardSpec, n: int = 15, seed: int = 0, look: CameraLook | None = None
+) -> list[tuple[str, np.ndarray]]:
     """``n`` images (name, RGB) of the board seen by a camera with ``intrinsics``."""
     item = board_item(spec, np.eye(4))
     poses = board_view_poses(n, spec, seed)
     state = {"pose": poses[0]}
-    camera = SimulatedCamera(intrinsics, lambda q: [item], lambda q: state["pose"], lambda: np.zeros(6), look=look or CameraLook(background=(0.35, 0.36, 0.38)), seed=seed)
+    camera = SimulatedCamera(
+        intrinsics,
+        lambda q: [item],
+        lambda q: state["pose"],
+        lambda: np.zeros(6),
+        look=look or CameraLook(background=(0.35, 0.36, 0.38)),
+        seed=seed,
+    )
     images = []
     for k, pose in enumerate(poses):
         state["pose"] = pose

@@ -19,19 +19,52 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     where = parser.add_mutually_exclusive_group(required=True)
     where.add_argument("--pty", action="store_true", help="serve on a new pseudo-terminal and print its path")
     where.add_argument("--tcp", type=int, metavar="PORT", help="serve on 127.0.0.1:PORT (0 picks a free port)")
-    parser.add_argument("--link", type=Path, help="with --pty: keep a symlink at this path to the current pty (stable across --reboot-after)")
-    parser.add_argument("--workcell", type=Path, help="simulate the controller of this cell's robot: its joint count, limits, speeds, axis order and home (default: the bundled cell)")
-    parser.add_argument("--robot", choices=("cell", "plain"), default="cell", help="the cell's robot (default), or a plain six-axis joint-space model")
-    parser.add_argument("--joints", help="initial joints in the controller's axis order, degrees or mm, separated by commas (default: the cell's home)")
-    parser.add_argument("--noise-rate", type=float, default=0.0, help="probability of random garbage bytes before a sentence")
+    parser.add_argument(
+        "--link",
+        type=Path,
+        help="with --pty: keep a symlink at this path to the current pty (stable across --reboot-after)",
+    )
+    parser.add_argument(
+        "--workcell",
+        type=Path,
+        help="simulate the controller of this cell's robot: its joint count, limits, speeds, axis order and home (default: the bundled cell)",
+    )
+    parser.add_argument(
+        "--robot",
+        choices=("cell", "plain"),
+        default="cell",
+        help="the cell's robot (default), or a plain six-axis joint-space model",
+    )
+    parser.add_argument(
+        "--joints",
+        help="initial joints in the controller's axis order, degrees or mm, separated by commas (default: the cell's home)",
+    )
+    parser.add_argument(
+        "--noise-rate", type=float, default=0.0, help="probability of random garbage bytes before a sentence"
+    )
     parser.add_argument("--corrupt-rate", type=float, default=0.0, help="probability of a flipped byte in a sentence")
     parser.add_argument("--drop-rate", type=float, default=0.0, help="probability that a sentence is not sent")
-    parser.add_argument("--disconnect-after", type=float, metavar="SECONDS", help="vanish after this many seconds (the process ends)")
-    parser.add_argument("--reboot-after", type=float, metavar="SECONDS", help="reboot after this many seconds: gone for --reboot-downtime, then back")
+    parser.add_argument(
+        "--disconnect-after", type=float, metavar="SECONDS", help="vanish after this many seconds (the process ends)"
+    )
+    parser.add_argument(
+        "--reboot-after",
+        type=float,
+        metavar="SECONDS",
+        help="reboot after this many seconds: gone for --reboot-downtime, then back",
+    )
     parser.add_argument("--reboot-downtime", type=float, default=1.0, metavar="SECONDS")
     parser.add_argument("--seed", type=int, default=0, help="seed of the fault injection")
-    parser.add_argument("--key-file", type=Path, help="the link key to require on motion sentences (default: the user's, made on first use; see `videocal link-key`)")
-    parser.add_argument("--open", action="store_true", help="no link key: a protocol-3 controller that obeys any client's MVJ (to test a workstation against an old controller)")
+    parser.add_argument(
+        "--key-file",
+        type=Path,
+        help="the link key to require on motion sentences (default: the user's, made on first use; see `videocal link-key`)",
+    )
+    parser.add_argument(
+        "--open",
+        action="store_true",
+        help="no link key: a protocol-3 controller that obeys any client's MVJ (to test a workstation against an old controller)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -67,7 +100,9 @@ def run(args: argparse.Namespace) -> int:
         try:
             values = np.array([float(v) for v in args.joints.split(",")])
         except ValueError:
-            raise VideocalError(f"--joints: expected {len(initial)} numbers separated by commas, got {args.joints!r}") from None
+            raise VideocalError(
+                f"--joints: expected {len(initial)} numbers separated by commas, got {args.joints!r}"
+            ) from None
         if values.shape != initial.shape:
             raise VideocalError(f"--joints: the robot has {len(initial)} joints, got {len(values)} values")
         initial = values
@@ -82,11 +117,23 @@ def run(args: argparse.Namespace) -> int:
     def announce(path: str) -> None:
         print(path, flush=True)
 
-    options = SimOptions(pty=args.pty, tcp_port=args.tcp, link_path=args.link, disconnect_after_s=args.disconnect_after, reboot_after_s=args.reboot_after, reboot_downtime_s=args.reboot_downtime)
+    options = SimOptions(
+        pty=args.pty,
+        tcp_port=args.tcp,
+        link_path=args.link,
+        disconnect_after_s=args.disconnect_after,
+        reboot_after_s=args.reboot_after,
+        reboot_downtime_s=args.reboot_downtime,
+    )
     try:
-        logic = ControllerLogic(model, initial, key=key, on_refusal=lambda text: print(f"refused: {text}", file=sys.stderr, flush=True))
+        logic = ControllerLogic(
+            model, initial, key=key, on_refusal=lambda text: print(f"refused: {text}", file=sys.stderr, flush=True)
+        )
         serve(logic, options, faults, announce, lambda: stop["flag"])
     except OSError as exc:
         raise VideocalError(f"cannot serve: {exc}") from None
-    print(f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} dropped", file=sys.stderr)
+    print(
+        f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} dropped",
+        file=sys.stderr,
+    )
     return 0

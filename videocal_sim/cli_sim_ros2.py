@@ -9,16 +9,24 @@ import threading
 
 from app.cli.options import bounded_float, resolved_path
 
-HELP = "serve a cell's robot as a simulated ros2_control arm (joint_states, a joint trajectory controller) on Cyclone DDS"
+HELP = (
+    "serve a cell's robot as a simulated ros2_control arm (joint_states, a joint trajectory controller) on Cyclone DDS"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell whose robot it is (default: the bundled one)")
-    parser.add_argument("--rate", type=bounded_float(1.0, 2000.0), default=100.0, help="joint_states rate, Hz (default 100)")
+    parser.add_argument(
+        "--workcell", type=resolved_path, default=None, help="the cell whose robot it is (default: the bundled one)"
+    )
+    parser.add_argument(
+        "--rate", type=bounded_float(1.0, 2000.0), default=100.0, help="joint_states rate, Hz (default 100)"
+    )
     parser.add_argument("--controller", default="joint_trajectory_controller", help="the trajectory controller's name")
     parser.add_argument("--joint-states", default="/joint_states", help="the joint states topic")
     parser.add_argument("--domain", type=int, default=None, help="ROS domain id (default: ROS_DOMAIN_ID, else 0)")
-    parser.add_argument("--joints", help="initial joints in URDF order, deg or mm, separated by commas (default: the cell's home)")
+    parser.add_argument(
+        "--joints", help="initial joints in URDF order, deg or mm, separated by commas (default: the cell's home)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,8 +40,17 @@ def run(args: argparse.Namespace) -> int:
     cell = Cell.open(args.workcell or DEFAULT_WORKCELL)
     robot = cell.robot
     initial = joints_option(args.joints, robot.n_joints, cell.home_joints)
-    arm = SimulatedRos2Arm(robot.joint_names, user_per_si(robot.joint_units), robot.lower_limits_deg, robot.upper_limits_deg, initial,
-                           rate_hz=args.rate, domain=domain_id(args.domain), controller=args.controller, joint_states=args.joint_states).start()
+    arm = SimulatedRos2Arm(
+        robot.joint_names,
+        user_per_si(robot.joint_units),
+        robot.lower_limits_deg,
+        robot.upper_limits_deg,
+        initial,
+        rate_hz=args.rate,
+        domain=domain_id(args.domain),
+        controller=args.controller,
+        joint_states=args.joint_states,
+    ).start()
     done = threading.Event()
     for sig in (signal.SIGTERM, signal.SIGINT):
         signal.signal(sig, lambda *_: done.set())

@@ -15,9 +15,20 @@ HELP = "serve a cell's robot as a simulated Universal Robots controller (RTDE on
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--host", default="127.0.0.2", help="the loopback address to serve on (default 127.0.0.2; the ports are UR's fixed ones)")
-    parser.add_argument("--workcell", type=resolved_path, default=None, help="the cell whose robot it is (6 joints; default: the bundled one)")
-    parser.add_argument("--joints", help="initial joints in URDF order, deg, separated by commas (default: the cell's home)")
+    parser.add_argument(
+        "--host",
+        default="127.0.0.2",
+        help="the loopback address to serve on (default 127.0.0.2; the ports are UR's fixed ones)",
+    )
+    parser.add_argument(
+        "--workcell",
+        type=resolved_path,
+        default=None,
+        help="the cell whose robot it is (6 joints; default: the bundled one)",
+    )
+    parser.add_argument(
+        "--joints", help="initial joints in URDF order, deg, separated by commas (default: the cell's home)"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,13 +43,20 @@ def run(args: argparse.Namespace) -> int:
     cell = Cell.open(args.workcell or DEFAULT_WORKCELL)
     robot = cell.robot
     if robot.n_joints != 6 or any(u != "deg" for u in robot.joint_units):
-        raise VideocalError(f"a UR controller drives 6 revolute joints; {cell.workcell.path}'s robot has {robot.n_joints} ({', '.join(robot.joint_units)})")
+        raise VideocalError(
+            f"a UR controller drives 6 revolute joints; {cell.workcell.path}'s robot has {robot.n_joints} ({', '.join(robot.joint_units)})"
+        )
     initial = joints_option(args.joints, 6, cell.home_joints)
     lower = np.radians(np.where(np.isfinite(robot.lower_limits_deg), robot.lower_limits_deg, -360.0))
     upper = np.radians(np.where(np.isfinite(robot.upper_limits_deg), robot.upper_limits_deg, 360.0))
     try:
-        sim = SimulatedURController(np.radians(initial), host=args.host, lower_rad=lower, upper_rad=upper,
-                                    log=lambda text: print(text, file=sys.stderr, flush=True)).start()
+        sim = SimulatedURController(
+            np.radians(initial),
+            host=args.host,
+            lower_rad=lower,
+            upper_rad=upper,
+            log=lambda text: print(text, file=sys.stderr, flush=True),
+        ).start()
     except OSError as exc:
         raise VideocalError(f"cannot serve on {args.host}: {exc}") from None
     done = threading.Event()

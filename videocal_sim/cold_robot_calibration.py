@@ -47,8 +47,18 @@ class ColdRun:
     cell_views: int = 0
 
 
-def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: int = 3, grasps: bool = True, grasp_tasks: list[str] | None = None,
-                        with_intrinsics: bool = True, seen_grasps: bool = True, progress=None, say=lambda text: None) -> ColdRun:
+def calibrate_cold_cell(
+    views: int = 40,
+    seed: int = 0,
+    *,
+    cell_views_per_task: int = 3,
+    grasps: bool = True,
+    grasp_tasks: list[str] | None = None,
+    with_intrinsics: bool = True,
+    seen_grasps: bool = True,
+    progress=None,
+    say=lambda text: None,
+) -> ColdRun:
     """``views`` board views and ``cell_views_per_task`` views of each task location's component
     (surveyed features: they tie the robot to the cell; 0 leaves the base unidentified); with
     ``grasps``, the gripper closed on each task location's fixture (``grasp_tasks``: only these) gives
@@ -60,9 +70,20 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
     board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
     say(f"planning {views} poses...")
     wanted = views + HELD_OUT
-    plan = plan_poses(bed.model_robot, nominal, spec, board2base, wanted, start_deg=bed.workcell.home_joints_deg, candidates=min(160, 3 * wanted), seed=seed)
+    plan = plan_poses(
+        bed.model_robot,
+        nominal,
+        spec,
+        board2base,
+        wanted,
+        start_deg=bed.workcell.home_joints_deg,
+        candidates=min(160, 3 * wanted),
+        seed=seed,
+    )
     calibration_q, held_out = plan.joints_deg[:views], plan.joints_deg[views:]
-    board_views, pose_views, rejected = simulated_pose_views(bed, spec, board2base, calibration_q, seed=seed, progress=progress)
+    board_views, pose_views, rejected = simulated_pose_views(
+        bed, spec, board2base, calibration_q, seed=seed, progress=progress
+    )
     intrinsics = calibrate_intrinsics(board_views, spec)
     say(f"intrinsics: RMS {intrinsics.rms_px:.3f} px from {len(board_views)} views")
     cell_frames = []
@@ -70,11 +91,21 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
         from calib_core.robot.collision import CollisionWorld
 
         world = CollisionWorld(bed.model_robot, list(bed.workcell.components), bed.workcell.home_joints_deg)
-        targets = cell_view_joints(bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed, collisions=world)
+        targets = cell_view_joints(
+            bed.model_robot, bed.workcell, intrinsics.intrinsics, cell_views_per_task, seed, collisions=world
+        )
         say(f"locating surveyed features in {len(targets)} views...")
         cell_frames = simulated_cell_frames(bed, targets, seed=seed)
     say("identifying...")
-    identified = identify_robot(bed.model_robot, intrinsics.intrinsics, bed.workcell, pose_views, cell_frames, visuals=bed.visuals_for_model(), with_intrinsics=with_intrinsics)
+    identified = identify_robot(
+        bed.model_robot,
+        intrinsics.intrinsics,
+        bed.workcell,
+        pose_views,
+        cell_frames,
+        visuals=bed.visuals_for_model(),
+        with_intrinsics=with_intrinsics,
+    )
     result = identified.result
     robot, tool = result.robot, None
     if grasps:
@@ -89,15 +120,35 @@ def calibrate_cold_cell(views: int = 40, seed: int = 0, *, cell_views_per_task: 
                 except GraspNotSeenError as e:
                     say(f"{e}: that grasp is taken through the calibrated robot and the survey")
             done.append(Grasp(t.name, q, t.tcp2base, seen))
-        tool = camera_to_tool(result.robot, done, placement_sigma_mm=SURVEY_SIGMA_MM, camera_covariance=lambda q: pose_covariance(result, q))
+        tool = camera_to_tool(
+            result.robot,
+            done,
+            placement_sigma_mm=SURVEY_SIGMA_MM,
+            camera_covariance=lambda q: pose_covariance(result, q),
+        )
         robot = with_tool(result.robot, tool.tcp2cam)
-        say(f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
+        say(
+            f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)"
+        )
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
     score["parameters_against_truth"] = parameters_against_truth(result, bed, identified.views, intrinsics.intrinsics)
-    return ColdRun(result, intrinsics, plan, rejected, score, bed.model_robot, tool, robot, identified.board_views, identified.cell_views)
+    return ColdRun(
+        result,
+        intrinsics,
+        plan,
+        rejected,
+        score,
+        bed.model_robot,
+        tool,
+        robot,
+        identified.board_views,
+        identified.cell_views,
+    )
 
 
-def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray, robot=None) -> dict:
+def score_against_truth(
+    result: RobotCalibration, bed, truth, held_out: list[np.ndarray], board2base_true: np.ndarray, robot=None
+) -> dict:
     """How far the calibrated model is from the test bed's truth at ``held_out`` poses: the camera and
     the TCP relative to the board (what board views determine) and in the base frame, RMS mm and deg;
     the intrinsics' differences. ``robot``: the calibrated robot to score (default the
@@ -127,7 +178,12 @@ def score_against_truth(result: RobotCalibration, bed, truth, held_out: list[np.
             out[f"{frame}_nominal_model_mm_deg"] = rms(nominal)
         out["held_out_poses"] = len(held_out)
     t, i = truth.intrinsics, result.intrinsics
-    out["intrinsics_error_px"] = {"fu": round(i.fu - t.fu, 3), "fv": round(i.fv - t.fv, 3), "cx": round(i.cx - t.cx, 3), "cy": round(i.cy - t.cy, 3)}
+    out["intrinsics_error_px"] = {
+        "fu": round(i.fu - t.fu, 3),
+        "fv": round(i.fv - t.fv, 3),
+        "cx": round(i.cx - t.cx, 3),
+        "cy": round(i.cy - t.cy, 3),
+    }
     return out
 
 
@@ -183,8 +239,14 @@ def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -
     with_intrinsics = len(result.names) > truth.size
     if with_intrinsics:  # the true camera as the corrections to the intrinsics the fit started from
         t = bed.intrinsics
-        truth = np.r_[truth, t.fu - intrinsics.fu, t.fv - intrinsics.fv, t.cx - intrinsics.cx, t.cy - intrinsics.cy,
-                      1000.0 * (np.asarray(t.distortion[:4]) - np.asarray(intrinsics.distortion[:4]))]
+        truth = np.r_[
+            truth,
+            t.fu - intrinsics.fu,
+            t.fv - intrinsics.fv,
+            t.cx - intrinsics.cx,
+            t.cy - intrinsics.cy,
+            1000.0 * (np.asarray(t.distortion[:4]) - np.asarray(intrinsics.distortion[:4])),
+        ]
     problem = _Problem(result.nominal, intrinsics, views, result.camera_frame, with_intrinsics, SURVEY_SIGMA_MM)
     problem.board0 = result.board2base if result.board2base is not None else np.eye(4)
     ids, unid = result.observability.identified, result.observability.unidentified
@@ -194,5 +256,8 @@ def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -
     absorbed = np.linalg.lstsq(A, W * J[:, unid], rcond=None)[0][: len(ids)] @ truth[unid]
     expected = truth[ids] + absorbed
     z = (result.values[ids] - expected) / result.sigmas[ids]
-    return {"within_3_sigma": round(float(np.mean(np.abs(z) < 3.0)), 3), "rms_error_over_sigma": round(float(np.sqrt(np.mean(z**2))), 2),
-            "worst": result.names[ids[int(np.argmax(np.abs(z)))]]}
+    return {
+        "within_3_sigma": round(float(np.mean(np.abs(z) < 3.0)), 3),
+        "rms_error_over_sigma": round(float(np.sqrt(np.mean(z**2))), 2),
+        "worst": result.names[ids[int(np.argmax(np.abs(z)))]],
+    }

@@ -26,8 +26,17 @@ from calib_core.vision.edge_solution import edge_solution
 from calib_core.vision.find_points import find_points
 
 
-def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int = 0, model_covariance=None, placement_sigma_mm: float = 0.0,
-                 from_where: str = "task", tool=None) -> dict:
+def look_at_task(
+    bed,
+    robot,
+    intrinsics,
+    task_name: str | None = None,
+    seed: int = 0,
+    model_covariance=None,
+    placement_sigma_mm: float = 0.0,
+    from_where: str = "task",
+    tool=None,
+) -> dict:
     """Figures of one look at ``task_name`` (default: the cell's first task) with the calibrated
     ``robot`` and ``intrinsics``, made from the task location itself (``from_where="task"``, as the
     paper and ``videocal demo`` do) or from its approach (``"approach"``): the TCP's true error at the task commanded through the calibrated
@@ -48,7 +57,9 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     if from_where == "task":
         q_approach = solve_ik(robot, task.tcp2base, q_approach).q_deg
     bed.joints_deg = q_approach
-    camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 7)
+    camera = SimulatedCamera(
+        bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 7
+    )
     view = ModelView(intrinsics)
     try:
         image = camera.read().image
@@ -59,7 +70,12 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
     finally:
         camera.close()
         view.close()
-    out = {"task": task.name, "looked_from": from_where, "found": bool(found.edges is not None and found.edges.settled), "message": found.message}
+    out = {
+        "task": task.name,
+        "looked_from": from_where,
+        "found": bool(found.edges is not None and found.edges.settled),
+        "message": found.message,
+    }
     true_item = next((c for c in bed.true_components or () if c.name == item.name), item)
     task_true = concat(task.tcp2base, invert(item.item2world), true_item.item2world)
 
@@ -74,20 +90,31 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         return out
     solution = edge_solution(found.edges, intrinsics)
     features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
-    estimate = end_effector_from_solution(solution, item.item2world, cam2world_model, robot.fk(q_approach, "tcp"),
-                                          shared_covariance=shared_shift_covariance(solution.obj2cam, features, intrinsics))
+    estimate = end_effector_from_solution(
+        solution,
+        item.item2world,
+        cam2world_model,
+        robot.fk(q_approach, "tcp"),
+        shared_covariance=shared_shift_covariance(solution.obj2cam, features, intrinsics),
+    )
     q_task = solve_ik(robot, concat(task.tcp2base, invert(estimate.delta_base)), q_approach).q_deg
     d, r, after = error(q_task)
     tool_covariance = tool.covariance_in_base(cam2world_model) if tool is not None else None
-    look_std = np.sqrt(np.diag(estimate.covariance + tool_covariance)) if tool_covariance is not None and estimate.covariance is not None else None
+    look_std = (
+        np.sqrt(np.diag(estimate.covariance + tool_covariance))
+        if tool_covariance is not None and estimate.covariance is not None
+        else None
+    )
     sigma_mm = float(np.linalg.norm(estimate.std_displacement_mm if look_std is None else look_std[:3]))
     sigma_deg = float(np.linalg.norm(estimate.std_rotation_deg if look_std is None else look_std[3:]))
-    out.update({
-        "after_look_mm_deg": after,
-        "look_sigma_mm_deg": [round(sigma_mm, 4), round(sigma_deg, 5)],
-        "look_displacement_mm": [round(float(v), 4) for v in estimate.displacement_mm],
-        "within_3_sigma": bool(np.linalg.norm(d) <= 3 * sigma_mm and np.linalg.norm(r) <= 3 * sigma_deg),
-    })
+    out.update(
+        {
+            "after_look_mm_deg": after,
+            "look_sigma_mm_deg": [round(sigma_mm, 4), round(sigma_deg, 5)],
+            "look_displacement_mm": [round(float(v), 4) for v in estimate.displacement_mm],
+            "within_3_sigma": bool(np.linalg.norm(d) <= 3 * sigma_mm and np.linalg.norm(r) <= 3 * sigma_deg),
+        }
+    )
     if model_covariance is not None and estimate.covariance is not None:
         from calib_core.calibration.look_fusion import fuse_look
 
@@ -98,8 +125,14 @@ def look_at_task(bed, robot, intrinsics, task_name: str | None = None, seed: int
         out["fused"] = {
             "after_mm_deg": after,
             "sigma_mm_deg": [round(float(np.linalg.norm(s[:3])), 4), round(float(np.linalg.norm(s[3:])), 5)],
-            "look_weight_position_rotation": [round(float(np.mean(fused.look_weight[:3])), 3), round(float(np.mean(fused.look_weight[3:])), 3)],
-            "agree": fused.agree, "message": fused.message,
-            "within_3_sigma": bool(np.linalg.norm(d) <= 3 * np.linalg.norm(s[:3]) and np.linalg.norm(r) <= 3 * np.linalg.norm(s[3:])),
+            "look_weight_position_rotation": [
+                round(float(np.mean(fused.look_weight[:3])), 3),
+                round(float(np.mean(fused.look_weight[3:])), 3),
+            ],
+            "agree": fused.agree,
+            "message": fused.message,
+            "within_3_sigma": bool(
+                np.linalg.norm(d) <= 3 * np.linalg.norm(s[:3]) and np.linalg.norm(r) <= 3 * np.linalg.norm(s[3:])
+            ),
         }
     return out

@@ -45,7 +45,9 @@ def grasp_frame(bed: TestBed, q_commanded_deg: np.ndarray, seed: int = 0) -> np.
     """The camera's frame (h, w, 3) uint8 with the robot at ``q_commanded_deg`` (the gripper closed on
     a pin): what an operator's camera shows while the controller holds the grasp."""
     bed.joints_deg = np.asarray(q_commanded_deg, dtype=float)
-    camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 11)
+    camera = SimulatedCamera(
+        bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 11
+    )
     try:
         return camera.read().image
     finally:

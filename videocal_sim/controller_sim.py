@@ -60,8 +60,15 @@ class ControllerLogic:
     workstation's replies travel on). Without a key it is a protocol-3 controller: any client's ``MVJ`` moves it.
     """
 
-    def __init__(self, joint_model: JointModel | None = None, initial_deg=None, clock: Callable[[], float] = time.monotonic, seq_start: int = 0,
-                 key: bytes | None = None, on_refusal: Callable[[str], None] | None = None):
+    def __init__(
+        self,
+        joint_model: JointModel | None = None,
+        initial_deg=None,
+        clock: Callable[[], float] = time.monotonic,
+        seq_start: int = 0,
+        key: bytes | None = None,
+        on_refusal: Callable[[str], None] | None = None,
+    ):
         self.model = joint_model or PlainJointModel()
         self.clock = clock
         self.t_start = clock()
@@ -117,7 +124,11 @@ class ControllerLogic:
     def _update_motion(self, now: float) -> list:
         out = []
         if self.move is not None and self.deadman_s > 0 and now - self._last_heartbeat_t > self.deadman_s:
-            return self._halt(now, "DEADMAN", f"no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: stopped")
+            return self._halt(
+                now,
+                "DEADMAN",
+                f"no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: stopped",
+            )
         if self.move is not None:
             self.joints_deg = self.move.position(now)
             if self.move.finished(now):
@@ -159,11 +170,20 @@ class ControllerLogic:
                 out.append(ErrorReply("SYNTAX", f"move {msg.id}: {goal.size} joint values for a robot of {lo.size}"))
             elif len(bad):
                 j = int(bad[0])
-                out.append(ErrorReply("LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} outside [{lo[j]:.1f}; {hi[j]:.1f}]"))
+                out.append(
+                    ErrorReply(
+                        "LIMIT", f"move {msg.id}: joint {j + 1} target {goal[j]:.2f} outside [{lo[j]:.1f}; {hi[j]:.1f}]"
+                    )
+                )
             elif self.move is not None:
                 out.append(ErrorReply("BUSY", f"move {msg.id}: still executing move {self.move_id}"))
             elif self.deadman_s > 0 and now - self._last_heartbeat_t > self.deadman_s:
-                out.append(ErrorReply("DEADMAN", f"move {msg.id}: no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: not moving"))
+                out.append(
+                    ErrorReply(
+                        "DEADMAN",
+                        f"move {msg.id}: no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: not moving",
+                    )
+                )
             else:
                 self.move = TrapezoidMove.plan(self.joints_deg, goal, np.asarray(self.model.max_speed_deg_s), now)
                 self.move_id = msg.id
@@ -207,14 +227,20 @@ class ControllerLogic:
         if isinstance(msg, Hello):
             if not auth.proof_is_valid(auth.hello_request(self.key, msg.nonce), msg.request):
                 # not from the key's holder: answered (rate-limited) and forgotten; the offer in force stays
-                return self._refuse(f"hello {msg.nonce}: wrong request: the workstation does not hold this controller's link key", now)
+                return self._refuse(
+                    f"hello {msg.nonce}: wrong request: the workstation does not hold this controller's link key", now
+                )
             if msg.nonce in self._seen_hellos:
                 return []  # a hello of the key's holder seen before: replayed from a capture
             self._seen_hellos = (self._seen_hellos + [msg.nonce])[-SEEN_HELLOS:]
             # The session in force stays until a new handshake completes.
             controller_nonce, clock_ms = auth.new_nonce(), self.clock_ms(now)
             self._hello = (msg.nonce, controller_nonce, now)
-            return [HelloReply(controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce, clock_ms), clock_ms)]
+            return [
+                HelloReply(
+                    controller_nonce, auth.controller_proof(self.key, msg.nonce, controller_nonce, clock_ms), clock_ms
+                )
+            ]
         if self._hello is None:
             return self._refuse("auth: AUT without a HEL first", now)
         ws_nonce, controller_nonce, offered = self._hello

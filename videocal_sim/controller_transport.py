@@ -48,7 +48,9 @@ class _PtyEndpoint:
         self.link_path = link_path
         if link_path is not None:
             if link_path.exists() and not link_path.is_symlink():
-                raise FileExistsError(f"--link {link_path}: a file is there and it is not a link; give another path (nothing was replaced)")
+                raise FileExistsError(
+                    f"--link {link_path}: a file is there and it is not a link; give another path (nothing was replaced)"
+                )
             tmp = Path(str(link_path) + ".tmp")
             if tmp.is_symlink() or tmp.exists():
                 tmp.unlink()
@@ -115,7 +117,9 @@ class _TcpEndpoint:
             if self.client is not None and self._alive(self.client) and keeps_port:
                 # One workstation at a time: a second client does not take the robot over.
                 with contextlib.suppress(OSError):
-                    conn.sendall(encode(ErrorReply("BUSY", "another workstation is connected; this connection is closed").body()))
+                    conn.sendall(
+                        encode(ErrorReply("BUSY", "another workstation is connected; this connection is closed").body())
+                    )
                 conn.close()
                 self.refused += 1
                 return b""
@@ -150,7 +154,13 @@ class _TcpEndpoint:
         self.server.close()
 
 
-def serve(logic: ControllerLogic, options: SimOptions, faults: FaultInjector | None = None, announce: Callable[[str], None] = print, should_stop: Callable[[], bool] = lambda: False) -> None:
+def serve(
+    logic: ControllerLogic,
+    options: SimOptions,
+    faults: FaultInjector | None = None,
+    announce: Callable[[str], None] = print,
+    should_stop: Callable[[], bool] = lambda: False,
+) -> None:
     """Serve ``logic`` until ``should_stop()`` or a simulated disconnect; ``announce`` receives
     the device path (again after each reboot)."""
     if options.pty == (options.tcp_port is not None):
@@ -158,7 +168,11 @@ def serve(logic: ControllerLogic, options: SimOptions, faults: FaultInjector | N
     faults = faults or FaultInjector()
 
     def open_endpoint():
-        return _PtyEndpoint(options.link_path) if options.pty else _TcpEndpoint(options.tcp_port, None if logic.key is None else lambda: logic.session_open)
+        return (
+            _PtyEndpoint(options.link_path)
+            if options.pty
+            else _TcpEndpoint(options.tcp_port, None if logic.key is None else lambda: logic.session_open)
+        )
 
     endpoint = open_endpoint()
     announce(endpoint.path)

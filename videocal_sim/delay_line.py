@@ -69,8 +69,15 @@ class DelayLine:
     connection to ``target`` through ``weather``. ``tap(direction, data)`` sees every chunk as it is
     delivered (``"up"`` towards the target). Start with :meth:`start`, end with :meth:`close`."""
 
-    def __init__(self, listen: tuple[str, int], target: tuple[str, int], weather: LinkWeather, *, seed: int = 0,
-                 tap: Callable[[str, bytes], None] | None = None):
+    def __init__(
+        self,
+        listen: tuple[str, int],
+        target: tuple[str, int],
+        weather: LinkWeather,
+        *,
+        seed: int = 0,
+        tap: Callable[[str, bytes], None] | None = None,
+    ):
         self.target = target
         self.weather = weather
         self.stats = DelayStats()
@@ -199,7 +206,10 @@ def main(argv: list[str] | None = None) -> int:
     if len(args.listen) != len(args.to):
         parser.error("give one --to for each --listen")
     weather = LinkWeather(args.one_way_ms / 1000.0, args.jitter, args.loss)
-    lines = [DelayLine(_address(a), _address(b), weather, seed=args.seed + i).start() for i, (a, b) in enumerate(zip(args.listen, args.to))]
+    lines = [
+        DelayLine(_address(a), _address(b), weather, seed=args.seed + i).start()
+        for i, (a, b) in enumerate(zip(args.listen, args.to))
+    ]
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     print("ready " + " ".join(f"{h}:{p}" for h, p in (line.address for line in lines)), flush=True)

@@ -52,7 +52,10 @@ def _visible_features(component, cam2world: np.ndarray, intrinsics) -> list[str]
         if p_cam[0, 2] <= 1.0:
             continue
         u, v = project(p_cam, intrinsics)[0]
-        if _EDGE_MARGIN_PX <= u <= intrinsics.width - 1 - _EDGE_MARGIN_PX and _EDGE_MARGIN_PX <= v <= intrinsics.height - 1 - _EDGE_MARGIN_PX:
+        if (
+            _EDGE_MARGIN_PX <= u <= intrinsics.width - 1 - _EDGE_MARGIN_PX
+            and _EDGE_MARGIN_PX <= v <= intrinsics.height - 1 - _EDGE_MARGIN_PX
+        ):
             names.append(name)
     return names
 
@@ -67,7 +70,9 @@ def _wait(app: QApplication, condition, timeout_s: float, what: str, state=None)
     deadline = time.monotonic() + timeout_s
     while not condition():
         if time.monotonic() > deadline:
-            raise DemoTimeoutError(f"demo: waited {timeout_s:g} s for {what}" + (f" ({state()})" if state is not None else ""))
+            raise DemoTimeoutError(
+                f"demo: waited {timeout_s:g} s for {what}" + (f" ({state()})" if state is not None else "")
+            )
         app.processEvents(QEventLoop.ProcessEventsFlag.AllEvents, 20)
         time.sleep(0.01)
 
@@ -82,7 +87,14 @@ def _pause(app: QApplication, seconds: float) -> None:
 def _click(widget, x: float, y: float, button=Qt.MouseButton.LeftButton) -> None:
     pos = QPointF(round(x), round(y))
     for kind in (QMouseEvent.Type.MouseButtonPress, QMouseEvent.Type.MouseButtonRelease):
-        event = QMouseEvent(kind, pos, widget.mapToGlobal(pos), button, button if kind == QMouseEvent.Type.MouseButtonPress else Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
+        event = QMouseEvent(
+            kind,
+            pos,
+            widget.mapToGlobal(pos),
+            button,
+            button if kind == QMouseEvent.Type.MouseButtonPress else Qt.MouseButton.NoButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
         QApplication.sendEvent(widget, event)
 
 
@@ -95,8 +107,17 @@ def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
 METHODS = ("find-points", "picks", "edges")
 
 
-def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORKCELL, location: str | None = None, method: str = "find-points", site_kind: str = "sim",
-             link_delay_ms: float = 0.0, look: str = "plain") -> dict:
+def run_demo(
+    out_dir: Path,
+    *,
+    scale: float = 1.0,
+    workcell: Path = DEFAULT_WORKCELL,
+    location: str | None = None,
+    method: str = "find-points",
+    site_kind: str = "sim",
+    link_delay_ms: float = 0.0,
+    look: str = "plain",
+) -> dict:
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
@@ -108,15 +129,23 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     # as exact): the demo's true robot has typical joint, link and base errors and the modelled camera mounting.
     n_joints = load_workcell(workcell).load_robot().n_joints
     typical = RobotErrors.typical(0, n_joints=n_joints)
-    cell, site = simulated_cell(workcell, errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg), image_scale=scale,
-                                less_kind=look == "workshop")
+    cell, site = simulated_cell(
+        workcell,
+        errors=RobotErrors(
+            typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg
+        ),
+        image_scale=scale,
+        less_kind=look == "workshop",
+    )
     weather = None
     if link_delay_ms:  # the same cell far away, with a far link's weather
         from videocal_sim.delay_line import LinkWeather
 
         weather = LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01)
         if site_kind not in ("sim", "ros2"):
-            raise ValueError(f"--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site {site_kind}")
+            raise ValueError(
+                f"--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site {site_kind}"
+            )
     if site_kind == "ros2":  # the same simulated cell, its robot and camera reached through ROS 2
         from videocal_sim.ros2_site import Ros2SimulatedSite
 
@@ -139,7 +168,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
         wb.set_task(location)
     if wb.task is None or wb.task.component is None:
         wb.close()
-        raise ValueError(f"{workcell}: the demo needs a task location with a component to look at (task_locations[].component)")
+        raise ValueError(
+            f"{workcell}: the demo needs a task location with a component to look at (task_locations[].component)"
+        )
     wb.start_controller()
     settings = QSettings(str(out_dir / "settings.ini"), QSettings.Format.IniFormat)
     settings.setValue("files/autosave_dir", str(out_dir))  # the demo's session stays in its folder
@@ -168,9 +199,16 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
     hand = np.random.default_rng(0)
     try:
         # (60 s: a loaded machine starts the simulator, the camera's process and the link slowly)
-        _wait(app, lambda: wb.link_up and win.camera.last_frame is not None, 60, "the controller link and the camera",
-              lambda: f"link {'up' if wb.link_up else 'not up'}; camera {'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
-                      f"status: {win.results.status.text()!r}")
+        _wait(
+            app,
+            lambda: wb.link_up and win.camera.last_frame is not None,
+            60,
+            "the controller link and the camera",
+            lambda: (
+                f"link {'up' if wb.link_up else 'not up'}; camera {'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
+                f"status: {win.results.status.text()!r}"
+            ),
+        )
         shot("start")
         task = wb.task
 
@@ -179,8 +217,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
 
         def where(target):
             """What a move's timeout reports: the motion's state, the distance left, the status line."""
-            return lambda: (f"motion {wb.motion.motion.value}, {np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]):.3f} mm from the target; "
-                            f"status: {win.results.status.text()!r}")
+            return lambda: (
+                f"motion {wb.motion.motion.value}, {np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]):.3f} mm from the target; "
+                f"status: {win.results.status.text()!r}"
+            )
 
         def settle(what: str) -> None:
             # a frame the core accepts for picks (the robot settled before it, its own rule), captured after the
@@ -211,10 +251,14 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             stored_before = len(wb.session.corrections.history(task.name))
             place = wb.desk.look_place()
             if place is None or not place.counts:  # the window would ask; the demo's looks are made where they count
-                raise RuntimeError(f"demo: the look does not count for {task.name}: {place.text if place else 'no robot pose'}")
+                raise RuntimeError(
+                    f"demo: the look does not count for {task.name}: {place.text if place else 'no robot pose'}"
+                )
             _click(win.commands.store, 10, 10)
             if len(wb.session.corrections.history(task.name)) != stored_before + 1:
-                raise RuntimeError(f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})")
+                raise RuntimeError(
+                    f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})"
+                )
             win.camera.freeze.setChecked(False)
 
         def find_and_calibrate(round_name: str) -> None:
@@ -223,18 +267,26 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
             _click(win.commands.find_points, 10, 10)
-            if win.finder.dialog is None or not win.finder.dialog.isVisible():  # Find points runs in the click: it showed why not
-                raise OperatorError(f"demo ({round_name} look): Find points proposed nothing: {win.statusBar().currentMessage() or win.results.status.text()}")
+            if (
+                win.finder.dialog is None or not win.finder.dialog.isVisible()
+            ):  # Find points runs in the click: it showed why not
+                raise OperatorError(
+                    f"demo ({round_name} look): Find points proposed nothing: {win.statusBar().currentMessage() or win.results.status.text()}"
+                )
             dialog = win.finder.dialog
             shot(f"{round_name}_points_found")
             shot(f"{round_name}_points_found_list", dialog)  # the proposals and what was missed, with the reasons
             if method == "edges":
                 if not dialog.edges_button.isEnabled():
-                    raise OperatorError(f"demo ({round_name} look): Find points found no settled edge fit: {dialog.found.result.message}")
+                    raise OperatorError(
+                        f"demo ({round_name} look): Find points found no settled edge fit: {dialog.found.result.message}"
+                    )
                 _click(dialog.edges_button, 10, 10)
             else:
                 if not dialog.accept_button.isEnabled():
-                    raise OperatorError(f"demo ({round_name} look): Find points found nothing to accept: {dialog.found.result.message}")
+                    raise OperatorError(
+                        f"demo ({round_name} look): Find points found nothing to accept: {dialog.found.result.message}"
+                    )
                 _click(dialog.accept_button, 10, 10)
                 _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
@@ -251,7 +303,11 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 _click(win.commands.clear, 10, 10)
             fixture = wb.workcell.component(wb.session.target)
             model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
-            names = [n for n in _visible_features(fixture, model_cam, wb.intrinsics) if n in _visible_features(fixture, true_cam, wb.intrinsics)]
+            names = [
+                n
+                for n in _visible_features(fixture, model_cam, wb.intrinsics)
+                if n in _visible_features(fixture, true_cam, wb.intrinsics)
+            ]
             picked = []
             for name in names:
                 p_world = apply(fixture.item2world, fixture.features[name])
@@ -261,7 +317,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 if pending is None or pending.feature != name:
                     if pending is not None:
                         wb.session.delete(pending.number)
-                    skipped.append(f"{round_name}: {name} ({win.virtual.info.text() or 'hidden in the virtual camera'})")
+                    skipped.append(
+                        f"{round_name}: {name} ({win.virtual.info.text() or 'hidden in the virtual camera'})"
+                    )
                     continue
                 picked.append(name)
                 uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
@@ -270,10 +328,14 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 refined = wb.session.pairs.get(pending.number).pixel
                 if refined is None:
                     h = wb.observations.live_history
-                    tail = [(round(t - h.latest_s, 3), np.round(q, 3).tolist()) for t, q in list(zip(h._t, h._q))[-40::4]]
+                    tail = [
+                        (round(t - h.latest_s, 3), np.round(q, 3).tolist()) for t, q in list(zip(h._t, h._q))[-40::4]
+                    ]
                     frame = win.camera.last_frame_received
-                    raise RuntimeError(f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; {wb.motion.text}; "
-                                       f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events {moves_seen}")
+                    raise RuntimeError(
+                        f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; {wb.motion.text}; "
+                        f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events {moves_seen}"
+                    )
                 if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
                     # refinement takes for another corner): clicks it again, refinement off.
@@ -284,7 +346,9 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
                 win.actions.accept()
                 app.processEvents()
             if len(picked) < _MIN_FEATURES:
-                raise RuntimeError(f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} ({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}")
+                raise RuntimeError(
+                    f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} ({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}"
+                )
             shot(f"{round_name}_pairs_picked")
             _click(win.commands.calibrate, 10, 10)
             _wait(app, lambda: wb.session.result is not None, 30, "the solve")
@@ -324,8 +388,17 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "method": method,
             "site": site.description,
             "camera_look": look,
-            "link": {"one_way_ms": link_delay_ms, "measured_one_way_s": getattr(wb.link, "delay_s", None), "go_to_settled_frame_s": [round(v, 2) for v in looks_s]},
-            "connectors": {"controller": wb.link.url, "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(site_kind, "the simulated camera (in process)")},
+            "link": {
+                "one_way_ms": link_delay_ms,
+                "measured_one_way_s": getattr(wb.link, "delay_s", None),
+                "go_to_settled_frame_s": [round(v, 2) for v in looks_s],
+            },
+            "connectors": {
+                "controller": wb.link.url,
+                "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(
+                    site_kind, "the simulated camera (in process)"
+                ),
+            },
             "target": wb.session.target,
             "features_skipped": skipped,
             "subpixel_refinement_refused": refined_away,
@@ -338,7 +411,10 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "std": {"d_mm": r.std_displacement_mm.tolist(), "rotation_deg": r.std_rotation_deg.tolist()},
             "true_displacement": {"d_mm": d_true.tolist(), "rotation_deg": r_true.tolist()},
             "first_look": {
-                "estimated_displacement": {"d_mm": first.displacement_mm.tolist(), "rotation_deg": first.rotation_deg.tolist()},
+                "estimated_displacement": {
+                    "d_mm": first.displacement_mm.tolist(),
+                    "rotation_deg": first.rotation_deg.tolist(),
+                },
                 "true_displacement": {"d_mm": d_first.tolist(), "rotation_deg": r_first.tolist()},
                 "rms_px": first.solution.rms_px,
             },
@@ -350,8 +426,8 @@ def run_demo(out_dir: Path, *, scale: float = 1.0, workcell: Path = DEFAULT_WORK
             "estimate_within_3_sigma": bool(np.all(np.abs(r.displacement_mm - d_true) <= 3 * r.std_displacement_mm)),
             "screenshots": shots,
             "note": "the true robot has typical joint, link and base errors and the modelled camera mounting (hand_eye exact: a hand-eye "
-                    "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they are); the "
-                    "correction is measured at the task location, then again from the corrected location, and the second one is stored last",
+            "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they are); the "
+            "correction is measured at the task location, then again from the corrected location, and the second one is stored last",
         }
         wb.files.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
         report["workspace"] = "workspace.json"

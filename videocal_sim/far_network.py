@@ -67,8 +67,13 @@ def why_not_available() -> str | None:
 def _probe() -> str | None:
     """Make the two devices and the namespace once, and take them down (a container may refuse either)."""
     try:
-        done = subprocess.run([sys.executable, "-m", "videocal_sim.far_network", "--probe"], capture_output=True, text=True, timeout=20,
-                              cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        done = subprocess.run(
+            [sys.executable, "-m", "videocal_sim.far_network", "--probe"],
+            capture_output=True,
+            text=True,
+            timeout=20,
+            cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+        )
     except subprocess.TimeoutExpired:
         return "making the far network took over 20 s"
     if done.returncode != 0:
@@ -123,8 +128,10 @@ class PacketRelay:
         self._rng = random.Random(seed)
         self._rng_lock = threading.Lock()
         self._stop = threading.Event()
-        self._threads = [threading.Thread(target=self._pump, args=(near_fd, far_fd, "up"), name="far up", daemon=True),
-                         threading.Thread(target=self._pump, args=(far_fd, near_fd, "down"), name="far down", daemon=True)]
+        self._threads = [
+            threading.Thread(target=self._pump, args=(near_fd, far_fd, "up"), name="far up", daemon=True),
+            threading.Thread(target=self._pump, args=(far_fd, near_fd, "down"), name="far down", daemon=True),
+        ]
 
     def start(self) -> PacketRelay:
         for t in self._threads:
@@ -179,13 +186,31 @@ class FarNetwork:
         why = why_not_available()
         if why is not None:
             raise FarNetworkError(f"cannot make a far network here: {why}")
-        cmd = [sys.executable, "-m", "videocal_sim.far_network", "--one-way-ms", f"{1000 * weather.one_way_s:g}",
-               "--jitter", f"{weather.jitter:g}", "--loss", f"{weather.loss:g}", "--seed", str(seed)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "videocal_sim.far_network",
+            "--one-way-ms",
+            f"{1000 * weather.one_way_s:g}",
+            "--jitter",
+            f"{weather.jitter:g}",
+            "--loss",
+            f"{weather.loss:g}",
+            "--seed",
+            str(seed),
+        ]
         project = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
         from videocal_sim.sim_process import _die_with_parent  # the relay ends with the program that made it (SIGTERM)
 
-        self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True, cwd=project,
-                                        preexec_fn=_die_with_parent)
+        self.process = subprocess.Popen(
+            cmd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            stdin=subprocess.DEVNULL,
+            text=True,
+            cwd=project,
+            preexec_fn=_die_with_parent,
+        )
         line = self.process.stdout.readline().split()
         if len(line) != 4 or line[0] != "ready":
             self.process.kill()
@@ -201,10 +226,12 @@ class FarNetwork:
         """Cyclone DDS's configuration for ``side`` (``"near"``, ``"far"``): its own address on the link, the other
         side as its one discovery peer (the link carries no multicast)."""
         own, peer = (self.near_ip, self.far_ip) if side == "near" else (self.far_ip, self.near_ip)
-        return ("<CycloneDDS><Domain id=\"any\"><General><Interfaces>"
-                f"<NetworkInterface address=\"{own}\"/></Interfaces><AllowMulticast>false</AllowMulticast></General>"
-                f"<Discovery><Peers><Peer address=\"{peer}\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
-                "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>")
+        return (
+            '<CycloneDDS><Domain id="any"><General><Interfaces>'
+            f'<NetworkInterface address="{own}"/></Interfaces><AllowMulticast>false</AllowMulticast></General>'
+            f'<Discovery><Peers><Peer address="{peer}"/></Peers><ParticipantIndex>auto</ParticipantIndex>'
+            "<MaxAutoParticipantIndex>20</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>"
+        )
 
     def close(self) -> None:
         if self.process.poll() is None:
@@ -231,7 +258,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jitter", type=float, default=0.0, help="fraction of the delay (0.3: +-30 %%)")
     parser.add_argument("--loss", type=float, default=0.0, help="fraction of packets dropped (0.01)")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--probe", action="store_true", help="make the devices and the namespace, then end at once (exit 0: it can be done here)")
+    parser.add_argument(
+        "--probe",
+        action="store_true",
+        help="make the devices and the namespace, then end at once (exit 0: it can be done here)",
+    )
     args = parser.parse_args(argv)
     why = "network namespaces and TAP devices need root (CAP_NET_ADMIN)" if os.geteuid() != 0 else None
     if why is not None:
@@ -263,7 +294,10 @@ def main(argv: list[str] | None = None) -> int:
     stop.wait()
     relay.close()
     s = relay.stats
-    print(f"relayed up {s.packets['up']} (dropped {s.dropped['up']}), down {s.packets['down']} (dropped {s.dropped['down']})", file=sys.stderr)
+    print(
+        f"relayed up {s.packets['up']} (dropped {s.dropped['up']}), down {s.packets['down']} (dropped {s.dropped['down']})",
+        file=sys.stderr,
+    )
     return 0
 
 

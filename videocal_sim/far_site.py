@@ -21,12 +21,16 @@ class FarSimulatedSite(SimulatedSite):
         self.weather = weather
         self.seed = seed
         self.line: DelayLine | None = None
-        self.description = (f"simulated cell {self.bed.workcell.name}, {1000 * weather.one_way_s:.0f} ms away "
-                            f"(+-{100 * weather.jitter:.0f} %, {100 * weather.loss:g} % lost)")
+        self.description = (
+            f"simulated cell {self.bed.workcell.name}, {1000 * weather.one_way_s:.0f} ms away "
+            f"(+-{100 * weather.jitter:.0f} %, {100 * weather.loss:g} % lost)"
+        )
 
     def start_controller(self) -> str:
         if self.process is None:
-            self.process = SimulatorProcess(self.bed.workcell.path, self.joint_map.to_controller(self.bed.joints_deg), tcp=True)
+            self.process = SimulatorProcess(
+                self.bed.workcell.path, self.joint_map.to_controller(self.bed.joints_deg), tcp=True
+            )
         if self.line is None:
             port = int(re.search(r":(\d+)$", self.process.wait_ready()).group(1))
             self.line = DelayLine(("127.0.0.1", 0), ("127.0.0.1", port), self.weather, seed=self.seed).start()

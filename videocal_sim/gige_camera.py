@@ -39,7 +39,10 @@ def _gpointer(obj) -> int:
     """The C pointer of a PyGObject wrapper (its ``__gpointer__`` capsule)."""
     api = ctypes.pythonapi
     api.PyCapsule_GetName.restype, api.PyCapsule_GetName.argtypes = ctypes.c_char_p, [ctypes.py_object]
-    api.PyCapsule_GetPointer.restype, api.PyCapsule_GetPointer.argtypes = ctypes.c_void_p, [ctypes.py_object, ctypes.c_char_p]
+    api.PyCapsule_GetPointer.restype, api.PyCapsule_GetPointer.argtypes = (
+        ctypes.c_void_p,
+        [ctypes.py_object, ctypes.c_char_p],
+    )
     capsule = obj.__gpointer__
     return api.PyCapsule_GetPointer(capsule, api.PyCapsule_GetName(capsule))
 

@@ -71,15 +71,20 @@ def render(noise_seed: int = 0, printed: bool = True) -> np.ndarray:
     mesh, texture, uv = printed_box()
     renderer = SceneRenderer(CAMERA.width, CAMERA.height)
     try:
-        item = (SceneItem("box", mesh, TRUTH, color=(1.0, 1.0, 1.0), texture=texture, texture_coords=uv) if printed
-                else SceneItem("box", mesh, TRUTH, color=(0.9, 0.75, 0.2)))
+        item = (
+            SceneItem("box", mesh, TRUTH, color=(1.0, 1.0, 1.0), texture=texture, texture_coords=uv)
+            if printed
+            else SceneItem("box", mesh, TRUTH, color=(0.9, 0.75, 0.2))
+        )
         renderer.set_items([item])
         rgba = renderer.render_view(CAMERA, np.eye(4), RenderOptions(transparent_background=True, show_edges=False))
     finally:
         renderer.close()
     alpha = rgba[:, :, 3:4] / 255.0
     image = rgba[:, :, :3] * alpha + wood_table() * (1 - alpha)
-    image = cv2.GaussianBlur(image.astype(np.float32), (0, 0), 0.7) + np.random.default_rng(noise_seed).normal(0, 2.5, image.shape)
+    image = cv2.GaussianBlur(image.astype(np.float32), (0, 0), 0.7) + np.random.default_rng(noise_seed).normal(
+        0, 2.5, image.shape
+    )
     return np.clip(image, 0, 255).astype(np.uint8)
 
 

@@ -34,7 +34,11 @@ PRINT_TEXELS = 1024
 def workshop_studio(components: list[SceneItem]) -> Studio:
     """Three lamps around the cell's components (world frame, z up): a key light high at the front left, a weaker
     fill from the right and a rim light from behind, each casting shadows; and the camera's own weak ring light."""
-    corners = np.vstack([trimesh.transform_points(c.mesh.bounds, c.item2world) for c in components]) if components else np.zeros((2, 3))
+    corners = (
+        np.vstack([trimesh.transform_points(c.mesh.bounds, c.item2world) for c in components])
+        if components
+        else np.zeros((2, 3))
+    )
     centre = corners.mean(axis=0)
     radius = float(max(np.linalg.norm(corners - centre, axis=1).max(), 300.0))
     distance = 2.5 * radius + 1500.0
@@ -44,7 +48,11 @@ def workshop_studio(components: list[SceneItem]) -> Studio:
         d = np.asarray(direction, float) / np.linalg.norm(direction)
         return Lamp(tuple(centre + distance * d), tuple(centre), intensity, cone)
 
-    return Studio((lamp((-0.6, -0.5, 0.9), 0.8), lamp((0.8, -0.2, 0.5), 0.45), lamp((0.1, 0.9, 0.7), 0.35)), ring_light=0.3, ambient=0.25)
+    return Studio(
+        (lamp((-0.6, -0.5, 0.9), 0.8), lamp((0.8, -0.2, 0.5), 0.45), lamp((0.1, 0.9, 0.7), 0.35)),
+        ring_light=0.3,
+        ambient=0.25,
+    )
 
 
 def real_camera_look(components: list[SceneItem]) -> CameraLook:
@@ -84,7 +92,16 @@ def print_tile(color: tuple[float, float, float], seed: int) -> np.ndarray:
     # a label: a white card with text and a bar code (about 100 x 50 mm)
     x, y = int(rng.uniform(0, n - 260)), int(rng.uniform(0, n - 130))
     cv2.rectangle(tile, (x, y), (x + 250, y + 125), (235, 235, 228), -1)
-    cv2.putText(tile, f"PART {int(rng.integers(1000, 9999))}", (x + 14, y + 42), cv2.FONT_HERSHEY_SIMPLEX, 1.1, (20, 20, 20), 3, cv2.LINE_AA)
+    cv2.putText(
+        tile,
+        f"PART {int(rng.integers(1000, 9999))}",
+        (x + 14, y + 42),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        1.1,
+        (20, 20, 20),
+        3,
+        cv2.LINE_AA,
+    )
     for k in range(36):
         if rng.random() < 0.55:
             bx = x + 14 + 6 * k
@@ -95,14 +112,25 @@ def print_tile(color: tuple[float, float, float], seed: int) -> np.ndarray:
         cv2.line(tile, (int(x0), int(y0)), (int(x1), int(y1)), ink, int(rng.integers(3, 8)), cv2.LINE_AA)
     cx, cy = rng.integers(80, n - 80, 2)
     cv2.circle(tile, (int(cx), int(cy)), 60, ink, 7, cv2.LINE_AA)
-    cv2.putText(tile, "KEEP CLEAR", (int(rng.uniform(0, n - 330)), int(rng.uniform(50, n))), cv2.FONT_HERSHEY_DUPLEX, 1.4, ink, 3, cv2.LINE_AA)
+    cv2.putText(
+        tile,
+        "KEEP CLEAR",
+        (int(rng.uniform(0, n - 330)), int(rng.uniform(50, n))),
+        cv2.FONT_HERSHEY_DUPLEX,
+        1.4,
+        ink,
+        3,
+        cv2.LINE_AA,
+    )
     return tile
 
 
 def printed(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, np.ndarray]:
     """``mesh`` with a vertex per face corner and texture coordinates (n, 2): each face takes the print projected
     along the axis nearest its normal, ``TEXEL_MM`` mm a texel, repeating."""
-    unmerged = trimesh.Trimesh(mesh.vertices[mesh.faces].reshape(-1, 3), np.arange(3 * len(mesh.faces)).reshape(-1, 3), process=False)
+    unmerged = trimesh.Trimesh(
+        mesh.vertices[mesh.faces].reshape(-1, 3), np.arange(3 * len(mesh.faces)).reshape(-1, 3), process=False
+    )
     axis = np.abs(mesh.face_normals).argmax(axis=1).repeat(3)
     v = unmerged.vertices
     keep = np.array([[1, 2], [0, 2], [0, 1]])[axis]  # the two coordinates across the face's main axis
@@ -110,15 +138,25 @@ def printed(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, np.ndarray]:
     return unmerged, uv
 
 
-def real_components(components: list[SceneItem], *, form_error_mm: float = WORKSHOP_FORM_ERROR_MM, seed: int = 0) -> list[SceneItem]:
+def real_components(
+    components: list[SceneItem], *, form_error_mm: float = WORKSHOP_FORM_ERROR_MM, seed: int = 0
+) -> list[SceneItem]:
     """The cell's components as they really are: each with its form error and its print (fixtures such as the
     floor only printed). The CAD (``components``) is untouched."""
     real = []
     for k, item in enumerate(components):
-        mesh = form_error(item.mesh, form_error_mm, seed + k) if item.kind == "component" and form_error_mm > 0 else item.mesh
+        mesh = (
+            form_error(item.mesh, form_error_mm, seed + k)
+            if item.kind == "component" and form_error_mm > 0
+            else item.mesh
+        )
         mesh, uv = printed(mesh)
         # the print carries the colour: a textured surface is drawn white under it, as the renderer multiplies the two
-        real.append(dataclasses.replace(item, mesh=mesh, color=(1.0, 1.0, 1.0), texture=print_tile(item.color, seed + k), texture_coords=uv))
+        real.append(
+            dataclasses.replace(
+                item, mesh=mesh, color=(1.0, 1.0, 1.0), texture=print_tile(item.color, seed + k), texture_coords=uv
+            )
+        )
     return real
 
 

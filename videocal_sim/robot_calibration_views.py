@@ -15,10 +15,14 @@ from calib_core.vision.board import board_item
 from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 
 
-def simulated_pose_views(bed: TestBed, spec, board2base: np.ndarray, joints: list[np.ndarray], seed: int = 0, progress=None) -> tuple[list[BoardView], list[PoseView], list[str]]:
+def simulated_pose_views(
+    bed: TestBed, spec, board2base: np.ndarray, joints: list[np.ndarray], seed: int = 0, progress=None
+) -> tuple[list[BoardView], list[PoseView], list[str]]:
     """(board views, pose views, rejections) at ``joints`` (commanded, deg) with the board at ``board2base``."""
     bed.extra_items = [board_item(spec, board2base)]
-    camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed)
+    camera = SimulatedCamera(
+        bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed
+    )
     detect = spec.detector()
     corners = spec.corners_mm()
     board_views, pose_views, rejected = [], [], []
@@ -40,16 +44,22 @@ def simulated_pose_views(bed: TestBed, spec, board2base: np.ndarray, joints: lis
     return board_views, pose_views, rejected
 
 
-def simulated_cell_frames(bed: TestBed, targets: list[tuple[str, np.ndarray]], seed: int = 0, progress=None) -> list[CellFrame]:
+def simulated_cell_frames(
+    bed: TestBed, targets: list[tuple[str, np.ndarray]], seed: int = 0, progress=None
+) -> list[CellFrame]:
     """Frames of surveyed features (:mod:`calib_core.robot_calibration.cell_views`) at ``targets``
     ((component, commanded joints deg)), rendered by the true camera; the identification's driver
     locates them as it does a real camera's."""
-    camera = SimulatedCamera(bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 1)
+    camera = SimulatedCamera(
+        bed.intrinsics, bed.true_scene, bed.true_cam2world, lambda: bed.joints_deg.copy(), seed=seed + 1
+    )
     frames = []
     try:
         for k, (component, q) in enumerate(targets):
             bed.joints_deg = np.asarray(q, dtype=float)
-            frames.append(CellFrame(component, bed.joints_deg.copy(), camera.read().image, f"cell_{k + 1:02d}_{component}"))
+            frames.append(
+                CellFrame(component, bed.joints_deg.copy(), camera.read().image, f"cell_{k + 1:02d}_{component}")
+            )
             if progress is not None:
                 progress(k + 1, len(targets))
     finally:

@@ -54,7 +54,9 @@ class FollowJointTrajectoryServer:
         qos = Qos(Policy.Userdata(at.client_id_user_data("serviceid", os.urandom(16))), base=qos)
         self._takers, self._replies = {}, {}
         for service, (request_type, reply_type) in at.SERVICES.items():
-            self._takers[service] = Taker(DataReader(dp, Topic(dp, topics[f"{service}.request"], request_type), qos=qos))
+            self._takers[service] = Taker(
+                DataReader(dp, Topic(dp, topics[f"{service}.request"], request_type), qos=qos)
+            )
             self._replies[service] = DataWriter(dp, Topic(dp, topics[f"{service}.reply"], reply_type), qos=qos)
         self._feedback = DataWriter(dp, Topic(dp, topics["feedback"], at.FeedbackMessage), qos=default_qos(10))
         self._status = DataWriter(dp, Topic(dp, topics["status"], at.GoalStatusArray), qos=static_tf_qos())
@@ -112,7 +114,9 @@ class FollowJointTrajectoryServer:
             code, canceling = at.CANCEL_ERROR_GOAL_TERMINATED, []
         else:
             code, canceling = at.CANCEL_ERROR_UNKNOWN_GOAL_ID, []
-        self._replies["cancel_goal"].write(at.CancelGoalResponse(header=request.header, return_code=code, goals_canceling=canceling))
+        self._replies["cancel_goal"].write(
+            at.CancelGoalResponse(header=request.header, return_code=code, goals_canceling=canceling)
+        )
 
     def _on_get_result(self, request) -> None:
         goal_id = bytes(request.goal_id.uuid)
@@ -125,8 +129,9 @@ class FollowJointTrajectoryServer:
 
     def _answer(self, header, ended: tuple[int, int, str]) -> None:
         status, code, text = ended
-        self._replies["get_result"].write(at.GetResultResponse(header=header, status=status,
-                                                               result=at.FollowJointTrajectoryResult(code, text)))
+        self._replies["get_result"].write(
+            at.GetResultResponse(header=header, status=status, result=at.FollowJointTrajectoryResult(code, text))
+        )
 
     # --- the running goal ----------------------------------------------------------------------
     def _watch_active(self, now: float) -> None:
@@ -166,7 +171,12 @@ class FollowJointTrajectoryServer:
         desired = self.arm.plan_end()
         si = self.arm.per_si
         point = lambda q: msg.JointTrajectoryPoint(positions=[float(v) for v in np.asarray(q) / si])  # noqa: E731
-        feedback = at.FollowJointTrajectoryFeedback(header=msg.Header(msg.Time.of_ns(time.time_ns())), joint_names=list(self.arm.joint_names),
-                                                    desired=point(desired), actual=point(actual), error=point(desired - actual))
+        feedback = at.FollowJointTrajectoryFeedback(
+            header=msg.Header(msg.Time.of_ns(time.time_ns())),
+            joint_names=list(self.arm.joint_names),
+            desired=point(desired),
+            actual=point(actual),
+            error=point(desired - actual),
+        )
         if active is not None:
             self._feedback.write(at.FeedbackMessage(at.UUID(list(active[0])), feedback))

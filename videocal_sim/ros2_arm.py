@@ -24,9 +24,21 @@ class SimulatedRos2Arm:
     """``joint_names`` (URDF order), ``per_si`` (n,) deg per rad or mm per m, limits (n,) in deg/mm,
     ``initial_deg`` (n,). ``log``: where rejections are said."""
 
-    def __init__(self, joint_names, per_si, lower_deg, upper_deg, initial_deg, *, rate_hz: float = 100.0, domain: int = 0,
-                 controller: str = "joint_trajectory_controller", joint_states: str = "/joint_states", log=sys.stderr,
-                 action: bool = True):
+    def __init__(
+        self,
+        joint_names,
+        per_si,
+        lower_deg,
+        upper_deg,
+        initial_deg,
+        *,
+        rate_hz: float = 100.0,
+        domain: int = 0,
+        controller: str = "joint_trajectory_controller",
+        joint_states: str = "/joint_states",
+        log=sys.stderr,
+        action: bool = True,
+    ):
         self.joint_names = list(joint_names)
         self.per_si = np.asarray(per_si, float)
         self.lower, self.upper = np.asarray(lower_deg, float), np.asarray(upper_deg, float)
@@ -60,7 +72,9 @@ class SimulatedRos2Arm:
 
         dp = participant(self.domain)
         self._writer = DataWriter(dp, Topic(dp, dds_topic(self.joint_states), msg.JointState), qos=default_qos(10))
-        self._reader = DataReader(dp, Topic(dp, dds_topic(f"/{self.controller}/joint_trajectory"), msg.JointTrajectory), qos=default_qos(10))
+        self._reader = DataReader(
+            dp, Topic(dp, dds_topic(f"/{self.controller}/joint_trajectory"), msg.JointTrajectory), qos=default_qos(10)
+        )
         self._taker = Taker(self._reader)
         for target, name in ((self._publish_loop, "joint_states"), (self._listen_loop, "trajectories")):
             thread = threading.Thread(target=target, name=f"sim ros2 {name}", daemon=True)
@@ -156,7 +170,9 @@ class SimulatedRos2Arm:
         while not self._stop.is_set():
             q_si = self.position(time.monotonic()) / self.per_si
             stamp = msg.Time.of_ns(time.time_ns())
-            self._writer.write(msg.JointState(msg.Header(stamp, "base_link"), list(self.joint_names), [float(v) for v in q_si], [], []))
+            self._writer.write(
+                msg.JointState(msg.Header(stamp, "base_link"), list(self.joint_names), [float(v) for v in q_si], [], [])
+            )
             self.published += 1
             next_s += period
             delay = next_s - time.monotonic()

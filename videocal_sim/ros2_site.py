@@ -36,15 +36,35 @@ class Ros2ArmProcess:
     def __init__(self, workcell_path: Path, joints_deg, domain: int, rate_hz: float = 100.0, *, network=None):
         self._folder = tempfile.TemporaryDirectory(prefix="videocal-sim-ros2-")
         self._stderr_path = Path(self._folder.name) / "stderr.txt"
-        cmd = [sys.executable, "-m", "app.cli.main", "sim-ros2", "--workcell", str(Path(workcell_path).resolve()), "--domain", str(domain),
-               "--rate", f"{rate_hz:g}", "--joints", ",".join(f"{v:.6f}" for v in joints_deg)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "sim-ros2",
+            "--workcell",
+            str(Path(workcell_path).resolve()),
+            "--domain",
+            str(domain),
+            "--rate",
+            f"{rate_hz:g}",
+            "--joints",
+            ",".join(f"{v:.6f}" for v in joints_deg),
+        ]
         env = None
         if network is not None:  # on the far side of the link, with its own address and the workstation as its peer
             cmd = network.far_command(cmd)
             env = dict(os.environ, CYCLONEDDS_URI=network.cyclone_config("far"))
         with open(self._stderr_path, "w") as err:
-            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), env=env,
-                                            preexec_fn=_die_with_parent)
+            self.process = subprocess.Popen(
+                cmd,
+                stdout=subprocess.PIPE,
+                stderr=err,
+                stdin=subprocess.DEVNULL,
+                text=True,
+                cwd=str(_PROJECT),
+                env=env,
+                preexec_fn=_die_with_parent,
+            )
         self._ready = False
 
     def wait_ready(self) -> None:
@@ -52,7 +72,9 @@ class Ros2ArmProcess:
             if self.process.stdout.readline().strip() != "ready":
                 self.process.wait(timeout=5)
                 why = self._stderr_path.read_text().strip().splitlines()
-                raise SiteError(f"the simulated ROS 2 arm did not start: {why[-1] if why else f'exit code {self.process.returncode}'}")
+                raise SiteError(
+                    f"the simulated ROS 2 arm did not start: {why[-1] if why else f'exit code {self.process.returncode}'}"
+                )
             self._ready = True
 
     def stop(self) -> None:
@@ -89,7 +111,9 @@ class CameraPublisher:
         period = 1.0 / self.source.fps if self.source.fps else 0.0
         next_s = time.monotonic()
         while not self._stop.is_set():
-            next_s = max(next_s + period, time.monotonic() - period)  # at the camera's rate (behind: no burst to catch up)
+            next_s = max(
+                next_s + period, time.monotonic() - period
+            )  # at the camera's rate (behind: no burst to catch up)
             self._stop.wait(max(0.0, next_s - time.monotonic()))
             frame = self.source.read()
             if frame is None:
@@ -98,8 +122,18 @@ class CameraPublisher:
             stamp = msg.Time.of_ns(self.stamp_ns(self.source.last_truth.q_commanded_deg))
             header = msg.Header(stamp, "camera")
             images.write(msg.Image(header, h, w, "rgb8", 0, w * 3, frame.image.tobytes()))
-            infos.write(msg.CameraInfo(header, h, w, i.model, [float(v) for v in i.distortion], k, [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
-                                       [i.fu, 0.0, i.cx, 0.0, 0.0, i.fv, i.cy, 0.0, 0.0, 0.0, 1.0, 0.0]))
+            infos.write(
+                msg.CameraInfo(
+                    header,
+                    h,
+                    w,
+                    i.model,
+                    [float(v) for v in i.distortion],
+                    k,
+                    [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0],
+                    [i.fu, 0.0, i.cx, 0.0, 0.0, i.fv, i.cy, 0.0, 0.0, 0.0, 1.0, 0.0],
+                )
+            )
             self.published += 1
         self.source.close()
 
@@ -131,20 +165,27 @@ class Ros2SimulatedSite(SimulatedSite):
 
         private = domain is None and "ROS_DOMAIN_ID" not in os.environ
         self.domain = private_domain() if private else domain_id(domain)
-        self.description = (f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain}"
-                            + (", a private one: set ROS_DOMAIN_ID to choose" if private else "") + ")")
+        self.description = (
+            f"simulated cell {self.bed.workcell.name} over ROS 2 (domain {self.domain}"
+            + (", a private one: set ROS_DOMAIN_ID to choose" if private else "")
+            + ")"
+        )
         self.arm: Ros2ArmProcess | None = None
         self.publisher: CameraPublisher | None = None
         self.network = None
-        self._poses: deque[tuple[np.ndarray, int]] = deque([(self.bed.joints_deg.copy(), time.time_ns())], maxlen=256)  # (joints, stamp ns)
+        self._poses: deque[tuple[np.ndarray, int]] = deque(
+            [(self.bed.joints_deg.copy(), time.time_ns())], maxlen=256
+        )  # (joints, stamp ns)
         if weather is not None:
             from calib_core.ros2.participant import configure
             from videocal_sim.far_network import FarNetwork
 
             self.network = FarNetwork(weather, seed=seed)
             configure(self.domain, self.network.cyclone_config("near"))
-            self.description += (f", {1000 * weather.one_way_s:.0f} ms away (+-{100 * weather.jitter:.0f} %, "
-                                 f"{100 * weather.loss:g} % of the packets lost)")
+            self.description += (
+                f", {1000 * weather.one_way_s:.0f} ms away (+-{100 * weather.jitter:.0f} %, "
+                f"{100 * weather.loss:g} % of the packets lost)"
+            )
 
     def _follow(self, sample) -> None:
         # The robot is where its joint states say, at their stamp (the controller's epoch clock), kept as a pair so

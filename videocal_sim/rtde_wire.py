@@ -19,18 +19,46 @@ CONTROL_PACKAGE_START = ord("S")
 CONTROL_PACKAGE_PAUSE = ord("P")
 
 # The guide's type names and their packing (big endian).
-FORMATS = {"BOOL": "?", "UINT8": "B", "UINT32": "I", "UINT64": "Q", "INT32": "i", "DOUBLE": "d",
-           "VECTOR3D": "3d", "VECTOR6D": "6d", "VECTOR6INT32": "6i", "VECTOR6UINT32": "6I"}
+FORMATS = {
+    "BOOL": "?",
+    "UINT8": "B",
+    "UINT32": "I",
+    "UINT64": "Q",
+    "INT32": "i",
+    "DOUBLE": "d",
+    "VECTOR3D": "3d",
+    "VECTOR6D": "6d",
+    "VECTOR6INT32": "6i",
+    "VECTOR6UINT32": "6I",
+}
 
 # Output variables the simulated controller offers, with the guide's types.
 OUTPUTS = {
-    "timestamp": "DOUBLE", "target_q": "VECTOR6D", "target_qd": "VECTOR6D", "target_qdd": "VECTOR6D", "actual_q": "VECTOR6D",
-    "actual_qd": "VECTOR6D", "actual_TCP_pose": "VECTOR6D", "target_TCP_pose": "VECTOR6D", "actual_execution_time": "DOUBLE",
-    "robot_mode": "INT32", "joint_mode": "VECTOR6INT32", "safety_mode": "INT32", "safety_status": "INT32", "speed_scaling": "DOUBLE",
-    "target_speed_fraction": "DOUBLE", "runtime_state": "UINT32", "robot_status_bits": "UINT32", "safety_status_bits": "UINT32",
-    "actual_digital_input_bits": "UINT64", "actual_digital_output_bits": "UINT64", "output_bit_registers0_to_31": "UINT32",
-    "output_bit_registers32_to_63": "UINT32", "payload": "DOUBLE",
-    **{f"output_int_register_{i}": "INT32" for i in range(48)}, **{f"output_double_register_{i}": "DOUBLE" for i in range(48)},
+    "timestamp": "DOUBLE",
+    "target_q": "VECTOR6D",
+    "target_qd": "VECTOR6D",
+    "target_qdd": "VECTOR6D",
+    "actual_q": "VECTOR6D",
+    "actual_qd": "VECTOR6D",
+    "actual_TCP_pose": "VECTOR6D",
+    "target_TCP_pose": "VECTOR6D",
+    "actual_execution_time": "DOUBLE",
+    "robot_mode": "INT32",
+    "joint_mode": "VECTOR6INT32",
+    "safety_mode": "INT32",
+    "safety_status": "INT32",
+    "speed_scaling": "DOUBLE",
+    "target_speed_fraction": "DOUBLE",
+    "runtime_state": "UINT32",
+    "robot_status_bits": "UINT32",
+    "safety_status_bits": "UINT32",
+    "actual_digital_input_bits": "UINT64",
+    "actual_digital_output_bits": "UINT64",
+    "output_bit_registers0_to_31": "UINT32",
+    "output_bit_registers32_to_63": "UINT32",
+    "payload": "DOUBLE",
+    **{f"output_int_register_{i}": "INT32" for i in range(48)},
+    **{f"output_double_register_{i}": "DOUBLE" for i in range(48)},
 }
 
 ROBOT_MODE_RUNNING = 7

@@ -76,8 +76,14 @@ def supersampled(intrinsics: Intrinsics, samples: int) -> Intrinsics:
     if samples == 1:
         return intrinsics
     shift = (samples - 1) / 2.0
-    return Intrinsics(intrinsics.fu * samples, intrinsics.fv * samples, intrinsics.cx * samples + shift, intrinsics.cy * samples + shift,
-                      intrinsics.width * samples, intrinsics.height * samples)
+    return Intrinsics(
+        intrinsics.fu * samples,
+        intrinsics.fv * samples,
+        intrinsics.cx * samples + shift,
+        intrinsics.cy * samples + shift,
+        intrinsics.width * samples,
+        intrinsics.height * samples,
+    )
 
 
 class SimulatedCamera(FrameSource):
@@ -87,8 +93,18 @@ class SimulatedCamera(FrameSource):
 
     description = "simulated camera"
 
-    def __init__(self, intrinsics: Intrinsics, scene_at: Callable[[np.ndarray], list[SceneItem]], cam2world_at: Callable[[np.ndarray], np.ndarray], joints: Callable[[], np.ndarray], *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0,
-                 coarse_while_moving: bool = False):
+    def __init__(
+        self,
+        intrinsics: Intrinsics,
+        scene_at: Callable[[np.ndarray], list[SceneItem]],
+        cam2world_at: Callable[[np.ndarray], np.ndarray],
+        joints: Callable[[], np.ndarray],
+        *,
+        fps: float = 15.0,
+        look: CameraLook | None = None,
+        seed: int = 0,
+        coarse_while_moving: bool = False,
+    ):
         self.intrinsics = intrinsics
         self._scene_at = scene_at
         self._cam2world_at = cam2world_at
@@ -124,7 +140,9 @@ class SimulatedCamera(FrameSource):
         items = self._scene_at(q)
         cam2world = self._cam2world_at(q)
         ideal = self._ideal_render(items, cam2world)
-        if self._last_ideal[2] < samples_per_pixel(self.look, self._map.ideal.width) and np.array_equal(np.asarray(self._joints(), dtype=float), q):
+        if self._last_ideal[2] < samples_per_pixel(self.look, self._map.ideal.width) and np.array_equal(
+            np.asarray(self._joints(), dtype=float), q
+        ):
             # Point-sampled because the scene changed, yet the robot did not move during that render:
             # it may have come to rest, and the first frame at rest must be integrated too (a slow
             # machine can deliver it after the robot has been still long enough to be measured on).
@@ -141,7 +159,20 @@ class SimulatedCamera(FrameSource):
         """The scene through the ideal (undistorted) lens, each pixel the mean of its samples; the
         last one again while neither the scene nor the camera moved (a robot at rest costs no render:
         only the noise is new)."""
-        key = (cam2world.tobytes(), tuple((i.name, id(i.mesh), np.asarray(i.item2world).tobytes(), tuple(map(float, i.color)), float(i.opacity), id(i.texture)) for i in items))
+        key = (
+            cam2world.tobytes(),
+            tuple(
+                (
+                    i.name,
+                    id(i.mesh),
+                    np.asarray(i.item2world).tobytes(),
+                    tuple(map(float, i.color)),
+                    float(i.opacity),
+                    id(i.texture),
+                )
+                for i in items
+            ),
+        )
         same_scene = self._last_ideal is not None and self._last_ideal[0] == key
         ideal_intrinsics = self._map.ideal
         samples = samples_per_pixel(self.look, ideal_intrinsics.width)

@@ -75,7 +75,15 @@ class SimulatorProcess:
         if joints_controller is not None:
             cmd += ["--joints", ",".join(f"{v:.4f}" for v in joints_controller)]
         with open(self._stderr_path, "w") as err:
-            self.process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, stdin=subprocess.DEVNULL, text=True, cwd=str(_PROJECT), preexec_fn=_die_with_parent)
+            self.process = subprocess.Popen(
+                cmd,
+                stdout=subprocess.PIPE,
+                stderr=err,
+                stdin=subprocess.DEVNULL,
+                text=True,
+                cwd=str(_PROJECT),
+                preexec_fn=_die_with_parent,
+            )
         self.device: str | None = None
 
     def wait_ready(self) -> str:
@@ -85,7 +93,9 @@ class SimulatorProcess:
             if not line:
                 self.process.wait(timeout=5)
                 why = self._stderr_path.read_text().strip().splitlines()
-                raise SiteError(f"the controller simulator did not start: {why[-1] if why else f'exit code {self.process.returncode}'}")
+                raise SiteError(
+                    f"the controller simulator did not start: {why[-1] if why else f'exit code {self.process.returncode}'}"
+                )
             self.device = line
         return self.device if self.tcp else str(self.link_path)
 

@@ -21,11 +21,14 @@ from videocal_sim.test_bed import TestBed
 from videocal_sim.true_robot import RobotErrors
 from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
+
 class SimulatedSite:
     """The devices of a simulated cell: the controller simulator (started for ``bed``'s workcell)
     and the test bed's camera, which follows the joints the controller reports."""
 
-    def __init__(self, bed: TestBed, *, process: SimulatorProcess | None = None, camera_fps: float = 15.0, camera_seed: int = 0):
+    def __init__(
+        self, bed: TestBed, *, process: SimulatorProcess | None = None, camera_fps: float = 15.0, camera_seed: int = 0
+    ):
         self.bed = bed
         self.process = process
         self.camera_fps = camera_fps
@@ -57,15 +60,24 @@ class SimulatedSite:
             self.process.stop()
 
 
-def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: RobotErrors | None = None, image_scale: float = 1.0,
-                   process: SimulatorProcess | None = None, camera_fps: float = 15.0, intrinsics: Intrinsics | None = None,
-                   less_kind: bool = False) -> tuple[Cell, SimulatedSite]:
+def simulated_cell(
+    workcell_path: str | Path = DEFAULT_WORKCELL,
+    *,
+    errors: RobotErrors | None = None,
+    image_scale: float = 1.0,
+    process: SimulatorProcess | None = None,
+    camera_fps: float = 15.0,
+    intrinsics: Intrinsics | None = None,
+    less_kind: bool = False,
+) -> tuple[Cell, SimulatedSite]:
     """The cell at ``workcell_path`` and a simulated site for it: the true robot has ``errors``
     (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels); ``intrinsics``: another
     camera than the workcell's (its lens, a fisheye), the same for the simulated camera and the cell's model."""
     workcell = load_workcell(workcell_path)
     if workcell.intrinsics_path is None and intrinsics is None:
-        raise VideocalError(f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated camera needs one")
+        raise VideocalError(
+            f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated camera needs one"
+        )
     nominal: Intrinsics = intrinsics or load_intrinsics(workcell.intrinsics_path)
     if image_scale != 1.0:
         nominal = nominal.scaled(image_scale)
@@ -74,7 +86,9 @@ def simulated_cell(workcell_path: str | Path = DEFAULT_WORKCELL, *, errors: Robo
         from videocal_sim.real_look import WORKSHOP_FORM_TOLERANCE_MM, make_less_kind
 
         make_less_kind(bed)
-        for component in workcell.components:  # what the cell's drawings state of such parts (the truth's field stays unread)
+        for (
+            component
+        ) in workcell.components:  # what the cell's drawings state of such parts (the truth's field stays unread)
             if component.kind == "component":
                 component.form_tolerance_mm = WORKSHOP_FORM_TOLERANCE_MM
     cell = Cell.from_workcell(workcell, intrinsics=nominal)

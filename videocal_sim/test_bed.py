@@ -46,15 +46,21 @@ class TestBed:
     __test__ = False  # not a pytest test class despite its name
 
     @classmethod
-    def create(cls, workcell: Workcell | None = None, errors: RobotErrors | None = None, intrinsics: Intrinsics | None = None) -> TestBed:
+    def create(
+        cls, workcell: Workcell | None = None, errors: RobotErrors | None = None, intrinsics: Intrinsics | None = None
+    ) -> TestBed:
         """The bundled workcell with typical robot errors (seed 0) unless told otherwise."""
         cell = workcell or load_workcell()
         model = cell.load_robot()
         true = TrueRobot(model, RobotErrors.typical(0, n_joints=model.n_joints) if errors is None else errors)
         if intrinsics is None and cell.intrinsics_path is None:
-            raise VideocalError(f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)")
+            raise VideocalError(
+                f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+            )
         intr = intrinsics or load_intrinsics(cell.intrinsics_path)
-        return cls(cell, model, true, intr, RobotVisuals.from_robot(true.robot), np.array(cell.home_joints_deg, dtype=float))
+        return cls(
+            cell, model, true, intr, RobotVisuals.from_robot(true.robot), np.array(cell.home_joints_deg, dtype=float)
+        )
 
     def true_scene(self, q_commanded_deg: ArrayLike) -> list[SceneItem]:
         """Workcell plus the true robot's links where they really are at commanded joints."""
@@ -78,8 +84,24 @@ class TestBed:
     def model_cam2world(self, q_commanded_deg: ArrayLike) -> np.ndarray:
         return self.model_robot.fk(q_commanded_deg, "camera")
 
-    def camera(self, *, fps: float = 15.0, look: CameraLook | None = None, seed: int = 0, intrinsics: Intrinsics | None = None, live: bool = False) -> SimulatedCamera:
+    def camera(
+        self,
+        *,
+        fps: float = 15.0,
+        look: CameraLook | None = None,
+        seed: int = 0,
+        intrinsics: Intrinsics | None = None,
+        live: bool = False,
+    ) -> SimulatedCamera:
         """The test bed's camera, following ``joints_deg``; ``live``: video for the window (frames of
         a moving robot point-sampled, :attr:`SimulatedCamera.coarse_while_moving`)."""
-        return SimulatedCamera(intrinsics or self.intrinsics, self.true_scene, self.true_cam2world, lambda: self.joints_deg.copy(), fps=fps, look=look or self.camera_look, seed=seed,
-                               coarse_while_moving=live)
+        return SimulatedCamera(
+            intrinsics or self.intrinsics,
+            self.true_scene,
+            self.true_cam2world,
+            lambda: self.joints_deg.copy(),
+            fps=fps,
+            look=look or self.camera_look,
+            seed=seed,
+            coarse_while_moving=live,
+        )

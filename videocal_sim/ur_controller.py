@@ -30,7 +30,9 @@ _STOPJ = re.compile(r"stopj\(")
 class SimulatedURController:
     """``initial_rad`` (6,); ``lower_rad``/``upper_rad`` the joint limits. ``host``: a loopback address."""
 
-    def __init__(self, initial_rad, *, host: str = "127.0.0.1", lower_rad=None, upper_rad=None, version=(5, 11, 0, 0), log=None):
+    def __init__(
+        self, initial_rad, *, host: str = "127.0.0.1", lower_rad=None, upper_rad=None, version=(5, 11, 0, 0), log=None
+    ):
         self.host = host
         self.version = version
         self.lower = np.asarray(lower_rad if lower_rad is not None else [-2 * math.pi] * 6, float)
@@ -117,15 +119,31 @@ class SimulatedURController:
         moving = self._move is not None
         status_bits = 0b1 | (0b10 if moving else 0)
         safety_bits = 0b100 if self.protective_stopped else 0b1
-        values = {"timestamp": time.monotonic() - self._t0, "actual_q": list(q), "target_q": list(q), "actual_qd": [0.0] * 6, "target_qd": [0.0] * 6,
-                  "target_qdd": [0.0] * 6, "actual_TCP_pose": [0.0] * 6, "target_TCP_pose": [0.0] * 6, "actual_execution_time": 0.1,
-                  "robot_mode": wire.ROBOT_MODE_RUNNING, "joint_mode": [253] * 6,
-                  "safety_mode": wire.SAFETY_MODE_PROTECTIVE_STOP if self.protective_stopped else wire.SAFETY_MODE_NORMAL,
-                  "safety_status": wire.SAFETY_MODE_PROTECTIVE_STOP if self.protective_stopped else wire.SAFETY_MODE_NORMAL,
-                  "speed_scaling": self.speed_slider, "target_speed_fraction": self.speed_slider,
-                  "runtime_state": wire.RUNTIME_STATE_PLAYING if moving else wire.RUNTIME_STATE_STOPPED,
-                  "robot_status_bits": status_bits, "safety_status_bits": safety_bits, "payload": 0.0}
-        return [values.get(name, 0) if wire.FORMATS[wire.OUTPUTS[name]][0] != "6" or name in values else [0] * 6 for name in names]
+        values = {
+            "timestamp": time.monotonic() - self._t0,
+            "actual_q": list(q),
+            "target_q": list(q),
+            "actual_qd": [0.0] * 6,
+            "target_qd": [0.0] * 6,
+            "target_qdd": [0.0] * 6,
+            "actual_TCP_pose": [0.0] * 6,
+            "target_TCP_pose": [0.0] * 6,
+            "actual_execution_time": 0.1,
+            "robot_mode": wire.ROBOT_MODE_RUNNING,
+            "joint_mode": [253] * 6,
+            "safety_mode": wire.SAFETY_MODE_PROTECTIVE_STOP if self.protective_stopped else wire.SAFETY_MODE_NORMAL,
+            "safety_status": wire.SAFETY_MODE_PROTECTIVE_STOP if self.protective_stopped else wire.SAFETY_MODE_NORMAL,
+            "speed_scaling": self.speed_slider,
+            "target_speed_fraction": self.speed_slider,
+            "runtime_state": wire.RUNTIME_STATE_PLAYING if moving else wire.RUNTIME_STATE_STOPPED,
+            "robot_status_bits": status_bits,
+            "safety_status_bits": safety_bits,
+            "payload": 0.0,
+        }
+        return [
+            values.get(name, 0) if wire.FORMATS[wire.OUTPUTS[name]][0] != "6" or name in values else [0] * 6
+            for name in names
+        ]
 
     def _serve_rtde(self, conn: socket.socket) -> None:
         recipe: list[str] = []
@@ -151,7 +169,9 @@ class SimulatedURController:
                 if delay > 0:
                     time.sleep(delay)
                 else:
-                    next_s = time.monotonic() + period  # behind: skip ahead, never a burst (a controller's packages are a period apart)
+                    next_s = (
+                        time.monotonic() + period
+                    )  # behind: skip ahead, never a burst (a controller's packages are a period apart)
                     time.sleep(period)
 
         try:
@@ -206,7 +226,7 @@ class SimulatedURController:
                         end = re.search(r"\nend\s*\n", text)
                         if end is None:
                             break
-                        program, buffer = text[: end.end()], text[end.end():].encode()
+                        program, buffer = text[: end.end()], text[end.end() :].encode()
                     else:
                         line, _, rest = text.partition("\n")
                         program, buffer = line, rest.encode()
@@ -239,8 +259,14 @@ class SimulatedURController:
             conn.close()
 
     # --- life cycle ----------------------------------------------------------------------------
-    def start(self, rtde_port: int = 30004, script_port: int = 30002, dashboard_port: int = 29999) -> SimulatedURController:
-        for port, serve in ((rtde_port, self._serve_rtde), (script_port, self._serve_script), (dashboard_port, self._serve_dashboard)):
+    def start(
+        self, rtde_port: int = 30004, script_port: int = 30002, dashboard_port: int = 29999
+    ) -> SimulatedURController:
+        for port, serve in (
+            (rtde_port, self._serve_rtde),
+            (script_port, self._serve_script),
+            (dashboard_port, self._serve_dashboard),
+        ):
             server = socket.create_server((self.host, port), reuse_port=False)
             server.settimeout(0.2)
             self._servers.append(server)

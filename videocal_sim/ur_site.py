@@ -45,14 +45,34 @@ class URSimulatedSite(SimulatedSite):
         if self.ur is None:
             self.host = free_loopback_host()
             stderr_path = Path(self._folder.name) / "stderr.txt"
-            cmd = [sys.executable, "-m", "app.cli.main", "sim-ur", "--host", self.host, "--workcell", str(Path(self.bed.workcell.path).resolve()),
-                   "--joints", ",".join(f"{v:.6f}" for v in self.bed.joints_deg)]
+            cmd = [
+                sys.executable,
+                "-m",
+                "app.cli.main",
+                "sim-ur",
+                "--host",
+                self.host,
+                "--workcell",
+                str(Path(self.bed.workcell.path).resolve()),
+                "--joints",
+                ",".join(f"{v:.6f}" for v in self.bed.joints_deg),
+            ]
             with open(stderr_path, "w") as err:
-                self.ur = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True, cwd=str(_PROJECT), preexec_fn=_die_with_parent)
+                self.ur = subprocess.Popen(
+                    cmd,
+                    stdin=subprocess.PIPE,
+                    stdout=subprocess.PIPE,
+                    stderr=err,
+                    text=True,
+                    cwd=str(_PROJECT),
+                    preexec_fn=_die_with_parent,
+                )
             if self.ur.stdout.readline().strip() != "ready":
                 self.ur.wait(timeout=5)
                 why = stderr_path.read_text().strip().splitlines()
-                raise SiteError(f"the simulated UR controller did not start: {why[-1] if why else f'exit code {self.ur.returncode}'}")
+                raise SiteError(
+                    f"the simulated UR controller did not start: {why[-1] if why else f'exit code {self.ur.returncode}'}"
+                )
         return f"ur-rtde://{self.host}"
 
     def close(self) -> None:

@@ -20,33 +20,97 @@ from app.cli.options import bounded_float, bounded_int
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="'sim', a cal_data.yaml (or its folder), a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>, "
-                                        "or a ROS 2 bag (a bag folder, .mcap or .db3: images, /joint_states, CameraInfo)")
+    parser.add_argument(
+        "source",
+        help="'sim', a cal_data.yaml (or its folder), a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>, "
+        "or a ROS 2 bag (a bag folder, .mcap or .db3: images, /joint_states, CameraInfo)",
+    )
     parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
-    parser.add_argument("--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)")
-    parser.add_argument("--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)")
-    parser.add_argument("--flange-from", choices=("auto", "joints", "tf"), default="auto",
-                        help="with a bag: the flange pose from the joint states through the cell's robot, or from /tf (default: the joints when the bag has a JointState topic, else /tf)")
-    parser.add_argument("--base-frame", help="with a bag's /tf: the robot's base frame (default: the workcell's base link)")
-    parser.add_argument("--flange-frame", help="with a bag's /tf: the flange frame (default: the workcell's flange link)")
-    parser.add_argument("--workcell", type=Path, help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)")
-    parser.add_argument("--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)")
-    parser.add_argument("--intrinsics", type=Path, help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics")
-    parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
+    parser.add_argument(
+        "--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)"
+    )
+    parser.add_argument(
+        "--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)"
+    )
+    parser.add_argument(
+        "--flange-from",
+        choices=("auto", "joints", "tf"),
+        default="auto",
+        help="with a bag: the flange pose from the joint states through the cell's robot, or from /tf (default: the joints when the bag has a JointState topic, else /tf)",
+    )
+    parser.add_argument(
+        "--base-frame", help="with a bag's /tf: the robot's base frame (default: the workcell's base link)"
+    )
+    parser.add_argument(
+        "--flange-frame", help="with a bag's /tf: the flange frame (default: the workcell's flange link)"
+    )
+    parser.add_argument(
+        "--workcell",
+        type=Path,
+        help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)",
+    )
+    parser.add_argument(
+        "--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)"
+    )
+    parser.add_argument(
+        "--intrinsics",
+        type=Path,
+        help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics",
+    )
+    parser.add_argument(
+        "--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)"
+    )
     mount = parser.add_mutually_exclusive_group()
-    mount.add_argument("--static-camera", dest="static", action="store_const", const=True, help="the camera stands in the cell and the robot holds the board")
-    mount.add_argument("--camera-on-robot", dest="static", action="store_const", const=False, help="the camera is on the robot's flange (the default)")
-    parser.add_argument("--pose-sigma-mm", type=bounded_float(0.001, 100.0), default=1.0, help="how well the robot's poses are known, 1-sigma mm (sets when views are said to disagree)")
-    parser.add_argument("--poses", type=bounded_int(3, 200), default=10, help="with 'sim': robot poses to view the board from (3 to 200)")
-    parser.add_argument("--out", type=Path, required=True, action="append",
-                        help="where to write the mounting, in the form the name asks (repeat for several): .yaml videocal's (xyz mm, rpy deg, "
-                             "1-sigma); .launch.py a ROS 2 launch file running tf2_ros's static_transform_publisher; .urdf or .xacro a "
-                             "fixed-joint snippet for the robot's description")
-    parser.add_argument("--parent-frame", help="the ROS frame the camera hangs from in the .launch.py and .urdf outputs (default: the workcell's "
-                                               "site.camera_parent_frame, else its robot's flange link, else tool0; the base link for --static-camera)")
-    parser.add_argument("--camera-frame", help="the camera's ROS frame in those outputs: the camera driver's optical frame (default: the workcell's "
-                                               "site.camera_frame, else videocal_camera_optical_frame)")
-    parser.add_argument("--robot-errors", action="store_true", help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)")
+    mount.add_argument(
+        "--static-camera",
+        dest="static",
+        action="store_const",
+        const=True,
+        help="the camera stands in the cell and the robot holds the board",
+    )
+    mount.add_argument(
+        "--camera-on-robot",
+        dest="static",
+        action="store_const",
+        const=False,
+        help="the camera is on the robot's flange (the default)",
+    )
+    parser.add_argument(
+        "--pose-sigma-mm",
+        type=bounded_float(0.001, 100.0),
+        default=1.0,
+        help="how well the robot's poses are known, 1-sigma mm (sets when views are said to disagree)",
+    )
+    parser.add_argument(
+        "--poses",
+        type=bounded_int(3, 200),
+        default=10,
+        help="with 'sim': robot poses to view the board from (3 to 200)",
+    )
+    parser.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        action="append",
+        help="where to write the mounting, in the form the name asks (repeat for several): .yaml videocal's (xyz mm, rpy deg, "
+        "1-sigma); .launch.py a ROS 2 launch file running tf2_ros's static_transform_publisher; .urdf or .xacro a "
+        "fixed-joint snippet for the robot's description",
+    )
+    parser.add_argument(
+        "--parent-frame",
+        help="the ROS frame the camera hangs from in the .launch.py and .urdf outputs (default: the workcell's "
+        "site.camera_parent_frame, else its robot's flange link, else tool0; the base link for --static-camera)",
+    )
+    parser.add_argument(
+        "--camera-frame",
+        help="the camera's ROS frame in those outputs: the camera driver's optical frame (default: the workcell's "
+        "site.camera_frame, else videocal_camera_optical_frame)",
+    )
+    parser.add_argument(
+        "--robot-errors",
+        action="store_true",
+        help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)",
+    )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
@@ -67,7 +131,9 @@ def run(args: argparse.Namespace) -> int:
         return 0
     camera = "cam2base" if result.static_camera else "cam2flange"
     print(f"{result.views} poses, RMS {result.rms_px:.3f} px (the corners' own noise {result.noise_px:.3f} px)")
-    print(f"{camera} xyz {', '.join(f'{v:.3f}' for v in result.camera2mount[:3, 3])} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})")
+    print(
+        f"{camera} xyz {', '.join(f'{v:.3f}' for v in result.camera2mount[:3, 3])} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})"
+    )
     if truth is not None:
         print(f"error against the test bed's truth: {truth['mm']:.3f} mm, {truth['deg']:.4f} deg")
     for w in result.warnings:
@@ -123,20 +189,39 @@ def _from_bag(args, source: Path):
     cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
     robot = cell.load_robot()
     spec = parse_board(args.board or DEFAULT_SPEC)
-    use_tf = args.flange_from == "tf" or (args.flange_from == "auto" and args.joint_topic is None and not any(t.msgtype == JOINT_STATE and t.count for t in bag_topics(source)))
+    use_tf = args.flange_from == "tf" or (
+        args.flange_from == "auto"
+        and args.joint_topic is None
+        and not any(t.msgtype == JOINT_STATE and t.count for t in bag_topics(source))
+    )
     if use_tf:
         frames = cell.robot_spec.frames
-        base, flange = args.base_frame or str(frames.get("base") or "base_link"), args.flange_frame or str(frames.get("flange") or "tool0")
+        base, flange = (
+            args.base_frame or str(frames.get("base") or "base_link"),
+            args.flange_frame or str(frames.get("flange") or "tool0"),
+        )
         settled, to_flange = flange_settled(source, base, flange), lambda pose: pose
         print(f"{source}: the flange ({flange} in {base}) from /tf", file=sys.stderr)
     else:
         settled, to_flange = joints_settled(source, robot, args.joint_topic), lambda q: robot.fk(q, "flange")
-    found = bag_board_views(source, spec, _detector(args, spec), settled, topic=args.topic, every=args.every, say=lambda text: print(text, file=sys.stderr))
+    found = bag_board_views(
+        source,
+        spec,
+        _detector(args, spec),
+        settled,
+        topic=args.topic,
+        every=args.every,
+        say=lambda text: print(text, file=sys.stderr),
+    )
     print(f"{source}: {found.summary}", file=sys.stderr)
     views = [v for v, _ in found.views]
     flanges = [to_flange(pose) for _, pose in found.views]
     size = found.size
-    intrinsics = load_intrinsics(args.intrinsics, image_size=size) if args.intrinsics is not None else bag_intrinsics(source, size)
+    intrinsics = (
+        load_intrinsics(args.intrinsics, image_size=size)
+        if args.intrinsics is not None
+        else bag_intrinsics(source, size)
+    )
     if intrinsics is None:
         raise VideocalError(f"{source}: the bag has no CameraInfo: pass --intrinsics FILE")
     static = bool(args.static)
@@ -158,10 +243,21 @@ def _from_files(args):
 
     if looks_like_bag(source) and not source.name.endswith(".yaml"):
         return _from_bag(args, source)
-    bag_only = [flag for flag, given in (("--topic", args.topic), ("--joint-topic", args.joint_topic), ("--flange-from", args.flange_from != "auto"),
-                                         ("--base-frame", args.base_frame), ("--flange-frame", args.flange_frame)) if given]
+    bag_only = [
+        flag
+        for flag, given in (
+            ("--topic", args.topic),
+            ("--joint-topic", args.joint_topic),
+            ("--flange-from", args.flange_from != "auto"),
+            ("--base-frame", args.base_frame),
+            ("--flange-frame", args.flange_frame),
+        )
+        if given
+    ]
     if bag_only:
-        raise VideocalError(f"{', '.join(bag_only)} appl{'ies' if len(bag_only) == 1 else 'y'} to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
+        raise VideocalError(
+            f"{', '.join(bag_only)} appl{'ies' if len(bag_only) == 1 else 'y'} to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)"
+        )
     data = load_posed_images(source)
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     static = args.static if args.static is not None else bool(data.static_camera)
@@ -175,19 +271,26 @@ def _from_files(args):
     views, flanges, size = [], [], None
     for posed in data.views:
         if posed.component is not None:
-            print(f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; calibrate-robot uses both)", file=sys.stderr)
+            print(
+                f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; calibrate-robot uses both)",
+                file=sys.stderr,
+            )
             continue
         image = data.read_image(posed)
         if size is None:
             size = (image.shape[1], image.shape[0])
         elif (image.shape[1], image.shape[0]) != size:
-            raise VideocalError(f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+            raise VideocalError(
+                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode"
+            )
         v = detect_view(posed.name, image, spec, detect)
         if not isinstance(v, BoardView):
             print(f"rejected {posed.name}: {v.reason}", file=sys.stderr)
             continue
         views.append(v)
-        flanges.append(posed.flange2base if posed.flange2base is not None else robot.fk(posed.joints_deg[order], "flange"))
+        flanges.append(
+            posed.flange2base if posed.flange2base is not None else robot.fk(posed.joints_deg[order], "flange")
+        )
     if args.intrinsics is not None:
         intrinsics = load_intrinsics(args.intrinsics, image_size=size)
     elif data.pinhole is not None:
@@ -201,7 +304,15 @@ def _simulated(args):
     from calib_core.plugins import SITES, load_plugin
 
     if args.intrinsics is not None:
-        raise VideocalError("--intrinsics is not used with 'sim': the simulated camera's intrinsics are the bundled cell's")
+        raise VideocalError(
+            "--intrinsics is not used with 'sim': the simulated camera's intrinsics are the bundled cell's"
+        )
     simulated = load_plugin(SITES, "sim")
-    return simulated.hand_eye(board=args.board, workcell=args.workcell, robot_errors=args.robot_errors, poses=args.poses,
-                              detector_params=args.detector_params, pose_sigma_mm=args.pose_sigma_mm)
+    return simulated.hand_eye(
+        board=args.board,
+        workcell=args.workcell,
+        robot_errors=args.robot_errors,
+        poses=args.poses,
+        detector_params=args.detector_params,
+        pose_sigma_mm=args.pose_sigma_mm,
+    )

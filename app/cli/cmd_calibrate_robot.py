@@ -24,20 +24,52 @@ from calib_core.errors import VideocalError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("source", help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, a folder holding views.csv (and grasps.csv), "
-                                       "or a ROS 2 bag (a bag folder, .mcap or .db3: board images, /joint_states, CameraInfo)")
+    parser.add_argument(
+        "source",
+        help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, a folder holding views.csv (and grasps.csv), "
+        "or a ROS 2 bag (a bag folder, .mcap or .db3: board images, /joint_states, CameraInfo)",
+    )
     parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
-    parser.add_argument("--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)")
-    parser.add_argument("--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)")
-    parser.add_argument("--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)")
-    parser.add_argument("--fixed-intrinsics", action="store_true", help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot")
-    parser.add_argument("--seed", type=bounded_int(0, 10_000), default=0, help="with 'sim': which cold cell (its errors are drawn from this)")
-    parser.add_argument("--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)")
+    parser.add_argument(
+        "--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)"
+    )
+    parser.add_argument(
+        "--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)"
+    )
+    parser.add_argument(
+        "--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)"
+    )
+    parser.add_argument(
+        "--fixed-intrinsics",
+        action="store_true",
+        help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot",
+    )
+    parser.add_argument(
+        "--seed",
+        type=bounded_int(0, 10_000),
+        default=0,
+        help="with 'sim': which cold cell (its errors are drawn from this)",
+    )
+    parser.add_argument(
+        "--workcell", type=Path, help="with a CSV: the cell whose robot took the views (default: the bundled one)"
+    )
     parser.add_argument("--board", help="with a CSV: the board (default charuco:9x7:30:22:DICT_5X5_100)")
-    parser.add_argument("--intrinsics", type=Path, help="with a CSV or a bag: the camera's intrinsics file (default: a bag's CameraInfo, else calibrated from the same views)")
-    parser.add_argument("--grasps", type=Path, help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)")
-    parser.add_argument("--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)")
-    parser.add_argument("--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF")
+    parser.add_argument(
+        "--intrinsics",
+        type=Path,
+        help="with a CSV or a bag: the camera's intrinsics file (default: a bag's CameraInfo, else calibrated from the same views)",
+    )
+    parser.add_argument(
+        "--grasps",
+        type=Path,
+        help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)",
+    )
+    parser.add_argument(
+        "--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)"
+    )
+    parser.add_argument(
+        "--out", type=Path, required=True, help="folder for robot_calibration.yaml and the calibrated URDF"
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
@@ -51,8 +83,21 @@ def run(args: argparse.Namespace) -> int:
     if args.source == "sim":
         from calib_core.plugins import SITES, load_plugin
 
-        run_ = load_plugin(SITES, "sim").calibrate_robot(args.views, args.seed, with_intrinsics=not args.fixed_intrinsics, progress=_progress, say=lambda text: print(text, file=sys.stderr))
-        result, robot, nominal, tool, rejected, score = run_.result, run_.robot, run_.nominal_robot, run_.tool, run_.rejected, run_.score
+        run_ = load_plugin(SITES, "sim").calibrate_robot(
+            args.views,
+            args.seed,
+            with_intrinsics=not args.fixed_intrinsics,
+            progress=_progress,
+            say=lambda text: print(text, file=sys.stderr),
+        )
+        result, robot, nominal, tool, rejected, score = (
+            run_.result,
+            run_.robot,
+            run_.nominal_robot,
+            run_.tool,
+            run_.rejected,
+            run_.score,
+        )
         intrinsics_rms = run_.intrinsics.rms_px
         counts = {"board_views": run_.board_views, "cell_views": run_.cell_views}
     else:
@@ -78,18 +123,36 @@ def run(args: argparse.Namespace) -> int:
         print(f"rejected {r}", file=sys.stderr)
     args.out.mkdir(parents=True, exist_ok=True)
     save_robot_calibration(args.out, result, nominal, robot=robot, tool=tool)
-    summary = {"views": len(result.per_view_rms_px), **counts, "rejected": rejected, "rms_px": result.rms_px, "start_rms_px": result.start_rms_px, "seconds": result.seconds,
-               "identified": len(result.observability.identified), "of": len(result.names), "condition": result.observability.condition,
-               "intrinsics_rms_px": intrinsics_rms, "warnings": list(result.warnings), "out": str(args.out)}
+    summary = {
+        "views": len(result.per_view_rms_px),
+        **counts,
+        "rejected": rejected,
+        "rms_px": result.rms_px,
+        "start_rms_px": result.start_rms_px,
+        "seconds": result.seconds,
+        "identified": len(result.observability.identified),
+        "of": len(result.names),
+        "condition": result.observability.condition,
+        "intrinsics_rms_px": intrinsics_rms,
+        "warnings": list(result.warnings),
+        "out": str(args.out),
+    }
     if tool is not None:
-        summary["tool"] = {"grasps": len(tool.per_grasp), "seen": tool.seen_grasps, "spread_mm": tool.spread_mm, "spread_deg": tool.spread_deg}
+        summary["tool"] = {
+            "grasps": len(tool.per_grasp),
+            "seen": tool.seen_grasps,
+            "spread_mm": tool.spread_mm,
+            "spread_deg": tool.spread_deg,
+        }
     if score is not None:
         summary["score"] = score
     if args.json:
         json.dump(summary, sys.stdout, indent=2, default=float)
         sys.stdout.write("\n")
         return 0
-    print(f"{counts['board_views']} board views, {counts['cell_views']} views of surveyed components; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s")
+    print(
+        f"{counts['board_views']} board views, {counts['cell_views']} views of surveyed components; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s"
+    )
     for w in result.warnings:
         print(f"warning: {w}")
     for key, value in (score or {}).items():
@@ -116,21 +179,29 @@ def _from_files(args):
     if looks_like_bag(source):
         return _from_bag(args, source)
     if args.topic is not None or args.joint_topic is not None:
-        raise VideocalError(f"--topic and --joint-topic apply to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)")
+        raise VideocalError(
+            f"--topic and --joint-topic apply to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)"
+        )
     data = load_posed_images(source)
     if data.joint_columns is None:
-        raise VideocalError(f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses")
+        raise VideocalError(
+            f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses"
+        )
     cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
     robot = cell.load_robot()
     order = data.joint_order(robot.joint_names)
     components = {c.name for c in cell.components if c.features}
     for posed in data.views:  # before any work: a view of a component the cell does not survey
         if posed.component is not None and posed.component not in components:
-            raise VideocalError(f"{data.source}: view {posed.name}: no surveyed component {posed.component!r} in {cell.path.name} (components with features: "
-                                f"{', '.join(sorted(components)) or 'none'})")
+            raise VideocalError(
+                f"{data.source}: view {posed.name}: no surveyed component {posed.component!r} in {cell.path.name} (components with features: "
+                f"{', '.join(sorted(components)) or 'none'})"
+            )
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     if not spec.unambiguous:
-        raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+        raise VideocalError(
+            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+        )
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
     board_views, views, rejected, size, of_components = [], [], [], None, []
@@ -139,7 +210,9 @@ def _from_files(args):
         if size is None:
             size = (image.shape[1], image.shape[0])
         elif (image.shape[1], image.shape[0]) != size:
-            raise VideocalError(f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode")
+            raise VideocalError(
+                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode"
+            )
         if posed.component is not None:
             of_components.append(posed)  # located once the intrinsics are known
             continue
@@ -155,7 +228,10 @@ def _from_files(args):
     else:
         calibrated = calibrate_intrinsics(board_views, spec, rejected=[])
         intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
-    frames = [CellFrame(posed.component, posed.joints_deg[order], data.read_image(posed), posed.name) for posed in of_components]
+    frames = [
+        CellFrame(posed.component, posed.joints_deg[order], data.read_image(posed), posed.name)
+        for posed in of_components
+    ]
     done = identify_robot(robot, intrinsics, cell, views, frames, with_intrinsics=not args.fixed_intrinsics)
     return done.result, robot, rejected, rms, {"board_views": done.board_views, "cell_views": done.cell_views}
 
@@ -177,9 +253,13 @@ def _from_bag(args, source: Path):
     robot = cell.load_robot()
     spec = parse_board(args.board or DEFAULT_SPEC)
     if not spec.unambiguous:
-        raise VideocalError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+        raise VideocalError(
+            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+        )
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
-    found = bag_board_views(source, spec, detect, joints_settled(source, robot, args.joint_topic), topic=args.topic, every=args.every)
+    found = bag_board_views(
+        source, spec, detect, joints_settled(source, robot, args.joint_topic), topic=args.topic, every=args.every
+    )
     for why in found.skipped:  # the rejected ones are said with the identification's (run)
         print(f"skipped {why}", file=sys.stderr)
     print(f"{source}: {found.summary}", file=sys.stderr)
@@ -195,7 +275,10 @@ def _from_bag(args, source: Path):
         if intrinsics is None:
             calibrated = calibrate_intrinsics([v for v, _ in found.views], spec, rejected=[])
             intrinsics, rms = calibrated.intrinsics, calibrated.rms_px
-            print(f"{source}: no CameraInfo: the intrinsics calibrated from the same views (RMS {rms:.2f} px)", file=sys.stderr)
+            print(
+                f"{source}: no CameraInfo: the intrinsics calibrated from the same views (RMS {rms:.2f} px)",
+                file=sys.stderr,
+            )
     done = identify_robot(robot, intrinsics, cell, views, [], with_intrinsics=not args.fixed_intrinsics)
     return done.result, robot, found.rejected, rms, {"board_views": done.board_views, "cell_views": done.cell_views}
 
@@ -215,7 +298,14 @@ def _seen_grasps(rows, grasps_path: Path, result, cell) -> list:
             continue
         image = read_grey_image(row.image_path, grasps_path, g.name)
         try:
-            grasps.append(Grasp(g.name, g.joints_deg, g.tcp2base, see_grasp(image, result.intrinsics, result.robot, cell, cell.task(row.task), g.joints_deg)))
+            grasps.append(
+                Grasp(
+                    g.name,
+                    g.joints_deg,
+                    g.tcp2base,
+                    see_grasp(image, result.intrinsics, result.robot, cell, cell.task(row.task), g.joints_deg),
+                )
+            )
         except GraspNotSeenError as e:
             print(f"grasp {g.name}: {e}: taken through the robot and the survey", file=sys.stderr)
             grasps.append(g)

@@ -16,13 +16,21 @@ BAG_FORMAT = "ros2-bag"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("workspace", type=Path, help="a workspace file (a recording .mcap with --format ros2-bag)")
-    parser.add_argument("--format", choices=EXPORT_FORMATS + (BAG_FORMAT,), default="csv",
-                        help="csv, json (every correction, with the target to command), a controller listing: urscript (UR), rapid (ABB), krl (KUKA), "
-                             "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: images, "
-                             "joint states in rad and m, camera_info)")
+    parser.add_argument(
+        "--format",
+        choices=EXPORT_FORMATS + (BAG_FORMAT,),
+        default="csv",
+        help="csv, json (every correction, with the target to command), a controller listing: urscript (UR), rapid (ABB), krl (KUKA), "
+        "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: images, "
+        "joint states in rad and m, camera_info)",
+    )
     parser.add_argument("--out", type=Path)
-    parser.add_argument("--workcell", type=resolved_path, help="the cell whose robot gives the tool data of a controller listing, or with ros2-bag each "
-                                                               "joint's unit (default: the workspace's or recording's own)")
+    parser.add_argument(
+        "--workcell",
+        type=resolved_path,
+        help="the cell whose robot gives the tool data of a controller listing, or with ros2-bag each "
+        "joint's unit (default: the workspace's or recording's own)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -42,7 +50,14 @@ def run(args: argparse.Namespace) -> int:
 
     ws = load_workspace(args.workspace)
     robot, joint_map = _robot(args.workcell or ws.workcell_path)
-    text = export_corrections(args.format, ws.corrections, ws.task_locations, args.out.name.split(".")[0] if args.out else None, robot, joint_map)
+    text = export_corrections(
+        args.format,
+        ws.corrections,
+        ws.task_locations,
+        args.out.name.split(".")[0] if args.out else None,
+        robot,
+        joint_map,
+    )
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")
@@ -76,7 +91,10 @@ def _robot(workcell: str | Path | None):
     configurations of a listing; ``(None, None)`` (the listing then has neither, and says so) when the workspace names
     no workcell or it is not there."""
     if not workcell or not Path(workcell).is_file():
-        print(f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not there (give --workcell)", file=sys.stderr)
+        print(
+            f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not there (give --workcell)",
+            file=sys.stderr,
+        )
         return None, None
     from calib_core.connectors.joint_map import JointMap
     from calib_core.workcell import load_workcell

@@ -15,10 +15,23 @@ EXIT_SILENT = 4
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("spec", help="a camera spec: an OpenCV device number, a video file, a folder, rtsp://, ros2:///camera/image_raw, ...")
+    parser.add_argument(
+        "spec",
+        help="a camera spec: an OpenCV device number, a video file, a folder, rtsp://, ros2:///camera/image_raw, ...",
+    )
     parser.add_argument("--count", type=bounded_int(1, 1_000_000), required=True, help="how many frames")
-    parser.add_argument("--out", type=resolved_path, required=True, help="the folder for the PNG files and frames.csv (made if missing; must hold no frames.csv)")
-    parser.add_argument("--wait", type=bounded_float(0.1, 3600.0), default=10.0, help="how long a silent camera is waited for, s (default 10)")
+    parser.add_argument(
+        "--out",
+        type=resolved_path,
+        required=True,
+        help="the folder for the PNG files and frames.csv (made if missing; must hold no frames.csv)",
+    )
+    parser.add_argument(
+        "--wait",
+        type=bounded_float(0.1, 3600.0),
+        default=10.0,
+        help="how long a silent camera is waited for, s (default 10)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -56,12 +69,18 @@ def run(args: argparse.Namespace) -> int:
                     silent_since = now
                     print(f"waiting: {exc}", file=sys.stderr, flush=True)
                 if now - silent_since > args.wait:
-                    print(f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); {_kept(rows, args)}", file=sys.stderr)
+                    print(
+                        f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); {_kept(rows, args)}",
+                        file=sys.stderr,
+                    )
                     code = EXIT_SILENT
                     break
                 continue
             if frame is None:
-                print(f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames ({_kept(rows, args)})", file=sys.stderr)
+                print(
+                    f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames ({_kept(rows, args)})",
+                    file=sys.stderr,
+                )
                 code = EXIT_SILENT
                 break
             if silent_since is not None:
@@ -91,4 +110,8 @@ def run(args: argparse.Namespace) -> int:
 def _kept(rows: list[str], args) -> str:
     """What a grab that ended early leaves: the frames it got, or nothing at all."""
     got = len(rows) - 1
-    return f"{got} of {args.count} frames kept in {args.out}" if got else f"0 of {args.count} frames: nothing was left behind"
+    return (
+        f"{got} of {args.count} frames kept in {args.out}"
+        if got
+        else f"0 of {args.count} frames: nothing was left behind"
+    )

@@ -14,7 +14,11 @@ from pathlib import Path
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--file", type=Path, help="the key file (default: the user's, in the config folder)")
     parser.add_argument("--new", action="store_true", help="replace the key with a fresh one")
-    parser.add_argument("--show", action="store_true", help="print the key (64 hex digits) for the controller program's link_key constant")
+    parser.add_argument(
+        "--show",
+        action="store_true",
+        help="print the key (64 hex digits) for the controller program's link_key constant",
+    )
 
 
 def run(args: argparse.Namespace) -> int:

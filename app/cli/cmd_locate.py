@@ -33,13 +33,43 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("photo", type=Path, help="the photo (PNG, JPEG, ...) of the object")
     parser.add_argument("--mesh", type=Path, required=True, help="the object's mesh (STL, OBJ, PLY, DAE, glTF)")
-    parser.add_argument("--intrinsics", type=Path, required=True, help="the camera's intrinsics (OpenCV YAML or ROS camera_info YAML)")
-    parser.add_argument("--prior", type=Path, required=True, help="JSON: the object's rough pose in the camera frame (R_obj2cam, t_obj2cam_mm)")
-    parser.add_argument("--features", type=Path, help="YAML: name: [x, y, z] corner points in the mesh's units (default: a small mesh's vertices)")
-    parser.add_argument("--units", choices=sorted(MESH_SCALE, key=MESH_SCALE.get), default="mm", help="the mesh's and the features' units (default mm)")
-    parser.add_argument("--reach-mm", type=float, default=REACH_MM, help=f"how far the prior's position may be off, mm (default {REACH_MM:g})")
-    parser.add_argument("--reach-deg", type=float, default=REACH_DEG, help=f"how far the prior may be turned, degrees (default {REACH_DEG:g})")
-    parser.add_argument("--overlay", type=Path, help="write the photo with the located outline (green) and the prior's (red) to this PNG")
+    parser.add_argument(
+        "--intrinsics", type=Path, required=True, help="the camera's intrinsics (OpenCV YAML or ROS camera_info YAML)"
+    )
+    parser.add_argument(
+        "--prior",
+        type=Path,
+        required=True,
+        help="JSON: the object's rough pose in the camera frame (R_obj2cam, t_obj2cam_mm)",
+    )
+    parser.add_argument(
+        "--features",
+        type=Path,
+        help="YAML: name: [x, y, z] corner points in the mesh's units (default: a small mesh's vertices)",
+    )
+    parser.add_argument(
+        "--units",
+        choices=sorted(MESH_SCALE, key=MESH_SCALE.get),
+        default="mm",
+        help="the mesh's and the features' units (default mm)",
+    )
+    parser.add_argument(
+        "--reach-mm",
+        type=float,
+        default=REACH_MM,
+        help=f"how far the prior's position may be off, mm (default {REACH_MM:g})",
+    )
+    parser.add_argument(
+        "--reach-deg",
+        type=float,
+        default=REACH_DEG,
+        help=f"how far the prior may be turned, degrees (default {REACH_DEG:g})",
+    )
+    parser.add_argument(
+        "--overlay",
+        type=Path,
+        help="write the photo with the located outline (green) and the prior's (red) to this PNG",
+    )
     parser.add_argument("--indent", type=int, default=2, help="JSON indentation (0 for one line)")
 
 
@@ -57,9 +87,14 @@ def read_prior(path: Path) -> np.ndarray:
             for key in ("R_obj2cam", "t_obj2cam_mm"):
                 if data.get(key) is None:
                     raise FileFormatError(path, "required field is missing (or give obj2cam, 4 x 4)", key)
-            pose = make_transform(np.asarray(data["R_obj2cam"], dtype=float).reshape(3, 3), np.asarray(data["t_obj2cam_mm"], dtype=float).reshape(3))
+            pose = make_transform(
+                np.asarray(data["R_obj2cam"], dtype=float).reshape(3, 3),
+                np.asarray(data["t_obj2cam_mm"], dtype=float).reshape(3),
+            )
     except (TypeError, ValueError) as exc:
-        raise FileFormatError(path, f"R_obj2cam must be 3 x 3 and t_obj2cam_mm 3 numbers (or obj2cam 4 x 4): {exc}") from None
+        raise FileFormatError(
+            path, f"R_obj2cam must be 3 x 3 and t_obj2cam_mm 3 numbers (or obj2cam 4 x 4): {exc}"
+        ) from None
     # a rough prior written by hand (four decimals) is a rotation to a few 1e-4: the nearest rotation is meant
     u, singular, vt = np.linalg.svd(pose[:3, :3]) if np.all(np.isfinite(pose)) else (None, None, None)
     if singular is not None and np.max(np.abs(singular - 1.0)) < 0.01 and np.linalg.det(u @ vt) > 0:
@@ -79,7 +114,11 @@ def read_features(path: Path, scale: float) -> dict[str, np.ndarray]:
         raise FileFormatError(path, f"{len(data)} features; at most {MAX_FEATURES}")
     out = {}
     for name, value in data.items():
-        if not (isinstance(value, list) and len(value) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        if not (
+            isinstance(value, list)
+            and len(value) == 3
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        ):
             raise FileFormatError(path, f"must be [x, y, z] numbers, got {value!r}", str(name))
         point = np.asarray(value, dtype=float) * scale
         if not np.all(np.isfinite(point)):
@@ -97,11 +136,16 @@ def run(args: argparse.Namespace) -> int:
     for name in ("reach_mm", "reach_deg"):
         value = getattr(args, name)
         if not (np.isfinite(value) and 0.0 < value <= (500.0 if name == "reach_mm" else 30.0)):
-            raise ValueError(f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got {value:g}")
+            raise ValueError(
+                f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got {value:g}"
+            )
     image = read_image(args.photo)
     intrinsics = load_intrinsics(args.intrinsics, image_size=(image.shape[1], image.shape[0]))
     if (intrinsics.width, intrinsics.height) != (image.shape[1], image.shape[0]):
-        raise FileFormatError(args.photo, f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x {intrinsics.height} px")
+        raise FileFormatError(
+            args.photo,
+            f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x {intrinsics.height} px",
+        )
     from calib_core.mesh_files import load_mesh  # trimesh: loaded for a run, not for --help
 
     mesh = load_mesh(args.mesh, args.units)
@@ -109,8 +153,11 @@ def run(args: argparse.Namespace) -> int:
     prior = read_prior(args.prior)
     centre = prior[:3, :3] @ np.asarray(mesh.bounding_box.centroid, dtype=float) + prior[:3, 3]
     if not centre[2] > 0.0:
-        raise FileFormatError(args.prior, f"the prior puts the object's centre {centre[2]:.1f} mm in front of the camera: behind it, or in its "
-                                          "plane; the camera looks along +z (OpenCV's axes)")
+        raise FileFormatError(
+            args.prior,
+            f"the prior puts the object's centre {centre[2]:.1f} mm in front of the camera: behind it, or in its "
+            "plane; the camera looks along +z (OpenCV's axes)",
+        )
     view = ModelView(intrinsics)
     try:
         from calib_core.scene import SceneItem
@@ -118,7 +165,17 @@ def run(args: argparse.Namespace) -> int:
         # the model's view only says which edges show: the object alone, light on the renderer's black, its faces
         # shaded apart by the light
         expected = view.of([SceneItem(args.mesh.stem, mesh, np.eye(4), color=(0.75, 0.75, 0.75))], np.eye(4))
-        result = locate(image, intrinsics, mesh, prior, features=features, expected=expected, reach_mm=args.reach_mm, reach_deg=args.reach_deg, name=args.mesh.stem)
+        result = locate(
+            image,
+            intrinsics,
+            mesh,
+            prior,
+            features=features,
+            expected=expected,
+            reach_mm=args.reach_mm,
+            reach_deg=args.reach_deg,
+            name=args.mesh.stem,
+        )
     finally:
         view.close()
     if args.overlay:
@@ -141,7 +198,15 @@ def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.nd
         if pose is None or len(creases) == 0:
             continue
         for a, b in project_points(vertices[creases.reshape(-1)], pose, intrinsics).reshape(-1, 2, 2):
-            cv2.line(out, (int(round(a[0] * 4)), int(round(a[1] * 4))), (int(round(b[0] * 4)), int(round(b[1] * 4))), colour, 1, cv2.LINE_AA, shift=2)
+            cv2.line(
+                out,
+                (int(round(a[0] * 4)), int(round(a[1] * 4))),
+                (int(round(b[0] * 4)), int(round(b[1] * 4))),
+                colour,
+                1,
+                cv2.LINE_AA,
+                shift=2,
+            )
     for f in result.features:
         cv2.drawMarker(out, (int(round(f.uv_px[0])), int(round(f.uv_px[1]))), (255, 200, 0), cv2.MARKER_CROSS, 9, 1)
     if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):

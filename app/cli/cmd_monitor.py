@@ -19,15 +19,43 @@ EXIT_TIMEOUT = 4
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("url", help="a controller connector URL: a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port, loop://, ros2:///joint_states, ...")
-    parser.add_argument("--workcell", type=resolved_path, help="the cell's workcell file: samples in its robot's joint order and zero, its joint count checked (needed by connectors that name joints, such as ros2://)")
+    parser.add_argument(
+        "url",
+        help="a controller connector URL: a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port, loop://, ros2:///joint_states, ...",
+    )
+    parser.add_argument(
+        "--workcell",
+        type=resolved_path,
+        help="the cell's workcell file: samples in its robot's joint order and zero, its joint count checked (needed by connectors that name joints, such as ros2://)",
+    )
     rate = parser.add_mutually_exclusive_group()
-    rate.add_argument("--poll", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="request samples at this rate (the paper's cyclic request)")
-    rate.add_argument("--stream", type=bounded_float(0.0, 1000.0, exclusive_low=True), metavar="HZ", help="ask the controller to stream at this rate (default 20)")
+    rate.add_argument(
+        "--poll",
+        type=bounded_float(0.0, 1000.0, exclusive_low=True),
+        metavar="HZ",
+        help="request samples at this rate (the paper's cyclic request)",
+    )
+    rate.add_argument(
+        "--stream",
+        type=bounded_float(0.0, 1000.0, exclusive_low=True),
+        metavar="HZ",
+        help="ask the controller to stream at this rate (default 20)",
+    )
     parser.add_argument("--count", type=bounded_int(1, 10**12), help="stop after this many samples")
-    parser.add_argument("--timeout", type=bounded_float(0.0, 86400.0, exclusive_low=True), default=5.0, help="give up after this many seconds without a sample (default 5)")
-    parser.add_argument("--json", action="store_true", help="one JSON object per line: seq, t_ms (ms since the epoch), t_controller_ms (the controller's own stamp), joints_deg")
-    parser.add_argument("--baud", type=bounded_int(50, 20_000_000), help="serial baud rate (videocal's protocol; default 115200)")
+    parser.add_argument(
+        "--timeout",
+        type=bounded_float(0.0, 86400.0, exclusive_low=True),
+        default=5.0,
+        help="give up after this many seconds without a sample (default 5)",
+    )
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="one JSON object per line: seq, t_ms (ms since the epoch), t_controller_ms (the controller's own stamp), joints_deg",
+    )
+    parser.add_argument(
+        "--baud", type=bounded_int(50, 20_000_000), help="serial baud rate (videocal's protocol; default 115200)"
+    )
     parser.add_argument("--parity", choices=("N", "E", "O"), help="serial parity (videocal's protocol; default N)")
 
 
@@ -108,7 +136,10 @@ def run(args: argparse.Namespace) -> int:
             if not samples:
                 if time.monotonic() - last > args.timeout:
                     why = getattr(link, "last_error", None) or (reasons[-1] if reasons else "no reply")
-                    print(f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {why})", file=sys.stderr)
+                    print(
+                        f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {why})",
+                        file=sys.stderr,
+                    )
                     code = EXIT_TIMEOUT
                     break
                 continue
@@ -118,13 +149,21 @@ def run(args: argparse.Namespace) -> int:
                 q = s.sample.joints_deg
                 if len(q) != expected:
                     skipped += 1
-                    print(f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown", file=sys.stderr)
+                    print(
+                        f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown",
+                        file=sys.stderr,
+                    )
                     continue
                 if to_model is not None:
                     q = tuple(float(v) for v in to_model(q))
                 t_ms = epoch_ms(s)
                 if args.json:
-                    print(json.dumps({"seq": s.sample.seq, "t_ms": t_ms, "t_controller_ms": s.sample.t_ms, "joints_deg": list(q)}), flush=True)
+                    print(
+                        json.dumps(
+                            {"seq": s.sample.seq, "t_ms": t_ms, "t_controller_ms": s.sample.t_ms, "joints_deg": list(q)}
+                        ),
+                        flush=True,
+                    )
                 else:
                     print(f"{s.sample.seq:>8} {t_ms:>14} ms  " + " ".join(f"{v:9.4f}" for v in q), flush=True)
                 printed += 1

@@ -25,17 +25,35 @@ OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG = -130.0, 32.0
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)")
+    parser.add_argument(
+        "--workcell", type=Path, default=DEFAULT_WORKCELL, help="workcell YAML (default: the bundled one)"
+    )
     where = parser.add_mutually_exclusive_group()
-    where.add_argument("--joints", help="one value per driven joint (deg, or mm for a prismatic joint), comma separated")
+    where.add_argument(
+        "--joints", help="one value per driven joint (deg, or mm for a prismatic joint), comma separated"
+    )
     where.add_argument("--location", help="a task location: the robot goes to its approach pose")
-    where.add_argument("--at-task", metavar="LOCATION", help="a task location: the robot goes to the task pose itself, where the first look is made")
-    parser.add_argument("--view", choices=VIEWS, default="virtual", help="virtual (modelled camera), overview, or true (the simulated camera on the true robot)")
+    where.add_argument(
+        "--at-task",
+        metavar="LOCATION",
+        help="a task location: the robot goes to the task pose itself, where the first look is made",
+    )
+    parser.add_argument(
+        "--view",
+        choices=VIEWS,
+        default="virtual",
+        help="virtual (modelled camera), overview, or true (the simulated camera on the true robot)",
+    )
     parser.add_argument("--out", type=Path, required=True, help="PNG file to write")
     parser.add_argument("--highlight", help="component to highlight (default: the location's component)")
     parser.add_argument("--features", action="store_true", help="show feature points and their names")
     parser.add_argument("--style", choices=("surface", "wireframe", "edges"), default="surface")
-    parser.add_argument("--scale", type=bounded_float(0.05, 4.0), default=1.0, help="image size relative to the camera's (virtual and true views)")
+    parser.add_argument(
+        "--scale",
+        type=bounded_float(0.05, 4.0),
+        default=1.0,
+        help="image size relative to the camera's (virtual and true views)",
+    )
 
 
 def _joints(text: str) -> np.ndarray:
@@ -61,7 +79,9 @@ def run(args: argparse.Namespace) -> int:
 
     cell = load_workcell(args.workcell)
     if cell.intrinsics_path is None:
-        raise VideocalError(f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)")
+        raise VideocalError(
+            f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+        )
     robot = cell.load_robot()
     highlight = args.highlight
     q = np.array(cell.home_joints_deg, dtype=float)
@@ -85,7 +105,9 @@ def run(args: argparse.Namespace) -> int:
         except KeyError as exc:
             raise VideocalError(str(exc.args[0])) from None
     intr = load_intrinsics(cell.intrinsics_path).scaled(args.scale)
-    options = RenderOptions(highlight=highlight, show_features=args.features, feature_names=args.features, style=args.style)
+    options = RenderOptions(
+        highlight=highlight, show_features=args.features, feature_names=args.features, style=args.style
+    )
     if args.view == "true":
         from calib_core.plugins import SITES, load_plugin
 
@@ -100,7 +122,9 @@ def run(args: argparse.Namespace) -> int:
             from calib_core.scene_framing import cell_framing, eye_at
 
             target, distance = cell_framing(items)  # the whole cell, as the window's overview frames it
-            image = renderer.render_overview(eye_at(target, distance, OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG), target, options=options)
+            image = renderer.render_overview(
+                eye_at(target, distance, OVERVIEW_AZIMUTH_DEG, OVERVIEW_ELEVATION_DEG), target, options=options
+            )
         renderer.close()
     import cv2
 
@@ -108,5 +132,7 @@ def run(args: argparse.Namespace) -> int:
     if not ok:
         raise VideocalError("could not encode the image as PNG")
     atomic_write_bytes(args.out, png.tobytes())
-    print(f"wrote {args.out} ({image.shape[1]} x {image.shape[0]}, {args.view} view, joints {', '.join(f'{v:.2f}' for v in q)} deg)")
+    print(
+        f"wrote {args.out} ({image.shape[1]} x {image.shape[0]}, {args.view} view, joints {', '.join(f'{v:.2f}' for v in q)} deg)"
+    )
     return 0

@@ -34,7 +34,12 @@ def _field(data: dict, name: str, path: Path):
 
 def _points(data: dict, name: str, dim: int, path: Path) -> np.ndarray:
     raw = _field(data, name, path)
-    if not isinstance(raw, list) or not all(isinstance(p, list) and len(p) == dim and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in raw):
+    if not isinstance(raw, list) or not all(
+        isinstance(p, list)
+        and len(p) == dim
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in p)
+        for p in raw
+    ):
         raise FileFormatError(path, f"must be a list of [{', '.join('xyz'[:dim] if dim == 3 else 'uv')}] numbers", name)
     points = np.array(raw, dtype=float).reshape(len(raw), dim)
     if not np.all(np.isfinite(points)):
@@ -59,7 +64,15 @@ def _intrinsics(data: dict, path: Path):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise FileFormatError(path, f"must be a number, got {value!r}", f"intrinsics.{key}")
     try:
-        return Intrinsics(raw["fu"], raw["fv"], raw["cx"], raw["cy"], raw["width"], raw["height"], tuple(raw.get("distortion", (0.0,) * 5)))
+        return Intrinsics(
+            raw["fu"],
+            raw["fv"],
+            raw["cx"],
+            raw["cy"],
+            raw["width"],
+            raw["height"],
+            tuple(raw.get("distortion", (0.0,) * 5)),
+        )
     except (TypeError, ValueError) as exc:
         raise FileFormatError(path, str(exc), "intrinsics") from None
 
@@ -102,14 +115,20 @@ def read_solve_inputs(path: Path) -> dict:
         raise FileFormatError(path, "the top level must be a JSON object")
     unknown = set(data) - _KNOWN_FIELDS
     if unknown:
-        raise FileFormatError(path, f"unknown field(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KNOWN_FIELDS))}")
+        raise FileFormatError(
+            path, f"unknown field(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_KNOWN_FIELDS))}"
+        )
     for name in ("points_3d", "points_2d"):
         if isinstance(data.get(name), list) and len(data[name]) > MAX_POINTS:
             raise FileFormatError(path, f"{len(data[name])} points; a solve takes at most {MAX_POINTS}", name)
     return {
-        "points_3d": _points(data, "points_3d", 3, path), "points_2d": _points(data, "points_2d", 2, path), "intrinsics": _intrinsics(data, path),
-        "prior": _prior(data, path), "estimate_focal": _option(data, "estimate_focal", bool, False, path),
-        "model": _option(data, "model", str, "pinhole", path), "sigma_px": _option(data, "sigma_px", float, None, path),
+        "points_3d": _points(data, "points_3d", 3, path),
+        "points_2d": _points(data, "points_2d", 2, path),
+        "intrinsics": _intrinsics(data, path),
+        "prior": _prior(data, path),
+        "estimate_focal": _option(data, "estimate_focal", bool, False, path),
+        "model": _option(data, "model", str, "pinhole", path),
+        "sigma_px": _option(data, "sigma_px", float, None, path),
         "robust": _option(data, "robust", bool, False, path),
     }
 

@@ -26,21 +26,51 @@ def _register(name: str, module: str, help_text: str) -> None:
     COMMANDS[name] = (module, help_text)
 
 
-_register("gui", "app.cli.cmd_gui", "open the operator's window (the bundled workcell with simulated robot and camera by default)")
+_register(
+    "gui",
+    "app.cli.cmd_gui",
+    "open the operator's window (the bundled workcell with simulated robot and camera by default)",
+)
 _register("solve", "app.cli.cmd_solve", "solve a camera pose from point pairs in a JSON file")
 _register("table1", "app.cli.cmd_table1", "reproduce the paper's Table 1 (Newton convergence)")
 _register("link-key", "app.cli.cmd_link_key", "name, show or renew the controller link's pre-shared key")
 _register("monitor", "app.cli.cmd_monitor", "print the joint samples of any controller connector")
 _register("grab", "app.cli.cmd_grab", "save N frames of any camera connector as PNG files and frames.csv")
-_register("replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results")
-_register("recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut")
+_register(
+    "replay", "app.cli.cmd_replay", "re-solve every calibration in a recording and compare with the recorded results"
+)
+_register(
+    "recover", "app.cli.cmd_recover", "rewrite a recording cut off by a crash, keeping every message before the cut"
+)
 _register("export", "app.cli.cmd_export", "export a workspace's corrections as JSON, CSV or a PDL2 listing")
-_register("calibrate-intrinsics", "app.cli.cmd_calibrate_intrinsics", "calibrate the camera's intrinsics from ChArUco board views (folder, video or 'sim')")
-_register("calibrate-hand-eye", "app.cli.cmd_calibrate_hand_eye", "calibrate the camera's mounting from robot poses viewing a board (sim, cal_data.yaml, CSV)")
-_register("calibrate-robot", "app.cli.cmd_calibrate_robot", "identify the robot's geometric parameters and camera mounting from board views at many poses")
-_register("new-cell", "app.cli.cmd_new_cell", "write a starting cell for a robot description (URDF or xacro): loads and renders at once")
-_register("locate", "app.cli.cmd_locate", "a known object's pose in a photo (mesh, intrinsics, rough pose): Find points and the edge fit, as JSON")
-_register("render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)")
+_register(
+    "calibrate-intrinsics",
+    "app.cli.cmd_calibrate_intrinsics",
+    "calibrate the camera's intrinsics from ChArUco board views (folder, video or 'sim')",
+)
+_register(
+    "calibrate-hand-eye",
+    "app.cli.cmd_calibrate_hand_eye",
+    "calibrate the camera's mounting from robot poses viewing a board (sim, cal_data.yaml, CSV)",
+)
+_register(
+    "calibrate-robot",
+    "app.cli.cmd_calibrate_robot",
+    "identify the robot's geometric parameters and camera mounting from board views at many poses",
+)
+_register(
+    "new-cell",
+    "app.cli.cmd_new_cell",
+    "write a starting cell for a robot description (URDF or xacro): loads and renders at once",
+)
+_register(
+    "locate",
+    "app.cli.cmd_locate",
+    "a known object's pose in a photo (mesh, intrinsics, rough pose): Find points and the edge fit, as JSON",
+)
+_register(
+    "render", "app.cli.cmd_render", "render the workcell to a PNG (virtual camera, overview, or simulated true camera)"
+)
 
 
 def _register_plugins() -> None:

@@ -33,7 +33,9 @@ def bounded_float(low: float, high: float, *, exclusive_low: bool = False):
         except ValueError:
             raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
         if not math.isfinite(value) or value > high or value < low or (exclusive_low and value == low):
-            raise argparse.ArgumentTypeError(f"must be a finite number {'above' if exclusive_low else 'from'} {low:g} up to {high:g}, got {text}")
+            raise argparse.ArgumentTypeError(
+                f"must be a finite number {'above' if exclusive_low else 'from'} {low:g} up to {high:g}, got {text}"
+            )
         return value
 
     return parse

@@ -22,8 +22,12 @@ class CameraChooser:
     def __init__(self, window, menu: QMenu):
         self.window = window
         self.dialog: QInputDialog | None = None
-        self.action = QAction("Open ca&mera...", window, shortcut=QKeySequence("Ctrl+Shift+M"), triggered=self.open_dialog)
-        self.action.setToolTip("a device number, a video file, an image folder, rtsp://..., aravis://ID, ros2:///camera/image_raw")
+        self.action = QAction(
+            "Open ca&mera...", window, shortcut=QKeySequence("Ctrl+Shift+M"), triggered=self.open_dialog
+        )
+        self.action.setToolTip(
+            "a device number, a video file, an image folder, rtsp://..., aravis://ID, ros2:///camera/image_raw"
+        )
         menu.addAction(self.action)
 
     def recent(self) -> list[str]:
@@ -34,7 +38,9 @@ class CameraChooser:
         """The dialog (not blocking): an editable list of the recent specs."""
         dialog = QInputDialog(self.window)
         dialog.setWindowTitle("Open camera")
-        dialog.setLabelText("Camera: a device number (0), a video file, a folder of images,\nrtsp:// or http:// stream, aravis://ID, ros2:///camera/image_raw")
+        dialog.setLabelText(
+            "Camera: a device number (0), a video file, a folder of images,\nrtsp:// or http:// stream, aravis://ID, ros2:///camera/image_raw"
+        )
         dialog.setComboBoxEditable(True)
         recent = self.recent()
         dialog.setComboBoxItems(recent or [""])

@@ -53,10 +53,14 @@ class CameraPane(QWidget):
         self._proposal_joints: np.ndarray | None = None
         self._drag_at: tuple[float, float] | None = None
         self.freeze = QCheckBox("Hold")
-        self.freeze.setToolTip("Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner")
+        self.freeze.setToolTip(
+            "Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner"
+        )
         self.subpixel = QCheckBox("Sub-pixel")
         self.subpixel.setChecked(True)
-        self.subpixel.setToolTip("Refine each pick: a round feature to the centre of its rim, anything else to the nearest corner (cv2.cornerSubPix)")
+        self.subpixel.setToolTip(
+            "Refine each pick: a round feature to the centre of its rim, anything else to the nearest corner (cv2.cornerSubPix)"
+        )
         self.edges = QCheckBox("CAD edges")
         self.edges.setToolTip("After a solve, draw the model's edges from the measured camera pose")
         self.edges.setChecked(True)
@@ -143,10 +147,17 @@ class CameraPane(QWidget):
             return
         h, w = self.last_frame.image.shape[:2]
         if not (-0.5 <= u < w - 0.5 and -0.5 <= v < h - 0.5):
-            self.pick_rejected.emit(f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked")
+            self.pick_rejected.emit(
+                f"the click at ({u:.1f}, {v:.1f}) px is outside the camera image ({w} x {h} px): nothing picked"
+            )
             return
         # The core holds the newest frame at the first pick of a set and refines on it.
-        attempt(lambda text: self.pick_rejected.emit(f"nothing picked: {text}"), self.workbench.picking.pick_image_point, (u, v), refine=self.subpixel.isChecked())
+        attempt(
+            lambda text: self.pick_rejected.emit(f"nothing picked: {text}"),
+            self.workbench.picking.pick_image_point,
+            (u, v),
+            refine=self.subpixel.isChecked(),
+        )
 
     # --- a picked point dragged (after Accept too), or clicked to select its pair ------------------------
     def _grab(self, u: float, v: float, radius_px: float) -> bool:
@@ -154,8 +165,11 @@ class CameraPane(QWidget):
         shown (picked at the robot state it shows). Not while a pair waits for its point: the click is its."""
         if self.workbench.session.pairs.pending() is not None:
             return False
-        near = [(np.hypot(p.pixel[0] - u, p.pixel[1] - v), p.number) for p in self.workbench.session.pairs
-                if p.pixel is not None and (p.view is None or self._same_state(p.view.joints_deg))]
+        near = [
+            (np.hypot(p.pixel[0] - u, p.pixel[1] - v), p.number)
+            for p in self.workbench.session.pairs
+            if p.pixel is not None and (p.view is None or self._same_state(p.view.joints_deg))
+        ]
         near = [n for n in near if n[0] <= radius_px]
         self._grabbed = min(near)[1] if near else None
         return self._grabbed is not None
@@ -170,7 +184,13 @@ class CameraPane(QWidget):
             return
         self.pair_selected.emit(number)
         if moved:
-            attempt(self.pick_rejected.emit, self.workbench.picking.move_pair_pixel, number, (u, v), refine=self.subpixel.isChecked())
+            attempt(
+                self.pick_rejected.emit,
+                self.workbench.picking.move_pair_pixel,
+                number,
+                (u, v),
+                refine=self.subpixel.isChecked(),
+            )
         self.refresh_overlay()
 
     def set_board_corners(self, corners_px: np.ndarray | None, text: str = "") -> None:
@@ -192,7 +212,9 @@ class CameraPane(QWidget):
         if found is None:
             self.set_proposals(None)
         else:
-            self.set_proposals([(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg)
+            self.set_proposals(
+                [(p.uv_px[0], p.uv_px[1], p.feature) for p in found.result.proposals], found.view.joints_deg
+            )
 
     def set_edges_image(self, rgba: np.ndarray | None) -> None:
         self._edges_image = rgba
@@ -222,7 +244,9 @@ class CameraPane(QWidget):
     def shown_joints(self) -> np.ndarray:
         """The joints (deg/mm) of the robot state the image shows: the held frame's, else the robot's now."""
         held = self.held
-        return np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.workbench.joints_deg, dtype=float)
+        return (
+            np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.workbench.joints_deg, dtype=float)
+        )
 
     def _same_state(self, joints) -> bool:
         if joints is None:
@@ -233,7 +257,9 @@ class CameraPane(QWidget):
     def _state_key(self) -> tuple:
         session = self.workbench.session
         context = session.context
-        pairs = tuple(p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None)
+        pairs = tuple(
+            p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None
+        )
         result = context is None or context.joints_deg is None or self._same_state(context.joints_deg)
         board = self._board_joints is None or self._same_state(self._board_joints)
         return pairs, result, board
@@ -255,7 +281,9 @@ class CameraPane(QWidget):
             u, v = self._drag_at if pair.number == self._grabbed and self._drag_at is not None else pair.pixel
             overlay.points.append((u, v, str(pair.number) if current else f"{pair.number}?", color))
         if not all(pairs_current):
-            banner.append(f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)")
+            banner.append(
+                f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)"
+            )
         result = session.result
         stale = session.stale_reason
         if result is not None and not result_current:

@@ -80,7 +80,9 @@ class CellPanel(QWidget):
         fl = QVBoxLayout(feats)
         self.pick_features = QCheckBox("Name features by clicking (virtual camera)")
         self.pick_features.setObjectName("pick_features")
-        self.pick_features.setToolTip("A click on the chosen component in the virtual camera adds a feature, snapped to a circle centre, a corner or a vertex")
+        self.pick_features.setToolTip(
+            "A click on the chosen component in the virtual camera adds a feature, snapped to a circle centre, a corner or a vertex"
+        )
         fl.addWidget(self.pick_features)
         name_row = QFormLayout()
         self.feature_name = QLineEdit()
@@ -118,7 +120,9 @@ class CellPanel(QWidget):
 
         self.save = QPushButton("Save cell")
         self.save.setObjectName("save_cell")
-        self.save.setToolTip("Write the components, features and task locations back into the workcell file (its comments are kept)")
+        self.save.setToolTip(
+            "Write the components, features and task locations back into the workcell file (its comments are kept)"
+        )
         layout.addWidget(self.save)
         layout.addStretch(1)
 
@@ -158,10 +162,17 @@ class CellPanel(QWidget):
     # --- edits ------------------------------------------------------------------------------------
     def _placement_edited(self) -> None:
         name = self.component.currentText()
-        self._attempt(self.workbench.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
+        self._attempt(
+            self.workbench.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy]
+        )
 
     def _add_component_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Add component", str(self.workbench.workcell.path.parent), "Meshes (*.stl *.obj *.dae *.glb *.gltf *.ply)")
+        path, _ = QFileDialog.getOpenFileName(
+            self,
+            "Add component",
+            str(self.workbench.workcell.path.parent),
+            "Meshes (*.stl *.obj *.dae *.glb *.gltf *.ply)",
+        )
         if not path:
             return
         name, ok = QInputDialog.getText(self, "Add component", "Name of the component:", text=Path(path).stem)
@@ -203,5 +214,7 @@ class CellPanel(QWidget):
         wb.editor.add_feature(hit.component, name, snap.point_mm)
         self.feature_name.clear()
         world = apply(item.item2world, np.asarray(snap.point_mm)[None])[0]
-        self.feature_info.setText(f"{hit.component}/{name}: {snap.kind.replace('_', ' ')} at ({', '.join(f'{v:.1f}' for v in snap.point_mm)}) mm, "
-                                  f"{snap.distance_mm:.1f} mm from the click; base ({', '.join(f'{v:.1f}' for v in world)})")
+        self.feature_info.setText(
+            f"{hit.component}/{name}: {snap.kind.replace('_', ' ')} at ({', '.join(f'{v:.1f}' for v in snap.point_mm)}) mm, "
+            f"{snap.distance_mm:.1f} mm from the click; base ({', '.join(f'{v:.1f}' for v in world)})"
+        )

@@ -23,7 +23,6 @@ from app.gui.error_boundary import attempt
 from app.gui.workbench import Workbench
 
 
-
 class CommandPanel(QTabWidget):
     """The panel binds what only sets the session or the task to the core itself (target, solve options,
     task location and its approach, Clear) and shows what they hold; the actions that need the window
@@ -99,9 +98,17 @@ class CommandPanel(QTabWidget):
         self.hint = QLabel("Point: click a feature in the virtual camera, then the same point on the camera image.")
         self.hint.setWordWrap(True)
         sl2.addWidget(self.hint)
-        self.find_points = button("Find points (F6)", "find_points", "Find the target's features on the camera image and propose them as pairs")
+        self.find_points = button(
+            "Find points (F6)",
+            "find_points",
+            "Find the target's features on the camera image and propose them as pairs",
+        )
         sl2.addWidget(self.find_points)
-        self.accept = button("Accept pair", "accept", "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then")
+        self.accept = button(
+            "Accept pair",
+            "accept",
+            "Keep the current pair (Ctrl+Return); clicking the image again moves its 2D point until then",
+        )
         self.delete = button("Delete pair", "delete")
         self.clear = button("Clear all", "clear")
         self.undo = button("Undo", "undo")
@@ -130,11 +137,17 @@ class CommandPanel(QTabWidget):
         self.live.setChecked(True)
         el.addWidget(self.monitoring)
         el.addWidget(self.live)
-        self.go_corrected = button("Go to task, corrected", "go_corrected", "Move to the task location with its stored correction")
+        self.go_corrected = button(
+            "Go to task, corrected", "go_corrected", "Move to the task location with its stored correction"
+        )
         self.go_uncorrected = button("Go to task, uncorrected", "go_uncorrected")
         el.addWidget(self.go_corrected)
         el.addWidget(self.go_uncorrected)
-        self.verify = button("Verify: look again", "verify", "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree")
+        self.verify = button(
+            "Verify: look again",
+            "verify",
+            "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree",
+        )
         el.addWidget(self.verify)
         self.corrections = QLabel("No corrections stored.")
         self.corrections.setWordWrap(True)
@@ -194,11 +207,15 @@ class CommandPanel(QTabWidget):
             c = table.latest(task)
             history = table.history(task)
             measurements = sum(1 for h in history if h.kind == "measurement")
-            kept = f"{len(history) - measurements} stored" + (f", {measurements} measurement{'s' if measurements > 1 else ''} at other poses" if measurements else "")
+            kept = f"{len(history) - measurements} stored" + (
+                f", {measurements} measurement{'s' if measurements > 1 else ''} at other poses" if measurements else ""
+            )
             if c is None:
                 lines.append(f"{task}: no correction ({kept})")
                 continue
-            line = f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({kept}"
+            line = (
+                f"{task}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg ({kept}"
+            )
             line += f", {c.verdict} confirmed)" if c.confirmation else ")"
             looks = table.verifications(task)
             if looks:

@@ -18,8 +18,13 @@ from app.gui.session_files import Autosave, RecentFiles
 from calib_core.errors import OperatorError
 
 EXPORT_FILTERS = {
-    "URScript, Universal Robots (*.script)": "urscript", "RAPID module, ABB (*.mod)": "rapid", "KRL data, KUKA (*.dat)": "krl",
-    "TP program, FANUC (*.ls)": "fanuc", "PDL2, COMAU (*.pdl)": "pdl2", "CSV (*.csv)": "csv", "JSON (*.json)": "json",
+    "URScript, Universal Robots (*.script)": "urscript",
+    "RAPID module, ABB (*.mod)": "rapid",
+    "KRL data, KUKA (*.dat)": "krl",
+    "TP program, FANUC (*.ls)": "fanuc",
+    "PDL2, COMAU (*.pdl)": "pdl2",
+    "CSV (*.csv)": "csv",
+    "JSON (*.json)": "json",
 }
 
 
@@ -33,22 +38,50 @@ class FileMenu:
         self.restore_action: QAction | None = None
         self.workspace_path: str | None = None  # the workspace last saved or opened: Save goes there
         w = window
-        self.open_cell_action = QAction("Open &cell...", w, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog)
+        self.open_cell_action = QAction(
+            "Open &cell...", w, shortcut=QKeySequence("Ctrl+Shift+C"), triggered=self._open_cell_dialog
+        )
         menu.addAction(self.open_cell_action)
-        self.recent_cells = RecentFiles(w.settings, menu.addMenu("Recent ce&lls"), self.open_cell, key="files/recent_cells")
+        self.recent_cells = RecentFiles(
+            w.settings, menu.addMenu("Recent ce&lls"), self.open_cell, key="files/recent_cells"
+        )
         if w.launcher is None:
             self.open_cell_action.setEnabled(False)
             self.open_cell_action.setToolTip("this window was opened on one cell only")
         menu.addSeparator()
-        menu.addAction(QAction("&Open workspace...", w, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog))
-        menu.addAction(QAction("&Save workspace", w, shortcut=QKeySequence.StandardKey.Save, triggered=lambda: self.save_workspace_dialog()))
-        menu.addAction(QAction("Save workspace &as...", w, shortcut=QKeySequence("Ctrl+Alt+S"), triggered=self._save_dialog))
-        menu.addAction(QAction("Save ce&ll", w, shortcut=QKeySequence("Ctrl+Shift+S"), triggered=lambda: w.report(w.workbench.editor.save)()))
-        menu.addAction(QAction("E&xport corrections...", w, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog))
+        menu.addAction(
+            QAction("&Open workspace...", w, shortcut=QKeySequence.StandardKey.Open, triggered=self._open_dialog)
+        )
+        menu.addAction(
+            QAction(
+                "&Save workspace",
+                w,
+                shortcut=QKeySequence.StandardKey.Save,
+                triggered=lambda: self.save_workspace_dialog(),
+            )
+        )
+        menu.addAction(
+            QAction("Save workspace &as...", w, shortcut=QKeySequence("Ctrl+Alt+S"), triggered=self._save_dialog)
+        )
+        menu.addAction(
+            QAction(
+                "Save ce&ll",
+                w,
+                shortcut=QKeySequence("Ctrl+Shift+S"),
+                triggered=lambda: w.report(w.workbench.editor.save)(),
+            )
+        )
+        menu.addAction(
+            QAction("E&xport corrections...", w, shortcut=QKeySequence("Ctrl+E"), triggered=self._export_dialog)
+        )
         menu.addSeparator()
         self.record_action = QAction("&Record session...", w, checkable=True, triggered=self._record_toggled)
         menu.addAction(self.record_action)
-        menu.addAction(QAction("Open r&ecording...", w, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog))
+        menu.addAction(
+            QAction(
+                "Open r&ecording...", w, shortcut=QKeySequence("Ctrl+Shift+O"), triggered=self._open_recording_dialog
+            )
+        )
         self.recent = RecentFiles(w.settings, menu.addMenu("Recent &files"), self.open_recent)
         menu.addSeparator()
         self.camera = CameraChooser(w, menu)
@@ -81,7 +114,12 @@ class FileMenu:
         return True
 
     def _open_cell_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open cell", str(self.window.workbench.workcell.path.parent), "videocal workcell (*.yaml *.yml)")
+        path, _ = QFileDialog.getOpenFileName(
+            self.window,
+            "Open cell",
+            str(self.window.workbench.workcell.path.parent),
+            "videocal workcell (*.yaml *.yml)",
+        )
         if path:
             self.open_cell(path)
 
@@ -90,7 +128,9 @@ class FileMenu:
         """Save; only a save that succeeded joins the recent files and counts as saved for the autosave.
         The recovery folder holds autosaves only: a save there is refused."""
         if Path(path).resolve().parent == self.autosave.folder.resolve():
-            self.window.show_error(f"{path}: that is the recovery folder, which holds autosaves only; save the workspace somewhere else")
+            self.window.show_error(
+                f"{path}: that is the recovery folder, which holds autosaves only; save the workspace somewhere else"
+            )
             return False
         if not attempt(self.window.show_error, self.window.workbench.files.save_workspace, path):
             return False
@@ -103,7 +143,9 @@ class FileMenu:
         """Open a workspace file. ``restored``: an autosave, which is no file of the operator's: it joins
         no recent list and *Save* asks where (it once wrote into the recovery folder, offered again at
         the next start as an unsaved autosave)."""
-        if not attempt(self.window.show_error, lambda: self.window.workbench.files.open_workspace(path, hold=not restored)):
+        if not attempt(
+            self.window.show_error, lambda: self.window.workbench.files.open_workspace(path, hold=not restored)
+        ):
             return False
         if restored:
             self.workspace_path = None
@@ -126,7 +168,9 @@ class FileMenu:
         """Save to the workspace last saved or opened (or ask where); True when it was saved."""
         path = None if ask_path else self.workspace_path
         if path is None:
-            path, _ = QFileDialog.getSaveFileName(self.window, "Save workspace", "workspace.json", "videocal workspace (*.json)")
+            path, _ = QFileDialog.getSaveFileName(
+                self.window, "Save workspace", "workspace.json", "videocal workspace (*.json)"
+            )
         return bool(path) and self.save_workspace(path)
 
     def _open_dialog(self) -> None:
@@ -135,7 +179,9 @@ class FileMenu:
             self.open_workspace(path)
 
     def _export_dialog(self) -> None:
-        path, chosen = QFileDialog.getSaveFileName(self.window, "Export corrections", "corrections.script", ";;".join(EXPORT_FILTERS))
+        path, chosen = QFileDialog.getSaveFileName(
+            self.window, "Export corrections", "corrections.script", ";;".join(EXPORT_FILTERS)
+        )
         if path:
             self.window.report(self.window.workbench.files.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
 
@@ -184,8 +230,10 @@ class FileMenu:
         self.record_action.setChecked(False)
         w.show_error(f"recording {rec.path.name} stopped: {failure}")
         again = rec.path.with_name(f"{rec.path.stem}-jpeg{rec.path.suffix}")
-        text = (f"Recording to {rec.path} stopped: {failure}.\n\nThe file keeps what was written before the failure "
-                f"(videocal recover completes it). Record on to {again.name}, with JPEG frames instead of H.264 video?")
+        text = (
+            f"Recording to {rec.path} stopped: {failure}.\n\nThe file keeps what was written before the failure "
+            f"(videocal recover completes it). Record on to {again.name}, with JPEG frames instead of H.264 video?"
+        )
         if ask(w, "Recording stopped", text, "Record as JPEG"):
             self.start_recording(again, frames="jpeg")
 
@@ -204,16 +252,28 @@ class FileMenu:
         """Autosave every minute when the session changed. Sessions that ended without saving left their
         autosave: offer each (File > Restore autosave of ...) rather than load one unasked."""
         wb = self.window.workbench
-        self.autosave = Autosave(self.window.settings, lambda: wb.revision, lambda path: wb.files.save_workspace(path, hold=False), self._status, self.window)
+        self.autosave = Autosave(
+            self.window.settings,
+            lambda: wb.revision,
+            lambda path: wb.files.save_workspace(path, hold=False),
+            self._status,
+            self.window,
+        )
         self.restore_actions: dict[str, QAction] = {}
         for path in self.autosave.orphans():
             stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))
-            action = QAction(f"Restore &autosave of {stamp}", self.window, triggered=lambda checked=False, p=path: self.restore_autosave(p))
+            action = QAction(
+                f"Restore &autosave of {stamp}",
+                self.window,
+                triggered=lambda checked=False, p=path: self.restore_autosave(p),
+            )
             self.menu.insertAction(self.menu.actions()[0], action)
             self.restore_actions[str(path)] = action
         self.restore_action = next(iter(self.restore_actions.values()), None)
         if self.restore_actions:
-            self._status(f"{len(self.restore_actions)} unsaved session(s) were autosaved: File > Restore autosave", 30000)
+            self._status(
+                f"{len(self.restore_actions)} unsaved session(s) were autosaved: File > Restore autosave", 30000
+            )
 
     def restore_autosave(self, path=None) -> bool:
         """Open an autosave (the newest by default); once restored it is not offered again."""
@@ -237,14 +297,22 @@ class FileMenu:
         from PySide6.QtWidgets import QApplication
 
         w = self.window
-        if self.autosave is None or not self.autosave.unsaved or QApplication.instance().property("videocal_quit_by_signal"):
+        if (
+            self.autosave is None
+            or not self.autosave.unsaved
+            or QApplication.instance().property("videocal_quit_by_signal")
+        ):
             return True
         if str(w.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
             return True
         s = w.workbench.session
         what = f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored corrections"
-        choice = ask_save(w, "Unsaved work", f"The session has changes that are not saved in a workspace file ({what}). Save them before closing?\n"
-                          "Discard closes the window; the changes stay in the recovery file, offered at the next start.")
+        choice = ask_save(
+            w,
+            "Unsaved work",
+            f"The session has changes that are not saved in a workspace file ({what}). Save them before closing?\n"
+            "Discard closes the window; the changes stay in the recovery file, offered at the next start.",
+        )
         if choice == "cancel":
             return False
         if choice == "save":

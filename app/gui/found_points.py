@@ -7,7 +7,15 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QDialog, QDialogButtonBox, QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout
+from PySide6.QtWidgets import (
+    QDialog,
+    QDialogButtonBox,
+    QLabel,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+)
 
 from app.gui.busy import busy
 from app.gui.error_boundary import attempt
@@ -52,7 +60,9 @@ class FoundPointsDialog(QDialog):
         self.accept_button.setEnabled(bool(result.proposals))
         buttons.addButton(self.accept_button, QDialogButtonBox.ButtonRole.AcceptRole)
         self.edges_button = QPushButton("Calibrate on edges")
-        self.edges_button.setToolTip("Solve from the target's edges on this frame (hundreds of samples, no pairs): usually the most accurate")
+        self.edges_button.setToolTip(
+            "Solve from the target's edges on this frame (hundreds of samples, no pairs): usually the most accurate"
+        )
         edges = result.edges
         self.edges_button.setEnabled(edges is not None and edges.settled)
         buttons.addButton(self.edges_button, QDialogButtonBox.ButtonRole.ActionRole)
@@ -64,7 +74,11 @@ class FoundPointsDialog(QDialog):
         self.resize(520, 420)
 
     def checked_features(self) -> list[str]:
-        return [self.table.item(r, 0).text() for r in range(self.table.rowCount()) if self.table.item(r, 0).checkState() == Qt.CheckState.Checked]
+        return [
+            self.table.item(r, 0).text()
+            for r in range(self.table.rowCount())
+            if self.table.item(r, 0).checkState() == Qt.CheckState.Checked
+        ]
 
     def _calibrate_on_edges(self) -> None:
         if self._on_edges is not None and self._on_edges():
@@ -99,7 +113,9 @@ class FindPoints:
         if self.dialog is not None:
             self.dialog.close()
         self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, window)
-        self.dialog.finished.connect(lambda _: window.workbench.finder.dismiss_found_points())  # the camera pane hides them
+        self.dialog.finished.connect(
+            lambda _: window.workbench.finder.dismiss_found_points()
+        )  # the camera pane hides them
         self.dialog.show()
 
     def _calibrate_on_edges(self) -> bool:
@@ -110,7 +126,12 @@ class FindPoints:
             self.window.show_error("check at least one point to accept, or Cancel")
             return False
         numbers = {}
-        ok = attempt(self.window.show_error, lambda: numbers.setdefault("n", self.window.workbench.finder.accept_found_points(features)))
+        ok = attempt(
+            self.window.show_error,
+            lambda: numbers.setdefault("n", self.window.workbench.finder.accept_found_points(features)),
+        )
         if ok:
-            self.window.statusBar().showMessage(f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000)
+            self.window.statusBar().showMessage(
+                f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000
+            )
         return ok

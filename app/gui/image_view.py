@@ -231,7 +231,10 @@ class ImageView(QWidget):
             p.setPen(QColor(255, 235, 200))
             p.drawText(box.adjusted(8, 0, -8, 0), flags, self.overlay.banner)
         if self._inset is not None:
-            marks = [QRectF(x - 10, y - 10, 20, 20) for x, y in (self.image_to_widget(u, v) for u, v, _, _ in self.overlay.points)]
+            marks = [
+                QRectF(x - 10, y - 10, 20, 20)
+                for x, y in (self.image_to_widget(u, v) for u, v, _, _ in self.overlay.points)
+            ]
             w = min(float(self._inset.width()), 0.22 * self.width())  # a small pane keeps most of its frame
             box = _inset_box(QRectF(self.rect()), w, w * self._inset.height() / self._inset.width(), marks + taken)
             # The inset steps aside while the cursor is over it: a pick under it stays possible.
@@ -241,7 +244,9 @@ class ImageView(QWidget):
                 p.setOpacity(1.0)
                 p.setPen(QPen(QColor(255, 214, 10), 1.5))
                 p.drawRect(box)
-                p.drawText(box.adjusted(4, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop, self._inset_label)
+                p.drawText(
+                    box.adjusted(4, 2, 0, 0), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop, self._inset_label
+                )
 
     def _paint_crosshair(self, p: QPainter) -> None:
         u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())
@@ -260,21 +265,30 @@ class ImageView(QWidget):
             return None
         h, w = a.shape[:2]
         out = np.zeros((2 * radius_px + 1, 2 * radius_px + 1, 3), np.uint8)
-        y0, y1, x0, x1 = max(cv_ - radius_px, 0), min(cv_ + radius_px + 1, h), max(cu - radius_px, 0), min(cu + radius_px + 1, w)
+        y0, y1, x0, x1 = (
+            max(cv_ - radius_px, 0),
+            min(cv_ + radius_px + 1, h),
+            max(cu - radius_px, 0),
+            min(cu + radius_px + 1, w),
+        )
         if y0 >= y1 or x0 >= x1:
             return out
         crop = a[y0:y1, x0:x1, :3].astype(np.float32)
         lo, hi = np.percentile(crop, 2), np.percentile(crop, 98)
         if hi - lo < 4:
             return None
-        out[y0 - (cv_ - radius_px):y1 - (cv_ - radius_px), x0 - (cu - radius_px):x1 - (cu - radius_px)] = np.clip((crop - lo) * (255.0 / (hi - lo)), 0, 255).astype(np.uint8)
+        out[y0 - (cv_ - radius_px) : y1 - (cv_ - radius_px), x0 - (cu - radius_px) : x1 - (cu - radius_px)] = np.clip(
+            (crop - lo) * (255.0 / (hi - lo)), 0, 255
+        ).astype(np.uint8)
         return out
 
     def _paint_loupe(self, p: QPainter, radius_px: int = 10, size: int = 150) -> None:
         """A magnified inset of the pixels around the cursor, in the corner away from it."""
         u, v = self.widget_to_image(self._mouse.x(), self._mouse.y())
         cu, cv_ = int(round(u)), int(round(v))
-        src = QRectF(cu - radius_px, cv_ - radius_px, 2 * radius_px + 1, 2 * radius_px + 1)  # QImage pixel k spans [k, k + 1)
+        src = QRectF(
+            cu - radius_px, cv_ - radius_px, 2 * radius_px + 1, 2 * radius_px + 1
+        )  # QImage pixel k spans [k, k + 1)
         x = 8 if self._mouse.x() > self.width() / 2 else self.width() - size - 8
         target = QRectF(x, self.height() - size - 8, size, size)
         p.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, False)
@@ -290,7 +304,11 @@ class ImageView(QWidget):
         p.drawRect(QRectF(cx - cell / 2, cy - cell / 2, cell, cell))
         p.setPen(QPen(QColor(200, 200, 200), 1.0))
         p.drawRect(target)
-        p.drawText(QRectF(target.x() + 4, target.y() + 2, size, 16), Qt.AlignmentFlag.AlignLeft, f"({cu}, {cv_}) x{cell:.0f}, contrast stretched")
+        p.drawText(
+            QRectF(target.x() + 4, target.y() + 2, size, 16),
+            Qt.AlignmentFlag.AlignLeft,
+            f"({cu}, {cv_}) x{cell:.0f}, contrast stretched",
+        )
 
     # --- interaction ------------------------------------------------------------------------
     def wheelEvent(self, event: QWheelEvent) -> None:
@@ -351,19 +369,35 @@ def _inset_box(bounds: QRectF, w: float, h: float, obstacles: list[QRectF]) -> Q
     right, left = bounds.right() - w - 8, bounds.left() + 8
     bottom, top = bounds.bottom() - h - 34, bounds.top() + 48  # clear of the status banner and the overlay's text
     middle_x, middle_y = (left + right) / 2, (top + bottom) / 2
-    corners = [QRectF(x, y, w, h) for x, y in ((right, bottom), (left, bottom), (right, top), (left, top),
-                                                (right, middle_y), (left, middle_y), (middle_x, bottom), (middle_x, top))]
+    corners = [
+        QRectF(x, y, w, h)
+        for x, y in (
+            (right, bottom),
+            (left, bottom),
+            (right, top),
+            (left, top),
+            (right, middle_y),
+            (left, middle_y),
+            (middle_x, bottom),
+            (middle_x, top),
+        )
+    ]
     under = [sum(box.intersects(o) for o in obstacles) for box in corners]
     return corners[under.index(min(under))]
 
 
-def _free_label_box(metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF], bounds: QRectF | None = None) -> QRectF | None:
+def _free_label_box(
+    metrics: QFontMetricsF, x: float, y: float, label: str, taken: list[QRectF], bounds: QRectF | None = None
+) -> QRectF | None:
     """Where a mark's label at widget (x, y) px goes: above right, below right, above left or below left
     of the mark, the first place no placed label overlaps, inside ``bounds`` (the widget) where one is;
     ``None`` when all are taken (the mark is drawn without it, its name is in the pairs table and the
     Find points list)."""
     w, h = metrics.horizontalAdvance(label) + 2, metrics.height()
-    free = [box for box in (QRectF(x + dx, y + dy, w, h) for dx, dy in ((7, -8 - h), (7, 8), (-7 - w, -8 - h), (-7 - w, 8)))
-            if not any(box.intersects(other) for other in taken)]
+    free = [
+        box
+        for box in (QRectF(x + dx, y + dy, w, h) for dx, dy in ((7, -8 - h), (7, 8), (-7 - w, -8 - h), (-7 - w, 8)))
+        if not any(box.intersects(other) for other in taken)
+    ]
     inside = [box for box in free if bounds is None or bounds.contains(box)]
     return (inside or free or [None])[0]

@@ -54,7 +54,16 @@ class MainWindow(QMainWindow):
             scroll.setWidgetResizable(True)
             scroll.setWidget(panel)
             self.commands.addTab(scroll, title)
-        self.actions = WorkflowActions(workbench, self.commands, self.table, self.results, self.overview, lambda text, ms: self.statusBar().showMessage(text, ms), self.show_error, self)
+        self.actions = WorkflowActions(
+            workbench,
+            self.commands,
+            self.table,
+            self.results,
+            self.overview,
+            lambda text, ms: self.statusBar().showMessage(text, ms),
+            self.show_error,
+            self,
+        )
         # the actions by their old names (tests, the bench and the demo's scripted operator use them)
         for name in ("undo_action", "redo_action", "delete_action", "accept_action", "calibrate_action", "stop_action"):
             setattr(self, name, getattr(self.actions, name))
@@ -113,17 +122,33 @@ class MainWindow(QMainWindow):
 
     def _build_menus(self) -> None:
         self.files = FileMenu(self, self.menuBar().addMenu("&File"))
-        self.play_action = QAction("Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play)
+        self.play_action = QAction(
+            "Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play
+        )
         self.addAction(self.play_action)
         edit = self.menuBar().addMenu("&Edit")
-        for a in (self.actions.undo_action, self.actions.redo_action, self.actions.delete_action, self.actions.accept_action):
+        for a in (
+            self.actions.undo_action,
+            self.actions.redo_action,
+            self.actions.delete_action,
+            self.actions.accept_action,
+        ):
             edit.addAction(a)
         cal = self.calibration_menu = self.menuBar().addMenu("&Calibration")
         cal.addAction(self.actions.calibrate_action)
         cal.addAction(self.actions.store_action)
         view = self.menuBar().addMenu("&View")
-        view.addAction(QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view))
-        view.addAction(QAction("&Fit the overview to the cell", self, shortcut=QKeySequence("Ctrl+F"), triggered=lambda: (self.overview.fit_view(), self.overview.refresh())))
+        view.addAction(
+            QAction("&Reset camera zoom", self, shortcut=QKeySequence("Ctrl+0"), triggered=self.camera.view.reset_view)
+        )
+        view.addAction(
+            QAction(
+                "&Fit the overview to the cell",
+                self,
+                shortcut=QKeySequence("Ctrl+F"),
+                triggered=lambda: (self.overview.fit_view(), self.overview.refresh()),
+            )
+        )
         robot = self.menuBar().addMenu("&Robot")
         for a in (self.actions.stop_action, self.actions.approach_action, self.actions.corrected_action):
             robot.addAction(a)

@@ -69,7 +69,9 @@ class OverviewPane(QWidget):
         bar = QHBoxLayout()
         bar.addWidget(QLabel("<b>Workcell overview</b>"))
         bar.addStretch(1)
-        legend = QLabel("<span style='color:#5a9aff'>model camera</span>  <span style='color:#33ff66'>measured camera</span>")
+        legend = QLabel(
+            "<span style='color:#5a9aff'>model camera</span>  <span style='color:#33ff66'>measured camera</span>"
+        )
         bar.addWidget(legend)
         self.preview_bar = QWidget()
         self.preview_bar.setObjectName("move_preview")
@@ -120,9 +122,13 @@ class OverviewPane(QWidget):
         if preview is None:
             self.preview_bar.hide()
         else:
-            state = "refused" if preview.blocked else ("waiting for your confirmation" if send is not None else "moving")
+            state = (
+                "refused" if preview.blocked else ("waiting for your confirmation" if send is not None else "moving")
+            )
             color = "#ff6b6b" if preview.blocked else ("#ffb347" if send is not None else "#9ad0ff")
-            self.preview_text.setText(f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - {html.escape(preview.summary, quote=False)}")
+            self.preview_text.setText(
+                f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - {html.escape(preview.summary, quote=False)}"
+            )
             self.move_button.setVisible(send is not None and not preview.blocked)
             self.cancel_button.setText("Cancel" if send is not None else ("Hide" if preview.blocked else "Stop"))
             self.preview_bar.show()
@@ -130,7 +136,12 @@ class OverviewPane(QWidget):
 
     def _cancel(self) -> None:
         """Cancel a move waiting for Move; while one runs, the button is Stop (``$STP``)."""
-        if self._send is None and self.preview is not None and self.workbench.motion.motion.value == "moving" and self.workbench.motion.what == self.preview.what:
+        if (
+            self._send is None
+            and self.preview is not None
+            and self.workbench.motion.motion.value == "moving"
+            and self.workbench.motion.what == self.preview.what
+        ):
             self.workbench.moves.stop_robot()
             return
         self.show_preview(None)
@@ -155,11 +166,17 @@ class OverviewPane(QWidget):
                 self.show_preview(None)
             elif state.motion.value in ("refused", "failed", "unknown"):
                 self.cancel_button.setText("Hide")
-                self.preview_text.setText(f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - {html.escape(state.text, quote=False)}")
+                self.preview_text.setText(
+                    f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - {html.escape(state.text, quote=False)}"
+                )
 
     def _ghost_items(self) -> list:
         p = self.preview
-        moving = self._send is None and not p.blocked and self.workbench.motion.motion.value == "moving" if p is not None else False
+        moving = (
+            self._send is None and not p.blocked and self.workbench.motion.motion.value == "moving"
+            if p is not None
+            else False
+        )
         if p is None or moving:
             # While the robot runs the move the real one heads there: the tool's path line is enough, and a
             # second robot would halve the overview's rate with a vendor robot's meshes.
@@ -168,7 +185,16 @@ class OverviewPane(QWidget):
         q = p.path_deg[p.contact_step] if (p.blocked and p.contact_step is not None) else p.goal_deg
         items = []
         for item in self.workbench.cell.model_visuals().scene_items(q):
-            items.append(SceneItem(name="ghost/" + item.name, mesh=item.mesh, item2world=item.item2world, color=color, kind="ghost", opacity=0.35))
+            items.append(
+                SceneItem(
+                    name="ghost/" + item.name,
+                    mesh=item.mesh,
+                    item2world=item.item2world,
+                    color=color,
+                    kind="ghost",
+                    opacity=0.35,
+                )
+            )
         return items
 
     def orbit(self, d_azimuth: float, d_elevation: float) -> None:
@@ -198,7 +224,9 @@ class OverviewPane(QWidget):
         """Frame the cell: its components and the robot where it stands (a floor or a wall, far wider
         than it is thick, does not count), seen from the current direction."""
         wb = self.workbench
-        self.target, self.distance_mm = cell_framing(list(wb.workcell.components) + wb.cell.model_visuals().scene_items(wb.joints_deg))
+        self.target, self.distance_mm = cell_framing(
+            list(wb.workcell.components) + wb.cell.model_visuals().scene_items(wb.joints_deg)
+        )
         self.mark_dirty()
 
     def play_path(self, joints_deg: list[np.ndarray], interval_ms: int = 40) -> None:
@@ -228,16 +256,26 @@ class OverviewPane(QWidget):
         wb = self.workbench
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
         q = wb.joints_deg if self._shown_joints is None else self._shown_joints
-        self.renderer.set_items(wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.cell.extras) + self._ghost_items())
+        self.renderer.set_items(
+            wb.workcell.components + wb.cell.model_visuals().scene_items(q) + list(wb.cell.extras) + self._ghost_items()
+        )
         lines = [(frustum_polyline(wb.intrinsics, wb.model_cam2world(), 300.0), MODEL_FRUSTUM)]
         if self.preview is not None and self.preview.tcp_path_mm is not None and len(self.preview.tcp_path_mm) > 1:
             lines.append((self.preview.tcp_path_mm, (1.0, 0.7, 0.3)))
         if wb.session.result is not None:
-            lines.append((frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM))
+            lines.append(
+                (frustum_polyline(wb.intrinsics, wb.session.result.cam2world_measured, 300.0), MEASURED_FRUSTUM)
+            )
         markers = [(np.array(p.point_world_mm), (1.0, 0.84, 0.04)) for p in wb.session.pairs]
         size = self.view.size()
         w, h = max(size.width(), 320), max(size.height(), 240)
-        image = self.renderer.render_overview(self.eye(), self.target, width=w, height=h, options=RenderOptions(highlight=wb.session.target, lines=lines, markers=markers, feature_size_px=8))
+        image = self.renderer.render_overview(
+            self.eye(),
+            self.target,
+            width=w,
+            height=h,
+            options=RenderOptions(highlight=wb.session.target, lines=lines, markers=markers, feature_size_px=8),
+        )
         self.view.set_image(image)
         self.redraws += 1
         self._dirty = False

@@ -57,7 +57,9 @@ class PairsTable(QTableWidget):
         if result is None:
             return set()
         s = result.solution
-        flags = np.asarray(s.outliers, dtype=bool) | (np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False)
+        flags = np.asarray(s.outliers, dtype=bool) | (
+            np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False
+        )
         return {n for n, f in zip(self.workbench.session.solved_numbers, flags) if f}
 
     def refresh(self) -> None:
@@ -69,12 +71,23 @@ class PairsTable(QTableWidget):
         for row, p in enumerate(pairs):
             x, y, z = p.point_world_mm
             u, v = p.pixel if p.pixel is not None else (np.nan, np.nan)
-            texts = [str(p.number), p.feature or "(surface)", f"{x:.1f}", f"{y:.1f}", f"{z:.1f}",
-                     "pending" if p.pixel is None else f"{u:.2f}", "" if p.pixel is None else f"{v:.2f}",
-                     f"{residuals[p.number]:.2f}" if p.number in residuals else ""]
+            texts = [
+                str(p.number),
+                p.feature or "(surface)",
+                f"{x:.1f}",
+                f"{y:.1f}",
+                f"{z:.1f}",
+                "pending" if p.pixel is None else f"{u:.2f}",
+                "" if p.pixel is None else f"{v:.2f}",
+                f"{residuals[p.number]:.2f}" if p.number in residuals else "",
+            ]
             for col, text in enumerate(texts):
                 item = QTableWidgetItem(text)
-                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter if col >= 2 else Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+                item.setTextAlignment(
+                    Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter
+                    if col >= 2
+                    else Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter
+                )
                 if p.number in suspects and col in (0, 7):
                     item.setForeground(QColor(230, 80, 70))
                     item.setToolTip("this pick does not fit the others (the last solve): check it, or untick it")

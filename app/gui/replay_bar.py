@@ -69,7 +69,9 @@ class ReplayBar(QWidget):
         self.state_label = QLabel("")
         self.state_label.setWordWrap(False)
         self.recover_button = QPushButton("Recover...")
-        self.recover_button.setToolTip("Write a complete copy of this cut-off recording, with every message before the cut")
+        self.recover_button.setToolTip(
+            "Write a complete copy of this cut-off recording, with every message before the cut"
+        )
         self.recover_button.clicked.connect(self._recover)
         self.recover_button.hide()
         self.close_button = QPushButton("Close replay")
@@ -99,7 +101,11 @@ class ReplayBar(QWidget):
         path = Path(path)
         if is_bag(path):  # a ROS 2 bag: its frames, with the arm's joints at each frame's stamp
             robot = self.workbench.robot
-            playback, complete, problem = BagPlayback(path, robot.joint_names, user_per_si(robot.joint_units)), True, None
+            playback, complete, problem = (
+                BagPlayback(path, robot.joint_names, user_per_si(robot.joint_units)),
+                True,
+                None,
+            )
             if not len(playback.frames):
                 playback.close()
                 raise FileFormatError(path, f"no image on {playback.frames.topic}")
@@ -123,7 +129,12 @@ class ReplayBar(QWidget):
         if recorded_intrinsics is not None:
             self.workbench.cell.use_intrinsics(recorded_intrinsics)
         self.playback, self.path = playback, path
-        history = JointHistory.from_arrays(playback.joint_times_s, playback.joints_deg, self.workbench.workcell.safety.settle_rule, self.workbench.robot.joint_names)
+        history = JointHistory.from_arrays(
+            playback.joint_times_s,
+            playback.joints_deg,
+            self.workbench.workcell.safety.settle_rule,
+            self.workbench.robot.joint_names,
+        )
         self.workbench.picking.begin_replay(history, path.name)
         self.branched_at_s = None
         self._shown_frame = self._shown_solve = None
@@ -141,9 +152,15 @@ class ReplayBar(QWidget):
         self.seek(0.0)
         note = "" if complete else f" - cut off: {problem}; Recover... writes a complete copy"
         if isinstance(playback, BagPlayback):
-            joints = f"joints from {playback.joint_topic}" if playback.joint_topic else "no joint states: a camera alone, nothing robot-bound"
+            joints = (
+                f"joints from {playback.joint_topic}"
+                if playback.joint_topic
+                else "no joint states: a camera alone, nothing robot-bound"
+            )
             note = f" (ROS 2 bag, {playback.frames.topic}; {joints})"
-        self.workbench.message.emit(f"replaying {path.name}: {playback.duration_s:.1f} s, {len(playback.frames)} frames, {len(playback.solves)} solves{note}")
+        self.workbench.message.emit(
+            f"replaying {path.name}: {playback.duration_s:.1f} s, {len(playback.frames)} frames, {len(playback.solves)} solves{note}"
+        )
 
     def close_replay(self) -> None:
         if self.playback is None:
@@ -166,7 +183,10 @@ class ReplayBar(QWidget):
         self.playback = self.path = self._live_state = None
         self.workbench.picking.end_replay()
         self.hide()
-        self.workbench.message.emit("replay closed: " + ("the branched session stays open" if branched else "the live session is back as it was"))
+        self.workbench.message.emit(
+            "replay closed: "
+            + ("the branched session stays open" if branched else "the live session is back as it was")
+        )
         self.closed.emit()
 
     def _close_playback(self) -> None:
@@ -271,13 +291,25 @@ class ReplayBar(QWidget):
     def _show_solve(self, solve: RecordedSolve) -> None:
         c = solve.context
         if not c:
-            self.workbench.message.emit(f"solve {solve.id} was recorded without its robot context: its camera pose only is in the file")
+            self.workbench.message.emit(
+                f"solve {solve.id} was recorded without its robot context: its camera pose only is in the file"
+            )
             return
         solution = solve_from_inputs(solve.inputs)  # deterministic: the same answer as recorded
         numbers = [p.number for p in self.workbench.session.pairs.usable()]
-        obj2world, cam_model, tcp_model = (np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model"))
-        self.workbench.session.show_result(solution, obj2world, cam_model, tcp_model, c.get("joints_deg"), numbers,
-                                           points_obj_mm=solve.inputs.get("points_3d"), intrinsics=Intrinsics.from_dict(solve.inputs["intrinsics"]))
+        obj2world, cam_model, tcp_model = (
+            np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model")
+        )
+        self.workbench.session.show_result(
+            solution,
+            obj2world,
+            cam_model,
+            tcp_model,
+            c.get("joints_deg"),
+            numbers,
+            points_obj_mm=solve.inputs.get("points_3d"),
+            intrinsics=Intrinsics.from_dict(solve.inputs["intrinsics"]),
+        )
 
     # --- branching -----------------------------------------------------------------------------
     def _on_edit(self) -> None:
@@ -285,7 +317,9 @@ class ReplayBar(QWidget):
             return
         self.branched_at_s = self.position_s
         self._update_state()
-        self.workbench.message.emit(f"new session branched from {self.path.name} at {self.position_s:.1f} s; the recording is not changed")
+        self.workbench.message.emit(
+            f"new session branched from {self.path.name} at {self.position_s:.1f} s; the recording is not changed"
+        )
 
     def _update_state(self) -> None:
         pb = self.playback
@@ -294,4 +328,6 @@ class ReplayBar(QWidget):
         if self.branched_at_s is not None:
             self.state_label.setText(f"<span style='color:#e0a030'>branched at {self.branched_at_s:.1f} s</span>")
         else:
-            self.state_label.setText(f"{len(self.workbench.session.pairs)} pairs, {sum(1 for s in pb.solves if s.t_s <= self.position_s)} solves so far")
+            self.state_label.setText(
+                f"{len(self.workbench.session.pairs)} pairs, {sum(1 for s in pb.solves if s.t_s <= self.position_s)} solves so far"
+            )

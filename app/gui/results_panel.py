@@ -16,7 +16,13 @@ from calib_core.calibration.verdict import Verdict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.solver import SolveStatus
 
-_VERDICT_COLORS = {Verdict.OK: "#5fd35f", Verdict.AMBIGUOUS: "#ffb347", Verdict.UNCERTAIN: "#ffb347", Verdict.IMPLAUSIBLE: "#ff8c42", Verdict.FAILED: "#ff6b6b"}
+_VERDICT_COLORS = {
+    Verdict.OK: "#5fd35f",
+    Verdict.AMBIGUOUS: "#ffb347",
+    Verdict.UNCERTAIN: "#ffb347",
+    Verdict.IMPLAUSIBLE: "#ff8c42",
+    Verdict.FAILED: "#ff6b6b",
+}
 
 
 class ResidualChart(QWidget):
@@ -52,7 +58,9 @@ class ResidualChart(QWidget):
             p.setPen(QColor(200, 200, 200))
             p.drawText(QRectF(i * w, h, w, 16), Qt.AlignmentFlag.AlignCenter, label)
         p.setPen(QColor(160, 160, 160))
-        p.drawText(QRectF(4, 2, self.width() - 8, 14), Qt.AlignmentFlag.AlignRight, f"max {top:.2f} px  (red: if left out)")
+        p.drawText(
+            QRectF(4, 2, self.width() - 8, 14), Qt.AlignmentFlag.AlignRight, f"max {top:.2f} px  (red: if left out)"
+        )
 
 
 class ResultsPanel(QWidget):
@@ -118,7 +126,9 @@ class ResultsPanel(QWidget):
 
     def show_message(self, text: str, ok: bool = True) -> None:
         """A step's outcome on the message line (green, or orange when it found a problem)."""
-        self.status.setText(f"<span style='color:{'#5fd35f' if ok else '#ffb347'}'>{html.escape(text, quote=False)}</span>")
+        self.status.setText(
+            f"<span style='color:{'#5fd35f' if ok else '#ffb347'}'>{html.escape(text, quote=False)}</span>"
+        )
         self._fit_text()
 
     def show_error(self, text: str) -> None:
@@ -142,7 +152,9 @@ class ResultsPanel(QWidget):
         verdict = session.verdict
         stale = session.stale_reason
         if stale:
-            text = f"<span style='color:#9a9a9a'><b>FROM AN EARLIER STATE</b></span> - {html.escape(stale, quote=False)}"
+            text = (
+                f"<span style='color:#9a9a9a'><b>FROM AN EARLIER STATE</b></span> - {html.escape(stale, quote=False)}"
+            )
             text += f"<br><span style='color:#9a9a9a'>it was: {html.escape(verdict.text if verdict else sol.status.value, quote=False)}</span>"
         else:
             color = _VERDICT_COLORS[verdict.verdict if verdict else Verdict(sol.status.value)]
@@ -176,11 +188,21 @@ class ResultsPanel(QWidget):
         numbers = session.solved_numbers
         present = {p.number for p in session.pairs.usable()}
         # bars only for pairs that still exist as they were solved; a stale result shows none
-        bars = [] if stale else [(str(n), float(e), float(l)) for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px) if n in present]
+        bars = (
+            []
+            if stale
+            else [
+                (str(n), float(e), float(l))
+                for n, e, l in zip(numbers, sol.residual_norms_px, sol.leave_one_out_px)
+                if n in present
+            ]
+        )
         self.chart.set_values(bars)
         if sol.status is SolveStatus.AMBIGUOUS:
             for i, c in enumerate(sol.candidates):
-                button = QPushButton(f"Use solution {i + 1} ({c.rms_px:.2f} px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})")
+                button = QPushButton(
+                    f"Use solution {i + 1} ({c.rms_px:.2f} px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})"
+                )
                 button.setObjectName(f"candidate_{i}")
                 button.setCheckable(True)
                 button.setChecked(i == session.chosen_candidate)

@@ -9,7 +9,19 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from PySide6.QtCore import QEventLoop, Qt
-from PySide6.QtWidgets import QApplication, QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QProgressBar, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QApplication,
+    QCheckBox,
+    QFileDialog,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QProgressBar,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
 
 from app.gui.buttons import button
 from app.gui.busy import busy
@@ -19,7 +31,6 @@ from app.gui.tool_group import ToolGroup
 from calib_core.errors import OperatorError
 from calib_core.operator.calibration_run import VIA
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
-
 
 
 class RobotPanel(QWidget):
@@ -37,10 +48,14 @@ class RobotPanel(QWidget):
         plan = QGroupBox("Plan")
         pl = QVBoxLayout(plan)
         self.spec = QLineEdit(DEFAULT_SPEC)
-        self.spec.setToolTip("a ChArUco or ArUco board: charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
+        self.spec.setToolTip(
+            "a ChArUco or ArUco board: charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
+        )
         pl.addWidget(self.spec)
         self.show_board = QCheckBox("Board in the simulated cell")
-        self.show_board.setToolTip("Put the board up where the cell's hand_eye_board says (the simulated camera sees it)")
+        self.show_board.setToolTip(
+            "Put the board up where the cell's hand_eye_board says (the simulated camera sees it)"
+        )
         self.show_board.toggled.connect(guard(lambda on: self.workbench.show_calibration_board(self._spec(), on)))
         pl.addWidget(self.show_board)
         row = QHBoxLayout()
@@ -50,7 +65,11 @@ class RobotPanel(QWidget):
         self.poses.setValue(40)
         self.poses.setToolTip("How many poses to view the board from (30-40 determine a 6-axis robot well)")
         row.addWidget(self.poses)
-        self.plan_button = button("Plan poses", "robot_plan", "Choose reachable, collision-free poses that see the whole board and determine the parameters best")
+        self.plan_button = button(
+            "Plan poses",
+            "robot_plan",
+            "Choose reachable, collision-free poses that see the whole board and determine the parameters best",
+        )
         self.plan_button.clicked.connect(guard(self.make_plan))
         row.addWidget(self.plan_button, 1)
         pl.addLayout(row)
@@ -61,7 +80,11 @@ class RobotPanel(QWidget):
         run = QGroupBox("Run")
         rl = QVBoxLayout(run)
         row = QHBoxLayout()
-        self.run_button = button("Run plan", "robot_run", "Drive the robot through the planned poses (MVJ), capturing a board view at each once the robot settled")
+        self.run_button = button(
+            "Run plan",
+            "robot_run",
+            "Drive the robot through the planned poses (MVJ), capturing a board view at each once the robot settled",
+        )
         self.run_button.clicked.connect(guard(self.start_run))
         self.stop_button = button("Stop", "robot_stop", "Stop after the current move; the views taken so far are kept")
         self.stop_button.clicked.connect(guard(lambda: self.run.stop() if self.run is not None else None))
@@ -78,23 +101,35 @@ class RobotPanel(QWidget):
 
         review = QGroupBox("Identify")
         vl = QVBoxLayout(review)
-        self.identify_button = button("Identify", "robot_identify", "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)")
+        self.identify_button = button(
+            "Identify",
+            "robot_identify",
+            "The robot's joint placements and the camera mounting from the views (6 or more, 30-40 recommended)",
+        )
         self.identify_button.clicked.connect(guard(self.identify))
         vl.addWidget(self.identify_button)
         self.fit_intrinsics = QCheckBox("Refine the camera's intrinsics with the robot")
         self.fit_intrinsics.setChecked(True)
-        self.fit_intrinsics.setToolTip("The board views correct fu, fv, cx, cy, k1, k2, p1, p2 together with the robot; Apply uses them too, Revert takes them back")
+        self.fit_intrinsics.setToolTip(
+            "The board views correct fu, fv, cx, cy, k1, k2, p1, p2 together with the robot; Apply uses them too, Revert takes them back"
+        )
         vl.addWidget(self.fit_intrinsics)
         self.result_text = QLabel("")
         self.result_text.setWordWrap(True)
         self.result_text.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         vl.addWidget(self.result_text)
         row = QHBoxLayout()
-        self.apply_button = button("Apply", "robot_apply", "Use the calibrated robot for the views, the solver's prior and every move from now on")
+        self.apply_button = button(
+            "Apply",
+            "robot_apply",
+            "Use the calibrated robot for the views, the solver's prior and every move from now on",
+        )
         self.apply_button.clicked.connect(guard(self.apply))
         self.revert_button = button("Revert", "robot_revert", "Use the robot's model as loaded again")
         self.revert_button.clicked.connect(guard(self.revert))
-        self.save_button = button("Save...", "robot_save", "Save robot_calibration.yaml and the calibrated URDF into a folder")
+        self.save_button = button(
+            "Save...", "robot_save", "Save robot_calibration.yaml and the calibrated URDF into a folder"
+        )
         self.save_button.clicked.connect(guard(self._save_dialog))
         for b in (self.apply_button, self.revert_button, self.save_button):
             row.addWidget(b)
@@ -112,7 +147,9 @@ class RobotPanel(QWidget):
     def _spec(self):
         spec = parse_board(self.spec.text().strip())
         if not spec.unambiguous:
-            raise OperatorError(f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board")
+            raise OperatorError(
+                f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+            )
         return spec
 
     def _refresh(self) -> None:
@@ -133,10 +170,14 @@ class RobotPanel(QWidget):
         n = len(self.plan.joints_deg)
         why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
         seen = [c for c, _ in self.plan.cell_views if c != VIA]
-        self.plan_text.setText(f"{n} board poses (of {self.plan.candidates} candidates) and {len(seen)} views of surveyed components "
-                               f"({', '.join(sorted(set(seen))) or 'none reachable'}), which tie the robot to the cell.")
-        self.plan_text.setToolTip("Every pose sees its target with the model, and every move from the one before is free of collisions."
-                                  + (f" Left out: {why}." if why else ""))
+        self.plan_text.setText(
+            f"{n} board poses (of {self.plan.candidates} candidates) and {len(seen)} views of surveyed components "
+            f"({', '.join(sorted(set(seen))) or 'none reachable'}), which tie the robot to the cell."
+        )
+        self.plan_text.setToolTip(
+            "Every pose sees its target with the model, and every move from the one before is free of collisions."
+            + (f" Left out: {why}." if why else "")
+        )
         self.workbench.message.emit(f"robot calibration: {n} poses planned")
         self._refresh()
 
@@ -144,11 +185,18 @@ class RobotPanel(QWidget):
         if self.plan is None or not self.plan.joints_deg:
             raise OperatorError("plan the poses first")
         n = len(self.plan.joints_deg) + len(self.plan.cell_views)
-        if not ask(self, "Drive the robot through the calibration poses?", f"The robot will move through {n} poses, one after the other, stopping at each "
-                   "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
-                   "Stop ends the run after the current move.", "Run"):
+        if not ask(
+            self,
+            "Drive the robot through the calibration poses?",
+            f"The robot will move through {n} poses, one after the other, stopping at each "
+            "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
+            "Stop ends the run after the current move.",
+            "Run",
+        ):
             return
-        self.run = self.workbench.robot_calibration.robot_calibration_run(self._spec(), self.plan.joints_deg, self.plan.cell_views)
+        self.run = self.workbench.robot_calibration.robot_calibration_run(
+            self._spec(), self.plan.joints_deg, self.plan.cell_views
+        )
         self.progress.setRange(0, n)
         self.progress.setValue(0)
         self.run.progress.connect(self._on_progress)
@@ -165,6 +213,7 @@ class RobotPanel(QWidget):
     def identify(self) -> None:
         if self.run is None:
             raise OperatorError("run the plan first: the identification needs the views it takes")
+
         def step(done: int, total: int, text: str) -> None:
             self.progress.setRange(0, total)
             self.progress.setValue(done)
@@ -175,7 +224,12 @@ class RobotPanel(QWidget):
         self.identify_button.setEnabled(False)
         try:
             with busy(self, "identifying the robot ..."):
-                r = self.result = self.workbench.robot_calibration.calibrate_robot(self.run.capture, cell_frames=self.run.cell_frames, with_intrinsics=self.fit_intrinsics.isChecked(), progress=step)
+                r = self.result = self.workbench.robot_calibration.calibrate_robot(
+                    self.run.capture,
+                    cell_frames=self.run.cell_frames,
+                    with_intrinsics=self.fit_intrinsics.isChecked(),
+                    progress=step,
+                )
         finally:  # the run's own progress back (the panel says what the run did)
             self.progress.setRange(0, before[0])
             self.progress.setValue(before[1])
@@ -186,7 +240,9 @@ class RobotPanel(QWidget):
             f"<b>Robot</b> from {len(r.per_view_rms_px)} views ({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
             f"{len(obs.identified)} of {len(r.names)} parameters identified (condition {obs.condition:.0f}); {len(obs.directions)} combinations the views do not determine"
             + (f", e.g. {', '.join(f'{w:+.2f} {n}' for n, w in obs.directions[0][:3])}" if obs.directions else ""),
-            f"{len(obs.correlations)} pairs correlated above 0.9" if obs.correlations else "no two parameters correlated above 0.9",
+            f"{len(obs.correlations)} pairs correlated above 0.9"
+            if obs.correlations
+            else "no two parameters correlated above 0.9",
         ]
         worst = max(r.per_view_rms_px.items(), key=lambda kv: kv[1])
         lines.append(f"worst view {worst[0]}: {worst[1]:.3f} px")

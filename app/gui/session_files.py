@@ -63,7 +63,14 @@ class Autosave:
     never writes over the autosave of a session that ended without saving, which :meth:`orphans` finds.
     """
 
-    def __init__(self, settings: QSettings, revision: Callable[[], int], save: Callable[[Path], None], report: Callable[[str], None], parent):
+    def __init__(
+        self,
+        settings: QSettings,
+        revision: Callable[[], int],
+        save: Callable[[Path], None],
+        report: Callable[[str], None],
+        parent,
+    ):
         self.settings = settings
         self._revision = revision
         self._save = save

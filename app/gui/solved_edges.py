@@ -33,8 +33,12 @@ class SolvedEdges:
         if self._half is None:
             self._half = distortion_map(self.intrinsics.scaled(0.5))
         self._renderer.set_items(items)
-        rgba = self._renderer.render_view(self._half.ideal, cam2world, RenderOptions(style="edges", transparent_background=True, highlight=highlight))
-        return cv2.resize(self._half.apply(rgba), (self.intrinsics.width, self.intrinsics.height), interpolation=cv2.INTER_LINEAR)
+        rgba = self._renderer.render_view(
+            self._half.ideal, cam2world, RenderOptions(style="edges", transparent_background=True, highlight=highlight)
+        )
+        return cv2.resize(
+            self._half.apply(rgba), (self.intrinsics.width, self.intrinsics.height), interpolation=cv2.INTER_LINEAR
+        )
 
     def close(self) -> None:
         if self._renderer is not None:

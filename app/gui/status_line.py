@@ -33,11 +33,21 @@ class StatusLine:
         self.motion_label.setObjectName("motion")
         self.settled_label = QLabel("")
         self.settled_label.setObjectName("settled")
-        for w in (self.motion_label, self.settled_label, self.record_label, self.link_label, self.fps_label, self.pairs_label):
+        for w in (
+            self.motion_label,
+            self.settled_label,
+            self.record_label,
+            self.link_label,
+            self.fps_label,
+            self.pairs_label,
+        ):
             bar.addPermanentWidget(w)
         workbench.arm.motion_changed.connect(self.show_motion)
         workbench.arm.link_state.connect(self.show_link_state)
-        for signal in (workbench.session.pairs.changed, workbench.session.changed):  # pairs change outside the undo stack too
+        for signal in (
+            workbench.session.pairs.changed,
+            workbench.session.changed,
+        ):  # pairs change outside the undo stack too
             signal.connect(self.show_pairs)
         self.show_pairs()
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
@@ -78,12 +88,24 @@ class StatusLine:
             self.link_label.setText(text)
         self._show_settled()
         rec = self.workbench.recorder
-        self.record_label.setText("" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB")
+        self.record_label.setText(
+            "" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB"
+        )
 
     def show_motion(self, state) -> None:
         """Moving / arrived / refused / pose unknown, from the controller's answers."""
-        color = {"moving": "#9ad0ff", "arrived": "#5fd35f", "refused": "#ff6b6b", "failed": "#ff6b6b", "unknown": "#ff9a30"}.get(state.motion.value)
-        self.motion_label.setText(f"<span style='color:{color}'>{html.escape(state.text, quote=False)}</span>" if color else html.escape(state.text))
+        color = {
+            "moving": "#9ad0ff",
+            "arrived": "#5fd35f",
+            "refused": "#ff6b6b",
+            "failed": "#ff6b6b",
+            "unknown": "#ff9a30",
+        }.get(state.motion.value)
+        self.motion_label.setText(
+            f"<span style='color:{color}'>{html.escape(state.text, quote=False)}</span>"
+            if color
+            else html.escape(state.text)
+        )
         self.motion_label.setToolTip(state.text)
         self._show_settled()
 
@@ -94,7 +116,11 @@ class StatusLine:
             self.settled_label.setText("")
             return
         still = wb.picking.robot_settled()
-        self.settled_label.setText("<span style='color:#5fd35f'>settled</span>" if still.settled else "<span style='color:#ff9a30'>not settled</span>")
+        self.settled_label.setText(
+            "<span style='color:#5fd35f'>settled</span>"
+            if still.settled
+            else "<span style='color:#ff9a30'>not settled</span>"
+        )
         self.settled_label.setToolTip(still.reason or f"still for {still.still_for_s:.1f} s: frames can be picked on")
 
     def show_pairs(self, *_) -> None:
@@ -102,4 +128,6 @@ class StatusLine:
         self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.required_pairs} needed")
 
     def show_link_state(self, text: str) -> None:
-        self.link_label.setText(f"link: {html.escape(text, quote=False)}")  # the label shows markup (warnings); a device's text is not
+        self.link_label.setText(
+            f"link: {html.escape(text, quote=False)}"
+        )  # the label shows markup (warnings); a device's text is not

@@ -26,14 +26,23 @@ def store_with_consent(parent: QWidget, core, say) -> None:
         _store(parent, core, convert, say)
     except LookNotAtTask as exc:
         task = exc.place.task
-        question = "\n".join([
-            f"This look cannot be {task}'s correction as it is: {exc.place.text}.", "",
-            "A robot's error changes with its pose: a look made elsewhere corrects that pose, not the task location.", "",
-            f"Store as measurement: kept in {task}'s history at its own pose; nothing the robot does changes.",
-            f"Convert into {task}'s correction: the target commanded for {task} moves by {exc.change_mm:.2f} mm and {exc.change_deg:.3f} deg. "
-            "Your conversion is kept with the correction.",
-        ])
-        chosen = ask_choice(parent, "A look from another place", question, [("measurement", "Store as measurement"), ("convert", f"Convert into {task}'s correction")])
+        question = "\n".join(
+            [
+                f"This look cannot be {task}'s correction as it is: {exc.place.text}.",
+                "",
+                "A robot's error changes with its pose: a look made elsewhere corrects that pose, not the task location.",
+                "",
+                f"Store as measurement: kept in {task}'s history at its own pose; nothing the robot does changes.",
+                f"Convert into {task}'s correction: the target commanded for {task} moves by {exc.change_mm:.2f} mm and {exc.change_deg:.3f} deg. "
+                "Your conversion is kept with the correction.",
+            ]
+        )
+        chosen = ask_choice(
+            parent,
+            "A look from another place",
+            question,
+            [("measurement", "Store as measurement"), ("convert", f"Convert into {task}'s correction")],
+        )
         if chosen == "measurement":
             core.desk.store_measurement()
         elif chosen == "convert":
@@ -46,9 +55,18 @@ def _store(parent: QWidget, core, convert: str, say) -> None:
     try:
         core.desk.store_correction(convert=convert)
     except ConfirmationNeeded as exc:
-        question = "\n".join(["This result is not OK:", *[f"- {r}" for r in exc.reasons], "", "Store it as the correction for this task location anyway?",
-                              "Your confirmation is kept with the correction."])
+        question = "\n".join(
+            [
+                "This result is not OK:",
+                *[f"- {r}" for r in exc.reasons],
+                "",
+                "Store it as the correction for this task location anyway?",
+                "Your confirmation is kept with the correction.",
+            ]
+        )
         if not ask(parent, "Store an implausible result?", question, "Store anyway"):
             say("nothing stored")
             return
-        core.desk.store_correction(convert=convert, confirmation=f"confirmed in the window by {_who()}: {'; '.join(exc.reasons)}")
+        core.desk.store_correction(
+            convert=convert, confirmation=f"confirmed in the window by {_who()}: {'; '.join(exc.reasons)}"
+        )

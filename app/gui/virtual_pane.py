@@ -74,7 +74,9 @@ class VirtualPane(QWidget):
             self.renderer.set_items(items)
             # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
             # cover the very surface points the picker tests for visibility.
-            image = self.renderer.render_view(self.intrinsics, wb.model_cam2world(), RenderOptions(highlight=wb.session.target))
+            image = self.renderer.render_view(
+                self.intrinsics, wb.model_cam2world(), RenderOptions(highlight=wb.session.target)
+            )
             self.view.set_image(image)
             self._render_key = key
             self.renders += 1
@@ -92,13 +94,18 @@ class VirtualPane(QWidget):
             uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
             if np.all(np.isfinite(uv)):
                 overlay.points.append((uv[0], uv[1], str(p.number), _qcolor(p.complete)))
-        overlay.text = f"target: {wb.session.target or '(choose one)'}" + ("" if wb.session.pairs.pending() else " - click a feature to pick its 3D point")
+        overlay.text = f"target: {wb.session.target or '(choose one)'}" + (
+            "" if wb.session.pairs.pending() else " - click a feature to pick its 3D point"
+        )
         self.view.set_overlay(overlay)
         self._last_joints = wb.joints_deg.copy()
 
     def is_current(self, tolerance_deg: float = 1e-3) -> bool:
         """Whether the view shows the robot at the current joints (to ``tolerance_deg``)."""
-        return self._last_joints is not None and float(np.max(np.abs(self.workbench.joints_deg - self._last_joints))) <= tolerance_deg
+        return (
+            self._last_joints is not None
+            and float(np.max(np.abs(self.workbench.joints_deg - self._last_joints))) <= tolerance_deg
+        )
 
     def refresh_if_moved(self, tolerance_deg: float = 1e-3) -> None:
         if not self.is_current(tolerance_deg):
@@ -126,11 +133,15 @@ class VirtualPane(QWidget):
                 return
         target = self.feature_component or self.workbench.session.target
         snap = 0.0 if self.feature_component else 10.0  # naming a feature: the core snaps it to the mesh
-        hit: PickResult | None = self.renderer.pick(u, v, snap_radius_px=snap, components=None if target is None else {target})
+        hit: PickResult | None = self.renderer.pick(
+            u, v, snap_radius_px=snap, components=None if target is None else {target}
+        )
         if hit is None:
             self.info.setText(f"nothing of {target or 'the target object'} there")
             return
-        where = f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm"
+        where = (
+            f"{hit.component}: {hit.feature or 'surface'} ({', '.join(f'{x:.1f}' for x in hit.point_component_mm)}) mm"
+        )
         if self.feature_component is not None:
             self.info.setText(where)
             self.feature_picked.emit(hit, self.workbench.model_cam2world(), self.intrinsics.fu)  # the pane's own pixels

@@ -12,7 +12,17 @@ from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import QCheckBox, QFileDialog, QGroupBox, QHBoxLayout, QLabel, QLineEdit, QListWidget, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QFileDialog,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QVBoxLayout,
+    QWidget,
+)
 
 from app.gui.buttons import button
 from app.gui.confirm import ask
@@ -53,16 +63,26 @@ class VisionPanel(QWidget):
         board = QGroupBox("Board")
         bl = QVBoxLayout(board)
         self.spec = QLineEdit(DEFAULT_SPEC)
-        self.spec.setToolTip("charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM, circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT")
+        self.spec.setToolTip(
+            "charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM, circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
+        )
         self.spec.editingFinished.connect(guard(self._spec_changed))
         bl.addWidget(self.spec)
         self.show_board = QCheckBox("Board in the simulated cell")
-        self.show_board.setToolTip("Put the board up in front of the robot in the simulated cell (the simulated camera sees it)")
+        self.show_board.setToolTip(
+            "Put the board up in front of the robot in the simulated cell (the simulated camera sees it)"
+        )
         self.show_board.toggled.connect(guard(self._show_board_toggled))
         bl.addWidget(self.show_board)
-        self.next_pose = button("Next board pose", "vision_next_pose", "Move the robot (MVJ) to the next planned pose that sees the board")
+        self.next_pose = button(
+            "Next board pose", "vision_next_pose", "Move the robot (MVJ) to the next planned pose that sees the board"
+        )
         self.next_pose.clicked.connect(guard(self._next_pose))
-        self.capture_button = button("Capture view", "vision_capture", "Detect the board in the camera's current frame and keep the view with the robot's joints")
+        self.capture_button = button(
+            "Capture view",
+            "vision_capture",
+            "Detect the board in the camera's current frame and keep the view with the robot's joints",
+        )
         self.capture_button.clicked.connect(guard(self.capture_view))
         row = QHBoxLayout()
         row.addWidget(self.next_pose)
@@ -83,9 +103,15 @@ class VisionPanel(QWidget):
 
         cal = QGroupBox("Calibrate")
         cl = QVBoxLayout(cal)
-        self.calibrate_intrinsics_button = button("Calibrate intrinsics", "vision_intrinsics", "fu, fv, cx, cy and k1 k2 p1 p2 k3 from the views (3 or more)")
+        self.calibrate_intrinsics_button = button(
+            "Calibrate intrinsics", "vision_intrinsics", "fu, fv, cx, cy and k1 k2 p1 p2 k3 from the views (3 or more)"
+        )
         self.calibrate_intrinsics_button.clicked.connect(guard(self.calibrate_intrinsics))
-        self.calibrate_hand_eye_button = button("Calibrate hand-eye", "vision_hand_eye", "The camera's mounting on the flange from the views and their robot poses (3 or more, 10 recommended)")
+        self.calibrate_hand_eye_button = button(
+            "Calibrate hand-eye",
+            "vision_hand_eye",
+            "The camera's mounting on the flange from the views and their robot poses (3 or more, 10 recommended)",
+        )
         self.calibrate_hand_eye_button.clicked.connect(guard(self.calibrate_hand_eye))
         row = QHBoxLayout()
         row.addWidget(self.calibrate_intrinsics_button)
@@ -95,15 +121,30 @@ class VisionPanel(QWidget):
         self.result.setWordWrap(True)
         self.result.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         cl.addWidget(self.result)
-        self.apply_intrinsics_button = button("Apply intrinsics", "vision_apply_intrinsics", "Use the calibrated intrinsics for picking, solving and the virtual camera")
+        self.apply_intrinsics_button = button(
+            "Apply intrinsics",
+            "vision_apply_intrinsics",
+            "Use the calibrated intrinsics for picking, solving and the virtual camera",
+        )
         self.apply_intrinsics_button.clicked.connect(guard(self.apply_intrinsics))
-        self.save_intrinsics_button = button("Save...", "vision_save_intrinsics", "Save the intrinsics as OpenCV YAML or ROS camera_info")
+        self.save_intrinsics_button = button(
+            "Save...", "vision_save_intrinsics", "Save the intrinsics as OpenCV YAML or ROS camera_info"
+        )
         self.save_intrinsics_button.clicked.connect(guard(self._save_intrinsics_dialog))
-        self.apply_hand_eye_button = button("Apply mounting", "vision_apply_hand_eye", "Use the measured camera mounting for the virtual camera, the solver's prior and the displacement")
+        self.apply_hand_eye_button = button(
+            "Apply mounting",
+            "vision_apply_hand_eye",
+            "Use the measured camera mounting for the virtual camera, the solver's prior and the displacement",
+        )
         self.apply_hand_eye_button.clicked.connect(guard(self.apply_hand_eye))
-        self.save_hand_eye_button = button("Save...", "vision_save_hand_eye", "Save cam2flange (xyz mm, rpy deg) with its 1-sigma as YAML")
+        self.save_hand_eye_button = button(
+            "Save...", "vision_save_hand_eye", "Save cam2flange (xyz mm, rpy deg) with its 1-sigma as YAML"
+        )
         self.save_hand_eye_button.clicked.connect(guard(self._save_hand_eye_dialog))
-        for pair in ((self.apply_intrinsics_button, self.save_intrinsics_button), (self.apply_hand_eye_button, self.save_hand_eye_button)):
+        for pair in (
+            (self.apply_intrinsics_button, self.save_intrinsics_button),
+            (self.apply_hand_eye_button, self.save_hand_eye_button),
+        ):
             row = QHBoxLayout()
             row.addWidget(pair[0], 2)
             row.addWidget(pair[1], 1)
@@ -126,7 +167,9 @@ class VisionPanel(QWidget):
         if self.capture is not None and str(spec) == str(self.capture.spec):
             return
         if self.capture is not None and self.capture.views:
-            self._report(f"board changed to {spec}: the {len(self.capture.views)} views of the old board were set aside")
+            self._report(
+                f"board changed to {spec}: the {len(self.capture.views)} views of the old board were set aside"
+            )
         self.capture = BoardCapture(spec)
         self._plan, self._plan_index = [], 0
         if self.show_board.isChecked():
@@ -154,15 +197,24 @@ class VisionPanel(QWidget):
         # robot had settled, with the joints then: a refusal says why, nothing is captured.
         frame, stamp = self.workbench.picking.frame_to_capture()
         joints = None if stamp is None else np.array(stamp.joints_deg)
-        view = self.capture.add(frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s))
+        view = self.capture.add(
+            frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s)
+        )
         if isinstance(view, RejectedView):
             self.board_detected.emit(None, "")
             self._report(f"{view.name} rejected: {view.reason}")
         else:
             self.board_detected.emit(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
             lost = views_with_lost_corners([len(v.ids) for v in self.capture.views]).get(len(self.capture.views) - 1)
-            self._report(f"{view.name}: {len(view.ids)} corners" + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
-                         + ("" if lost is None else f"; it lost corners against its neighbours ({lost:.0f}): look at it, remove it if the board was cut off or blurred"))
+            self._report(
+                f"{view.name}: {len(view.ids)} corners"
+                + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
+                + (
+                    ""
+                    if lost is None
+                    else f"; it lost corners against its neighbours ({lost:.0f}): look at it, remove it if the board was cut off or blurred"
+                )
+            )
         self._refresh()
 
     def _remove_selected(self) -> None:
@@ -183,7 +235,14 @@ class VisionPanel(QWidget):
         for r in c.rejected:
             self.views.addItem(f"x {r.name}: {r.reason}")
         n = len(c.views)
-        self.coverage.setText(f"{n} views, corners cover {100 * c.coverage():.0f} % of the image." + ("" if n >= 10 else f" Add views with the board in every part of the image, tilted 20-40 deg ({max(0, 10 - n)} more for a stable calibration)."))
+        self.coverage.setText(
+            f"{n} views, corners cover {100 * c.coverage():.0f} % of the image."
+            + (
+                ""
+                if n >= 10
+                else f" Add views with the board in every part of the image, tilted 20-40 deg ({max(0, 10 - n)} more for a stable calibration)."
+            )
+        )
         self.calibrate_intrinsics_button.setEnabled(n >= 3)
         self.calibrate_hand_eye_button.setEnabled(n >= 3 and all(q is not None for q in c.joints_deg))
         self.apply_intrinsics_button.setEnabled(self.intrinsics_result is not None)
@@ -202,7 +261,9 @@ class VisionPanel(QWidget):
             f"{' '.join(i.distortion_names)}: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
         ]
         lines += [f"&bull; {a}" for a in r.advice]
-        lines += [f"<span style='color:#e0a030'>check: {p}</span>" for p in intrinsics_problems(r, self.workbench.intrinsics)]
+        lines += [
+            f"<span style='color:#e0a030'>check: {p}</span>" for p in intrinsics_problems(r, self.workbench.intrinsics)
+        ]
         self._intrinsics_text = "<br>".join(lines)
         self._show_results()
         self._refresh()
@@ -211,17 +272,27 @@ class VisionPanel(QWidget):
         self.result.setText("<br><br>".join(t for t in (self._intrinsics_text, self._hand_eye_text) if t))
 
     def calibrate_hand_eye(self) -> None:
-        intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
+        intrinsics = (
+            self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
+        )
         r = self.hand_eye_result = self.capture.calibrate_hand_eye(self.workbench.robot, intrinsics)
-        modelled = concat(self.workbench.robot.frame_placement("camera"), invert(self.workbench.robot.frame_placement("flange")))
+        modelled = concat(
+            self.workbench.robot.frame_placement("camera"), invert(self.workbench.robot.frame_placement("flange"))
+        )
         d, rot = pose_difference(r.cam2flange, modelled)
         lines = [
             f"<b>Camera mounting</b> from {r.views} poses, RMS {r.rms_px:.3f} px",
-            "position " + ", ".join(f"{v:.2f}" for v in r.cam2flange[:3, 3]) + " mm (1-sigma " + ", ".join(f"{v:.3f}" for v in r.std_xyz_mm) + ")",
+            "position "
+            + ", ".join(f"{v:.2f}" for v in r.cam2flange[:3, 3])
+            + " mm (1-sigma "
+            + ", ".join(f"{v:.3f}" for v in r.std_xyz_mm)
+            + ")",
             f"differs from the model by {np.linalg.norm(d):.2f} mm and {np.linalg.norm(rot):.3f} deg",
         ]
         noise = self.intrinsics_result.rms_px if self.intrinsics_result is not None else None
-        self.hand_eye_problems = hand_eye_problems(r, (float(np.linalg.norm(d)), float(np.linalg.norm(rot))), noise, self.workbench.workcell.safety)
+        self.hand_eye_problems = hand_eye_problems(
+            r, (float(np.linalg.norm(d)), float(np.linalg.norm(rot))), noise, self.workbench.workcell.safety
+        )
         lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in self.hand_eye_problems]
         self._hand_eye_text = "<br>".join(lines)
         self._show_results()
@@ -231,7 +302,9 @@ class VisionPanel(QWidget):
         """A result that fails its own checks is applied only when the operator says so (recorded)."""
         if not problems:
             return True
-        text = "\n".join([f"The {what} failed its checks:", *[f"- {p}" for p in problems], "", f"Use this {what} anyway?"])
+        text = "\n".join(
+            [f"The {what} failed its checks:", *[f"- {p}" for p in problems], "", f"Use this {what} anyway?"]
+        )
         if not ask(self, f"Apply a {what} that failed its checks?", text, "Apply anyway"):
             self._report(f"{what} not applied")
             return False
@@ -241,16 +314,24 @@ class VisionPanel(QWidget):
     def apply_intrinsics(self) -> None:
         if self.intrinsics_result is None:
             raise OperatorError("calibrate the intrinsics first")
-        if not self._confirmed("intrinsics calibration", intrinsics_problems(self.intrinsics_result, self.workbench.intrinsics)):
+        if not self._confirmed(
+            "intrinsics calibration", intrinsics_problems(self.intrinsics_result, self.workbench.intrinsics)
+        ):
             return
-        self.workbench.apply_intrinsics(self.intrinsics_result.intrinsics, f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)")
+        self.workbench.apply_intrinsics(
+            self.intrinsics_result.intrinsics,
+            f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)",
+        )
 
     def apply_hand_eye(self) -> None:
         if self.hand_eye_result is None:
             raise OperatorError("calibrate the hand-eye first")
         if not self._confirmed("camera mounting", self.hand_eye_problems):
             return
-        self.workbench.apply_cam2flange(self.hand_eye_result.cam2flange, f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)")
+        self.workbench.apply_cam2flange(
+            self.hand_eye_result.cam2flange,
+            f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)",
+        )
 
     def save_intrinsics(self, path, fmt: str = "opencv") -> None:
         save_intrinsics(path, self.intrinsics_result.intrinsics, fmt)
@@ -261,11 +342,15 @@ class VisionPanel(QWidget):
         self._report(f"camera mounting saved to {path}")
 
     def _save_intrinsics_dialog(self) -> None:
-        path, chosen = QFileDialog.getSaveFileName(self, "Save intrinsics", "camera.yaml", "OpenCV YAML (*.yaml *.yml);;ROS camera_info (*.yaml *.yml)")
+        path, chosen = QFileDialog.getSaveFileName(
+            self, "Save intrinsics", "camera.yaml", "OpenCV YAML (*.yaml *.yml);;ROS camera_info (*.yaml *.yml)"
+        )
         if path:
             self.save_intrinsics(path, "ros" if chosen.startswith("ROS") else "opencv")
 
     def _save_hand_eye_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Save camera mounting", "hand_eye.yaml", "hand-eye YAML (*.yaml *.yml)")
+        path, _ = QFileDialog.getSaveFileName(
+            self, "Save camera mounting", "hand_eye.yaml", "hand-eye YAML (*.yaml *.yml)"
+        )
         if path:
             self.save_hand_eye(path)

@@ -7,7 +7,11 @@ from PySide6.QtCore import QSettings
 
 
 def _splitters(window) -> tuple:
-    return (("window/split_main", window.splitter), ("window/split_top", window.top_splitter), ("window/split_bottom", window.bottom_splitter))
+    return (
+        ("window/split_main", window.splitter),
+        ("window/split_top", window.top_splitter),
+        ("window/split_bottom", window.bottom_splitter),
+    )
 
 
 def restore_layout(window, settings: QSettings) -> None:

@@ -26,21 +26,48 @@ class WorkflowActions(QObject):
     ``overview`` (a move's preview and its *Move* button, Simulate's path); ``say(text, ms)`` writes the
     status bar; ``show_error(text)`` shows a refusal; ``parent``: where the store dialogs open."""
 
-    def __init__(self, workbench, commands, table, results, overview, say: Callable[[str, int], None], show_error: Callable[[str], None], parent: QWidget):
+    def __init__(
+        self,
+        workbench,
+        commands,
+        table,
+        results,
+        overview,
+        say: Callable[[str, int], None],
+        show_error: Callable[[str], None],
+        parent: QWidget,
+    ):
         super().__init__(parent)
-        self.workbench, self.commands, self.table, self.results, self.overview = workbench, commands, table, results, overview
+        self.workbench, self.commands, self.table, self.results, self.overview = (
+            workbench,
+            commands,
+            table,
+            results,
+            overview,
+        )
         self.say, self.show_error, self.parent_widget = say, show_error, parent
         self.report = guarded(show_error)
         self.undo_action = QAction("&Undo", parent, shortcut=QKeySequence.StandardKey.Undo, triggered=self.undo)
         self.redo_action = QAction("&Redo", parent, shortcut=QKeySequence.StandardKey.Redo, triggered=self.redo)
-        self.delete_action = QAction("&Delete pair", parent, shortcut=QKeySequence.StandardKey.Delete, triggered=self.delete)
-        self.accept_action = QAction("&Accept pair", parent, shortcut=QKeySequence("Ctrl+Return"), triggered=self.accept)
+        self.delete_action = QAction(
+            "&Delete pair", parent, shortcut=QKeySequence.StandardKey.Delete, triggered=self.delete
+        )
+        self.accept_action = QAction(
+            "&Accept pair", parent, shortcut=QKeySequence("Ctrl+Return"), triggered=self.accept
+        )
         self.calibrate_action = QAction("&Calibrate", parent, shortcut=QKeySequence("F5"), triggered=self.calibrate)
         self.store_action = QAction("&Store correction", parent, triggered=self.store)
-        self.stop_action = QAction("&Stop the robot", parent, shortcut=QKeySequence("Esc"), triggered=lambda: self.report(workbench.moves.stop_robot)())
+        self.stop_action = QAction(
+            "&Stop the robot",
+            parent,
+            shortcut=QKeySequence("Esc"),
+            triggered=lambda: self.report(workbench.moves.stop_robot)(),
+        )
         self.stop_action.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)  # Esc stops the robot from any pane
         self.approach_action = QAction("Go to &approach", parent, triggered=lambda: self.go(approach=True))
-        self.corrected_action = QAction("Go to task, &corrected", parent, triggered=lambda: self.go(approach=False, corrected=True))
+        self.corrected_action = QAction(
+            "Go to task, &corrected", parent, triggered=lambda: self.go(approach=False, corrected=True)
+        )
         c = commands
         c.accept.clicked.connect(self.accept)
         c.delete.clicked.connect(self.delete)
@@ -58,7 +85,9 @@ class WorkflowActions(QObject):
         results.candidate_chosen.connect(self.report(workbench.choose_candidate))
         workbench.arm.move_finished.connect(self._move_finished)
         workbench.session.undo.changed.connect(self.update)
-        workbench.session.pairs.changed.connect(self.update)  # pairs also change outside the undo stack (replay, workspace)
+        workbench.session.pairs.changed.connect(
+            self.update
+        )  # pairs also change outside the undo stack (replay, workspace)
         self.update()
 
     def update(self, *_) -> None:
@@ -92,7 +121,10 @@ class WorkflowActions(QObject):
     def _calibrate(self) -> None:
         result = self.workbench.picking.calibrate()
         s = result.solution
-        self.say(f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm", 10000)
+        self.say(
+            f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm",
+            10000,
+        )
 
     def store(self) -> None:
         self.report(store_with_consent)(self.parent_widget, self.workbench, lambda text: self.say(text, 5000))
@@ -102,7 +134,11 @@ class WorkflowActions(QObject):
         self.results.show_message(v.text, ok=v.ok)
 
     def go(self, *, approach: bool, corrected: bool = False) -> None:
-        self.move(lambda confirmed: self.workbench.moves.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))
+        self.move(
+            lambda confirmed: self.workbench.moves.go_to_task(
+                approach=approach, corrected=corrected, confirmed=confirmed
+            )
+        )
 
     def move(self, send: Callable[[object], object]) -> None:
         """Send a move (``send(confirmed)`` calls the core). The core previews it in the overview; one

@@ -42,12 +42,21 @@ def main() -> int:
                     if name == "rapid":
                         ratio, rvec, tvec = tracker.compute(image, 200, 15, K, rvec, tvec)
                     else:
-                        ratio, rvec, tvec = tracker.compute(image, 200, 15, K, rvec, tvec, (cv2.TERM_CRITERIA_MAX_ITER, 3, 0))
+                        ratio, rvec, tvec = tracker.compute(
+                            image, 200, 15, K, rvec, tvec, (cv2.TERM_CRITERIA_MAX_ITER, 3, 0)
+                        )
                 ok = bool(np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec)))
             except cv2.error as exc:
                 ok, ratio = False, str(exc).strip().splitlines()[-1]
-            rows.append({"ok": ok, "rvec": np.asarray(rvec).ravel().tolist(), "tvec": np.asarray(tvec).ravel().tolist(),
-                         "ratio": float(ratio) if isinstance(ratio, (int, float)) else ratio, "seconds": time.perf_counter() - t0})
+            rows.append(
+                {
+                    "ok": ok,
+                    "rvec": np.asarray(rvec).ravel().tolist(),
+                    "tvec": np.asarray(tvec).ravel().tolist(),
+                    "ratio": float(ratio) if isinstance(ratio, (int, float)) else ratio,
+                    "seconds": time.perf_counter() - t0,
+                }
+            )
         out[name] = rows
     sys.stdout.write(json.dumps(out) + "\n")
     return 0

@@ -43,7 +43,13 @@ def _stamp(T, t_ns: int):
     return T["builtin_interfaces/msg/Time"](sec=t_ns // 10**9, nanosec=t_ns % 10**9)
 
 
-def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: list[str] | None = None, mounting: tuple[str, str, np.ndarray] | None = None) -> dict:
+def recording_to_bag(
+    recording: str | Path,
+    out: str | Path,
+    *,
+    joint_units: list[str] | None = None,
+    mounting: tuple[str, str, np.ndarray] | None = None,
+) -> dict:
     """Write the recording at ``recording`` as a ROS 2 bag folder ``out`` (which must not exist). ``joint_units``: each
     joint's unit (``deg``/``mm``) in the recording's joint order (default: the recording's workcell's robot).
     ``mounting``: ``(parent, child, camera2parent)`` (:func:`cell_mounting`) put on ``/tf_static``, its ``child`` the
@@ -83,18 +89,45 @@ def recording_to_bag(recording: str | Path, out: str | Path, *, joint_units: lis
     camera_frame = DEFAULT_CAMERA_FRAME if mounting is None else mounting[1]
     first_ns = min([m.log_time_ns for m in track.messages[:1]] + [m.log_time_ns for m in joints[:1]])
     try:
-        _write(Writer(out, version=9, storage_plugin=StoragePlugin.MCAP), ts, T, track, joints, names, joint_units, intrinsics, camera_frame, counts,
-               mounting, first_ns)
+        _write(
+            Writer(out, version=9, storage_plugin=StoragePlugin.MCAP),
+            ts,
+            T,
+            track,
+            joints,
+            names,
+            joint_units,
+            intrinsics,
+            camera_frame,
+            counts,
+            mounting,
+            first_ns,
+        )
     except BaseException as exc:
         shutil.rmtree(out, ignore_errors=True)  # no half-written bag left behind
         if isinstance(exc, OSError) or type(exc).__name__ == "WriterError":  # a full disk, a read-only folder
             cause = exc.__cause__ if isinstance(exc.__cause__, OSError) else exc
-            raise FileWriteError(out, f"cannot write the bag ({getattr(cause, 'strerror', None) or cause}); nothing was left behind") from None
+            raise FileWriteError(
+                out, f"cannot write the bag ({getattr(cause, 'strerror', None) or cause}); nothing was left behind"
+            ) from None
         raise
     return counts
 
 
-def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_frame: str, counts: dict, mounting, first_ns: int) -> None:
+def _write(
+    writer,
+    ts,
+    T,
+    track,
+    joints,
+    names,
+    joint_units,
+    intrinsics,
+    camera_frame: str,
+    counts: dict,
+    mounting,
+    first_ns: int,
+) -> None:
     with writer:
         if mounting is not None:
             _write_mounting(writer, ts, T, mounting, first_ns)
@@ -102,14 +135,20 @@ def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_
         if len(track):
             images = writer.add_connection(IMAGE_TOPIC, "sensor_msgs/msg/CompressedImage", typestore=ts)
             info = _camera_info(T, intrinsics, camera_frame) if intrinsics else None
-            infos = writer.add_connection(INFO_TOPIC, "sensor_msgs/msg/CameraInfo", typestore=ts) if info is not None else None
+            infos = (
+                writer.add_connection(INFO_TOPIC, "sensor_msgs/msg/CameraInfo", typestore=ts)
+                if info is not None
+                else None
+            )
             for k, message in enumerate(track.messages):
                 rgb = track.image(k)
                 if rgb is None:
                     continue  # before the first keyframe of a cut recording: no picture to give
                 ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 92])
                 header = T["std_msgs/msg/Header"](stamp=_stamp(T, message.log_time_ns), frame_id=camera_frame)
-                msg = T["sensor_msgs/msg/CompressedImage"](header=header, format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8))
+                msg = T["sensor_msgs/msg/CompressedImage"](
+                    header=header, format="jpeg", data=np.frombuffer(jpeg.tobytes(), np.uint8)
+                )
                 writer.write(images, message.log_time_ns, ts.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage"))
                 counts[IMAGE_TOPIC] += 1
                 if info is not None:
@@ -123,7 +162,9 @@ def _write(writer, ts, T, track, joints, names, joint_units, intrinsics, camera_
             for message in joints:
                 q = np.asarray(message.payload["joints_deg"], float) * per_si
                 header = T["std_msgs/msg/Header"](stamp=_stamp(T, message.log_time_ns), frame_id="")
-                js = T["sensor_msgs/msg/JointState"](header=header, name=names, position=q, velocity=np.array([], float), effort=np.array([], float))
+                js = T["sensor_msgs/msg/JointState"](
+                    header=header, name=names, position=q, velocity=np.array([], float), effort=np.array([], float)
+                )
                 writer.write(connection, message.log_time_ns, ts.serialize_cdr(js, "sensor_msgs/msg/JointState"))
                 counts[JOINT_TOPIC] += 1
 
@@ -136,13 +177,31 @@ def _write_mounting(writer, ts, T, mounting, t_ns: int) -> None:
 
     parent, child, camera2parent = mounting
     never = QosTime(0x7FFFFFFF, 0xFFFFFFFF)
-    qos = Qos(QosHistory.KEEP_LAST, 1, QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL, never, never, QosLiveliness.AUTOMATIC, never, False)
-    connection = writer.add_connection(TF_STATIC_TOPIC, "tf2_msgs/msg/TFMessage", typestore=ts, offered_qos_profiles=[qos])
+    qos = Qos(
+        QosHistory.KEEP_LAST,
+        1,
+        QosReliability.RELIABLE,
+        QosDurability.TRANSIENT_LOCAL,
+        never,
+        never,
+        QosLiveliness.AUTOMATIC,
+        never,
+        False,
+    )
+    connection = writer.add_connection(
+        TF_STATIC_TOPIC, "tf2_msgs/msg/TFMessage", typestore=ts, offered_qos_profiles=[qos]
+    )
     x, y, z = (float(v) / 1000.0 for v in camera2parent[:3, 3])
     qx, qy, qz, qw = Rotation.from_matrix(camera2parent[:3, :3]).as_quat()
-    transform = T["geometry_msgs/msg/Transform"](translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
-                                                rotation=T["geometry_msgs/msg/Quaternion"](x=float(qx), y=float(qy), z=float(qz), w=float(qw)))
-    stamped = T["geometry_msgs/msg/TransformStamped"](header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=parent), child_frame_id=child, transform=transform)
+    transform = T["geometry_msgs/msg/Transform"](
+        translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
+        rotation=T["geometry_msgs/msg/Quaternion"](x=float(qx), y=float(qy), z=float(qz), w=float(qw)),
+    )
+    stamped = T["geometry_msgs/msg/TransformStamped"](
+        header=T["std_msgs/msg/Header"](stamp=_stamp(T, t_ns), frame_id=parent),
+        child_frame_id=child,
+        transform=transform,
+    )
     message = T["tf2_msgs/msg/TFMessage"](transforms=[stamped])
     writer.write(connection, t_ns, ts.serialize_cdr(message, "tf2_msgs/msg/TFMessage"))
 
@@ -152,11 +211,17 @@ def _units_from_workcell(recording: Path, workcell: str | None, n: int) -> list[
     from calib_core.workcell import load_workcell
 
     if not workcell or not Path(workcell).is_file():
-        raise FileFormatError(recording, f"the joints' units (deg or mm) come from the recording's workcell, {workcell or 'not named'}, which is not there: "
-                                         "give --workcell")
+        raise FileFormatError(
+            recording,
+            f"the joints' units (deg or mm) come from the recording's workcell, {workcell or 'not named'}, which is not there: "
+            "give --workcell",
+        )
     units = list(load_workcell(workcell).load_robot().joint_units)
     if len(units) != n:
-        raise FileFormatError(recording, f"the recording's samples have {n} joints, the workcell's robot {len(units)}: another cell's recording?")
+        raise FileFormatError(
+            recording,
+            f"the recording's samples have {n} joints, the workcell's robot {len(units)}: another cell's recording?",
+        )
     return units
 
 
@@ -166,7 +231,16 @@ def _camera_info(T, intrinsics: dict, camera_frame: str):
     d = [float(v) for v in intrinsics.get("distortion", [0.0] * 5)]
     roi = T["sensor_msgs/msg/RegionOfInterest"](x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
     header = T["std_msgs/msg/Header"](stamp=_stamp(T, 0), frame_id=camera_frame)
-    return T["sensor_msgs/msg/CameraInfo"](header=header, height=int(intrinsics["height"]), width=int(intrinsics["width"]),
-                                           distortion_model=str(intrinsics.get("distortion_model", "plumb_bob")), d=np.array(d, float),
-                                           k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float), r=np.eye(3).ravel(),
-                                           p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float), binning_x=0, binning_y=0, roi=roi)
+    return T["sensor_msgs/msg/CameraInfo"](
+        header=header,
+        height=int(intrinsics["height"]),
+        width=int(intrinsics["width"]),
+        distortion_model=str(intrinsics.get("distortion_model", "plumb_bob")),
+        d=np.array(d, float),
+        k=np.array([fu, 0, cx, 0, fv, cy, 0, 0, 1], float),
+        r=np.eye(3).ravel(),
+        p=np.array([fu, 0, cx, 0, 0, fv, cy, 0, 0, 0, 1, 0], float),
+        binning_x=0,
+        binning_y=0,
+        roi=roi,
+    )

@@ -62,7 +62,9 @@ class BagFrames:
         if not 0 <= k < len(self):
             raise IndexError(f"frame {k} of a bag topic with {len(self)} images")
         log_ns = int(self.log_ns[k])
-        for connection, _, raw in messages(self._reader, self.path, connections=self._connections, start=log_ns, stop=log_ns + 1):
+        for connection, _, raw in messages(
+            self._reader, self.path, connections=self._connections, start=log_ns, stop=log_ns + 1
+        ):
             if _header_stamp_ns(raw, log_ns) == self.stamps_ns[k]:
                 message = deserialize(self._reader, raw, connection, f"{self.path} {self.topic} image {k}")
                 return _rgb(message, connection.msgtype, f"{self.path} {self.topic} image {k}")
@@ -74,7 +76,9 @@ class BagPlayback:
     (deg, mm; empty for a bag without the arm's joint states), ``setup`` (``{"intrinsics": ...}`` from its CameraInfo),
     ``duration_s``, no ``solves``. Close it (or use it as a context manager) to close the bag."""
 
-    def __init__(self, path: str | Path, joint_names, per_si, *, topic: str | None = None, joint_topic: str | None = None):
+    def __init__(
+        self, path: str | Path, joint_names, per_si, *, topic: str | None = None, joint_topic: str | None = None
+    ):
         self.path = Path(path)
         self.solves: list = []
         chosen = choose_image_topic(self.path, topic)  # an error lists the image topics, or says what the bag holds
@@ -145,4 +149,9 @@ def is_bag(path: str | Path) -> bool:
     path = Path(path)
     if not looks_like_bag(path):
         return False
-    return path.is_dir() or (path.parent / "metadata.yaml").is_file() or path.suffix.lower() != ".mcap" or is_ros2_mcap(path)
+    return (
+        path.is_dir()
+        or (path.parent / "metadata.yaml").is_file()
+        or path.suffix.lower() != ".mcap"
+        or is_ros2_mcap(path)
+    )

@@ -24,7 +24,9 @@ BAG_SUFFIXES = (".mcap", ".db3", ".bag")
 def looks_like_bag(path: Path) -> bool:
     """A bag folder, a bag storage file, or an MCAP file (a videocal recording is told apart when it is read)."""
     path = Path(path)
-    return (path.is_dir() and (path / "metadata.yaml").is_file()) or (path.is_file() and path.suffix.lower() in BAG_SUFFIXES)
+    return (path.is_dir() and (path / "metadata.yaml").is_file()) or (
+        path.is_file() and path.suffix.lower() in BAG_SUFFIXES
+    )
 
 
 @dataclass(frozen=True)
@@ -56,7 +58,10 @@ def open_reader(path: str | Path):
         reader = AnyReader(_bag_paths(path))
         reader.open()
     except Exception as exc:  # rosbags raises its own errors per storage and profile
-        raise FileFormatError(path, f"not a ROS bag rosbags can read: {str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}") from None
+        raise FileFormatError(
+            path,
+            f"not a ROS bag rosbags can read: {str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}",
+        ) from None
     return reader
 
 
@@ -82,7 +87,9 @@ def deserialize(reader, raw: bytes, connection, where: str):
         return reader.deserialize(raw, connection.msgtype)
     except Exception as exc:  # rosbags' own serde errors (and struct/index errors on truncated bytes)
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise FileFormatError(Path(where.split(" ")[0]), f"{where}: not a {connection.msgtype} in CDR ({text})") from None
+        raise FileFormatError(
+            Path(where.split(" ")[0]), f"{where}: not a {connection.msgtype} in CDR ({text})"
+        ) from None
 
 
 @contextmanager
@@ -111,7 +118,10 @@ def choose_image_topic(path: str | Path, topic: str | None = None) -> Topic:
         for t in topics:
             if t.name == topic:
                 if t.msgtype not in IMAGE_TYPES:
-                    raise FileFormatError(Path(path), f"topic {topic} holds {t.msgtype}, not images; image topics: {', '.join(map(str, images)) or 'none'}")
+                    raise FileFormatError(
+                        Path(path),
+                        f"topic {topic} holds {t.msgtype}, not images; image topics: {', '.join(map(str, images)) or 'none'}",
+                    )
                 return t
         raise FileFormatError(Path(path), f"no topic {topic}; image topics: {', '.join(map(str, images)) or 'none'}")
     if len(images) == 1:
@@ -134,7 +144,9 @@ def bag_images(path: str | Path, topic: str | None = None, every: int = 1) -> It
         yield name, image
 
 
-def bag_stamped_images(path: str | Path, topic: str | None = None, every: int = 1) -> Iterator[tuple[int, str, np.ndarray]]:
+def bag_stamped_images(
+    path: str | Path, topic: str | None = None, every: int = 1
+) -> Iterator[tuple[int, str, np.ndarray]]:
     """(header stamp ns, name, RGB image) of every ``every``-th image of the topic, in the bag's order; the stamp is
     the camera driver's (the bag's record time when the header has none)."""
     chosen = choose_image_topic(path, topic)
@@ -157,8 +169,13 @@ def bag_intrinsics(path: str | Path, image_size: tuple[int, int]):
     if found is None:
         return None
     topic, message = found
-    data = {"width": int(message.width), "height": int(message.height), "distortion_model": str(message.distortion_model),
-            "k": [float(v) for v in message.k], "d": [float(v) for v in message.d]}
+    data = {
+        "width": int(message.width),
+        "height": int(message.height),
+        "distortion_model": str(message.distortion_model),
+        "k": [float(v) for v in message.k],
+        "d": [float(v) for v in message.d],
+    }
     return _load_camera_info_message(Path(f"{path} {topic}"), data, image_size)
 
 

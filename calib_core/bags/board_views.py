@@ -38,8 +38,16 @@ class BagBoardViews:
         return f"{self.images} images, {self.images - len(self.skipped)} taken while the arm stood still, {len(self.views)} with the board"
 
 
-def bag_board_views(source: Path, spec, detector, settled: Callable[[int], tuple[object, str | None]], *, topic: str | None = None, every: int = 1,
-                    say: Callable[[str], None] = lambda text: None) -> BagBoardViews:
+def bag_board_views(
+    source: Path,
+    spec,
+    detector,
+    settled: Callable[[int], tuple[object, str | None]],
+    *,
+    topic: str | None = None,
+    every: int = 1,
+    say: Callable[[str], None] = lambda text: None,
+) -> BagBoardViews:
     """Every ``every``-th image of ``topic`` (the only image topic by default) in the bag ``source``, with what
     ``settled(stamp_ns)`` says of the arm at the image's header stamp: ``(pose, None)`` where it stood still (the
     joints, or the flange pose), ``(None, why)`` where not. ``say`` hears each frame left out and why. One camera
@@ -51,7 +59,9 @@ def bag_board_views(source: Path, spec, detector, settled: Callable[[int], tuple
         if out.size is None:
             out.size = size
         elif size != out.size:
-            raise VideocalError(f"{source} {name}: {size[0]} x {size[1]} px, the first image is {out.size[0]} x {out.size[1]} px: one calibration is for one camera mode")
+            raise VideocalError(
+                f"{source} {name}: {size[0]} x {size[1]} px, the first image is {out.size[0]} x {out.size[1]} px: one calibration is for one camera mode"
+            )
         pose, why = settled(stamp)
         if pose is None:
             out.skipped.append(f"{name}: {why}")
@@ -66,7 +76,9 @@ def bag_board_views(source: Path, spec, detector, settled: Callable[[int], tuple
     return out
 
 
-def joints_settled(source: Path, robot, joint_topic: str | None = None) -> Callable[[int], tuple[np.ndarray | None, str | None]]:
+def joints_settled(
+    source: Path, robot, joint_topic: str | None = None
+) -> Callable[[int], tuple[np.ndarray | None, str | None]]:
     """``settled`` for :func:`bag_board_views` from the bag's JointState (``joint_topic``, else the only one, else
     ``/joint_states``): ``robot``'s joints (deg/mm, its order) where the arm stood still."""
     track = read_joint_track(source, robot.joint_names, user_per_si(robot.joint_units), joint_topic)

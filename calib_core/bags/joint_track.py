@@ -50,10 +50,10 @@ class JointTrack:
         i, j = int(np.searchsorted(t, lo, side="left")), int(np.searchsorted(t, hi, side="right"))
         if i == 0 or j == len(t):
             return None  # the window reaches past the track's ends
-        window = t[i - 1:j + 1]
+        window = t[i - 1 : j + 1]
         if np.max(np.diff(window)) > MAX_GAP_S * 1e9:
             return None
-        q = self.joints[i - 1:j + 1]
+        q = self.joints[i - 1 : j + 1]
         return float(np.max(q.max(axis=0) - q.min(axis=0)))
 
 
@@ -63,11 +63,16 @@ STILL = 0.02
 """Still: no joint moved more than this (deg, or mm for a prismatic joint) within the window."""
 
 
-def settled_joints(track: JointTrack, stamp_ns: int, half_window_s: float = SETTLE_HALF_WINDOW_S, still: float = STILL) -> tuple[np.ndarray | None, str | None]:
+def settled_joints(
+    track: JointTrack, stamp_ns: int, half_window_s: float = SETTLE_HALF_WINDOW_S, still: float = STILL
+) -> tuple[np.ndarray | None, str | None]:
     """(the joints at ``stamp_ns``, None) when the arm stood still round it; (None, why not) otherwise."""
     moved = track.motion_around(stamp_ns, half_window_s)
     if moved is None:
-        return None, f"no joint states on {track.topic} all round it (within {half_window_s:g} s, no gap over {MAX_GAP_S:g} s)"
+        return (
+            None,
+            f"no joint states on {track.topic} all round it (within {half_window_s:g} s, no gap over {MAX_GAP_S:g} s)",
+        )
     if moved > still:
         return None, f"the arm moved {moved:.2f} deg (or mm) within {half_window_s:g} s of it: not a still view"
     return track.at(stamp_ns), None
@@ -89,11 +94,16 @@ def read_joint_track(path: str | Path, joint_names, per_si, topic: str | None = 
         topics = sorted({c.topic for c in candidates})
         if not topics:
             held = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})) or "no messages"
-            raise FileFormatError(path, f"no JointState topic{' ' + topic if topic else ''} in this bag (it holds {held}): the flange poses come from the joints")
+            raise FileFormatError(
+                path,
+                f"no JointState topic{' ' + topic if topic else ''} in this bag (it holds {held}): the flange poses come from the joints",
+            )
         if len(topics) > 1:
             chosen = "/joint_states" if "/joint_states" in topics else None
             if chosen is None:
-                raise FileFormatError(path, f"several JointState topics: choose one with --joint-topic: {', '.join(topics)}")
+                raise FileFormatError(
+                    path, f"several JointState topics: choose one with --joint-topic: {', '.join(topics)}"
+                )
             candidates = [c for c in candidates if c.topic == chosen]
         stamps, rows, seen_names = [], [], set()
         for connection, log_ns, raw in messages(reader, path, connections=candidates):
@@ -112,8 +122,11 @@ def read_joint_track(path: str | Path, joint_names, per_si, topic: str | None = 
             stamps.append(stamp or log_ns)
             rows.append(q)
     if not rows:
-        raise FileFormatError(path, f"no JointState message on {candidates[0].topic} names all of the arm's joints ({', '.join(names)}); "
-                                    f"it names {', '.join(sorted(seen_names)) or 'none'}: is it this cell's robot?")
+        raise FileFormatError(
+            path,
+            f"no JointState message on {candidates[0].topic} names all of the arm's joints ({', '.join(names)}); "
+            f"it names {', '.join(sorted(seen_names)) or 'none'}: is it this cell's robot?",
+        )
     order = np.argsort(np.asarray(stamps), kind="stable")
     stamps_ns = np.asarray(stamps, dtype=np.int64)[order]
     joints = np.asarray(rows)[order]

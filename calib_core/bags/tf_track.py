@@ -83,7 +83,9 @@ class TfTrack:
             if pose is None:
                 return None
             moved_mm = max(moved_mm, float(np.linalg.norm(pose[:3, 3] - here[:3, 3])))
-            moved_deg = max(moved_deg, float(np.degrees(Rotation.from_matrix(here[:3, :3].T @ pose[:3, :3]).magnitude())))
+            moved_deg = max(
+                moved_deg, float(np.degrees(Rotation.from_matrix(here[:3, :3].T @ pose[:3, :3]).magnitude()))
+            )
         return moved_mm, moved_deg
 
 
@@ -96,9 +98,15 @@ def settled_flange(track: TfTrack, stamp_ns: int, half_window_s: float = 0.25) -
     """(``flange2base`` at ``stamp_ns``, None) when the flange stood still round it; (None, why not) otherwise."""
     moved = track.motion_around(stamp_ns, half_window_s)
     if moved is None:
-        return None, f"no transform from {track.flange} to {track.base} all round it (within {half_window_s:g} s, no gap over {MAX_GAP_S:g} s)"
+        return (
+            None,
+            f"no transform from {track.flange} to {track.base} all round it (within {half_window_s:g} s, no gap over {MAX_GAP_S:g} s)",
+        )
     if moved[0] > STILL_MM or moved[1] > STILL_DEG:
-        return None, f"the flange moved {moved[0]:.2f} mm, {moved[1]:.3f} deg within {half_window_s:g} s of it: not a still view"
+        return (
+            None,
+            f"the flange moved {moved[0]:.2f} mm, {moved[1]:.3f} deg within {half_window_s:g} s of it: not a still view",
+        )
     return track.at(stamp_ns), None
 
 
@@ -116,7 +124,9 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
         connections = [c for c in reader.connections if c.msgtype == TF_MESSAGE]
         if not connections:
             held = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})) or "no messages"
-            raise FileFormatError(path, f"no /tf in this bag (it holds {held}): the flange poses come from the transforms")
+            raise FileFormatError(
+                path, f"no /tf in this bag (it holds {held}): the flange poses come from the transforms"
+            )
         for connection, log_ns, raw in messages(reader, path, connections=connections):
             for tf in deserialize(reader, raw, connection, f"{path} {connection.topic}").transforms:
                 parent, child = tf.header.frame_id.lstrip("/"), tf.child_frame_id.lstrip("/")
@@ -126,7 +136,10 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
                 if not (np.all(np.isfinite(xyz)) and np.all(np.isfinite(quat))) or np.linalg.norm(quat) < 1e-9:
                     continue
                 if child in samples and samples[child][0] != parent:
-                    raise FileFormatError(path, f"the frame {child!r} has two parents in /tf ({samples[child][0]!r} and {parent!r}): tf2 would refuse this tree")
+                    raise FileFormatError(
+                        path,
+                        f"the frame {child!r} has two parents in /tf ({samples[child][0]!r} and {parent!r}): tf2 would refuse this tree",
+                    )
                 rows = samples.setdefault(child, (parent, []))[1]
                 if connection.topic == "/tf_static":
                     rows.clear()  # latched: the newest one holds, whatever its stamp
@@ -135,13 +148,20 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
     while frame != base:
         if frame not in samples:
             frames = sorted(set(samples) | {p for p, _ in samples.values()})
-            raise FileFormatError(path, f"no chain of transforms from {flange!r} up to {base!r} in /tf (it stops at {frame!r}; frames: {', '.join(frames)}): "
-                                        "name them with --base-frame and --flange-frame")
+            raise FileFormatError(
+                path,
+                f"no chain of transforms from {flange!r} up to {base!r} in /tf (it stops at {frame!r}; frames: {', '.join(frames)}): "
+                "name them with --base-frame and --flange-frame",
+            )
         parent, rows = samples[frame]
         rows.sort(key=lambda r: r[0])
         stamps = np.array([r[0] for r in rows], dtype=np.int64)
         keep = np.concatenate([[True], np.diff(stamps) > 0])
-        chain.append(TfEdge(parent, frame, stamps[keep], np.array([r[1] for r in rows])[keep], np.array([r[2] for r in rows])[keep]))
+        chain.append(
+            TfEdge(
+                parent, frame, stamps[keep], np.array([r[1] for r in rows])[keep], np.array([r[2] for r in rows])[keep]
+            )
+        )
         frame = parent
         if len(chain) > len(samples):
             raise FileFormatError(path, f"the transforms above {flange!r} form a loop")

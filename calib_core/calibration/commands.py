@@ -119,8 +119,18 @@ class AddPairs(Command):
 
     def __init__(self, pairs: CorrespondenceSet, pairs_spec, view=None):
         self.pairs = pairs
-        self.added = [Correspondence(pairs.new_number(), component, feature, tuple(float(v) for v in point), (float(pixel[0]), float(pixel[1])), True, view)
-                      for component, feature, point, pixel in pairs_spec]
+        self.added = [
+            Correspondence(
+                pairs.new_number(),
+                component,
+                feature,
+                tuple(float(v) for v in point),
+                (float(pixel[0]), float(pixel[1])),
+                True,
+                view,
+            )
+            for component, feature, point, pixel in pairs_spec
+        ]
         self.label = f"Accept {len(self.added)} found point{'s' if len(self.added) != 1 else ''}"
 
     def do(self) -> None:

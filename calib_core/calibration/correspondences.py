@@ -96,7 +96,11 @@ class CorrespondenceSet:
     def arrays(self) -> tuple[np.ndarray, np.ndarray, list[int]]:
         """Usable pairs as ``points_world_mm`` (n, 3), ``pixels`` (n, 2) and their numbers."""
         use = self.usable()
-        return (np.array([p.point_world_mm for p in use], dtype=float).reshape(-1, 3), np.array([p.pixel for p in use], dtype=float).reshape(-1, 2), [p.number for p in use])
+        return (
+            np.array([p.point_world_mm for p in use], dtype=float).reshape(-1, 3),
+            np.array([p.pixel for p in use], dtype=float).reshape(-1, 2),
+            [p.number for p in use],
+        )
 
     # Low-level edits used by the commands only.
     def _insert(self, index: int, pair: Correspondence) -> None:
@@ -129,13 +133,24 @@ class CorrespondenceSet:
         return old
 
 
-def with_pixel(pair: Correspondence, pixel: tuple[float, float] | None, view: ViewStamp | None = None) -> Correspondence:
-    return replace(pair, pixel=None if pixel is None else (float(pixel[0]), float(pixel[1])), view=None if pixel is None else view)
+def with_pixel(
+    pair: Correspondence, pixel: tuple[float, float] | None, view: ViewStamp | None = None
+) -> Correspondence:
+    return replace(
+        pair, pixel=None if pixel is None else (float(pixel[0]), float(pixel[1])), view=None if pixel is None else view
+    )
 
 
 def pair_to_dict(pair: Correspondence) -> dict:
     """The JSON form of a pair (workspaces, recorded ``pair_*`` events)."""
-    d = {"number": pair.number, "component": pair.component, "feature": pair.feature, "point_world_mm": list(pair.point_world_mm), "pixel": None if pair.pixel is None else list(pair.pixel), "enabled": pair.enabled}
+    d = {
+        "number": pair.number,
+        "component": pair.component,
+        "feature": pair.feature,
+        "point_world_mm": list(pair.point_world_mm),
+        "pixel": None if pair.pixel is None else list(pair.pixel),
+        "enabled": pair.enabled,
+    }
     if pair.view is not None:
         d["view"] = pair.view.to_dict()
     return d
@@ -146,7 +161,11 @@ def pair_from_dict(d: dict) -> Correspondence:
     pixel = d.get("pixel")
     view = d.get("view")
     return Correspondence(
-        int(d["number"]), str(d["component"]), d.get("feature"), tuple(float(v) for v in d["point_world_mm"]),
-        None if pixel is None else (float(pixel[0]), float(pixel[1])), bool(d.get("enabled", True)),
+        int(d["number"]),
+        str(d["component"]),
+        d.get("feature"),
+        tuple(float(v) for v in d["point_world_mm"]),
+        None if pixel is None else (float(pixel[0]), float(pixel[1])),
+        bool(d.get("enabled", True)),
         None if view is None or pixel is None else ViewStamp.from_dict(view),
     )

@@ -53,7 +53,9 @@ truth the same way in one frame; without it one look at the task location was 3.
 along the image's vertical."""
 
 
-def shared_shift_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intrinsics, bias_px: float = SHARED_BIAS_PX, step_px: float = 0.5) -> np.ndarray:
+def shared_shift_covariance(
+    obj2cam: np.ndarray, points_obj_mm: np.ndarray, intrinsics, bias_px: float = SHARED_BIAS_PX, step_px: float = 0.5
+) -> np.ndarray:
     """(6, 6) covariance, in the solver's (dt mm, phi rad) on ``obj2cam`` (4, 4), of every image
     point of ``points_obj_mm`` (m, 3, the object's frame) shifted by the same ``bias_px`` (1-sigma per
     image axis): how the pose that puts the points on the shifted pixels moves, by central
@@ -67,6 +69,7 @@ def shared_shift_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intr
         def change(d, pixels):
             pixels[:, axis] += d
             return pixels, intrinsics
+
         return change
 
     def difference(start, moved):  # the solver's (dt mm, phi rad)
@@ -81,8 +84,14 @@ def _measured_tcp(obj2cam: np.ndarray, obj2world: np.ndarray, tcp2cam: np.ndarra
     return concat(tcp2cam, cam2world)
 
 
-def end_effector_from_solution(solution: PoseSolution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, obj2cam: np.ndarray | None = None,
-                               shared_covariance: np.ndarray | None = None) -> EndEffectorEstimate:
+def end_effector_from_solution(
+    solution: PoseSolution,
+    obj2world: np.ndarray,
+    cam2world_model: np.ndarray,
+    tcp2base_model: np.ndarray,
+    obj2cam: np.ndarray | None = None,
+    shared_covariance: np.ndarray | None = None,
+) -> EndEffectorEstimate:
     """The real TCP from a solve (or from candidate ``obj2cam`` when given); its covariance is the
     solve's plus ``shared_covariance`` (6, 6, the solver's units: the image points' shared error,
     :func:`shared_shift_covariance`)."""
@@ -112,4 +121,16 @@ def end_effector_from_solution(solution: PoseSolution, obj2world: np.ndarray, ca
         cov = J @ pose_cov @ J.T
         std = np.sqrt(np.clip(np.diag(cov), 0, None))
         std_d, std_r = std[:3], std[3:]
-    return EndEffectorEstimate(solution, obj2world, cam2world_model, concat(invert(obj2cam), obj2world), tcp2base_model, tcp_meas, d, rv, std_d, std_r, cov)
+    return EndEffectorEstimate(
+        solution,
+        obj2world,
+        cam2world_model,
+        concat(invert(obj2cam), obj2world),
+        tcp2base_model,
+        tcp_meas,
+        d,
+        rv,
+        std_d,
+        std_r,
+        cov,
+    )

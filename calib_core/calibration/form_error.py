@@ -36,7 +36,9 @@ def _pose_jacobian(obj2cam: np.ndarray, points: np.ndarray, intrinsics: Intrinsi
     return np.column_stack(columns)
 
 
-def form_error_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intrinsics: Intrinsics, tolerance_mm: float) -> np.ndarray:
+def form_error_covariance(
+    obj2cam: np.ndarray, points_obj_mm: np.ndarray, intrinsics: Intrinsics, tolerance_mm: float
+) -> np.ndarray:
     """(6, 6) covariance, in the solver's (dt mm, phi rad) on ``obj2cam`` (4, 4) mm, from the features
     ``points_obj_mm`` (m, 3, the object's frame) lying off their CAD positions by ``tolerance_mm`` (1-sigma per axis,
     independent). Zeros without a tolerance or with fewer than 4 points."""
@@ -49,6 +51,6 @@ def form_error_covariance(obj2cam: np.ndarray, points_obj_mm: np.ndarray, intrin
     Jt = J[:, :3].reshape(-1, 2, 3)
     AAt = np.zeros((2 * len(pts), 2 * len(pts)))
     for i, block in enumerate(Jt):
-        AAt[2 * i:2 * i + 2, 2 * i:2 * i + 2] = block @ block.T
+        AAt[2 * i : 2 * i + 2, 2 * i : 2 * i + 2] = block @ block.T
     H_inv = np.linalg.pinv(J.T @ J)
     return tolerance_mm**2 * H_inv @ J.T @ AAt @ J @ H_inv

@@ -56,7 +56,9 @@ def tcp_covariance_from_camera(camera_cov: np.ndarray, cam2base: np.ndarray, tcp
     return A @ camera_cov @ A.T
 
 
-def fuse_look(look: EndEffectorEstimate, model_covariance: np.ndarray, placement_sigma_mm: float = 0.0) -> FusedCorrection:
+def fuse_look(
+    look: EndEffectorEstimate, model_covariance: np.ndarray, placement_sigma_mm: float = 0.0
+) -> FusedCorrection:
     """The look's displacement fused with the model's prior (zero, ``model_covariance`` (6, 6) mm
     and deg of the TCP at the look's joints). The look sees the component where it stands, the model
     aims where the workcell file places it: ``placement_sigma_mm`` (1-sigma per axis, the survey's)
@@ -77,8 +79,10 @@ def fuse_look(look: EndEffectorEstimate, model_covariance: np.ndarray, placement
         message = f"look and model agree (squared distance {m2:.1f}); the look weighs {100 * float(np.mean(weight[:3])):.0f} % in position, {100 * float(np.mean(weight[3:])):.0f} % in rotation"
     else:
         fused, cov, weight = np.zeros(6), C_model, np.zeros(6)
-        message = (f"the look is {np.sqrt(m2):.1f} sigma from the calibrated model (its displacement {np.linalg.norm(x[:3]):.3f} mm, "
-                   f"{np.linalg.norm(x[3:]):.4f} deg): not used; look again or pick the points by hand")
+        message = (
+            f"the look is {np.sqrt(m2):.1f} sigma from the calibrated model (its displacement {np.linalg.norm(x[:3]):.3f} mm, "
+            f"{np.linalg.norm(x[3:]):.4f} deg): not used; look again or pick the points by hand"
+        )
     tcp = look.tcp2base_model
     R = Rotation.from_rotvec(np.radians(fused[3:])).as_matrix() @ tcp[:3, :3]
     delta = concat(invert(tcp), make_transform(R, tcp[:3, 3] + fused[:3]))

@@ -48,13 +48,19 @@ class LookPlace:
         if self.at == "recording":
             return f"the look was made on the recording {self.source}, not live at {self.task}"
         if self.at == "elsewhere":
-            return (f"the look was made {self.offset_mm:.1f} mm and {self.offset_deg:.2f} deg from {self.task}'s pose "
-                    f"(tolerance {self.tolerance_mm:g} mm, {self.tolerance_deg:.2f} deg)")
+            return (
+                f"the look was made {self.offset_mm:.1f} mm and {self.offset_deg:.2f} deg from {self.task}'s pose "
+                f"(tolerance {self.tolerance_mm:g} mm, {self.tolerance_deg:.2f} deg)"
+            )
         where = "pose" if self.at == "task" else "corrected pose"
-        return f"the look was made at {self.task}'s {where} ({self.offset_mm:.2f} mm, {self.offset_deg:.3f} deg from it)"
+        return (
+            f"the look was made at {self.task}'s {where} ({self.offset_mm:.2f} mm, {self.offset_deg:.3f} deg from it)"
+        )
 
 
-def place_of_look(task, tcp2base_at_look: np.ndarray, corrected2base: np.ndarray | None, view_sources: tuple[str, ...]) -> LookPlace:
+def place_of_look(
+    task, tcp2base_at_look: np.ndarray, corrected2base: np.ndarray | None, view_sources: tuple[str, ...]
+) -> LookPlace:
     """Where a look was made for ``task`` (a :class:`~calib_core.workcell.model.TaskLocation`):
     ``tcp2base_at_look`` (4, 4) mm, the modelled TCP at the look's joints; ``corrected2base`` (4, 4) mm
     the task's corrected target (``None`` without a stored correction); ``view_sources``: where the
@@ -85,5 +91,7 @@ class LookNotAtTask(CalibrationError):
 
     def __init__(self, place: LookPlace, change_mm: float, change_deg: float):
         self.place, self.change_mm, self.change_deg = place, change_mm, change_deg
-        super().__init__(f"{place.text}: it is not {place.task}'s correction. Store it as a measurement at that pose, or convert it explicitly "
-                         f"(the target commanded for {place.task} would move by {change_mm:.2f} mm, {change_deg:.3f} deg)")
+        super().__init__(
+            f"{place.text}: it is not {place.task}'s correction. Store it as a measurement at that pose, or convert it explicitly "
+            f"(the target commanded for {place.task} would move by {change_mm:.2f} mm, {change_deg:.3f} deg)"
+        )

@@ -70,8 +70,9 @@ def _shared(context: SolveContext | None, obj2cam):
     known."""
     if context is None or context.points_obj_mm is None or context.intrinsics is None:
         return None
-    return (shared_shift_covariance(obj2cam, context.points_obj_mm, context.intrinsics)
-            + form_error_covariance(obj2cam, context.points_obj_mm, context.intrinsics, context.form_tolerance_mm))
+    return shared_shift_covariance(obj2cam, context.points_obj_mm, context.intrinsics) + form_error_covariance(
+        obj2cam, context.points_obj_mm, context.intrinsics, context.form_tolerance_mm
+    )
 
 
 class _ShowResult(Command):
@@ -194,8 +195,16 @@ class CalibrationSession:
         self.undo.push(ClearPairs(self.pairs))
 
     # --- solve ---------------------------------------------------------------------------------
-    def calibrate(self, intrinsics: Intrinsics, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg=None, *,
-                  form_tolerance_mm: float = 0.0) -> EndEffectorEstimate:
+    def calibrate(
+        self,
+        intrinsics: Intrinsics,
+        obj2world: np.ndarray,
+        cam2world_model: np.ndarray,
+        tcp2base_model: np.ndarray,
+        joints_deg=None,
+        *,
+        form_tolerance_mm: float = 0.0,
+    ) -> EndEffectorEstimate:
         """``Calibrate``: solve the camera pose from the usable pairs (in the target's frame) with
         the modelled camera pose as the prior, and the real end-effector location from it; its uncertainty carries the
         target's ``form_tolerance_mm`` (1-sigma of its features about their CAD positions)."""
@@ -203,7 +212,9 @@ class CalibrationSession:
             raise CalibrationError("choose the target object first")
         use = self.pairs.usable()
         if len(use) < self.required_pairs:
-            raise CalibrationError(f"{len(use)} complete pairs; calibrating needs {self.required_pairs}{' (focal lengths are estimated)' if self.estimate_focal else ''}")
+            raise CalibrationError(
+                f"{len(use)} complete pairs; calibrating needs {self.required_pairs}{' (focal lengths are estimated)' if self.estimate_focal else ''}"
+            )
         points_world, pixels, numbers = self.pairs.arrays()
         points_obj = apply(invert(obj2world), points_world)
         prior = concat(obj2world, invert(cam2world_model))
@@ -211,14 +222,40 @@ class CalibrationSession:
         from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on the first solve
 
         with named_points("pair", numbers):  # messages name pairs by the numbers the table shows
-            solution = solve_pose(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
-        self.last_solve_inputs = solve_inputs(points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust)
-        return self.show_result(solution, obj2world, cam2world_model, tcp2base_model, joints_deg, numbers, points_obj_mm=points_obj, intrinsics=intrinsics,
-                                label=f"Calibrate ({len(numbers)} pairs)", form_tolerance_mm=form_tolerance_mm)
+            solution = solve_pose(
+                points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust
+            )
+        self.last_solve_inputs = solve_inputs(
+            points_obj, pixels, intrinsics, prior=prior, estimate_focal=self.estimate_focal, robust=self.robust
+        )
+        return self.show_result(
+            solution,
+            obj2world,
+            cam2world_model,
+            tcp2base_model,
+            joints_deg,
+            numbers,
+            points_obj_mm=points_obj,
+            intrinsics=intrinsics,
+            label=f"Calibrate ({len(numbers)} pairs)",
+            form_tolerance_mm=form_tolerance_mm,
+        )
 
-    def show_result(self, solution, obj2world: np.ndarray, cam2world_model: np.ndarray, tcp2base_model: np.ndarray, joints_deg, numbers: list[int], *,
-                    points_obj_mm=None, intrinsics: Intrinsics | None = None, view_sources: tuple[str, ...] | None = None,
-                    label: str | None = None, form_tolerance_mm: float = 0.0) -> EndEffectorEstimate:
+    def show_result(
+        self,
+        solution,
+        obj2world: np.ndarray,
+        cam2world_model: np.ndarray,
+        tcp2base_model: np.ndarray,
+        joints_deg,
+        numbers: list[int],
+        *,
+        points_obj_mm=None,
+        intrinsics: Intrinsics | None = None,
+        view_sources: tuple[str, ...] | None = None,
+        label: str | None = None,
+        form_tolerance_mm: float = 0.0,
+    ) -> EndEffectorEstimate:
         """Make ``solution`` this session's result. With a ``label`` it is an operator's solve: one
         command on the undo stack (undo brings the previous result back); without, a solve shown from
         elsewhere (a recording being replayed), which is not an edit. With the solve's
@@ -231,9 +268,21 @@ class CalibrationSession:
         points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
         if view_sources is None:
             view_sources = tuple(sorted({p.view.source for p in used if p.view is not None})) or ("live",)
-        context = SolveContext(obj2world, cam2world_model, tcp2base_model, None if joints_deg is None else np.asarray(joints_deg, float), tuple(numbers), _pairs_key(used),
-                               points, intrinsics, tuple(view_sources), float(form_tolerance_mm))
-        result = end_effector_from_solution(solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=_shared(context, solution.obj2cam))
+        context = SolveContext(
+            obj2world,
+            cam2world_model,
+            tcp2base_model,
+            None if joints_deg is None else np.asarray(joints_deg, float),
+            tuple(numbers),
+            _pairs_key(used),
+            points,
+            intrinsics,
+            tuple(view_sources),
+            float(form_tolerance_mm),
+        )
+        result = end_effector_from_solution(
+            solution, obj2world, cam2world_model, tcp2base_model, shared_covariance=_shared(context, solution.obj2cam)
+        )
         solved = (result, context, 0)  # the verdict is judged where it is shown (restore_result)
         if label is None:
             self.restore_result(solved)
@@ -275,9 +324,13 @@ class CalibrationSession:
         moved = sorted(n for n in set(then) & set(now) if then[n] != now[n])
         parts = []
         if gone:
-            parts.append(f"pair{'s' if len(gone) > 1 else ''} {', '.join(map(str, gone))} {'are' if len(gone) > 1 else 'is'} no longer used")
+            parts.append(
+                f"pair{'s' if len(gone) > 1 else ''} {', '.join(map(str, gone))} {'are' if len(gone) > 1 else 'is'} no longer used"
+            )
         if new:
-            parts.append(f"pair{'s' if len(new) > 1 else ''} {', '.join(map(str, new))} {'were' if len(new) > 1 else 'was'} added")
+            parts.append(
+                f"pair{'s' if len(new) > 1 else ''} {', '.join(map(str, new))} {'were' if len(new) > 1 else 'was'} added"
+            )
         if moved:
             parts.append(f"pair{'s' if len(moved) > 1 else ''} {', '.join(map(str, moved))} changed")
         return "; ".join(parts) + " since the solve: calibrate again"
@@ -299,8 +352,14 @@ class CalibrationSession:
             raise CalibrationError(f"there is no solution {index + 1}")
         c = self._context
         obj2cam = candidates[index].obj2cam if candidates else None
-        self.result = end_effector_from_solution(self.result.solution, c.obj2world, c.cam2world_model, c.tcp2base_model, obj2cam,
-                                                 shared_covariance=_shared(c, self.result.solution.obj2cam if obj2cam is None else obj2cam))
+        self.result = end_effector_from_solution(
+            self.result.solution,
+            c.obj2world,
+            c.cam2world_model,
+            c.tcp2base_model,
+            obj2cam,
+            shared_covariance=_shared(c, self.result.solution.obj2cam if obj2cam is None else obj2cam),
+        )
         self.chosen_candidate = index
         self.verdict = self._judge(self.result)
         self._changed()
@@ -308,8 +367,16 @@ class CalibrationSession:
     def choose_candidate(self, index: int) -> None:
         self.undo.push(ChooseCandidate(self, index))
 
-    def store_correction(self, task: str, source: str = "", *, confirmation: str = "", fused=None, tool_covariance: np.ndarray | None = None,
-                         kind: str = "correction") -> Correction:
+    def store_correction(
+        self,
+        task: str,
+        source: str = "",
+        *,
+        confirmation: str = "",
+        fused=None,
+        tool_covariance: np.ndarray | None = None,
+        kind: str = "correction",
+    ) -> Correction:
         """``Store correction`` for a task location from the last solve. A result that is not ``ok``
         (implausible, uncertain, ambiguous) raises :class:`ConfirmationNeeded` unless
         ``confirmation`` says who accepted it and why; that text is stored with the correction.
@@ -332,16 +399,33 @@ class CalibrationSession:
         if kind == "measurement":
             fused = None  # what this pose measured, alone
         elif not verdict.ok and not confirmation.strip():
-            raise ConfirmationNeeded(f"the result is {verdict.verdict.value}: {'; '.join(verdict.reasons)}. Storing it needs your confirmation", verdict.reasons)
+            raise ConfirmationNeeded(
+                f"the result is {verdict.verdict.value}: {'; '.join(verdict.reasons)}. Storing it needs your confirmation",
+                verdict.reasons,
+            )
         if fused is not None and not fused.agree and not confirmation.strip():
-            raise ConfirmationNeeded(f"{fused.message}. Storing the look alone needs your confirmation", (fused.message,))
+            raise ConfirmationNeeded(
+                f"{fused.message}. Storing the look alone needs your confirmation", (fused.message,)
+            )
         c = self._context
         joints, numbers = c.joints_deg, c.numbers
         source = source or (f"pairs {', '.join(map(str, numbers))}" if numbers else "edges")
-        measured, d, rv, std_d, std_r = r.tcp2base_measured, r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
+        measured, d, rv, std_d, std_r = (
+            r.tcp2base_measured,
+            r.displacement_mm,
+            r.rotation_deg,
+            r.std_displacement_mm,
+            r.std_rotation_deg,
+        )
         if fused is not None and fused.agree:
             std = np.sqrt(np.clip(np.diag(fused.covariance), 0.0, None))
-            measured, d, rv, std_d, std_r = concat(r.tcp2base_model, fused.delta_base), fused.displacement_mm, fused.rotation_deg, std[:3], std[3:]
+            measured, d, rv, std_d, std_r = (
+                concat(r.tcp2base_model, fused.delta_base),
+                fused.displacement_mm,
+                fused.rotation_deg,
+                std[:3],
+                std[3:],
+            )
             source += f"; {fused.message}"
         else:
             if fused is not None:
@@ -351,9 +435,20 @@ class CalibrationSession:
                 std_d, std_r = std[:3], std[3:]
                 source += "; with the measured tool's uncertainty"
         correction = Correction(
-            task, r.tcp2base_model, measured, d, rv, std_d, std_r,
-            np.zeros(0) if joints is None else joints, r.solution.rms_px, len(numbers), source=source,
-            verdict=verdict.verdict.value, confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation.strip(), kind=kind,
+            task,
+            r.tcp2base_model,
+            measured,
+            d,
+            rv,
+            std_d,
+            std_r,
+            np.zeros(0) if joints is None else joints,
+            r.solution.rms_px,
+            len(numbers),
+            source=source,
+            verdict=verdict.verdict.value,
+            confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation.strip(),
+            kind=kind,
         )
         self.undo.push(_StoreCorrection(self.corrections, correction))
         return correction

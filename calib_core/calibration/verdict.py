@@ -62,18 +62,30 @@ def judge(estimate, limits: SafetyLimits | None = None, tolerance_mm: float = DE
     r_deg = float(np.linalg.norm(estimate.rotation_deg))
     implausible = []
     if d_mm > limits.model_error_mm:
-        implausible.append(f"the end effector would be {d_mm:.1f} mm from the model, beyond the cell's stated model error of {limits.model_error_mm:g} mm")
+        implausible.append(
+            f"the end effector would be {d_mm:.1f} mm from the model, beyond the cell's stated model error of {limits.model_error_mm:g} mm"
+        )
     if r_deg > limits.model_error_deg:
-        implausible.append(f"it would be turned {r_deg:.2f} deg from the model, beyond the cell's stated {limits.model_error_deg:g} deg")
+        implausible.append(
+            f"it would be turned {r_deg:.2f} deg from the model, beyond the cell's stated {limits.model_error_deg:g} deg"
+        )
     if implausible:
         implausible.append("check that the pairs belong to this robot pose and object, and the camera mounting")
         return ResultVerdict(Verdict.IMPLAUSIBLE, tuple(implausible))
     if solution.status is SolveStatus.AMBIGUOUS:
-        return ResultVerdict(Verdict.AMBIGUOUS, (f"{len(solution.candidates)} poses fit the pairs equally well: choose one, or add pairs",))
+        return ResultVerdict(
+            Verdict.AMBIGUOUS,
+            (f"{len(solution.candidates)} poses fit the pairs equally well: choose one, or add pairs",),
+        )
     sigma = np.asarray(estimate.std_displacement_mm, float)
     if not np.all(np.isfinite(sigma)):
         return ResultVerdict(Verdict.UNCERTAIN, ("the result has no uncertainty (too few pairs for one): add pairs",))
     sigma_mm = float(np.linalg.norm(sigma))
     if sigma_mm > tolerance_mm:
-        return ResultVerdict(Verdict.UNCERTAIN, (f"its 1-sigma of {sigma_mm:.2f} mm is over the task's tolerance of {tolerance_mm:g} mm: add pairs spread over the object",))
+        return ResultVerdict(
+            Verdict.UNCERTAIN,
+            (
+                f"its 1-sigma of {sigma_mm:.2f} mm is over the task's tolerance of {tolerance_mm:g} mm: add pairs spread over the object",
+            ),
+        )
     return ResultVerdict(Verdict.OK)

@@ -64,19 +64,34 @@ class Verification:
     def text(self) -> str:
         d, s = self.remaining_mm, self.std_remaining_mm
         limit = min(self.agree_within_mm, self.tolerance_mm)
-        return (f"{self.task}: the tool is {np.linalg.norm(d):.2f} mm (1-sigma {np.linalg.norm(s):.2f} mm) and {np.linalg.norm(self.remaining_deg):.3f} deg "
-                f"from the task location, {'within' if self.within_tolerance else 'OUTSIDE'} its {self.tolerance_mm:g} mm tolerance; "
-                f"the two looks {'agree' if self.agree else 'DISAGREE'} ({self.disagreement_mm:.2f} mm apart, "
-                f"{'within' if self.agree else 'over'} {limit:.2f} mm: 3 x their 1-sigma {self.agree_within_mm:.2f} mm, the tolerance {self.tolerance_mm:g} mm)")
+        return (
+            f"{self.task}: the tool is {np.linalg.norm(d):.2f} mm (1-sigma {np.linalg.norm(s):.2f} mm) and {np.linalg.norm(self.remaining_deg):.3f} deg "
+            f"from the task location, {'within' if self.within_tolerance else 'OUTSIDE'} its {self.tolerance_mm:g} mm tolerance; "
+            f"the two looks {'agree' if self.agree else 'DISAGREE'} ({self.disagreement_mm:.2f} mm apart, "
+            f"{'within' if self.agree else 'over'} {limit:.2f} mm: 3 x their 1-sigma {self.agree_within_mm:.2f} mm, the tolerance {self.tolerance_mm:g} mm)"
+        )
 
 
-def verify(task: str, target2base: np.ndarray, correction, look, tolerance_mm: float = DEFAULT_TOLERANCE_MM) -> Verification:
+def verify(
+    task: str, target2base: np.ndarray, correction, look, tolerance_mm: float = DEFAULT_TOLERANCE_MM
+) -> Verification:
     """``correction``: the stored :class:`~calib_core.calibration.corrections.Correction` (look 1);
     ``look``: the :class:`~calib_core.calibration.end_effector.EndEffectorEstimate` from the corrected
     joints (look 2); ``target2base`` (4, 4) mm the task location; ``tolerance_mm`` the task's."""
     remaining, rotation = pose_difference(look.tcp2base_measured, target2base)
     predicted = concat(look.tcp2base_model, correction.delta_base)  # look 1's Δ at the pose look 2 was made from
     disagreement = float(np.linalg.norm(look.tcp2base_measured[:3, 3] - predicted[:3, 3]))
-    sigma = float(np.sqrt(np.sum(np.square(correction.std_displacement_mm)) + np.sum(np.square(look.std_displacement_mm))))
-    return Verification(task, remaining, rotation, np.asarray(look.std_displacement_mm, float), disagreement, 3.0 * sigma, float(look.solution.rms_px), len(look.solution.residuals_px),
-                        tolerance_mm=float(tolerance_mm))
+    sigma = float(
+        np.sqrt(np.sum(np.square(correction.std_displacement_mm)) + np.sum(np.square(look.std_displacement_mm)))
+    )
+    return Verification(
+        task,
+        remaining,
+        rotation,
+        np.asarray(look.std_displacement_mm, float),
+        disagreement,
+        3.0 * sigma,
+        float(look.solution.rms_px),
+        len(look.solution.residuals_px),
+        tolerance_mm=float(tolerance_mm),
+    )

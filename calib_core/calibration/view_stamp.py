@@ -45,7 +45,14 @@ class ViewStamp:
         return f"frame {self.frame_index}" + (f" of {self.captured_at}" if self.captured_at else "")
 
     def to_dict(self) -> dict:
-        return {"frame_index": self.frame_index, "t_capture_s": self.t_capture_s, "joints_deg": list(self.joints_deg), "stamp_gap_s": self.stamp_gap_s, "captured_at": self.captured_at, "source": self.source}
+        return {
+            "frame_index": self.frame_index,
+            "t_capture_s": self.t_capture_s,
+            "joints_deg": list(self.joints_deg),
+            "stamp_gap_s": self.stamp_gap_s,
+            "captured_at": self.captured_at,
+            "source": self.source,
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> ViewStamp:
@@ -54,4 +61,11 @@ class ViewStamp:
         joints = tuple(float(v) for v in d["joints_deg"])
         if not joints or not all(np.isfinite(joints)):
             raise ValueError("joints_deg must be a non-empty list of finite numbers")
-        return cls(int(d["frame_index"]), float(d["t_capture_s"]), joints, float(d.get("stamp_gap_s", 0.0)), str(d.get("captured_at", "")), str(d.get("source", "live")))
+        return cls(
+            int(d["frame_index"]),
+            float(d["t_capture_s"]),
+            joints,
+            float(d.get("stamp_gap_s", 0.0)),
+            str(d.get("captured_at", "")),
+            str(d.get("source", "live")),
+        )

@@ -24,7 +24,9 @@ class DistortionMap:
 
     def apply(self, ideal_image: np.ndarray) -> np.ndarray:
         """The distorted image (h, w, c) from an ideal render of ``self.ideal``."""
-        return cv2.remap(ideal_image, self.map_x, self.map_y, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        return cv2.remap(
+            ideal_image, self.map_x, self.map_y, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        )
 
 
 def distortion_map(intrinsics: Intrinsics) -> DistortionMap:

@@ -58,19 +58,27 @@ class Intrinsics:
             if int(v) != v or int(v) <= 0:
                 raise ValueError(f"intrinsics: {name} must be a positive whole number of pixels, got {v}")
             if int(v) > MAX_IMAGE_SIDE_PX:
-                raise ValueError(f"intrinsics: {name} is {v} pixels; videocal takes images up to {MAX_IMAGE_SIDE_PX} pixels a side")
+                raise ValueError(
+                    f"intrinsics: {name} is {v} pixels; videocal takes images up to {MAX_IMAGE_SIDE_PX} pixels a side"
+                )
             object.__setattr__(self, name, int(v))
         if self.model not in DISTORTION_MODELS:
-            raise ValueError(f"intrinsics: unknown distortion model {self.model!r}; videocal knows {', '.join(DISTORTION_MODELS)}")
+            raise ValueError(
+                f"intrinsics: unknown distortion model {self.model!r}; videocal knows {', '.join(DISTORTION_MODELS)}"
+            )
         names = DISTORTION_MODELS[self.model]
         d = tuple(float(x) for x in np.asarray(self.distortion, dtype=float).ravel())
         if len(d) != len(names):
-            raise ValueError(f"intrinsics: {self.model} distortion needs {len(names)} values ({', '.join(names)}), got {len(d)}")
+            raise ValueError(
+                f"intrinsics: {self.model} distortion needs {len(names)} values ({', '.join(names)}), got {len(d)}"
+            )
         if not all(np.isfinite(d)):
             raise ValueError("intrinsics: distortion contains NaN or infinite values")
         if max((abs(x) for x in d), default=0.0) > MAX_DISTORTION:
             k = max(range(len(d)), key=lambda i: abs(d[i]))
-            raise ValueError(f"intrinsics: distortion {names[k]} = {d[k]:g} is no lens's (at most {MAX_DISTORTION:g} in size)")
+            raise ValueError(
+                f"intrinsics: distortion {names[k]} = {d[k]:g} is no lens's (at most {MAX_DISTORTION:g} in size)"
+            )
         object.__setattr__(self, "distortion", d)
 
     @property

@@ -42,20 +42,29 @@ def load_intrinsics(path: str | Path, image_size: tuple[int, int] | None = None)
         return _load_ros(path, data, image_size)
     if isinstance(data, dict) and ("k" in data or "K" in data) and ("width" in data or "height" in data):
         return _load_camera_info_message(path, data, image_size)
-    raise FileFormatError(path, "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
-                          "!!opencv-matrix), ROS camera_info YAML (camera_matrix: {rows, cols, data}) or a "
-                          "sensor_msgs/CameraInfo message as `ros2 topic echo` prints it (k, d, width, height)")
+    raise FileFormatError(
+        path,
+        "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
+        "!!opencv-matrix), ROS camera_info YAML (camera_matrix: {rows, cols, data}) or a "
+        "sensor_msgs/CameraInfo message as `ros2 topic echo` prints it (k, d, width, height)",
+    )
 
 
-def save_intrinsics(path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv", camera_name: str = "videocal_camera") -> None:
+def save_intrinsics(
+    path: str | Path, intrinsics: Intrinsics, fmt: str = "opencv", camera_name: str = "videocal_camera"
+) -> None:
     """Write ``intrinsics`` as ``fmt`` ("opencv" or "ros") to ``path``, atomically."""
     if fmt not in FORMATS:
         raise ValueError(f"unknown intrinsics format {fmt!r}; expected one of {', '.join(FORMATS)}")
     path = Path(path)
     if fmt == "opencv":
+
         def same(tmp: Path) -> None:  # cv2.FileStorage reports no write error: read it back
             back = _load_opencv(tmp)
-            if not np.allclose(back.K, intrinsics.K) or (back.width, back.height) != (intrinsics.width, intrinsics.height):
+            if not np.allclose(back.K, intrinsics.K) or (back.width, back.height) != (
+                intrinsics.width,
+                intrinsics.height,
+            ):
                 raise ValueError("the written camera matrix or image size differs")
 
         with atomic_path(path, same) as tmp:
@@ -91,7 +100,9 @@ def _load_opencv(path: Path, image_size: tuple[int, int] | None = None) -> Intri
         model_node = fs.getNode("distortion_model")
         model = model_node.string() if not model_node.empty() and model_node.isString() else None
     except cv2.error as exc:  # a node of another shape than the file's kind says (OpenCV asserts)
-        raise FileFormatError(path, f"not an OpenCV intrinsics file ({_first_line(exc).split('error: ')[-1]})") from None
+        raise FileFormatError(
+            path, f"not an OpenCV intrinsics file ({_first_line(exc).split('error: ')[-1]})"
+        ) from None
     finally:
         fs.release()
     return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients", model)
@@ -117,12 +128,18 @@ def _image_side(path: Path, key: str, value, from_images: int | None) -> int:
     """The file's ``value`` for an image side (``None``: absent), checked against the images' side."""
     if value is None:
         if from_images is None:
-            raise FileFormatError(path, "missing (the image size is needed; give the images it is used with, whose size then counts)", key)
+            raise FileFormatError(
+                path, "missing (the image size is needed; give the images it is used with, whose size then counts)", key
+            )
         return int(from_images)
     if isinstance(value, bool) or not isinstance(value, int) or not 0 < value <= MAX_IMAGE_SIDE_PX:
-        raise FileFormatError(path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}, got {value!r}", key)
+        raise FileFormatError(
+            path, f"expected a whole number of pixels from 1 to {MAX_IMAGE_SIDE_PX}, got {value!r}", key
+        )
     if from_images is not None and value != from_images:
-        raise FileFormatError(path, f"says {value} px, the images are {from_images} px: the file is for another camera mode", key)
+        raise FileFormatError(
+            path, f"says {value} px, the images are {from_images} px: the file is for another camera mode", key
+        )
     return value
 
 
@@ -136,8 +153,16 @@ def _fs_int(fs: cv2.FileStorage, path: Path, key: str, from_images: int | None =
 
 
 def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
-    known = {"image_width", "image_height", "camera_name", "camera_matrix", "distortion_model",
-             "distortion_coefficients", "rectification_matrix", "projection_matrix"}
+    known = {
+        "image_width",
+        "image_height",
+        "camera_name",
+        "camera_matrix",
+        "distortion_model",
+        "distortion_coefficients",
+        "rectification_matrix",
+        "projection_matrix",
+    }
     unknown = sorted(set(data) - known)
     if unknown:
         raise FileFormatError(path, f"unknown key(s) for a ROS camera_info file: {', '.join(unknown)}")
@@ -145,16 +170,35 @@ def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None)
     height = _image_side(path, "image_height", data.get("image_height"), image_size[1] if image_size else None)
     model = _model_field(path, data.get("distortion_model") or "plumb_bob")
     K = _ros_matrix(path, data, "camera_matrix", 9).reshape(3, 3)
-    dist = _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(0)
+    dist = (
+        _ros_matrix(path, data, "distortion_coefficients", None) if "distortion_coefficients" in data else np.zeros(0)
+    )
     return _build(path, K, dist, width, height, "camera_matrix", "distortion_coefficients", model)
 
 
 def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
     """A ``sensor_msgs/CameraInfo`` message as YAML: ROS 2's lower-case fields (``k``, ``d``) or ROS 1's (``K``, ``D``)."""
+
     def field(name: str):
         return data.get(name, data.get(name.upper()))
 
-    known = {"header", "height", "width", "distortion_model", "d", "k", "r", "p", "binning_x", "binning_y", "roi", "D", "K", "R", "P"}
+    known = {
+        "header",
+        "height",
+        "width",
+        "distortion_model",
+        "d",
+        "k",
+        "r",
+        "p",
+        "binning_x",
+        "binning_y",
+        "roi",
+        "D",
+        "K",
+        "R",
+        "P",
+    }
     unknown = sorted(set(map(str, data)) - known)
     if unknown:
         raise FileFormatError(path, f"unknown key(s) for a CameraInfo message: {', '.join(unknown)}")
@@ -166,7 +210,11 @@ def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int
         v = field(name)
         if v is None and name == "d":
             v = []
-        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v) or (size and len(v) != size):
+        if (
+            not isinstance(v, list)
+            or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+            or (size and len(v) != size)
+        ):
             raise FileFormatError(path, f"must be a list of {size or 'the distortion'} numbers, got {v!r}", name)
         values[name] = np.asarray(v, dtype=float)
     return _build(path, values["k"].reshape(3, 3), values["d"], width, height, "k", "d", model)
@@ -192,7 +240,11 @@ def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarra
 
 def _model_field(path: Path, model) -> str:
     if model not in DISTORTION_MODELS:
-        raise FileFormatError(path, f"unsupported distortion model {model!r}; videocal reads {', '.join(DISTORTION_MODELS)}", "distortion_model")
+        raise FileFormatError(
+            path,
+            f"unsupported distortion model {model!r}; videocal reads {', '.join(DISTORTION_MODELS)}",
+            "distortion_model",
+        )
     return str(model)
 
 
@@ -211,15 +263,28 @@ def _coefficients(path: Path, dist: np.ndarray, model: str | None, d_field: str)
     if model == "plumb_bob" and n in (4, 5, 8) and not np.any(dist[5:]):
         return model, tuple(np.r_[dist[:5], np.zeros(5 - min(n, 5))])
     if n != len(names):
-        raise FileFormatError(path, f"a {model} lens has {len(names)} coefficients ({' '.join(names)}), the file gives {n}", d_field)
+        raise FileFormatError(
+            path, f"a {model} lens has {len(names)} coefficients ({' '.join(names)}), the file gives {n}", d_field
+        )
     return model, tuple(float(v) for v in dist)
 
 
-def _build(path: Path, K: np.ndarray, dist: np.ndarray, width: int, height: int, k_field: str, d_field: str, model: str | None = None) -> Intrinsics:
+def _build(
+    path: Path,
+    K: np.ndarray,
+    dist: np.ndarray,
+    width: int,
+    height: int,
+    k_field: str,
+    d_field: str,
+    model: str | None = None,
+) -> Intrinsics:
     if not np.all(np.isfinite(K)):
         raise FileFormatError(path, "contains NaN or infinite values", k_field)
     if abs(K[0, 1]) > 1e-9 or np.any(np.abs(K[2] - [0, 0, 1]) > 1e-9) or abs(K[1, 0]) > 1e-9:
-        raise FileFormatError(path, "not a pinhole camera matrix [[fu,0,cx],[0,fv,cy],[0,0,1]] (skew is not supported)", k_field)
+        raise FileFormatError(
+            path, "not a pinhole camera matrix [[fu,0,cx],[0,fv,cy],[0,0,1]] (skew is not supported)", k_field
+        )
     model, coefficients = _coefficients(path, np.asarray(dist, dtype=float).ravel(), model, d_field)
     try:
         return Intrinsics(K[0, 0], K[1, 1], K[0, 2], K[1, 2], width, height, coefficients, model)
@@ -236,7 +301,11 @@ def _ros_dict(intr: Intrinsics, camera_name: str) -> dict:
         "camera_name": camera_name,
         "camera_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in intr.K.ravel()]},
         "distortion_model": intr.model,
-        "distortion_coefficients": {"rows": 1, "cols": len(intr.distortion), "data": [float(v) for v in intr.distortion]},
+        "distortion_coefficients": {
+            "rows": 1,
+            "cols": len(intr.distortion),
+            "data": [float(v) for v in intr.distortion],
+        },
         "rectification_matrix": {"rows": 3, "cols": 3, "data": [float(v) for v in np.eye(3).ravel()]},
         "projection_matrix": {"rows": 3, "cols": 4, "data": [float(v) for v in P.ravel()]},
     }

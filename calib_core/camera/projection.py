@@ -88,12 +88,16 @@ def project(points_cam_mm: ArrayLike, intrinsics: Intrinsics, *, distort: bool =
     return np.stack([u, v], axis=1)
 
 
-def project_points(points_obj_mm: ArrayLike, obj2cam: ArrayLike, intrinsics: Intrinsics, *, distort: bool = True) -> np.ndarray:
+def project_points(
+    points_obj_mm: ArrayLike, obj2cam: ArrayLike, intrinsics: Intrinsics, *, distort: bool = True
+) -> np.ndarray:
     """Pixels (n, 2) of points (n, 3) in an object frame (mm) seen with pose ``obj2cam`` (4x4, mm)."""
     return project(apply(obj2cam, points_obj_mm), intrinsics, distort=distort)
 
 
-def unproject(pixels: ArrayLike, intrinsics: Intrinsics, *, undistort: bool = True, depth_mm: ArrayLike | None = None) -> np.ndarray:
+def unproject(
+    pixels: ArrayLike, intrinsics: Intrinsics, *, undistort: bool = True, depth_mm: ArrayLike | None = None
+) -> np.ndarray:
     """Back-project pixels (n, 2).
 
     Without ``depth_mm``: unit-free rays (n, 3) with z = 1 in the camera frame.

@@ -32,7 +32,10 @@ class JointMap:
         """The map of a robot whose driven joints are ``joint_names`` (URDF order)."""
         if controller is None:
             return cls.identity(len(joint_names))
-        return cls(np.array([joint_names.index(j) for j in controller.joints]), np.asarray(controller.zero_offsets, dtype=float))
+        return cls(
+            np.array([joint_names.index(j) for j in controller.joints]),
+            np.asarray(controller.zero_offsets, dtype=float),
+        )
 
     @property
     def n_joints(self) -> int:

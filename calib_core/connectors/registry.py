@@ -25,7 +25,9 @@ class ConnectorNotFoundError(VideocalError, LookupError):
 def _load(group: str, scheme: str, url: str, what: str):
     if any(ord(c) < 32 or ord(c) == 127 for c in url):
         # a NUL or a newline pasted into a URL: opened as it is, the connector's failure reads as a network fault
-        raise ConnectorNotFoundError(f"the {what} address {url!r} holds a control character (a newline, a tab, a NUL): type it again")
+        raise ConnectorNotFoundError(
+            f"the {what} address {url!r} holds a control character (a newline, a tab, a NUL): type it again"
+        )
     if scheme not in plugin_names(group):
         installed = ", ".join(f"{name}://" for name in plugin_names(group)) or "none"
         raise ConnectorNotFoundError(f"no {what} connector for {url!r} (scheme {scheme!r}); installed: {installed}")

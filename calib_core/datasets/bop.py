@@ -85,7 +85,9 @@ def _numbers(path: Path, where: str, value, count: int) -> np.ndarray:
     return a
 
 
-def symmetry_transforms(info: dict, *, path: Path | None = None, where: str = "", max_step_rad: float = 0.01) -> np.ndarray:
+def symmetry_transforms(
+    info: dict, *, path: Path | None = None, where: str = "", max_step_rad: float = 0.01
+) -> np.ndarray:
     """The poses (k, 4, 4) under which an object of BOP's ``models_info`` entry ``info`` looks the same: the
     identity, each of ``symmetries_discrete`` (4 x 4 row by row, mm), and each of those composed with turns about
     each of ``symmetries_continuous`` (``axis``, ``offset`` mm) in ``ceil(pi / max_step_rad)`` equal steps (the
@@ -118,14 +120,19 @@ class BopDataset:
     """A BOP data set at ``root`` (its folder name is the data set's name unless ``name`` is given), the models in
     ``models_folder`` (``models``; T-LESS also has ``models_cad``), the images of ``split``."""
 
-    def __init__(self, root: str | Path, split: str = "test", *, models_folder: str = "models", name: str | None = None):
+    def __init__(
+        self, root: str | Path, split: str = "test", *, models_folder: str = "models", name: str | None = None
+    ):
         self.root = Path(root)
         self.split = split
         self.name = name or self.root.name
         self.models_dir = self.root / models_folder
         if not (self.root / split).is_dir():
-            raise FileFormatError(self.root / split, f"no split {split!r} in the data set (folders: "
-                                  f"{', '.join(sorted(p.name for p in self.root.iterdir() if p.is_dir())) or 'none'})")
+            raise FileFormatError(
+                self.root / split,
+                f"no split {split!r} in the data set (folders: "
+                f"{', '.join(sorted(p.name for p in self.root.iterdir() if p.is_dir())) or 'none'})",
+            )
         self._models: dict[int, ModelInfo] | None = None
 
     def models(self) -> dict[int, ModelInfo]:
@@ -143,8 +150,12 @@ class BopDataset:
                 if not isinstance(entry, dict) or "diameter" not in entry:
                     raise FileFormatError(path, "expected an object with a diameter", where)
                 diameter = float(_numbers(path, f"{where}.diameter", entry["diameter"], 1)[0])
-                models[obj_id] = ModelInfo(obj_id, self.models_dir / f"obj_{obj_id:06d}.ply", diameter,
-                                           symmetry_transforms(entry, path=path, where=where))
+                models[obj_id] = ModelInfo(
+                    obj_id,
+                    self.models_dir / f"obj_{obj_id:06d}.ply",
+                    diameter,
+                    symmetry_transforms(entry, path=path, where=where),
+                )
             self._models = models
         return self._models
 
@@ -152,7 +163,9 @@ class BopDataset:
         """The split's scenes, by id."""
         return sorted(int(p.name) for p in (self.root / self.split).iterdir() if p.is_dir() and p.name.isdigit())
 
-    def views(self, *, min_visible: float = 0.0, scene_ids: list[int] | None = None, obj_ids: set[int] | None = None) -> Iterator[ObjectView]:
+    def views(
+        self, *, min_visible: float = 0.0, scene_ids: list[int] | None = None, obj_ids: set[int] | None = None
+    ) -> Iterator[ObjectView]:
         """Every annotated object of the split with at least ``min_visible`` of it in sight, scene by scene and
         image by image in id order."""
         for scene_id in scene_ids if scene_ids is not None else self.scene_ids():
@@ -182,9 +195,13 @@ class BopDataset:
                         intrinsics = _intrinsics(K, image)
                     where = f"{key}[{index}]"
                     T = np.eye(4)
-                    T[:3, :3] = _numbers(folder / "scene_gt.json", f"{where}.cam_R_m2c", gt.get("cam_R_m2c"), 9).reshape(3, 3)
+                    T[:3, :3] = _numbers(
+                        folder / "scene_gt.json", f"{where}.cam_R_m2c", gt.get("cam_R_m2c"), 9
+                    ).reshape(3, 3)
                     T[:3, 3] = _numbers(folder / "scene_gt.json", f"{where}.cam_t_m2c", gt.get("cam_t_m2c"), 3)
-                    yield ObjectView(self.name, self.split, scene_id, im_id, index, obj_id, image, intrinsics, T, visible)
+                    yield ObjectView(
+                        self.name, self.split, scene_id, im_id, index, obj_id, image, intrinsics, T, visible
+                    )
 
 
 def _image_file(scene: Path, im_id: int) -> Path:

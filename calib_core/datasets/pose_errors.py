@@ -29,11 +29,18 @@ def mssd(estimate: np.ndarray, truth: np.ndarray, points_mm: np.ndarray, symmetr
     return float(min(np.max(np.linalg.norm(at_estimate - _posed(points_mm, truth @ s), axis=1)) for s in symmetries))
 
 
-def mspd(estimate: np.ndarray, truth: np.ndarray, points_mm: np.ndarray, symmetries: np.ndarray, intrinsics: Intrinsics) -> float:
+def mspd(
+    estimate: np.ndarray, truth: np.ndarray, points_mm: np.ndarray, symmetries: np.ndarray, intrinsics: Intrinsics
+) -> float:
     """Maximum symmetry-aware projection distance, px: as :func:`mssd` between the points' pixels through
     ``intrinsics``."""
     at_estimate = project_points(points_mm, estimate, intrinsics)
-    return float(min(np.max(np.linalg.norm(at_estimate - project_points(points_mm, truth @ s, intrinsics), axis=1)) for s in symmetries))
+    return float(
+        min(
+            np.max(np.linalg.norm(at_estimate - project_points(points_mm, truth @ s, intrinsics), axis=1))
+            for s in symmetries
+        )
+    )
 
 
 def translation_error_mm(estimate: np.ndarray, truth: np.ndarray) -> float:

@@ -13,5 +13,7 @@ def aravis():
         gi.require_version("Aravis", "0.8")
         from gi.repository import Aravis
     except (ImportError, ValueError) as exc:
-        raise VideoSourceError(f"GenICam cameras need Aravis 0.8 and PyGObject (apt-get install gir1.2-aravis-0.8; make venv): {exc}") from None
+        raise VideoSourceError(
+            f"GenICam cameras need Aravis 0.8 and PyGObject (apt-get install gir1.2-aravis-0.8; make venv): {exc}"
+        ) from None
     return Aravis

@@ -35,7 +35,9 @@ def _device_id(spec: str) -> str:
     parts = urlsplit(spec)
     device = unquote(parts.netloc + parts.path).strip("/")
     if not device:
-        raise VideoSourceError(f"{spec!r}: name the camera: aravis://DEVICE-ID (see `arv-tool-0.8`), an IP address, or Fake_1")
+        raise VideoSourceError(
+            f"{spec!r}: name the camera: aravis://DEVICE-ID (see `arv-tool-0.8`), an IP address, or Fake_1"
+        )
     return device
 
 
@@ -45,7 +47,9 @@ class AravisSource(FrameSource):
         merged.update({k: v[-1] for k, v in parse_qs(urlsplit(spec).query).items()})
         unknown = set(merged) - _OPTIONS
         if unknown:
-            raise VideoSourceError(f"{spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+            raise VideoSourceError(
+                f"{spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}"
+            )
         self.device = _device_id(spec.split("?", 1)[0])
         self.options = merged
         try:
@@ -98,8 +102,16 @@ class AravisSource(FrameSource):
         Aravis.update_device_list()
         found = [Aravis.get_device_id(i) for i in range(Aravis.get_n_devices())]
         if self.device not in found:
-            seen = ", ".join(f"{d} ({Aravis.get_device_address(i) or Aravis.get_device_protocol(i)})" for i, d in enumerate(found)) or "none"
-            raise VideoSourceError(f"{self.description}: no camera with that id; cameras found: {seen} (an id is Vendor-Model-Serial, as `arv-tool-0.8` lists them)")
+            seen = (
+                ", ".join(
+                    f"{d} ({Aravis.get_device_address(i) or Aravis.get_device_protocol(i)})"
+                    for i, d in enumerate(found)
+                )
+                or "none"
+            )
+            raise VideoSourceError(
+                f"{self.description}: no camera with that id; cameras found: {seen} (an id is Vendor-Model-Serial, as `arv-tool-0.8` lists them)"
+            )
 
     def _configure(self, camera) -> None:
         """The options, each checked against the range the camera offers, set, and read back: a refusal, or a value
@@ -119,25 +131,35 @@ class AravisSource(FrameSource):
             try:
                 apply()
             except Exception as exc:
-                raise VideoSourceError(f"{self.description}: it refuses {name}={o[name]!r}: {getattr(exc, 'message', exc)}") from None
+                raise VideoSourceError(
+                    f"{self.description}: it refuses {name}={o[name]!r}: {getattr(exc, 'message', exc)}"
+                ) from None
 
         def within(name: str, value: float, bounds, unit: str) -> None:
             low, high = float(bounds[0]), float(bounds[1])
             if not low <= value <= high:
-                raise VideoSourceError(f"{self.description}: it refuses {name}={o[name]!r}: it offers {low:.10g}-{high:.10g} {unit}")
+                raise VideoSourceError(
+                    f"{self.description}: it refuses {name}={o[name]!r}: it offers {low:.10g}-{high:.10g} {unit}"
+                )
 
         def read_back(name: str, asked: float, got: float, tolerance: float, unit: str) -> None:
             if abs(got - asked) > tolerance:
-                raise VideoSourceError(f"{self.description}: {name}={o[name]!r} was not taken: the camera reports {got:g} {unit}")
+                raise VideoSourceError(
+                    f"{self.description}: {name}={o[name]!r} was not taken: the camera reports {got:g} {unit}"
+                )
 
         if "pixel_format" in o:
             allowed = list(camera.dup_available_pixel_formats_as_strings() or [])
             if o["pixel_format"] not in allowed:
-                raise VideoSourceError(f"{self.description}: it refuses pixel_format={o['pixel_format']!r}; it offers {', '.join(allowed)}")
+                raise VideoSourceError(
+                    f"{self.description}: it refuses pixel_format={o['pixel_format']!r}; it offers {', '.join(allowed)}"
+                )
             setting("pixel_format", lambda: camera.set_pixel_format_from_string(str(o["pixel_format"])))
             got = camera.get_pixel_format_as_string()
             if got != o["pixel_format"]:
-                raise VideoSourceError(f"{self.description}: pixel_format={o['pixel_format']!r} was not taken: the camera reports {got}")
+                raise VideoSourceError(
+                    f"{self.description}: pixel_format={o['pixel_format']!r} was not taken: the camera reports {got}"
+                )
         if "width" in o or "height" in o:
             x, y, w, h = camera.get_region()
             width = number("width") if "width" in o else float(w)
@@ -187,7 +209,11 @@ class AravisSource(FrameSource):
         while True:
             if self._stream is None:
                 self._reopen()
-            buffer = self._stream.timeout_pop_buffer(int(max(deadline - time.monotonic(), 0.01) * 1e6)) if self._stream is not None else None
+            buffer = (
+                self._stream.timeout_pop_buffer(int(max(deadline - time.monotonic(), 0.01) * 1e6))
+                if self._stream is not None
+                else None
+            )
             while buffer is not None:  # frames queued while the caller was busy are old: keep only the newest
                 newer = self._stream.try_pop_buffer()
                 if newer is None:
@@ -206,7 +232,9 @@ class AravisSource(FrameSource):
             if now - self._last_frame_s > self.reopen_after_s and self._stream is not None:
                 self._close_device()  # gone quiet for long: open it afresh on the next read
             if now >= deadline:
-                raise FrameTimeout(f"{self.description}: no frame for {now - self._last_frame_s:.1f} s (waiting; reconnecting after {self.reopen_after_s:g} s)")
+                raise FrameTimeout(
+                    f"{self.description}: no frame for {now - self._last_frame_s:.1f} s (waiting; reconnecting after {self.reopen_after_s:g} s)"
+                )
 
     def _reopen(self) -> None:
         try:
@@ -217,7 +245,9 @@ class AravisSource(FrameSource):
 
     def _frame(self, buffer) -> Frame:
         data = buffer.get_data()
-        rgb = to_rgb(data, buffer.get_image_width(), buffer.get_image_height(), buffer.get_image_pixel_format(), self.description)
+        rgb = to_rgb(
+            data, buffer.get_image_width(), buffer.get_image_height(), buffer.get_image_pixel_format(), self.description
+        )
         received_ns = buffer.get_system_timestamp()  # the host's realtime clock at the frame
         age_s = (time.time_ns() - received_ns) / 1e9 if received_ns else 0.0
         now = time.monotonic()

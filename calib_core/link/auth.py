@@ -81,7 +81,9 @@ def workstation_proof(key: bytes, workstation_nonce: str, controller_nonce: str)
 
 def session_key(key: bytes, workstation_nonce: str, controller_nonce: str) -> bytes:
     """The session's sealing key (32 bytes)."""
-    return hmac.new(key, f"videocal-session|{workstation_nonce}|{controller_nonce}".encode("ascii"), hashlib.sha256).digest()
+    return hmac.new(
+        key, f"videocal-session|{workstation_nonce}|{controller_nonce}".encode("ascii"), hashlib.sha256
+    ).digest()
 
 
 def seal(session: bytes, counter: int, t_ms: int, body: str) -> str:

@@ -11,6 +11,8 @@ def open_link(url: str, context: ControllerContext) -> ControllerLink:
     (the workcell's ``robot.controller`` map). Options from the ``site:`` section: ``mode``
     (``stream``/``poll``), ``deadman_ms``, ``baudrate``, ``parity``."""
     options = dict(context.options or {})
-    link = ControllerLink(url, mode=options.pop("mode", "stream"), rate_hz=context.rate_hz, n_joints=context.n_joints or None, **options)
+    link = ControllerLink(
+        url, mode=options.pop("mode", "stream"), rate_hz=context.rate_hz, n_joints=context.n_joints or None, **options
+    )
     link.joint_map = context.cell_joint_map
     return link

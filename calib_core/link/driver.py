@@ -81,8 +81,20 @@ class ControllerLink(ConnectorEvents):
     held up on a slow link is no reason to stop the robot), a link is stale only after ``stale_after_s``
     plus the round trip's spread, and a hello waits at least the round trip's timeout."""
 
-    def __init__(self, url: str, *, mode: str = "stream", rate_hz: float = 50.0, stale_after_s: float | None = None, queue_size: int = 10_000, reconnect: bool = True, n_joints: int | None = None,
-                 deadman_ms: int = 1000, key: bytes | str | None = "user", **serial_settings):
+    def __init__(
+        self,
+        url: str,
+        *,
+        mode: str = "stream",
+        rate_hz: float = 50.0,
+        stale_after_s: float | None = None,
+        queue_size: int = 10_000,
+        reconnect: bool = True,
+        n_joints: int | None = None,
+        deadman_ms: int = 1000,
+        key: bytes | str | None = "user",
+        **serial_settings,
+    ):
         if mode not in MODES:
             raise ValueError(f"mode must be 'poll' or 'stream', got {mode!r}")
         if not (0 < rate_hz <= 250):

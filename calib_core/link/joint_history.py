@@ -114,7 +114,9 @@ class JointHistory:
         """Set when the pose became unknown (``forget``); cleared by the next sample."""
 
     @classmethod
-    def from_arrays(cls, times_s, joints_deg, rule: SettleRule | None = None, joint_names: list[str] | None = None) -> JointHistory:
+    def from_arrays(
+        cls, times_s, joints_deg, rule: SettleRule | None = None, joint_names: list[str] | None = None
+    ) -> JointHistory:
         """A whole recorded history: ``times_s`` (n,) s, non-decreasing; ``joints_deg`` (n, j)."""
         history = cls(keep_s=float("inf"), rule=rule, joint_names=joint_names)
         for t, q in zip(np.asarray(times_s, float), np.asarray(joints_deg, float)):
@@ -172,23 +174,42 @@ class JointHistory:
         ``t_s - hold_s - margin_s`` to ``t_s``."""
         held = self._stillness(t_s, self.rule.hold_s + margin_s, self.rule.max_gap_s + margin_s)
         if margin_s >= 0.005 and not held.settled and held.reason.startswith("the robot was moving"):
-            return Stillness(False, held.reason + f" (the frame may be up to {margin_s:.2f} s older than it says: the link's spread of delays)",
-                             held.still_for_s, held.speed_deg_s, held.joint)
+            return Stillness(
+                False,
+                held.reason
+                + f" (the frame may be up to {margin_s:.2f} s older than it says: the link's spread of delays)",
+                held.still_for_s,
+                held.speed_deg_s,
+                held.joint,
+            )
         return held
 
     def _stillness(self, t_s: float, hold_s: float, unknown_after_s: float) -> Stillness:
         rule = self.rule
         if not self._t:
-            why = "the link dropped: the robot's pose is unknown until a fresh joint sample arrives" if self.unknown_since_s is not None else "no joint samples: the robot's pose is unknown (is the controller link up?)"
+            why = (
+                "the link dropped: the robot's pose is unknown until a fresh joint sample arrives"
+                if self.unknown_since_s is not None
+                else "no joint samples: the robot's pose is unknown (is the controller link up?)"
+            )
             return Stillness(False, why, 0.0)
         times = np.fromiter(self._t, float)
         if t_s - times[-1] > unknown_after_s:
-            return Stillness(False, f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown", 0.0)
+            return Stillness(
+                False,
+                f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown",
+                0.0,
+            )
         if t_s < times[0]:
             return Stillness(False, "the frame is older than the joint history: its robot pose is unknown", 0.0)
         if times[-1] < t_s:
             # Judged before the samples around the capture have arrived, a frame would be judged on older ones.
-            return Stillness(False, f"waiting for the joint samples of the frame's time (the newest is {t_s - times[-1]:.2f} s older)", 0.0, pending=True)
+            return Stillness(
+                False,
+                f"waiting for the joint samples of the frame's time (the newest is {t_s - times[-1]:.2f} s older)",
+                0.0,
+                pending=True,
+            )
         end = bisect.bisect_right(self._t, t_s)  # samples at or before the capture
         stop = min(end + 1, len(times))  # and the one after it: the motion across the capture counts
         q = np.array([self._q[k] for k in range(stop)])
@@ -208,9 +229,17 @@ class JointHistory:
         if still_for + 1e-9 >= hold_s:
             return Stillness(True, "", still_for)
         if k == 0:
-            return Stillness(False, f"the joint history is only {still_for:.2f} s old at the frame ({hold_s:.2g} s of stillness needed)", still_for)
+            return Stillness(
+                False,
+                f"the joint history is only {still_for:.2f} s old at the frame ({hold_s:.2g} s of stillness needed)",
+                still_for,
+            )
         if times[k] - times[k - 1] > rule.max_gap_s:
-            return Stillness(False, f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen", still_for)
+            return Stillness(
+                False,
+                f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen",
+                still_for,
+            )
         # moving: the fastest joint speed in the hold window, over sample pairs >= 0.1 s apart
         first = max(0, bisect.bisect_left(self._t, t_s - hold_s) - 1)
         speed, joint = 0.0, 0
@@ -222,7 +251,13 @@ class JointHistory:
                 if v.max() > speed:
                     speed, joint = float(v.max()), int(np.argmax(v))
         when = "when the frame was taken" if still_for < 0.05 else f"{still_for:.2f} s before the frame"
-        return Stillness(False, f"the robot was moving {when} ({self._name(joint)} at {speed:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)", still_for, speed, joint)
+        return Stillness(
+            False,
+            f"the robot was moving {when} ({self._name(joint)} at {speed:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)",
+            still_for,
+            speed,
+            joint,
+        )
 
     def _name(self, joint: int) -> str:
         return self.joint_names[joint] if joint < len(self.joint_names) else f"joint {joint + 1}"

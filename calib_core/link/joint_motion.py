@@ -47,7 +47,14 @@ class TrapezoidMove:
     duration_s: float
 
     @classmethod
-    def plan(cls, start_deg: np.ndarray, goal_deg: np.ndarray, max_speed_deg_s: np.ndarray, t0_s: float, speed_scale: float = 1.0) -> TrapezoidMove:
+    def plan(
+        cls,
+        start_deg: np.ndarray,
+        goal_deg: np.ndarray,
+        max_speed_deg_s: np.ndarray,
+        t0_s: float,
+        speed_scale: float = 1.0,
+    ) -> TrapezoidMove:
         distance = np.abs(np.asarray(goal_deg, float) - np.asarray(start_deg, float))
         # Peak speed = distance / (duration * (1 - ramp)): choose the duration that keeps every joint within its limit.
         per_joint = distance / (np.asarray(max_speed_deg_s, float) * speed_scale * (1.0 - _RAMP_FRACTION))

@@ -42,7 +42,9 @@ def read_key(path: str | Path | None = None) -> bytes:
     except (OSError, UnicodeDecodeError) as exc:
         raise LinkKeyError(f"{path}: cannot read the link key: {getattr(exc, 'strerror', None) or exc}") from None
     if stat.S_IMODE(info.st_mode) & 0o077:
-        raise LinkKeyError(f"{path}: the link key is readable by others (mode {stat.S_IMODE(info.st_mode):o}); `chmod 600 {path}`, and make a new key if others may have read it")
+        raise LinkKeyError(
+            f"{path}: the link key is readable by others (mode {stat.S_IMODE(info.st_mode):o}); `chmod 600 {path}`, and make a new key if others may have read it"
+        )
     lines = [line.strip() for line in text.splitlines() if line.strip() and not line.strip().startswith("#")]
     if len(lines) != 1:
         raise LinkKeyError(f"{path}: expected one line of {2 * KEY_BYTES} hex digits, found {len(lines)} lines")

@@ -58,7 +58,9 @@ class JointSample(SharedJointSample):
     :class:`~calib_core.connectors.link_types.JointSample`). ``seq`` wraps at 2^32."""
 
     def body(self) -> str:
-        return ",".join(["JNT", str(self.seq % SEQ_MODULUS), str(self.t_ms)] + [format_angle(q) for q in self.joints_deg])
+        return ",".join(
+            ["JNT", str(self.seq % SEQ_MODULUS), str(self.t_ms)] + [format_angle(q) for q in self.joints_deg]
+        )
 
 
 @dataclass(frozen=True)
@@ -221,8 +223,24 @@ class RequestState:
         return "STA"
 
 
-Message = (JointSample | Ack | Done | StateReport | ErrorReply | VersionReport | RequestJoints | Stream | MoveJoints | RequestState | RequestVersion | Stop | Heartbeat
-           | Hello | HelloReply | Authenticate)
+Message = (
+    JointSample
+    | Ack
+    | Done
+    | StateReport
+    | ErrorReply
+    | VersionReport
+    | RequestJoints
+    | Stream
+    | MoveJoints
+    | RequestState
+    | RequestVersion
+    | Stop
+    | Heartbeat
+    | Hello
+    | HelloReply
+    | Authenticate
+)
 
 
 def _number(text: str, what: str) -> float:
@@ -272,11 +290,15 @@ def parse_body(body: str) -> Message:
     n = len(fields)
     if kind == "JNT":
         if not 4 <= n <= 3 + MAX_JOINTS:
-            raise ProtocolError("malformed", f"JNT needs a sequence number, a time and 1 to {MAX_JOINTS} joint values; got {n} fields")
+            raise ProtocolError(
+                "malformed", f"JNT needs a sequence number, a time and 1 to {MAX_JOINTS} joint values; got {n} fields"
+            )
         seq = _integer(fields[1], "JNT seq")
         if seq >= SEQ_MODULUS:
             raise ProtocolError("malformed", f"JNT seq {seq} exceeds 2^32 - 1")
-        return JointSample(seq, _integer(fields[2], "JNT t_ms"), tuple(_number(f, f"JNT q{i + 1}") for i, f in enumerate(fields[3:])))
+        return JointSample(
+            seq, _integer(fields[2], "JNT t_ms"), tuple(_number(f, f"JNT q{i + 1}") for i, f in enumerate(fields[3:]))
+        )
     if kind == "ACK" and n == 3:
         return Ack(_token(fields[1], "ACK cmd"), _token(fields[2], "ACK id"))
     if kind == "DON" and n == 2:
@@ -314,7 +336,9 @@ def parse_body(body: str) -> Message:
     if kind == "MVJ":
         if not 3 <= n <= 2 + MAX_JOINTS:
             raise ProtocolError("malformed", f"MVJ needs an id and 1 to {MAX_JOINTS} joint values; got {n} fields")
-        return MoveJoints(_token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:])))
+        return MoveJoints(
+            _token(fields[1], "MVJ id"), tuple(_number(f, f"MVJ q{i + 1}") for i, f in enumerate(fields[2:]))
+        )
     if kind in ("JNT", "ACK", "DON", "STA", "ERR", "RQJ", "STR", "MVJ", "VER", "STP", "HBT", "HEL", "AUT"):
         raise ProtocolError("malformed", f"{kind} with {n - 1} fields")
     raise ProtocolError("unknown", f"unknown sentence type {kind!r}")

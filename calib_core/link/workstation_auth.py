@@ -128,18 +128,32 @@ class WorkstationAuth:
             return False
         if msg.code == "AUTH" and msg.text.startswith("hello "):
             # the controller refused a hello: ours only if it names our nonce (a flood of others' is not our failure)
-            if self.state is AuthState.PENDING and self._nonce is not None and msg.text.startswith(f"hello {self._nonce}:"):
-                self._set(AuthState.FAILED, f"the controller does not hold {self._key_name}: it refused our hello (another key installed?); "
-                                            "the robot is not moved")
+            if (
+                self.state is AuthState.PENDING
+                and self._nonce is not None
+                and msg.text.startswith(f"hello {self._nonce}:")
+            ):
+                self._set(
+                    AuthState.FAILED,
+                    f"the controller does not hold {self._key_name}: it refused our hello (another key installed?); "
+                    "the robot is not moved",
+                )
             return True
         if msg.code == "AUTH" and msg.text.startswith("auth:") and self.state is AuthState.PENDING:
             # (in a session, an "auth:" refusal answers another writer's handshake on the line, not ours)
             self._set(AuthState.FAILED, f"the controller refused {self._key_name} ({msg.text}); the robot is not moved")
             return True
-        if self.state is AuthState.PENDING and not msg.text.startswith("move ") and ("HEL" in msg.text or "AUT" in msg.text):
-            self._set(AuthState.FAILED, f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): videocal moves only a "
-                                        "controller that holds the link key; install the controller program (resources/controller/videocal_link.pdl, protocol 6) "
-                                        "with `videocal link-key`'s key")
+        if (
+            self.state is AuthState.PENDING
+            and not msg.text.startswith("move ")
+            and ("HEL" in msg.text or "AUT" in msg.text)
+        ):
+            self._set(
+                AuthState.FAILED,
+                f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): videocal moves only a "
+                "controller that holds the link key; install the controller program (resources/controller/videocal_link.pdl, protocol 6) "
+                "with `videocal link-key`'s key",
+            )
             return True
         return False
 
@@ -147,13 +161,23 @@ class WorkstationAuth:
         """A move refused for want of a session (the controller restarted), or for its time (the clocks have drifted
         apart, or the link held it back): time for a new hello, which reads the controller's clock again. The move
         itself is not sent again."""
-        return self._key is not None and msg.code == "AUTH" and ("no authenticated session" in msg.text or "stale:" in msg.text
-                                                                 or "ahead of the controller clock" in msg.text)
+        return (
+            self._key is not None
+            and msg.code == "AUTH"
+            and (
+                "no authenticated session" in msg.text
+                or "stale:" in msg.text
+                or "ahead of the controller clock" in msg.text
+            )
+        )
 
     def _try_wait_s(self) -> float:
         """How long the current try waits for its answer (s): doubling per try, at least the round trip's
         timeout (an AUT already sent waits its own round trip too)."""
-        return max(HANDSHAKE_TIMEOUT_S * 2 ** (self._attempts - 1), 2.0 * self.round_trip.rto_s if self._aut_sent_s else self.round_trip.rto_s)
+        return max(
+            HANDSHAKE_TIMEOUT_S * 2 ** (self._attempts - 1),
+            2.0 * self.round_trip.rto_s if self._aut_sent_s else self.round_trip.rto_s,
+        )
 
     def check_timeout(self, now_s: float) -> bool:
         """True when an unanswered hello is due to be sent again; after :data:`HANDSHAKE_ATTEMPTS` the
@@ -163,7 +187,10 @@ class WorkstationAuth:
         if self._attempts < HANDSHAKE_ATTEMPTS:
             return True
         waited = now_s - min([self._sent_s, *self._earlier.values()])
-        self._set(AuthState.FAILED, f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:.1f} s; a protocol-3 controller?); the robot is not moved")
+        self._set(
+            AuthState.FAILED,
+            f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:.1f} s; a protocol-3 controller?); the robot is not moved",
+        )
         return False
 
     def wait_settled(self, timeout_s: float) -> AuthState:

@@ -82,7 +82,9 @@ class Arm:
         link.sample_received.connect(lambda sample: self._call_soon(self.observe_sample, sample))
         link.state_changed.connect(lambda state, why: self._call_soon(self._on_link_state, state.value, why))
         link.auth_changed.connect(lambda state, failure: self._call_soon(self._on_link_auth, state.value, failure))
-        status = getattr(link, "status_changed", None)  # a controller's own state (a UR's protective stop, speed slider)
+        status = getattr(
+            link, "status_changed", None
+        )  # a controller's own state (a UR's protective stop, speed slider)
         if status is not None:
             status.connect(lambda text: self._call_soon(self._on_link_status, text))
         self.link = link
@@ -100,7 +102,13 @@ class Arm:
             # (A stale link, open but late, leaves a gap in the samples: the settle rule sees it.)
             self.observations.live_history.forget(time.monotonic())
             if self.state.motion is Motion.MOVING:
-                self._set_state(MotionState(Motion.UNKNOWN, self.state.what, f"the link went {state} during the move to {self.state.what}; waiting for a fresh joint sample"))
+                self._set_state(
+                    MotionState(
+                        Motion.UNKNOWN,
+                        self.state.what,
+                        f"the link went {state} during the move to {self.state.what}; waiting for a fresh joint sample",
+                    )
+                )
         self.link_state.emit(f"{state}: {why}")
 
     def _on_link_status(self, text: str) -> None:
@@ -131,7 +139,9 @@ class Arm:
             if pending is not None and not pending[1].finished:
                 self._set_state(MotionState(Motion.MOVING, pending[0], "the link is back"))
             else:
-                self._set_state(MotionState(Motion.IDLE, self.state.what, "the link is back: the robot stands where its joints say"))
+                self._set_state(
+                    MotionState(Motion.IDLE, self.state.what, "the link is back: the robot stands where its joints say")
+                )
         self.sample_received.emit(sample, q)
         if self.observations.replaying:
             return  # the recorded joints drive the views while a recording is replayed
@@ -154,7 +164,15 @@ class Arm:
 
     def preview(self, q, what: str, allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
         """The move from the current joints to ``q`` (deg/mm), checked; ``move_previewed`` shows it."""
-        preview = preview_move(self.robot, self.cell.collision_world(), self.joints_deg, q, what, self.cell.workcell.safety, allowed_contacts)
+        preview = preview_move(
+            self.robot,
+            self.cell.collision_world(),
+            self.joints_deg,
+            q,
+            what,
+            self.cell.workcell.safety,
+            allowed_contacts,
+        )
         self.move_previewed.emit(preview)
         return preview
 
@@ -163,14 +181,25 @@ class Arm:
         q = solve_ik(self.robot, target2base, self.joints_deg).q_deg
         return self.move_joints(q, what, **options)
 
-    def move_joints(self, q, what: str, *, wait: bool = False, timeout_s: float = 30.0, confirmed: bool | Confirmation = False, allowed_contacts: frozenset[str] = frozenset()) -> MoveHandle:
+    def move_joints(
+        self,
+        q,
+        what: str,
+        *,
+        wait: bool = False,
+        timeout_s: float = 30.0,
+        confirmed: bool | Confirmation = False,
+        allowed_contacts: frozenset[str] = frozenset(),
+    ) -> MoveHandle:
         """Move to model joints ``q`` (deg/mm) over the link; ``move_finished`` tells how it ended.
         The move is previewed first: refused (:class:`MoveRefused`) outside the limits or into a
         collision, and sent only with ``confirmed`` when it turns a joint further than the cell's
         ``confirm_joint_change_deg`` (:class:`MoveNeedsConfirmation`). ``confirmed``: ``True`` (a
         script's), or the prompt's :class:`Confirmation`, void once a Stop was sent after it."""
         if self.observations.replaying:
-            raise CalibrationError("a recording is being replayed: the views show it, not the robot; close the replay before moving the robot")
+            raise CalibrationError(
+                "a recording is being replayed: the views show it, not the robot; close the replay before moving the robot"
+            )
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
         robot = self.robot
@@ -183,15 +212,21 @@ class Arm:
                 f"[{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]"
             )
         if self.state.motion is Motion.UNKNOWN:
-            raise CalibrationError(f"not moving to {what}: the robot's pose is unknown (the link dropped); wait for a fresh joint sample")
+            raise CalibrationError(
+                f"not moving to {what}: the robot's pose is unknown (the link dropped); wait for a fresh joint sample"
+            )
         preview = self.preview(q, what, allowed_contacts)
         if preview.blocked:
             raise MoveRefused(preview)
         if preview.needs_confirmation:
             if not confirmed:
                 raise MoveNeedsConfirmation(preview, Confirmation(what, self.stops_sent))
-            if isinstance(confirmed, Confirmation) and (confirmed.stops_seen != self.stops_sent or confirmed.what != what):
-                raise CalibrationError(f"not moving to {what}: the robot was stopped after this move was asked for; ask for it again")
+            if isinstance(confirmed, Confirmation) and (
+                confirmed.stops_seen != self.stops_sent or confirmed.what != what
+            ):
+                raise CalibrationError(
+                    f"not moving to {what}: the robot was stopped after this move was asked for; ask for it again"
+                )
             self.event.emit("move_confirmed", {"what": what, "reasons": list(preview.confirm_reasons)})
         handle = self.link.move_joints(self.link.joint_map.to_controller(q), timeout_s=timeout_s)
         if not handle.sent:
@@ -223,5 +258,7 @@ class Arm:
             raise CalibrationError("no controller link: nothing to stop")
         sent = self.link.stop()
         self.event.emit("stop", {"sent": sent, "during": self.state.what if self.state.motion is Motion.MOVING else ""})
-        self.message.emit("stop sent to the controller" if sent else f"stop NOT sent: the link is {self.link.state.value}")
+        self.message.emit(
+            "stop sent to the controller" if sent else f"stop NOT sent: the link is {self.link.state.value}"
+        )
         return sent

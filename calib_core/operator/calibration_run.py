@@ -60,7 +60,9 @@ class CalibrationRun:
     @property
     def what(self) -> str:
         component = self.components[self.index] if self.index < len(self.plan) else None
-        return f"calibration pose {self.index + 1} of {len(self.plan)}" + (" (on the way, through home)" if component == VIA else f" ({component})" if component else "")
+        return f"calibration pose {self.index + 1} of {len(self.plan)}" + (
+            " (on the way, through home)" if component == VIA else f" ({component})" if component else ""
+        )
 
     def start(self) -> None:
         if not self.plan:
@@ -72,7 +74,10 @@ class CalibrationRun:
     def stop(self, why: str = "stopped by the operator") -> None:
         if self.phase in (DONE, STOPPED):
             return
-        self._end(STOPPED, f"calibration run stopped at pose {self.index + 1} of {len(self.plan)}: {why}; {len(self.capture.views)} views kept")
+        self._end(
+            STOPPED,
+            f"calibration run stopped at pose {self.index + 1} of {len(self.plan)}: {why}; {len(self.capture.views)} views kept",
+        )
 
     def _end(self, phase: str, text: str) -> None:
         self.phase = phase
@@ -87,7 +92,11 @@ class CalibrationRun:
 
     def _visit(self) -> None:
         if self.index >= len(self.plan):
-            self._end(DONE, f"calibration run done: {len(self.capture.views)} board views and {len(self.cell_frames)} of the surveyed components from {len(self.plan)} poses" + (f" ({len(self.skipped)} skipped)" if self.skipped else ""))
+            self._end(
+                DONE,
+                f"calibration run done: {len(self.capture.views)} board views and {len(self.cell_frames)} of the surveyed components from {len(self.plan)} poses"
+                + (f" ({len(self.skipped)} skipped)" if self.skipped else ""),
+            )
             return
         self.phase, self._tries = MOVING, 0
         try:

@@ -44,8 +44,17 @@ def cell_identity(workcell: Workcell, robot: RobotModel) -> CellIdentity:
     h = hashlib.sha256()
     h.update(robot.urdf_xml.encode())
     spec = workcell.robot_spec
-    roles = {role: robot.frame_placement(role).round(6).tolist() + [robot.roles[role]] for role in robot.roles if role != "base"}
-    h.update(json.dumps({"roles": roles, "base": robot.roles.get("base"), "held": spec.held_joints, "joints": robot.joint_names}, sort_keys=True).encode())
+    roles = {
+        role: robot.frame_placement(role).round(6).tolist() + [robot.roles[role]]
+        for role in robot.roles
+        if role != "base"
+    }
+    h.update(
+        json.dumps(
+            {"roles": roles, "base": robot.roles.get("base"), "held": spec.held_joints, "joints": robot.joint_names},
+            sort_keys=True,
+        ).encode()
+    )
     for item in workcell.components:
         h.update(item.name.encode())
         h.update(np.round(item.item2world, 6).tobytes())
@@ -84,9 +93,17 @@ class Cell:
         robot = workcell.load_robot()
         if intrinsics is None:
             if workcell.intrinsics_path is None:
-                raise VideocalError(f"{workcell.path}: the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)")
+                raise VideocalError(
+                    f"{workcell.path}: the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+                )
             intrinsics = load_intrinsics(workcell.intrinsics_path)
-        return cls(workcell, robot, intrinsics, JointMap.for_robot(robot.joint_names, workcell.robot_spec.controller), cell_identity(workcell, robot))
+        return cls(
+            workcell,
+            robot,
+            intrinsics,
+            JointMap.for_robot(robot.joint_names, workcell.robot_spec.controller),
+            cell_identity(workcell, robot),
+        )
 
     @classmethod
     def open(cls, path: str | Path = DEFAULT_WORKCELL, intrinsics: Intrinsics | None = None) -> Cell:
@@ -134,7 +151,10 @@ class Cell:
         """The robot's collision bodies and the cell's components with what is put up in it, built again
         only after the scene changed."""
         if self._collision is None or self._collision[0] != self.scene_version:
-            self._collision = (self.scene_version, CollisionWorld(self.robot, list(self.workcell.components) + list(self.extras), self.home_joints))
+            self._collision = (
+                self.scene_version,
+                CollisionWorld(self.robot, list(self.workcell.components) + list(self.extras), self.home_joints),
+            )
         return self._collision[1]
 
     def model_visuals(self) -> RobotVisuals:

@@ -20,7 +20,14 @@ from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.task_choice import TaskChoice
 from calib_core.scene import SceneItem
 from calib_core.workcell import TaskLocation
-from calib_core.workcell.edits import AddComponent, AddFeature, AddTaskLocation, PlaceComponent, check_name, load_component_mesh
+from calib_core.workcell.edits import (
+    AddComponent,
+    AddFeature,
+    AddTaskLocation,
+    PlaceComponent,
+    check_name,
+    load_component_mesh,
+)
 from calib_core.workcell.snapping import Snap, snap_point
 from calib_core.workcell.writer import save_workcell
 
@@ -40,27 +47,49 @@ class CellEditor:
         else:
             self.cell.scene_edited()
 
-    def add_task_location(self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None) -> TaskLocation:
+    def add_task_location(
+        self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None
+    ) -> TaskLocation:
         """A task location at ``tcp2base`` (4, 4) mm in base (default: the current TCP pose), for
         ``component`` (default: the current target). Undoable."""
-        task = TaskLocation(str(name).strip(), self.cell.robot.fk(self.arm.joints_deg, "tcp") if tcp2base is None else np.asarray(tcp2base, dtype=float), float(approach_mm), component or self.session.target)
+        task = TaskLocation(
+            str(name).strip(),
+            self.cell.robot.fk(self.arm.joints_deg, "tcp") if tcp2base is None else np.asarray(tcp2base, dtype=float),
+            float(approach_mm),
+            component or self.session.target,
+        )
         self.session.undo.push(AddTaskLocation(self.cell.workcell, task, self._edited))
         return task
 
-    def add_component(self, mesh_file, name: str, *, kind: str = "component", units: str = "mm", color=(0.7, 0.7, 0.7), item2world: np.ndarray | None = None) -> None:
+    def add_component(
+        self,
+        mesh_file,
+        name: str,
+        *,
+        kind: str = "component",
+        units: str = "mm",
+        color=(0.7, 0.7, 0.7),
+        item2world: np.ndarray | None = None,
+    ) -> None:
         """A component from a mesh file, placed at ``item2world`` (default: 1 m in front of the robot). Undoable."""
         name = check_name(name, "component")
         if kind not in ("component", "fixture"):
             raise OperatorError(f"a component's kind is 'component' or 'fixture', got {kind!r}")
         mesh = load_component_mesh(mesh_file, units)
-        placement = np.array(item2world, dtype=float) if item2world is not None else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+        placement = (
+            np.array(item2world, dtype=float)
+            if item2world is not None
+            else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+        )
         item = SceneItem(name, mesh, placement, tuple(float(c) for c in color), kind, {})
         self.session.undo.push(AddComponent(self.cell.workcell, item, mesh_file, units, self._edited))
 
     def place_component(self, name: str, xyz_mm, rpy_deg) -> None:
         """Place a component by numbers (its surveyed placement: mm, deg, in base). Successive
         placements of one component are one undo step."""
-        self.session.undo.push(PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._edited))
+        self.session.undo.push(
+            PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._edited)
+        )
 
     def snap_feature(self, component: str, point_component_mm, radius_mm: float) -> Snap:
         """Where a click on ``component`` defines a feature (circle centre, corner, vertex or the surface point)."""

@@ -76,9 +76,18 @@ class OperatorCore:
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the
         target): the autosave writes only when it moved."""
-        for signal in (self.session.pairs.changed, self.session.corrections.changed, self.session.undo.changed, self.session.changed, self.tasks.changed):
+        for signal in (
+            self.session.pairs.changed,
+            self.session.corrections.changed,
+            self.session.undo.changed,
+            self.session.changed,
+            self.tasks.changed,
+        ):
             signal.connect(self._count_change)
-        self.observations = Observations(JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names), margin_s=lambda: self.arm.controller_clock.spread_s)
+        self.observations = Observations(
+            JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names),
+            margin_s=lambda: self.arm.controller_clock.spread_s,
+        )
         """The frames (live, or a recording's while it is replayed), the held one, and the joint history
         that stamps them."""
         self.arm = Arm(cell, self.observations, call_soon=self._call_soon)
@@ -89,8 +98,12 @@ class OperatorCore:
         self.finder = PointFinding(cell, self.session, self.picking, self.log)
         self.moves = Moves(cell, self.session, self.tasks, self.arm)
         self.robot_calibration = RobotCalibrating(cell, self.session, self.arm, self.log)
-        self.tool = ToolMeasuring(cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log)
-        self.desk = CorrectionDesk(cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log)
+        self.tool = ToolMeasuring(
+            cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log
+        )
+        self.desk = CorrectionDesk(
+            cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log
+        )
         self.files = SessionFiles(cell, self.session, self.log)
         self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
@@ -166,7 +179,9 @@ class OperatorCore:
             self.site.attach(link)
         link.start()
         self.log.say(f"controller link: {url}")
-        if getattr(link, "publishes_transforms", False):  # declared by the connector (ROS 2: the results on /tf_static too)
+        if getattr(
+            link, "publishes_transforms", False
+        ):  # declared by the connector (ROS 2: the results on /tf_static too)
             for signal in (self.camera_model_changed, self.correction_stored):
                 signal.connect(self._publish_static_transforms, unique=True)
             self._publish_static_transforms()
@@ -249,7 +264,11 @@ class OperatorCore:
 
     def _judge(self, estimate) -> ResultVerdict:
         tolerance = self.task.tolerance_mm if self.task is not None else None
-        return judge(estimate, self.workcell.safety, tolerance) if tolerance is not None else judge(estimate, self.workcell.safety)
+        return (
+            judge(estimate, self.workcell.safety, tolerance)
+            if tolerance is not None
+            else judge(estimate, self.workcell.safety)
+        )
 
     def undo(self) -> str | None:
         """Undo the last edit (its label, None if there was none); the pair being made is let go."""
@@ -291,7 +310,9 @@ class OperatorCore:
     def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
         """Use calibrated intrinsics for picking, solving and the virtual camera (the size must match)."""
         if (intrinsics.width, intrinsics.height) != (self.intrinsics.width, self.intrinsics.height):
-            raise CalibrationError(f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px")
+            raise CalibrationError(
+                f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px"
+            )
         self.cell.use_intrinsics(intrinsics)
         self.log.say(why)
 
@@ -355,12 +376,16 @@ class OperatorCore:
             self._tap.detach()
             rec.close()
             if rec.failure is not None:
-                self.log.say(f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal recover` completes it")
+                self.log.say(
+                    f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal recover` completes it"
+                )
             elif not rec.finished:
                 self.log.say(f"recording {rec.path}: the file is being finished in the background")
             else:
                 dropped = f", {rec.frames_dropped} frames dropped" if rec.frames_dropped else ""
-                self.log.say(f"recording {rec.path} closed ({rec.messages} messages, {rec.frames_written} frames{dropped})")
+                self.log.say(
+                    f"recording {rec.path} closed ({rec.messages} messages, {rec.frames_written} frames{dropped})"
+                )
         self.recorder, self._tap = None, None
 
     def close(self) -> None:

@@ -31,8 +31,25 @@ class CorrectionDesk:
 
     correction_stored = Signal(object)
 
-    def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, arm: Arm, picking: Picking, robot_calibration: RobotCalibrating, log: OperatorLog):
-        self.cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log = cell, session, tasks, arm, picking, robot_calibration, log
+    def __init__(
+        self,
+        cell: Cell,
+        session: CalibrationSession,
+        tasks: TaskChoice,
+        arm: Arm,
+        picking: Picking,
+        robot_calibration: RobotCalibrating,
+        log: OperatorLog,
+    ):
+        self.cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log = (
+            cell,
+            session,
+            tasks,
+            arm,
+            picking,
+            robot_calibration,
+            log,
+        )
 
     @property
     def task(self):
@@ -64,7 +81,9 @@ class CorrectionDesk:
             raise CalibrationError(f"the result is from an earlier state ({self.session.stale_reason}); nothing stored")
         place = self.look_place()
         if place is None:
-            raise CalibrationError("the look carries no robot pose: pick the image points again on a frame of this pose, then Calibrate")
+            raise CalibrationError(
+                "the look carries no robot pose: pick the image points again on a frame of this pose, then Calibrate"
+            )
         if not place.counts and not convert.strip():
             raise LookNotAtTask(place, *self._conversion_change())
         tool, context = self.robot_calibration.measured_tool, self.session.context
@@ -74,14 +93,29 @@ class CorrectionDesk:
         source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
         if source:
             source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source
-        c = self.session.store_correction(self.task.name, source, confirmation=confirmation, fused=self.robot_calibration.look_fused_with_robot(self.session.result),
-                                          tool_covariance=tool_covariance)
+        c = self.session.store_correction(
+            self.task.name,
+            source,
+            confirmation=confirmation,
+            fused=self.robot_calibration.look_fused_with_robot(self.session.result),
+            tool_covariance=tool_covariance,
+        )
         if not place.counts:
-            self.log.record("look_converted", task=c.task, at=place.at, offset_mm=place.offset_mm, offset_deg=place.offset_deg, source=place.source, conversion=convert.strip())
+            self.log.record(
+                "look_converted",
+                task=c.task,
+                at=place.at,
+                offset_mm=place.offset_mm,
+                offset_deg=place.offset_deg,
+                source=place.source,
+                conversion=convert.strip(),
+            )
         if c.confirmation:
             self.log.record("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)
-        self.log.say(f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg")
+        self.log.say(
+            f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg"
+        )
         return c
 
     def store_measurement(self):
@@ -100,7 +134,9 @@ class CorrectionDesk:
         """How far the target commanded for the task would move (mm, deg) if the last result became its correction."""
         r, task = self.session.result, self.task
         now = self.session.corrections.corrected_target(task.name, task.tcp2base)
-        delta = concat(invert(r.tcp2base_model), r.tcp2base_measured)  # tcp_real = delta @ tcp_model, as a stored correction's
+        delta = concat(
+            invert(r.tcp2base_model), r.tcp2base_measured
+        )  # tcp_real = delta @ tcp_model, as a stored correction's
         converted = concat(task.tcp2base, invert(delta))
         d, rot = pose_difference(converted, now)
         return float(np.linalg.norm(d)), float(np.linalg.norm(rot))
@@ -118,14 +154,32 @@ class CorrectionDesk:
         executed = f"{task.name} (task, corrected)"
         motion = self.arm.state
         if motion.motion is not Motion.ARRIVED or motion.what != executed:
-            raise CalibrationError(f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({motion.text})")
+            raise CalibrationError(
+                f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({motion.text})"
+            )
         use = self.session.pairs.usable()
-        here = [p for p in use if p.view is not None and np.max(np.abs(np.array(p.view.joints_deg) - self.arm.joints_deg)) <= SAME_STATE_DEG]
+        here = [
+            p
+            for p in use
+            if p.view is not None
+            and np.max(np.abs(np.array(p.view.joints_deg) - self.arm.joints_deg)) <= SAME_STATE_DEG
+        ]
         if len(here) != len(use) or not use:
-            raise CalibrationError("the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify")
+            raise CalibrationError(
+                "the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify"
+            )
         look = self.picking.calibrate()
         v = verify(task.name, task.tcp2base, correction, look, task.tolerance_mm)
         self.session.corrections.add_verification(v)
-        self.log.record("verified", task=task.name, remaining_mm=v.remaining_mm.tolist(), std_remaining_mm=v.std_remaining_mm.tolist(), disagreement_mm=v.disagreement_mm, agree=v.agree, within_tolerance=v.within_tolerance, tolerance_mm=v.tolerance_mm)
+        self.log.record(
+            "verified",
+            task=task.name,
+            remaining_mm=v.remaining_mm.tolist(),
+            std_remaining_mm=v.std_remaining_mm.tolist(),
+            disagreement_mm=v.disagreement_mm,
+            agree=v.agree,
+            within_tolerance=v.within_tolerance,
+            tolerance_mm=v.tolerance_mm,
+        )
         self.log.say(v.text)
         return v

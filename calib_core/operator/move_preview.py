@@ -62,7 +62,11 @@ class MovePreview:
         """One line: the joint change, then what refuses, needs a confirmation or is worth knowing."""
         j = int(np.argmax(np.abs(self.joint_change_deg))) if len(self.joint_change_deg) else 0
         name = self.joint_names[j] if j < len(self.joint_names) else f"joint {j + 1}"
-        head = f"{self.what}: joints turn up to {abs(self.joint_change_deg[j]):.1f} ({name})" if len(self.joint_change_deg) else self.what
+        head = (
+            f"{self.what}: joints turn up to {abs(self.joint_change_deg[j]):.1f} ({name})"
+            if len(self.joint_change_deg)
+            else self.what
+        )
         parts = [head, *self.problems, *self.confirm_reasons, *self.warnings]
         if not self.problems and not self.contacts:
             parts.append("no collision along the path")
@@ -111,8 +115,15 @@ def scaled_min_singular(robot: RobotModel, q_deg) -> float:
     return float(np.linalg.svd(scaled, compute_uv=False)[-1])
 
 
-def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goal_deg, what: str, limits: SafetyLimits | None = None,
-                 allowed_contacts: frozenset[str] = frozenset()) -> MovePreview:
+def preview_move(
+    robot: RobotModel,
+    world: CollisionWorld | None,
+    start_deg,
+    goal_deg,
+    what: str,
+    limits: SafetyLimits | None = None,
+    allowed_contacts: frozenset[str] = frozenset(),
+) -> MovePreview:
     """Check the move from ``start_deg`` to ``goal_deg`` (deg/mm). ``allowed_contacts``: cell
     components the move may touch (the task's object when going to the task pose itself): said,
     not refused."""
@@ -123,20 +134,31 @@ def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goa
     margin = np.min(np.minimum(path - lower, upper - path), axis=0)
     problems, warnings, confirm = [], [], []
     for j in np.flatnonzero(margin < 0):
-        problems.append(f"joint {robot.joint_names[j]} would go {-margin[j]:.2f} {robot.joint_units[j]} beyond its limits [{lower[j]:g}, {upper[j]:g}]")
+        problems.append(
+            f"joint {robot.joint_names[j]} would go {-margin[j]:.2f} {robot.joint_units[j]} beyond its limits [{lower[j]:g}, {upper[j]:g}]"
+        )
     singular = np.array([scaled_min_singular(robot, q) for q in path])
     near = np.flatnonzero(singular < limits.singularity_margin)
     k_sing = int(near[0]) if len(near) else int(np.argmin(singular))  # where it first comes near
     if len(near):
-        where = "at the goal" if k_sing == len(path) - 1 else ("from the start" if k_sing == 0 else f"{100 * k_sing / (len(path) - 1):.0f} % along the path")
-        warnings.append(f"near a singularity {where} (smallest singular value {singular.min():.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot")
+        where = (
+            "at the goal"
+            if k_sing == len(path) - 1
+            else ("from the start" if k_sing == 0 else f"{100 * k_sing / (len(path) - 1):.0f} % along the path")
+        )
+        warnings.append(
+            f"near a singularity {where} (smallest singular value {singular.min():.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot"
+        )
     contact_step, contacts = None, []
     if world is not None:
         # Contacts the robot is in already (the tool at its task, on its object) are how it leaves them,
         # not collisions of the move: said, not refused. A new contact along the path is.
         at_start = set(world.check(path[0]))
         if at_start:
-            warnings.append("leaves its contact with " + ", ".join(sorted({c.b[5:] if c.b.startswith("cell/") else c.b for c in at_start})))
+            warnings.append(
+                "leaves its contact with "
+                + ", ".join(sorted({c.b[5:] if c.b.startswith("cell/") else c.b for c in at_start}))
+            )
         for k, q in enumerate(path[1:], start=1):
             hits = [c for c in world.check(q) if c not in at_start]
             if hits:
@@ -145,13 +167,41 @@ def preview_move(robot: RobotModel, world: CollisionWorld | None, start_deg, goa
         touching = [c for c in contacts if c.b.startswith("cell/") and c.b[5:] in allowed_contacts]
         blocking = [c for c in contacts if c not in touching]
         if blocking:
-            where = "at the start" if contact_step == 0 else f"{100 * contact_step / max(len(path) - 1, 1):.0f} % along the path"
-            problems.append(f"collision {where}: " + ", ".join(c.text for c in blocking[:4]) + (f" and {len(blocking) - 4} more" if len(blocking) > 4 else ""))
+            where = (
+                "at the start"
+                if contact_step == 0
+                else f"{100 * contact_step / max(len(path) - 1, 1):.0f} % along the path"
+            )
+            problems.append(
+                f"collision {where}: "
+                + ", ".join(c.text for c in blocking[:4])
+                + (f" and {len(blocking) - 4} more" if len(blocking) > 4 else "")
+            )
         elif touching:
             warnings.append("touches " + ", ".join(sorted({c.b[5:] for c in touching})) + ", the task's object")
     change = goal - start
     big = np.flatnonzero(np.abs(change) > limits.confirm_joint_change_deg)
     if len(big):
-        confirm.append("large joint change: " + ", ".join(f"{robot.joint_names[j]} {change[j]:+.1f} {robot.joint_units[j]}" for j in big) + f" (over {limits.confirm_joint_change_deg:g})")
+        confirm.append(
+            "large joint change: "
+            + ", ".join(f"{robot.joint_names[j]} {change[j]:+.1f} {robot.joint_units[j]}" for j in big)
+            + f" (over {limits.confirm_joint_change_deg:g})"
+        )
     tcp = np.array([robot.fk(q, "tcp")[:3, 3] for q in path])
-    return MovePreview(what, start, goal, path, change, margin, float(singular.min()), k_sing, contact_step, contacts, tuple(problems), tuple(warnings), tuple(confirm), tcp, tuple(robot.joint_names))
+    return MovePreview(
+        what,
+        start,
+        goal,
+        path,
+        change,
+        margin,
+        float(singular.min()),
+        k_sing,
+        contact_step,
+        contacts,
+        tuple(problems),
+        tuple(warnings),
+        tuple(confirm),
+        tcp,
+        tuple(robot.joint_names),
+    )

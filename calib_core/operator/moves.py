@@ -55,7 +55,14 @@ class Moves:
     def stop_robot(self) -> bool:
         return self.arm.stop()
 
-    def go_to_task(self, *, approach: bool = True, corrected: bool = False, wait: bool = False, confirmed: bool | Confirmation = False) -> MoveHandle:
+    def go_to_task(
+        self,
+        *,
+        approach: bool = True,
+        corrected: bool = False,
+        wait: bool = False,
+        confirmed: bool | Confirmation = False,
+    ) -> MoveHandle:
         """Move to the task location's approach (or the task pose itself), as planned or ``corrected``
         by its stored correction."""
         if self.task is None:
@@ -79,6 +86,10 @@ class Moves:
         start = np.array(self.arm.joints_deg, dtype=float)
         goal = solve_ik(robot, self.task.approach2base, start).q_deg
         margin = np.minimum(goal - robot.lower_limits_deg, robot.upper_limits_deg - goal)
-        near = [f"joint {robot.joint_names[i]} within {m:.1f} {robot.joint_units[i]} of its limit" for i, m in enumerate(margin) if m < NEAR_LIMIT_DEG]
+        near = [
+            f"joint {robot.joint_names[i]} within {m:.1f} {robot.joint_units[i]} of its limit"
+            for i, m in enumerate(margin)
+            if m < NEAR_LIMIT_DEG
+        ]
         text = "; ".join(near) if near else f"path to {self.task.name}: joints within limits"
         return SimulatedPath(start + (goal - start) * (np.arange(steps + 1)[:, None] / steps), text)

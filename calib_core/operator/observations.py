@@ -130,7 +130,14 @@ class Observations:
             captured_at = (datetime.now(timezone.utc) - timedelta(seconds=age_s)).isoformat(timespec="milliseconds")
         else:
             captured_at = f"{frame.t_host_s:.3f} s into {self.source}"
-        return ViewStamp(int(frame.index), float(frame.t_host_s), tuple(float(v) for v in at.joints_deg), float(at.stamp_gap_s), captured_at, self.source)
+        return ViewStamp(
+            int(frame.index),
+            float(frame.t_host_s),
+            tuple(float(v) for v in at.joints_deg),
+            float(at.stamp_gap_s),
+            captured_at,
+            self.source,
+        )
 
     def newest_usable(self) -> Frame | None:
         """The newest frame whose joint samples have arrived: the joint stream lags the frames by up to a sample

@@ -61,8 +61,14 @@ class Picking:
         self.check_same_state(use)
         joints = np.array(use[0].view.joints_deg) if use else self.arm.joints_deg
         self.current_pair = None
-        result = self.session.calibrate(self.cell.intrinsics, obj2world, self.cell.robot.fk(joints, "camera"), self.cell.robot.fk(joints, "tcp"), joints,
-                                        form_tolerance_mm=item.form_tolerance_mm)
+        result = self.session.calibrate(
+            self.cell.intrinsics,
+            obj2world,
+            self.cell.robot.fk(joints, "camera"),
+            self.cell.robot.fk(joints, "tcp"),
+            joints,
+            form_tolerance_mm=item.form_tolerance_mm,
+        )
         self.solved.emit()
         return result
 
@@ -85,7 +91,9 @@ class Picking:
         held frame."""
         session = self.session
         pending = session.pairs.pending()
-        moving = pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
+        moving = (
+            pending is None and self.current_pair is not None and self.current_pair in [p.number for p in session.pairs]
+        )
         if pending is None and not moving:
             session.pick_2d(pixel)  # raises with what to do instead
         view = self._view_for_pick(self.current_pair if moving else pending.number)
@@ -107,7 +115,9 @@ class Picking:
         view = pair.view
         held = self.observations.still
         if view is not None and held is not None and not held.stamp.same_state(view):
-            raise CalibrationError(f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move its point")
+            raise CalibrationError(
+                f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move its point"
+            )
         shown = held.frame if held is not None else self.observations.latest
         if refine and shown is not None:
             pixel = refine_corner_pick(shown.image, pixel)
@@ -121,7 +131,9 @@ class Picking:
         joints = np.asarray(held.stamp.joints_deg if held is not None else self.arm.joints_deg, dtype=float)
         obj2world = self.cell.workcell.component(self.session.target).item2world
         obj2cam = concat(obj2world, invert(self.cell.robot.fk(joints, "camera")))
-        done = [p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)]
+        done = [
+            p for p in self.session.pairs.usable() if held is None or p.view is None or p.view.same_state(held.stamp)
+        ]
         if len(done) >= 3:
             from calib_core.solver import solve_pose
             from calib_core.solver.errors import SolverInputError
@@ -145,7 +157,9 @@ class Picking:
             return None
         obj2cam, basis = self._pick_pose()
         obj2world = self.cell.workcell.component(self.session.target).item2world
-        uv = project_points(apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.cell.intrinsics)[0]
+        uv = project_points(
+            apply(invert(obj2world), np.array(pending.point_world_mm)[None]), obj2cam, self.cell.intrinsics
+        )[0]
         return (uv, basis) if np.all(np.isfinite(uv)) else None
 
     def refine_pick(self, image, pixel) -> tuple[float, float]:
@@ -212,7 +226,12 @@ class Picking:
     def hold_frame(self) -> HeldFrame:
         """Hold the newest frame for picking (refused while the robot moves); ``still_changed``."""
         held = self.observations.hold()
-        self.log.record("frame_held", frame_index=held.stamp.frame_index, t_capture_s=held.stamp.t_capture_s, joints_deg=list(held.stamp.joints_deg))
+        self.log.record(
+            "frame_held",
+            frame_index=held.stamp.frame_index,
+            t_capture_s=held.stamp.t_capture_s,
+            joints_deg=list(held.stamp.joints_deg),
+        )
         return held
 
     def frame_to_capture(self) -> tuple:
@@ -225,7 +244,9 @@ class Picking:
             raise OperatorError("no camera frame yet: start the camera (Execute > Live) or open a recording")
         sent_s = self.arm.last_move_sent_s
         if not self.replaying and sent_s is not None and frame.t_host_s <= sent_s:
-            raise NotSettledError(f"frame {frame.index} was taken before the last move ({self.arm.state.what}) was sent: wait for a frame from where the robot stands now")
+            raise NotSettledError(
+                f"frame {frame.index} was taken before the last move ({self.arm.state.what}) was sent: wait for a frame from where the robot stands now"
+            )
         has_robot = self.replaying or self.arm.link is not None
         return frame, (self.observations.stamp(frame) if has_robot else None)
 
@@ -254,9 +275,13 @@ class Picking:
         """*Accept*: the pair being made is done. Returns its number."""
         pending = self.session.pairs.pending()
         if pending is not None:
-            raise OperatorError(f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept")
+            raise OperatorError(
+                f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept"
+            )
         if self.current_pair is None:
-            raise OperatorError("nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image")
+            raise OperatorError(
+                "nothing to accept: pick a point on the model (virtual camera), then the same point on the camera image"
+            )
         number, self.current_pair = self.current_pair, None
         self.log.record("pair_accepted", number=number)
         return number

@@ -61,10 +61,18 @@ class PointFinding:
         obj2cam_model = concat(item.item2world, invert(self.cell.robot.fk(q, "camera")))
         from calib_core.vision.find_points import find_points
 
-        result = find_points(held.frame.image, self.cell.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item))
+        result = find_points(
+            held.frame.image, self.cell.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item)
+        )
         self.found = FoundOnFrame(result, held.stamp)
-        self.log.record("points_found", component=target, found=result.found, proposed=[p.feature for p in result.proposals],
-                          missed={m.feature: m.reason for m in result.missed}, seconds=round(result.seconds, 3))
+        self.log.record(
+            "points_found",
+            component=target,
+            found=result.found,
+            proposed=[p.feature for p in result.proposals],
+            missed={m.feature: m.reason for m in result.missed},
+            seconds=round(result.seconds, 3),
+        )
         self.points_found.emit(self.found)
         self.log.say(result.message)
         return self.found
@@ -83,7 +91,13 @@ class PointFinding:
             if self._model_view is not None:
                 self._model_view.close()
             self._model_view = ModelView(self.cell.intrinsics)
-        return self._model_view.of_cell(self.cell.workcell.components, self.cell.model_visuals(), q_deg, item.item2world, extras=list(self.cell.extras))
+        return self._model_view.of_cell(
+            self.cell.workcell.components,
+            self.cell.model_visuals(),
+            q_deg,
+            item.item2world,
+            extras=list(self.cell.extras),
+        )
 
     def calibrate_on_edges(self):
         """*Calibrate on edges*: the pose the last Find points' edge refinement found (the target's
@@ -93,7 +107,9 @@ class PointFinding:
         if found is None or found.result.edges is None:
             raise OperatorError("Find points (F6) first: the edges are fitted on its frame")
         if not found.result.edges.settled:
-            raise OperatorError(f"the target's edges did not settle on this frame (RMS {found.result.edges.rms_px:.2f} px): pick the points by hand")
+            raise OperatorError(
+                f"the target's edges did not settle on this frame (RMS {found.result.edges.rms_px:.2f} px): pick the points by hand"
+            )
         from calib_core.solver.solve_inputs import solve_inputs
         from calib_core.vision.edge_solution import edge_solution
 
@@ -101,14 +117,29 @@ class PointFinding:
         item = self.cell.workcell.component(found.result.component)
         q = np.asarray(found.view.joints_deg, dtype=float)
         cam2world_model = self.cell.robot.fk(q, "camera")
-        inputs = solve_inputs(np.zeros((0, 3)), np.zeros((0, 2)), self.cell.intrinsics, prior=concat(item.item2world, invert(cam2world_model)))
+        inputs = solve_inputs(
+            np.zeros((0, 3)),
+            np.zeros((0, 2)),
+            self.cell.intrinsics,
+            prior=concat(item.item2world, invert(cam2world_model)),
+        )
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.session.last_solve_inputs = inputs
         self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
-        estimate = self.session.show_result(solution, item.item2world, cam2world_model, self.cell.robot.fk(q, "tcp"), q, [], points_obj_mm=features, intrinsics=self.cell.intrinsics,
-                                          view_sources=(found.view.source,), label="Calibrate on edges",
-                                          form_tolerance_mm=item.form_tolerance_mm)
+        estimate = self.session.show_result(
+            solution,
+            item.item2world,
+            cam2world_model,
+            self.cell.robot.fk(q, "tcp"),
+            q,
+            [],
+            points_obj_mm=features,
+            intrinsics=self.cell.intrinsics,
+            view_sources=(found.view.source,),
+            label="Calibrate on edges",
+            form_tolerance_mm=item.form_tolerance_mm,
+        )
         self.solved.emit()
         return estimate
 
@@ -121,7 +152,9 @@ class PointFinding:
         session = self.session
         pending = session.pairs.pending()
         if pending is not None:
-            raise OperatorError(f"pair {pending.number} still waits for its point on the camera image: click it there, or delete it, then accept")
+            raise OperatorError(
+                f"pair {pending.number} still waits for its point on the camera image: click it there, or delete it, then accept"
+            )
         chosen = [p for p in found.result.proposals if features is None or p.feature in features]
         unknown = set(features or ()) - {p.feature for p in found.result.proposals}
         if unknown:
@@ -129,7 +162,9 @@ class PointFinding:
         paired = {p.feature for p in session.pairs if p.component == found.result.component and p.feature}
         fresh = [p for p in chosen if p.feature not in paired]
         if not fresh:
-            raise OperatorError(f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})")
+            raise OperatorError(
+                f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})"
+            )
         self.picking.check_same_state([p for p in session.pairs if p.complete], found.view)
         item = self.cell.workcell.component(found.result.component)
         spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]

@@ -17,7 +17,13 @@ from calib_core.calibration.correspondences import pair_to_dict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.frames import concat, invert
 from calib_core.recording import foxglove_messages as fm
-from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, FOUND_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC
+from calib_core.recording.schemas import (
+    ANNOTATIONS_TOPIC,
+    CALIBRATION_TOPIC,
+    FOUND_TOPIC,
+    SCENE_TOPIC,
+    TRANSFORMS_TOPIC,
+)
 
 
 TF_CHANGE_DEG = 1e-3
@@ -35,8 +41,12 @@ class RecordingTap:
         recorder.camera_frame = self.camera_frame
         core.recorder = recorder
         recorder.record_setup(
-            workcell=str(core.workcell.path), cell=core.cell.identity.to_dict(), intrinsics=core.intrinsics.to_dict(),
-            target=core.session.target, task=None if core.task is None else core.task.name, joint_names=core.robot.joint_names,
+            workcell=str(core.workcell.path),
+            cell=core.cell.identity.to_dict(),
+            intrinsics=core.intrinsics.to_dict(),
+            target=core.session.target,
+            task=None if core.task is None else core.task.name,
+            joint_names=core.robot.joint_names,
         )
         self._last_frame_s: float | None = None
         self._tf_sent: tuple[float, np.ndarray] | None = None
@@ -80,9 +90,13 @@ class RecordingTap:
         for g, mesh, visual2base in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q)):
             link = core.robot.model.frames[g.parentFrame].name
             color = tuple(float(c) for c in np.asarray(g.meshColor)[:3])
-            entities.append(fm.mesh_entity(f"robot/{g.name}", link, mesh, concat(visual2base, invert(links[link])), color, t_ns))
+            entities.append(
+                fm.mesh_entity(f"robot/{g.name}", link, mesh, concat(visual2base, invert(links[link])), color, t_ns)
+            )
         for item in core.workcell.components:
-            entities.append(fm.mesh_entity(f"cell/{item.name}", fm.WORLD_FRAME, item.mesh, item.item2world, item.color, t_ns))
+            entities.append(
+                fm.mesh_entity(f"cell/{item.name}", fm.WORLD_FRAME, item.mesh, item.item2world, item.color, t_ns)
+            )
             if item.features:
                 points = {name: (item.item2world @ np.append(p, 1.0))[:3] for name, p in item.features.items()}
                 entities.append(fm.feature_entity(f"features/{item.name}", points, t_ns))
@@ -102,7 +116,11 @@ class RecordingTap:
         # transform; the repeat is what a seek finds): most of a calibration the robot is still.
         if last is None or np.max(np.abs(q - last[1])) > TF_CHANGE_DEG or sample.t_host_s - last[0] >= TF_REPEAT_S:
             self._tf_sent = (sample.t_host_s, q)
-            rec.record_message(TRANSFORMS_TOPIC, fm.frame_transforms(self.core.robot.frame_tree(q), rec.unix_ns(sample.t_host_s)), sample.t_host_s)
+            rec.record_message(
+                TRANSFORMS_TOPIC,
+                fm.frame_transforms(self.core.robot.frame_tree(q), rec.unix_ns(sample.t_host_s)),
+                sample.t_host_s,
+            )
 
     def _event(self, kind: str, detail: dict) -> None:
         self.recorder.record_event(kind, **detail)
@@ -110,8 +128,11 @@ class RecordingTap:
     def _solved(self) -> None:
         core, result = self.core, self.core.session.result
         context = {
-            "obj2world": core.workcell.component(core.session.target).item2world, "cam2world_model": result.cam2world_model,
-            "tcp2base_model": result.tcp2base_model, "joints_deg": core.joints_deg, "target": core.session.target,
+            "obj2world": core.workcell.component(core.session.target).item2world,
+            "cam2world_model": result.cam2world_model,
+            "tcp2base_model": result.tcp2base_model,
+            "joints_deg": core.joints_deg,
+            "target": core.session.target,
         }
         inputs = core.session.last_solve_inputs
         self.recorder.record_solve(inputs, result.solution.to_dict(), context=context)
@@ -124,11 +145,21 @@ class RecordingTap:
         self._annotate()
 
     def _correction(self, c) -> None:
-        self.recorder.record_correction({
-            "task": c.task, "displacement_mm": c.displacement_mm, "rotation_deg": c.rotation_deg, "std_displacement_mm": c.std_displacement_mm,
-            "std_rotation_deg": c.std_rotation_deg, "joints_deg": c.joints_deg, "rms_px": c.rms_px, "pairs": c.pairs,
-            "verdict": c.verdict, "confirmation": c.confirmation, "time_s": c.time_s,
-        })
+        self.recorder.record_correction(
+            {
+                "task": c.task,
+                "displacement_mm": c.displacement_mm,
+                "rotation_deg": c.rotation_deg,
+                "std_displacement_mm": c.std_displacement_mm,
+                "std_rotation_deg": c.std_rotation_deg,
+                "joints_deg": c.joints_deg,
+                "rms_px": c.rms_px,
+                "pairs": c.pairs,
+                "verdict": c.verdict,
+                "confirmation": c.confirmation,
+                "time_s": c.time_s,
+            }
+        )
 
     def _pairs(self, event: str, number) -> None:
         pairs = self.core.session.pairs
@@ -147,7 +178,10 @@ class RecordingTap:
             return  # the proposals withdrawn from the view: the recording keeps them
         t_ns = self.recorder.unix_ns(found.view.t_capture_s)
         edges = found.result.edges.edges_px if found.result.edges is not None and found.result.edges.settled else None
-        self.recorder.record_message(FOUND_TOPIC, fm.found_points_annotations([(p.feature, p.uv_px) for p in found.result.proposals], t_ns, edges))
+        self.recorder.record_message(
+            FOUND_TOPIC,
+            fm.found_points_annotations([(p.feature, p.uv_px) for p in found.result.proposals], t_ns, edges),
+        )
 
     def _annotate(self) -> None:
         """The picks (numbered as in the window's table) and the last solve's reprojections, on the
@@ -156,7 +190,13 @@ class RecordingTap:
         picks = [(p.number, p.pixel) for p in core.session.pairs if p.pixel is not None]
         views = [p.view for p in core.session.pairs if p.pixel is not None and p.view is not None]
         q = np.asarray(core.joints_deg, float)
-        stale = [p.number for p in core.session.pairs if p.pixel is not None and p.view is not None and np.max(np.abs(np.asarray(p.view.joints_deg) - q)) > SAME_STATE_DEG]
+        stale = [
+            p.number
+            for p in core.session.pairs
+            if p.pixel is not None
+            and p.view is not None
+            and np.max(np.abs(np.asarray(p.view.joints_deg) - q)) > SAME_STATE_DEG
+        ]
         t_s = max((v.t_capture_s for v in views), default=self._last_frame_s)
         t_ns = rec.unix_ns(t_s)
         rec.record_message(ANNOTATIONS_TOPIC, fm.image_annotations(picks, t_ns, self._reprojected, stale))

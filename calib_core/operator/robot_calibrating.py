@@ -48,7 +48,16 @@ class RobotCalibrating:
 
         world = self.cell.collision_world()
         start = np.asarray(self.arm.joints_deg, dtype=float)
-        plan = plan_poses(self.cell.robot, self.cell.intrinsics, spec, board_in_cell(spec, self.cell.workcell, self.cell.robot), n, start_deg=start, collisions=world, candidates=max(60, 3 * n))
+        plan = plan_poses(
+            self.cell.robot,
+            self.cell.intrinsics,
+            spec,
+            board_in_cell(spec, self.cell.workcell, self.cell.robot),
+            n,
+            start_deg=start,
+            collisions=world,
+            candidates=max(60, 3 * n),
+        )
         kept, q = [], start
         for goal in plan.joints_deg:
             if not any(world.check(p) for p in joint_path(q, goal)):
@@ -62,13 +71,21 @@ class RobotCalibrating:
         def free(a, b):
             return not any(world.check(p) for p in joint_path(a, b))
 
-        for component, goal in cell_view_joints(self.cell.robot, self.cell.workcell, self.cell.intrinsics, cell_views_per_target, collisions=world) if cell_views_per_target else []:
+        for component, goal in (
+            cell_view_joints(
+                self.cell.robot, self.cell.workcell, self.cell.intrinsics, cell_views_per_target, collisions=world
+            )
+            if cell_views_per_target
+            else []
+        ):
             if free(q, goal):
                 cell.append((component, goal))
             elif free(q, home) and free(home, goal):  # round the cell's obstacles through home
                 cell += [(VIA, home), (component, goal)]
             else:
-                rejected["a component's view with no collision-free path"] = rejected.get("a component's view with no collision-free path", 0) + 1
+                rejected["a component's view with no collision-free path"] = (
+                    rejected.get("a component's view with no collision-free path", 0) + 1
+                )
                 continue
             q = goal
         return PosePlan(kept, plan.candidates, rejected, plan.log_det, cell)
@@ -95,10 +112,25 @@ class RobotCalibrating:
             raise OperatorError(f"{len(posed)} views with a robot pose, at least 6 needed (run the calibration plan)")
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
-        done = identify_robot(self.cell.robot, self.cell.intrinsics, self.cell.workcell, views, cell_frames, visuals=self.cell.model_visuals(), extras=self.cell.extras,
-                              with_intrinsics=with_intrinsics, progress=progress)
+        done = identify_robot(
+            self.cell.robot,
+            self.cell.intrinsics,
+            self.cell.workcell,
+            views,
+            cell_frames,
+            visuals=self.cell.model_visuals(),
+            extras=self.cell.extras,
+            with_intrinsics=with_intrinsics,
+            progress=progress,
+        )
         result = done.result
-        self.log.record("robot_calibrated", views=done.board_views, component_views=done.cell_views, rms_px=result.rms_px, identified=len(result.observability.identified))
+        self.log.record(
+            "robot_calibrated",
+            views=done.board_views,
+            component_views=done.cell_views,
+            rms_px=result.rms_px,
+            identified=len(result.observability.identified),
+        )
         return result
 
     def apply_robot_calibration(self, result) -> None:
@@ -117,7 +149,9 @@ class RobotCalibrating:
             self.cell.use_intrinsics(result.intrinsics)
         self.log.record("robot_calibration_applied", rms_px=result.rms_px)
         self.cell.robot_edited()
-        self.log.say(f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)")
+        self.log.say(
+            f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)"
+        )
 
     def look_fused_with_robot(self, look):
         """The look (an :class:`~calib_core.calibration.end_effector.EndEffectorEstimate` at its
@@ -134,7 +168,9 @@ class RobotCalibrating:
 
         q = context.joints_deg
         cam2base = self.cell.robot.fk(q, "camera")
-        model = tcp_covariance_from_camera(pose_covariance(result, q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base)))
+        model = tcp_covariance_from_camera(
+            pose_covariance(result, q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base))
+        )
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
         tool = self.measured_tool
         tool_covariance = tool.covariance_in_base(cam2base) if tool is not None else None
@@ -146,7 +182,11 @@ class RobotCalibrating:
     def keep_robot_before_calibration(self) -> None:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
         if self._robot_before_calibration is None:
-            self._robot_before_calibration = ([_to_mm(p) for p in self.cell.robot.model.jointPlacements], self.cell.robot.frame_placement("camera"), self.cell.robot.frame_placement("tcp"))
+            self._robot_before_calibration = (
+                [_to_mm(p) for p in self.cell.robot.model.jointPlacements],
+                self.cell.robot.frame_placement("camera"),
+                self.cell.robot.frame_placement("tcp"),
+            )
 
     @property
     def can_revert(self) -> bool:

@@ -37,7 +37,15 @@ class SessionFiles:
     def workspace(self):
         from calib_core.workspace.workspace import Workspace
 
-        return Workspace(str(self.cell.workcell.path), self.cell.intrinsics, dict(self.cell.workcell.task_locations), self.session.target, self.session.pairs.pairs(), self.session.corrections, cell=self.cell.identity.to_dict())
+        return Workspace(
+            str(self.cell.workcell.path),
+            self.cell.intrinsics,
+            dict(self.cell.workcell.task_locations),
+            self.session.target,
+            self.session.pairs.pairs(),
+            self.session.corrections,
+            cell=self.cell.identity.to_dict(),
+        )
 
     def save_workspace(self, path, *, hold: bool = True) -> None:
         """Write the workspace to ``path``, holding it for this window (``hold``; an autosave into the recovery
@@ -60,7 +68,9 @@ class SessionFiles:
         if hold:
             self._hold(path)
         if ws.target and ws.target not in {c.name for c in self.cell.workcell.components}:
-            raise CalibrationError(f"workspace {path}: target {ws.target!r} is not a component of the open cell {self.cell.name!r}")
+            raise CalibrationError(
+                f"workspace {path}: target {ws.target!r} is not a component of the open cell {self.cell.name!r}"
+            )
         self.cell.workcell.task_locations.update(ws.task_locations)
         if ws.target:
             self.session.set_target(ws.target)
@@ -68,7 +78,9 @@ class SessionFiles:
         self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
         self.session.corrections.replace_with(ws.corrections)
         self.session.undo.clear()
-        self.log.say(f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations")
+        self.log.say(
+            f"workspace {path} opened: {len(ws.pairs)} pairs, {len(ws.corrections.tasks())} corrected locations"
+        )
 
     def export_corrections(self, path, fmt: str) -> None:
         """Write the corrected task locations as ``fmt`` (``videocal export``'s formats) to ``path``, atomically."""
@@ -76,6 +88,18 @@ class SessionFiles:
         from calib_core.workspace.exports import export_corrections
 
         if not self.session.corrections.tasks():
-            raise CalibrationError("no corrections stored yet: calibrate at a task location and store its correction first")
-        atomic_write_text(path, export_corrections(fmt, self.session.corrections, self.cell.workcell.task_locations, Path(path).name.split(".")[0], self.cell.robot, self.cell.joint_map))
+            raise CalibrationError(
+                "no corrections stored yet: calibrate at a task location and store its correction first"
+            )
+        atomic_write_text(
+            path,
+            export_corrections(
+                fmt,
+                self.session.corrections,
+                self.cell.workcell.task_locations,
+                Path(path).name.split(".")[0],
+                self.cell.robot,
+                self.cell.joint_map,
+            ),
+        )
         self.log.say(f"corrections exported to {path} ({fmt})")

@@ -44,12 +44,21 @@ class RealSite:
     camera alone, for picking and solving without moving; a controller alone). ``controller_options`` and
     ``camera_options``: the connectors' options from the workcell's ``site:`` section."""
 
-    def __init__(self, controller_url: str | None, camera: str | None = None, *, controller_options: dict | None = None, camera_options: dict | None = None):
+    def __init__(
+        self,
+        controller_url: str | None,
+        camera: str | None = None,
+        *,
+        controller_options: dict | None = None,
+        camera_options: dict | None = None,
+    ):
         self.controller_url = controller_url
         self.camera = camera
         self.controller_options = controller_options
         self.camera_options = camera_options
-        parts = ([f"controller {controller_url}"] if controller_url else ["no controller"]) + ([f"camera {camera}"] if camera else [])
+        parts = ([f"controller {controller_url}"] if controller_url else ["no controller"]) + (
+            [f"camera {camera}"] if camera else []
+        )
         self.description = ", ".join(parts)
 
     def start_controller(self) -> str | None:

@@ -33,8 +33,25 @@ from calib_core.operator.task_choice import TaskChoice
 class ToolMeasuring:
     """``grasps``: the :class:`~calib_core.robot_calibration.camera_to_tool.Grasp` recorded so far."""
 
-    def __init__(self, cell: Cell, tasks: TaskChoice, arm: Arm, picking: Picking, finder: PointFinding, robot_calibration: RobotCalibrating, log: OperatorLog):
-        self.cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log = cell, tasks, arm, picking, finder, robot_calibration, log
+    def __init__(
+        self,
+        cell: Cell,
+        tasks: TaskChoice,
+        arm: Arm,
+        picking: Picking,
+        finder: PointFinding,
+        robot_calibration: RobotCalibrating,
+        log: OperatorLog,
+    ):
+        self.cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log = (
+            cell,
+            tasks,
+            arm,
+            picking,
+            finder,
+            robot_calibration,
+            log,
+        )
         self.grasps: list = []
 
     @property
@@ -53,24 +70,45 @@ class ToolMeasuring:
         if not self.arm.link_up:
             raise OperatorError("the controller link is down: a grasp needs the joints the controller reports")
         if self.arm.state.motion in (Motion.MOVING, Motion.UNKNOWN):
-            raise OperatorError(f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed on the pin")
+            raise OperatorError(
+                f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed on the pin"
+            )
         q = np.array(self.arm.joints_deg, dtype=float)
         seen, how = None, "no camera frame: taken through the robot and the fixture's survey"
         if self.picking.observations.latest is not None:
-            held = self.picking.hold_frame()  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
+            held = (
+                self.picking.hold_frame()
+            )  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
             q = np.asarray(held.stamp.joints_deg, dtype=float)
             workcell = self.cell.workcell
             item = workcell.component(self.task.component) if self.task.component else None
             try:
-                seen = see_grasp(held.frame.image, self.cell.intrinsics, self.cell.robot, workcell, self.task, q,
-                                 expected=self.finder.modelled_view(q, item) if item is not None else None)
+                seen = see_grasp(
+                    held.frame.image,
+                    self.cell.intrinsics,
+                    self.cell.robot,
+                    workcell,
+                    self.task,
+                    q,
+                    expected=self.finder.modelled_view(q, item) if item is not None else None,
+                )
                 how = f"seen on frame {held.stamp.frame_index} ({seen.edge_samples} edge samples of {seen.component})"
             except GraspNotSeenError as e:
                 how = f"not seen ({e}): taken through the robot and the fixture's survey"
             self.picking.release_unused_still()
-        grasp = Grasp(f"{self.task.name} #{sum(g.name.startswith(self.task.name + ' #') for g in self.grasps) + 1}", q, self.task.tcp2base.copy(), seen)
+        grasp = Grasp(
+            f"{self.task.name} #{sum(g.name.startswith(self.task.name + ' #') for g in self.grasps) + 1}",
+            q,
+            self.task.tcp2base.copy(),
+            seen,
+        )
         self.grasps.append(grasp)
-        self.log.record("grasp_recorded", task=self.task.name, joints_deg=[float(v) for v in grasp.joints_deg], seen=seen is not None)
+        self.log.record(
+            "grasp_recorded",
+            task=self.task.name,
+            joints_deg=[float(v) for v in grasp.joints_deg],
+            seen=seen is not None,
+        )
         self.log.say(f"grasp recorded at {self.task.name} ({len(self.grasps)} in all): {how}")
         return grasp
 
@@ -85,13 +123,21 @@ class ToolMeasuring:
         from calib_core.robot_calibration.camera_to_tool import camera_to_tool
 
         if not self.grasps:
-            raise OperatorError("record a grasp first: close the gripper on a task location's pin in compliance, then Record grasp")
+            raise OperatorError(
+                "record a grasp first: close the gripper on a task location's pin in compliance, then Record grasp"
+            )
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
 
         calibration = self.robot_calibration.applied_robot_calibration
-        tool = camera_to_tool(self.cell.robot, self.grasps, placement_sigma_mm=SURVEY_SIGMA_MM,
-                              camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None)
+        tool = camera_to_tool(
+            self.cell.robot,
+            self.grasps,
+            placement_sigma_mm=SURVEY_SIGMA_MM,
+            camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None,
+        )
         self.robot_calibration.use_tool(tool)
         self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
-        self.log.say(f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)")
+        self.log.say(
+            f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)"
+        )
         return tool

@@ -14,7 +14,14 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, FOUND_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC, VIDEO_TOPIC
+from calib_core.recording.schemas import (
+    ANNOTATIONS_TOPIC,
+    CALIBRATION_TOPIC,
+    FOUND_TOPIC,
+    SCENE_TOPIC,
+    TRANSFORMS_TOPIC,
+    VIDEO_TOPIC,
+)
 
 WORLD_FRAME = "world"
 """The root of the recorded frame tree: the cell's world (the robot's base frame)."""
@@ -27,8 +34,14 @@ def _classes() -> dict:
     from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
     from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 
-    return {VIDEO_TOPIC: CompressedVideo, CALIBRATION_TOPIC: CameraCalibration, TRANSFORMS_TOPIC: FrameTransforms, ANNOTATIONS_TOPIC: ImageAnnotations, FOUND_TOPIC: ImageAnnotations,
-            SCENE_TOPIC: SceneUpdate}
+    return {
+        VIDEO_TOPIC: CompressedVideo,
+        CALIBRATION_TOPIC: CameraCalibration,
+        TRANSFORMS_TOPIC: FrameTransforms,
+        ANNOTATIONS_TOPIC: ImageAnnotations,
+        FOUND_TOPIC: ImageAnnotations,
+        SCENE_TOPIC: SceneUpdate,
+    }
 
 
 def protobuf_schema(topic: str) -> tuple[str, bytes]:
@@ -52,7 +65,9 @@ def _pose(target, T_mm: np.ndarray) -> None:
     t = np.asarray(T_mm)[:3, 3] / 1000.0
     if hasattr(target, "position"):
         target.position.x, target.position.y, target.position.z = map(float, t)
-        target.orientation.x, target.orientation.y, target.orientation.z, target.orientation.w = map(float, (x, y, z, w))
+        target.orientation.x, target.orientation.y, target.orientation.z, target.orientation.w = map(
+            float, (x, y, z, w)
+        )
     else:
         target.translation.x, target.translation.y, target.translation.z = map(float, t)
         target.rotation.x, target.rotation.y, target.rotation.z, target.rotation.w = map(float, (x, y, z, w))
@@ -68,8 +83,13 @@ def camera_calibration(intrinsics: Intrinsics, frame_id: str, t_ns: int):
     model = {"equidistant": "kannala_brandt"}.get(intrinsics.model, intrinsics.model)
     fu, fv, cx, cy = map(float, (intrinsics.fu, intrinsics.fv, intrinsics.cx, intrinsics.cy))
     message = CameraCalibration(
-        frame_id=frame_id, width=int(intrinsics.width), height=int(intrinsics.height), distortion_model=model, D=d,
-        K=[fu, 0.0, cx, 0.0, fv, cy, 0.0, 0.0, 1.0], R=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        frame_id=frame_id,
+        width=int(intrinsics.width),
+        height=int(intrinsics.height),
+        distortion_model=model,
+        D=d,
+        K=[fu, 0.0, cx, 0.0, fv, cy, 0.0, 0.0, 1.0],
+        R=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
         P=[fu, 0.0, cx, 0.0, 0.0, fv, cy, 0.0, 0.0, 0.0, 1.0, 0.0],
     )
     _stamp(message, t_ns)
@@ -137,11 +157,11 @@ def image_annotations(picks, t_ns: int, reprojected=None, stale_numbers=()):
         _color(residuals.outline_color, (1.0, 0.2, 0.2, 1.0))
         for number, uv in reprojected:
             u, v = _corner_origin(uv)
-            for (du, dv) in ((-6, -6), (6, 6), (-6, 6), (6, -6)):
+            for du, dv in ((-6, -6), (6, 6), (-6, 6), (6, -6)):
                 p = crosses.points.add()
                 p.x, p.y = u + du, v + dv
             if number in picked:
-                for (x, y) in (picked[number], (u, v)):
+                for x, y in (picked[number], (u, v)):
                     p = residuals.points.add()
                     p.x, p.y = x, y
     return message
@@ -215,11 +235,16 @@ def feature_entity(entity_id: str, points_mm: dict, t_ns: int):
     _stamp(entity, t_ns)
     for name, p in points_mm.items():
         sphere = entity.spheres.add()
-        _pose(sphere.pose, np.block([[np.eye(3), np.asarray(p, float).reshape(3, 1)], [np.zeros((1, 3)), np.ones((1, 1))]]))
+        _pose(
+            sphere.pose,
+            np.block([[np.eye(3), np.asarray(p, float).reshape(3, 1)], [np.zeros((1, 3)), np.ones((1, 1))]]),
+        )
         sphere.size.x = sphere.size.y = sphere.size.z = 0.006
         _color(sphere.color, _MODEL)
         text = entity.texts.add(text=name, billboard=True, font_size=12.0, scale_invariant=True)
-        text.pose.position.x, text.pose.position.y, text.pose.position.z = (np.asarray(p, float) / 1000.0 + [0, 0, 0.008]).tolist()
+        text.pose.position.x, text.pose.position.y, text.pose.position.z = (
+            np.asarray(p, float) / 1000.0 + [0, 0, 0.008]
+        ).tolist()
         text.pose.orientation.w = 1.0
         _color(text.color, (1, 1, 1, 1))
     return entity

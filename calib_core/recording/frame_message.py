@@ -30,10 +30,18 @@ class FrameEncoder:
         if image.ndim == 2 or image.shape[2] == 1:  # a monochrome camera: recorded as grey RGB
             image = np.repeat(image.reshape(image.shape[0], image.shape[1], 1), 3, axis=2)
         if self.frames == "jpeg":
-            ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality])
+            ok, jpeg = cv2.imencode(
+                ".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality]
+            )
             if not ok:
                 raise ValueError("a frame could not be JPEG-encoded")
-            payload = {"timestamp": {"sec": capture_ns // 10**9, "nsec": capture_ns % 10**9}, "frame_id": frame_id, "format": "jpeg", "data": base64.b64encode(jpeg.tobytes()).decode(), "t_host_s": t_host_s}
+            payload = {
+                "timestamp": {"sec": capture_ns // 10**9, "nsec": capture_ns % 10**9},
+                "frame_id": frame_id,
+                "format": "jpeg",
+                "data": base64.b64encode(jpeg.tobytes()).decode(),
+                "t_host_s": t_host_s,
+            }
             return FRAME_TOPIC, json.dumps(payload, separators=(",", ":")).encode()
         from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
 

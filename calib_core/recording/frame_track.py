@@ -24,7 +24,11 @@ class FrameTrack:
         self.is_video = bool(video)
         t0 = contents.messages[0].log_time_ns if contents.messages else 0
         self.times_s = np.array([(m.log_time_ns - t0) / 1e9 for m in self.messages])
-        self.keyframes = [k for k, m in enumerate(self.messages) if is_keyframe(m.payload["data"])] if self.is_video else list(range(len(self.messages)))
+        self.keyframes = (
+            [k for k, m in enumerate(self.messages) if is_keyframe(m.payload["data"])]
+            if self.is_video
+            else list(range(len(self.messages)))
+        )
         self._decoder: H264Decoder | None = None
         self._decoded = -1
         self._last: np.ndarray | None = None

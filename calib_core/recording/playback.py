@@ -44,12 +44,23 @@ class RecordingPlayback:
         self.joint_times_s = np.array([self._t(m) for m in joints])
         rows = [m.payload["joints_deg"] for m in joints]
         if len({len(r) for r in rows}) > 1:
-            raise ValueError(f"the joint samples of the recording have {' and '.join(str(n) for n in sorted({len(r) for r in rows}))} values")
+            raise ValueError(
+                f"the joint samples of the recording have {' and '.join(str(n) for n in sorted({len(r) for r in rows}))} values"
+            )
         # A recording of a camera alone has no joint samples: its frames replay, nothing is robot-bound.
         self.joints_deg = np.array(rows, dtype=float).reshape(len(rows), len(rows[0]) if rows else 0)
         self._events = [m for m in contents.topic(EVENT_TOPIC) if str(m.payload.get("kind", "")).startswith("pair_")]
         self._event_times = [self._t(m) for m in self._events]
-        self.solves = [RecordedSolve(int(m.payload.get("id", k + 1)), self._t(m), m.payload["inputs"], m.payload["result"], m.payload.get("context") or {}) for k, m in enumerate(contents.topic(SOLVE_TOPIC))]
+        self.solves = [
+            RecordedSolve(
+                int(m.payload.get("id", k + 1)),
+                self._t(m),
+                m.payload["inputs"],
+                m.payload["result"],
+                m.payload.get("context") or {},
+            )
+            for k, m in enumerate(contents.topic(SOLVE_TOPIC))
+        ]
         self._solve_times = [s.t_s for s in self.solves]
         setups = contents.topic(SETUP_TOPIC)
         self.setup: dict = setups[0].payload if setups else {}
@@ -99,7 +110,14 @@ class RecordingPlayback:
             return None
         i = bisect.bisect_right(self.joint_times_s, t_s) - 1
         k = self.frame_index_at(t_s)
-        return ViewStamp(-1 if k is None else int(k), float(t_s), tuple(float(v) for v in q), float(t_s - self.joint_times_s[i]), f"{t_s:.3f} s into the recording", self.name)
+        return ViewStamp(
+            -1 if k is None else int(k),
+            float(t_s),
+            tuple(float(v) for v in q),
+            float(t_s - self.joint_times_s[i]),
+            f"{t_s:.3f} s into the recording",
+            self.name,
+        )
 
     def solve_at(self, t_s: float) -> RecordedSolve | None:
         """The last solve at or before ``t_s``."""

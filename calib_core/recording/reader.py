@@ -42,7 +42,12 @@ def _video_payload(data: bytes) -> dict:
     from foxglove_schemas_protobuf.CompressedVideo_pb2 import CompressedVideo
 
     m = CompressedVideo.FromString(data)
-    return {"timestamp": {"sec": m.timestamp.seconds, "nsec": m.timestamp.nanos}, "frame_id": m.frame_id, "format": m.format, "data": m.data}
+    return {
+        "timestamp": {"sec": m.timestamp.seconds, "nsec": m.timestamp.nanos},
+        "frame_id": m.frame_id,
+        "format": m.format,
+        "data": m.data,
+    }
 
 
 @dataclass
@@ -59,9 +64,14 @@ class RecordingContents:
         return [m for m in self.messages if m.topic == name]
 
 
-
 _RECORD_HEADER = struct.Struct("<BQ")
-_READERS = {Opcode.CHANNEL: Channel, Opcode.MESSAGE: Message, Opcode.CHUNK: Chunk, Opcode.ATTACHMENT: Attachment, Opcode.FOOTER: Footer}
+_READERS = {
+    Opcode.CHANNEL: Channel,
+    Opcode.MESSAGE: Message,
+    Opcode.CHUNK: Chunk,
+    Opcode.ATTACHMENT: Attachment,
+    Opcode.FOOTER: Footer,
+}
 
 
 def _records(data: bytes | mmap.mmap, problems: list[str]):
@@ -104,7 +114,10 @@ def read_recording(path: str | Path) -> RecordingContents:
     path = Path(path)
     if path.is_dir():
         what = "a ROS bag folder" if (path / "metadata.yaml").is_file() else "a folder"
-        raise FileFormatError(path, f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)")
+        raise FileFormatError(
+            path,
+            f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)",
+        )
     try:
         handle = open(path, "rb")
     except FileNotFoundError:
@@ -131,12 +144,19 @@ def read_recording(path: str | Path) -> RecordingContents:
                     bad_messages += 1
                     continue
                 try:
-                    payload = _video_payload(record.data) if channel.topic == VIDEO_TOPIC and channel.message_encoding == "protobuf" else (
-                        json.loads(record.data) if channel.message_encoding == "json" else {})
+                    payload = (
+                        _video_payload(record.data)
+                        if channel.topic == VIDEO_TOPIC and channel.message_encoding == "protobuf"
+                        else (json.loads(record.data) if channel.message_encoding == "json" else {})
+                    )
                 except Exception:  # json and protobuf raise different errors on bad bytes
                     bad_messages += 1
                     continue
-                messages.append(RecordedMessage(channel.topic, record.log_time, payload, bytes(record.data), channel.message_encoding))
+                messages.append(
+                    RecordedMessage(
+                        channel.topic, record.log_time, payload, bytes(record.data), channel.message_encoding
+                    )
+                )
             elif isinstance(record, Attachment):
                 attachments.append(record)
             elif isinstance(record, Footer):
@@ -144,14 +164,29 @@ def read_recording(path: str | Path) -> RecordingContents:
     if not any(m.topic in KNOWN_TOPICS for m in messages):
         # Another program's MCAP (a ROS 2 bag) or an empty one: replaying it would show "0 frames" and succeed.
         topics = sorted({f"{c.topic} ({c.message_encoding})" for c in channels.values()})
-        held = f"its topics: {', '.join(topics[:8])}{' ...' if len(topics) > 8 else ''}" if topics else "it holds no messages"
-        hint = "; a ROS 2 bag is read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)" if any("cdr" in t or "ros" in t for t in topics) else ""
+        held = (
+            f"its topics: {', '.join(topics[:8])}{' ...' if len(topics) > 8 else ''}"
+            if topics
+            else "it holds no messages"
+        )
+        hint = (
+            "; a ROS 2 bag is read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)"
+            if any("cdr" in t or "ros" in t for t in topics)
+            else ""
+        )
         raise FileFormatError(path, f"not a videocal recording: no videocal message ({held}){hint}")
     if bad_messages:
         problems.append(f"{bad_messages} message{'s' if bad_messages > 1 else ''} could not be decoded: skipped")
     if not complete and not any("ends" in p for p in problems):
-        problems.append(f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)")
-    return RecordingContents(messages, bool(complete), "; ".join(problems) or None, [(a.name, a.media_type, bytes(a.data)) for a in attachments])
+        problems.append(
+            f"the file ends without its footer after {len(messages)} messages (the recorder did not finish)"
+        )
+    return RecordingContents(
+        messages,
+        bool(complete),
+        "; ".join(problems) or None,
+        [(a.name, a.media_type, bytes(a.data)) for a in attachments],
+    )
 
 
 def decode_frame(payload: dict) -> np.ndarray:

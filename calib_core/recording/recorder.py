@@ -32,7 +32,15 @@ from mcap.writer import CompressionType, Writer
 
 from calib_core import __version__
 from calib_core.recording.frame_message import FrameEncoder
-from calib_core.recording.schemas import CORRECTION_TOPIC, EVENT_TOPIC, JOINTS_TOPIC, SETUP_TOPIC, SOLVE_TOPIC, TOPICS, schema_bytes
+from calib_core.recording.schemas import (
+    CORRECTION_TOPIC,
+    EVENT_TOPIC,
+    JOINTS_TOPIC,
+    SETUP_TOPIC,
+    SOLVE_TOPIC,
+    TOPICS,
+    schema_bytes,
+)
 from calib_core.recording.video_codec import DEFAULT_CRF
 
 PROFILE = "videocal"
@@ -75,11 +83,23 @@ class SessionRecorder:
     ``late_messages`` messages whose log time had to be raised to keep the file in order."""
 
     def __init__(
-        self, path: str | Path, *, frames: str = "h264", jpeg_quality: int = 90, crf: int = DEFAULT_CRF, fps: float = 15.0,
-        queue_frames: int = 60, drop_when_busy: bool = True, clock=time.monotonic, chunk_every_s: float = 0.5, hold_s: float = 0.3,
+        self,
+        path: str | Path,
+        *,
+        frames: str = "h264",
+        jpeg_quality: int = 90,
+        crf: int = DEFAULT_CRF,
+        fps: float = 15.0,
+        queue_frames: int = 60,
+        drop_when_busy: bool = True,
+        clock=time.monotonic,
+        chunk_every_s: float = 0.5,
+        hold_s: float = 0.3,
         camera_frame: str = "camera",
     ):
-        self._frame_encoder = FrameEncoder(frames, fps=fps, crf=crf, jpeg_quality=jpeg_quality)  # checks ``frames`` first
+        self._frame_encoder = FrameEncoder(
+            frames, fps=fps, crf=crf, jpeg_quality=jpeg_quality
+        )  # checks ``frames`` first
         self.path = Path(path)
         self.frames, self.crf, self.fps, self.jpeg_quality = frames, crf, fps, jpeg_quality
         self.drop_when_busy = drop_when_busy
@@ -88,7 +108,13 @@ class SessionRecorder:
         self._unix_minus_host_ns = time.time_ns() - int(round(clock() * 1e9))
         self.chunk_every_ns, self.hold_ns = int(chunk_every_s * 1e9), int(hold_s * 1e9)
         self._file = open(self.path, "wb")
-        self._writer = Writer(self._file, compression=CompressionType.LZ4, chunk_size=4 * 1024 * 1024, enable_crcs=True, enable_data_crcs=True)
+        self._writer = Writer(
+            self._file,
+            compression=CompressionType.LZ4,
+            chunk_size=4 * 1024 * 1024,
+            enable_crcs=True,
+            enable_data_crcs=True,
+        )
         self._writer.start(profile=PROFILE, library=f"videocal {__version__}")
         self._channels: dict[str, int] = {}
         self._schemas: dict[tuple[str, str], int] = {}
@@ -144,7 +170,9 @@ class SessionRecorder:
             heapq.heappush(self._pending, (t, next(self._order), topic, bytes(data), False))
 
     def _write(self, topic: str, payload: dict, log_time_ns: int | None = None) -> None:
-        self.write_raw(topic, json.dumps(to_jsonable(payload), separators=(",", ":"), allow_nan=False).encode(), log_time_ns)
+        self.write_raw(
+            topic, json.dumps(to_jsonable(payload), separators=(",", ":"), allow_nan=False).encode(), log_time_ns
+        )
 
     def record_message(self, topic: str, message, t_host_s: float | None = None) -> None:
         """A protobuf message (a Foxglove schema) on ``topic`` at host time ``t_host_s`` (default now)."""
@@ -159,7 +187,10 @@ class SessionRecorder:
             heapq.heappush(self._pending, (t, next(self._order), None, (name, media_type, bytes(data)), False))
 
     def record_setup(self, **setup) -> None:
-        self._write(SETUP_TOPIC, {"videocal_version": __version__, "frames": self.frames, "camera_frame": self.camera_frame, **setup})
+        self._write(
+            SETUP_TOPIC,
+            {"videocal_version": __version__, "frames": self.frames, "camera_frame": self.camera_frame, **setup},
+        )
 
     def record_frame(self, image_rgb: np.ndarray, t_host_s: float, frame_id: str | None = None) -> None:
         """Record an RGB frame (h, w, 3) uint8 captured at ``t_host_s`` (host s): its log time and
@@ -185,7 +216,11 @@ class SessionRecorder:
 
     def record_joints(self, seq: int, t_ms: int, t_host_s: float, joints_deg) -> None:
         """A joint sample received at ``t_host_s`` (host s), logged at that time."""
-        self._write(JOINTS_TOPIC, {"seq": seq, "t_ms": t_ms, "t_host_s": t_host_s, "joints_deg": list(joints_deg)}, self.unix_ns(t_host_s))
+        self._write(
+            JOINTS_TOPIC,
+            {"seq": seq, "t_ms": t_ms, "t_host_s": t_host_s, "joints_deg": list(joints_deg)},
+            self.unix_ns(t_host_s),
+        )
 
     def record_event(self, kind: str, **detail) -> None:
         self._write(EVENT_TOPIC, {"kind": kind, "detail": detail})
@@ -194,7 +229,10 @@ class SessionRecorder:
         """A solve: ``inputs`` to re-solve it, its ``result``, and the ``context`` that turns it
         into an end-effector estimate (obj2world, cam2world_model, tcp2base_model (4, 4) mm, joints)."""
         self._solve_id += 1
-        self._write(SOLVE_TOPIC, {"id": self._solve_id, "inputs": inputs, "result": result, **({"context": context} if context else {})})
+        self._write(
+            SOLVE_TOPIC,
+            {"id": self._solve_id, "inputs": inputs, "result": result, **({"context": context} if context else {})},
+        )
         return self._solve_id
 
     def record_correction(self, correction: dict) -> None:
@@ -218,7 +256,10 @@ class SessionRecorder:
                 if item is not None:
                     self._take(item)
                 self._release(self.unix_ns() - self.hold_ns)
-                if self._chunk_start_ns is not None and self.unix_ns() - self._chunk_start_ns >= self.chunk_every_ns + self.hold_ns:
+                if (
+                    self._chunk_start_ns is not None
+                    and self.unix_ns() - self._chunk_start_ns >= self.chunk_every_ns + self.hold_ns
+                ):
                     self._flush_chunk()  # a quiet spell: what was written reaches the disk anyway
             self._drain()
             self._release(None)
@@ -290,7 +331,9 @@ class SessionRecorder:
             self._last_written_ns = log_ns
             if topic is None:
                 name, media_type, blob = data
-                self._writer.add_attachment(create_time=log_ns, log_time=log_ns, name=name, media_type=media_type, data=blob)
+                self._writer.add_attachment(
+                    create_time=log_ns, log_time=log_ns, name=name, media_type=media_type, data=blob
+                )
                 continue
             if self._chunk_start_ns is None:
                 self._chunk_start_ns = log_ns
@@ -298,7 +341,9 @@ class SessionRecorder:
                 self._flush_chunk()  # a chunk spans chunk_every_s of log time: what a crash can lose, what a seek reads
                 self._chunk_start_ns = log_ns
             self._sequence[topic] += 1
-            self._writer.add_message(self._channel(topic), log_time=log_ns, data=data, publish_time=log_ns, sequence=self._sequence[topic])
+            self._writer.add_message(
+                self._channel(topic), log_time=log_ns, data=data, publish_time=log_ns, sequence=self._sequence[topic]
+            )
             self._chunk_messages += 1
             self._chunk_frames += is_frame
 
@@ -316,7 +361,12 @@ class SessionRecorder:
         channel = self._channels.get(topic)
         if channel is None:
             if topic in TOPICS:
-                name, encoding, data, message_encoding = TOPICS[topic]["title"], "jsonschema", schema_bytes(topic), "json"
+                name, encoding, data, message_encoding = (
+                    TOPICS[topic]["title"],
+                    "jsonschema",
+                    schema_bytes(topic),
+                    "json",
+                )
             else:
                 from calib_core.recording.foxglove_messages import protobuf_schema
 

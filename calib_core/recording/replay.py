@@ -27,9 +27,14 @@ def solve_from_inputs(inputs: dict):
     from calib_core.solver.solve import solve_pose  # the solver's compiled kernels load on first use
 
     return solve_pose(
-        inputs["points_3d"], inputs["points_2d"], Intrinsics.from_dict(inputs["intrinsics"]), prior=prior,
-        estimate_focal=inputs.get("estimate_focal", False), model=inputs.get("model", "pinhole"),
-        sigma_px=inputs.get("sigma_px"), robust=inputs.get("robust", False),
+        inputs["points_3d"],
+        inputs["points_2d"],
+        Intrinsics.from_dict(inputs["intrinsics"]),
+        prior=prior,
+        estimate_focal=inputs.get("estimate_focal", False),
+        model=inputs.get("model", "pinhole"),
+        sigma_px=inputs.get("sigma_px"),
+        robust=inputs.get("robust", False),
     )
 
 
@@ -51,7 +56,16 @@ class ReplayedSolve:
 
     @property
     def equivalent(self) -> bool:
-        return self.agree or self.skipped is not None or (self.recorded["status"] == self.recomputed["status"] and self.translation_diff_mm <= 1e-6 and self.rotation_diff <= 1e-9 and self.rms_diff_px <= 1e-6)
+        return (
+            self.agree
+            or self.skipped is not None
+            or (
+                self.recorded["status"] == self.recomputed["status"]
+                and self.translation_diff_mm <= 1e-6
+                and self.rotation_diff <= 1e-9
+                and self.rms_diff_px <= 1e-6
+            )
+        )
 
 
 def _diff(a, b) -> float:
@@ -71,16 +85,33 @@ def replay(path: str | Path) -> list[ReplayedSolve]:
         payload = message.payload
         number = payload.get("id", k + 1) if isinstance(payload, dict) else k + 1
         recorded = payload.get("result") if isinstance(payload, dict) else None
-        if not isinstance(recorded, dict) or not all(key in recorded for key in ("status", "t_obj2cam_mm", "R_obj2cam", "rms_px")):
-            raise FileFormatError(path, f"solve {number} has no complete result (status, R_obj2cam, t_obj2cam_mm, rms_px)", SOLVE_TOPIC)
+        if not isinstance(recorded, dict) or not all(
+            key in recorded for key in ("status", "t_obj2cam_mm", "R_obj2cam", "rms_px")
+        ):
+            raise FileFormatError(
+                path, f"solve {number} has no complete result (status, R_obj2cam, t_obj2cam_mm, rms_px)", SOLVE_TOPIC
+            )
         inputs = payload.get("inputs")
         if isinstance(inputs, dict) and inputs.get("method") == "edges":
-            out.append(ReplayedSolve(int(number), recorded, recorded, False, 0.0, 0.0, 0.0, skipped="solved on the image's edges: not re-computed from a recording"))
+            out.append(
+                ReplayedSolve(
+                    int(number),
+                    recorded,
+                    recorded,
+                    False,
+                    0.0,
+                    0.0,
+                    0.0,
+                    skipped="solved on the image's edges: not re-computed from a recording",
+                )
+            )
             continue
         try:
             recomputed = to_jsonable(solve_from_inputs(payload["inputs"]).to_dict())  # as it would be recorded
         except (KeyError, TypeError, ValueError) as exc:
-            raise FileFormatError(path, f"solve {number}: its inputs cannot be solved again ({type(exc).__name__}: {exc})", SOLVE_TOPIC) from None
+            raise FileFormatError(
+                path, f"solve {number}: its inputs cannot be solved again ({type(exc).__name__}: {exc})", SOLVE_TOPIC
+            ) from None
         dt = _diff(recorded["t_obj2cam_mm"], recomputed["t_obj2cam_mm"])
         dr = _diff(recorded["R_obj2cam"], recomputed["R_obj2cam"])
         drms = _diff(recorded["rms_px"], recomputed["rms_px"])

@@ -20,7 +20,16 @@ noise goes first) at ~2 MB/min for the simulated camera."""
 class H264Encoder:
     """Encode RGB frames (h, w, 3) uint8 of one size; ``encode`` gives that frame's Annex B packet."""
 
-    def __init__(self, width: int, height: int, *, fps: float = 15.0, crf: int = DEFAULT_CRF, keyframe_interval: int = 30, preset: str = "veryfast"):
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        *,
+        fps: float = 15.0,
+        crf: int = DEFAULT_CRF,
+        keyframe_interval: int = 30,
+        preset: str = "veryfast",
+    ):
         if width % 2 or height % 2:
             raise ValueError(f"H.264 (4:2:0) needs an even frame size, got {width} x {height}")
         self.width, self.height = width, height
@@ -32,13 +41,21 @@ class H264Encoder:
         # zerolatency: no lookahead and no frame buffering, so every frame's packet comes out at
         # once and a recording cut off by a crash loses no frame before the cut; bf=0: Foxglove
         # cannot play B-frames; repeat-headers: SPS/PPS in front of every IDR.
-        ctx.options = {"preset": preset, "tune": "zerolatency", "crf": str(crf), "bf": "0", "x264-params": f"keyint={keyframe_interval}:min-keyint={keyframe_interval}:scenecut=0:repeat-headers=1"}
+        ctx.options = {
+            "preset": preset,
+            "tune": "zerolatency",
+            "crf": str(crf),
+            "bf": "0",
+            "x264-params": f"keyint={keyframe_interval}:min-keyint={keyframe_interval}:scenecut=0:repeat-headers=1",
+        }
         self._ctx = ctx
         self._pts = 0
 
     def encode(self, image_rgb: np.ndarray) -> bytes:
         if image_rgb.shape[:2] != (self.height, self.width):
-            raise ValueError(f"frame is {image_rgb.shape[1]} x {image_rgb.shape[0]}, the video is {self.width} x {self.height}")
+            raise ValueError(
+                f"frame is {image_rgb.shape[1]} x {image_rgb.shape[0]}, the video is {self.width} x {self.height}"
+            )
         frame = av.VideoFrame.from_ndarray(np.ascontiguousarray(image_rgb), format="rgb24")
         frame.pts = self._pts
         self._pts += 1

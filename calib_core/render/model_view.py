@@ -30,8 +30,14 @@ class ModelView:
         self._renderer: SceneRenderer | None = None
         self._items: list[SceneItem] | None = None
 
-    def render(self, items: list[SceneItem], cam2world: np.ndarray, moved: dict[str, np.ndarray] | None = None, box_px: tuple[int, int, int, int] | None = None,
-               supersample: float = 1) -> np.ndarray:
+    def render(
+        self,
+        items: list[SceneItem],
+        cam2world: np.ndarray,
+        moved: dict[str, np.ndarray] | None = None,
+        box_px: tuple[int, int, int, int] | None = None,
+        supersample: float = 1,
+    ) -> np.ndarray:
         """The image (h, w, 3) uint8 the modelled camera at ``cam2world`` (4, 4, mm) would take;
         ``moved``: items (by name) put at these poses (4, 4, mm) first (the renderer writes an item's
         pose into it: pass items of your own). ``box_px`` (u0, v0, u1, v1), px of the image, ends
@@ -68,11 +74,18 @@ class ModelView:
             image = cv2.resize(image, (part.width, part.height), interpolation=cv2.INTER_AREA)
         elif supersample < 1:
             image = cv2.resize(image, (part.width, part.height), interpolation=cv2.INTER_LINEAR)
-        out[v0:v1, u0:u1] = cv2.remap(image, map_x - a0, map_y - b0, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        out[v0:v1, u0:u1] = cv2.remap(
+            image, map_x - a0, map_y - b0, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        )
         return out
 
-    def of(self, items: list[SceneItem], item2world: np.ndarray, riding: frozenset[str] = frozenset(), cam2world_model: np.ndarray | None = None
-           ) -> Callable[[np.ndarray], np.ndarray]:
+    def of(
+        self,
+        items: list[SceneItem],
+        item2world: np.ndarray,
+        riding: frozenset[str] = frozenset(),
+        cam2world_model: np.ndarray | None = None,
+    ) -> Callable[[np.ndarray], np.ndarray]:
         """``expected(obj2cam, box_px=None, supersample=1) -> image`` for an object at ``item2world``: the
         view with the object at ``obj2cam`` from the camera (the camera placed accordingly; ``box_px`` and
         ``supersample`` as :meth:`render`'s). ``riding``: the names of the items
@@ -81,20 +94,35 @@ class ModelView:
         cell (a robot's error moves the camera 10-20 mm from where the model puts it, and the fingers
         with it, 40-90 px at a task location)."""
         if cam2world_model is None or not riding:
-            return lambda obj2cam, box_px=None, supersample=1: self.render(items, concat(invert(obj2cam), item2world), box_px=box_px, supersample=supersample)
+            return lambda obj2cam, box_px=None, supersample=1: self.render(
+                items, concat(invert(obj2cam), item2world), box_px=box_px, supersample=supersample
+            )
         own = {i.name: np.array(i.item2world, dtype=float) for i in items if i.name in riding}
-        scene = [replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items]  # the caller's items keep their poses
+        scene = [
+            replace(i, item2world=own[i.name].copy()) if i.name in own else i for i in items
+        ]  # the caller's items keep their poses
         world2cam_model = invert(cam2world_model)
 
-        def expected(obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1) -> np.ndarray:
+        def expected(
+            obj2cam: np.ndarray, box_px: tuple[int, int, int, int] | None = None, supersample: float = 1
+        ) -> np.ndarray:
             cam2world = concat(invert(obj2cam), item2world)
             carry = concat(world2cam_model, cam2world)  # the modelled camera onto the one placed here
-            return self.render(scene, cam2world, {name: concat(pose, carry) for name, pose in own.items()}, box_px, supersample)
+            return self.render(
+                scene, cam2world, {name: concat(pose, carry) for name, pose in own.items()}, box_px, supersample
+            )
 
         return expected
 
-    def of_cell(self, components: list[SceneItem], visuals, q_deg, item2world: np.ndarray, camera_frame: str = "camera", extras: list[SceneItem] = ()
-                ) -> Callable[[np.ndarray], np.ndarray]:
+    def of_cell(
+        self,
+        components: list[SceneItem],
+        visuals,
+        q_deg,
+        item2world: np.ndarray,
+        camera_frame: str = "camera",
+        extras: list[SceneItem] = (),
+    ) -> Callable[[np.ndarray], np.ndarray]:
         """:meth:`of` for the cell's ``components`` and a robot's ``visuals``
         (:class:`~calib_core.robot.visuals.RobotVisuals`) at joints ``q_deg``, plus ``extras``: what
         rides on ``camera_frame``'s joint goes with the camera."""

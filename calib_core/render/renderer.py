@@ -137,10 +137,16 @@ class SceneRenderer:
                 continue
             highlighted = name == options.highlight
             # A highlight tints the component rather than repainting it, so its shading still shows its shape.
-            color = tuple(0.45 * c + 0.55 * h for c, h in zip(actor.item.color, options.highlight_color)) if highlighted else actor.item.color
+            color = (
+                tuple(0.45 * c + 0.55 * h for c, h in zip(actor.item.color, options.highlight_color))
+                if highlighted
+                else actor.item.color
+            )
             if options.style == "edges":
                 a = actor.edges
-                a.GetProperty().SetColor(*(options.highlight_color if name == options.highlight else options.edge_color))
+                a.GetProperty().SetColor(
+                    *(options.highlight_color if name == options.highlight else options.edge_color)
+                )
                 a.GetProperty().SetLineWidth(2.0 if name == options.highlight else 1.0)
                 a.GetProperty().LightingOff()
                 self.renderer.AddActor(a)
@@ -159,9 +165,16 @@ class SceneRenderer:
             else:
                 prop.SetRepresentationToSurface()
             self.renderer.AddActor(a)
-            if options.show_edges and options.style == "surface" and actor.item.kind not in ("fixture", "ghost") or highlighted:
+            if (
+                options.show_edges
+                and options.style == "surface"
+                and actor.item.kind not in ("fixture", "ghost")
+                or highlighted
+            ):
                 e = actor.edges
-                e.GetProperty().SetColor(*((0.55, 0.25, 0.0) if highlighted else tuple(0.35 * c for c in actor.item.color)))
+                e.GetProperty().SetColor(
+                    *((0.55, 0.25, 0.0) if highlighted else tuple(0.35 * c for c in actor.item.color))
+                )
                 e.GetProperty().SetLineWidth(1.5 if highlighted else 1.0)
                 e.GetProperty().LightingOff()
                 self.renderer.AddActor(e)
@@ -245,7 +258,9 @@ class SceneRenderer:
         img = numpy_support.vtk_to_numpy(arr).reshape(h, w, 4)[::-1]
         return np.ascontiguousarray(img if transparent else img[:, :, :3])
 
-    def render_view(self, intrinsics: Intrinsics, cam2world: np.ndarray, options: RenderOptions | None = None) -> np.ndarray:
+    def render_view(
+        self, intrinsics: Intrinsics, cam2world: np.ndarray, options: RenderOptions | None = None
+    ) -> np.ndarray:
         """The image (h, w, 3) uint8 RGB (RGBA with a transparent background) seen by the
         calibrated camera at ``cam2world`` (4, 4, mm, OpenCV axes), without lens distortion."""
         options = options or RenderOptions()
@@ -256,7 +271,17 @@ class SceneRenderer:
         self._last = (intrinsics, np.asarray(cam2world, dtype=float))
         return self._read_back(options.transparent_background)
 
-    def render_overview(self, eye_mm=(-1900.0, -2300.0, 2900.0), target_mm=(700.0, 0.0, 800.0), *, width: int = 800, height: int = 600, view_angle_deg: float = 40.0, up=(0.0, 0.0, 1.0), options: RenderOptions | None = None) -> np.ndarray:
+    def render_overview(
+        self,
+        eye_mm=(-1900.0, -2300.0, 2900.0),
+        target_mm=(700.0, 0.0, 800.0),
+        *,
+        width: int = 800,
+        height: int = 600,
+        view_angle_deg: float = 40.0,
+        up=(0.0, 0.0, 1.0),
+        options: RenderOptions | None = None,
+    ) -> np.ndarray:
         """The image (h, w, 3) uint8 from an ordinary perspective camera at ``eye_mm`` looking at ``target_mm``."""
         options = options or RenderOptions()
         self.window.SetSize(width, height)
@@ -285,7 +310,9 @@ class SceneRenderer:
         return depth_from_zbuffer(zbuf)
 
     # --- picking -----------------------------------------------------------------------
-    def pick(self, u: float, v: float, *, snap_radius_px: float = 12.0, components: set[str] | None = None) -> PickResult | None:
+    def pick(
+        self, u: float, v: float, *, snap_radius_px: float = 12.0, components: set[str] | None = None
+    ) -> PickResult | None:
         """What pixel ``(u, v)`` of the last virtual-camera render shows.
 
         The nearest visible named feature within ``snap_radius_px`` wins (so a click just
@@ -294,7 +321,11 @@ class SceneRenderer:
         calibration's target object). ``None`` when nothing pickable is there."""
         if self._last is None:
             raise RuntimeError("pick works on the last render_view")
-        allowed = [a.item for a in self._actors.values() if a.item.kind == "component" and (components is None or a.item.name in components)]
+        allowed = [
+            a.item
+            for a in self._actors.values()
+            if a.item.kind == "component" and (components is None or a.item.name in components)
+        ]
         snapped = self._snap(u, v, snap_radius_px, allowed)
         if snapped is not None:
             return snapped

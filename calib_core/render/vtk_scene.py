@@ -23,7 +23,10 @@ def polydata_of(mesh) -> vtk.vtkPolyData:
     faces = np.ascontiguousarray(mesh.faces, dtype=np.int64)
     offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
     cells = vtk.vtkCellArray()
-    cells.SetData(vtk.numpy_support.numpy_to_vtkIdTypeArray(offsets, deep=True), vtk.numpy_support.numpy_to_vtkIdTypeArray(faces.ravel(), deep=True))
+    cells.SetData(
+        vtk.numpy_support.numpy_to_vtkIdTypeArray(offsets, deep=True),
+        vtk.numpy_support.numpy_to_vtkIdTypeArray(faces.ravel(), deep=True),
+    )
     data = vtk.vtkPolyData()
     data.SetPoints(points)
     data.SetPolys(cells)
@@ -55,7 +58,9 @@ class ItemActor:
         data = vtk.vtkImageData()
         data.SetDimensions(w, h, 1)
         # VTK images start at the bottom row.
-        pixels = vtk.numpy_support.numpy_to_vtk(np.ascontiguousarray(image[::-1].reshape(-1, 3)), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
+        pixels = vtk.numpy_support.numpy_to_vtk(
+            np.ascontiguousarray(image[::-1].reshape(-1, 3)), deep=True, array_type=vtk.VTK_UNSIGNED_CHAR
+        )
         pixels.SetNumberOfComponents(3)
         data.GetPointData().SetScalars(pixels)
         texture = vtk.vtkTexture()

@@ -5,4 +5,12 @@ from calib_core.robot.errors import RobotModelError, UnknownFrameError, Unreacha
 from calib_core.robot.ik import IKSolution, solve_ik
 from calib_core.robot.model import RobotModel, load_robot
 
-__all__ = ["RobotModel", "load_robot", "solve_ik", "IKSolution", "RobotModelError", "UnknownFrameError", "UnreachableTargetError"]
+__all__ = [
+    "RobotModel",
+    "load_robot",
+    "solve_ik",
+    "IKSolution",
+    "RobotModelError",
+    "UnknownFrameError",
+    "UnreachableTargetError",
+]

@@ -34,7 +34,7 @@ class Contact:
 
     @property
     def text(self) -> str:
-        other = self.b[len(CELL_PREFIX):] if self.b.startswith(CELL_PREFIX) else f"the robot's {self.b}"
+        other = self.b[len(CELL_PREFIX) :] if self.b.startswith(CELL_PREFIX) else f"the robot's {self.b}"
         return f"{self.a} hits {other}"
 
 
@@ -78,7 +78,7 @@ class CollisionWorld:
     def _pairs(self, home_deg) -> None:
         candidates = []
         for i, a in enumerate(self._robot_ids):
-            for b in self._robot_ids[i + 1:]:
+            for b in self._robot_ids[i + 1 :]:
                 if not self._adjacent(self._joint_of(a), self._joint_of(b)):
                     candidates.append((a, b))
         candidates += [(a, c) for a in self._robot_ids for c in self._cell_ids]

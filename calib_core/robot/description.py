@@ -20,9 +20,10 @@ from calib_core.robot.ros_packages import find_package, search_roots
 from calib_core.robot.xacro_expand import expand_xacro
 
 
-
 def _is_xacro(path: Path, text: str) -> bool:
-    return path.suffix == ".xacro" or path.name.endswith(".urdf.xacro") or "http://www.ros.org/wiki/xacro" in text[:4000]
+    return (
+        path.suffix == ".xacro" or path.name.endswith(".urdf.xacro") or "http://www.ros.org/wiki/xacro" in text[:4000]
+    )
 
 
 def package_search_roots(package_paths: Iterable[str | Path]) -> list[Path]:
@@ -48,10 +49,10 @@ def _package_candidates(package: str, rest: str, roots: list[Path]) -> list[Path
 def resolve_uri(uri: str, urdf_dir: Path, roots: list[Path]) -> tuple[Path | None, list[Path]]:
     """The file a mesh reference names, and every place looked in (for the error message)."""
     if uri.startswith("package://"):
-        package, _, rest = uri[len("package://"):].partition("/")
+        package, _, rest = uri[len("package://") :].partition("/")
         looked = _package_candidates(package, rest, roots)
     elif uri.startswith("file://"):
-        looked = [Path(uri[len("file://"):])]
+        looked = [Path(uri[len("file://") :])]
     else:
         looked = [Path(uri) if Path(uri).is_absolute() else urdf_dir / uri]
     for candidate in looked:
@@ -69,17 +70,27 @@ def _resolve_meshes(root: ET.Element, path: Path, roots: list[Path], uris: dict[
                     found, looked = resolve_uri(uri, path.parent, roots)
                     where = f"link '{link.get('name')}' {role} mesh"
                     if found is None:
-                        places = "; ".join(str(p) for p in looked) or "(no package path: add robot.package_paths to the workcell)"
+                        places = (
+                            "; ".join(str(p) for p in looked)
+                            or "(no package path: add robot.package_paths to the workcell)"
+                        )
                         raise FileFormatError(path, f"{where} {uri!r} not found; looked in: {places}")
                     if found.suffix.lower() not in MESH_SUFFIXES:
-                        raise FileFormatError(path, f"{where} {uri!r}: unsupported format {found.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY")
+                        raise FileFormatError(
+                            path,
+                            f"{where} {uri!r}: unsupported format {found.suffix!r}; use STL, OBJ, DAE, glTF/GLB or PLY",
+                        )
                     mesh.set("filename", str(found))
                     if uris is not None:
                         uris[str(found)] = uri
 
 
-def read_description(path: str | Path, package_paths: Iterable[str | Path] = (), xacro_args: dict[str, str] | None = None,
-                     mesh_uris: dict[str, str] | None = None) -> str:
+def read_description(
+    path: str | Path,
+    package_paths: Iterable[str | Path] = (),
+    xacro_args: dict[str, str] | None = None,
+    mesh_uris: dict[str, str] | None = None,
+) -> str:
     """URDF text of a URDF or xacro file with every mesh as an absolute path. A xacro file is expanded with
     ``xacro_args`` (``$(arg name)``) and packages found as :mod:`calib_core.robot.ros_packages` says.
     ``mesh_uris``, when given, receives each absolute path's reference as the file wrote it (``package://...``),
@@ -128,7 +139,9 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
     previewed with must be the one the file says."""
     joints = root.findall(".//joint")
     if len(joints) > MAX_URDF_JOINTS:
-        raise FileFormatError(path, f"{len(joints)} joints: over the limit of {MAX_URDF_JOINTS} for one robot description")
+        raise FileFormatError(
+            path, f"{len(joints)} joints: over the limit of {MAX_URDF_JOINTS} for one robot description"
+        )
     for parent in root.iter():
         for origin in parent.findall("origin"):
             for attr in ("xyz", "rpy"):
@@ -137,20 +150,33 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
                 values = _numbers(origin.get(attr), 3)
                 owner = f"{parent.tag} '{parent.get('name')}'" if parent.get("name") else f"a {parent.tag}"
                 if values is None or not all(math.isfinite(v) for v in values):
-                    raise FileFormatError(path, f"{owner}: origin {attr}={origin.get(attr)!r} must be three finite numbers")
+                    raise FileFormatError(
+                        path, f"{owner}: origin {attr}={origin.get(attr)!r} must be three finite numbers"
+                    )
                 if attr == "xyz" and max(abs(v) for v in values) > MAX_ORIGIN_M:
-                    raise FileFormatError(path, f"{owner}: origin xyz={origin.get(attr)!r} is over {MAX_ORIGIN_M:g} m away: a URDF is in metres (mm written as m?)")
+                    raise FileFormatError(
+                        path,
+                        f"{owner}: origin xyz={origin.get(attr)!r} is over {MAX_ORIGIN_M:g} m away: a URDF is in metres (mm written as m?)",
+                    )
     for joint in root.iter("joint"):
         axis = joint.find("axis")
         if axis is not None and joint.get("type") in ("revolute", "continuous", "prismatic"):
             values = _numbers(axis.get("xyz", "1 0 0"), 3)
             if values is None or not all(math.isfinite(v) for v in values) or math.hypot(*values) < 1e-9:
-                raise FileFormatError(path, f"joint '{joint.get('name')}': axis xyz={axis.get('xyz')!r} must be three finite numbers, not all zero")
+                raise FileFormatError(
+                    path,
+                    f"joint '{joint.get('name')}': axis xyz={axis.get('xyz')!r} must be three finite numbers, not all zero",
+                )
         limit = joint.find("limit")
         if limit is None or joint.get("type") not in ("revolute", "prismatic"):
             continue
         lo, hi = (_numbers(limit.get(k, "0"), 1) for k in ("lower", "upper"))
         if lo is None or hi is None or not all(math.isfinite(v) for v in lo + hi):
-            raise FileFormatError(path, f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be finite numbers")
+            raise FileFormatError(
+                path,
+                f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be finite numbers",
+            )
         if lo[0] > hi[0]:
-            raise FileFormatError(path, f"joint '{joint.get('name')}': limit lower ({lo[0]:g}) is above upper ({hi[0]:g})")
+            raise FileFormatError(
+                path, f"joint '{joint.get('name')}': limit lower ({lo[0]:g}) is above upper ({hi[0]:g})"
+            )

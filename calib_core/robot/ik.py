@@ -46,7 +46,9 @@ def _pose_error(robot: RobotModel, q_deg: np.ndarray, target: np.ndarray, frame:
     return np.concatenate([e_p, e_w])
 
 
-def _descend(robot: RobotModel, q0: np.ndarray, target: np.ndarray, frame: str, max_iterations: int) -> tuple[np.ndarray, np.ndarray, int]:
+def _descend(
+    robot: RobotModel, q0: np.ndarray, target: np.ndarray, frame: str, max_iterations: int
+) -> tuple[np.ndarray, np.ndarray, int]:
     lo, hi = robot.lower_limits_deg, robot.upper_limits_deg
     q = np.clip(q0, lo, hi)
     W = np.diag([1.0, 1.0, 1.0, _ROTATION_WEIGHT_MM, _ROTATION_WEIGHT_MM, _ROTATION_WEIGHT_MM])
@@ -76,7 +78,16 @@ def _seeds(robot: RobotModel, q_current: np.ndarray, extra: int, rng: np.random.
     return seeds
 
 
-def solve_ik(robot: RobotModel, target2base: ArrayLike, q_current_deg: ArrayLike | None = None, *, frame: str = "tcp", extra_seeds: int = 12, max_iterations: int = 200, seed: int = 0) -> IKSolution:
+def solve_ik(
+    robot: RobotModel,
+    target2base: ArrayLike,
+    q_current_deg: ArrayLike | None = None,
+    *,
+    frame: str = "tcp",
+    extra_seeds: int = 12,
+    max_iterations: int = 200,
+    seed: int = 0,
+) -> IKSolution:
     """Joints (deg) that put ``frame`` at ``target2base`` (4, 4, mm), closest to ``q_current_deg``.
 
     Raises :class:`UnreachableTargetError` (with the closest attempt) when no seed converges
@@ -102,7 +113,10 @@ def solve_ik(robot: RobotModel, target2base: ArrayLike, q_current_deg: ArrayLike
             best_miss = (pos, rot)
     if not found:
         raise UnreachableTargetError(
-            f"the {frame} cannot reach the target within the joint limits (closest: {best_miss[0]:.1f} mm, {best_miss[1]:.2f} deg away)", best_miss
+            f"the {frame} cannot reach the target within the joint limits (closest: {best_miss[0]:.1f} mm, {best_miss[1]:.2f} deg away)",
+            best_miss,
         )
     q, e, iterations = min(found, key=lambda f: float(np.max(np.abs(f[0] - q_current))))
-    return IKSolution(q, float(np.linalg.norm(e[:3])), float(np.degrees(np.linalg.norm(e[3:]))), iterations, len(found), tried)
+    return IKSolution(
+        q, float(np.linalg.norm(e[:3])), float(np.degrees(np.linalg.norm(e[3:]))), iterations, len(found), tried
+    )

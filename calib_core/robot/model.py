@@ -80,7 +80,10 @@ class RobotModel:
         for i in range(1, self.model.njoints):
             kind = _joint_kind(self.model.joints[i])
             if kind is None:
-                raise FileFormatError(self.urdf_path, f"joint '{self.model.names[i]}' is of a kind videocal cannot drive ({self.model.joints[i].shortname()}); mark it held in the workcell (robot.held_joints)")
+                raise FileFormatError(
+                    self.urdf_path,
+                    f"joint '{self.model.names[i]}' is of a kind videocal cannot drive ({self.model.joints[i].shortname()}); mark it held in the workcell (robot.held_joints)",
+                )
             kinds.append(kind)
         self.joint_kinds: list[str] = kinds
         self._internal_per_user = np.array([_INTERNAL_PER_USER[k] for k in kinds])
@@ -132,7 +135,9 @@ class RobotModel:
         """``q_deg`` as a float array (n,); :class:`RobotModelError` if its length or values are wrong."""
         q = np.asarray(q_deg, dtype=float).reshape(-1)
         if q.shape != (self.n_joints,):
-            raise RobotModelError(f"expected {self.n_joints} joint values ({', '.join(self.joint_names)}), got {q.size}")
+            raise RobotModelError(
+                f"expected {self.n_joints} joint values ({', '.join(self.joint_names)}), got {q.size}"
+            )
         if not np.all(np.isfinite(q)):
             raise RobotModelError(f"joint values must be finite, got {q.tolist()}")
         return q
@@ -201,7 +206,9 @@ class RobotModel:
             if parent == 0 or parent == i:
                 tree.append((None, frames[i].name, concat(_to_mm(self.data.oMf[i]), self._root2base)))
             else:
-                tree.append((frames[parent].name, frames[i].name, _to_mm(self.data.oMf[parent].actInv(self.data.oMf[i]))))
+                tree.append(
+                    (frames[parent].name, frames[i].name, _to_mm(self.data.oMf[parent].actInv(self.data.oMf[i])))
+                )
         return tree
 
     def jacobian(self, q_deg: ArrayLike, frame: str = "tcp") -> np.ndarray:
@@ -209,7 +216,11 @@ class RobotModel:
         (rad), per internal joint unit (rad or m); multiply column j by ``internal_per_user[j]``
         for per degree or per millimetre."""
         fid = self.frame_id(frame)
-        J = np.array(pin.computeFrameJacobian(self.model, self.data, self.configuration(q_deg), fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
+        J = np.array(
+            pin.computeFrameJacobian(
+                self.model, self.data, self.configuration(q_deg), fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            )
+        )
         R = self._root2base[:3, :3]
         J[:3] = 1000.0 * (R @ J[:3])
         J[3:] = R @ J[3:]
@@ -233,16 +244,33 @@ class RobotModel:
         if frame is None or frame == "flange" or frame == self.roles.get("flange"):
             return np.asarray(pose_on_frame_mm, dtype=float)
         if not self.model.existFrame(frame):
-            raise VideocalError(f"{source}: frame {frame!r} is not on this cell's robot (its flange is {self.roles.get('flange', 'flange')!r})")
-        if self.model.frames[self.frame_id(frame)].parentJoint != self.model.frames[self.frame_id("flange")].parentJoint:
-            raise VideocalError(f"{source}: frame {frame!r} is not fixed to the flange's link: a joint moves between them")
+            raise VideocalError(
+                f"{source}: frame {frame!r} is not on this cell's robot (its flange is {self.roles.get('flange', 'flange')!r})"
+            )
+        if (
+            self.model.frames[self.frame_id(frame)].parentJoint
+            != self.model.frames[self.frame_id("flange")].parentJoint
+        ):
+            raise VideocalError(
+                f"{source}: frame {frame!r} is not fixed to the flange's link: a joint moves between them"
+            )
         frame2flange = concat(self.frame_placement(frame), invert(self.frame_placement("flange")))
         return concat(np.asarray(pose_on_frame_mm, dtype=float), frame2flange)
 
     def copy(self) -> RobotModel:
         model = self.model.copy()
-        return RobotModel(model, model.createData(), self.urdf_path, self.urdf_xml, dict(self.roles), self.base2root.copy(), self.full_model, self.locked_joint_ids,
-                          self.locked_configuration, dict(self.mesh_uris))
+        return RobotModel(
+            model,
+            model.createData(),
+            self.urdf_path,
+            self.urdf_xml,
+            dict(self.roles),
+            self.base2root.copy(),
+            self.full_model,
+            self.locked_joint_ids,
+            self.locked_configuration,
+            dict(self.mesh_uris),
+        )
 
 
 def _held_configuration(full: pin.Model, held: dict[str, float], path: Path) -> tuple[list[int], np.ndarray]:
@@ -250,11 +278,17 @@ def _held_configuration(full: pin.Model, held: dict[str, float], path: Path) -> 
     ids = []
     for name, value in held.items():
         if not full.existJointName(name):
-            raise RobotSpecError("robot.held_joints", f"the URDF has no joint {name!r}; joints: {', '.join(full.names[1:])}", path)
+            raise RobotSpecError(
+                "robot.held_joints", f"the URDF has no joint {name!r}; joints: {', '.join(full.names[1:])}", path
+            )
         jid = full.getJointId(name)
         kind = _joint_kind(full.joints[jid])
         if kind is None:
-            raise RobotSpecError(f"robot.held_joints.{name}", f"joint {name!r} is of an unsupported kind ({full.joints[jid].shortname()})", path)
+            raise RobotSpecError(
+                f"robot.held_joints.{name}",
+                f"joint {name!r} is of an unsupported kind ({full.joints[jid].shortname()})",
+                path,
+            )
         iq = full.joints[jid].idx_q
         internal = float(value) * _INTERNAL_PER_USER[kind]
         if kind == CONTINUOUS:
@@ -288,7 +322,11 @@ def _assign_roles(model: pin.Model, frames: dict, path: Path) -> dict[str, str]:
         elif model.existFrame(spec):
             roles[role] = spec
         elif role in frames:  # named on purpose but absent: say so now rather than at the first FK
-            raise RobotSpecError(f"robot.frames.{role}", f"the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: [...]}}", path)
+            raise RobotSpecError(
+                f"robot.frames.{role}",
+                f"the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: [...]}}",
+                path,
+            )
     return roles
 
 
@@ -316,7 +354,11 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
     data = model.createData()
     base_id = model.getFrameId(roles["base"])
     if model.frames[base_id].parentJoint != 0:
-        raise RobotSpecError("robot.frames.base", f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world", path)
+        raise RobotSpecError(
+            "robot.frames.base",
+            f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world",
+            path,
+        )
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     base2root = _to_mm(data.oMf[base_id])
     return RobotModel(model, data, path, xml, roles, base2root, full, tuple(locked), q_ref, mesh_uris)

@@ -50,7 +50,9 @@ def find_package(name: str, roots: list[Path]) -> Path | None:
             deeper = []
             for folder in level:
                 try:
-                    children = sorted(p for p in folder.iterdir() if p.is_dir() and p.name not in _SKIP and not p.name.startswith("."))
+                    children = sorted(
+                        p for p in folder.iterdir() if p.is_dir() and p.name not in _SKIP and not p.name.startswith(".")
+                    )
                 except OSError:
                     continue
                 for child in children:

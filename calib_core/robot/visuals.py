@@ -43,7 +43,9 @@ def _mesh_of(g: pin.GeometryObject, where: str) -> trimesh.Trimesh:
     if isinstance(geometry, coal.Box):
         return trimesh.creation.box(extents=2000.0 * np.asarray(geometry.halfSide))
     if isinstance(geometry, coal.Cylinder):
-        return trimesh.creation.cylinder(radius=1000.0 * geometry.radius, height=2000.0 * geometry.halfLength, sections=_CYLINDER_SECTIONS)
+        return trimesh.creation.cylinder(
+            radius=1000.0 * geometry.radius, height=2000.0 * geometry.halfLength, sections=_CYLINDER_SECTIONS
+        )
     if isinstance(geometry, coal.Sphere):
         return trimesh.creation.icosphere(radius=1000.0 * geometry.radius, subdivisions=2)
     if isinstance(geometry, coal.Capsule):
@@ -56,7 +58,10 @@ def _mesh_of(g: pin.GeometryObject, where: str) -> trimesh.Trimesh:
                 raise FileFormatError(g.meshPath, f"{where}: the mesh has no triangles")
             _MESH_CACHE[key] = trimesh.Trimesh(vertices * 1000.0, triangles, process=False)
         return _MESH_CACHE[key]
-    raise FileFormatError(g.meshPath or "(URDF)", f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres or capsules)")
+    raise FileFormatError(
+        g.meshPath or "(URDF)",
+        f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres or capsules)",
+    )
 
 
 _GEOMETRY_CACHE: dict[tuple, pin.GeometryModel] = {}
@@ -69,7 +74,13 @@ def geometry_model(robot: RobotModel, kind: str = "visual") -> pin.GeometryModel
     Shapes are placed on their parent joints, so one model serves every copy of a robot (the
     modelled and the true one of the simulated site): it is built once per description and
     never modified (each pose computation makes its own data)."""
-    key = (hash(robot.urdf_xml), str(robot.urdf_path), kind, robot.locked_joint_ids, None if robot.locked_configuration is None else robot.locked_configuration.tobytes())
+    key = (
+        hash(robot.urdf_xml),
+        str(robot.urdf_path),
+        kind,
+        robot.locked_joint_ids,
+        None if robot.locked_configuration is None else robot.locked_configuration.tobytes(),
+    )
     if key not in _GEOMETRY_CACHE:
         _GEOMETRY_CACHE[key] = _build_geometry_model(robot, kind)
     return _GEOMETRY_CACHE[key]
@@ -80,10 +91,16 @@ _CACHED_MESHES: dict[int, dict[str, trimesh.Trimesh]] = {}  # id(geometry model)
 
 def _build_geometry_model(robot: RobotModel, kind: str) -> pin.GeometryModel:
     full = robot.full_model if robot.full_model is not None else robot.model
-    placeholder = mesh_cache.placeholder_description(robot.urdf_xml, kind) if robot.urdf_xml and kind == "visual" else None
+    placeholder = (
+        mesh_cache.placeholder_description(robot.urdf_xml, kind) if robot.urdf_xml and kind == "visual" else None
+    )
     xml = placeholder[0] if placeholder else robot.urdf_xml
     try:
-        gm = pin.buildGeomFromUrdfString(full, xml, _KINDS[kind]) if xml else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])
+        gm = (
+            pin.buildGeomFromUrdfString(full, xml, _KINDS[kind])
+            if xml
+            else pin.buildGeomFromUrdf(full, str(robot.urdf_path), _KINDS[kind])
+        )
     except (RuntimeError, ValueError) as exc:
         raise FileFormatError(robot.urdf_path, f"cannot read the robot's {kind} geometry: {exc}") from None
     if robot.locked_joint_ids:
@@ -136,4 +153,3 @@ class RobotVisuals:
             color = tuple(float(c) for c in np.asarray(g.meshColor)[:3])
             items.append(SceneItem(name=f"robot/{g.name}", mesh=mesh, item2world=pose, color=color, kind="robot"))
         return items
-

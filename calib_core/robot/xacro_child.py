@@ -31,7 +31,10 @@ def main() -> int:
     def find(name: str) -> str:
         found = find_package(name, roots)
         if found is None:
-            looked = ", ".join(str(r) for r in roots) or "nowhere (give --package-path, ROS_PACKAGE_PATH or AMENT_PREFIX_PATH)"
+            looked = (
+                ", ".join(str(r) for r in roots)
+                or "nowhere (give --package-path, ROS_PACKAGE_PATH or AMENT_PREFIX_PATH)"
+            )
             missing.append(f"$(find {name}): no package '{name}' (a package.xml naming it) in {looked}")
             raise substitution.SubstitutionException(missing[-1])
         return str(found)
@@ -47,7 +50,9 @@ def main() -> int:
         cause = exc
         while cause is not None:  # xacro wraps what went wrong in an expression
             if isinstance(cause, MemoryError) or isinstance(getattr(cause, "exc", None), MemoryError):
-                print(f"expanding it needed more than {request['memory_mb']} MB (a runaway expression?)", file=sys.stderr)
+                print(
+                    f"expanding it needed more than {request['memory_mb']} MB (a runaway expression?)", file=sys.stderr
+                )
                 return 2
             cause = cause.__cause__ or cause.__context__
         text = str(exc).strip().splitlines()

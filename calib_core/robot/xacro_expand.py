@@ -18,16 +18,39 @@ MEMORY_MB = 2048
 MAX_OUTPUT_BYTES = 200 * 1024 * 1024
 
 
-def expand_xacro(path: Path, roots: list[Path], args: dict[str, str] | None = None, *, timeout_s: float = TIMEOUT_S, memory_mb: int = MEMORY_MB) -> str:
+def expand_xacro(
+    path: Path,
+    roots: list[Path],
+    args: dict[str, str] | None = None,
+    *,
+    timeout_s: float = TIMEOUT_S,
+    memory_mb: int = MEMORY_MB,
+) -> str:
     """The URDF text of xacro ``path`` with ``$(find pkg)`` from ``roots`` and ``$(arg name)`` from ``args``."""
     # Absolute: the child runs in the project's folder, not the caller's.
-    request = json.dumps({"path": str(Path(path).resolve()), "roots": [str(Path(r).resolve()) for r in roots], "args": dict(args or {}), "memory_mb": memory_mb,
-                          "cpu_s": int(timeout_s) + 1})
+    request = json.dumps(
+        {
+            "path": str(Path(path).resolve()),
+            "roots": [str(Path(r).resolve()) for r in roots],
+            "args": dict(args or {}),
+            "memory_mb": memory_mb,
+            "cpu_s": int(timeout_s) + 1,
+        }
+    )
     try:
-        done = subprocess.run([sys.executable, "-m", "calib_core.robot.xacro_child"], input=request, capture_output=True, text=True,
-                              timeout=timeout_s, cwd=str(Path(__file__).resolve().parents[2]), preexec_fn=die_with_parent)
+        done = subprocess.run(
+            [sys.executable, "-m", "calib_core.robot.xacro_child"],
+            input=request,
+            capture_output=True,
+            text=True,
+            timeout=timeout_s,
+            cwd=str(Path(__file__).resolve().parents[2]),
+            preexec_fn=die_with_parent,
+        )
     except subprocess.TimeoutExpired:
-        raise FileFormatError(path, f"cannot expand xacro: it took longer than {timeout_s:g} s (a runaway expression?)") from None
+        raise FileFormatError(
+            path, f"cannot expand xacro: it took longer than {timeout_s:g} s (a runaway expression?)"
+        ) from None
     if done.returncode != 0:
         why = done.stderr.strip().splitlines()
         raise FileFormatError(path, f"cannot expand xacro: {why[-1] if why else f'exit code {done.returncode}'}")

@@ -71,8 +71,14 @@ class CameraToTool:
         return R @ self.covariance @ R.T
 
 
-def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "camera", *, placement_sigma_mm: float | None = None,
-                   camera_covariance=None) -> CameraToTool:
+def camera_to_tool(
+    robot: RobotModel,
+    grasps: list[Grasp],
+    camera_frame: str = "camera",
+    *,
+    placement_sigma_mm: float | None = None,
+    camera_covariance=None,
+) -> CameraToTool:
     """``tcp2cam`` from ``grasps``: a seen grasp's own, the others' with ``robot`` (calibrated)
     placing the camera.
 
@@ -90,7 +96,9 @@ def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "
     cams = {g.name: robot.fk(g.joints_deg, camera_frame) for g in grasps}
     per = {g.name: g.seen.tcp2cam if g.seen is not None else concat(g.tcp2base, invert(cams[g.name])) for g in grasps}
     Ts = list(per.values())
-    mean = make_transform(Rotation.from_matrix([T[:3, :3] for T in Ts]).mean().as_matrix(), np.mean([T[:3, 3] for T in Ts], axis=0))
+    mean = make_transform(
+        Rotation.from_matrix([T[:3, :3] for T in Ts]).mean().as_matrix(), np.mean([T[:3, 3] for T in Ts], axis=0)
+    )
     spreads = [pose_difference(T, mean) for T in Ts]
     covariance = None
     if placement_sigma_mm is not None or all(g.seen is not None for g in grasps):
@@ -101,19 +109,31 @@ def camera_to_tool(robot: RobotModel, grasps: list[Grasp], camera_frame: str = "
                 continue
             in_base = np.diag([placement_sigma_mm**2] * 3 + [0.0] * 3)
             if camera_covariance is not None:
-                in_base = in_base + tcp_covariance_from_camera(camera_covariance(g.joints_deg), cams[g.name], per[g.name])
+                in_base = in_base + tcp_covariance_from_camera(
+                    camera_covariance(g.joints_deg), cams[g.name], per[g.name]
+                )
             R = np.kron(np.eye(2), cams[g.name][:3, :3].T)
             total += R @ in_base @ R.T
         covariance = total / len(grasps) ** 2
-    return CameraToTool(mean, per, max(float(np.linalg.norm(d)) for d, _ in spreads), max(float(np.linalg.norm(r)) for _, r in spreads), covariance,
-                        sum(g.seen is not None for g in grasps))
+    return CameraToTool(
+        mean,
+        per,
+        max(float(np.linalg.norm(d)) for d, _ in spreads),
+        max(float(np.linalg.norm(r)) for _, r in spreads),
+        covariance,
+        sum(g.seen is not None for g in grasps),
+    )
 
 
-def with_tool(robot: RobotModel, tcp2cam: np.ndarray, tcp_frame: str = "tcp", camera_frame: str = "camera") -> RobotModel:
+def with_tool(
+    robot: RobotModel, tcp2cam: np.ndarray, tcp_frame: str = "tcp", camera_frame: str = "camera"
+) -> RobotModel:
     """A copy of ``robot`` whose TCP is ``tcp2cam`` from its camera (both frames on one joint)."""
     tcp_id, cam_id = robot.frame_id(tcp_frame), robot.frame_id(camera_frame)
     if robot.model.frames[tcp_id].parentJoint != robot.model.frames[cam_id].parentJoint:
-        raise CameraToToolError(f"the {tcp_frame} and {camera_frame} frames move with different joints: the camera must ride on the tool's joint")
+        raise CameraToToolError(
+            f"the {tcp_frame} and {camera_frame} frames move with different joints: the camera must ride on the tool's joint"
+        )
     out = robot.copy()
     out.set_frame_placement(tcp_frame, concat(tcp2cam, robot.frame_placement(camera_frame)))
     return out

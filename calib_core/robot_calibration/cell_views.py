@@ -85,7 +85,9 @@ def _look_at(target_mm: np.ndarray, distance_mm: float, eye_height_mm: float) ->
     return T
 
 
-def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_target: int = 3, seed: int = 0, collisions=None) -> list[tuple[str, np.ndarray]]:
+def cell_view_joints(
+    robot: RobotModel, workcell, intrinsics: Intrinsics, per_target: int = 3, seed: int = 0, collisions=None
+) -> list[tuple[str, np.ndarray]]:
     """(component, joints deg) for ``per_target`` poses around each of :func:`surveyed_targets`'
     views, from which the modelled camera sees every feature of the component; with ``collisions``
     (a :class:`~calib_core.robot.collision.CollisionWorld`) only poses free of contacts."""
@@ -105,20 +107,36 @@ def cell_view_joints(robot: RobotModel, workcell, intrinsics: Intrinsics, per_ta
             attempts += 1
             T = camera2base.copy()
             if found or attempts > 1:
-                T[:3, :3] = Rotation.from_rotvec(np.radians(SPREAD_DEG) * rng.normal(size=3) / np.sqrt(3)).as_matrix() @ T[:3, :3]
+                T[:3, :3] = (
+                    Rotation.from_rotvec(np.radians(SPREAD_DEG) * rng.normal(size=3) / np.sqrt(3)).as_matrix()
+                    @ T[:3, :3]
+                )
                 T[:3, 3] += rng.normal(0.0, SPREAD_MM / np.sqrt(3), 3)
             try:
                 q = solve_ik(robot, concat(invert(cam2flange), T), q0, frame="flange").q_deg  # T: a camera2base
             except UnreachableTargetError:
                 continue
             uv = project_points(points, concat(item.item2world, invert(robot.fk(q, "camera"))), intrinsics)
-            if intrinsics.contains(uv, margin_px=40).all() and np.all(robot.within_limits(q, 1.0)) and (collisions is None or not collisions.check(q)):
+            if (
+                intrinsics.contains(uv, margin_px=40).all()
+                and np.all(robot.within_limits(q, 1.0))
+                and (collisions is None or not collisions.check(q))
+            ):
                 out.append((component, q))
                 found += 1
     return out
 
 
-def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, component: str, robot: RobotModel, intrinsics: Intrinsics, expected=None) -> ObjectPoseView | str:
+def cell_view(
+    name: str,
+    image: np.ndarray,
+    joints_deg: np.ndarray,
+    workcell,
+    component: str,
+    robot: RobotModel,
+    intrinsics: Intrinsics,
+    expected=None,
+) -> ObjectPoseView | str:
     """``component`` located in ``image`` taken at ``joints_deg``: its pose from the edges with their
     covariance, as an :class:`ObjectPoseView` (the component surveyed in the base frame); or the
     reason there is none. ``robot`` places the modelled camera
@@ -133,4 +151,11 @@ def cell_view(name: str, image: np.ndarray, joints_deg: np.ndarray, workcell, co
     if not np.all(np.isfinite(result.edges.covariance)):
         return f"{name}: {component}'s edge fit gives no covariance"
     points = np.array(list(item.features.values()), dtype=float)
-    return ObjectPoseView(name, np.asarray(joints_deg, dtype=float), result.edges.obj2cam, result.edges.covariance, item.item2world, points_mm=points)
+    return ObjectPoseView(
+        name,
+        np.asarray(joints_deg, dtype=float),
+        result.edges.obj2cam,
+        result.edges.covariance,
+        item.item2world,
+        points_mm=points,
+    )

@@ -63,7 +63,11 @@ def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Gras
     elif sorted(columns) == sorted(joint_names) and len(set(columns)) == len(columns):
         order = [columns.index(n) for n in joint_names]
     else:
-        raise FileFormatError(path, f"the joint columns {', '.join(columns) or '(none)'} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}", "header")
+        raise FileFormatError(
+            path,
+            f"the joint columns {', '.join(columns) or '(none)'} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}",
+            "header",
+        )
     if not 1 <= len(rows) - 1 <= MAX_GRASPS:
         raise FileFormatError(path, f"expected 1 to {MAX_GRASPS} grasps, got {len(rows) - 1}")
     grasps = []
@@ -73,10 +77,20 @@ def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Gras
             raise FileFormatError(path, f"{len(row)} values, the header has {len(header)}", where)
         task = row[0].strip()
         if task not in workcell.task_locations:
-            raise FileFormatError(path, f"no task location {task!r} in the workcell; task locations: {', '.join(workcell.task_locations)}", f"{where}, task")
+            raise FileFormatError(
+                path,
+                f"no task location {task!r} in the workcell; task locations: {', '.join(workcell.task_locations)}",
+                f"{where}, task",
+            )
         image = row[1].strip() if with_images else ""
         if image and not (path.parent / image).is_file():
             raise FileFormatError(path, f"no such image {path.parent / image}", f"{where}, image")
         q = np.array(csv_numbers(row[2:] if with_images else row[1:], columns, path, where), dtype=float)[order]
-        grasps.append(GraspRow(Grasp(f"{task} (row {n})", q, workcell.task(task).tcp2base), path.parent / image if image else None, task))
+        grasps.append(
+            GraspRow(
+                Grasp(f"{task} (row {n})", q, workcell.task(task).tcp2base),
+                path.parent / image if image else None,
+                task,
+            )
+        )
     return grasps

@@ -61,21 +61,34 @@ def tcp_covariance_in_camera(obj2cam: np.ndarray, tcp2obj: np.ndarray, pose_cova
     return J @ np.asarray(pose_covariance, dtype=float) @ J.T
 
 
-def see_grasp(image: np.ndarray, intrinsics: Intrinsics, robot: RobotModel, workcell, task, joints_deg, camera_frame: str = "camera", expected=None) -> SeenGrasp:
+def see_grasp(
+    image: np.ndarray,
+    intrinsics: Intrinsics,
+    robot: RobotModel,
+    workcell,
+    task,
+    joints_deg,
+    camera_frame: str = "camera",
+    expected=None,
+) -> SeenGrasp:
     """The tool from one frame ``image`` (h, w[, 3]) uint8 taken with the gripper closed on ``task``'s
     fixture at ``joints_deg`` (deg); ``robot`` (calibrated when it is) only predicts where the
     component lies in the frame, within Find points' reach. ``expected``: Find points' modelled view
     (default: the workcell and ``robot`` rendered here). Raises :class:`GraspNotSeenError` naming the
     task when the component's edges do not settle."""
     if task.component is None:
-        raise GraspNotSeenError(f"task location {task.name!r} names no component: the camera cannot see what the gripper holds")
+        raise GraspNotSeenError(
+            f"task location {task.name!r} names no component: the camera cannot see what the gripper holds"
+        )
     item = workcell.component(task.component)
     q = np.asarray(joints_deg, dtype=float)
     cam2base = robot.fk(q, camera_frame)
     view = ModelView(intrinsics) if expected is None else None
     try:
         if view is not None:
-            expected = view.of_cell(workcell.components, RobotVisuals.from_robot(robot), q, item.item2world, camera_frame)
+            expected = view.of_cell(
+                workcell.components, RobotVisuals.from_robot(robot), q, item.item2world, camera_frame
+            )
         found = find_points(image, intrinsics, item, concat(item.item2world, invert(cam2base)), expected=expected)
     finally:
         if view is not None:

@@ -106,7 +106,15 @@ def pose_residual(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
 
 
 class _Problem:
-    def __init__(self, robot: RobotModel, intrinsics: Intrinsics, views: list, camera_frame: str, with_intrinsics: bool, survey_sigma_mm: float = 0.0):
+    def __init__(
+        self,
+        robot: RobotModel,
+        intrinsics: Intrinsics,
+        views: list,
+        camera_frame: str,
+        with_intrinsics: bool,
+        survey_sigma_mm: float = 0.0,
+    ):
         self.corrected = CorrectedRobot(robot, camera_frame, with_intrinsics)
         self.nominal_intrinsics = intrinsics
         self.views = views
@@ -117,7 +125,11 @@ class _Problem:
         self.whiten = {}
         for k, v in enumerate(views):
             if v.target == OBJECT:
-                cov = np.asarray(v.covariance, dtype=float) + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3) + turn_about_object(v.obj2cam, OBJECT_TURN_SIGMA_MRAD)
+                cov = (
+                    np.asarray(v.covariance, dtype=float)
+                    + np.diag([0.0, 0.0, 0.0] + [survey_sigma_mm**2] * 3)
+                    + turn_about_object(v.obj2cam, OBJECT_TURN_SIGMA_MRAD)
+                )
                 self.whiten[k] = np.linalg.inv(np.linalg.cholesky(cov + 1e-15 * np.eye(6)))
         # With the intrinsics fitted, an object's pose measured through the starting ones moves with them.
         self.moves_with_intrinsics = {}
@@ -168,7 +180,9 @@ def turn_about_object(obj2cam: np.ndarray, sigma_mrad: float) -> np.ndarray:
     return (sigma_mrad / 1000.0) ** 2 * G @ G.T
 
 
-def pose_sensitivity_to_intrinsics(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Intrinsics, step: float = 0.1) -> np.ndarray:
+def pose_sensitivity_to_intrinsics(
+    obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Intrinsics, step: float = 0.1
+) -> np.ndarray:
     """(6, 8): how an object's pose measured at ``obj2cam`` (4, 4) mm through ``intrinsics`` moves
     (left perturbation: rotation vector rad, translation mm) per unit of each correction in
     :data:`~calib_core.robot_calibration.parameters.INTRINSICS`: the pose that puts ``points_mm``
@@ -182,12 +196,17 @@ def pose_sensitivity_to_intrinsics(obj2cam: np.ndarray, points_mm: np.ndarray, i
             delta = np.zeros(len(INTRINSICS))
             delta[j] = d
             return pixels, corrected_intrinsics(intrinsics, delta)
+
         return change
 
-    return pose_derivatives(obj2cam, points_mm, intrinsics, [correct(j) for j in range(len(INTRINSICS))], pose_residual, step)
+    return pose_derivatives(
+        obj2cam, points_mm, intrinsics, [correct(j) for j in range(len(INTRINSICS))], pose_residual, step
+    )
 
 
-def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str) -> np.ndarray:
+def initial_board2base(
+    robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], camera_frame: str
+) -> np.ndarray:
     """The board's placement (4, 4) mm from each board view's PnP through the nominal robot, averaged."""
     placements = []
     for v in views:
@@ -196,15 +215,26 @@ def initial_board2base(robot: RobotModel, intrinsics: Intrinsics, views: list[Po
         pixels, camera = as_pinhole(v.pixels, intrinsics)  # OpenCV's PnP knows no fisheye lens
         ok, rvec, tvec = cv2.solvePnP(v.points_mm, pixels, camera.K, camera.dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE)
         if ok:
-            placements.append(concat(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()), robot.fk(v.joints_deg, camera_frame)))
+            placements.append(
+                concat(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()), robot.fk(v.joints_deg, camera_frame))
+            )
     if not placements:
         raise RobotCalibrationError("no board view gives the board's pose: every board view needs 4 points or more")
     R = Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix()
     return make_transform(R, np.median([P[:3, 3] for P in placements], axis=0))
 
 
-def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *, camera_frame: str = "camera", with_intrinsics: bool = False,
-             parameters: list[str] | None = None, survey_sigma_mm: float = SURVEY_SIGMA_MM, max_iterations: int = 50) -> RobotCalibration:
+def identify(
+    robot: RobotModel,
+    intrinsics: Intrinsics,
+    views: list[PoseView],
+    *,
+    camera_frame: str = "camera",
+    with_intrinsics: bool = False,
+    parameters: list[str] | None = None,
+    survey_sigma_mm: float = SURVEY_SIGMA_MM,
+    max_iterations: int = 50,
+) -> RobotCalibration:
     """Calibrate ``robot`` (its nominal model) from ``views``; see the module's docstring.
     ``survey_sigma_mm``: how well the surveyed points are known (1-sigma per axis), added to the
     surveyed views' measured noise as the pixels it makes at each point's distance.
@@ -220,19 +250,25 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     start_r = problem.residuals(p0, b0)
     pixel_rows = np.concatenate([np.full(residual_count(v), v.target != OBJECT) for v in views])
     if not np.all(np.isfinite(start_r)):
-        raise RobotCalibrationError("some points project behind the camera with the nominal model: a view's joints or points are wrong")
+        raise RobotCalibrationError(
+            "some points project behind the camera with the nominal model: a view's joints or points are wrong"
+        )
     names = problem.corrected.layout.names
     J_all, Jb = problem.jacobian(p0, b0, list(range(problem.size)))
     obs = analyse(J_all, names, problem.corrected.layout.scale, Jb if Jb.size else None)
     if parameters is not None:
         unknown = [n for n in parameters if n not in names]
         if unknown:
-            raise RobotCalibrationError(f"no parameter {unknown[0]!r}; parameters are named like {names[0]} or camera.rz_mrad")
+            raise RobotCalibrationError(
+                f"no parameter {unknown[0]!r}; parameters are named like {names[0]} or camera.rz_mrad"
+            )
         chosen = sorted(names.index(n) for n in parameters)
         obs = replace(obs, identified=chosen, unidentified=[k for k in range(len(names)) if k not in chosen])
     chosen = obs.identified
     if not chosen:
-        raise RobotCalibrationError("the views determine no parameter: spread the poses (turn every joint, tilt the camera about two axes)")
+        raise RobotCalibrationError(
+            "the views determine no parameter: spread the poses (turn every joint, tilt the camera about two axes)"
+        )
     k = len(chosen)
 
     def unpack(x):
@@ -247,8 +283,20 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     weights = np.ones(group_of.size)
     # A surveyed point off by survey_sigma_mm moves its pixel by f * sigma / depth: a floor under the
     # surveyed points' noise that their few residuals cannot show (each view's points share one pose).
-    survey_px = np.concatenate([np.repeat(0.5 * (intrinsics.fu + intrinsics.fv) * survey_sigma_mm / np.maximum(apply(invert(robot.fk(v.joints_deg, camera_frame)), v.points_mm)[:, 2], 1.0), 2)
-                                if v.target == CELL else np.zeros(residual_count(v)) for v in views])
+    survey_px = np.concatenate(
+        [
+            np.repeat(
+                0.5
+                * (intrinsics.fu + intrinsics.fv)
+                * survey_sigma_mm
+                / np.maximum(apply(invert(robot.fk(v.joints_deg, camera_frame)), v.points_mm)[:, 2], 1.0),
+                2,
+            )
+            if v.target == CELL
+            else np.zeros(residual_count(v))
+            for v in views
+        ]
+    )
 
     def fun(x):
         return weights * problem.residuals(*unpack(x))
@@ -281,7 +329,7 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     r = np.where(kept, r_all, 0.0)
     dof = max(int(kept.sum()) - x0.size, 1)
     rp = r[pixel_rows]
-    noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float('nan')
+    noise = float(np.sqrt(rp @ rp / max(rp.size - x0.size, 1))) if rp.size else float("nan")
     J = fit.jac
     # The weighted residuals have unit variance when the groups' sigmas are right: scale by what they have.
     # A view's residuals share its error (a board view's blur and the board's flatness there, an object
@@ -294,15 +342,35 @@ def identify(robot: RobotModel, intrinsics: Intrinsics, views: list[PoseView], *
     sig = np.full(problem.size, np.nan)
     sig[chosen] = np.sqrt(np.clip(np.diag(cov)[:k], 0, None))
     problem.corrected.set(p)
-    per_view = {v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r_all[a:b] ** 2))) for v, a, b in zip(views, bounds[:-1], bounds[1:])}
+    per_view = {
+        v.name: float(np.sqrt((1.0 if v.target == OBJECT else 2.0) * np.mean(r_all[a:b] ** 2)))
+        for v, a, b in zip(views, bounds[:-1], bounds[1:])
+    }
     warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
     board2base = concat(problem.board0, delta_transform(board)) if problem.has_board else None
-    return RobotCalibration(names, p, sig, obs, board2base, float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))), per_view, noise,
-                            problem.corrected.calibrated_model(), problem.corrected.intrinsics(intrinsics), time.perf_counter() - started,
-                            float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))), warnings, cov[:k, :k], robot.copy(), camera_frame, weights.copy(),
-                            {groups[g]: v for g, v in group_sigma.items()}, left_out)
+    return RobotCalibration(
+        names,
+        p,
+        sig,
+        obs,
+        board2base,
+        float(np.sqrt(2.0 * np.mean(r[pixel_rows] ** 2))),
+        per_view,
+        noise,
+        problem.corrected.calibrated_model(),
+        problem.corrected.intrinsics(intrinsics),
+        time.perf_counter() - started,
+        float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))),
+        warnings,
+        cov[:k, :k],
+        robot.copy(),
+        camera_frame,
+        weights.copy(),
+        {groups[g]: v for g, v in group_sigma.items()},
+        left_out,
+    )
 
 
 def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray, kept: np.ndarray) -> dict[str, str]:
@@ -311,21 +379,29 @@ def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray,
     since one bad view raises the others' residuals too."""
     out = {}
     while True:
-        rms = {k: float(np.sqrt(np.mean(residuals[bounds[k]:bounds[k + 1]] ** 2))) for k, v in enumerate(views) if v.target == OBJECT and kept[bounds[k]]}
+        rms = {
+            k: float(np.sqrt(np.mean(residuals[bounds[k] : bounds[k + 1]] ** 2)))
+            for k, v in enumerate(views)
+            if v.target == OBJECT and kept[bounds[k]]
+        }
         if len(rms) < 4:
             return out
         median = float(np.median(list(rms.values())))
         worst = max(rms, key=rms.get)
         if rms[worst] <= max(OUTLIER_RATIO * median, 3.0):
             return out
-        kept[bounds[worst]:bounds[worst + 1]] = False
-        out[views[worst].name] = f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} (median)"
+        kept[bounds[worst] : bounds[worst + 1]] = False
+        out[views[worst].name] = (
+            f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} (median)"
+        )
 
 
 def pose_covariance(result: RobotCalibration, q_deg, frame: str = "camera") -> np.ndarray:
     """The covariance (6, 6) of ``frame``'s pose at joints ``q_deg`` from the identified parameters'
     covariance: translation (mm) then rotation vector (mrad), both in the base frame."""
-    corrected = CorrectedRobot(result.nominal, result.camera_frame, len(result.values) > 6 * (result.nominal.n_joints + 1))
+    corrected = CorrectedRobot(
+        result.nominal, result.camera_frame, len(result.values) > 6 * (result.nominal.n_joints + 1)
+    )
     corrected.set(result.values)
     T0 = corrected.robot.fk(q_deg, frame)
     ids = result.observability.identified

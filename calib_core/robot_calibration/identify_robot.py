@@ -49,8 +49,18 @@ class IdentifiedRobot:
     not_located: list[str] = field(default_factory=list)
 
 
-def identify_robot(robot: RobotModel, intrinsics: Intrinsics, workcell, board_views: Sequence[PoseView], cell_frames: Sequence[CellFrame] = (), *,
-                   visuals=None, extras: Sequence = (), with_intrinsics: bool = False, progress: Progress | None = None) -> IdentifiedRobot:
+def identify_robot(
+    robot: RobotModel,
+    intrinsics: Intrinsics,
+    workcell,
+    board_views: Sequence[PoseView],
+    cell_frames: Sequence[CellFrame] = (),
+    *,
+    visuals=None,
+    extras: Sequence = (),
+    with_intrinsics: bool = False,
+    progress: Progress | None = None,
+) -> IdentifiedRobot:
     """Identify ``robot`` (as it is now: nominal, or calibrated before, is the start) from
     ``board_views`` (detected ChArUco corners at their joints) and ``cell_frames`` (each component
     located by its edges through ``intrinsics`` against what the modelled camera would see: the

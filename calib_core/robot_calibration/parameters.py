@@ -37,8 +37,17 @@ def delta_transform(v: np.ndarray) -> np.ndarray:
 def corrected_intrinsics(nominal: Intrinsics, d: np.ndarray) -> Intrinsics:
     """``nominal`` with the corrections ``d`` (8,) in the units of :data:`INTRINSICS` applied."""
     dist = np.asarray(nominal.distortion, dtype=float).copy()
-    dist[:4] += np.asarray(d[4:8], dtype=float) / 1000.0  # the first four of any model: k1 k2 p1 p2, or a fisheye's k1..k4
-    return replace(nominal, fu=nominal.fu + d[0], fv=nominal.fv + d[1], cx=nominal.cx + d[2], cy=nominal.cy + d[3], distortion=tuple(dist))
+    dist[:4] += (
+        np.asarray(d[4:8], dtype=float) / 1000.0
+    )  # the first four of any model: k1 k2 p1 p2, or a fisheye's k1..k4
+    return replace(
+        nominal,
+        fu=nominal.fu + d[0],
+        fv=nominal.fv + d[1],
+        cx=nominal.cx + d[2],
+        cy=nominal.cy + d[3],
+        distortion=tuple(dist),
+    )
 
 
 def delta_of(T: np.ndarray) -> np.ndarray:
@@ -122,4 +131,3 @@ class CorrectedRobot:
 def joint_placement(robot: RobotModel, j: int) -> np.ndarray:
     """The placement (4, 4) mm of driven joint ``j`` (0-based) in its parent joint's frame."""
     return _to_mm(robot.model.jointPlacements[j + 1])
-

@@ -51,8 +51,18 @@ def _sees_board(robot: RobotModel, intrinsics: Intrinsics, q, board2base, corner
     return bool(np.all(np.isfinite(px)) and np.all(intrinsics.contains(px, EDGE_MARGIN_PX)))
 
 
-def plan_poses(robot: RobotModel, intrinsics: Intrinsics, spec, board2base: np.ndarray, n: int = 40, *, start_deg=None,
-               collisions=None, candidates: int = 160, seed: int = 0) -> PosePlan:
+def plan_poses(
+    robot: RobotModel,
+    intrinsics: Intrinsics,
+    spec,
+    board2base: np.ndarray,
+    n: int = 40,
+    *,
+    start_deg=None,
+    collisions=None,
+    candidates: int = 160,
+    seed: int = 0,
+) -> PosePlan:
     """``n`` poses (deg/mm) viewing the board at ``board2base`` (4, 4) mm; ``collisions`` a
     :class:`~calib_core.robot.collision.CollisionWorld` (``None``: not checked)."""
     start = np.zeros(robot.n_joints) if start_deg is None else np.asarray(start_deg, dtype=float)
@@ -72,12 +82,17 @@ def plan_poses(robot: RobotModel, intrinsics: Intrinsics, spec, board2base: np.n
     if not kept:
         return PosePlan([], len(pool), rejected, float("-inf"))
     # Each candidate's block of the identification Jacobian at the nominal model, board as nuisance.
-    views = [PoseView(f"c{k}", q, corners, project(apply(concat(board2base, invert(robot.fk(q, "camera"))), corners), intrinsics)) for k, q in enumerate(kept)]
+    views = [
+        PoseView(
+            f"c{k}", q, corners, project(apply(concat(board2base, invert(robot.fk(q, "camera"))), corners), intrinsics)
+        )
+        for k, q in enumerate(kept)
+    ]
     problem = _Problem(robot, intrinsics, views, "camera", True)
     problem.board0 = board2base
     J, Jb = problem.jacobian(np.zeros(problem.size), np.zeros(6), list(range(problem.size)))
     rows = 2 * len(corners)
-    blocks = [np.hstack([J[k * rows:(k + 1) * rows], Jb[k * rows:(k + 1) * rows]]) for k in range(len(kept))]
+    blocks = [np.hstack([J[k * rows : (k + 1) * rows], Jb[k * rows : (k + 1) * rows]]) for k in range(len(kept))]
     info_blocks = [B.T @ B for B in blocks]
     p = J.shape[1]
     total = sum(info_blocks)

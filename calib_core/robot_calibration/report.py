@@ -64,11 +64,15 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
             folded = concat(invert(_origin_mm(element)), before)
             _set_origin(element, concat(after, invert(folded)))
         else:
-            left.append(f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})")
+            left.append(
+                f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})"
+            )
     for mesh in root.iter("mesh"):  # package:// meshes as the description named them, not where this machine found them
         original = nominal.mesh_uris.get(mesh.get("filename", ""), "")
         if original.startswith("package://"):
-            mesh.set("filename", original)  # (a path relative to the original URDF stays absolute: the file is written elsewhere)
+            mesh.set(
+                "filename", original
+            )  # (a path relative to the original URDF stays absolute: the file is written elsewhere)
     return ET.tostring(root, encoding="unicode"), left
 
 
@@ -83,25 +87,50 @@ def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_f
     return {
         "units": {"length": "mm", "angle": "mrad for corrections, deg for rpy", "pixels": "px"},
         "model": "each joint's placement in its parent, and the camera's on its joint, corrected by a small transform applied before it, in the parent's frame",
-        "parameters": {name: {"value": round(float(v), 5), "sigma": (round(float(s), 5) if k in identified else None), "identified": k in identified}
-                       for k, (name, v, s) in enumerate(zip(result.names, result.values, result.sigmas))},
+        "parameters": {
+            name: {
+                "value": round(float(v), 5),
+                "sigma": (round(float(s), 5) if k in identified else None),
+                "identified": k in identified,
+            }
+            for k, (name, v, s) in enumerate(zip(result.names, result.values, result.sigmas))
+        },
         "observability": {
-            "identified": len(result.observability.identified), "of": len(result.names), "rank": result.observability.rank,
+            "identified": len(result.observability.identified),
+            "of": len(result.names),
+            "rank": result.observability.rank,
             "condition_number": round(result.observability.condition, 2),
             "unidentifiable_directions": [[f"{w:+.2f} {n}" for n, w in d] for d in result.observability.directions],
             "correlations_over_0_9": [[a, b, r] for a, b, r in result.observability.correlations],
         },
         "camera_on_parent": _xyz_rpy(result.robot.frame_placement(camera_frame)),
-        "intrinsics": {"fu": i.fu, "fv": i.fv, "cx": i.cx, "cy": i.cy, "distortion": list(i.distortion), "distortion_model": i.model},
+        "intrinsics": {
+            "fu": i.fu,
+            "fv": i.fv,
+            "cx": i.cx,
+            "cy": i.cy,
+            "distortion": list(i.distortion),
+            "distortion_model": i.model,
+        },
         "board2base": None if result.board2base is None else _xyz_rpy(result.board2base),
-        "rms_px": round(result.rms_px, 4), "start_rms_px": round(result.start_rms_px, 4), "noise_px": round(result.noise_px, 4),
+        "rms_px": round(result.rms_px, 4),
+        "start_rms_px": round(result.start_rms_px, 4),
+        "noise_px": round(result.noise_px, 4),
         "noise_by_target_px": {k: round(v, 4) for k, v in result.noise_by_target_px.items()},
         "per_view_rms_px": {k: round(v, 4) for k, v in result.per_view_rms_px.items()},
         "warnings": list(result.warnings),
     }
 
 
-def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal: RobotModel, camera_frame: str = "camera", *, robot: RobotModel | None = None, tool=None) -> tuple[Path, Path]:
+def save_robot_calibration(
+    folder: str | Path,
+    result: RobotCalibration,
+    nominal: RobotModel,
+    camera_frame: str = "camera",
+    *,
+    robot: RobotModel | None = None,
+    tool=None,
+) -> tuple[Path, Path]:
     """Write ``robot_calibration.yaml`` and ``<urdf stem>_calibrated.urdf`` into ``folder``, atomically.
     ``robot``: the robot to write (default the identification's; with the TCP from the grasps, say);
     ``tool``: the :class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool` it came from."""
@@ -109,12 +138,22 @@ def save_robot_calibration(folder: str | Path, result: RobotCalibration, nominal
     robot = robot or result.robot
     doc = calibration_document(result, nominal, camera_frame)
     if tool is not None:
-        doc["tcp2cam"] = {**_xyz_rpy(tool.tcp2cam), "grasps": len(tool.per_grasp),
-                          "spread_mm": round(tool.spread_mm, 4), "spread_deg": round(tool.spread_deg, 5),
-                          "measured": "the TCP in the camera frame, from the gripper closed on surveyed fixtures"}
-    doc["measured"] = ["the intrinsics (from the board views)", "the joints' placements the observability report lists as identified", "the camera's placement",
-                       "the board's placement"] + (["the TCP from the camera (grasps)"] if tool is not None else [])
-    doc["from_the_model"] = ["every parameter listed as not identified (left at the nominal value)"] + ([] if tool is not None else ["the TCP's placement on the flange"])
+        doc["tcp2cam"] = {
+            **_xyz_rpy(tool.tcp2cam),
+            "grasps": len(tool.per_grasp),
+            "spread_mm": round(tool.spread_mm, 4),
+            "spread_deg": round(tool.spread_deg, 5),
+            "measured": "the TCP in the camera frame, from the gripper closed on surveyed fixtures",
+        }
+    doc["measured"] = [
+        "the intrinsics (from the board views)",
+        "the joints' placements the observability report lists as identified",
+        "the camera's placement",
+        "the board's placement",
+    ] + (["the TCP from the camera (grasps)"] if tool is not None else [])
+    doc["from_the_model"] = ["every parameter listed as not identified (left at the nominal value)"] + (
+        [] if tool is not None else ["the TCP's placement on the flange"]
+    )
     urdf, left = calibrated_urdf(nominal, robot, camera_frame)
     doc["warnings"] += left
     yaml_path = folder / "robot_calibration.yaml"

@@ -57,8 +57,11 @@ class FollowJointTrajectoryClient:
 
     def server_ready(self) -> bool:
         """Every service of the action has a server that reads our requests and writes to our reply readers."""
-        return all(self._writers[s].get_publication_matched_status().current_count > 0
-                   and self._readers[s].get_subscription_matched_status().current_count > 0 for s in at.SERVICES)
+        return all(
+            self._writers[s].get_publication_matched_status().current_count > 0
+            and self._readers[s].get_subscription_matched_status().current_count > 0
+            for s in at.SERVICES
+        )
 
     def send_goal(self, goal: at.FollowJointTrajectoryGoal) -> bytes:
         """Send ``goal``; its id (16 random bytes) is returned, its acceptance comes through :meth:`poll`."""
@@ -81,7 +84,11 @@ class FollowJointTrajectoryClient:
         events = []
         for service, taker in self._takers.items():
             for reply in taker.take(20, timeout_s):
-                goal_id = self._pending.pop((service, int(reply.header.seq)), None) if int(reply.header.guid) == self._id else None
+                goal_id = (
+                    self._pending.pop((service, int(reply.header.seq)), None)
+                    if int(reply.header.guid) == self._id
+                    else None
+                )
                 if goal_id is None:
                     continue  # another client's reply
                 if service == "send_goal":
@@ -89,7 +96,15 @@ class FollowJointTrajectoryClient:
                     if reply.accepted:
                         self._request("get_result", goal_id, goal_id=at.UUID(list(goal_id)))
                 elif service == "get_result":
-                    events.append(ActionEvent("ended", goal_id, int(reply.status), int(reply.result.error_code), str(reply.result.error_string)))
+                    events.append(
+                        ActionEvent(
+                            "ended",
+                            goal_id,
+                            int(reply.status),
+                            int(reply.result.error_code),
+                            str(reply.result.error_string),
+                        )
+                    )
                 else:
                     events.append(ActionEvent("cancel", goal_id, int(reply.return_code)))
         return events

@@ -21,10 +21,23 @@ from calib_core.ros2.messages import Duration, Header, JointTrajectory, JointTra
 
 ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED, ABORTED = 1, 2, 3, 4, 5, 6
 """``action_msgs/GoalStatus`` values."""
-STATUS_NAMES = {0: "unknown", ACCEPTED: "accepted", EXECUTING: "executing", CANCELING: "canceling", SUCCEEDED: "succeeded",
-                CANCELED: "canceled", ABORTED: "aborted"}
-ERROR_NAMES = {0: "SUCCESSFUL", -1: "INVALID_GOAL", -2: "INVALID_JOINTS", -3: "OLD_HEADER_TIMESTAMP", -4: "PATH_TOLERANCE_VIOLATED",
-               -5: "GOAL_TOLERANCE_VIOLATED"}
+STATUS_NAMES = {
+    0: "unknown",
+    ACCEPTED: "accepted",
+    EXECUTING: "executing",
+    CANCELING: "canceling",
+    SUCCEEDED: "succeeded",
+    CANCELED: "canceled",
+    ABORTED: "aborted",
+}
+ERROR_NAMES = {
+    0: "SUCCESSFUL",
+    -1: "INVALID_GOAL",
+    -2: "INVALID_JOINTS",
+    -3: "OLD_HEADER_TIMESTAMP",
+    -4: "PATH_TOLERANCE_VIOLATED",
+    -5: "GOAL_TOLERANCE_VIOLATED",
+}
 """``FollowJointTrajectory`` result codes."""
 CANCEL_ERROR_NONE, CANCEL_ERROR_REJECTED, CANCEL_ERROR_UNKNOWN_GOAL_ID, CANCEL_ERROR_GOAL_TERMINATED = 0, 1, 2, 3
 
@@ -173,8 +186,11 @@ class FeedbackMessage(IdlStruct, typename="control_msgs::action::dds_::FollowJoi
     feedback: FollowJointTrajectoryFeedback = field(default_factory=FollowJointTrajectoryFeedback)
 
 
-SERVICES = {"send_goal": (SendGoalRequest, SendGoalResponse), "cancel_goal": (CancelGoalRequest, CancelGoalResponse),
-            "get_result": (GetResultRequest, GetResultResponse)}
+SERVICES = {
+    "send_goal": (SendGoalRequest, SendGoalResponse),
+    "cancel_goal": (CancelGoalRequest, CancelGoalResponse),
+    "get_result": (GetResultRequest, GetResultResponse),
+}
 """Each of an action's services: (request type, reply type), both with the request header."""
 
 

@@ -8,9 +8,24 @@ import numpy as np
 
 from calib_core.connectors.frame import VideoSourceError
 
-_BAYER = {"bayer_rggb8": cv2.COLOR_BayerRGGB2RGB, "bayer_bggr8": cv2.COLOR_BayerBGGR2RGB,
-          "bayer_gbrg8": cv2.COLOR_BayerGBRG2RGB, "bayer_grbg8": cv2.COLOR_BayerGRBG2RGB}
-_CHANNELS = {"rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4, "mono8": 1, "8UC1": 1, "8UC3": 3, "mono16": 1, "16UC1": 1, **{k: 1 for k in _BAYER}}
+_BAYER = {
+    "bayer_rggb8": cv2.COLOR_BayerRGGB2RGB,
+    "bayer_bggr8": cv2.COLOR_BayerBGGR2RGB,
+    "bayer_gbrg8": cv2.COLOR_BayerGBRG2RGB,
+    "bayer_grbg8": cv2.COLOR_BayerGRBG2RGB,
+}
+_CHANNELS = {
+    "rgb8": 3,
+    "bgr8": 3,
+    "rgba8": 4,
+    "bgra8": 4,
+    "mono8": 1,
+    "8UC1": 1,
+    "8UC3": 3,
+    "mono16": 1,
+    "16UC1": 1,
+    **{k: 1 for k in _BAYER},
+}
 SUPPORTED = tuple(_CHANNELS)
 
 
@@ -18,13 +33,17 @@ def image_to_rgb(message, where: str) -> np.ndarray:
     """(h, w, 3) uint8 RGB of a ``sensor_msgs/Image``; :class:`VideoSourceError` names ``where`` and the fault."""
     encoding = str(message.encoding)
     if encoding not in _CHANNELS:
-        raise VideoSourceError(f"{where}: image encoding {encoding!r} is not supported (supported: {', '.join(SUPPORTED)})")
+        raise VideoSourceError(
+            f"{where}: image encoding {encoding!r} is not supported (supported: {', '.join(SUPPORTED)})"
+        )
     channels = _CHANNELS[encoding]
     depth = 2 if encoding in ("mono16", "16UC1") else 1
     h, w, step = int(message.height), int(message.width), int(message.step)
     data = message.data if isinstance(message.data, (bytes, bytearray)) else bytes(message.data)
     if h <= 0 or w <= 0 or step < w * channels * depth or len(data) < h * step:
-        raise VideoSourceError(f"{where}: an image of {w} x {h} with step {step} needs {h * step} bytes, got {len(data)}")
+        raise VideoSourceError(
+            f"{where}: an image of {w} x {h} with step {step} needs {h * step} bytes, got {len(data)}"
+        )
     rows = np.frombuffer(data, np.uint8, count=h * step).reshape(h, step)[:, : w * channels * depth]
     if depth == 2:
         values = rows.view(">u2" if message.is_bigendian else "<u2").reshape(h, w)
@@ -49,10 +68,14 @@ def compressed_to_rgb(message, where: str, max_pixels: int = 50_000_000) -> np.n
     data = np.frombuffer(bytes(message.data), np.uint8)
     header = _size_of(bytes(message.data[:32]))
     if header is not None and header[0] * header[1] > max_pixels:
-        raise VideoSourceError(f"{where}: a compressed image of {header[0]} x {header[1]} px is over the limit of {max_pixels} px")
+        raise VideoSourceError(
+            f"{where}: a compressed image of {header[0]} x {header[1]} px is over the limit of {max_pixels} px"
+        )
     bgr = cv2.imdecode(data, cv2.IMREAD_COLOR)
     if bgr is None:
-        raise VideoSourceError(f"{where}: a {message.format or 'compressed'} image that does not decode ({len(data)} bytes)")
+        raise VideoSourceError(
+            f"{where}: a {message.format or 'compressed'} image that does not decode ({len(data)} bytes)"
+        )
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)
 
 

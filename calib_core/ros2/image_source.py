@@ -27,12 +27,16 @@ class Ros2ImageSource(FrameSource):
 
         parts = urlsplit(spec)
         if parts.netloc:
-            raise VideoSourceError(f"{spec!r}: a ros2 URL has no host (ros2:///camera/image_raw); the domain is ROS_DOMAIN_ID or ?domain=N")
+            raise VideoSourceError(
+                f"{spec!r}: a ros2 URL has no host (ros2:///camera/image_raw); the domain is ROS_DOMAIN_ID or ?domain=N"
+            )
         merged = dict(options or {})
         merged.update({k: v[-1] for k, v in parse_qs(parts.query).items()})
         unknown = set(merged) - _OPTIONS
         if unknown:
-            raise VideoSourceError(f"{spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+            raise VideoSourceError(
+                f"{spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}"
+            )
         topic = parts.path or "/camera/image_raw"
         self.compressed = topic.endswith("/compressed")
         base = topic[: -len("/compressed")] if self.compressed else topic
@@ -93,12 +97,16 @@ class Ros2ImageSource(FrameSource):
 
         with self._ready:
             if not self._ready.wait_for(lambda: self._newest is not None or self._stop.is_set(), self.timeout_s):
-                raise FrameTimeout(f"{self.description}: no image for {self.timeout_s:g} s (waiting for it; check the camera driver and ROS_DOMAIN_ID={self.domain})")
+                raise FrameTimeout(
+                    f"{self.description}: no image for {self.timeout_s:g} s (waiting for it; check the camera driver and ROS_DOMAIN_ID={self.domain})"
+                )
             if self._newest is None:
                 raise VideoSourceError(f"{self.description}: closed")
             message, t_arrival_host, t_arrival_epoch = self._newest
             self._newest = None
-        rgb = compressed_to_rgb(message, self.description) if self.compressed else image_to_rgb(message, self.description)
+        rgb = (
+            compressed_to_rgb(message, self.description) if self.compressed else image_to_rgb(message, self.description)
+        )
         stamp_s = message.header.stamp.ns() / 1e9
         age_s = t_arrival_epoch - stamp_s
         # However old the frame, its stamp dates it (a late frame must never pass for a new one); a zero stamp

@@ -27,7 +27,20 @@ from calib_core.frames import make_transform
 
 LAUNCH_SUFFIXES = (".launch.py", ".launch", ".launch.xml")
 _PUBLISHER = "static_transform_publisher"
-_NAMED = {"--x", "--y", "--z", "--qx", "--qy", "--qz", "--qw", "--roll", "--pitch", "--yaw", "--frame-id", "--child-frame-id"}
+_NAMED = {
+    "--x",
+    "--y",
+    "--z",
+    "--qx",
+    "--qy",
+    "--qz",
+    "--qw",
+    "--roll",
+    "--pitch",
+    "--yaw",
+    "--frame-id",
+    "--child-frame-id",
+}
 
 
 @dataclass(frozen=True)
@@ -72,8 +85,14 @@ def _python_nodes(path: Path, text: str) -> list[list[str]]:
         if not (isinstance(executable, ast.Constant) and executable.value == _PUBLISHER):
             continue
         arguments = keywords.get("arguments")
-        if not isinstance(arguments, (ast.List, ast.Tuple)) or not all(isinstance(a, ast.Constant) and isinstance(a.value, (str, int, float)) for a in arguments.elts):
-            raise FileFormatError(path, f"the {_PUBLISHER} node's arguments must be a list of constants (the file is read, never run)", "arguments")
+        if not isinstance(arguments, (ast.List, ast.Tuple)) or not all(
+            isinstance(a, ast.Constant) and isinstance(a.value, (str, int, float)) for a in arguments.elts
+        ):
+            raise FileFormatError(
+                path,
+                f"the {_PUBLISHER} node's arguments must be a list of constants (the file is read, never run)",
+                "arguments",
+            )
         out.append([str(a.value) for a in arguments.elts])
     return out
 
@@ -101,7 +120,9 @@ def _frames(path: Path, args: list[str]) -> tuple[str, str]:
 
 def _named(path: Path, args: list[str]) -> dict[str, str]:
     if len(args) % 2:
-        raise FileFormatError(path, f"{_PUBLISHER}'s named arguments come in pairs (--x 0.1 ...), got {len(args)} words", "arguments")
+        raise FileFormatError(
+            path, f"{_PUBLISHER}'s named arguments come in pairs (--x 0.1 ...), got {len(args)} words", "arguments"
+        )
     named = dict(zip(args[::2], args[1::2]))
     unknown = set(named) - _NAMED
     if unknown:
@@ -131,12 +152,21 @@ def _transform(path: Path, args: list[str]) -> StaticTransform:
         if quaternion and euler:
             raise FileFormatError(path, "both a quaternion and roll/pitch/yaw: give one", "arguments")
         if quaternion:
-            q = np.array([_number(path, named.get(k, "1" if k == "--qw" else "0"), k[2:]) for k in ("--qx", "--qy", "--qz", "--qw")])
+            q = np.array(
+                [
+                    _number(path, named.get(k, "1" if k == "--qw" else "0"), k[2:])
+                    for k in ("--qx", "--qy", "--qz", "--qw")
+                ]
+            )
             R = _quaternion(path, q)
         else:  # tf2's setRPY: fixed axes x, y, z (R = Rz(yaw) Ry(pitch) Rx(roll))
-            R = Rotation.from_euler("xyz", [_number(path, named.get(f"--{k}", "0"), k) for k in ("roll", "pitch", "yaw")]).as_matrix()
+            R = Rotation.from_euler(
+                "xyz", [_number(path, named.get(f"--{k}", "0"), k) for k in ("roll", "pitch", "yaw")]
+            ).as_matrix()
         parent, child = named["--frame-id"], named["--child-frame-id"]
-    elif len(args) == 10 or (len(args) == 9 and not _is_number(args[8])):  # x y z qx qy qz qw frame child [period: ROS 1's tf]
+    elif len(args) == 10 or (
+        len(args) == 9 and not _is_number(args[8])
+    ):  # x y z qx qy qz qw frame child [period: ROS 1's tf]
         xyz = [_number(path, a, n) for a, n in zip(args[:3], "xyz")]
         R = _quaternion(path, np.array([_number(path, a, n) for a, n in zip(args[3:7], ("qx", "qy", "qz", "qw"))]))
         parent, child = args[7], args[8]
@@ -146,8 +176,12 @@ def _transform(path: Path, args: list[str]) -> StaticTransform:
         R = Rotation.from_euler("xyz", [roll, pitch, yaw]).as_matrix()
         parent, child = args[6], args[7]
     else:
-        raise FileFormatError(path, f"{_PUBLISHER}'s arguments are not a transform: expected x y z yaw pitch roll frame child, "
-                                    f"x y z qx qy qz qw frame child, or the named form (--x ... --frame-id ...), got {' '.join(args)!r}", "arguments")
+        raise FileFormatError(
+            path,
+            f"{_PUBLISHER}'s arguments are not a transform: expected x y z yaw pitch roll frame child, "
+            f"x y z qx qy qz qw frame child, or the named form (--x ... --frame-id ...), got {' '.join(args)!r}",
+            "arguments",
+        )
     return StaticTransform(parent.lstrip("/"), child.lstrip("/"), make_transform(R, np.array(xyz) * 1000.0))
 
 

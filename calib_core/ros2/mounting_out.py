@@ -37,16 +37,18 @@ def static_transform_launch(camera2mount_mm, parent: str, child: str = DEFAULT_C
     qx, qy, qz, qw = Rotation.from_matrix(R).as_quat()
     numbers = {"x": xyz[0], "y": xyz[1], "z": xyz[2], "qx": qx, "qy": qy, "qz": qz, "qw": qw}
     args = ", ".join(f'"--{k}", "{v:.9g}"' for k, v in numbers.items())
-    return (f'"""Written by videocal on {date.today().isoformat()}: the camera mounting{": " + note if note else ""}.\n\n'
-            f"ros2 launch ./this_file.launch.py publishes {child} in {parent} on /tf_static (metres, quaternion x y z w).\n"
-            '"""\n\n'
-            "from launch import LaunchDescription\n"
-            "from launch_ros.actions import Node\n\n\n"
-            "def generate_launch_description():\n"
-            "    return LaunchDescription([\n"
-            '        Node(package="tf2_ros", executable="static_transform_publisher", name="videocal_camera_mounting",\n'
-            f'             arguments=[{args}, "--frame-id", "{parent}", "--child-frame-id", "{child}"]),\n'
-            "    ])\n")
+    return (
+        f'"""Written by videocal on {date.today().isoformat()}: the camera mounting{": " + note if note else ""}.\n\n'
+        f"ros2 launch ./this_file.launch.py publishes {child} in {parent} on /tf_static (metres, quaternion x y z w).\n"
+        '"""\n\n'
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n\n\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        '        Node(package="tf2_ros", executable="static_transform_publisher", name="videocal_camera_mounting",\n'
+        f'             arguments=[{args}, "--frame-id", "{parent}", "--child-frame-id", "{child}"]),\n'
+        "    ])\n"
+    )
 
 
 def _origin(camera2mount_mm) -> str:
@@ -63,36 +65,40 @@ def _header(note: str) -> str:
 def urdf_document(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:
     """A URDF that any parser reads alone: the ``parent`` link, the camera's ``child`` link and the fixed joint between
     them (check_urdf, urdf_parser_py, Pinocchio). Its joint and child link are what a robot's description takes."""
-    return ('<?xml version="1.0"?>\n' + _header(note) +
-            '<robot name="videocal_camera_mounting">\n'
-            f'  <link name="{parent}"/>\n'
-            f'  <link name="{child}"/>\n'
-            f'  <joint name="{child}_joint" type="fixed">\n'
-            f'    <parent link="{parent}"/>\n'
-            f'    <child link="{child}"/>\n'
-            f'    {_origin(camera2mount_mm)}\n'
-            "  </joint>\n"
-            "</robot>\n")
+    return (
+        '<?xml version="1.0"?>\n' + _header(note) + '<robot name="videocal_camera_mounting">\n'
+        f'  <link name="{parent}"/>\n'
+        f'  <link name="{child}"/>\n'
+        f'  <joint name="{child}_joint" type="fixed">\n'
+        f'    <parent link="{parent}"/>\n'
+        f'    <child link="{child}"/>\n'
+        f"    {_origin(camera2mount_mm)}\n"
+        "  </joint>\n"
+        "</robot>\n"
+    )
 
 
 def xacro_macro(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:
     """A xacro file defining the macro ``videocal_camera_mounting`` (parameters ``parent`` and ``child``, defaulting to
     these frames): ``<xacro:include filename="...">`` it in the robot's description and call
     ``<xacro:videocal_camera_mounting/>`` to add the camera's link and its fixed joint."""
-    return ('<?xml version="1.0"?>\n' + _header(note) +
-            '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
-            f'  <xacro:macro name="videocal_camera_mounting" params="parent:={parent} child:={child}">\n'
-            '    <link name="${child}"/>\n'
-            '    <joint name="${child}_joint" type="fixed">\n'
-            '      <parent link="${parent}"/>\n'
-            '      <child link="${child}"/>\n'
-            f'      {_origin(camera2mount_mm)}\n'
-            "    </joint>\n"
-            "  </xacro:macro>\n"
-            "</robot>\n")
+    return (
+        '<?xml version="1.0"?>\n' + _header(note) + '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        f'  <xacro:macro name="videocal_camera_mounting" params="parent:={parent} child:={child}">\n'
+        '    <link name="${child}"/>\n'
+        '    <joint name="${child}_joint" type="fixed">\n'
+        '      <parent link="${parent}"/>\n'
+        '      <child link="${child}"/>\n'
+        f"      {_origin(camera2mount_mm)}\n"
+        "    </joint>\n"
+        "  </xacro:macro>\n"
+        "</robot>\n"
+    )
 
 
-def mounting_text_for(path: str | Path, camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str | None:
+def mounting_text_for(
+    path: str | Path, camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = ""
+) -> str | None:
     """The text ``path``'s suffix asks for (``.launch.py``: the launch file; ``.urdf``: a URDF read alone; ``.xacro``:
     the xacro macro), or ``None`` for any other suffix (videocal's own YAML)."""
     name = Path(path).name.lower()

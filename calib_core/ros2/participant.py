@@ -24,7 +24,9 @@ def configure(domain: int, config_xml: str) -> None:
 
     with _lock:
         if domain in _participants or domain in _domains:
-            raise DomainConfiguredError(f"ROS domain {domain} is already in use in this process: its DDS configuration is fixed")
+            raise DomainConfiguredError(
+                f"ROS domain {domain} is already in use in this process: its DDS configuration is fixed"
+            )
         _domains[domain] = Domain(domain, config_xml)
 
 

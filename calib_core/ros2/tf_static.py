@@ -16,8 +16,11 @@ def transform_stamped(parent: str, child: str, child2parent_mm: np.ndarray, stam
     pose = np.asarray(child2parent_mm, dtype=float)
     x, y, z, w = Rotation.from_matrix(pose[:3, :3]).as_quat()
     t = pose[:3, 3] / 1000.0
-    return msg.TransformStamped(msg.Header(msg.Time.of_ns(stamp_ns), parent), child,
-                                msg.Transform(msg.Vector3(*map(float, t)), msg.Quaternion(float(x), float(y), float(z), float(w))))
+    return msg.TransformStamped(
+        msg.Header(msg.Time.of_ns(stamp_ns), parent),
+        child,
+        msg.Transform(msg.Vector3(*map(float, t)), msg.Quaternion(float(x), float(y), float(z), float(w))),
+    )
 
 
 class StaticTransformBroadcaster:

@@ -51,21 +51,34 @@ from calib_core.link.sample_order import SampleOrder
 from calib_core.ros2.joint_units import user_per_si
 
 DEFAULT_CONTROLLER = "joint_trajectory_controller"
-_OPTIONS = {"controller", "domain", "qos", "interface", "speed_deg_s", "done_tolerance_deg", "stale_after_s", "horizon_s"}
+_OPTIONS = {
+    "controller",
+    "domain",
+    "qos",
+    "interface",
+    "speed_deg_s",
+    "done_tolerance_deg",
+    "stale_after_s",
+    "horizon_s",
+}
 INTERFACES = ("auto", "action", "topic")
 
 
 def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
     parts = urlsplit(url)
     if parts.netloc:
-        raise LinkError(f"{url!r}: a ros2 URL has no host (ros2:///joint_states); the domain is ROS_DOMAIN_ID or ?domain=N")
+        raise LinkError(
+            f"{url!r}: a ros2 URL has no host (ros2:///joint_states); the domain is ROS_DOMAIN_ID or ?domain=N"
+        )
     topic = parts.path or "/joint_states"
     options = dict(context.options or {})
     for key, values in parse_qs(parts.query, keep_blank_values=True).items():
         options[key] = values[-1]
     unknown = set(options) - _OPTIONS
     if unknown:
-        raise LinkError(f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+        raise LinkError(
+            f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}"
+        )
     return topic, options
 
 
@@ -96,7 +109,9 @@ class Ros2TrajectoryController(ConnectorEvents):
             raise LinkError(f"ros2 option interface: one of {', '.join(INTERFACES)}, got {self.interface!r}")
         self.speed_deg_s = number_option(options, "speed_deg_s", 20.0, 0.1, 1000.0, "ros2")
         self.done_tolerance_deg = number_option(options, "done_tolerance_deg", 0.05, 1e-4, 10.0, "ros2")
-        self.stale_after_s = number_option(options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0, "ros2")
+        self.stale_after_s = number_option(
+            options, "stale_after_s", max(5.0 / context.rate_hz, 0.5), 0.05, 60.0, "ros2"
+        )
         self.horizon_s = number_option(options, "horizon_s", 0.5, 0.1, 30.0, "ros2")
         self.joint_states_topic = dds_topic(topic)
         self.trajectory_topic = dds_topic(f"/{self.controller}/joint_trajectory")
@@ -235,8 +250,12 @@ class Ros2TrajectoryController(ConnectorEvents):
         if self.interface == "action":
             if not self._goals.client.server_ready():
                 return f"no FollowJointTrajectory action server at {self.action_name} (is '{self.controller}' loaded and active?)"
-        elif self._writer.get_publication_matched_status().current_count == 0 and not (self._goals and self._goals.client.server_ready()):
-            where = f"/{self.trajectory_topic[3:]}" + (f" and no action server at {self.action_name}" if self._goals else "")
+        elif self._writer.get_publication_matched_status().current_count == 0 and not (
+            self._goals and self._goals.client.server_ready()
+        ):
+            where = f"/{self.trajectory_topic[3:]}" + (
+                f" and no action server at {self.action_name}" if self._goals else ""
+            )
             return f"no trajectory controller subscribes to {where} (is '{self.controller}' loaded and active?)"
         return None
 
@@ -247,7 +266,11 @@ class Ros2TrajectoryController(ConnectorEvents):
         latest = self._latest
         line = target - start
         length2 = float(line @ line)
-        s_measured = 0.0 if length2 == 0.0 or latest is None else float(np.clip((np.asarray(latest.joints_deg) - start) @ line / length2, 0.0, 1.0))
+        s_measured = (
+            0.0
+            if length2 == 0.0 or latest is None
+            else float(np.clip((np.asarray(latest.joints_deg) - start) @ line / length2, 0.0, 1.0))
+        )
         s_next = min(1.0, max(self._s_commanded, s_measured + self.horizon_now_s / duration_s))
         self._publish(start + s_next * line, max((s_next - s_measured) * duration_s, 0.05))
         self._s_commanded, self._renewed_s = s_next, now
@@ -262,14 +285,20 @@ class Ros2TrajectoryController(ConnectorEvents):
             if move is None or move.finished:
                 self._path = None
                 return
-            if self._s_commanded >= 1.0 or self._state is not LinkState.UP or now - self._renewed_s < self.horizon_s / 3.0:
+            if (
+                self._s_commanded >= 1.0
+                or self._state is not LinkState.UP
+                or now - self._renewed_s < self.horizon_s / 3.0
+            ):
                 return
             self._renew(now)
 
     def _publish(self, q_user: np.ndarray, duration_s: float) -> None:
         from calib_core.ros2 import messages as msg
 
-        point = msg.JointTrajectoryPoint(positions=[float(v) for v in q_user / self._per_si], time_from_start=msg.Duration.of_s(duration_s))
+        point = msg.JointTrajectoryPoint(
+            positions=[float(v) for v in q_user / self._per_si], time_from_start=msg.Duration.of_s(duration_s)
+        )
         # An empty stamp: the controller starts the trajectory on receipt (its own clock, not ours).
         trajectory = msg.JointTrajectory(msg.Header(), list(self.joint_names), [point])
         if self._through_action:
@@ -311,7 +340,11 @@ class Ros2TrajectoryController(ConnectorEvents):
         if self._state is LinkState.CONNECTING and now - self._types_checked_s >= TYPE_CHECK_S:
             self._say_foreign_types(now)
         last = self._last_sample_s
-        if self._state is LinkState.UP and last is not None and now - last > self.stale_after_s + self._arrival.spread_s:
+        if (
+            self._state is LinkState.UP
+            and last is not None
+            and now - last > self.stale_after_s + self._arrival.spread_s
+        ):
             self._set_state(LinkState.STALE, f"no joint states for {now - last:.1f} s")
             # A move under way cannot be followed any more: it ends now, not at its deadline (it is not renewed either).
             self._moves.finish(MoveError(f"the joint states stopped ({now - last:.1f} s): the robot's pose is unknown"))
@@ -328,8 +361,10 @@ class Ros2TrajectoryController(ConnectorEvents):
 
         foreign = self._types.foreign(self.joint_states_topic, msg.JointState.__idl_typename__)
         if foreign:
-            self.last_error = (f"{self.joint_states_topic[2:]} on ROS domain {self.domain} carries {', '.join(foreign)}, not sensor_msgs/msg/JointState: "
-                               "name the topic of the arm's joint states (ros2:///TOPIC)")
+            self.last_error = (
+                f"{self.joint_states_topic[2:]} on ROS domain {self.domain} carries {', '.join(foreign)}, not sensor_msgs/msg/JointState: "
+                "name the topic of the arm's joint states (ros2:///TOPIC)"
+            )
             self._restate(self.last_error)
 
     def _on_joint_state(self, message) -> None:
@@ -351,7 +386,9 @@ class Ros2TrajectoryController(ConnectorEvents):
             return
         q = q_si * self._per_si
         t_ns = message.header.stamp.ns()
-        sample = TimedSample(JointSample(next(self._seq), t_ns // 1_000_000, tuple(float(v) for v in q)), time.monotonic())
+        sample = TimedSample(
+            JointSample(next(self._seq), t_ns // 1_000_000, tuple(float(v) for v in q)), time.monotonic()
+        )
         self._arrival.add(t_ns / 1e9, time.time())
         with self._lock:
             if not self._order.admit(sample.sample):
@@ -377,8 +414,10 @@ def foreign_joints_text(topic: str, received: list[str], wanted: list[str]) -> s
     """What to tell a user whose joint states name other joints than the cell's robot: which names came, which are
     missing, and the renaming that would match them when one does (a prefix the driver adds, say)."""
     missing = [n for n in wanted if n not in received]
-    text = (f"{topic} arrives without this cell's joints: it names {', '.join(received[:8]) or 'no joint'}"
-            f"{' ...' if len(received) > 8 else ''}; missing {', '.join(missing[:6])}{' ...' if len(missing) > 6 else ''}")
+    text = (
+        f"{topic} arrives without this cell's joints: it names {', '.join(received[:8]) or 'no joint'}"
+        f"{' ...' if len(received) > 8 else ''}; missing {', '.join(missing[:6])}{' ...' if len(missing) > 6 else ''}"
+    )
     mapping = suggest_joint_names(wanted, received)
     if mapping:
         pairs = ", ".join(f"{a} -> {b}" for a, b in list(mapping.items())[:3])

@@ -25,7 +25,9 @@ class Ros2NameError(VideocalError, ValueError):
 def dds_topic(ros_topic: str) -> str:
     """``/ns/name`` -> ``rt/ns/name`` (a relative name is taken in the root namespace)."""
     if not _NAME.match(ros_topic) or "//" in ros_topic or ros_topic.endswith("/"):
-        raise Ros2NameError(f"{ros_topic!r} is not a ROS 2 topic name (letters, digits, _ and /, not starting with a digit)")
+        raise Ros2NameError(
+            f"{ros_topic!r} is not a ROS 2 topic name (letters, digits, _ and /, not starting with a digit)"
+        )
     return "rt/" + ros_topic.lstrip("/")
 
 
@@ -43,7 +45,11 @@ def domain_id(given: int | str | None = None) -> int:
 
 def default_qos(depth: int = 10) -> Qos:
     """ROS 2's default (``rmw_qos_profile_default``)."""
-    return Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(depth))
+    return Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)),
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(depth),
+    )
 
 
 def sensor_qos(depth: int = 5) -> Qos:
@@ -53,4 +59,8 @@ def sensor_qos(depth: int = 5) -> Qos:
 
 def static_tf_qos() -> Qos:
     """tf2_ros's ``/tf_static``: a late subscriber still receives the latest message."""
-    return Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.TransientLocal, Policy.History.KeepLast(1))
+    return Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)),
+        Policy.Durability.TransientLocal,
+        Policy.History.KeepLast(1),
+    )

@@ -9,11 +9,21 @@ import importlib
 # Submodule of each public name. They load on first use (PEP 562): the numba kernels behind
 # ``solve_pose`` cost a few tenths of a second to import, which the window's start need not pay.
 _WHERE = {
-    "BatchPoseSolution": "batch", "solve_pose_batch": "batch",
-    "DegenerateGeometryError": "errors", "DuplicatePointsError": "errors", "InvalidIntrinsicsError": "errors", "MismatchedPointsError": "errors",
-    "NonFiniteInputError": "errors", "PointsBehindCameraError": "errors", "SolverInputError": "errors", "TooFewPointsError": "errors",
-    "PoseCandidate": "solution", "PoseSolution": "solution", "SolveStatus": "solution",
-    "refine_pose": "solve", "solve_pose": "solve",
+    "BatchPoseSolution": "batch",
+    "solve_pose_batch": "batch",
+    "DegenerateGeometryError": "errors",
+    "DuplicatePointsError": "errors",
+    "InvalidIntrinsicsError": "errors",
+    "MismatchedPointsError": "errors",
+    "NonFiniteInputError": "errors",
+    "PointsBehindCameraError": "errors",
+    "SolverInputError": "errors",
+    "TooFewPointsError": "errors",
+    "PoseCandidate": "solution",
+    "PoseSolution": "solution",
+    "SolveStatus": "solution",
+    "refine_pose": "solve",
+    "solve_pose": "solve",
 }
 
 
@@ -24,7 +34,19 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "solve_pose", "refine_pose", "solve_pose_batch", "PoseSolution", "PoseCandidate", "SolveStatus", "BatchPoseSolution",
-    "SolverInputError", "TooFewPointsError", "MismatchedPointsError", "NonFiniteInputError", "DuplicatePointsError",
-    "DegenerateGeometryError", "PointsBehindCameraError", "InvalidIntrinsicsError",
+    "solve_pose",
+    "refine_pose",
+    "solve_pose_batch",
+    "PoseSolution",
+    "PoseCandidate",
+    "SolveStatus",
+    "BatchPoseSolution",
+    "SolverInputError",
+    "TooFewPointsError",
+    "MismatchedPointsError",
+    "NonFiniteInputError",
+    "DuplicatePointsError",
+    "DegenerateGeometryError",
+    "PointsBehindCameraError",
+    "InvalidIntrinsicsError",
 ]

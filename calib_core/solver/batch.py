@@ -25,7 +25,6 @@ from calib_core.solver.problem import check_intrinsics
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
 
 
-
 @dataclass(frozen=True)
 class BatchPoseSolution:
     """Per-problem results, each with the batch size ``b`` first.
@@ -65,17 +64,30 @@ def _check_batch(points_3d, points_2d, estimate_focal) -> tuple[np.ndarray, np.n
     P = np.asarray(points_3d, dtype=float)
     uv = np.asarray(points_2d, dtype=float)
     if P.ndim != 3 or P.shape[2] != 3 or uv.shape != P.shape[:2] + (2,):
-        raise MismatchedPointsError(f"batch: expected points_3d (b, n, 3) and points_2d (b, n, 2), got {P.shape} and {uv.shape}")
+        raise MismatchedPointsError(
+            f"batch: expected points_3d (b, n, 3) and points_2d (b, n, 2), got {P.shape} and {uv.shape}"
+        )
     needed = 4 if estimate_focal else 3
     if P.shape[1] < needed:
         raise TooFewPointsError(f"batch: {P.shape[1]} point pairs per problem, at least {needed} needed")
     bad = np.flatnonzero(~(np.isfinite(P).all(axis=(1, 2)) & np.isfinite(uv).all(axis=(1, 2))))
     if len(bad):
-        raise NonFiniteInputError(f"batch: problems {', '.join(map(str, bad[:10]))} contain NaN or infinite coordinates")
+        raise NonFiniteInputError(
+            f"batch: problems {', '.join(map(str, bad[:10]))} contain NaN or infinite coordinates"
+        )
     return P, uv
 
 
-def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, starts: ArrayLike | None = None, estimate_focal: bool = False, sigma_px: float | None = None, max_iterations: int = 100) -> BatchPoseSolution:
+def solve_pose_batch(
+    points_3d: ArrayLike,
+    points_2d: ArrayLike,
+    intrinsics: Intrinsics,
+    *,
+    starts: ArrayLike | None = None,
+    estimate_focal: bool = False,
+    sigma_px: float | None = None,
+    max_iterations: int = 100,
+) -> BatchPoseSolution:
     """Solve ``b`` independent problems: ``points_3d`` (b, n, 3) mm, ``points_2d`` (b, n, 2) px.
 
     ``starts`` (b, 4, 4): starting ``obj2cam`` poses; without them each problem is seeded
@@ -84,7 +96,9 @@ def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Int
     check_intrinsics(intrinsics)
     P, uv = _check_batch(points_3d, points_2d, estimate_focal)
     b, n, _ = P.shape
-    if intrinsics.model != "plumb_bob":  # the kernel knows OpenCV's 5-parameter lens: the ideal pinhole sees the same rays
+    if (
+        intrinsics.model != "plumb_bob"
+    ):  # the kernel knows OpenCV's 5-parameter lens: the ideal pinhole sees the same rays
         flat, intrinsics = as_pinhole(uv.reshape(-1, 2), intrinsics)
         uv = np.ascontiguousarray(flat.reshape(b, n, 2))
     if starts is not None:
@@ -93,7 +107,11 @@ def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Int
             raise MismatchedPointsError(f"batch: starts must be ({b}, 4, 4), got {S.shape}")
         R, t = S[:, :3, :3].copy(), S[:, :3, 3].copy()
     else:
-        R, t, usable = _dlt_seeds(np.ascontiguousarray(P), uv, intrinsics) if n >= 6 else (np.zeros((b, 3, 3)), np.zeros((b, 3)), np.zeros(b, bool))
+        R, t, usable = (
+            _dlt_seeds(np.ascontiguousarray(P), uv, intrinsics)
+            if n >= 6
+            else (np.zeros((b, 3, 3)), np.zeros((b, 3)), np.zeros(b, bool))
+        )
         for i in np.flatnonzero(~usable):
             seed = sqpnp_seed(P[i], uv[i], intrinsics, intrinsics.fu, intrinsics.fv)
             if seed:
@@ -104,7 +122,23 @@ def solve_pose_batch(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Int
     J = np.empty((b, n, 2, 8 if estimate_focal else 6))
     iterations = np.zeros(b, dtype=np.int64)
     outcomes = np.zeros(b, dtype=np.int64)
-    newton_batch(PINHOLE, np.ascontiguousarray(P), np.ascontiguousarray(uv), R, t, f, intrinsics.cx, intrinsics.cy, intrinsics.dist_coeffs, estimate_focal, max_iterations, r, J, iterations, outcomes)
+    newton_batch(
+        PINHOLE,
+        np.ascontiguousarray(P),
+        np.ascontiguousarray(uv),
+        R,
+        t,
+        f,
+        intrinsics.cx,
+        intrinsics.cy,
+        intrinsics.dist_coeffs,
+        estimate_focal,
+        max_iterations,
+        r,
+        J,
+        iterations,
+        outcomes,
+    )
     converged = (outcomes == CONVERGED) | (outcomes == EXACT_FIT)
     return _summarise(R, t, f[:, 0], f[:, 1], r, J, iterations, converged, sigma_px)
 
@@ -134,7 +168,14 @@ def _summarise(R, t, fu, fv, r, J, iterations, converged, sigma_px) -> BatchPose
     A = np.concatenate([-Rt, -Rt @ t_cross], axis=2)
     cov_c = A @ cov[:, :6, :6] @ np.swapaxes(A, 1, 2)
     return BatchPoseSolution(
-        obj2cam=obj2cam, fu=fu, fv=fv, rms_px=np.sqrt(cost / n), iterations=iterations, converged=converged,
-        std_t_obj2cam_mm=np.sqrt(var[:, :3]), std_rotation_deg=np.degrees(np.sqrt(var[:, 3:6])),
-        std_camera_position_mm=np.sqrt(np.einsum("bii->bi", cov_c)), sigma_px=sigma,
+        obj2cam=obj2cam,
+        fu=fu,
+        fv=fv,
+        rms_px=np.sqrt(cost / n),
+        iterations=iterations,
+        converged=converged,
+        std_t_obj2cam_mm=np.sqrt(var[:, :3]),
+        std_rotation_deg=np.degrees(np.sqrt(var[:, 3:6])),
+        std_camera_position_mm=np.sqrt(np.einsum("bii->bi", cov_c)),
+        sigma_px=sigma,
     )

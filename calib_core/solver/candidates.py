@@ -37,7 +37,17 @@ class RefinedPose:
     """(n,) bool: the pairs it was fitted to by least squares (a consensus refinement), or ``None`` (all)."""
 
 
-def refine_seed(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, huber_px: float | None, *, damped: bool = True, max_iterations: int = 100) -> RefinedPose | None:
+def refine_seed(
+    problem: PoseProblem,
+    R: np.ndarray,
+    t_mm: np.ndarray,
+    fu: float,
+    fv: float,
+    huber_px: float | None,
+    *,
+    damped: bool = True,
+    max_iterations: int = 100,
+) -> RefinedPose | None:
     """Refine one seed pose in the problem's model; ``None`` if the seed is unusable."""
     paper = problem.model == "paper"
     start_t = paper_shift_from_pose(t_mm, problem.intrinsics, fu, fv) if paper else t_mm
@@ -48,7 +58,15 @@ def refine_seed(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float
         return None
     t_f = pose_translation_from_paper_shift(result.t, problem.intrinsics, result.fu, result.fv) if paper else result.t
     cost = float(np.sum(result.residuals**2))
-    return RefinedPose(pose_matrix(result.R, t_f), result.fu, result.fv, cost, float(np.sqrt(cost / problem.n_points)), result.converged, result)
+    return RefinedPose(
+        pose_matrix(result.R, t_f),
+        result.fu,
+        result.fv,
+        cost,
+        float(np.sqrt(cost / problem.n_points)),
+        result.converged,
+        result,
+    )
 
 
 def same_pose(a: np.ndarray, b: np.ndarray) -> bool:

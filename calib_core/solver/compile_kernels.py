@@ -50,7 +50,9 @@ def compile_kernels() -> float:
     uv[:8] = rng.uniform(0.0, 900.0, (8, 2))
     solve_pose(points, uv, pinhole, robust=True, sigma_px=0.5)
     scenes = [_scene(6, rng) for _ in range(4)]
-    solve_pose_batch(np.array([p for p, _ in scenes]), np.array([project_points(p, T, pinhole) for p, T in scenes]), pinhole)
+    solve_pose_batch(
+        np.array([p for p, _ in scenes]), np.array([project_points(p, T, pinhole) for p, T in scenes]), pinhole
+    )
     return time.perf_counter() - t0
 
 

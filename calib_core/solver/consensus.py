@@ -39,8 +39,18 @@ def by_consensus(poses: list[RefinedPose], threshold_px: float) -> tuple[list[Re
     return [poses[k] for _, _, k in scored], [score for _, score, _ in scored]
 
 
-def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: float, fv: float, threshold_px: float, *, rounds: int = 4,
-                     inliers: np.ndarray | None = None, noise_floor_px: float | None = None) -> RefinedPose | None:
+def consensus_refine(
+    problem: PoseProblem,
+    R: np.ndarray,
+    t_mm: np.ndarray,
+    fu: float,
+    fv: float,
+    threshold_px: float,
+    *,
+    rounds: int = 4,
+    inliers: np.ndarray | None = None,
+    noise_floor_px: float | None = None,
+) -> RefinedPose | None:
     """Local optimisation as LO-RANSAC does it, in place of Huber's loss (which, with few pairs, walks from
     the right pose to one that spreads a mis-click over good pairs: 170 mm off from a right seed): the pairs
     within reach of the pose, least squares on those alone, again until the set stays. The result's
@@ -57,7 +67,9 @@ def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: 
         if inliers.sum() < minimal:
             return None
         idx = np.flatnonzero(inliers)
-        sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+        sub = replace(
+            problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=()
+        )
         fit = refine_seed(sub, R, t_mm, fu, fv, None)
         if fit is None or not np.all(np.isfinite(fit.obj2cam)):
             return None
@@ -78,7 +90,9 @@ def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: 
             break
         inliers = inliers | admit
         idx = np.flatnonzero(inliers)
-        sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+        sub = replace(
+            problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=()
+        )
         again = refine_seed(sub, R, t_mm, fu, fv, None)
         if again is None or not np.all(np.isfinite(again.obj2cam)):
             break
@@ -87,7 +101,9 @@ def consensus_refine(problem: PoseProblem, R: np.ndarray, t_mm: np.ndarray, fu: 
         r, J, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
     newton = NewtonResult(R, t_mm, fu, fv, r, J, fit.newton.iterations, fit.newton.outcome)
     cost = float(np.sum(r**2))
-    return RefinedPose(fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton, inliers.copy())
+    return RefinedPose(
+        fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton, inliers.copy()
+    )
 
 
 RIVAL_CHECK_POINTS = 10
@@ -104,8 +120,22 @@ def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
     if sub.n_points < 4 or sub.coplanar:
         return None
     intr = sub.intrinsics
-    out = p3p_newton_summary(sub.points_3d, sub.points_2d, chosen.fu, chosen.fv, intr.cx, intr.cy, sub.distortion, 100, -1.0, DEFAULT_SIGMA_PX,
-                             1e9, -1.0, 1.0, 0.0)
+    out = p3p_newton_summary(
+        sub.points_3d,
+        sub.points_2d,
+        chosen.fu,
+        chosen.fv,
+        intr.cx,
+        intr.cy,
+        sub.distortion,
+        100,
+        -1.0,
+        DEFAULT_SIGMA_PX,
+        1e9,
+        -1.0,
+        1.0,
+        0.0,
+    )
     if out is None:
         return None
     return refine_seed(sub, out[0], out[1], chosen.fu, chosen.fv, None)
@@ -132,7 +162,13 @@ def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) 
             subset = chosen.inliers.copy()
             subset[swap], subset[out] = False, True
             idx = np.flatnonzero(subset)
-            sub = replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+            sub = replace(
+                problem,
+                points_3d=problem.points_3d[idx],
+                points_2d=problem.points_2d[idx],
+                off_image=(),
+                repeated_3d=(),
+            )
             fit = refine_seed(sub, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv, None)
             if fit is None or not fit.converged or fit.cost > limit:
                 # from the chosen pose the swapped set's own minimum may be out of reach (a rival tens of mm away):
@@ -141,7 +177,13 @@ def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) 
             if fit is None or not fit.converged or fit.cost > limit:
                 continue
             r, J, _ = residuals_and_jacobian(problem, fit.newton.R, fit.newton.t, fit.fu, fit.fv)
-            newton = NewtonResult(fit.newton.R, fit.newton.t, fit.fu, fit.fv, r, J, fit.newton.iterations, fit.newton.outcome)
+            newton = NewtonResult(
+                fit.newton.R, fit.newton.t, fit.fu, fit.fv, r, J, fit.newton.iterations, fit.newton.outcome
+            )
             cost = float(np.sum(r**2))
-            rivals.append(RefinedPose(fit.obj2cam, fit.fu, fit.fv, cost, float(np.sqrt(cost / problem.n_points)), True, newton, subset))
+            rivals.append(
+                RefinedPose(
+                    fit.obj2cam, fit.fu, fit.fv, cost, float(np.sqrt(cost / problem.n_points)), True, newton, subset
+                )
+            )
     return rivals

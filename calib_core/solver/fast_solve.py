@@ -24,10 +24,18 @@ P3P_SEEDED_UP_TO = 8
 
 
 def applies(problem: PoseProblem, robust: bool) -> bool:
-    return problem.n_points >= 4 and not problem.coplanar and not problem.estimate_focal and problem.model == "pinhole" and not robust
+    return (
+        problem.n_points >= 4
+        and not problem.coplanar
+        and not problem.estimate_focal
+        and problem.model == "pinhole"
+        and not robust
+    )
 
 
-def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float, ambiguity_chi2: float = 9.0) -> PoseSolution | None:
+def fast_solve(
+    problem: PoseProblem, sigma_px: float | None, limit_px: float, ambiguity_chi2: float = 9.0
+) -> PoseSolution | None:
     """Solve ``problem`` through the compiled fast path, or ``None`` to fall back. With fewer than
     six pairs, a second minimum costing within ``ambiguity_chi2`` noise variances of the best is an
     ambiguity the full search reports (the same rule)."""
@@ -35,13 +43,38 @@ def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float, am
     sigma = -1.0 if sigma_px is None else float(sigma_px)
     out = None
     if problem.n_points >= SEEDED_BY_DLT:
-        out = dlt_newton_summary(problem.points_3d, problem.points_2d, intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX)
+        out = dlt_newton_summary(
+            problem.points_3d,
+            problem.points_2d,
+            intr.fu,
+            intr.fv,
+            intr.cx,
+            intr.cy,
+            problem.distortion,
+            _MAX_ITERATIONS,
+            sigma,
+            DEFAULT_SIGMA_PX,
+        )
     if out is None and problem.n_points <= P3P_SEEDED_UP_TO:
         # (six to eight pairs whose DLT found no seed, a noisy near-minimal DLT, take the triplets' roots as four do)
         # A P3P root that puts all the pairs more than ten times the limit off is refuted by them;
         # every minimum that fits them has a root of each triplet near it.
-        out = p3p_newton_summary(problem.points_3d, problem.points_2d, intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX,
-                                 10.0 * limit_px, ambiguity_chi2 * noise_px(sigma_px) ** 2, np.cos(np.radians(SAME_POSE_DEG)), SAME_POSE_REL * 1e3)
+        out = p3p_newton_summary(
+            problem.points_3d,
+            problem.points_2d,
+            intr.fu,
+            intr.fv,
+            intr.cx,
+            intr.cy,
+            problem.distortion,
+            _MAX_ITERATIONS,
+            sigma,
+            DEFAULT_SIGMA_PX,
+            10.0 * limit_px,
+            ambiguity_chi2 * noise_px(sigma_px) ** 2,
+            np.cos(np.radians(SAME_POSE_DEG)),
+            SAME_POSE_REL * 1e3,
+        )
     if out is None:
         return None
     R, t, r, J, cov, cov_c, loo, scalars = out
@@ -54,15 +87,27 @@ def fast_solve(problem: PoseProblem, sigma_px: float | None, limit_px: float, am
     n = len(r)
     fisher = 2.0 * fisher_quantile(n, 2 * n - 8) if 2 * n - 8 >= OWN_SCALE_MIN_DOF else np.inf
     # (a scale of zero is an exact fit: every residual is zero and no pair can be flagged)
-    if sigma > 0.0 and flags_a_misfit(J, r, cov / sigma**2, noise_px(sigma_px), fisher, OWN_SCALE_MIN_DOF, FALSE_FLAG_PER_SOLVE) != 0:
+    if (
+        sigma > 0.0
+        and flags_a_misfit(J, r, cov / sigma**2, noise_px(sigma_px), fisher, OWN_SCALE_MIN_DOF, FALSE_FLAG_PER_SOLVE)
+        != 0
+    ):
         return None
     obj2cam = np.zeros((4, 4))
     obj2cam[:3, :3] = R
     obj2cam[:3, 3] = t
     obj2cam[3, 3] = 1.0
     return PoseSolution(
-        status=SolveStatus.OK, obj2cam=obj2cam, fu=intr.fu, fv=intr.fv, model="pinhole", iterations=int(iterations),
-        residuals_px=r, uncertainty=uncertainty_from(cov, cov_c, sigma, int(source), condition), leave_one_out_px=loo,
-        outliers=np.zeros(len(r), dtype=bool), candidates=(PoseCandidate(obj2cam, intr.fu, intr.fv, float(rms)),),
+        status=SolveStatus.OK,
+        obj2cam=obj2cam,
+        fu=intr.fu,
+        fv=intr.fv,
+        model="pinhole",
+        iterations=int(iterations),
+        residuals_px=r,
+        uncertainty=uncertainty_from(cov, cov_c, sigma, int(source), condition),
+        leave_one_out_px=loo,
+        outliers=np.zeros(len(r), dtype=bool),
+        candidates=(PoseCandidate(obj2cam, intr.fu, intr.fv, float(rms)),),
         warnings=tuple(operator_warnings(problem, condition, noise_px(sigma_px))),
     )

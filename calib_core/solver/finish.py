@@ -38,16 +38,26 @@ def operator_warnings(problem: PoseProblem, condition_number: float, noise: floa
     for i, j in problem.repeated_3d:
         apart = float(np.linalg.norm(problem.points_2d[i] - problem.points_2d[j]))
         if apart > 3.0 * np.sqrt(2.0) * noise:  # two picks of one point differ by more than their noise allows
-            warnings.append(f"{point_label(i)} and {point_label(j)} are the same 3D point picked {apart:.1f} px apart: one of the two picks is off")
+            warnings.append(
+                f"{point_label(i)} and {point_label(j)} are the same 3D point picked {apart:.1f} px apart: one of the two picks is off"
+            )
     intr = problem.intrinsics
     if not (0.0 <= intr.cx <= intr.width and 0.0 <= intr.cy <= intr.height):
-        warnings.append(f"the principal point ({intr.cx:.1f}, {intr.cy:.1f}) px lies outside the {intr.width}x{intr.height} image: check the camera file")
+        warnings.append(
+            f"the principal point ({intr.cx:.1f}, {intr.cy:.1f}) px lies outside the {intr.width}x{intr.height} image: check the camera file"
+        )
     if problem.n_points * 2 <= problem.n_params:
-        warnings.append(f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click")
+        warnings.append(
+            f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click"
+        )
     if condition_number > _POOR_CONDITION:
-        warnings.append(f"the pose is poorly determined (condition number {condition_number:.3g}): spread the points over more of the object and the image")
+        warnings.append(
+            f"the pose is poorly determined (condition number {condition_number:.3g}): spread the points over more of the object and the image"
+        )
     if problem.off_image:
-        warnings.append(f"{points_label(problem.off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image")
+        warnings.append(
+            f"{points_label(problem.off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image"
+        )
     if problem.model == "paper" and problem.intrinsics.has_distortion:
         warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
     return warnings
@@ -70,7 +80,15 @@ def _worst(statistics: np.ndarray, loo: np.ndarray, e: np.ndarray) -> int:
     return int(np.nanargmax(np.where(np.isfinite(loo), loo, e)))
 
 
-def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple[PoseCandidate, ...], *, sigma_px: float | None, limit_px: float, huber_px: float | None) -> PoseSolution:
+def finish_solution(
+    problem: PoseProblem,
+    chosen: RefinedPose,
+    candidates: tuple[PoseCandidate, ...],
+    *,
+    sigma_px: float | None,
+    limit_px: float,
+    huber_px: float | None,
+) -> PoseSolution:
     """Build the solution for ``chosen``; ``candidates`` all poses that fit about as well."""
     warnings: list[str] = []
     noise = noise_px(sigma_px)
@@ -85,20 +103,34 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
         if outliers.any() and len(inliers) >= (4 if problem.estimate_focal else 3) and not fitted_already:
             # Least squares on the inliers alone: the Huber fit still leans slightly on the outliers.
             # (checked already: a subset of checked pairs needs no second check)
-            sub = replace(problem, points_3d=problem.points_3d[inliers], points_2d=problem.points_2d[inliers], off_image=(), repeated_3d=())
+            sub = replace(
+                problem,
+                points_3d=problem.points_3d[inliers],
+                points_2d=problem.points_2d[inliers],
+                off_image=(),
+                repeated_3d=(),
+            )
             again = refine_seed(sub, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], chosen.fu, chosen.fv, None)
             if again is not None and again.converged:
                 iterations += again.newton.iterations
                 chosen = again
         if outliers.any():
-            warnings.append(f"{points_label(np.flatnonzero(outliers))} rejected as outliers (robust fit); check those picks")
+            warnings.append(
+                f"{points_label(np.flatnonzero(outliers))} rejected as outliers (robust fit); check those picks"
+            )
     residuals, jacobian = chosen.newton.residuals, chosen.newton.jacobian
     if outliers.any() and not fitted_already:
         # The inlier re-fit's own arrays lack the outliers: evaluate every point at the final pose.
         residuals, jacobian, _ = residuals_and_jacobian(problem, chosen.newton.R, chosen.newton.t, chosen.fu, chosen.fv)
     weights = (~outliers).astype(float)
-    to_metric = paper_to_metric_jacobian(chosen.newton.t, problem.intrinsics, chosen.fu, chosen.fv, problem.n_params) if problem.model == "paper" else None
-    rms, e, loo, uncertainty = fit_uncertainty(jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma_px, to_metric)
+    to_metric = (
+        paper_to_metric_jacobian(chosen.newton.t, problem.intrinsics, chosen.fu, chosen.fv, problem.n_params)
+        if problem.model == "paper"
+        else None
+    )
+    rms, e, loo, uncertainty = fit_uncertainty(
+        jacobian, residuals, weights, chosen.obj2cam[:3, :3], chosen.obj2cam[:3, 3], sigma_px, to_metric
+    )
     status, reason = SolveStatus.OK, None
     agreeing = int(np.count_nonzero(~outliers))
     statistics = misfit_statistics(jacobian, residuals, ~outliers)
@@ -109,32 +141,53 @@ def finish_solution(problem: PoseProblem, chosen: RefinedPose, candidates: tuple
         # The search stops the focal lengths at a range around the camera file's: a solve resting there did not
         # find a camera, and blaming the worst pick would send the operator after good picks.
         status = SolveStatus.FAILED
-        reason = (f"the focal lengths ran to the edge of their search range ({clamp}): the pairs do not determine them; "
-                  "spread the picks over the image and in depth, or solve with the camera file's focal lengths")
+        reason = (
+            f"the focal lengths ran to the edge of their search range ({clamp}): the pairs do not determine them; "
+            "spread the picks over the image and in depth, or solve with the camera file's focal lengths"
+        )
     elif outliers.any() and 2 * agreeing - problem.n_params < 2:
         # The pairs left fit exactly by construction: nothing checks them, and a mis-click among them
         # would pass unseen (5 pairs, one off: three fitted exactly, two good ones rejected, 550 mm wrong).
         status = SolveStatus.FAILED
-        reason = (f"only {agreeing} pairs agree after rejecting {points_label(np.flatnonzero(outliers))}: too few to check one another; "
-                  "pick the rejected pairs again or add pairs")
+        reason = (
+            f"only {agreeing} pairs agree after rejecting {points_label(np.flatnonzero(outliers))}: too few to check one another; "
+            "pick the rejected pairs again or add pairs"
+        )
     elif rms > limit_px:
         worst = _worst(statistics, loo, e)
         status = SolveStatus.FAILED
-        advice = "check that pick" if huber_px is not None else "check that pick, or use robust"  # (robust is on already)
+        advice = (
+            "check that pick" if huber_px is not None else "check that pick, or use robust"
+        )  # (robust is on already)
         reason = f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; {point_label(worst)} fits worst ({advice})"
     elif misfits.any():
         # A single mis-pick among good ones barely moves the RMS (12 px among 9 good: 0.92 px) but tilts the pose.
         worst = _worst(statistics, loo, e)
         status = SolveStatus.FAILED
-        others = f" (also {points_label([i for i in np.flatnonzero(misfits) if i != worst])})" if misfits.sum() > 1 else ""
-        reason = (f"{point_label(worst)} does not fit the others: the pose from the other pairs misses it by {loo[worst]:.1f} px, "
-                  f"where picks good to {sigma_test[worst]:.2g} px allow about {np.sqrt(limit) * sigma_test[worst]:.1f} px{others}; check that pick or untick it")
+        others = (
+            f" (also {points_label([i for i in np.flatnonzero(misfits) if i != worst])})" if misfits.sum() > 1 else ""
+        )
+        reason = (
+            f"{point_label(worst)} does not fit the others: the pose from the other pairs misses it by {loo[worst]:.1f} px, "
+            f"where picks good to {sigma_test[worst]:.2g} px allow about {np.sqrt(limit) * sigma_test[worst]:.1f} px{others}; check that pick or untick it"
+        )
     elif len(candidates) > 1:
         status = SolveStatus.AMBIGUOUS
         reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
     warnings += operator_warnings(problem, uncertainty.condition_number, noise)
     return PoseSolution(
-        status=status, obj2cam=chosen.obj2cam, fu=chosen.fu, fv=chosen.fv, model=problem.model,
-        iterations=iterations, residuals_px=residuals, uncertainty=uncertainty, leave_one_out_px=loo,
-        outliers=outliers, candidates=candidates, reason=reason, warnings=tuple(warnings), misfits=misfits,
+        status=status,
+        obj2cam=chosen.obj2cam,
+        fu=chosen.fu,
+        fv=chosen.fv,
+        model=problem.model,
+        iterations=iterations,
+        residuals_px=residuals,
+        uncertainty=uncertainty,
+        leave_one_out_px=loo,
+        outliers=outliers,
+        candidates=candidates,
+        reason=reason,
+        warnings=tuple(warnings),
+        misfits=misfits,
     )

@@ -60,17 +60,23 @@ def dlt_seed(problem: PoseProblem, fu: float, fv: float) -> list[tuple[np.ndarra
     return []
 
 
-def p3p_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def p3p_seeds(
+    points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Every real root of P3P on exactly three pairs (up to four poses)."""
     K, dist = _camera(intrinsics, fu, fv)
     try:
-        n, rvecs, tvecs = cv2.solveP3P(points_3d.reshape(3, 1, 3), points_2d.reshape(3, 1, 2), K, dist, flags=cv2.SOLVEPNP_P3P)
+        n, rvecs, tvecs = cv2.solveP3P(
+            points_3d.reshape(3, 1, 3), points_2d.reshape(3, 1, 2), K, dist, flags=cv2.SOLVEPNP_P3P
+        )
     except cv2.error:
         return []
     return _as_seeds(rvecs[:n], tvecs[:n]) if n else []
 
 
-def sqpnp_seed(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def sqpnp_seed(
+    points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """The global minimum of SQPnP's algebraic cost (one pose), for four or more pairs."""
     K, dist = _camera(intrinsics, fu, fv)
     try:
@@ -80,7 +86,9 @@ def sqpnp_seed(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrins
     return _as_seeds([rvec], [tvec]) if ok else []
 
 
-def ippe_seeds(points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def ippe_seeds(
+    points_3d: np.ndarray, points_2d: np.ndarray, intrinsics: Intrinsics, fu: float, fv: float
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Both poses IPPE finds for four or more coplanar pairs (the planar two-fold ambiguity)."""
     K, dist = _camera(intrinsics, fu, fv)
     try:
@@ -121,8 +129,14 @@ def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tup
         d = P[j] - P[i]
         off_line = np.linalg.norm(np.cross(P - P[i], d), axis=1)
         k = int(np.argmax(off_line))
-        triplets = np.unique(np.vstack([drawn, np.sort([i, j, k])[None]]), axis=0) if len({i, j, k}) == 3 else np.unique(drawn, axis=0)
-    area = np.linalg.norm(np.cross(P[triplets[:, 1]] - P[triplets[:, 0]], P[triplets[:, 2]] - P[triplets[:, 0]]), axis=1)
+        triplets = (
+            np.unique(np.vstack([drawn, np.sort([i, j, k])[None]]), axis=0)
+            if len({i, j, k}) == 3
+            else np.unique(drawn, axis=0)
+        )
+    area = np.linalg.norm(
+        np.cross(P[triplets[:, 1]] - P[triplets[:, 0]], P[triplets[:, 2]] - P[triplets[:, 0]]), axis=1
+    )
     order = np.argsort(-area, kind="stable")[:limit]
     return [tuple(int(v) for v in triplets[o]) for o in order]
 
@@ -136,7 +150,9 @@ def subset_p3p_seeds(problem: PoseProblem, fu: float, fv: float) -> list[tuple[n
     return seeds
 
 
-def initial_seeds(problem: PoseProblem, fu: float, fv: float, gate_px: float | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+def initial_seeds(
+    problem: PoseProblem, fu: float, fv: float, gate_px: float | None = None
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """Seeds for a problem without a guess: P3P roots for 3 pairs; DLT (6 or more pairs off a
     plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs. With ``gate_px``
     (known focal lengths only) the triplets' roots that put all the pairs more than that off (RMS)
@@ -175,7 +191,9 @@ def seed_rms_px(problem: PoseProblem, seeds: list[tuple[np.ndarray, np.ndarray]]
     return np.where((z > 0).all(axis=1) & np.isfinite(rms), rms, np.inf)
 
 
-def distinct_seeds(seeds: list[tuple[np.ndarray, np.ndarray]], angle_deg: float = 2.0, rel_translation: float = 0.02) -> list[tuple[np.ndarray, np.ndarray]]:
+def distinct_seeds(
+    seeds: list[tuple[np.ndarray, np.ndarray]], angle_deg: float = 2.0, rel_translation: float = 0.02
+) -> list[tuple[np.ndarray, np.ndarray]]:
     """The seeds with near-copies left out (within ``angle_deg`` and ``rel_translation`` of the distance
     of one kept before): P3P over overlapping triplets gives the same pose several times, and each copy
     would be refined to the same minimum. Order kept."""

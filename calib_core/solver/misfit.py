@@ -24,7 +24,9 @@ fewer (5 pairs: 2) a least-squares pose that absorbed a 5-10 px mis-pick into th
 picks, and the mis-pick passed (a pose 20 mm wrong called ok)."""
 
 
-def _quadratic_forms(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, rows: np.ndarray, sign: float) -> np.ndarray:
+def _quadratic_forms(
+    jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, rows: np.ndarray, sign: float
+) -> np.ndarray:
     """``r_i^T (I + sign H_ii)^-1 r_i`` (len(rows),) for the ``rows``, ``H_ii = J_i (J^T J)^-1 J_i^T`` over the ``used``
     pairs: all 2 x 2 blocks at once (a loop over 5000 pairs cost 40 times the solve). NaN where the block is singular
     or there is no redundancy."""
@@ -68,7 +70,9 @@ def prediction_statistics(jacobian: np.ndarray, residuals: np.ndarray, used: np.
     return out
 
 
-def admissible(jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_params: int, noise_px: float) -> np.ndarray:
+def admissible(
+    jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_params: int, noise_px: float
+) -> np.ndarray:
     """(n,) bool: the pairs outside the fit (``used`` False) that its pose predicts as well as a good pick's
     noise allows, by :func:`prediction_statistics` against the larger of ``noise_px`` and the fit's own scale
     (its squared residuals over their degrees of freedom; then the limit is 2 F(2, dof), as in
@@ -98,7 +102,9 @@ def threshold(n_pairs: int) -> float:
     return -2.0 * float(np.log(FALSE_FLAG_PER_SOLVE / max(n_pairs, 1)))
 
 
-def flag_misfits(statistics: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_params: int, noise_px: float) -> tuple[np.ndarray, np.ndarray, float]:
+def flag_misfits(
+    statistics: np.ndarray, residuals: np.ndarray, used: np.ndarray, n_params: int, noise_px: float
+) -> tuple[np.ndarray, np.ndarray, float]:
     """(flags (n,) bool, the sigma used for each pair (n,) px, the limit of the statistic): see the module.
     ``residuals`` (n, 2) px of the fit, ``used`` (n,) the pairs in it, ``n_params`` its unknowns."""
     n = len(statistics)

@@ -58,7 +58,9 @@ PAPER_FINAL_ERRORS = (
 # gripper camera (no lens distortion, as in the paper) from about half a metre.
 FIXTURE_POINTS_MM = np.array([[-40.0, -30.0, 0.0], [45.0, -25.0, 10.0], [-5.0, 40.0, 25.0]])
 CAMERA = Intrinsics(fu=1120.0, fv=1116.0, cx=645.2, cy=476.8, width=1280, height=960)
-TRUE_OBJ2CAM = make_transform(Rotation.from_euler("xyz", [8.0, -12.0, 5.0], degrees=True).as_matrix(), [15.0, -10.0, 480.0])
+TRUE_OBJ2CAM = make_transform(
+    Rotation.from_euler("xyz", [8.0, -12.0, 5.0], degrees=True).as_matrix(), [15.0, -10.0, 480.0]
+)
 
 
 @dataclass(frozen=True)
@@ -109,10 +111,21 @@ def run_table1(model: str = "pinhole", *, as_printed: bool = False) -> list[Tabl
     for k, (start, paper) in enumerate(zip(PAPER_STARTS, PAPER_FINAL_ERRORS), start=1):
         d = np.asarray(start[:3], dtype=float)
         R0 = Rotation.from_rotvec(np.radians(start[3:])).as_matrix() @ R_true
-        result = run_newton(problem, R0, t_true + d, CAMERA.fu, CAMERA.fv, damped=not as_printed, as_printed=as_printed, max_iterations=100)
+        result = run_newton(
+            problem,
+            R0,
+            t_true + d,
+            CAMERA.fu,
+            CAMERA.fv,
+            damped=not as_printed,
+            as_printed=as_printed,
+            max_iterations=100,
+        )
         rot_err = Rotation.from_matrix(result.R @ R_true.T).as_rotvec(degrees=True)
         err = tuple(float(x) for x in np.concatenate([result.t - t_true, rot_err]))
-        rows.append(Table1Row(k, tuple(float(x) for x in start), err, result.iterations, result.converged, result.reason, paper))
+        rows.append(
+            Table1Row(k, tuple(float(x) for x in start), err, result.iterations, result.converged, result.reason, paper)
+        )
     return rows
 
 

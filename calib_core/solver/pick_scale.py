@@ -68,4 +68,6 @@ def pick_scale_px(problem: PoseProblem, fu: float, fv: float, order: np.ndarray 
 
 
 def _subset(problem: PoseProblem, idx: np.ndarray) -> PoseProblem:
-    return replace(problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=())
+    return replace(
+        problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=()
+    )

@@ -76,7 +76,9 @@ def _as_points(values: ArrayLike, dim: int, name: str) -> np.ndarray:
     except (TypeError, ValueError) as exc:
         raise MismatchedPointsError(f"{name}: not a list of numbers ({exc})") from None
     if arr.ndim != 2 or arr.shape[1] != dim:
-        raise MismatchedPointsError(f"{name}: expected a list of [{'x, y, z' if dim == 3 else 'u, v'}] rows, got shape {arr.shape}")
+        raise MismatchedPointsError(
+            f"{name}: expected a list of [{'x, y, z' if dim == 3 else 'u, v'}] rows, got shape {arr.shape}"
+        )
     return np.ascontiguousarray(arr)
 
 
@@ -87,7 +89,14 @@ def check_intrinsics(intrinsics: Intrinsics) -> None:
             raise InvalidIntrinsicsError(f"intrinsics: {name} must be a positive focal length in px, got {v}")
 
 
-def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, estimate_focal: bool = False, model: str = "pinhole") -> PoseProblem:
+def make_problem(
+    points_3d: ArrayLike,
+    points_2d: ArrayLike,
+    intrinsics: Intrinsics,
+    *,
+    estimate_focal: bool = False,
+    model: str = "pinhole",
+) -> PoseProblem:
     """Validate the input of a solve; raise a :class:`SolverInputError` subclass naming the points at fault."""
     if model not in MODELS:
         raise ValueError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
@@ -100,23 +109,45 @@ def make_problem(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrins
     if len(p3) < needed:
         why = " (the focal lengths are estimated too)" if estimate_focal else ""
         raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
-    code, i, j, coplanar, n_off_image, spread = check_pairs(p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height)
+    code, i, j, coplanar, n_off_image, spread = check_pairs(
+        p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height
+    )
     if code == NON_FINITE_3D or code == NON_FINITE_2D:
         bad = np.flatnonzero(~np.all(np.isfinite(p3), axis=1) | ~np.all(np.isfinite(p2), axis=1))
         raise NonFiniteInputError(f"{points_label(bad)}: coordinates are NaN or infinite", bad)
     repeated = _repeated_points(p3, p2, _DUPLICATE_REL_3D * max(spread, 1.0))
     if len(p3) - len({j for _, j in repeated}) < needed:
-        raise TooFewPointsError(f"{len(p3)} point pairs given but only {len(p3) - len({j for _, j in repeated})} distinct 3D points, at least {needed} needed")
+        raise TooFewPointsError(
+            f"{len(p3)} point pairs given but only {len(p3) - len({j for _, j in repeated})} distinct 3D points, at least {needed} needed"
+        )
     if code == COLLINEAR:
-        raise DegenerateGeometryError(f"{points_label(range(len(p3)))}: the 3D points are collinear; pick points that span a plane or a volume", range(len(p3)))
+        raise DegenerateGeometryError(
+            f"{points_label(range(len(p3)))}: the 3D points are collinear; pick points that span a plane or a volume",
+            range(len(p3)),
+        )
     off_image = ()
     if n_off_image:
         u, v = p2[:, 0], p2[:, 1]
-        off_image = tuple(int(k) for k in np.flatnonzero((u < -0.5) | (v < -0.5) | (u > intrinsics.width - 0.5) | (v > intrinsics.height - 0.5)))
+        off_image = tuple(
+            int(k)
+            for k in np.flatnonzero(
+                (u < -0.5) | (v < -0.5) | (u > intrinsics.width - 0.5) | (v > intrinsics.height - 0.5)
+            )
+        )
     # The kernels know OpenCV's 5-parameter lens; a rational or fisheye lens is solved on the ideal pinhole's pixels,
     # which see the same rays (the pose is the same; residuals are in the ideal image's pixels).
     p2, intrinsics = as_pinhole(p2, intrinsics)
-    return PoseProblem(p3, np.ascontiguousarray(p2), intrinsics, bool(estimate_focal), model, bool(coplanar), intrinsics.dist_coeffs, off_image, repeated)
+    return PoseProblem(
+        p3,
+        np.ascontiguousarray(p2),
+        intrinsics,
+        bool(estimate_focal),
+        model,
+        bool(coplanar),
+        intrinsics.dist_coeffs,
+        off_image,
+        repeated,
+    )
 
 
 def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tuple[int, int], ...]:
@@ -130,7 +161,10 @@ def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tu
         if other:
             a, b = other[0]
             raise DuplicatePointsError(f"{point_label(a)} and {point_label(b)} have the same pixel", (a, b))
-        raise RepeatedPairError(f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)", sorted({k for pair in same for k in pair}))
+        raise RepeatedPairError(
+            f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)",
+            sorted({k for pair in same for k in pair}),
+        )
     return tuple(_close_pairs(p3, tol3_mm))
 
 
@@ -160,4 +194,6 @@ def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> Non
     z = points_3d @ obj2cam[2, :3] + obj2cam[2, 3]
     behind = np.flatnonzero(z <= 0)
     if len(behind):
-        raise PointsBehindCameraError(f"the {what} puts {points_label(behind)} at or behind the camera (z <= 0)", behind)
+        raise PointsBehindCameraError(
+            f"the {what} puts {points_label(behind)} at or behind the camera (z <= 0)", behind
+        )

@@ -55,7 +55,18 @@ def _model_inputs(problem: PoseProblem, model: str) -> tuple[int, np.ndarray, np
     return PINHOLE, problem.points_2d, problem.distortion
 
 
-def run_newton(problem: PoseProblem, R, t, fu: float, fv: float, *, huber_px: float | None = None, max_iterations: int = 100, damped: bool = True, as_printed: bool = False) -> NewtonResult:
+def run_newton(
+    problem: PoseProblem,
+    R,
+    t,
+    fu: float,
+    fv: float,
+    *,
+    huber_px: float | None = None,
+    max_iterations: int = 100,
+    damped: bool = True,
+    as_printed: bool = False,
+) -> NewtonResult:
     """Iterate from ``(R, t, fu, fv)`` in the problem's model (``as_printed``: the paper's
     misprinted derivatives, with ``damped=False`` its undamped Newton steps)."""
     code, uv, dist = _model_inputs(problem, problem.model)
@@ -66,16 +77,50 @@ def run_newton(problem: PoseProblem, R, t, fu: float, fv: float, *, huber_px: fl
     r = np.empty((n, 2))
     J = np.empty((n, 2, problem.n_params))
     intr = problem.intrinsics
-    iterations, outcome = newton(code, problem.points_3d, uv, R, t, f, intr.cx, intr.cy, dist, problem.estimate_focal, as_printed, huber_px or 0.0, max_iterations, damped, r, J)
+    iterations, outcome = newton(
+        code,
+        problem.points_3d,
+        uv,
+        R,
+        t,
+        f,
+        intr.cx,
+        intr.cy,
+        dist,
+        problem.estimate_focal,
+        as_printed,
+        huber_px or 0.0,
+        max_iterations,
+        damped,
+        r,
+        J,
+    )
     return NewtonResult(R, t, float(f[0]), float(f[1]), r, J, int(iterations), int(outcome))
 
 
-def residuals_and_jacobian(problem: PoseProblem, R, t, fu: float, fv: float, *, as_printed: bool = False) -> tuple[np.ndarray, np.ndarray, float]:
+def residuals_and_jacobian(
+    problem: PoseProblem, R, t, fu: float, fv: float, *, as_printed: bool = False
+) -> tuple[np.ndarray, np.ndarray, float]:
     """Residuals (n, 2) px, Jacobian (n, 2, p) and the smallest depth (mm) at a state."""
     code, uv, dist = _model_inputs(problem, problem.model)
     n = problem.n_points
     r = np.empty((n, 2))
     J = np.empty((n, 2, problem.n_params))
     intr = problem.intrinsics
-    zmin = evaluate(code, problem.points_3d, uv, np.asarray(R, dtype=float), np.asarray(t, dtype=float), float(fu), float(fv), intr.cx, intr.cy, dist, problem.estimate_focal, as_printed, r, J)
+    zmin = evaluate(
+        code,
+        problem.points_3d,
+        uv,
+        np.asarray(R, dtype=float),
+        np.asarray(t, dtype=float),
+        float(fu),
+        float(fv),
+        intr.cx,
+        intr.cy,
+        dist,
+        problem.estimate_focal,
+        as_printed,
+        r,
+        J,
+    )
     return r, J, float(zmin)

@@ -41,7 +41,9 @@ def inlier_threshold_px(noise_px: float) -> float:
     return INLIER_SIGMAS * noise_px
 
 
-def robust_seed(problem: PoseProblem, fu: float, fv: float, noise_px: float, order: np.ndarray | None = None, seed: int = 0) -> RobustSeed | None:
+def robust_seed(
+    problem: PoseProblem, fu: float, fv: float, noise_px: float, order: np.ndarray | None = None, seed: int = 0
+) -> RobustSeed | None:
     """A pose from the largest consistent subset of the pairs, or ``None`` (too few pairs, or no
     hypothesis with four inliers). ``order`` (n,) indices best first, when the pairs carry a
     confidence (detections): PROSAC draws from the best ones first."""
@@ -56,10 +58,22 @@ def robust_seed(problem: PoseProblem, fu: float, fv: float, noise_px: float, ord
     if order is not None:
         P, uv = P[order], uv[order]
     camera = {"model": "PINHOLE", "width": intr.width, "height": intr.height, "params": [fu, fv, intr.cx, intr.cy]}
-    options = {"max_reproj_error": inlier_threshold_px(noise_px), "success_prob": CONFIDENCE, "max_iterations": MAX_HYPOTHESES,
-               "min_iterations": MIN_HYPOTHESES, "seed": seed, "progressive_sampling": order is not None}
+    options = {
+        "max_reproj_error": inlier_threshold_px(noise_px),
+        "success_prob": CONFIDENCE,
+        "max_iterations": MAX_HYPOTHESES,
+        "min_iterations": MIN_HYPOTHESES,
+        "seed": seed,
+        "progressive_sampling": order is not None,
+    }
     try:
-        pose, info = poselib.estimate_absolute_pose(np.ascontiguousarray(uv, dtype=np.float64), np.ascontiguousarray(P, dtype=np.float64), camera, options, {"max_iterations": 0})
+        pose, info = poselib.estimate_absolute_pose(
+            np.ascontiguousarray(uv, dtype=np.float64),
+            np.ascontiguousarray(P, dtype=np.float64),
+            camera,
+            options,
+            {"max_iterations": 0},
+        )
     except (RuntimeError, ValueError):
         return None
     inliers = np.flatnonzero(np.asarray(info.get("inliers", []), dtype=bool))

@@ -131,7 +131,9 @@ class PoseSolution:
             "leave_one_out_px": finite(self.leave_one_out_px),
             "outliers": [bool(x) for x in self.outliers],
             "misfits": [bool(x) for x in self.misfits] if self.misfits is not None else None,
-            "std": None if u is None else {
+            "std": None
+            if u is None
+            else {
                 "t_obj2cam_mm": finite(u.std_t_obj2cam_mm),
                 "rotation_deg": finite(u.std_rotation_deg),
                 "camera_position_mm": finite(u.std_camera_position_mm),

@@ -47,7 +47,9 @@ def _distance_to_prior_mm(pose, prior: np.ndarray, intrinsics: Intrinsics) -> fl
     return dt + (angle_rad + focal) * distance
 
 
-def _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px) -> tuple[PoseProblem, np.ndarray | None]:
+def _prepare(
+    points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px
+) -> tuple[PoseProblem, np.ndarray | None]:
     problem = make_problem(points_3d, points_2d, intrinsics, estimate_focal=estimate_focal, model=model)
     _check_sigma(sigma_px)
     prior2 = None
@@ -57,8 +59,19 @@ def _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sig
     return problem, prior2
 
 
-def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, *, prior: ArrayLike | None = None, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None,
-               confidence: ArrayLike | None = None) -> PoseSolution:
+def solve_pose(
+    points_3d: ArrayLike,
+    points_2d: ArrayLike,
+    intrinsics: Intrinsics,
+    *,
+    prior: ArrayLike | None = None,
+    estimate_focal: bool = False,
+    model: str = "pinhole",
+    sigma_px: float | None = None,
+    robust: bool = False,
+    max_rms_px: float | None = None,
+    confidence: ArrayLike | None = None,
+) -> PoseSolution:
     """Solve the object-to-camera pose from point pairs.
 
     ``points_3d`` (n, 3) mm in the object frame; ``points_2d`` (n, 2) px as observed (lens
@@ -84,8 +97,19 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
         first = first_of_each_pair(points_3d, points_2d)
         if np.all(first == np.arange(len(first))):
             raise
-        return _solve_distinct(first, points_3d, points_2d, intrinsics, prior=prior, estimate_focal=estimate_focal, model=model,
-                               sigma_px=sigma_px, robust=robust, max_rms_px=max_rms_px, confidence=confidence)
+        return _solve_distinct(
+            first,
+            points_3d,
+            points_2d,
+            intrinsics,
+            prior=prior,
+            estimate_focal=estimate_focal,
+            model=model,
+            sigma_px=sigma_px,
+            robust=robust,
+            max_rms_px=max_rms_px,
+            confidence=confidence,
+        )
     fu0, fv0 = intrinsics.fu, intrinsics.fv
     order = _confidence_order(confidence, problem.n_points)
     noise = floor = noise_px(sigma_px)
@@ -110,7 +134,11 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     gate = 10.0 * limit if not problem.estimate_focal and problem.model == "pinhole" and not robust else None
     # (a few pairs: every triplet's roots as well, so that a second pose fitting another subset as well is
     # found and the answer called ambiguous rather than ok)
-    seeds = [] if sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS else initial_seeds(problem, fu0, fv0, gate)
+    seeds = (
+        []
+        if sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS
+        else initial_seeds(problem, fu0, fv0, gate)
+    )
     if sampled is not None and problem.model != "pinhole":
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
@@ -119,14 +147,25 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
     if sampled is not None and problem.model == "pinhole":
         # the sampler's own inliers are where its seed's consensus starts (one least-squares fit, usually)
-        fit = consensus_refine(problem, sampled.R, sampled.t, fu0, fv0, inlier_threshold_px(noise), inliers=sampled.inliers, noise_floor_px=floor)
+        fit = consensus_refine(
+            problem,
+            sampled.R,
+            sampled.t,
+            fu0,
+            fv0,
+            inlier_threshold_px(noise),
+            inliers=sampled.inliers,
+            noise_floor_px=floor,
+        )
         refined += [fit] if fit is not None else []
     best_rms = min((r.rms_px for r in refined), default=np.inf)
     if problem.n_points > SMALL_PROBLEM_POINTS and sampled is None and (best_rms > limit or robust):
         # A mis-click spoils the all-points seeds; triplets that avoid it still find the pose.
         refined += [r for r in (refine(R, t) for R, t in subset_p3p_seeds(problem, fu0, fv0)) if r is not None]
     if not refined:
-        return _no_pose(problem, "no starting pose could be found for these picks (P3P/SQPnP found no pose in front of the camera)")
+        return _no_pose(
+            problem, "no starting pose could be found for these picks (P3P/SQPnP found no pose in front of the camera)"
+        )
 
     poses = distinct_poses(refined)
     if robust:  # judged by what they explain: two poses that each fit a different four of five pairs are ambiguous
@@ -140,18 +179,29 @@ def solve_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsic
     rivals = []
     if robust and problem.model == "pinhole":
         # with few pairs, the pair rejected is known only if no other one could be the mis-pick instead
-        rivals = distinct_poses([r for r in rival_consensus(problem, close[0], noise) if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)])
+        rivals = distinct_poses(
+            [
+                r
+                for r in rival_consensus(problem, close[0], noise)
+                if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)
+            ]
+        )
         close += rivals
     distances = [None if prior2 is None else _distance_to_prior_mm(p, prior2, intrinsics) for p in close]
-    rank = sorted(range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,))
+    rank = sorted(
+        range(len(close)), key=lambda i: (distances[i], close[i].cost) if prior2 is not None else (close[i].cost,)
+    )
     ranked = [close[i] for i in rank]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, rank))
     solution = finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
     if rivals and solution.status is SolveStatus.AMBIGUOUS:
         # name the pairs: the operator re-picks those, not every point
         suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
-        solution = replace(solution, reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the others fit as well); "
-                                            "pick them again or add a point")
+        solution = replace(
+            solution,
+            reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the others fit as well); "
+            "pick them again or add a point",
+        )
     return solution
 
 
@@ -173,7 +223,20 @@ def _refiner(problem: PoseProblem, fu: float, fv: float, huber: float | None, no
     return lambda R, t: refine_seed(problem, R, t, fu, fv, huber)
 
 
-def refine_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsics, start_obj2cam: ArrayLike, *, estimate_focal: bool = False, model: str = "pinhole", sigma_px: float | None = None, robust: bool = False, max_rms_px: float | None = None, damped: bool = True, max_iterations: int = 100) -> PoseSolution:
+def refine_pose(
+    points_3d: ArrayLike,
+    points_2d: ArrayLike,
+    intrinsics: Intrinsics,
+    start_obj2cam: ArrayLike,
+    *,
+    estimate_focal: bool = False,
+    model: str = "pinhole",
+    sigma_px: float | None = None,
+    robust: bool = False,
+    max_rms_px: float | None = None,
+    damped: bool = True,
+    max_iterations: int = 100,
+) -> PoseSolution:
     """Newton iterations from ``start_obj2cam`` (4, 4) only, as in the paper: no global seeds.
 
     Finds the pose nearest the start, silently ignoring any other pose that fits; use
@@ -186,7 +249,16 @@ def refine_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsi
     noise = noise_px(sigma_px)
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
     huber = 2.0 * noise if robust else None
-    r = refine_seed(problem, start[:3, :3], start[:3, 3], intrinsics.fu, intrinsics.fv, huber, damped=damped, max_iterations=max_iterations)
+    r = refine_seed(
+        problem,
+        start[:3, :3],
+        start[:3, 3],
+        intrinsics.fu,
+        intrinsics.fv,
+        huber,
+        damped=damped,
+        max_iterations=max_iterations,
+    )
     if r is None:
         return _no_pose(problem, "the starting pose puts points behind the camera")
     candidate = PoseCandidate(r.obj2cam, r.fu, r.fv, r.rms_px)
@@ -196,9 +268,18 @@ def refine_pose(points_3d: ArrayLike, points_2d: ArrayLike, intrinsics: Intrinsi
 def _no_pose(problem: PoseProblem, reason: str) -> PoseSolution:
     n = problem.n_points
     return PoseSolution(
-        status=SolveStatus.FAILED, obj2cam=np.full((4, 4), np.nan), fu=problem.intrinsics.fu, fv=problem.intrinsics.fv,
-        model=problem.model, iterations=0, residuals_px=np.full((n, 2), np.nan), uncertainty=None,
-        leave_one_out_px=np.full(n, np.nan), outliers=np.zeros(n, dtype=bool), candidates=(), reason=reason,
+        status=SolveStatus.FAILED,
+        obj2cam=np.full((4, 4), np.nan),
+        fu=problem.intrinsics.fu,
+        fv=problem.intrinsics.fv,
+        model=problem.model,
+        iterations=0,
+        residuals_px=np.full((n, 2), np.nan),
+        uncertainty=None,
+        leave_one_out_px=np.full(n, np.nan),
+        outliers=np.zeros(n, dtype=bool),
+        candidates=(),
+        reason=reason,
     )
 
 
@@ -216,9 +297,22 @@ def _solve_distinct(first: np.ndarray, points_3d, points_2d, intrinsics, **optio
         if confidence.shape == first.shape:
             confidence = confidence[keep]
     with named_points_as_given(keep):
-        solution = solve_pose(np.asarray(points_3d, float)[keep], np.asarray(points_2d, float)[keep], intrinsics, confidence=confidence, **options)
+        solution = solve_pose(
+            np.asarray(points_3d, float)[keep],
+            np.asarray(points_2d, float)[keep],
+            intrinsics,
+            confidence=confidence,
+            **options,
+        )
     repeats = np.flatnonzero(first != np.arange(len(first)))
-    shown = ", ".join(f"{point_label(int(r))} = {point_label(int(first[r]))}" for r in repeats[:5]) + (f" and {len(repeats) - 5} more" if len(repeats) > 5 else "")
+    shown = ", ".join(f"{point_label(int(r))} = {point_label(int(first[r]))}" for r in repeats[:5]) + (
+        f" and {len(repeats) - 5} more" if len(repeats) > 5 else ""
+    )
     note = f"{len(repeats)} pair{'s' if len(repeats) > 1 else ''} given again (the same 3D point at the same pixel), each counted once: {shown}"
-    return replace(solution, residuals_px=solution.residuals_px[place], leave_one_out_px=solution.leave_one_out_px[place], outliers=solution.outliers[place],
-                   warnings=(note, *solution.warnings))
+    return replace(
+        solution,
+        residuals_px=solution.residuals_px[place],
+        leave_one_out_px=solution.leave_one_out_px[place],
+        outliers=solution.outliers[place],
+        warnings=(note, *solution.warnings),
+    )

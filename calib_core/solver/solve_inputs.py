@@ -8,7 +8,17 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 
 
-def solve_inputs(points_3d, points_2d, intrinsics: Intrinsics, *, prior=None, estimate_focal=False, model="pinhole", sigma_px=None, robust=False) -> dict:
+def solve_inputs(
+    points_3d,
+    points_2d,
+    intrinsics: Intrinsics,
+    *,
+    prior=None,
+    estimate_focal=False,
+    model="pinhole",
+    sigma_px=None,
+    robust=False,
+) -> dict:
     """The JSON form of a solve's inputs (the fields of ``videocal solve``)."""
     inputs = {
         "intrinsics": intrinsics.to_dict(),
@@ -20,5 +30,8 @@ def solve_inputs(points_3d, points_2d, intrinsics: Intrinsics, *, prior=None, es
         "robust": bool(robust),
     }
     if prior is not None:
-        inputs["prior"] = {"R_obj2cam": np.asarray(prior)[:3, :3].tolist(), "t_obj2cam_mm": np.asarray(prior)[:3, 3].tolist()}
+        inputs["prior"] = {
+            "R_obj2cam": np.asarray(prior)[:3, :3].tolist(),
+            "t_obj2cam_mm": np.asarray(prior)[:3, 3].tolist(),
+        }
     return inputs

@@ -40,7 +40,15 @@ class PoseUncertainty:
 _SOURCES = ("given", "estimated", "default")
 
 
-def fit_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.ndarray, R_obj2cam: np.ndarray, t_obj2cam_mm: np.ndarray, sigma_px: float | None, to_metric: np.ndarray | None = None) -> tuple[float, np.ndarray, np.ndarray, PoseUncertainty]:
+def fit_uncertainty(
+    jacobian: np.ndarray,
+    residuals: np.ndarray,
+    weights: np.ndarray,
+    R_obj2cam: np.ndarray,
+    t_obj2cam_mm: np.ndarray,
+    sigma_px: float | None,
+    to_metric: np.ndarray | None = None,
+) -> tuple[float, np.ndarray, np.ndarray, PoseUncertainty]:
     """Covariance ``sigma^2 (J^T W J)^-1`` and the figures derived from it.
 
     ``jacobian`` (n, 2, p) of the predicted pixels, ``residuals`` (n, 2) px, ``weights``
@@ -59,7 +67,19 @@ def fit_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.nda
     cov_c = np.empty((3, 3))
     loo = np.empty(n)
     lengths = np.empty(n)
-    rms, sigma, source, condition = fit_summary(jacobian, residuals, weights, R_obj2cam, t_obj2cam_mm, -1.0 if sigma_px is None else float(sigma_px), DEFAULT_SIGMA_PX, cov, cov_c, loo, lengths)
+    rms, sigma, source, condition = fit_summary(
+        jacobian,
+        residuals,
+        weights,
+        R_obj2cam,
+        t_obj2cam_mm,
+        -1.0 if sigma_px is None else float(sigma_px),
+        DEFAULT_SIGMA_PX,
+        cov,
+        cov_c,
+        loo,
+        lengths,
+    )
     if to_metric is not None:
         # The paper's model solves image shifts: carry its covariance over to the metric pose.
         cov = to_metric @ cov @ to_metric.T
@@ -67,7 +87,9 @@ def fit_uncertainty(jacobian: np.ndarray, residuals: np.ndarray, weights: np.nda
     return float(rms), lengths, loo, uncertainty_from(cov, cov_c, sigma, int(source), condition)
 
 
-def uncertainty_from(cov: np.ndarray, cov_centre: np.ndarray, sigma_px: float, source: int, condition: float) -> PoseUncertainty:
+def uncertainty_from(
+    cov: np.ndarray, cov_centre: np.ndarray, sigma_px: float, source: int, condition: float
+) -> PoseUncertainty:
     """Package a covariance (p, p) and the camera centre's (3, 3) as 1-sigma figures."""
     var = cov.diagonal()
     std = np.sqrt(var)

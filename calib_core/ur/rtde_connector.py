@@ -30,7 +30,15 @@ from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
 from calib_core.connectors.joint_map import JointMap
-from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, MoveTimeout, TimedSample
+from calib_core.connectors.link_types import (
+    LinkError,
+    LinkState,
+    LinkStats,
+    MoveError,
+    MoveHandle,
+    MoveTimeout,
+    TimedSample,
+)
 from calib_core.connectors.link_types import JointSample
 from calib_core.link.round_trip import RoundTrip
 
@@ -51,14 +59,24 @@ class URRtdeController(ConnectorEvents):
         if not parts.hostname:
             raise LinkError(f"{url!r}: a UR controller is ur-rtde://HOST (its IP address or name)")
         if context.n_joints == 0:  # no cell (``monitor`` without --workcell): the UR's own six joints, in its order
-            context = ControllerContext(tuple(f"joint_{k + 1}" for k in range(6)), ("deg",) * 6, JointMap.identity(6), context.rate_hz, context.options)
+            context = ControllerContext(
+                tuple(f"joint_{k + 1}" for k in range(6)),
+                ("deg",) * 6,
+                JointMap.identity(6),
+                context.rate_hz,
+                context.options,
+            )
         if context.n_joints != 6 or any(u != "deg" for u in context.joint_units):
-            raise LinkError(f"{url}: a UR robot has 6 revolute joints; the cell's robot has {context.n_joints} ({', '.join(context.joint_units)})")
+            raise LinkError(
+                f"{url}: a UR robot has 6 revolute joints; the cell's robot has {context.n_joints} ({', '.join(context.joint_units)})"
+            )
         options = dict(context.options or {})
         options.update({k: v[-1] for k, v in parse_qs(parts.query).items()})
         unknown = set(options) - _OPTIONS
         if unknown:
-            raise LinkError(f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}")
+            raise LinkError(
+                f"{url!r}: unknown option(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(_OPTIONS))}"
+            )
         self.url = url
         self.host = parts.hostname
         self.rate_hz = number_option(options, "rate_hz", 500.0, 1.0, 500.0, "ur-rtde")
@@ -126,9 +144,11 @@ class URRtdeController(ConnectorEvents):
             raise ValueError(f"a move needs 6 finite joint values, got {list(q)}")
         handle = MoveHandle(f"ur.{next(self._ids)}", tuple(q), time.monotonic() + timeout_s)
         why = self._why_not_sendable()
-        program = ("def videocal_move():\n"
-                   f"  movej([{', '.join(f'{v:.6f}' for v in np.radians(q))}], a={math.radians(self.acceleration_deg_s2):.4f}, v={math.radians(self.speed_deg_s):.4f})\n"
-                   "end\n")
+        program = (
+            "def videocal_move():\n"
+            f"  movej([{', '.join(f'{v:.6f}' for v in np.radians(q))}], a={math.radians(self.acceleration_deg_s2):.4f}, v={math.radians(self.speed_deg_s):.4f})\n"
+            "end\n"
+        )
         if why is None:
             self._moves.begin(handle)
             why = self._send_script(program)
@@ -234,8 +254,10 @@ class URRtdeController(ConnectorEvents):
         period = 1.0 / self.rate_hz
         while not self._stop.is_set():
             if self._receive is None or not self._receive.isConnected():
-                self._set_state(LinkState.DOWN if self._receive is not None or self.stats.reconnects else LinkState.CONNECTING,
-                                f"no RTDE connection to {self.host}:{RTDE_PORT} ({self.last_error or 'connecting'})")
+                self._set_state(
+                    LinkState.DOWN if self._receive is not None or self.stats.reconnects else LinkState.CONNECTING,
+                    f"no RTDE connection to {self.host}:{RTDE_PORT} ({self.last_error or 'connecting'})",
+                )
                 if self._stop.wait(backoff) or not self._connect():
                     backoff = min(backoff * 2, 2.0)
                     continue

@@ -36,7 +36,9 @@ def open_stream(spec: str, options: dict) -> FrameSource:
     options = dict(options or {})
     unknown = set(options) - {"timeout_s", "reopen_every_s"}
     if unknown:
-        raise VideoSourceError(f"camera {spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: reopen_every_s, timeout_s")
+        raise VideoSourceError(
+            f"camera {spec!r}: unknown option(s) {', '.join(sorted(unknown))}; known: reopen_every_s, timeout_s"
+        )
     from calib_core.connectors.link_types import LinkError
 
     try:

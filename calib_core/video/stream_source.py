@@ -31,11 +31,15 @@ class StreamSource(FrameSource):
         self._last_try_s = 0.0
         self._cap = self._open()
         if self._cap is None:
-            raise VideoSourceError(f"cannot open {self.description} with OpenCV's FFmpeg back end (wrong URL, or the camera is not serving?)")
+            raise VideoSourceError(
+                f"cannot open {self.description} with OpenCV's FFmpeg back end (wrong URL, or the camera is not serving?)"
+            )
 
     def _open(self):
         ms = int(self.timeout_s * 1000)
-        cap = cv2.VideoCapture(self.url, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, ms, cv2.CAP_PROP_READ_TIMEOUT_MSEC, ms])
+        cap = cv2.VideoCapture(
+            self.url, cv2.CAP_FFMPEG, [cv2.CAP_PROP_OPEN_TIMEOUT_MSEC, ms, cv2.CAP_PROP_READ_TIMEOUT_MSEC, ms]
+        )
         if cap.isOpened():
             return cap
         cap.release()
@@ -68,7 +72,9 @@ class StreamSource(FrameSource):
         self._cap = self._open()
         if self._cap is None:
             gone = time.monotonic() - (self._down_since or self._last_try_s)
-            raise FrameTimeout(f"{self.description}: no frame for {gone:.0f} s (the stream is gone; opening it again every {self.reopen_every_s:g} s)")
+            raise FrameTimeout(
+                f"{self.description}: no frame for {gone:.0f} s (the stream is gone; opening it again every {self.reopen_every_s:g} s)"
+            )
         self.reconnects += 1
 
     def close(self) -> None:

@@ -43,10 +43,18 @@ class ArucoGridSpec:
 
     @property
     def size_mm(self) -> tuple[float, float]:
-        return (self.cols * (self.marker_mm + self.gap_mm) - self.gap_mm, self.rows * (self.marker_mm + self.gap_mm) - self.gap_mm)
+        return (
+            self.cols * (self.marker_mm + self.gap_mm) - self.gap_mm,
+            self.rows * (self.marker_mm + self.gap_mm) - self.gap_mm,
+        )
 
     def board(self) -> cv2.aruco.GridBoard:
-        return cv2.aruco.GridBoard((self.cols, self.rows), self.marker_mm, self.gap_mm, cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)))
+        return cv2.aruco.GridBoard(
+            (self.cols, self.rows),
+            self.marker_mm,
+            self.gap_mm,
+            cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, self.dictionary)),
+        )
 
     def corners_mm(self) -> np.ndarray:
         """Marker corners (4 * cols * rows, 3), marker by marker."""
@@ -54,7 +62,9 @@ class ArucoGridSpec:
 
     def image(self, px_per_mm: float = 4.0) -> np.ndarray:
         w, h = self.size_mm
-        return self.board().generateImage((int(round(w * px_per_mm)), int(round(h * px_per_mm))), marginSize=0, borderBits=1)
+        return self.board().generateImage(
+            (int(round(w * px_per_mm)), int(round(h * px_per_mm))), marginSize=0, borderBits=1
+        )
 
     def detector(self, settings: DetectorSettings | None = None):
         settings = settings or DetectorSettings()
@@ -76,7 +86,11 @@ class ArucoGridSpec:
                 return TargetDetection(np.zeros((0, 2)), np.zeros(0, dtype=int), 0)
             ids = ids.ravel().astype(int) - first_id
             keep = (ids >= 0) & (ids < self.cols * self.rows)
-            points = np.concatenate([c.reshape(4, 2) for c, k in zip(corners, keep) if k]) if keep.any() else np.zeros((0, 2))
+            points = (
+                np.concatenate([c.reshape(4, 2) for c, k in zip(corners, keep) if k])
+                if keep.any()
+                else np.zeros((0, 2))
+            )
             point_ids = (4 * ids[keep][:, None] + np.arange(4)[None, :]).ravel()
             return TargetDetection(points.astype(np.float64), point_ids, int(len(ids)))
 

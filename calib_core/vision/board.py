@@ -57,7 +57,9 @@ class BoardSpec:
         return cls(sx, sy, square, marker, parts[4], len(parts) == 6)
 
     def __str__(self) -> str:
-        return f"charuco:{self.squares_x}x{self.squares_y}:{self.square_mm:g}:{self.marker_mm:g}:{self.dictionary}" + (":legacy" if self.legacy else "")
+        return f"charuco:{self.squares_x}x{self.squares_y}:{self.square_mm:g}:{self.marker_mm:g}:{self.dictionary}" + (
+            ":legacy" if self.legacy else ""
+        )
 
     @property
     def size_mm(self) -> tuple[float, float]:
@@ -75,7 +77,9 @@ class BoardSpec:
 
     def image(self, px_per_mm: float = 4.0) -> np.ndarray:
         w, h = self.size_mm
-        return self.board().generateImage((int(round(w * px_per_mm)), int(round(h * px_per_mm))), marginSize=0, borderBits=1)
+        return self.board().generateImage(
+            (int(round(w * px_per_mm)), int(round(h * px_per_mm))), marginSize=0, borderBits=1
+        )
 
     def detector(self, settings: DetectorSettings | None = None):
         """A function grey image -> :class:`TargetDetection` (build once, use for many images)."""
@@ -117,4 +121,12 @@ def board_item(spec, board2world: np.ndarray, name: str = "charuco_board") -> Sc
     faces = np.array([[0, 1, 2], [0, 2, 3]])
     mesh = trimesh.Trimesh(vertices, faces, process=False)
     tcoords = np.array([[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]])  # image rows run down y; t runs up
-    return SceneItem(name, mesh, np.asarray(board2world, dtype=float), color=(1.0, 1.0, 1.0), kind="fixture", texture=spec.image(), texture_coords=tcoords)
+    return SceneItem(
+        name,
+        mesh,
+        np.asarray(board2world, dtype=float),
+        color=(1.0, 1.0, 1.0),
+        kind="fixture",
+        texture=spec.image(),
+        texture_coords=tcoords,
+    )

@@ -43,8 +43,15 @@ def board_in_cell(spec: BoardSpec, workcell, robot: RobotModel) -> np.ndarray:
     return board_from_centre(spec, centre) if centre is not None else board_in_front_of_robot(spec, robot)
 
 
-def board_view_joints(robot: RobotModel, start_deg, spec: BoardSpec, board2base: np.ndarray, n: int = 10, seed: int = 0,
-                      off_centre_deg: float = 0.0) -> list[np.ndarray]:
+def board_view_joints(
+    robot: RobotModel,
+    start_deg,
+    spec: BoardSpec,
+    board2base: np.ndarray,
+    n: int = 10,
+    seed: int = 0,
+    off_centre_deg: float = 0.0,
+) -> list[np.ndarray]:
     """Joint vectors (deg/mm) from which the modelled camera looks at the board from different
     directions, rolled about its axis: reachable ones only, each IK seeded from the one before.
     ``off_centre_deg``: the camera also panned and tilted about its own centre by up to this much,
@@ -68,7 +75,11 @@ def board_view_joints(robot: RobotModel, start_deg, spec: BoardSpec, board2base:
         x /= np.linalg.norm(x)
         y = np.cross(z, x)
         roll = Rotation.from_rotvec(np.radians(rng.uniform(-35, 35)) * z).as_matrix()
-        aim = Rotation.from_euler("xy", rng.uniform(-off_centre_deg, off_centre_deg, 2), degrees=True).as_matrix() if off_centre_deg else np.eye(3)
+        aim = (
+            Rotation.from_euler("xy", rng.uniform(-off_centre_deg, off_centre_deg, 2), degrees=True).as_matrix()
+            if off_centre_deg
+            else np.eye(3)
+        )
         cam2base = make_transform(roll @ np.column_stack([x, y, z]) @ aim, position)
         try:
             sol = solve_ik(robot, concat(invert(cam2flange), cam2base), q, frame="flange", extra_seeds=4)

@@ -12,7 +12,15 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.robot.model import RobotModel
 from calib_core.vision.hand_eye import HandEyeCalibration, calibrate_hand_eye
-from calib_core.vision.intrinsics_calibration import BoardView, CalibrationInputError, IntrinsicsCalibration, RejectedView, calibrate_intrinsics, coverage, detect_view
+from calib_core.vision.intrinsics_calibration import (
+    BoardView,
+    CalibrationInputError,
+    IntrinsicsCalibration,
+    RejectedView,
+    calibrate_intrinsics,
+    coverage,
+    detect_view,
+)
 
 
 class BoardCapture:
@@ -33,10 +41,14 @@ class BoardCapture:
         (hashable: the frame's source and number) refuses a frame captured already: four captures of one
         frame are one view, not four."""
         if frame_key is not None and frame_key in self._captured:
-            raise CalibrationInputError(f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next pose")
+            raise CalibrationInputError(
+                f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next pose"
+            )
         if self.views and (image_rgb.shape[1], image_rgb.shape[0]) != self.views[0].image_size:
             w, h = self.views[0].image_size
-            raise CalibrationInputError(f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one calibration is for one camera mode")
+            raise CalibrationInputError(
+                f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one calibration is for one camera mode"
+            )
         self._count += 1
         result = detect_view(f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
         if frame_key is not None:
@@ -67,5 +79,9 @@ class BoardCapture:
         """``cam2flange`` from the views taken with a robot pose, the flange placed by ``robot``'s FK."""
         posed = [(v, q) for v, q in zip(self.views, self.joints_deg) if q is not None]
         if len(posed) < len(self.views):
-            raise CalibrationInputError(f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a controller link)")
-        return calibrate_hand_eye([v for v, _ in posed], [robot.fk(q, "flange") for _, q in posed], self.spec, intrinsics)
+            raise CalibrationInputError(
+                f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a controller link)"
+            )
+        return calibrate_hand_eye(
+            [v for v, _ in posed], [robot.fk(q, "flange") for _, q in posed], self.spec, intrinsics
+        )

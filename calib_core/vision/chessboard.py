@@ -49,7 +49,7 @@ class ChessboardSpec:
 
     def corners_mm(self) -> np.ndarray:
         """Inner corners (cols * rows, 3), row by row, the first one square in from the sheet's corner."""
-        j, i = np.mgrid[0:self.rows, 0:self.cols]
+        j, i = np.mgrid[0 : self.rows, 0 : self.cols]
         return np.column_stack([(i.ravel() + 1) * self.square_mm, (j.ravel() + 1) * self.square_mm, np.zeros(i.size)])
 
     def image(self, px_per_mm: float = 4.0) -> np.ndarray:
@@ -63,13 +63,19 @@ class ChessboardSpec:
         size = (self.cols, self.rows)
 
         def detect(grey: np.ndarray) -> TargetDetection:
-            found, corners = cv2.findChessboardCornersSB(grey, size, flags=cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY)
+            found, corners = cv2.findChessboardCornersSB(
+                grey, size, flags=cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY
+            )
             if not found:
-                found, corners = cv2.findChessboardCorners(grey, size, flags=cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE)
+                found, corners = cv2.findChessboardCorners(
+                    grey, size, flags=cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+                )
                 if found:
                     corners = cv2.cornerSubPix(grey, corners, (5, 5), (-1, -1), _SUBPIX)
             if not found:
                 return TargetDetection(np.zeros((0, 2)), np.zeros(0, dtype=int), 0)
-            return TargetDetection(corners.reshape(-1, 2).astype(np.float64), np.arange(self.cols * self.rows), self.cols * self.rows)
+            return TargetDetection(
+                corners.reshape(-1, 2).astype(np.float64), np.arange(self.cols * self.rows), self.cols * self.rows
+            )
 
         return detect

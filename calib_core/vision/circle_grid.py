@@ -53,7 +53,7 @@ class CircleGridSpec:
 
     def corners_mm(self) -> np.ndarray:
         """Circle centres (cols * rows, 3) in OpenCV's order (row by row)."""
-        j, i = np.mgrid[0:self.rows, 0:self.cols]
+        j, i = np.mgrid[0 : self.rows, 0 : self.cols]
         i, j = i.ravel(), j.ravel()
         x = (2 * i + j % 2) if self.asymmetric else i
         return np.column_stack([(x + 1) * self.spacing_mm, (j + 1) * self.spacing_mm, np.zeros(i.size)])
@@ -63,7 +63,10 @@ class CircleGridSpec:
         out = np.full((int(round(h * px_per_mm)), int(round(w * px_per_mm))), 255, np.uint8)
         shift = 4
         for x, y, _ in self.corners_mm():
-            centre = (int(round((x * px_per_mm - 0.5) * (1 << shift))), int(round((y * px_per_mm - 0.5) * (1 << shift))))
+            centre = (
+                int(round((x * px_per_mm - 0.5) * (1 << shift))),
+                int(round((y * px_per_mm - 0.5) * (1 << shift))),
+            )
             cv2.circle(out, centre, int(round(self.radius_mm * px_per_mm * (1 << shift))), 0, -1, cv2.LINE_AA, shift)
         return out
 
@@ -76,9 +79,13 @@ class CircleGridSpec:
         def detect(grey: np.ndarray) -> TargetDetection:
             found, centres = cv2.findCirclesGrid(grey, size, flags=flags, blobDetector=blobs)
             if not found:
-                found, centres = cv2.findCirclesGrid(grey, size, flags=flags | cv2.CALIB_CB_CLUSTERING, blobDetector=blobs)
+                found, centres = cv2.findCirclesGrid(
+                    grey, size, flags=flags | cv2.CALIB_CB_CLUSTERING, blobDetector=blobs
+                )
             if not found:
                 return TargetDetection(np.zeros((0, 2)), np.zeros(0, dtype=int), len(blobs.detect(grey)))
-            return TargetDetection(centres.reshape(-1, 2).astype(np.float64), np.arange(self.cols * self.rows), self.cols * self.rows)
+            return TargetDetection(
+                centres.reshape(-1, 2).astype(np.float64), np.arange(self.cols * self.rows), self.cols * self.rows
+            )
 
         return detect

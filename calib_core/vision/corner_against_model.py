@@ -23,8 +23,13 @@ _ALIKE = 0.5
 _MODEL_EDGE_PX = 1.5
 
 
-def detect_corner_against_model(magnitude: np.ndarray, expected_magnitude: np.ndarray, corner_px: np.ndarray, arms_px: list[np.ndarray],
-                                search_px: float = 2.0) -> Detection | NotDetected:
+def detect_corner_against_model(
+    magnitude: np.ndarray,
+    expected_magnitude: np.ndarray,
+    corner_px: np.ndarray,
+    arms_px: list[np.ndarray],
+    search_px: float = 2.0,
+) -> Detection | NotDetected:
     """The image of a corner from its edges' offsets against the model's view.
 
     ``corner_px`` (2,): the corner projected at the pose the model's view was rendered at; ``arms_px``:
@@ -79,6 +84,9 @@ def detect_corner_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     if np.linalg.norm(delta) > search_px:
         return NotDetected("its edges lie away from where the model's view draws them")
     rms = float(np.sqrt(np.mean(residual[keep] ** 2)))
-    return detection(corner_px + delta, float(np.clip(keep.mean(), 0.0, 1.0) * np.exp(-rms / 0.5)),
-                     (float(keep.mean()), f"only {100 * keep.mean():.0f} % of its edges' samples agree with the model's view"),
-                     (float(np.exp(-rms / 0.5)), f"its edges differ from the model's view by {rms:.1f} px RMS"))
+    return detection(
+        corner_px + delta,
+        float(np.clip(keep.mean(), 0.0, 1.0) * np.exp(-rms / 0.5)),
+        (float(keep.mean()), f"only {100 * keep.mean():.0f} % of its edges' samples agree with the model's view"),
+        (float(np.exp(-rms / 0.5)), f"its edges differ from the model's view by {rms:.1f} px RMS"),
+    )

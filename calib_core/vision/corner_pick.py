@@ -6,7 +6,9 @@ import cv2
 import numpy as np
 
 
-def refine_corner_pick(image_rgb: np.ndarray, pixel, half_window: int = 5, max_shift_px: float = 2.0) -> tuple[float, float]:
+def refine_corner_pick(
+    image_rgb: np.ndarray, pixel, half_window: int = 5, max_shift_px: float = 2.0
+) -> tuple[float, float]:
     """The corner nearest ``pixel`` (u, v) px to sub-pixel accuracy on ``image_rgb`` (h, w, 3); the
     click itself when the refinement wanders further than ``max_shift_px`` (no corner there: a circle
     centre, a flat patch), since the operator's click is then the better estimate."""

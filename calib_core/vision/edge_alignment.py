@@ -62,7 +62,7 @@ def edge_samples_px(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intr
     mid = seg.mean(axis=1)
     facing = np.einsum("eij,ej->ei", normals, centre - mid) > 0
     seg = seg[facing.any(axis=1)]
-    z = (seg @ obj2cam[2, :3] + obj2cam[2, 3])
+    z = seg @ obj2cam[2, :3] + obj2cam[2, 3]
     seg = seg[(z > 1.0).all(axis=1)]
     if len(seg) == 0:
         return np.zeros((0, 2))

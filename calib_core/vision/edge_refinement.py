@@ -80,7 +80,9 @@ class EdgeFit:
         its ``rms_bound_px`` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold more of its edges)."""
         if not self.converged:
             return False
-        return (self.rms_px <= 0.5 and self.inlier_share >= self.min_share) or (self.rms_px <= self.rms_bound_px and self.inlier_share >= COARSE_FIT_SHARE)
+        return (self.rms_px <= 0.5 and self.inlier_share >= self.min_share) or (
+            self.rms_px <= self.rms_bound_px and self.inlier_share >= COARSE_FIT_SHARE
+        )
 
 
 CREASES_JOIN_PX = 2.0
@@ -108,7 +110,9 @@ def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return out
 
 
-def normal_jacobian(points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+def normal_jacobian(
+    points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndarray, intrinsics: Intrinsics
+) -> np.ndarray:
     """The derivative (m, 6) of each point's (m, 3, object frame, mm) pixel along its unit normal
     (m, 2) in the pose's six small motions (the rotation vector in rad, then the translation in mm,
     both in the camera frame, applied as :func:`_perturbed` does). The pixel's derivative in the
@@ -125,8 +129,19 @@ def normal_jacobian(points_mm: np.ndarray, obj2cam: np.ndarray, normals: np.ndar
     return np.column_stack([np.cross(X, d_offset), d_offset])  # n . D (w x X) = (X x (n D)) . w
 
 
-def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.ndarray, *, expected_magnitude: np.ndarray | None = None, search_px: float = 8.0,
-                    iterations: int = 30, magnitude: np.ndarray | None = None, rms_bound_px: float = SETTLED_RMS_PX, colour: np.ndarray | None = None) -> EdgeFit:
+def refine_to_edges(
+    grey: np.ndarray,
+    intrinsics: Intrinsics,
+    mesh,
+    obj2cam: np.ndarray,
+    *,
+    expected_magnitude: np.ndarray | None = None,
+    search_px: float = 8.0,
+    iterations: int = 30,
+    magnitude: np.ndarray | None = None,
+    rms_bound_px: float = SETTLED_RMS_PX,
+    colour: np.ndarray | None = None,
+) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
     ``obj2cam``, to leave out edges without contrast; ``rms_bound_px`` the fit's settle bound (:attr:`EdgeFit.settled`);
@@ -137,7 +152,14 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
     by_colour = colour is not None and colour.ndim == 3
     model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude, whole_outline=by_colour)
-    pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
+    pts, far, clearance, chain, outward, from_outline = (
+        model.points,
+        model.far,
+        model.clearance,
+        model.chain,
+        model.outward,
+        model.from_outline,
+    )
     regions = None
     if colour is not None and colour.ndim == 3:
         regions = RegionModel.from_image(colour, *model.silhouette)
@@ -156,7 +178,14 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
             # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
             model = edge_model(mesh, pose, intrinsics, expected_magnitude, whole_outline=by_colour)
-            pts, far, clearance, chain, outward, from_outline = model.points, model.far, model.clearance, model.chain, model.outward, model.from_outline
+            pts, far, clearance, chain, outward, from_outline = (
+                model.points,
+                model.far,
+                model.clearance,
+                model.chain,
+                model.outward,
+                model.from_outline,
+            )
             sampled_at = pose
         if len(pts) < 12:
             break
@@ -169,7 +198,9 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
         counted = np.ones(len(uv), dtype=bool)  # the samples the fit's share on its edges is of
         if regions is not None and outward.any():
             on_outline = outward != 0
-            step, contrast, step_inside = regions.step_edges(uv[on_outline], normals[on_outline] * outward[on_outline, None], window)
+            step, contrast, step_inside = regions.step_edges(
+                uv[on_outline], normals[on_outline] * outward[on_outline, None], window
+            )
             found[on_outline] = step
             # The outline alone brings the pose near, as the region-based trackers fit: a crease between two of the
             # object's faces has its colours on both sides, and on a printed part the strongest gradient within a
@@ -225,8 +256,11 @@ def refine_to_edges(grey: np.ndarray, intrinsics: Intrinsics, mesh, obj2cam: np.
     try:
         H_inv = np.linalg.inv(H)
         independent = sigma**2 * H_inv
-        covariance = independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
+        covariance = (
+            independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
+        )
     except np.linalg.LinAlgError:
         independent = covariance = np.full((6, 6), np.nan)
-    return EdgeFit(pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent, rms_bound_px)
-
+    return EdgeFit(
+        pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent, rms_bound_px
+    )

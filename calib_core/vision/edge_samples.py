@@ -27,6 +27,7 @@ OUTLINE_ONLY_WHEN_UNCOVERED = 0.5
 """The contour's samples join the mesh's own edge samples only when more than this share of them lies away from
 any (a scanned mesh's outline: none of its facet edges holds a sample)."""
 
+
 def _segment_keys(seg: np.ndarray) -> list[bytes]:
     """One key per segment (E, 2, 3), the same for both directions (to 1 um)."""
     ends = np.round(seg * 1000.0).astype(np.int64)
@@ -84,8 +85,9 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
     return np.array([root(i) for i in range(n)])
 
 
-def edge_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def edge_points(
+    mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """3D samples (m, 3) on the visible crease and silhouette edges and on the occluding contour, their edges'
     far ends (m, 3), their clearance (m,) px and their :func:`edge_chains` numbers (m,), every ~4 px. With
     ``expected_magnitude`` (h, w: the :func:`gradient_magnitude` of the cell rendered at ``obj2cam``)
@@ -114,8 +116,14 @@ class EdgeSamples:
     silhouette: tuple[np.ndarray, tuple[int, int]]
 
 
-def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None = None, *,
-               whole_outline: bool = False) -> EdgeSamples:
+def edge_model(
+    mesh,
+    obj2cam: np.ndarray,
+    intrinsics: Intrinsics,
+    expected_magnitude: np.ndarray | None = None,
+    *,
+    whole_outline: bool = False,
+) -> EdgeSamples:
     """The samples of :func:`edge_points`, with which of them lie on the outline (:class:`EdgeSamples`).
     ``whole_outline``: the contour's samples fill every gap the mesh's own edges leave (for a fit of the outline by
     colour); else only on a mesh whose own edges hold little of its outline (:data:`OUTLINE_ONLY_WHEN_UNCOVERED`)."""
@@ -143,7 +151,9 @@ def edge_model(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magni
             clearance = np.concatenate([clearance, np.full(int(keep.sum()), np.inf)])
             chain = np.concatenate([chain, first_chain + outline.chain[keep]])
             added = int(keep.sum())
-    return EdgeSamples(pts, far, clearance, chain, _outward(pts, far, obj2cam, intrinsics, silhouette), added, silhouette)
+    return EdgeSamples(
+        pts, far, clearance, chain, _outward(pts, far, obj2cam, intrinsics, silhouette), added, silhouette
+    )
 
 
 _SIDE_PX = 3.0
@@ -171,7 +181,13 @@ def _outward(pts: np.ndarray, far: np.ndarray, obj2cam: np.ndarray, intrinsics: 
     return np.where(minus & ~plus, 1, np.where(plus & ~minus, -1, 0))
 
 
-def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_magnitude: np.ndarray | None, rims: np.ndarray | None = None):
+def _crease_points(
+    mesh,
+    obj2cam: np.ndarray,
+    intrinsics: Intrinsics,
+    expected_magnitude: np.ndarray | None,
+    rims: np.ndarray | None = None,
+):
     """:func:`edge_points` along the mesh's own crease and silhouette edges (``rims``: the silhouette's, when known)."""
     seg = visible_segments(mesh, obj2cam, rims)
     if len(seg) == 0:
@@ -192,8 +208,11 @@ def _crease_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, expected_m
     # the edges that can crowd a sample: those the model's view shows (a rim's facets, too short to
     # hold a sample, by their midpoints)
     sampled = np.bincount(which, minlength=len(seg))
-    shown = np.where(sampled > 0, np.bincount(which[shows], minlength=len(seg)) >= 0.5 * sampled,
-                     model_shows_edge(expected_magnitude, project_points(seg.mean(axis=1), obj2cam, intrinsics)))
+    shown = np.where(
+        sampled > 0,
+        np.bincount(which[shows], minlength=len(seg)) >= 0.5 * sampled,
+        model_shows_edge(expected_magnitude, project_points(seg.mean(axis=1), obj2cam, intrinsics)),
+    )
     clearance = _clearance(uv, ends[shown], np.searchsorted(np.flatnonzero(shown), which), shown[which])
     keep = shows & (clearance > _CROWDED_PX)
     return pts[keep], far[keep], clearance[keep], chain[keep]

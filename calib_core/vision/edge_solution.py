@@ -37,11 +37,28 @@ def edge_solution(fit: EdgeFit, intrinsics: Intrinsics) -> PoseSolution:
     uncertainty = uncertainty_from(cov, cov_centre, fit.sigma_px, 1, condition)
     m = len(fit.residuals_px)
     settled = fit.settled
-    reason = None if settled else (f"the edges did not settle: RMS {fit.rms_px:.2f} px, {100 * fit.inlier_share:.0f} % of {fit.samples} samples on their edges"
-                                   if fit.converged else "the edge refinement did not converge")
+    reason = (
+        None
+        if settled
+        else (
+            f"the edges did not settle: RMS {fit.rms_px:.2f} px, {100 * fit.inlier_share:.0f} % of {fit.samples} samples on their edges"
+            if fit.converged
+            else "the edge refinement did not converge"
+        )
+    )
     return PoseSolution(
-        status=SolveStatus.OK if settled else SolveStatus.FAILED, obj2cam=fit.obj2cam.copy(), fu=intrinsics.fu, fv=intrinsics.fv, model="pinhole",
-        iterations=0, residuals_px=np.asarray(fit.residuals_px, dtype=float).reshape(-1, 2), uncertainty=uncertainty,
-        leave_one_out_px=np.full(m, np.nan), outliers=np.zeros(m, dtype=bool), candidates=(PoseCandidate(fit.obj2cam.copy(), intrinsics.fu, intrinsics.fv, fit.rms_px),),
-        reason=reason, warnings=(f"solved on {fit.samples} edge samples of the target (no point pairs)",), method="edges",
+        status=SolveStatus.OK if settled else SolveStatus.FAILED,
+        obj2cam=fit.obj2cam.copy(),
+        fu=intrinsics.fu,
+        fv=intrinsics.fv,
+        model="pinhole",
+        iterations=0,
+        residuals_px=np.asarray(fit.residuals_px, dtype=float).reshape(-1, 2),
+        uncertainty=uncertainty,
+        leave_one_out_px=np.full(m, np.nan),
+        outliers=np.zeros(m, dtype=bool),
+        candidates=(PoseCandidate(fit.obj2cam.copy(), intrinsics.fu, intrinsics.fv, fit.rms_px),),
+        reason=reason,
+        warnings=(f"solved on {fit.samples} edge samples of the target (no point pairs)",),
+        method="edges",
     )

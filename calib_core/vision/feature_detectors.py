@@ -71,7 +71,9 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
     if win is None:
         return NotDetected("at the edge of the image")
     roi, x0, y0 = win
-    corners = cv2.goodFeaturesToTrack(roi, maxCorners=12, qualityLevel=0.05, minDistance=3, blockSize=5, useHarrisDetector=True, k=0.04)
+    corners = cv2.goodFeaturesToTrack(
+        roi, maxCorners=12, qualityLevel=0.05, minDistance=3, blockSize=5, useHarrisDetector=True, k=0.04
+    )
     if corners is None:
         return NotDetected(f"no corner within {radius_px:.0f} px of where the model puts it")
     cand = corners.reshape(-1, 2) + (x0, y0)
@@ -80,7 +82,11 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
     if dist[k] > radius_px:
         return NotDetected(f"no corner within {radius_px:.0f} px of where the model puts it")
     start = cand[k].astype(np.float32).reshape(1, 1, 2).copy()
-    refined = cv2.cornerSubPix(grey, start, (4, 4), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.01)).reshape(2).astype(float)
+    refined = (
+        cv2.cornerSubPix(grey, start, (4, 4), (-1, -1), (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.01))
+        .reshape(2)
+        .astype(float)
+    )
     confidence = 1.0
     # a second corner close by makes the choice uncertain
     others = np.sort(dist)[1:2]
@@ -88,7 +94,12 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
         confidence *= 0.5
     crowded = (confidence, "another corner lies within 2.5 px")
     if np.linalg.norm(refined - cand[k]) > 1.5:  # the refinement walked off: three faces meet here
-        return detection(cand[k].astype(float), 0.3 * confidence, (0.3, "the sub-pixel refinement walked off it (three faces meeting?)"), crowded)
+        return detection(
+            cand[k].astype(float),
+            0.3 * confidence,
+            (0.3, "the sub-pixel refinement walked off it (three faces meeting?)"),
+            crowded,
+        )
     return detection(refined, confidence, crowded)
 
 
@@ -98,7 +109,9 @@ def gradient_magnitude(image: np.ndarray) -> np.ndarray:
     return colour_contrast.gradient_magnitude(image)
 
 
-def search_normals(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarray, search_px: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def search_normals(
+    magnitude: np.ndarray, points: np.ndarray, normals: np.ndarray, search_px: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For each point (m, 2) the strongest gradient along its unit normal (m, 2) within +-``search_px``:
     the edge points (m, 2) at sub-pixel precision (a parabola through the peak), their strengths (m,)
     and which searches stayed inside the image (m,) bool. One ``cv2.remap``
@@ -106,7 +119,9 @@ def search_normals(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarra
     h, w = magnitude.shape
     steps = np.arange(-search_px, search_px + 0.25, 0.5)
     lines = points[:, None, :] + steps[None, :, None] * normals[:, None, :]  # (m, s, 2)
-    inside = ((lines[..., 0] >= 1) & (lines[..., 0] < w - 2) & (lines[..., 1] >= 1) & (lines[..., 1] < h - 2)).all(axis=1)
+    inside = ((lines[..., 0] >= 1) & (lines[..., 0] < w - 2) & (lines[..., 1] >= 1) & (lines[..., 1] < h - 2)).all(
+        axis=1
+    )
     profile = cv2.remap(magnitude, lines[..., 0].astype(np.float32), lines[..., 1].astype(np.float32), cv2.INTER_LINEAR)
     k = np.argmax(profile, axis=1)
     rows = np.arange(len(points))
@@ -118,8 +133,14 @@ def search_normals(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarra
     return points + offset[:, None] * normals, profile[rows, k], inside
 
 
-def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.ndarray, search_px: float = 4.0, magnitude: np.ndarray | None = None,
-                  rim_has_contrast: np.ndarray | None = None) -> Detection | NotDetected:
+def detect_circle(
+    grey: np.ndarray,
+    rim_px: np.ndarray,
+    centre_offset_px: np.ndarray,
+    search_px: float = 4.0,
+    magnitude: np.ndarray | None = None,
+    rim_has_contrast: np.ndarray | None = None,
+) -> Detection | NotDetected:
     """The image of a circle's centre. ``rim_px`` (m, 2): the predicted rim (the projected circle,
     already shifted to where the target is); ``centre_offset_px`` (2,): the image of the centre minus the
     centre of the ellipse through the predicted rim (the perspective correction); ``rim_has_contrast``
@@ -152,19 +173,33 @@ def detect_circle(grey: np.ndarray, rim_px: np.ndarray, centre_offset_px: np.nda
             pts = pts[keep]
         ellipse = cv2.fitEllipse(pts)
         rms = float(np.sqrt(np.mean(_ellipse_residual(pts, ellipse) ** 2)))
-        return detection(np.array(ellipse[0]) + centre_offset_px, float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)),
-                         (float(coverage), f"only {100 * coverage:.0f} % of its rim found"), (float(np.exp(-rms / 0.7)), f"its rim is off an ellipse by {rms:.1f} px RMS"))
+        return detection(
+            np.array(ellipse[0]) + centre_offset_px,
+            float(np.clip(coverage, 0, 1) * np.exp(-rms / 0.7)),
+            (float(coverage), f"only {100 * coverage:.0f} % of its rim found"),
+            (float(np.exp(-rms / 0.7)), f"its rim is off an ellipse by {rms:.1f} px RMS"),
+        )
     # a partial rim: the predicted ellipse moved as a whole onto the edge points (two unknowns)
     shift = _rim_shift(normals[strong], np.einsum("ij,ij->i", points[strong] - rim_px[strong], normals[strong]), 0.5)
     if isinstance(shift, NotDetected):
         return shift
     delta, rms, _ = shift
     predicted_centre = np.array(cv2.fitEllipse(rim_px.astype(np.float32))[0]) + centre_offset_px
-    return detection(predicted_centre + delta, float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)),
-                     (float(coverage / 0.7 * 0.7), f"only {100 * coverage:.0f} % of its rim found: placed by the part seen"), (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"))
+    return detection(
+        predicted_centre + delta,
+        float(np.clip(coverage / 0.7, 0, 1) * 0.7 * np.exp(-rms / 0.5)),
+        (float(coverage / 0.7 * 0.7), f"only {100 * coverage:.0f} % of its rim found: placed by the part seen"),
+        (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"),
+    )
 
 
-def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.ndarray, rim_px: np.ndarray, centre_px: np.ndarray, search_px: float = 2.0) -> Detection | NotDetected:
+def detect_circle_against_model(
+    magnitude: np.ndarray,
+    expected_magnitude: np.ndarray,
+    rim_px: np.ndarray,
+    centre_px: np.ndarray,
+    search_px: float = 2.0,
+) -> Detection | NotDetected:
     """The image of a circle's centre, measured against the model's view of it.
 
     ``rim_px`` (m, 2): the rim projected at the pose the edges found (a closed polygon, in order);
@@ -182,14 +217,18 @@ def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     unlike (correlation under 0.5), is left out (beside the gripper's fingers a boss came out up to
     2.5 px off)."""
     tangent = np.roll(rim_px, -1, axis=0) - np.roll(rim_px, 1, axis=0)
-    normals = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-9)
+    normals = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(
+        np.linalg.norm(tangent, axis=1, keepdims=True), 1e-9
+    )
     _, strength, inside = search_normals(magnitude, rim_px, normals, search_px)
     modelled, model_strength, _ = search_normals(expected_magnitude, rim_px, normals, 1.5)
     model_offset = np.einsum("ij,ij->i", modelled - rim_px, normals)
     offset, alike = match_profiles(magnitude, expected_magnitude, rim_px, normals, search_px)
     usable = inside & (model_strength >= 12.0) & (np.abs(model_offset) <= 1.5) & (alike >= _ALIKE)
     if usable.sum() < 6:
-        return NotDetected(f"its rim is outside the image, stands beside another edge in the model's view or looks unlike it ({int(usable.sum())} of {len(rim_px)} rim points clear)")
+        return NotDetected(
+            f"its rim is outside the image, stands beside another edge in the model's view or looks unlike it ({int(usable.sum())} of {len(rim_px)} rim points clear)"
+        )
     floor = max(8.0, 0.35 * float(np.median(strength[usable])))
     strong = usable & (strength >= floor)
     if strong.sum() < 6:
@@ -198,12 +237,20 @@ def detect_circle_against_model(magnitude: np.ndarray, expected_magnitude: np.nd
     if isinstance(shift, NotDetected):
         return shift
     delta, rms, kept = shift
-    return detection(centre_px + delta, float(np.clip(kept / len(rim_px) / 0.5, 0, 1) * np.exp(-rms / 0.5)),
-                     (float(kept / len(rim_px) / 0.5), f"only {100 * kept / len(rim_px):.0f} % of its rim measured against the model's"),
-                     (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"))
+    return detection(
+        centre_px + delta,
+        float(np.clip(kept / len(rim_px) / 0.5, 0, 1) * np.exp(-rms / 0.5)),
+        (
+            float(kept / len(rim_px) / 0.5),
+            f"only {100 * kept / len(rim_px):.0f} % of its rim measured against the model's",
+        ),
+        (float(np.exp(-rms / 0.5)), f"its rim scatters by {rms:.1f} px"),
+    )
 
 
-def _rim_shift(normals: np.ndarray, offsets_px: np.ndarray, floor_px: float) -> tuple[np.ndarray, float, int] | NotDetected:
+def _rim_shift(
+    normals: np.ndarray, offsets_px: np.ndarray, floor_px: float
+) -> tuple[np.ndarray, float, int] | NotDetected:
     """The shift (2,) px that moves rim points along their unit ``normals`` (m, 2) by ``offsets_px``
     (m,), least squares with points off by more than 3 robust sigmas (at least ``floor_px``) dropped
     twice at most; with its RMS residual and how many points it kept."""
@@ -221,8 +268,14 @@ def _rim_shift(normals: np.ndarray, offsets_px: np.ndarray, floor_px: float) -> 
     return delta, float(np.sqrt(np.mean(residual**2))), len(n)
 
 
-def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: list[np.ndarray], search_px: float = 3.0, magnitude: np.ndarray | None = None,
-                             lens: Intrinsics | None = None) -> Detection | NotDetected:
+def detect_corner_from_edges(
+    grey: np.ndarray,
+    corner_px: np.ndarray,
+    arms_px: list[np.ndarray],
+    search_px: float = 3.0,
+    magnitude: np.ndarray | None = None,
+    lens: Intrinsics | None = None,
+) -> Detection | NotDetected:
     """A corner as the meeting point of the image lines along the model's edges that end there.
 
     ``corner_px`` (2,): the predicted corner; ``arms_px``: for each edge ending at it, the predicted
@@ -245,7 +298,9 @@ def detect_corner_from_edges(grey: np.ndarray, corner_px: np.ndarray, arms_px: l
         if len(s) < 4:
             continue
         normal = np.array([-d[1], d[0]])
-        pts, strength, inside = search_normals(mag, corner_px + s[:, None] * d, np.repeat(normal[None], len(s), axis=0), search_px)
+        pts, strength, inside = search_normals(
+            mag, corner_px + s[:, None] * d, np.repeat(normal[None], len(s), axis=0), search_px
+        )
         good = inside & (strength >= max(10.0, 0.4 * float(np.median(strength[inside])) if inside.any() else 10.0))
         if good.sum() < 4:
             continue
@@ -294,7 +349,9 @@ def detect_blob(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> Dete
     roi, x0, y0 = win
     _, mask = cv2.threshold(roi, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
     centre = np.array(roi.shape[::-1]) / 2
-    inside = mask[int(min(max(uv_pred[1] - y0, 0), roi.shape[0] - 1)), int(min(max(uv_pred[0] - x0, 0), roi.shape[1] - 1))]
+    inside = mask[
+        int(min(max(uv_pred[1] - y0, 0), roi.shape[0] - 1)), int(min(max(uv_pred[0] - x0, 0), roi.shape[1] - 1))
+    ]
     blob = (mask == inside).astype(np.uint8)
     n, labels, stats, centroids = cv2.connectedComponentsWithStats(blob)
     if n < 2:
@@ -304,4 +361,8 @@ def detect_blob(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> Dete
     if x == 0 or y == 0 or x + bw >= roi.shape[1] or y + bh >= roi.shape[0]:
         return NotDetected(f"no blob smaller than {2 * radius_px:.0f} px there")
     contrast = abs(float(roi[labels == k].mean()) - float(roi[labels != k].mean())) / 255.0
-    return detection(centroids[k] + (x0, y0), float(np.clip(4 * contrast, 0, 1)), (0.0, f"a faint blob ({100 * contrast:.0f} % contrast)"))
+    return detection(
+        centroids[k] + (x0, y0),
+        float(np.clip(4 * contrast, 0, 1)),
+        (0.0, f"a faint blob ({100 * contrast:.0f} % contrast)"),
+    )

@@ -40,6 +40,7 @@ from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
 from calib_core.vision.search_reach import REACH_DEG, REACH_MM  # noqa: E402 (named apart: a command's --help reads them)
+
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
 _FIT_SHARE = 0.6  # a fit settles (is proposed from) with this share of its samples on their edges: wrong minima seen held 52-56 %, the least right one 65 % (the bench)
@@ -48,7 +49,9 @@ _STARTS = 8  # starts tried at most: on one frame of the demo the right one rank
 _REUSE_PX = 0.25  # the second pass's view serves the detectors when its fit moved the target less than this
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put a feature further apart
-_MATCHED_SHARE = 0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
+_MATCHED_SHARE = (
+    0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
+)
 
 
 @dataclass(frozen=True)
@@ -120,7 +123,13 @@ def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> 
     return out
 
 
-def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG) -> float:
+def search_radius_px(
+    points_mm: np.ndarray,
+    obj2cam: np.ndarray,
+    intrinsics: Intrinsics,
+    reach_mm: float = REACH_MM,
+    reach_deg: float = REACH_DEG,
+) -> float:
     """How far (px) the target may lie from where a camera at ``obj2cam`` sees it, when the camera may be
     ``reach_mm`` and ``reach_deg`` off: a move across the line of sight shifts a point at depth z by
     f reach / z (the target's nearer half counts), a turn by f reach in radians."""
@@ -131,9 +140,19 @@ def search_radius_px(points_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Int
     return f * (reach_mm / near + np.radians(reach_deg))
 
 
-def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2cam_model: np.ndarray, *, kinds: dict[str, FeatureKind] | None = None,
-                reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, expected=None, edge_rms_px: float = SETTLED_RMS_PX,
-                by_colour: bool = False) -> FoundPoints:
+def find_points(
+    image: np.ndarray,
+    intrinsics: Intrinsics,
+    item: SceneItem,
+    obj2cam_model: np.ndarray,
+    *,
+    kinds: dict[str, FeatureKind] | None = None,
+    reach_mm: float = REACH_MM,
+    reach_deg: float = REACH_DEG,
+    expected=None,
+    edge_rms_px: float = SETTLED_RMS_PX,
+    by_colour: bool = False,
+) -> FoundPoints:
     """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
     ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
     the item's own, corner when absent). ``expected(obj2cam, box_px) -> image``: the cell rendered as this
@@ -173,15 +192,36 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
     # its rims onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right
     # pose at 0.13 px).
     t_edges = time.perf_counter()
-    samples, _, _, _ = edge_points(item.mesh, obj2cam_model, intrinsics, detectors.expected_magnitude(obj2cam_model) if expected is not None else None)
-    ranked = rank_starts(edge_distance_map(image, HYPOTHESIS_TRUNCATE_PX), intrinsics, samples, obj2cam_model, reach_mm, reach_deg, keep=_STARTS)
+    samples, _, _, _ = edge_points(
+        item.mesh,
+        obj2cam_model,
+        intrinsics,
+        detectors.expected_magnitude(obj2cam_model) if expected is not None else None,
+    )
+    ranked = rank_starts(
+        edge_distance_map(image, HYPOTHESIS_TRUNCATE_PX),
+        intrinsics,
+        samples,
+        obj2cam_model,
+        reach_mm,
+        reach_deg,
+        keep=_STARTS,
+    )
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     colour = image if by_colour and image.ndim == 3 else None
 
     def refined(start_pose: np.ndarray) -> EdgeFit:
-        fit = refine_to_edges(grey, intrinsics, item.mesh, start_pose, expected_magnitude=detectors.expected_magnitude(start_pose) if expected is not None else None,
-                              magnitude=detectors.magnitude, rms_bound_px=edge_rms_px, colour=colour)
+        fit = refine_to_edges(
+            grey,
+            intrinsics,
+            item.mesh,
+            start_pose,
+            expected_magnitude=detectors.expected_magnitude(start_pose) if expected is not None else None,
+            magnitude=detectors.magnitude,
+            rms_bound_px=edge_rms_px,
+            colour=colour,
+        )
         return replace(fit, min_share=_FIT_SHARE)  # settled only on more than half its edges: proposals follow from it
 
     best = None
@@ -199,19 +239,35 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         # edges, and a wrong proposal costs the operator more than a pick by hand.
         share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
         if share < _MATCHED_SHARE:
-            message = (f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an edge of the image): "
-                       "pick the points by hand")
+            message = (
+                f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an edge of the image): "
+                "pick the points by hand"
+            )
         else:
-            message = (f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
-                       f"{edge_fit.samples} edge samples on their edges): pick the points by hand")
-        return FoundPoints(item.name, False, message, missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names), offset_px=shift,
-                           seconds=time.perf_counter() - t0, edges=edge_fit, edge_seconds=edge_seconds)
+            message = (
+                f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
+                f"{edge_fit.samples} edge samples on their edges): pick the points by hand"
+            )
+        return FoundPoints(
+            item.name,
+            False,
+            message,
+            missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names),
+            offset_px=shift,
+            seconds=time.perf_counter() - t0,
+            edges=edge_fit,
+            edge_seconds=edge_seconds,
+        )
     start = edge_fit.obj2cam
     # The detectors measure against the model's view at the pose they predict from; the second pass's
     # view serves when its fit moved the target less than _REUSE_PX from there (a render saved: a
     # quarter of the time close up).
     shown = detectors.rendered_pose()
-    if expected is not None and shown is not None and _moved_px(np.vstack([points, detectors.box_corners]), shown, start, intrinsics) < _REUSE_PX:
+    if (
+        expected is not None
+        and shown is not None
+        and _moved_px(np.vstack([points, detectors.box_corners]), shown, start, intrinsics) < _REUSE_PX
+    ):
         start = shown
     # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
     # times the edges' scatter keeps a detector off the neighbouring edge (a boss's base beside its rim)
@@ -224,8 +280,10 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         agreement = max(_EDGE_AGREEMENT_PX, 2.0 * edge_fit.sigma_px)
         for i, d in list(first.items()):
             if isinstance(d, Detection) and np.linalg.norm(d.uv_px - uv_edges[i]) > agreement:
-                first[i] = NotDetected(f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges put it "
-                                       "(another edge in front of it?)")
+                first[i] = NotDetected(
+                    f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges put it "
+                    "(another edge in front of it?)"
+                )
     pose, fit = _robust_fit(first, points, intrinsics, start)
     if pose is not None and _moved_px(points, pose, edge_fit.obj2cam, intrinsics) > _AGREE_PX:
         # The edges can settle where every feature still passes the 1 px gate and yet off the pose the
@@ -234,18 +292,37 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         # again from there, and the fit with more samples on their edges is kept. Where the two poses
         # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
-        across = replace(refine_to_edges(grey, intrinsics, item.mesh, pose, expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
-                                         magnitude=detectors.magnitude, search_px=_RECHECK_SEARCH_PX, rms_bound_px=edge_rms_px, colour=colour),
-                         min_share=_FIT_SHARE)
+        across = replace(
+            refine_to_edges(
+                grey,
+                intrinsics,
+                item.mesh,
+                pose,
+                expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
+                magnitude=detectors.magnitude,
+                search_px=_RECHECK_SEARCH_PX,
+                rms_bound_px=edge_rms_px,
+                colour=colour,
+            ),
+            min_share=_FIT_SHARE,
+        )
         if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
             edge_fit = across
         edge_seconds += time.perf_counter() - t_across
     if pose is None:
         for i, d in first.items():
             missed.setdefault(names[i], d.reason if isinstance(d, NotDetected) else "no pose fits the detections")
-        return FoundPoints(item.name, False, f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: "
-                           "pick the points by hand, or Calibrate on edges (its edges settled)",
-                           missed=tuple(Missed(n, r) for n, r in missed.items()), offset_px=shift, seconds=time.perf_counter() - t0, edges=edge_fit, edge_seconds=edge_seconds)
+        return FoundPoints(
+            item.name,
+            False,
+            f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: "
+            "pick the points by hand, or Calibrate on edges (its edges settled)",
+            missed=tuple(Missed(n, r) for n, r in missed.items()),
+            offset_px=shift,
+            seconds=time.perf_counter() - t0,
+            edges=edge_fit,
+            edge_seconds=edge_seconds,
+        )
     final_pose, second = pose, first
     proposals = []
     uv_final = project_points(points, final_pose, intrinsics)
@@ -257,16 +334,39 @@ def find_points(image: np.ndarray, intrinsics: Intrinsics, item: SceneItem, obj2
         if not fit.get(i, False):
             missed[names[i]] = f"rejected by the pose fit: {residual:.1f} px from where the other features put it"
             continue
-        proposals.append(Proposal(names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual, d.why))
+        proposals.append(
+            Proposal(
+                names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual, d.why
+            )
+        )
     found = len(proposals) >= 4
-    message = (f"{len(proposals)} of {len(names)} features of {item.name} found" + (f"; {len(missed)} not: see the list" if missed else "")
-               if found else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand")
-    return FoundPoints(item.name, found, message, tuple(proposals), tuple(Missed(n, r) for n, r in missed.items()), shift, final_pose if found else None, time.perf_counter() - t0, edge_fit, edge_seconds)
+    message = (
+        f"{len(proposals)} of {len(names)} features of {item.name} found"
+        + (f"; {len(missed)} not: see the list" if missed else "")
+        if found
+        else f"{item.name}: only {len(proposals)} features found, too few: pick the points by hand"
+    )
+    return FoundPoints(
+        item.name,
+        found,
+        message,
+        tuple(proposals),
+        tuple(Missed(n, r) for n, r in missed.items()),
+        shift,
+        final_pose if found else None,
+        time.perf_counter() - t0,
+        edge_fit,
+        edge_seconds,
+    )
 
 
 def _moved_px(points_mm: np.ndarray, a: np.ndarray, b: np.ndarray, intrinsics: Intrinsics) -> float:
     """How far (px) the points (n, 3) of the target move in the image between poses ``a`` and ``b`` (4, 4), at most."""
-    return float(np.max(np.linalg.norm(project_points(points_mm, a, intrinsics) - project_points(points_mm, b, intrinsics), axis=1)))
+    return float(
+        np.max(
+            np.linalg.norm(project_points(points_mm, a, intrinsics) - project_points(points_mm, b, intrinsics), axis=1)
+        )
+    )
 
 
 def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
@@ -274,7 +374,9 @@ def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
     return fit.settled, fit.inlier_share * fit.samples
 
 
-def _robust_fit(detections: dict, points: np.ndarray, intrinsics: Intrinsics, prior: np.ndarray) -> tuple[np.ndarray | None, dict[int, bool]]:
+def _robust_fit(
+    detections: dict, points: np.ndarray, intrinsics: Intrinsics, prior: np.ndarray
+) -> tuple[np.ndarray | None, dict[int, bool]]:
     """The pose of the detections (robust, sampled best-confidence first) and which it keeps."""
     found = [(i, d) for i, d in detections.items() if isinstance(d, Detection)]
     if len(found) < 4:
@@ -283,7 +385,9 @@ def _robust_fit(detections: dict, points: np.ndarray, intrinsics: Intrinsics, pr
     uv = np.array([d.uv_px for _, d in found])
     confidence = np.array([d.confidence for _, d in found])
     try:
-        solution = solve_pose(points[idx], uv, intrinsics, prior=prior, robust=True, sigma_px=_SIGMA_PX, confidence=confidence)
+        solution = solve_pose(
+            points[idx], uv, intrinsics, prior=prior, robust=True, sigma_px=_SIGMA_PX, confidence=confidence
+        )
     except SolverInputError:
         return None, {}
     if solution.status.value == "failed":

@@ -111,28 +111,44 @@ def pose_set_warnings(flange2base: list[np.ndarray]) -> list[str]:
                 axes.append(rel / angle)
     out = []
     if not angles or max(angles) < _MIN_ROTATION_DEG:
-        out.append(f"the poses rotate the tool by at most {max(angles, default=0):.1f} deg: rotate 20-40 deg between poses")
+        out.append(
+            f"the poses rotate the tool by at most {max(angles, default=0):.1f} deg: rotate 20-40 deg between poses"
+        )
     if len(axes) >= 2:
         s = np.linalg.svd(np.array(axes), compute_uv=False)
         if s[1] < 0.2 * s[0]:
-            out.append("the rotations between poses are about nearly parallel axes: the mounting is then undetermined along that axis; tilt about two different axes")
+            out.append(
+                "the rotations between poses are about nearly parallel axes: the mounting is then undetermined along that axis; tilt about two different axes"
+            )
     elif angles:
         out.append("too few rotations between poses to determine the mounting")
     return out
 
 
-def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], spec, intrinsics: Intrinsics, *, static_camera: bool = False,
-                       pose_sigma_mm: float = POSE_SIGMA_MM, method: int = cv2.CALIB_HAND_EYE_PARK) -> HandEyeCalibration:
+def calibrate_hand_eye(
+    views: list[BoardView],
+    flange2base: list[np.ndarray],
+    spec,
+    intrinsics: Intrinsics,
+    *,
+    static_camera: bool = False,
+    pose_sigma_mm: float = POSE_SIGMA_MM,
+    method: int = cv2.CALIB_HAND_EYE_PARK,
+) -> HandEyeCalibration:
     """``views[i]`` seen with the flange at ``flange2base[i]`` (4, 4, mm, from forward kinematics or
     the controller). ``static_camera``: the camera stands in the cell and the robot holds the board.
     ``pose_sigma_mm``: how well the robot's poses are known (1-sigma per axis), which with the corners'
     measured noise sets when the views are said to disagree."""
     if len(views) != len(flange2base):
-        raise CalibrationInputError(f"{len(views)} views but {len(flange2base)} robot poses: every view needs the pose it was taken at")
+        raise CalibrationInputError(
+            f"{len(views)} views but {len(flange2base)} robot poses: every view needs the pose it was taken at"
+        )
     if len(views) < MIN_POSES:
         raise CalibrationInputError(f"{len(views)} poses, at least {MIN_POSES} needed (10 or more recommended)")
     if not spec.unambiguous:
-        raise CalibrationInputError(f"a {spec.kind} target looks the same turned half a turn, so a view does not say which corner is the first: use a ChArUco or ArUco board for the camera's mounting")
+        raise CalibrationInputError(
+            f"a {spec.kind} target looks the same turned half a turn, so a view does not say which corner is the first: use a ChArUco or ArUco board for the camera's mounting"
+        )
     warnings = pose_set_warnings(flange2base)
     # The camera on the robot sees the board at X^-1 A^-1 Y; a static camera at X^-1 A Y.
     moving = [invert(T) for T in flange2base] if static_camera else [np.asarray(T, dtype=float) for T in flange2base]
@@ -153,21 +169,45 @@ def calibrate_hand_eye(views: list[BoardView], flange2base: list[np.ndarray], sp
     pose_px = 0.5 * (intrinsics.fu + intrinsics.fv) * pose_sigma_mm / max(distance_mm, 1.0)
     limit = disagreement_limit_px(noise, pose_px)
     if rms > limit:
-        warnings.append(f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
-                        f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
-                        "calibrate the robot first, or use poses close together")
+        warnings.append(
+            f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
+            f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
+            "calibrate the robot first, or use poses close together"
+        )
         # One bad pose pulls every view: name it when leaving it out makes the rest agree.
         if len(views) > MIN_POSES + 1:
             worst = int(np.argmax(per_view))
             keep = [k for k in range(len(views)) if k != worst]
             try:
-                *_, r_rest, _ = _fit([views[k] for k in keep], [moving[k] for k in keep], [board2cam[k] for k in keep], spec, intrinsics, static_camera, method)
+                *_, r_rest, _ = _fit(
+                    [views[k] for k in keep],
+                    [moving[k] for k in keep],
+                    [board2cam[k] for k in keep],
+                    spec,
+                    intrinsics,
+                    static_camera,
+                    method,
+                )
             except CalibrationInputError:
                 r_rest = None
             if r_rest is not None and _rms(r_rest, [views[k] for k in keep])[0] <= limit:
-                warnings.append(f"view {views[worst].name} disagrees with the others: without it the RMS is {_rms(r_rest, [views[k] for k in keep])[0]:.2f} px; "
-                                "a wrong robot pose for it, or the board moved: remove it")
-    return HandEyeCalibration(cam2flange, std[3:6], np.degrees(std[:3]), board2base, rms, start, len(views), warnings, static_camera, noise, per_view)
+                warnings.append(
+                    f"view {views[worst].name} disagrees with the others: without it the RMS is {_rms(r_rest, [views[k] for k in keep])[0]:.2f} px; "
+                    "a wrong robot pose for it, or the board moved: remove it"
+                )
+    return HandEyeCalibration(
+        cam2flange,
+        std[3:6],
+        np.degrees(std[:3]),
+        board2base,
+        rms,
+        start,
+        len(views),
+        warnings,
+        static_camera,
+        noise,
+        per_view,
+    )
 
 
 def _rms(r: np.ndarray, views: list[BoardView]) -> tuple[float, tuple[float, ...]]:
@@ -182,23 +222,35 @@ def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
     (px) and their Jacobian at the optimum."""
     try:
         R_cam2flange, t_cam2flange = cv2.calibrateHandEye(
-            [T[:3, :3] for T in moving], [T[:3, 3] for T in moving],
-            [T[:3, :3] for T in board2cam], [T[:3, 3] for T in board2cam], method=method,
+            [T[:3, :3] for T in moving],
+            [T[:3, 3] for T in moving],
+            [T[:3, :3] for T in board2cam],
+            [T[:3, 3] for T in board2cam],
+            method=method,
         )
     except cv2.error:
-        raise CalibrationInputError(f"the robot poses and the board views fit no {'static camera' if static_camera else 'camera on the robot'}: "
-                                    f"{'is the camera on the robot?' if static_camera else 'is it a static camera (the robot holding the board)?'} "
-                                    "Are the poses the flange's in the base, in the views' order?") from None
+        raise CalibrationInputError(
+            f"the robot poses and the board views fit no {'static camera' if static_camera else 'camera on the robot'}: "
+            f"{'is the camera on the robot?' if static_camera else 'is it a static camera (the robot holding the board)?'} "
+            "Are the poses the flange's in the base, in the views' order?"
+        ) from None
     if not np.all(np.isfinite(R_cam2flange)) or abs(np.linalg.det(R_cam2flange) - 1.0) > 1e-3:
-        raise CalibrationInputError("the robot poses and the board views give no rotation for the camera's mounting: are the poses the flange's in the base, in the views' order?")
+        raise CalibrationInputError(
+            "the robot poses and the board views give no rotation for the camera's mounting: are the poses the flange's in the base, in the views' order?"
+        )
     start = make_transform(R_cam2flange, np.asarray(t_cam2flange).ravel())
     # The board's placement from the start: average over views of flange2base . cam2flange . board2cam.
     placements = [concat(B, start, F) for F, B in zip(moving, board2cam)]
-    board2base0 = make_transform(Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix(), np.mean([P[:3, 3] for P in placements], axis=0))
+    board2base0 = make_transform(
+        Rotation.from_matrix([P[:3, :3] for P in placements]).mean().as_matrix(),
+        np.mean([P[:3, 3] for P in placements], axis=0),
+    )
     corners = spec.corners_mm()
 
     def unpack(x):
-        return make_transform(Rotation.from_rotvec(x[:3]).as_matrix(), x[3:6]), make_transform(Rotation.from_rotvec(x[6:9]).as_matrix(), x[9:12])
+        return make_transform(Rotation.from_rotvec(x[:3]).as_matrix(), x[3:6]), make_transform(
+            Rotation.from_rotvec(x[6:9]).as_matrix(), x[9:12]
+        )
 
     def residuals(x):
         cam2flange, board2base = unpack(x)
@@ -208,7 +260,14 @@ def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
             out.append((project(apply(board2cam_i, corners[v.ids]), intrinsics) - v.corners_px).ravel())
         return np.concatenate(out)
 
-    x0 = np.concatenate([Rotation.from_matrix(start[:3, :3]).as_rotvec(), start[:3, 3], Rotation.from_matrix(board2base0[:3, :3]).as_rotvec(), board2base0[:3, 3]])
+    x0 = np.concatenate(
+        [
+            Rotation.from_matrix(start[:3, :3]).as_rotvec(),
+            start[:3, 3],
+            Rotation.from_matrix(board2base0[:3, :3]).as_rotvec(),
+            board2base0[:3, 3],
+        ]
+    )
     fit = least_squares(residuals, x0, method="lm", x_scale=np.r_[[0.01] * 3, [1.0] * 3, [0.01] * 3, [1.0] * 3])
     cam2flange, board2base = unpack(fit.x)
     return cam2flange, board2base, start, fit.fun, fit.jac

@@ -33,7 +33,9 @@ from calib_core.frames import make_transform
 
 POSE_COLUMNS = ("x_mm", "y_mm", "z_mm", "qx", "qy", "qz", "qw")
 MAX_VIEWS = 2000
-_ROS_DICTIONARIES = {getattr(cv2.aruco, n): n for n in dir(cv2.aruco) if n.startswith("DICT_") and isinstance(getattr(cv2.aruco, n), int)}
+_ROS_DICTIONARIES = {
+    getattr(cv2.aruco, n): n for n in dir(cv2.aruco) if n.startswith("DICT_") and isinstance(getattr(cv2.aruco, n), int)
+}
 
 
 @dataclass(frozen=True)
@@ -69,7 +71,11 @@ class PosedImages:
         if columns == generic:
             return list(range(len(columns)))
         if sorted(columns) != sorted(joint_names):
-            raise FileFormatError(self.source, f"the joint columns {', '.join(columns)} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}", "header")
+            raise FileFormatError(
+                self.source,
+                f"the joint columns {', '.join(columns)} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}",
+                "header",
+            )
         return [columns.index(n) for n in joint_names]
 
     def read_image(self, view: PosedImage) -> np.ndarray:
@@ -84,7 +90,10 @@ def load_posed_images(path: str | Path) -> PosedImages:
     if path.is_dir():
         found = [path / name for name in ("cal_data.yaml", "views.csv") if (path / name).is_file()]
         if not found:
-            raise FileFormatError(path, "a folder of views holds cal_data.yaml (ROS-Industrial's layout) or views.csv (image[,component],<joints>)")
+            raise FileFormatError(
+                path,
+                "a folder of views holds cal_data.yaml (ROS-Industrial's layout) or views.csv (image[,component],<joints>)",
+            )
         path = found[0]
     if path.suffix.lower() == ".csv":
         return _load_csv(path)
@@ -130,7 +139,11 @@ def _board_from_target_finder(finder, path: Path) -> str:
         return f"aruco:{whole('cols')}x{whole('rows')}:{1000 * number('aruco_marker_dim'):g}:{1000 * number('aruco_marker_gap'):g}:{dictionary()}"
     if kind == "ModifiedCircleGridTargetFinder":
         return f"circles:{whole('cols')}x{whole('rows')}:{1000 * number('spacing'):g}"
-    raise FileFormatError(path, f"videocal reads CharucoGridTargetFinder, ArucoGridTargetFinder and ModifiedCircleGridTargetFinder, not {kind!r}", "target_finder.type")
+    raise FileFormatError(
+        path,
+        f"videocal reads CharucoGridTargetFinder, ArucoGridTargetFinder and ModifiedCircleGridTargetFinder, not {kind!r}",
+        "target_finder.type",
+    )
 
 
 def _load_cal_data(path: Path) -> PosedImages:
@@ -142,7 +155,11 @@ def _load_cal_data(path: Path) -> PosedImages:
     views = []
     for k, entry in enumerate(doc["data"]):
         where = f"data[{k}]"
-        if not isinstance(entry, dict) or not isinstance(entry.get("image"), str) or not isinstance(entry.get("pose"), str):
+        if (
+            not isinstance(entry, dict)
+            or not isinstance(entry.get("image"), str)
+            or not isinstance(entry.get("pose"), str)
+        ):
             raise FileFormatError(path, "expected {image: PATH, pose: PATH}", where)
         pose_path = path.parent / entry["pose"]
         pose = read_yaml(pose_path, "pose file", max_bytes=64 * 1024)
@@ -155,7 +172,10 @@ def _load_cal_data(path: Path) -> PosedImages:
         intr = doc["intrinsics"]
         if not isinstance(intr, dict):
             raise FileFormatError(path, "expected fx fy cx cy", "intrinsics")
-        pinhole = tuple(finite_number(intr.get(k), path, f"intrinsics.{k}", low=0.0, exclusive_low=k in ("fx", "fy")) for k in ("fx", "fy", "cx", "cy"))
+        pinhole = tuple(
+            finite_number(intr.get(k), path, f"intrinsics.{k}", low=0.0, exclusive_low=k in ("fx", "fy"))
+            for k in ("fx", "fy", "cx", "cy")
+        )
     static = doc.get("static_camera")
     if static is not None and not isinstance(static, bool):
         raise FileFormatError(path, f"must be true or false, got {static!r}", "static_camera")
@@ -187,7 +207,9 @@ def _load_csv(path: Path) -> PosedImages:
     if not posed and (not columns or set(columns) & set(POSE_COLUMNS)):
         raise FileFormatError(path, f"expected the columns {', '.join(POSE_COLUMNS)} or one column per joint", "header")
     if posed and named:
-        raise FileFormatError(path, "a component column goes with joint columns (a robot calibration), not with flange poses", "header")
+        raise FileFormatError(
+            path, "a component column goes with joint columns (a robot calibration), not with flange poses", "header"
+        )
     if len(rows) - 1 > MAX_VIEWS or len(rows) < 2:
         raise FileFormatError(path, f"expected 1 to {MAX_VIEWS} rows of views, got {len(rows) - 1}")
     views = []
@@ -200,7 +222,13 @@ def _load_csv(path: Path) -> PosedImages:
         cells = row[2:] if named else row[1:]
         if posed:
             numbers = dict(zip(columns, csv_numbers(cells, columns, path, where)))
-            views.append(PosedImage(Path(image).stem, path.parent / image, flange2base=_quaternion_pose(numbers, path, where, 1.0, POSE_COLUMNS)))
+            views.append(
+                PosedImage(
+                    Path(image).stem,
+                    path.parent / image,
+                    flange2base=_quaternion_pose(numbers, path, where, 1.0, POSE_COLUMNS),
+                )
+            )
         else:
             q = np.array(csv_numbers(cells, columns, path, where))
             views.append(PosedImage(Path(image).stem, path.parent / image, joints_deg=q, component=component))

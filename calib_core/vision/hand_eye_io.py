@@ -27,7 +27,10 @@ def hand_eye_document(result: HandEyeCalibration) -> dict:
     return {
         camera: {"xyz": [round(float(v), 4) for v in xyz], "rpy": [round(float(v), 5) for v in rpy]},
         board: {"xyz": [round(float(v), 4) for v in bxyz], "rpy": [round(float(v), 5) for v in brpy]},
-        "std": {"xyz_mm": [round(float(v), 4) for v in result.std_xyz_mm], "rotation_deg": [round(float(v), 5) for v in result.std_rotation_deg]},
+        "std": {
+            "xyz_mm": [round(float(v), 4) for v in result.std_xyz_mm],
+            "rotation_deg": [round(float(v), 5) for v in result.std_rotation_deg],
+        },
         "units": {"length": "mm", "angle": "deg"},
         "rms_px": round(result.rms_px, 4),
         "corner_noise_px": round(float(result.noise_px), 4),
@@ -52,8 +55,12 @@ def load_mounting(path: str | Path) -> tuple[np.ndarray, str | None]:
         return _plausible(load_cam2flange(path), path, "cam2flange.xyz"), None
     found = read_static_transform(path)
     if "optical" not in found.child.lower():
-        raise FileFormatError(path, f"the camera frame {found.child!r} is not an optical frame (z along the view, x right, y down): "
-                                    "give the transform to the camera's *_optical_frame", "arguments")
+        raise FileFormatError(
+            path,
+            f"the camera frame {found.child!r} is not an optical frame (z along the view, x right, y down): "
+            "give the transform to the camera's *_optical_frame",
+            "arguments",
+        )
     return _plausible(found.child2parent_mm, path, "arguments"), found.parent
 
 
@@ -64,8 +71,12 @@ MAX_MOUNTING_MM = 3000.0
 def _plausible(cam2frame: np.ndarray, path, field: str) -> np.ndarray:
     distance = float(np.linalg.norm(cam2frame[:3, 3]))
     if distance > MAX_MOUNTING_MM:
-        raise FileFormatError(path, f"the camera would be {distance:.0f} mm from the frame it is mounted on, beyond {MAX_MOUNTING_MM:g} mm: "
-                                    "a camera on the robot is within an arm's reach of its flange (are the units mm?)", field)
+        raise FileFormatError(
+            path,
+            f"the camera would be {distance:.0f} mm from the frame it is mounted on, beyond {MAX_MOUNTING_MM:g} mm: "
+            "a camera on the robot is within an arm's reach of its flange (are the units mm?)",
+            field,
+        )
     return cam2frame
 
 
@@ -80,9 +91,15 @@ def load_cam2flange(path: str | Path) -> np.ndarray:
     if isinstance(doc, dict) and isinstance(doc.get("parameters"), dict) and "transform" in doc:
         return _easy_handeye2(path, doc)
     if isinstance(doc, dict) and "cam2base" in doc and "cam2flange" not in doc:
-        raise FileFormatError(path, "this is a static camera's calibration (cam2base): the camera is not on the robot's flange", "cam2base")
+        raise FileFormatError(
+            path,
+            "this is a static camera's calibration (cam2base): the camera is not on the robot's flange",
+            "cam2base",
+        )
     if not isinstance(doc, dict) or not isinstance(doc.get("cam2flange"), dict):
-        raise FileFormatError(path, "not a hand-eye file: expected a cam2flange section with xyz (mm) and rpy (deg)", "cam2flange")
+        raise FileFormatError(
+            path, "not a hand-eye file: expected a cam2flange section with xyz (mm) and rpy (deg)", "cam2flange"
+        )
     units = doc.get("units")
     if units is not None:
         if not isinstance(units, dict) or units.get("length", "mm") != "mm" or units.get("angle", "deg") != "deg":
@@ -103,10 +120,20 @@ def _easy_handeye2(path: Path, doc: dict) -> np.ndarray:
     camera mounting on the flange; the tracking frame is taken as the camera's optical frame (z along the axis)."""
     kind = doc["parameters"].get("calibration_type")
     if kind != "eye_in_hand":
-        raise FileFormatError(path, f"an easy_handeye2 calibration of type {kind!r}: only eye_in_hand is a camera on the robot's flange", "parameters.calibration_type")
+        raise FileFormatError(
+            path,
+            f"an easy_handeye2 calibration of type {kind!r}: only eye_in_hand is a camera on the robot's flange",
+            "parameters.calibration_type",
+        )
     transform = doc.get("transform")
-    if not isinstance(transform, dict) or not isinstance(transform.get("translation"), dict) or not isinstance(transform.get("rotation"), dict):
-        raise FileFormatError(path, "expected transform.translation {x, y, z} (m) and transform.rotation {x, y, z, w}", "transform")
+    if (
+        not isinstance(transform, dict)
+        or not isinstance(transform.get("translation"), dict)
+        or not isinstance(transform.get("rotation"), dict)
+    ):
+        raise FileFormatError(
+            path, "expected transform.translation {x, y, z} (m) and transform.rotation {x, y, z, w}", "transform"
+        )
     t = [finite_number(transform["translation"].get(k), path, f"transform.translation.{k}") for k in "xyz"]
     q = np.array([finite_number(transform["rotation"].get(k), path, f"transform.rotation.{k}") for k in "xyzw"])
     if abs(np.linalg.norm(q) - 1.0) > 1e-3:

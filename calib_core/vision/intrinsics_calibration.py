@@ -72,20 +72,31 @@ def detect_view(name: str, image: np.ndarray, spec, detector=None) -> BoardView 
     if max(h, w) > MAX_ASPECT * min(h, w):
         # no camera takes such a picture (a damaged file decodes so: 640 x 14304), and OpenCV's detectors allocate
         # past 2 GB on one
-        return RejectedView(name, f"the image is {w} x {h} px: not a camera's picture (sides more than {MAX_ASPECT:g} to 1; a damaged file?)")
+        return RejectedView(
+            name,
+            f"the image is {w} x {h} px: not a camera's picture (sides more than {MAX_ASPECT:g} to 1; a damaged file?)",
+        )
     grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
     found = (detector or spec.detector())(grey)
     size = (grey.shape[1], grey.shape[0])
     if len(found.ids) == 0:
         if found.markers_seen == 0 or spec.kind != "charuco":
             return RejectedView(name, "no board found")
-        return RejectedView(name, f"{found.markers_seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred")
+        return RejectedView(
+            name,
+            f"{found.markers_seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred",
+        )
     if len(found.ids) < MIN_CORNERS:
-        return RejectedView(name, f"only {len(found.ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden")
+        return RejectedView(
+            name,
+            f"only {len(found.ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden",
+        )
     return BoardView(name, found.corners_px, found.ids, size)
 
 
-def detect_views(images: Iterable[tuple[str, np.ndarray]], spec, settings: DetectorSettings | None = None) -> tuple[list[BoardView], list[RejectedView]]:
+def detect_views(
+    images: Iterable[tuple[str, np.ndarray]], spec, settings: DetectorSettings | None = None
+) -> tuple[list[BoardView], list[RejectedView]]:
     detector = spec.detector(settings)
     views, rejected = [], []
     size = None
@@ -95,7 +106,12 @@ def detect_views(images: Iterable[tuple[str, np.ndarray]], spec, settings: Detec
             if size is None:
                 size = result.image_size
             elif result.image_size != size:
-                rejected.append(RejectedView(name, f"image size {result.image_size[0]}x{result.image_size[1]} differs from the first view's {size[0]}x{size[1]}"))
+                rejected.append(
+                    RejectedView(
+                        name,
+                        f"image size {result.image_size[0]}x{result.image_size[1]} differs from the first view's {size[0]}x{size[1]}",
+                    )
+                )
                 continue
             views.append(result)
         else:
@@ -121,8 +137,14 @@ reach the image's corners a third radial term is free to bend the model where no
 the image's top 0.5-2 mm off in depth)."""
 
 
-def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = True, radial_terms: int = RADIAL_TERMS,
-                         rejected: list[RejectedView] | None = None) -> IntrinsicsCalibration:
+def calibrate_intrinsics(
+    views: list[BoardView],
+    spec,
+    *,
+    distortion: bool = True,
+    radial_terms: int = RADIAL_TERMS,
+    rejected: list[RejectedView] | None = None,
+) -> IntrinsicsCalibration:
     """Calibrate from detected views; ``distortion=False`` fits the pinhole only (what the paper's
     tool had); ``radial_terms`` 2 (k1, k2) or 3 (k1, k2, k3; for wide lenses, with views covering the
     image's corners). Tangential terms p1, p2 are fitted with any distortion."""
@@ -131,7 +153,9 @@ def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = Tru
         raise CalibrationInputError(f"radial_terms must be 2 (k1 k2) or 3 (k1 k2 k3), got {radial_terms}")
     if len(views) < MIN_VIEWS:
         why = "; ".join(f"{r.name}: {r.reason}" for r in rejected[:5])
-        raise CalibrationInputError(f"{len(views)} usable board views, at least {MIN_VIEWS} needed" + (f" (rejected: {why})" if why else ""))
+        raise CalibrationInputError(
+            f"{len(views)} usable board views, at least {MIN_VIEWS} needed" + (f" (rejected: {why})" if why else "")
+        )
     size = views[0].image_size
     corners3d = spec.corners_mm()
     object_points = [corners3d[v.ids].astype(np.float32) for v in views]
@@ -141,12 +165,30 @@ def calibrate_intrinsics(views: list[BoardView], spec, *, distortion: bool = Tru
         flags |= cv2.CALIB_FIX_K1 | cv2.CALIB_FIX_K2 | cv2.CALIB_FIX_K3 | cv2.CALIB_ZERO_TANGENT_DIST
     elif radial_terms == 2:
         flags |= cv2.CALIB_FIX_K3
-    rms, K, dist, _, _, std_intr, _, per_view = cv2.calibrateCameraExtended(object_points, image_points, size, None, None, flags=flags)
+    rms, K, dist, _, _, std_intr, _, per_view = cv2.calibrateCameraExtended(
+        object_points, image_points, size, None, None, flags=flags
+    )
     dist = np.asarray(dist, dtype=float).ravel()[:5]
-    intr = Intrinsics(float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2]), size[0], size[1], tuple(np.pad(dist, (0, 5 - len(dist)))))
+    intr = Intrinsics(
+        float(K[0, 0]),
+        float(K[1, 1]),
+        float(K[0, 2]),
+        float(K[1, 2]),
+        size[0],
+        size[1],
+        tuple(np.pad(dist, (0, 5 - len(dist)))),
+    )
     s = np.asarray(std_intr, dtype=float).ravel()
     std = {"fu": s[0], "fv": s[1], "cx": s[2], "cy": s[3], "k1": s[4], "k2": s[5], "p1": s[6], "p2": s[7], "k3": s[8]}
-    result = IntrinsicsCalibration(intr, float(rms), {v.name: float(e) for v, e in zip(views, np.asarray(per_view).ravel())}, {k: float(v) for k, v in std.items()}, coverage(views, size), [v.name for v in views], rejected)
+    result = IntrinsicsCalibration(
+        intr,
+        float(rms),
+        {v.name: float(e) for v, e in zip(views, np.asarray(per_view).ravel())},
+        {k: float(v) for k, v in std.items()},
+        coverage(views, size),
+        [v.name for v in views],
+        rejected,
+    )
     return IntrinsicsCalibration(**{**result.__dict__, "advice": advice(result)})
 
 
@@ -154,17 +196,23 @@ def advice(result: IntrinsicsCalibration) -> list[str]:
     """What the operator should do next, in words."""
     out = []
     if result.coverage < 0.7:
-        out.append(f"the corners cover {100 * result.coverage:.0f} % of the image: add views with the board near the image corners and edges, where distortion is strongest")
+        out.append(
+            f"the corners cover {100 * result.coverage:.0f} % of the image: add views with the board near the image corners and edges, where distortion is strongest"
+        )
     if len(result.used) < 10:
         out.append(f"{len(result.used)} views: 10-20 views at different tilts give a stable calibration")
     rel = result.std["fu"] / result.intrinsics.fu
     if rel > 0.002:
         out.append(f"fu is known to {100 * rel:.2f} % (1-sigma): add views tilted 20-40 deg about both axes")
     if result.std["cx"] > 1.0 or result.std["cy"] > 1.0:
-        out.append(f"the principal point is known to {max(result.std['cx'], result.std['cy']):.1f} px: add tilted views")
+        out.append(
+            f"the principal point is known to {max(result.std['cx'], result.std['cy']):.1f} px: add tilted views"
+        )
     worst = max(result.per_view_rms_px.items(), key=lambda kv: kv[1])
     if worst[1] > 3 * max(result.rms_px, 0.05):
-        out.append(f"view {worst[0]} fits poorly ({worst[1]:.2f} px against {result.rms_px:.2f} px overall): blurred or mis-detected, consider removing it")
+        out.append(
+            f"view {worst[0]} fits poorly ({worst[1]:.2f} px against {result.rms_px:.2f} px overall): blurred or mis-detected, consider removing it"
+        )
     if not out:
         out.append("good enough: every parameter is well determined and the image is covered")
     return out

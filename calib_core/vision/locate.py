@@ -71,21 +71,44 @@ class Located:
 
     def to_dict(self) -> dict:
         """The JSON form (mm, degrees): ``R_obj2cam``, ``t_obj2cam_mm``, ``std`` and the rest."""
+
         def matrix(a):
             return None if a is None else np.round(np.asarray(a, float), 9).tolist()
 
         return {
-            "status": self.status, "message": self.message,
+            "status": self.status,
+            "message": self.message,
             "R_obj2cam": matrix(None if self.obj2cam is None else self.obj2cam[:3, :3]),
             "t_obj2cam_mm": matrix(None if self.obj2cam is None else self.obj2cam[:3, 3]),
-            "std": None if self.std_translation_mm is None else {"rotation_deg": matrix(self.std_rotation_deg), "translation_mm": matrix(self.std_translation_mm)},
-            "edges": {"rms_px": _finite(self.edge_rms_px), "share_on_edges": _finite(self.edge_share), "samples": self.edge_samples},
-            "features": [{"name": f.name, "uv_px": matrix(f.uv_px), "point_mm": matrix(f.point_mm), "confidence": round(f.confidence, 3), **({"unsure_because": f.why} if f.why else {})} for f in self.features],
+            "std": None
+            if self.std_translation_mm is None
+            else {"rotation_deg": matrix(self.std_rotation_deg), "translation_mm": matrix(self.std_translation_mm)},
+            "edges": {
+                "rms_px": _finite(self.edge_rms_px),
+                "share_on_edges": _finite(self.edge_share),
+                "samples": self.edge_samples,
+            },
+            "features": [
+                {
+                    "name": f.name,
+                    "uv_px": matrix(f.uv_px),
+                    "point_mm": matrix(f.point_mm),
+                    "confidence": round(f.confidence, 3),
+                    **({"unsure_because": f.why} if f.why else {}),
+                }
+                for f in self.features
+            ],
             "missed": [{"name": n, "reason": r} for n, r in self.missed],
-            "features_pose": None if self.features_obj2cam is None else {
-                "R_obj2cam": matrix(self.features_obj2cam[:3, :3]), "t_obj2cam_mm": matrix(self.features_obj2cam[:3, 3]),
-                "origin_from_edges_mm": self.features_vs_edges_mm},
-            "moved_from_prior": None if self.prior_moved_mm is None else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
+            "features_pose": None
+            if self.features_obj2cam is None
+            else {
+                "R_obj2cam": matrix(self.features_obj2cam[:3, :3]),
+                "t_obj2cam_mm": matrix(self.features_obj2cam[:3, 3]),
+                "origin_from_edges_mm": self.features_vs_edges_mm,
+            },
+            "moved_from_prior": None
+            if self.prior_moved_mm is None
+            else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
             "starts_apart_mm": self.extra.get("starts_apart_mm"),
             "starts_apart_px": self.extra.get("starts_apart_px"),
             "seconds": round(self.seconds, 3),
@@ -106,20 +129,46 @@ def default_features(mesh) -> dict[str, np.ndarray]:
     return {f"v{i}": v.copy() for i, v in enumerate(vertices)}
 
 
-def locate(image: np.ndarray, intrinsics: Intrinsics, mesh, prior_obj2cam: np.ndarray, *, features: dict[str, np.ndarray] | None = None,
-           expected=None, reach_mm: float = REACH_MM, reach_deg: float = REACH_DEG, name: str = "object", color=(0.7, 0.7, 0.7)) -> Located:
+def locate(
+    image: np.ndarray,
+    intrinsics: Intrinsics,
+    mesh,
+    prior_obj2cam: np.ndarray,
+    *,
+    features: dict[str, np.ndarray] | None = None,
+    expected=None,
+    reach_mm: float = REACH_MM,
+    reach_deg: float = REACH_DEG,
+    name: str = "object",
+    color=(0.7, 0.7, 0.7),
+) -> Located:
     """The pose of the object ``mesh`` (mm, its own frame) in ``image`` (h, w[, 3]) uint8 taken by a camera of
     ``intrinsics``, starting from ``prior_obj2cam`` (4, 4, mm: the object's frame to the camera's) and searching
     ``reach_mm`` and ``reach_deg`` round it. ``features`` name -> (3,) mm (default :func:`default_features`);
     ``expected``: the object rendered as the camera would see it (as :func:`find_points` takes it), to leave out
     edges without contrast."""
     prior = check_transform(prior_obj2cam, name="prior (obj2cam)")
-    item = SceneItem(name, mesh, np.eye(4), color=tuple(color), features=default_features(mesh) if features is None else dict(features))
+    item = SceneItem(
+        name,
+        mesh,
+        np.eye(4),
+        color=tuple(color),
+        features=default_features(mesh) if features is None else dict(features),
+    )
 
     def look(start: np.ndarray) -> FoundPoints:
         if item.features:
-            return find_points(image, intrinsics, item, start, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg, edge_rms_px=PHOTO_EDGE_RMS_PX,
-                               by_colour=True)
+            return find_points(
+                image,
+                intrinsics,
+                item,
+                start,
+                expected=expected,
+                reach_mm=reach_mm,
+                reach_deg=reach_deg,
+                edge_rms_px=PHOTO_EDGE_RMS_PX,
+                by_colour=True,
+            )
         return _edges_only(image, intrinsics, item, start, expected, reach_mm, reach_deg)
 
     located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg)
@@ -134,7 +183,9 @@ def locate(image: np.ndarray, intrinsics: Intrinsics, mesh, prior_obj2cam: np.nd
     # with printed or inner edges (the tutorial box's printed frame lies 10-15 px inside its outline) a fit that
     # took an inner edge for the outline, or the outline for an inner edge, finds the other one from there.
     fits = [located]
-    for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(located.obj2cam, RIVAL_DEPTH_SHARE):
+    for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(
+        located.obj2cam, RIVAL_DEPTH_SHARE
+    ):
         other = _report(look(start), intrinsics, start, reach_mm, reach_deg)
         if other.status == "ok" and _within_reach(other.obj2cam, prior, reach_mm, reach_deg):
             fits.append(other)
@@ -174,7 +225,9 @@ def image_distance_px(a: np.ndarray, b: np.ndarray, mesh, intrinsics: Intrinsics
     seen = edge_points(mesh, a, intrinsics)[0]
     if not len(seen):
         seen = np.asarray(mesh.vertices, dtype=float)[:: max(1, len(mesh.vertices) // 2000)]
-    return float(np.max(np.linalg.norm(project_points(seen, a, intrinsics) - project_points(seen, b, intrinsics), axis=1)))
+    return float(
+        np.max(np.linalg.norm(project_points(seen, a, intrinsics) - project_points(seen, b, intrinsics), axis=1))
+    )
 
 
 def _fit_quality(fit: Located) -> tuple[float, float]:
@@ -199,21 +252,34 @@ def _verdict(fits: list[Located], mesh, intrinsics: Intrinsics, prior: np.ndarra
     bound = max(AGREE_PX, 3.0 * (best.edge_rms_px or 0.0))
     apart = [image_distance_px(best.obj2cam, f.obj2cam, mesh, intrinsics) for f in fits]
     agreeing = [f.obj2cam for f, d in zip(fits, apart) if d <= bound]
-    rivals = [(d, f) for f, d in zip(fits, apart) if d > bound and (f.edge_share or 0.0) >= (best.edge_share or 0.0) - RIVAL_SHARE]
+    rivals = [
+        (d, f)
+        for f, d in zip(fits, apart)
+        if d > bound and (f.edge_share or 0.0) >= (best.edge_share or 0.0) - RIVAL_SHARE
+    ]
     moved = float(np.linalg.norm(best.obj2cam[:3, 3] - prior[:3, 3]))
     turned = rotation_angle_deg(best.obj2cam[:3, :3] @ prior[:3, :3].T)
     located = with_fields(best, prior_moved_mm=round(moved, 3), prior_turned_deg=round(float(turned), 4))
     located = _with_spread(located, agreeing, len(fits))
-    located = with_fields(located, extra={**located.extra, "starts_apart_px": round(max(apart), 2),
-                                          "rival_apart_px": round(max(d for d, _ in rivals), 2) if rivals else None})
+    located = with_fields(
+        located,
+        extra={
+            **located.extra,
+            "starts_apart_px": round(max(apart), 2),
+            "rival_apart_px": round(max(d for d, _ in rivals), 2) if rivals else None,
+        },
+    )
     if not rivals:
         return located
     d, rival = max(rivals, key=lambda r: r[0])
-    return with_fields(located, status="uncertain",
-                       message=f"uncertain: another start settled with the object {d:.1f} px away in the image (more than {bound:.1f} px), "
-                               f"{100 * (rival.edge_share or 0.0):.0f} % of its samples on their edges against this answer's "
-                               f"{100 * (best.edge_share or 0.0):.0f} %: an inner, printed or neighbouring edge explains the outline about as well; "
-                               + located.message)
+    return with_fields(
+        located,
+        status="uncertain",
+        message=f"uncertain: another start settled with the object {d:.1f} px away in the image (more than {bound:.1f} px), "
+        f"{100 * (rival.edge_share or 0.0):.0f} % of its samples on their edges against this answer's "
+        f"{100 * (best.edge_share or 0.0):.0f} %: an inner, printed or neighbouring edge explains the outline about as well; "
+        + located.message,
+    )
 
 
 def _starts_round(prior: np.ndarray, mm: float, deg: float) -> list[np.ndarray]:
@@ -240,7 +306,10 @@ def _with_spread(located: Located, ends: list[np.ndarray], starts: int = 5) -> L
     from scipy.spatial.transform import Rotation
 
     if len(ends) < 2:
-        return with_fields(located, message=located.message + f"; 1 of {starts} settled fits put it here: the 1-sigma is the edge fit's own")
+        return with_fields(
+            located,
+            message=located.message + f"; 1 of {starts} settled fits put it here: the 1-sigma is the edge fit's own",
+        )
     t = np.array([e[:3, 3] for e in ends])
     turn = np.array([Rotation.from_matrix(e[:3, :3] @ ends[0][:3, :3].T).as_rotvec() for e in ends])
     spread_t, spread_r = t.std(axis=0, ddof=1), np.degrees(turn.std(axis=0, ddof=1))
@@ -250,8 +319,13 @@ def _with_spread(located: Located, ends: list[np.ndarray], starts: int = 5) -> L
     note = f"; {len(ends)} of {starts} settled fits put it here, within {apart:.1f} mm of one another"
     if np.any(np.abs(t - t[0]).max(axis=0) > 3.0 * np.maximum(located.std_translation_mm, 1e-6)):
         note += " (more than the edges' own 1-sigma allows: the photo fixes the pose less well than one fit says; the 1-sigma includes the starts' spread)"
-    return with_fields(located, message=located.message + note, std_translation_mm=std_t, std_rotation_deg=std_r,
-                       extra={**located.extra, "starts_apart_mm": round(apart, 3)})
+    return with_fields(
+        located,
+        message=located.message + note,
+        std_translation_mm=std_t,
+        std_rotation_deg=std_r,
+        extra={**located.extra, "starts_apart_mm": round(apart, 3)},
+    )
 
 
 def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -> FoundPoints:
@@ -260,35 +334,98 @@ def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -
     centre = np.asarray(item.mesh.bounding_box.centroid, dtype=float)
     from calib_core.workcell.feature_kinds import FeatureKind
 
-    item = SceneItem(item.name, item.mesh, item.item2world, color=item.color, features={"centre": centre}, feature_kinds={"centre": FeatureKind("point")})
-    return find_points(image, intrinsics, item, prior, expected=expected, reach_mm=reach_mm, reach_deg=reach_deg, edge_rms_px=PHOTO_EDGE_RMS_PX, by_colour=True)
+    item = SceneItem(
+        item.name,
+        item.mesh,
+        item.item2world,
+        color=item.color,
+        features={"centre": centre},
+        feature_kinds={"centre": FeatureKind("point")},
+    )
+    return find_points(
+        image,
+        intrinsics,
+        item,
+        prior,
+        expected=expected,
+        reach_mm=reach_mm,
+        reach_deg=reach_deg,
+        edge_rms_px=PHOTO_EDGE_RMS_PX,
+        by_colour=True,
+    )
 
 
-def _report(found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float) -> Located:
+def _report(
+    found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float
+) -> Located:
     edges = found.edges
     features = tuple(LocatedFeature(p.feature, p.uv_px, p.point_mm, p.confidence, p.why) for p in found.proposals)
     missed = tuple((m.feature, m.reason) for m in found.missed if m.feature != "centre")
     if edges is None or not edges.settled:
         why = found.message.replace(": pick the points by hand", "")
-        return Located("not found", f"{why}; give a prior nearer the object, or a larger reach", None, None, None,
-                       None if edges is None else edges.rms_px, None if edges is None else edges.inlier_share, 0 if edges is None else edges.samples,
-                       features, missed, seconds=found.seconds)
+        return Located(
+            "not found",
+            f"{why}; give a prior nearer the object, or a larger reach",
+            None,
+            None,
+            None,
+            None if edges is None else edges.rms_px,
+            None if edges is None else edges.inlier_share,
+            0 if edges is None else edges.samples,
+            features,
+            missed,
+            seconds=found.seconds,
+        )
     moved = float(np.linalg.norm(edges.obj2cam[:3, 3] - prior[:3, 3]))
     turned = rotation_angle_deg(edges.obj2cam[:3, :3] @ prior[:3, :3].T)
     if moved > 3.0 * reach_mm or turned > 3.0 * reach_deg:
         # the search covered the reach round the prior; a fit that walked far beyond it found something else
-        return Located("not found", f"the edges settled {moved:.0f} mm and {turned:.1f} deg from the prior, beyond three times the reach "
-                       f"({reach_mm:g} mm, {reach_deg:g} deg) the search covered: give a prior nearer the object, or a larger reach",
-                       None, None, None, edges.rms_px, edges.inlier_share, edges.samples, (), missed, prior_moved_mm=round(moved, 3),
-                       prior_turned_deg=round(float(turned), 4), seconds=found.seconds)
+        return Located(
+            "not found",
+            f"the edges settled {moved:.0f} mm and {turned:.1f} deg from the prior, beyond three times the reach "
+            f"({reach_mm:g} mm, {reach_deg:g} deg) the search covered: give a prior nearer the object, or a larger reach",
+            None,
+            None,
+            None,
+            edges.rms_px,
+            edges.inlier_share,
+            edges.samples,
+            (),
+            missed,
+            prior_moved_mm=round(moved, 3),
+            prior_turned_deg=round(float(turned), 4),
+            seconds=found.seconds,
+        )
     std = np.sqrt(np.clip(np.diag(edges.covariance), 0.0, None))
     features_pose, apart = None, None
     if len(features) >= 4:
-        solution = solve_pose(np.array([f.point_mm for f in features]), np.array([f.uv_px for f in features]), intrinsics, prior=edges.obj2cam)
+        solution = solve_pose(
+            np.array([f.point_mm for f in features]),
+            np.array([f.uv_px for f in features]),
+            intrinsics,
+            prior=edges.obj2cam,
+        )
         if solution.status.value != "failed":
             features_pose = solution.obj2cam
             apart = round(float(np.linalg.norm(features_pose[:3, 3] - edges.obj2cam[:3, 3])), 3)
-    message = (f"located by its edges: {edges.samples} samples, {100 * edges.inlier_share:.0f} % on their edges, RMS {edges.rms_px:.2f} px; "
-               f"{len(features)} features found" + (f", {len(missed)} not" if missed else ""))
-    return Located("ok", message, edges.obj2cam, np.degrees(std[:3]), std[3:], round(edges.rms_px, 3), round(edges.inlier_share, 3), edges.samples,
-                   features, missed, features_pose, apart, round(moved, 3), round(float(turned), 4), found.seconds)
+    message = (
+        f"located by its edges: {edges.samples} samples, {100 * edges.inlier_share:.0f} % on their edges, RMS {edges.rms_px:.2f} px; "
+        f"{len(features)} features found" + (f", {len(missed)} not" if missed else "")
+    )
+    return Located(
+        "ok",
+        message,
+        edges.obj2cam,
+        np.degrees(std[:3]),
+        std[3:],
+        round(edges.rms_px, 3),
+        round(edges.inlier_share, 3),
+        edges.samples,
+        features,
+        missed,
+        features_pose,
+        apart,
+        round(moved, 3),
+        round(float(turned), 4),
+        found.seconds,
+    )

@@ -78,8 +78,14 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
     tri = tri[np.isfinite(tri).all(axis=(1, 2))]
     if not len(tri):
         return np.zeros((0, 0), np.uint8), (0, 0)
-    lo = np.floor(np.clip(tri.reshape(-1, 2).min(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) - 2
-    hi = np.ceil(np.clip(tri.reshape(-1, 2).max(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) + 3
+    lo = (
+        np.floor(np.clip(tri.reshape(-1, 2).min(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int)
+        - 2
+    )
+    hi = (
+        np.ceil(np.clip(tri.reshape(-1, 2).max(axis=0), 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int)
+        + 3
+    )
     lo = np.maximum(lo, 0)
     hi = np.minimum(hi, [intrinsics.width, intrinsics.height])
     mask = np.zeros((max(hi[1] - lo[1], 1), max(hi[0] - lo[0], 1)), np.uint8)
@@ -94,13 +100,20 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
         cv2.fillConvexPoly(mask, f, 255, lineType=cv2.LINE_8, shift=4)
     if not large.all():
         corners = np.rint(tri[~large].reshape(-1, 2) - lo).astype(int)
-        corners = corners[(corners[:, 0] >= 0) & (corners[:, 0] < mask.shape[1]) & (corners[:, 1] >= 0) & (corners[:, 1] < mask.shape[0])]
+        corners = corners[
+            (corners[:, 0] >= 0)
+            & (corners[:, 0] < mask.shape[1])
+            & (corners[:, 1] >= 0)
+            & (corners[:, 1] < mask.shape[0])
+        ]
         mask[corners[:, 1], corners[:, 0]] = 255
         mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
     return mask, (int(lo[0]), int(lo[1]))
 
 
-def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _rim_points(
+    mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Points (k, 3) mm along the rim edges (``rims`` (E, 2, 3) when the caller has them), about a pixel apart in
     the image, and their pixels (k, 2)."""
     seg = silhouette_segments(mesh, -obj2cam[:3, :3].T @ obj2cam[:3, 3]) if rims is None else rims
@@ -118,7 +131,14 @@ def _rim_points(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, rims: np.ndar
     return points, project_points(points, obj2cam, intrinsics)
 
 
-def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: float = 4.0, silhouette=None, rims: np.ndarray | None = None) -> Outline:
+def outline_samples(
+    mesh,
+    obj2cam: np.ndarray,
+    intrinsics: Intrinsics,
+    step_px: float = 4.0,
+    silhouette=None,
+    rims: np.ndarray | None = None,
+) -> Outline:
     """Samples every ``step_px`` along the outer boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
     mesh's frame to the camera's, mm), each on the rim edge nearest its boundary pixel (within 2.5 px); none
     where the image's border cuts the silhouette (the border is not the object's edge). ``silhouette``: the
@@ -141,8 +161,12 @@ def outline_samples(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics, step_px: 
         picks = np.searchsorted(arc, np.arange(0.0, arc[-1], step_px))
         picks = picks[picks < len(c)]
         px = c[picks]
-        inside = ((px[:, 0] > _BORDER_PX) & (px[:, 0] < intrinsics.width - 1 - _BORDER_PX)
-                  & (px[:, 1] > _BORDER_PX) & (px[:, 1] < intrinsics.height - 1 - _BORDER_PX))
+        inside = (
+            (px[:, 0] > _BORDER_PX)
+            & (px[:, 0] < intrinsics.width - 1 - _BORDER_PX)
+            & (px[:, 1] > _BORDER_PX)
+            & (px[:, 1] < intrinsics.height - 1 - _BORDER_PX)
+        )
         distance, nearest = tree.query(px)
         good = inside & (distance <= _MATCH_PX)
         # runs of good samples, each walked in order: a sample's direction is toward its neighbour

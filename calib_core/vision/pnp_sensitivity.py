@@ -14,8 +14,14 @@ from calib_core.camera.projection import as_pinhole, project_points
 from calib_core.frames import make_transform
 
 
-def pose_derivatives(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Intrinsics, changes: list[Callable[[float, np.ndarray], tuple[np.ndarray, Intrinsics]]],
-                     difference: Callable[[np.ndarray, np.ndarray], np.ndarray], step: float) -> np.ndarray:
+def pose_derivatives(
+    obj2cam: np.ndarray,
+    points_mm: np.ndarray,
+    intrinsics: Intrinsics,
+    changes: list[Callable[[float, np.ndarray], tuple[np.ndarray, Intrinsics]]],
+    difference: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    step: float,
+) -> np.ndarray:
     """(k, len(changes)): the derivative of ``difference(obj2cam, moved)`` (k,) per unit of each change.
     ``points_mm`` (m, 3) in the object's frame, seen at ``obj2cam`` (4, 4) mm through ``intrinsics``;
     each change maps ``(signed step, pixels (m, 2))`` to the pixels and intrinsics to solve with."""
@@ -29,7 +35,16 @@ def pose_derivatives(obj2cam: np.ndarray, points_mm: np.ndarray, intrinsics: Int
         for sign in (1.0, -1.0):
             uv, camera = change(sign * step, pixels.copy())
             uv, camera = as_pinhole(uv, camera)  # OpenCV's PnP knows no fisheye lens
-            _, rvec, tvec = cv2.solvePnP(pts, uv, camera.K, camera.dist_coeffs, rvec0.copy(), tvec0.copy(), useExtrinsicGuess=True, flags=cv2.SOLVEPNP_ITERATIVE)
+            _, rvec, tvec = cv2.solvePnP(
+                pts,
+                uv,
+                camera.K,
+                camera.dist_coeffs,
+                rvec0.copy(),
+                tvec0.copy(),
+                useExtrinsicGuess=True,
+                flags=cv2.SOLVEPNP_ITERATIVE,
+            )
             moved.append(difference(obj2cam, make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())))
         columns.append((moved[0] - moved[1]) / (2.0 * step))
     return np.column_stack(columns)

@@ -66,8 +66,15 @@ def _scores(padded_flat: np.ndarray, base: np.ndarray, offsets_flat: np.ndarray)
     return padded_flat[base[:, None, :] + offsets_flat[None, :, None]].mean(axis=2)
 
 
-def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.ndarray, obj2cam: np.ndarray, reach_mm: float, reach_deg: float,
-                keep: int = 3) -> list[np.ndarray]:
+def rank_starts(
+    distance: np.ndarray,
+    intrinsics: Intrinsics,
+    samples_mm: np.ndarray,
+    obj2cam: np.ndarray,
+    reach_mm: float,
+    reach_deg: float,
+    keep: int = 3,
+) -> list[np.ndarray]:
     """The ``keep`` best poses (4, 4) to start an edge refinement from, best first, near ``obj2cam``.
 
     ``distance`` (h, w): each pixel's distance to the nearest image edge, truncated at
@@ -89,7 +96,9 @@ def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.nda
     uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
-    offsets = np.rint(np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2))  # whole pixels: a chamfer ranking needs no finer
+    offsets = np.rint(
+        np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2)
+    )  # whole pixels: a chamfer ranking needs no finer
     # whole pixels; anything outside the image (or behind the camera: NaN) clipped to just outside it,
     # where the padding (wider than any offset) holds the cap
     h, w = distance.shape
@@ -104,7 +113,9 @@ def rank_starts(distance: np.ndarray, intrinsics: Intrinsics, samples_mm: np.nda
     # every candidate on a third of the samples, the best few hundred again on all of them (the coarse
     # score only has to keep the right one among those)
     coarse = base[:, : max(10, base.shape[1] // 3)]
-    rough = np.concatenate([_scores(flat, chunk, offsets_flat) for chunk in np.array_split(coarse, max(1, len(coarse) // 128))])  # (H, S)
+    rough = np.concatenate(
+        [_scores(flat, chunk, offsets_flat) for chunk in np.array_split(coarse, max(1, len(coarse) // 128))]
+    )  # (H, S)
     best = np.argpartition(rough, min(_RESCORED, rough.size) - 1, axis=None)[:_RESCORED]
     rows, cols = np.unravel_index(best, rough.shape)
     cost = np.full(rough.shape, np.inf, dtype=np.float32)

@@ -23,8 +23,14 @@ def _profiles(magnitude: np.ndarray, points: np.ndarray, normals: np.ndarray, ha
     return cv2.remap(magnitude, lines[..., 0].astype(np.float32), lines[..., 1].astype(np.float32), cv2.INTER_LINEAR)
 
 
-def match_profiles(magnitude: np.ndarray, expected_magnitude: np.ndarray, points_px: np.ndarray, normals: np.ndarray, search_px: float,
-                   half_px: float = 3.0) -> tuple[np.ndarray, np.ndarray]:
+def match_profiles(
+    magnitude: np.ndarray,
+    expected_magnitude: np.ndarray,
+    points_px: np.ndarray,
+    normals: np.ndarray,
+    search_px: float,
+    half_px: float = 3.0,
+) -> tuple[np.ndarray, np.ndarray]:
     """How far (m,) px along each unit normal (m, 2) the image's edge lies from the model's at the
     points (m, 2) px, and how alike the two profiles are there (m,) in [-1, 1].
 

@@ -53,7 +53,7 @@ class RegionModel:
         rows, cols = min(mask.shape[0], h - v0), min(mask.shape[1], w - u0)
         if rows <= 0 or cols <= 0:
             return None
-        full[v0:v0 + rows, u0:u0 + cols] = mask[:rows, :cols]
+        full[v0 : v0 + rows, u0 : u0 + cols] = mask[:rows, :cols]
         kernel = lambda r: cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))  # noqa: E731
         inner = cv2.erode(full, kernel(_INNER_PX)) > 0
         near = cv2.dilate(full, kernel(_BAND_PX[0])) > 0
@@ -62,7 +62,7 @@ class RegionModel:
         if inner.sum() < 50 or band.sum() < 50:
             return None
         bins = _bins(image_rgb)
-        n = _LEVELS ** 3
+        n = _LEVELS**3
         h_object = np.bincount(bins[inner], minlength=n).astype(np.float64) / inner.sum()
         h_around = np.bincount(bins[band], minlength=n).astype(np.float64) / band.sum()
         # a colour seen in neither region is even odds; a little of each keeps a rare colour from being certain
@@ -72,7 +72,9 @@ class RegionModel:
         separation = float(probability[inner].mean() - probability[band].mean())
         return RegionModel(probability, separation)
 
-    def step_edges(self, points_px: np.ndarray, outward: np.ndarray, window_px: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def step_edges(
+        self, points_px: np.ndarray, outward: np.ndarray, window_px: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For each outline sample (m, 2) px with its unit normal pointing out of the object (m, 2), where along
         the normal within +-``window_px`` a step from object to surroundings fits the object probabilities best
         (the sum of log-probabilities of object on the inner :data:`STEP_LENGTH_PX` pixels and of surroundings
@@ -83,9 +85,17 @@ class RegionModel:
         W = int(np.ceil(window_px))
         t = np.arange(-W - L, W + L + 1, dtype=float) + 0.5  # pixel centres along the line; edges fall between them
         lines = points_px[:, None, :] + t[None, :, None] * outward[:, None, :]
-        inside = ((lines[..., 0] >= 0) & (lines[..., 0] < w - 1) & (lines[..., 1] >= 0) & (lines[..., 1] < h - 1)).all(axis=1)
-        p = cv2.remap(self.object_probability, lines[..., 0].astype(np.float32), lines[..., 1].astype(np.float32), cv2.INTER_LINEAR,
-                      borderMode=cv2.BORDER_CONSTANT, borderValue=0.5)
+        inside = ((lines[..., 0] >= 0) & (lines[..., 0] < w - 1) & (lines[..., 1] >= 0) & (lines[..., 1] < h - 1)).all(
+            axis=1
+        )
+        p = cv2.remap(
+            self.object_probability,
+            lines[..., 0].astype(np.float32),
+            lines[..., 1].astype(np.float32),
+            cv2.INTER_LINEAR,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=0.5,
+        )
         p = np.clip(p, 1e-3, 1 - 1e-3)
         a = np.cumsum(np.log(p), axis=1)  # object on the inner side
         b = np.cumsum(np.log(1 - p), axis=1)  # surroundings on the outer side

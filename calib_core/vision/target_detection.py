@@ -63,12 +63,16 @@ class DetectorSettings:
 
 def _set_fields(target, values, path: Path, section: str) -> None:
     if not isinstance(values, dict):
-        raise FileFormatError(path, f"must be a mapping of parameter names to values, got {type(values).__name__}", section)
+        raise FileFormatError(
+            path, f"must be a mapping of parameter names to values, got {type(values).__name__}", section
+        )
     known = sorted(n for n in dir(target) if not n.startswith("_") and not callable(getattr(target, n)))
     for name, value in values.items():
         where = f"{section}.{name}"
         if name not in known:
-            raise FileFormatError(path, f"OpenCV has no such parameter; {section} parameters: {', '.join(known)}", where)
+            raise FileFormatError(
+                path, f"OpenCV has no such parameter; {section} parameters: {', '.join(known)}", where
+            )
         current = getattr(target, name)
         if isinstance(current, bool):
             if not isinstance(value, bool):
@@ -101,7 +105,9 @@ def load_detector_settings(path: str | Path) -> DetectorSettings:
         raise FileFormatError(path, f"expected a mapping with any of {', '.join(SECTIONS)}")
     unknown = [k for k in doc if k not in SECTIONS]
     if unknown:
-        raise FileFormatError(path, f"unknown section; a detector settings file has {', '.join(SECTIONS)}", str(unknown[0]))
+        raise FileFormatError(
+            path, f"unknown section; a detector settings file has {', '.join(SECTIONS)}", str(unknown[0])
+        )
     settings = DetectorSettings(source=path)
     if "refine_markers" in doc:
         if not isinstance(doc["refine_markers"], bool):

@@ -15,7 +15,16 @@ from calib_core.scene import SceneItem
 from calib_core.vision.corner_against_model import detect_corner_against_model
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.edge_samples import model_shows_edge
-from calib_core.vision.feature_detectors import Detection, NotDetected, detect_blob, detect_circle, detect_circle_against_model, detect_corner, detect_corner_from_edges, gradient_magnitude
+from calib_core.vision.feature_detectors import (
+    Detection,
+    NotDetected,
+    detect_blob,
+    detect_circle,
+    detect_circle_against_model,
+    detect_corner,
+    detect_corner_from_edges,
+    gradient_magnitude,
+)
 from calib_core.workcell.feature_kinds import FeatureKind
 
 _BOX_MARGIN_PX = 24.0  # the widest search from an edge (8 px) and the corner's arms' windows, twice
@@ -39,7 +48,9 @@ def rim_points_mm(point: np.ndarray, kind: FeatureKind, count: int = 48) -> np.n
     return point + kind.radius_mm * (np.cos(angles)[:, None] * a + np.sin(angles)[:, None] * b)
 
 
-def circle_rim(point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+def circle_rim(
+    point: np.ndarray, kind: FeatureKind, obj2cam: np.ndarray, intrinsics: Intrinsics
+) -> tuple[np.ndarray, np.ndarray]:
     """The projected rim (48, 2) of a circle feature and the perspective offset (2,)."""
     rim = project_points(rim_points_mm(point, kind), obj2cam, intrinsics)
     (cx, cy), _, _ = cv2.fitEllipse(rim.astype(np.float32))
@@ -51,10 +62,14 @@ class TargetDetectors:
     """The detectors of one image and one target: the gradient computed once, the edges that end at
     each corner found once."""
 
-    def __init__(self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None, colour: np.ndarray | None = None):
+    def __init__(
+        self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None, colour: np.ndarray | None = None
+    ):
         self.grey = grey
         self.expected = expected
-        self._rendered: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # (obj2cam, the view as rendered, its grey)
+        self._rendered: tuple[np.ndarray, np.ndarray, np.ndarray] | None = (
+            None  # (obj2cam, the view as rendered, its grey)
+        )
         self._expected_magnitude: np.ndarray | None = None
         self._box = (0, 0, 0, 0)
         # edges from colour as well as lightness (``colour``: the frame as taken, RGB): an orange top on a tan table
@@ -142,15 +157,21 @@ class TargetDetectors:
             return corner + (s[run - 1] / 0.8) * d / length
         return None
 
-    def _corner_from_lines(self, uv: np.ndarray, far: np.ndarray, radius: float, detail: np.ndarray, why: NotDetected) -> Detection | NotDetected:
+    def _corner_from_lines(
+        self, uv: np.ndarray, far: np.ndarray, radius: float, detail: np.ndarray, why: NotDetected
+    ) -> Detection | NotDetected:
         """When fewer than two arms can be measured against the model's view (a finger beside an edge,
         shaded otherwise in the model: the Panda's plate corner), the lines the image shows along the
         arms, intersected, less where the model's own lines meet off the corner (``detail``: the
         model's supersampled gradient there); ``why`` when that fails too."""
-        lines = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
+        lines = detect_corner_from_edges(
+            self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics
+        )
         if not isinstance(lines, Detection):
             return why
-        modelled = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=detail, lens=self.intrinsics)
+        modelled = detect_corner_from_edges(
+            self.grey, uv, list(far), search_px=radius, magnitude=detail, lens=self.intrinsics
+        )
         if isinstance(modelled, Detection):
             weaker = lines if lines.confidence <= modelled.confidence else modelled
             return Detection(lines.uv_px - (modelled.uv_px - uv), weaker.confidence, weaker.why)
@@ -166,22 +187,34 @@ class TargetDetectors:
                 if self.expected is not None:
                     # against the model's view, supersampled round the corner and along its arms' first 40 px:
                     # its chamfers, its plate's thickness and its silhouettes are the image's
-                    reach = [uv + min(float(np.linalg.norm(f - uv)), 40.0) * (f - uv) / max(float(np.linalg.norm(f - uv)), 1e-9) for f in far]
+                    reach = [
+                        uv
+                        + min(float(np.linalg.norm(f - uv)), 40.0) * (f - uv) / max(float(np.linalg.norm(f - uv)), 1e-9)
+                        for f in far
+                    ]
                     detail = self.detail_magnitude(obj2cam, np.vstack([uv[None], *[r[None] for r in reach]]))
                     # only the arms, or their stretches, along which the model shows an edge
                     shown = [self._visible_arm(uv, f, detail) for f in far]
                     far = np.array([f for f in shown if f is not None]).reshape(-1, 2)
-                    found = detect_corner_against_model(self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5))
-                    return found if isinstance(found, Detection) else self._corner_from_lines(uv, far, radius, detail, found)
-                found = detect_corner_from_edges(self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics)
+                    found = detect_corner_against_model(
+                        self.magnitude, detail, uv, list(far), search_px=max(radius, 1.5)
+                    )
+                    return (
+                        found
+                        if isinstance(found, Detection)
+                        else self._corner_from_lines(uv, far, radius, detail, found)
+                    )
+                found = detect_corner_from_edges(
+                    self.grey, uv, list(far), search_px=radius, magnitude=self.magnitude, lens=self.intrinsics
+                )
                 if isinstance(found, Detection):
                     return found
             return detect_corner(self.grey, uv, radius)
         if kind.kind == "circle":
             rim, offset = circle_rim(point, kind, obj2cam, self.intrinsics)
             if self.expected is not None:
-                return detect_circle_against_model(self.magnitude, self.detail_magnitude(obj2cam, rim), rim, uv, search_px=max(radius, 1.5))
+                return detect_circle_against_model(
+                    self.magnitude, self.detail_magnitude(obj2cam, rim), rim, uv, search_px=max(radius, 1.5)
+                )
             return detect_circle(self.grey, rim, offset, search_px=radius, magnitude=self.magnitude)
         return detect_blob(self.grey, uv, max(radius, 6.0))
-
-

@@ -61,14 +61,19 @@ def choose_flange(robot: RobotModel, flange: str | None) -> FlangeChoice:
     model = robot.full_model
     joint = 0
     while True:
-        children = [j for j in range(1, model.njoints) if model.parents[j] == joint and not _is_gripper_joint(model.names[j])]
+        children = [
+            j for j in range(1, model.njoints) if model.parents[j] == joint and not _is_gripper_joint(model.names[j])
+        ]
         if len(children) != 1:
             break
         joint = children[0]
     fingers = [model.names[j] for j in range(1, model.njoints) if model.parents[j] == joint]
     if children:  # the arm branches into two moving chains: the link they hang from (Panda: panda_hand)
         joint_frame = model.frames[model.getFrameId(model.names[children[0]], pin.FrameType.JOINT)]
-        return FlangeChoice(model.frames[joint_frame.parentFrame].name, f"the arm's chain branches there (joints {', '.join(model.names[j] for j in children)})")
+        return FlangeChoice(
+            model.frames[joint_frame.parentFrame].name,
+            f"the arm's chain branches there (joints {', '.join(model.names[j] for j in children)})",
+        )
     # The links fixed to the last joint: from its own link down the fixed joints, never into a finger, preferring
     # a link named as a tool or flange, stopping where the fixed links branch (JACO2: the end effector beside two
     # fixed fingers, not a finger tip)
@@ -76,19 +81,34 @@ def choose_flange(robot: RobotModel, flange: str | None) -> FlangeChoice:
     children_of: dict[int, list[int]] = {}
     for k, f in enumerate(model.frames):
         if f.type == pin.FrameType.BODY and f.parentJoint == joint and k != body:
-            parent = model.frames[f.parentFrame].parentFrame if model.frames[f.parentFrame].type == pin.FrameType.FIXED_JOINT else f.parentFrame
+            parent = (
+                model.frames[f.parentFrame].parentFrame
+                if model.frames[f.parentFrame].type == pin.FrameType.FIXED_JOINT
+                else f.parentFrame
+            )
             children_of.setdefault(parent, []).append(k)
     skipped = []
     chosen, why = body, f"the link of the last joint {model.names[joint]!r}"
     while True:
         kids = children_of.get(chosen, [])
-        arm = [k for k in kids if not _is_finger(model.frames[k].name) and not _is_finger(model.frames[model.frames[k].parentFrame].name)
-               and not any(w in model.frames[k].name.lower() for w in _TCP_WORDS)]
-        skipped += [model.frames[k].name for k in kids if k not in arm and not any(w in model.frames[k].name.lower() for w in _TCP_WORDS)]
+        arm = [
+            k
+            for k in kids
+            if not _is_finger(model.frames[k].name)
+            and not _is_finger(model.frames[model.frames[k].parentFrame].name)
+            and not any(w in model.frames[k].name.lower() for w in _TCP_WORDS)
+        ]
+        skipped += [
+            model.frames[k].name
+            for k in kids
+            if k not in arm and not any(w in model.frames[k].name.lower() for w in _TCP_WORDS)
+        ]
         named = [k for k in arm if any(w in model.frames[k].name.lower() for w in _FLANGE_WORDS)]
         if len(named) == 1 or len(arm) == 1:
             chosen = (named or arm)[0]
-            why = f"the link fixed beyond the last joint {model.names[joint]!r}" + (" named as a tool or flange" if named else "")
+            why = f"the link fixed beyond the last joint {model.names[joint]!r}" + (
+                " named as a tool or flange" if named else ""
+            )
             continue
         break
     if skipped or fingers:
@@ -105,7 +125,9 @@ def tool_alignment(robot: RobotModel, flange: str) -> tuple[np.ndarray, str | No
     q = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
     flange2base = robot.fk(q, flange)
     last_joint = robot.model.frames[robot.frame_id(flange)].parentJoint
-    wrist = robot.fk(q, robot.model.names[last_joint])[:3, 3] if last_joint > 0 else flange2base[:3, 3]  # (a joint's frame bears its name)
+    wrist = (
+        robot.fk(q, robot.model.names[last_joint])[:3, 3] if last_joint > 0 else flange2base[:3, 3]
+    )  # (a joint's frame bears its name)
     out = flange2base[:3, 3] - wrist
     if np.linalg.norm(out) < 5.0:
         return np.eye(4), None
@@ -120,6 +142,8 @@ def tool_alignment(robot: RobotModel, flange: str) -> tuple[np.ndarray, str | No
     from scipy.spatial.transform import Rotation
 
     align = make_transform(Rotation.from_rotvec(axis * angle).as_matrix(), np.zeros(3))
-    words = (f"the z axis of {flange!r} points {np.degrees(angle):.0f} deg from the way out of the wrist: the tool and camera are placed "
-             "along the way out instead (from the last joint to the flange); give --flange a frame whose z points out of the tool to change it")
+    words = (
+        f"the z axis of {flange!r} points {np.degrees(angle):.0f} deg from the way out of the wrist: the tool and camera are placed "
+        "along the way out instead (from the last joint to the flange); give --flange a frame whose z points out of the tool to change it"
+    )
     return align, words

@@ -28,10 +28,22 @@ from calib_core.workcell.site_section import read_site_section
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM, SAFETY_KEYS, SafetyLimits
 
 from calib_core.bundled import DEFAULT_WORKCELL  # noqa: E402 (re-exported: the package's name for it)
+
 SCHEMA_VERSION = 2
 # Version 1 files (the bundled robot frame names, six axes) read as they are: every key of 2 is optional.
 _READABLE_VERSIONS = (1, 2)
-_TOP_KEYS = {"schema_version", "name", "units", "robot", "camera", "components", "task_locations", "hand_eye_board", "safety", "site"}
+_TOP_KEYS = {
+    "schema_version",
+    "name",
+    "units",
+    "robot",
+    "camera",
+    "components",
+    "task_locations",
+    "hand_eye_board",
+    "safety",
+    "site",
+}
 _COMPONENT_KEYS = {"name", "kind", "mesh", "mesh_units", "color", "placement", "features", "form_tolerance_mm"}
 FORM_TOLERANCE_LIMIT_MM = 20.0
 """A part further from its CAD than this is not the part the CAD describes: model it anew."""
@@ -53,7 +65,9 @@ class _Reader:
             raise self.fail(field, f"must be a mapping, got {type(value).__name__}")
         unknown = set(value) - allowed
         if unknown:
-            raise self.fail(field, f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; allowed: {', '.join(sorted(allowed))}")
+            raise self.fail(
+                field, f"unknown key(s) {', '.join(sorted(map(str, unknown)))}; allowed: {', '.join(sorted(allowed))}"
+            )
         missing = required - set(value)
         if missing:
             raise self.fail(field, f"missing key(s) {', '.join(sorted(missing))}")
@@ -92,7 +106,9 @@ class _Reader:
 
     def placement(self, value, field: str) -> np.ndarray:
         value = self.mapping(value, field, {"xyz", "rpy"}, {"xyz", "rpy"})
-        return transform_from_xyz_rpy(self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy"))
+        return transform_from_xyz_rpy(
+            self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy")
+        )
 
     def file(self, value, field: str) -> Path:
         text = self.text(value, field)
@@ -100,7 +116,10 @@ class _Reader:
             path = (self.path.parent / text).resolve()
             found = path.is_file()
         except (ValueError, OSError) as exc:  # a NUL byte, a name longer than the file system takes
-            raise self.fail(field, f"not a usable file name ({exc.strerror if isinstance(exc, OSError) and exc.strerror else exc}): {text[:80]!r}") from None
+            raise self.fail(
+                field,
+                f"not a usable file name ({exc.strerror if isinstance(exc, OSError) and exc.strerror else exc}): {text[:80]!r}",
+            ) from None
         if not found:
             raise self.fail(field, f"file not found: {path}")
         return path
@@ -122,7 +141,9 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         raise reader.fail(f"{f}.color", f"RGB values must lie in [0, 1], got {list(color)}")
     features_raw = raw.get("features", {}) or {}
     if not isinstance(features_raw, dict):
-        raise reader.fail(f"{f}.features", "must be a mapping of name: [x, y, z] (mm), or name: {at: [x, y, z], kind: ...}")
+        raise reader.fail(
+            f"{f}.features", "must be a mapping of name: [x, y, z] (mm), or name: {at: [x, y, z], kind: ...}"
+        )
     features, kinds = {}, {}
     for k, v in features_raw.items():
         reader.name(k, f"{f}.features.{str(k)[:40]!r}")
@@ -131,9 +152,20 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
             kinds[str(k)] = feature_kind
     form = reader.number(raw.get("form_tolerance_mm", 0.0), f"{f}.form_tolerance_mm")
     if not 0.0 <= form <= FORM_TOLERANCE_LIMIT_MM:
-        raise reader.fail(f"{f}.form_tolerance_mm", f"must lie in [0, {FORM_TOLERANCE_LIMIT_MM:g}] mm (1-sigma of the part's features about their CAD positions), got {form:g}")
-    return SceneItem(name=name, mesh=mesh, item2world=reader.placement(raw["placement"], f"{f}.placement"), color=color, kind=kind, features=features, feature_kinds=kinds,
-                     form_tolerance_mm=form)
+        raise reader.fail(
+            f"{f}.form_tolerance_mm",
+            f"must lie in [0, {FORM_TOLERANCE_LIMIT_MM:g}] mm (1-sigma of the part's features about their CAD positions), got {form:g}",
+        )
+    return SceneItem(
+        name=name,
+        mesh=mesh,
+        item2world=reader.placement(raw["placement"], f"{f}.placement"),
+        color=color,
+        kind=kind,
+        features=features,
+        feature_kinds=kinds,
+        form_tolerance_mm=form,
+    )
 
 
 _FEATURE_KEYS = {"at", "kind", "radius_mm", "normal"}
@@ -144,8 +176,11 @@ def _feature_point(reader, value, field: str) -> np.ndarray:
 
     point = reader.vector(value, 3, field)
     if np.abs(point).max() > MAX_COORDINATE_MM:
-        raise reader.fail(field, f"lies {np.abs(point).max():.3g} mm from its component's origin, beyond {MAX_COORDINATE_MM:g} mm: "
-                                 "features are in mm in the component's frame")
+        raise reader.fail(
+            field,
+            f"lies {np.abs(point).max():.3g} mm from its component's origin, beyond {MAX_COORDINATE_MM:g} mm: "
+            "features are in mm in the component's frame",
+        )
     return point
 
 
@@ -163,7 +198,9 @@ def _feature(reader, value, field: str) -> tuple[np.ndarray, FeatureKind]:
         return point, FeatureKind(kind)
     for key in ("radius_mm", "normal"):
         if key not in entry:
-            raise reader.fail(f"{field}.{key}", "a circle needs radius_mm (mm) and normal ([x, y, z] in the component's frame)")
+            raise reader.fail(
+                f"{field}.{key}", "a circle needs radius_mm (mm) and normal ([x, y, z] in the component's frame)"
+            )
     radius = reader.number(entry["radius_mm"], f"{field}.radius_mm")
     normal = reader.vector(entry["normal"], 3, f"{field}.normal")
     try:
@@ -186,7 +223,13 @@ def _task(reader: _Reader, raw, i: int, components: set[str]) -> TaskLocation:
     tolerance = reader.number(raw.get("tolerance_mm", DEFAULT_TOLERANCE_MM), f"{f}.tolerance_mm")
     if tolerance <= 0:
         raise reader.fail(f"{f}.tolerance_mm", f"must be > 0 mm, got {tolerance}")
-    return TaskLocation(reader.name(raw["name"], f"{f}.name"), reader.placement(raw["tcp2base"], f"{f}.tcp2base"), approach, component, tolerance)
+    return TaskLocation(
+        reader.name(raw["name"], f"{f}.name"),
+        reader.placement(raw["tcp2base"], f"{f}.tcp2base"),
+        approach,
+        component,
+        tolerance,
+    )
 
 
 def _safety(reader: _Reader, raw) -> SafetyLimits:
@@ -217,8 +260,15 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     reader = _Reader(path)
     data = read_yaml(path, "workcell file")  # size, nesting and aliases bounded before anything is built
     data = reader.mapping(data, "(top level)", _TOP_KEYS, {"schema_version", "units", "robot", "components"})
-    if isinstance(data["schema_version"], bool) or not isinstance(data["schema_version"], int) or data["schema_version"] not in _READABLE_VERSIONS:
-        raise reader.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}")
+    if (
+        isinstance(data["schema_version"], bool)
+        or not isinstance(data["schema_version"], int)
+        or data["schema_version"] not in _READABLE_VERSIONS
+    ):
+        raise reader.fail(
+            "schema_version",
+            f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}",
+        )
     units = reader.mapping(data["units"], "units", {"length", "angle"}, {"length", "angle"})
     if units["length"] != "mm" or units["angle"] != "deg":
         raise reader.fail("units", f"placements must be in mm and deg, got {units['length']!r} and {units['angle']!r}")
@@ -257,4 +307,6 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     safety = _safety(reader, data.get("safety"))
     if data.get("site") is not None:
         meta["site"] = read_site_section(reader, data["site"], path.parent)
-    return Workcell(str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta, safety)
+    return Workcell(
+        str(data.get("name", path.stem)), path, components, tasks, robot_spec, intrinsics_path, home, meta, safety
+    )

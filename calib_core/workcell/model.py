@@ -69,19 +69,25 @@ class Workcell:
         for item in self.components:
             if item.name == name:
                 return item
-        raise UnknownNameError(f"the workcell has no component '{name}'; components: {', '.join(c.name for c in self.components)}")
+        raise UnknownNameError(
+            f"the workcell has no component '{name}'; components: {', '.join(c.name for c in self.components)}"
+        )
 
     def task(self, name: str) -> TaskLocation:
         """The task location called ``name``; ``KeyError`` names the known ones."""
         if name not in self.task_locations:
-            raise UnknownNameError(f"the workcell has no task location '{name}'; task locations: {', '.join(self.task_locations)}")
+            raise UnknownNameError(
+                f"the workcell has no task location '{name}'; task locations: {', '.join(self.task_locations)}"
+            )
         return self.task_locations[name]
 
     def feature_in_base(self, component: str, feature: str) -> np.ndarray:
         """A named feature point of a component in the robot base frame (3,), mm."""
         item = self.component(component)
         if feature not in item.features:
-            raise UnknownNameError(f"component '{component}' has no feature '{feature}'; features: {', '.join(item.features)}")
+            raise UnknownNameError(
+                f"component '{component}' has no feature '{feature}'; features: {', '.join(item.features)}"
+            )
         return apply(item.item2world, item.features[feature])
 
     @property

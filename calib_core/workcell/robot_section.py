@@ -19,7 +19,9 @@ def _frame(reader, value, field: str) -> str | NewFrame | None:
     if isinstance(value, str):
         return reader.text(value, field)
     raw = reader.mapping(value, field, {"parent", "xyz", "rpy"}, {"parent", "xyz", "rpy"})
-    placement = transform_from_xyz_rpy(reader.vector(raw["xyz"], 3, f"{field}.xyz"), reader.vector(raw["rpy"], 3, f"{field}.rpy"))
+    placement = transform_from_xyz_rpy(
+        reader.vector(raw["xyz"], 3, f"{field}.xyz"), reader.vector(raw["rpy"], 3, f"{field}.rpy")
+    )
     return NewFrame(reader.text(raw["parent"], f"{field}.parent"), placement)
 
 
@@ -56,7 +58,11 @@ def read_robot_section(reader, raw) -> RobotSpec:
     reader.mapping(frames_raw, "robot.frames", set(FRAME_ROLES), set())
     frames = {"base": None, "flange": "flange", "tcp": "tcp", "camera": "camera"}
     frames.update({role: _frame(reader, v, f"robot.frames.{role}") for role, v in frames_raw.items()})
-    home = _numbers(reader, raw["home_joints_deg"], "robot.home_joints_deg") if raw.get("home_joints_deg") is not None else None
+    home = (
+        _numbers(reader, raw["home_joints_deg"], "robot.home_joints_deg")
+        if raw.get("home_joints_deg") is not None
+        else None
+    )
     held_raw = raw.get("held_joints", {}) or {}
     if not isinstance(held_raw, dict):
         raise reader.fail("robot.held_joints", "must be a mapping of joint name: value (deg or mm)")
@@ -65,11 +71,20 @@ def read_robot_section(reader, raw) -> RobotSpec:
     if raw.get("controller") is not None:
         c = reader.mapping(raw["controller"], "robot.controller", {"joints", "zero_offsets"}, {"joints"})
         if not isinstance(c["joints"], list) or not c["joints"]:
-            raise reader.fail("robot.controller.joints", "must be the list of URDF joint names in the controller's axis order")
+            raise reader.fail(
+                "robot.controller.joints", "must be the list of URDF joint names in the controller's axis order"
+            )
         joints = tuple(reader.text(j, f"robot.controller.joints[{i}]") for i, j in enumerate(c["joints"]))
-        offsets = _numbers(reader, c["zero_offsets"], "robot.controller.zero_offsets") if c.get("zero_offsets") is not None else np.zeros(len(joints))
+        offsets = (
+            _numbers(reader, c["zero_offsets"], "robot.controller.zero_offsets")
+            if c.get("zero_offsets") is not None
+            else np.zeros(len(joints))
+        )
         if len(offsets) != len(joints):
-            raise reader.fail("robot.controller.zero_offsets", f"needs one value per controller joint ({len(joints)}), got {len(offsets)}")
+            raise reader.fail(
+                "robot.controller.zero_offsets",
+                f"needs one value per controller joint ({len(joints)}), got {len(offsets)}",
+            )
         controller = ControllerMap(joints, offsets)
     return RobotSpec(urdf, package_paths, frames, home, held, controller, xacro_args)
 
@@ -81,16 +96,27 @@ def check_against_robot(reader, spec: RobotSpec, robot) -> np.ndarray:
         home = np.clip(np.zeros(n), robot.lower_limits_deg, robot.upper_limits_deg)
     else:
         if len(spec.home_joints) != n:
-            raise reader.fail("robot.home_joints_deg", f"the robot drives {n} joints ({', '.join(robot.joint_names)}), the list has {len(spec.home_joints)} values")
+            raise reader.fail(
+                "robot.home_joints_deg",
+                f"the robot drives {n} joints ({', '.join(robot.joint_names)}), the list has {len(spec.home_joints)} values",
+            )
         home = spec.home_joints
         outside = np.flatnonzero(~robot.within_limits(home))
         if len(outside):
             j = int(outside[0])
-            raise reader.fail(f"robot.home_joints_deg[{j}]", f"{home[j]:g} {robot.joint_units[j]} is outside joint '{robot.joint_names[j]}' limits [{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]")
+            raise reader.fail(
+                f"robot.home_joints_deg[{j}]",
+                f"{home[j]:g} {robot.joint_units[j]} is outside joint '{robot.joint_names[j]}' limits [{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]",
+            )
     if spec.controller is not None:
         unknown = [j for j in spec.controller.joints if j not in robot.joint_names]
         if unknown:
-            raise reader.fail("robot.controller.joints", f"not driven joints of the robot: {', '.join(unknown)}; driven joints: {', '.join(robot.joint_names)}")
+            raise reader.fail(
+                "robot.controller.joints",
+                f"not driven joints of the robot: {', '.join(unknown)}; driven joints: {', '.join(robot.joint_names)}",
+            )
         if sorted(spec.controller.joints) != sorted(robot.joint_names):
-            raise reader.fail("robot.controller.joints", f"must name each driven joint once: {', '.join(robot.joint_names)}")
+            raise reader.fail(
+                "robot.controller.joints", f"must name each driven joint once: {', '.join(robot.joint_names)}"
+            )
     return np.asarray(home, dtype=float)

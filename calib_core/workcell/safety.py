@@ -11,7 +11,14 @@ from dataclasses import dataclass
 
 from calib_core.link.joint_history import SettleRule
 
-SAFETY_KEYS = {"model_error_mm", "model_error_deg", "settle_speed_deg_s", "settle_time_s", "confirm_joint_change_deg", "singularity_margin"}
+SAFETY_KEYS = {
+    "model_error_mm",
+    "model_error_deg",
+    "settle_speed_deg_s",
+    "settle_time_s",
+    "confirm_joint_change_deg",
+    "singularity_margin",
+}
 
 
 @dataclass(frozen=True)

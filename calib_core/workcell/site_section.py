@@ -68,6 +68,16 @@ def read_site_section(reader, raw, folder: Path) -> SiteSection:
     for key in ("camera_frame", "camera_parent_frame"):
         value = raw.get(key)
         if value is not None and (not isinstance(value, str) or not _FRAME_NAME.fullmatch(value) or len(value) > 200):
-            raise reader.fail(f"site.{key}", f"must be a tf frame name (letters, digits, _ and /, not starting with a digit), got {value!r}")
+            raise reader.fail(
+                f"site.{key}",
+                f"must be a tf frame name (letters, digits, _ and /, not starting with a digit), got {value!r}",
+            )
         names[key] = value
-    return SiteSection(values["controller"], camera, options["controller_options"], options["camera_options"], names["camera_frame"], names["camera_parent_frame"])
+    return SiteSection(
+        values["controller"],
+        camera,
+        options["controller_options"],
+        options["camera_options"],
+        names["camera_frame"],
+        names["camera_parent_frame"],
+    )

@@ -139,11 +139,15 @@ def _camera_frame(offset_mm: float) -> np.ndarray:
     """cam2tcp-aligned frame: off-axis on the TCP's -y side, ``CAMERA_OUT_MM`` out along the tool,
     looking along the tool axis, tilted to aim at the target face at the grasp."""
     aim = TCP_MM + GRASP_STANDOFF_MM
-    tilt = -np.degrees(np.arctan2(offset_mm, aim - CAMERA_OUT_MM))  # about x: the optical axis turns toward the tool axis
+    tilt = -np.degrees(
+        np.arctan2(offset_mm, aim - CAMERA_OUT_MM)
+    )  # about x: the optical axis turns toward the tool axis
     return transform_from_xyz_rpy([0.0, -offset_mm, CAMERA_OUT_MM], [tilt, 0.0, 0.0])
 
 
-def _find_task(robot: RobotModel, home: np.ndarray, camera_yaw_deg: float, floor_z_mm: float) -> tuple[np.ndarray, np.ndarray]:
+def _find_task(
+    robot: RobotModel, home: np.ndarray, camera_yaw_deg: float, floor_z_mm: float
+) -> tuple[np.ndarray, np.ndarray]:
     """A reachable grasp (tcp2base) facing +x in front of the robot, and the joints that reach its approach: unfolded
     where the arm's joints are read (:mod:`calib_core.workcell.task_pose`), else the first reached, from the middle
     of the workspace outward."""
@@ -165,7 +169,9 @@ def _find_task(robot: RobotModel, home: np.ndarray, camera_yaw_deg: float, floor
             except UnreachableTargetError:
                 continue
             return tcp, q_approach
-    raise StarterCellError("found no grasp pose in front of the robot that it reaches with the tool pointing forward; give --flange (the frame whose z points out of the tool)")
+    raise StarterCellError(
+        "found no grasp pose in front of the robot that it reaches with the tool pointing forward; give --flange (the frame whose z points out of the tool)"
+    )
 
 
 def _yaml_pose(T: np.ndarray) -> str:
@@ -175,11 +181,22 @@ def _yaml_pose(T: np.ndarray) -> str:
 
 def _frame_yaml(parent: str, T: np.ndarray) -> str:
     xyz, rpy = xyz_rpy_from_transform(T)
-    return "{parent: %s, xyz: [%s], rpy: [%s]}" % (parent, ", ".join(f"{v:.2f}" for v in xyz), ", ".join(f"{v:.4f}" for v in rpy))
+    return "{parent: %s, xyz: [%s], rpy: [%s]}" % (
+        parent,
+        ", ".join(f"{v:.2f}" for v in xyz),
+        ", ".join(f"{v:.4f}" for v in rpy),
+    )
 
 
-def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list[str | Path] = (), *, flange: str | None = None, name: str | None = None,
-                       xacro_args: dict[str, str] | None = None) -> StarterCell:
+def write_starter_cell(
+    folder: str | Path,
+    urdf: str | Path,
+    package_paths: list[str | Path] = (),
+    *,
+    flange: str | None = None,
+    name: str | None = None,
+    xacro_args: dict[str, str] | None = None,
+) -> StarterCell:
     """Write a starting cell for the robot ``urdf`` into ``folder`` (created; an existing
     ``workcell.yaml`` there is refused). Returns what was chosen."""
     folder = Path(folder)
@@ -192,23 +209,36 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     choice = choose_flange(plain, flange)
     flange = choice.name
     align, axis_warning = tool_alignment(plain, flange)
-    base = "base" if plain.model.existFrame("base") and plain.model.frames[plain.model.getFrameId("base")].parentJoint == 0 else None
+    base = (
+        "base"
+        if plain.model.existFrame("base") and plain.model.frames[plain.model.getFrameId("base")].parentJoint == 0
+        else None
+    )
     driven = _chain_to(plain.full_model, flange)
     held = {plain.full_model.names[j]: 0.0 for j in range(1, plain.full_model.njoints) if j not in driven}
     robot = load_robot(RobotSpec(urdf, tuple(package_paths), {"base": base}, None, held, xacro_args=xacro_args))
     yaw, offset = _tool_side(robot, flange, align)
-    turn = concat(transform_from_xyz_rpy([0, 0, 0], [0, 0, yaw]), align)  # (in the flange's frame: aligned, then turned about the tool)
+    turn = concat(
+        transform_from_xyz_rpy([0, 0, 0], [0, 0, yaw]), align
+    )  # (in the flange's frame: aligned, then turned about the tool)
     # The TCP is the flange moved along its z, not turned (the tool data a controller takes is a pure offset, for every
     # vendor's flange); the camera goes on the side the hand leaves room, turned about the tool from the TCP's -y.
-    frames = {"base": base, "flange": flange, "tcp": NewFrame(flange, align @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])),
-              "camera": NewFrame(flange, turn @ _camera_frame(offset))}
+    frames = {
+        "base": base,
+        "flange": flange,
+        "tcp": NewFrame(flange, align @ transform_from_xyz_rpy([0, 0, TCP_MM], [0, 0, 0])),
+        "camera": NewFrame(flange, turn @ _camera_frame(offset)),
+    }
     robot = load_robot(RobotSpec(urdf, tuple(package_paths), frames, None, held, xacro_args=xacro_args))
     home = np.clip(np.zeros(robot.n_joints), robot.lower_limits_deg, robot.upper_limits_deg)
     floor_z = _floor_z_mm(robot, home)
     tcp, q_approach = _find_task(robot, home, yaw, floor_z)
     home = q_approach  # start where the camera already sees the target from the approach
     # The target's face centre sits GRASP_STANDOFF_MM beyond the TCP, facing the robot (its x toward -x base).
-    target2base = make_transform(np.column_stack([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]), tcp[:3, 3] + [GRASP_STANDOFF_MM, 0.0, 0.0])
+    target2base = make_transform(
+        np.column_stack([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]),
+        tcp[:3, 3] + [GRASP_STANDOFF_MM, 0.0, 0.0],
+    )
     reach, _ = reach_of(robot)
 
     made_parents = [d for d in folder.parents if not d.exists()]
@@ -220,10 +250,28 @@ def write_starter_cell(folder: str | Path, urdf: str | Path, package_paths: list
     except OSError as exc:
         raise FileWriteError(folder, f"cannot make the cell's folder ({exc.strerror or exc})") from None
     try:
-        _write_files(staging, folder, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach, floor_z)
+        _write_files(
+            staging,
+            folder,
+            urdf,
+            package_paths,
+            name,
+            xacro_args,
+            base,
+            flange,
+            frames,
+            home,
+            held,
+            tcp,
+            target2base,
+            reach,
+            floor_z,
+        )
         _move_into(staging, folder)
     except OSError as exc:
-        raise FileWriteError(folder, f"cannot write the cell ({exc.strerror or exc}); nothing was left behind") from None
+        raise FileWriteError(
+            folder, f"cannot write the cell ({exc.strerror or exc}); nothing was left behind"
+        ) from None
     finally:
         shutil.rmtree(staging, ignore_errors=True)
         if not (folder / "workcell.yaml").exists():
@@ -259,12 +307,33 @@ def _floor_z_mm(robot: RobotModel, q_deg) -> float:
     from calib_core.robot.visuals import RobotVisuals
 
     visuals = RobotVisuals.from_robot(robot)
-    lows = [float(trimesh.transform_points(trimesh.bounds.corners(mesh.bounds), pose)[:, 2].min()) if len(mesh.vertices) else 0.0
-            for g, mesh, pose in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q_deg)) if g.parentJoint == 0]
+    lows = [
+        float(trimesh.transform_points(trimesh.bounds.corners(mesh.bounds), pose)[:, 2].min())
+        if len(mesh.vertices)
+        else 0.0
+        for g, mesh, pose in zip(visuals.geometry_model.geometryObjects, visuals.meshes, visuals.poses(q_deg))
+        if g.parentJoint == 0
+    ]
     return min(0.0, min(lows, default=0.0))
 
 
-def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_args, base, flange, frames, home, held, tcp, target2base, reach, floor_z=0.0) -> None:
+def _write_files(
+    folder: Path,
+    final: Path,
+    urdf,
+    package_paths,
+    name,
+    xacro_args,
+    base,
+    flange,
+    frames,
+    home,
+    held,
+    tcp,
+    target2base,
+    reach,
+    floor_z=0.0,
+) -> None:
     """The cell's files into ``folder`` (paths in them relative to ``final``, a sibling: the same relative paths);
     the floor's top at ``floor_z`` (mm, base frame)."""
     meshes = folder / "meshes"
@@ -304,32 +373,37 @@ def _write_files(folder: Path, final: Path, urdf, package_paths, name, xacro_arg
     ]
     if held:
         lines.append("  held_joints: {" + ", ".join(f"{k}: 0" for k in held) + "}   # not driven (deg or mm)")
-    lines += [
-        "",
-        "camera:",
-        "  intrinsics: camera.yaml",
-        "",
-        "components:",
-        "  - name: floor",
-        "    kind: fixture",
-        "    mesh: meshes/floor.stl",
-        "    mesh_units: mm",
-        "    color: [0.55, 0.56, 0.58]",
-        f"    placement: {{xyz: [0, 0, {floor_z:.2f}], rpy: [0, 0, 0]}}" + ("   # under the robot's base link" if floor_z < 0 else ""),
-        "  - name: target",
-        "    kind: component",
-        "    mesh: meshes/target.stl",
-        "    mesh_units: mm",
-        "    color: [0.80, 0.78, 0.72]",
-        f"    placement: {_yaml_pose(target2base)}",
-        "    features:",
-    ] + [f"      {k}: [{', '.join(f'{v:.6g}' for v in p)}]" for k, p in FEATURES.items()] + [
-        "",
-        "task_locations:",
-        "  - name: target_grasp",
-        "    component: target",
-        f"    tcp2base: {_yaml_pose(tcp)}",
-        f"    approach_mm: {APPROACH_MM:g}",
-        "",
-    ]
+    lines += (
+        [
+            "",
+            "camera:",
+            "  intrinsics: camera.yaml",
+            "",
+            "components:",
+            "  - name: floor",
+            "    kind: fixture",
+            "    mesh: meshes/floor.stl",
+            "    mesh_units: mm",
+            "    color: [0.55, 0.56, 0.58]",
+            f"    placement: {{xyz: [0, 0, {floor_z:.2f}], rpy: [0, 0, 0]}}"
+            + ("   # under the robot's base link" if floor_z < 0 else ""),
+            "  - name: target",
+            "    kind: component",
+            "    mesh: meshes/target.stl",
+            "    mesh_units: mm",
+            "    color: [0.80, 0.78, 0.72]",
+            f"    placement: {_yaml_pose(target2base)}",
+            "    features:",
+        ]
+        + [f"      {k}: [{', '.join(f'{v:.6g}' for v in p)}]" for k, p in FEATURES.items()]
+        + [
+            "",
+            "task_locations:",
+            "  - name: target_grasp",
+            "    component: target",
+            f"    tcp2base: {_yaml_pose(tcp)}",
+            f"    approach_mm: {APPROACH_MM:g}",
+            "",
+        ]
+    )
     (folder / "workcell.yaml").write_text("\n".join(lines), encoding="utf-8")

@@ -78,9 +78,12 @@ def posture(robot: RobotModel, joints: ArmJoints, q_deg, forward: np.ndarray) ->
     d = np.array([reach @ forward, reach[2]])
     e = np.array([upper @ forward, upper[2]])
     normal = np.array([-d[1], d[0]])
-    return Posture(elbow_deg=float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))), elbow_up=bool(e @ normal > 0.0),
-                   lean_back=bool(upper @ forward < -LEAN_BACK_SHARE * np.linalg.norm(upper)),
-                   wrist_in_front=bool((wrist - axis1) @ forward > 0.0))
+    return Posture(
+        elbow_deg=float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))),
+        elbow_up=bool(e @ normal > 0.0),
+        lean_back=bool(upper @ forward < -LEAN_BACK_SHARE * np.linalg.norm(upper)),
+        wrist_in_front=bool((wrist - axis1) @ forward > 0.0),
+    )
 
 
 def _wrist_twin(robot: RobotModel, joints: ArmJoints, q: np.ndarray) -> np.ndarray | None:
@@ -100,7 +103,9 @@ def _wrist_twin(robot: RobotModel, joints: ArmJoints, q: np.ndarray) -> np.ndarr
     return twin
 
 
-def _ways_to_stand(robot: RobotModel, joints: ArmJoints, target2base: np.ndarray, seeds: list[np.ndarray]) -> list[np.ndarray]:
+def _ways_to_stand(
+    robot: RobotModel, joints: ArmJoints, target2base: np.ndarray, seeds: list[np.ndarray]
+) -> list[np.ndarray]:
     found = []
     for seed in seeds:
         try:
@@ -113,8 +118,9 @@ def _ways_to_stand(robot: RobotModel, joints: ArmJoints, target2base: np.ndarray
     return found
 
 
-def find_task(robot: RobotModel, tool2base_rotation: np.ndarray, home: np.ndarray, approach_mm: float, min_z_mm: float
-              ) -> tuple[np.ndarray, np.ndarray] | None:
+def find_task(
+    robot: RobotModel, tool2base_rotation: np.ndarray, home: np.ndarray, approach_mm: float, min_z_mm: float
+) -> tuple[np.ndarray, np.ndarray] | None:
     """A grasp (tcp2base, (4, 4), mm; the tool along base +x with ``tool2base_rotation``) that the arm reaches
     unfolded from ``approach_mm`` back along the tool, and the joints (deg) at that approach; ``None`` when the arm's
     joints are not read here (see the module) or no candidate is reached unfolded."""
@@ -139,7 +145,9 @@ def find_task(robot: RobotModel, tool2base_rotation: np.ndarray, home: np.ndarra
                 continue
             approach = make_transform(tool2base_rotation, [approach_x, 0.0, z])
             tcp = make_transform(tool2base_rotation, [approach_x + approach_mm, 0.0, z])
-            standing = [q for q in _ways_to_stand(robot, joints, approach, seeds) if posture(robot, joints, q, forward).unfolded]
+            standing = [
+                q for q in _ways_to_stand(robot, joints, approach, seeds) if posture(robot, joints, q, forward).unfolded
+            ]
             for q in sorted(standing, key=lambda q: float(np.max(np.abs(q - home)))):
                 try:
                     q_grasp = solve_ik(robot, tcp, q, extra_seeds=0).q_deg

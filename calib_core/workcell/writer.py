@@ -45,10 +45,16 @@ def _same_pose(entry, T: np.ndarray) -> bool:
 
 def _component_entry(item, source: tuple[Path, str], folder: Path) -> CommentedMap:
     mesh_file, units = source
-    entry = CommentedMap([
-        ("name", item.name), ("kind", item.kind), ("mesh", os.path.relpath(mesh_file, folder)), ("mesh_units", units),
-        ("color", _flow(item.color)), ("placement", _placement(item.item2world)),
-    ])
+    entry = CommentedMap(
+        [
+            ("name", item.name),
+            ("kind", item.kind),
+            ("mesh", os.path.relpath(mesh_file, folder)),
+            ("mesh_units", units),
+            ("color", _flow(item.color)),
+            ("placement", _placement(item.item2world)),
+        ]
+    )
     if item.features:
         entry["features"] = CommentedMap((k, _feature_entry(item, k)) for k in item.features)
     if item.form_tolerance_mm > 0:
@@ -85,9 +91,16 @@ def _update_component(entry: CommentedMap, item) -> None:
         features = entry["features"] = CommentedMap()
     for name, point in item.features.items():
         stored = _stored_point(features[name]) if name in features else None
-        stored_kind = features[name].get("kind", "corner") if name in features and isinstance(features[name], dict) else "corner"
+        stored_kind = (
+            features[name].get("kind", "corner") if name in features and isinstance(features[name], dict) else "corner"
+        )
         kind = item.feature_kinds.get(name)
-        if stored is None or stored.shape != (3,) or not np.allclose(stored, point, atol=1e-6) or stored_kind != (kind.kind if kind else "corner"):
+        if (
+            stored is None
+            or stored.shape != (3,)
+            or not np.allclose(stored, point, atol=1e-6)
+            or stored_kind != (kind.kind if kind else "corner")
+        ):
             features[name] = _feature_entry(item, name)
     for name in [k for k in (features or {}) if k not in item.features]:
         del features[name]

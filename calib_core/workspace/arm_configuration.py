@@ -89,7 +89,9 @@ def _axes(robot, q_model_deg) -> tuple[list[_Axis], np.ndarray]:
     """The first six joint axes at ``q_model_deg`` in the robot's world (mm), and axis 1's frame's rotation (3, 3)."""
     model = robot.model
     if model.njoints - 1 < 6:
-        raise NotASixAxisArmError(f"the robot has {model.njoints - 1} joints; a controller's arm configuration is for six-axis arms")
+        raise NotASixAxisArmError(
+            f"the robot has {model.njoints - 1} joints; a controller's arm configuration is for six-axis arms"
+        )
     data = model.createData()
     pin.computeJointJacobians(model, data, robot.configuration(q_model_deg))
     axes = []
@@ -97,7 +99,9 @@ def _axes(robot, q_model_deg) -> tuple[list[_Axis], np.ndarray]:
         J = pin.getJointJacobian(model, data, j, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         omega = J[3:, model.idx_vs[j]] if model.nvs[j] == 1 else np.zeros(3)
         if np.linalg.norm(omega) < 0.5:  # a prismatic joint moves, it does not turn
-            raise NotASixAxisArmError(f"joint {model.names[j]!r} is not a revolute axis: a controller's arm configuration is for six revolute axes")
+            raise NotASixAxisArmError(
+                f"joint {model.names[j]!r} is not a revolute axis: a controller's arm configuration is for six revolute axes"
+            )
         axes.append(_Axis(data.oMi[j].translation * 1000.0, omega / np.linalg.norm(omega)))
     return axes, data.oMi[1].rotation.copy()
 
@@ -121,8 +125,10 @@ def _wrist_centre(axes: list[_Axis]) -> np.ndarray:
     off6 = centre - axes[5].point
     off6 = float(np.linalg.norm(off6 - (off6 @ axes[5].direction) * axes[5].direction)) if gap <= 1.0 else gap
     if not (gap <= 1.0 and off6 <= 1.0):
-        raise NotASixAxisArmError(f"axes 4, 5 and 6 do not meet (they pass {max(gap, off6):.1f} mm apart): no wrist centre; "
-                                  "an offset wrist names its configuration by its joints")
+        raise NotASixAxisArmError(
+            f"axes 4, 5 and 6 do not meet (they pass {max(gap, off6):.1f} mm apart): no wrist centre; "
+            "an offset wrist names its configuration by its joints"
+        )
     return centre
 
 
@@ -149,7 +155,9 @@ def arm_configuration(robot, joint_map, q_model_deg, reference_axes_deg) -> ArmC
     x_axis = turn1 @ turn1_zero.T @ np.array([1.0, 0.0, 0.0])
     x_axis -= (x_axis @ axes[0].direction) * axes[0].direction
     wrist_x = float((centre - axes[0].point) @ (x_axis / np.linalg.norm(x_axis)))
-    ref_axes, _ = _axes(robot, joint_map.to_model(np.r_[axes_deg[:1], np.asarray(reference_axes_deg, float)[1:3], axes_deg[3:]]))
+    ref_axes, _ = _axes(
+        robot, joint_map.to_model(np.r_[axes_deg[:1], np.asarray(reference_axes_deg, float)[1:3], axes_deg[3:]])
+    )
     ref_side = _elbow_side(ref_axes, _wrist_centre(ref_axes))
     elbow = _elbow_side(axes, centre) * (1.0 if ref_side >= 0 else -1.0)
     near = []

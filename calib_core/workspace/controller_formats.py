@@ -32,7 +32,13 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from calib_core.calibration.corrections import CorrectionTable
-from calib_core.workspace.arm_configuration import ArmConfiguration, NotASixAxisArmError, abb_confdata, arm_configuration, kuka_status_turn
+from calib_core.workspace.arm_configuration import (
+    ArmConfiguration,
+    NotASixAxisArmError,
+    abb_confdata,
+    arm_configuration,
+    kuka_status_turn,
+)
 from calib_core.errors import VideocalError
 from calib_core.names import InvalidNameError, check_name
 from calib_core.workcell.model import TaskLocation
@@ -133,8 +139,11 @@ class Entry:
     def arm_note(self, vendor_terms: str) -> str:
         """What a listing says of the configuration beside the target."""
         if isinstance(self.arm, ArmConfiguration):
-            return f"{vendor_terms} from the arm at this target (IK from the look's joints)" + (f"; near a boundary: {'; '.join(self.arm.near)}: check it" if self.arm.near else "")
+            return f"{vendor_terms} from the arm at this target (IK from the look's joints)" + (
+                f"; near a boundary: {'; '.join(self.arm.near)}: check it" if self.arm.near else ""
+            )
         return f"{vendor_terms} must be taught" + (f" ({self.arm})" if self.arm else " (no robot given)")
+
 
 DEFAULT_NAME = "videocal_corrections"
 
@@ -148,46 +157,72 @@ def listing_name(fmt: str, stem: str | None) -> str:
     if limit is None:
         return name
     if not _IDENTIFIER.fullmatch(name) or len(name) > limit:
-        raise InvalidNameError(f"{name!r}: a {fmt} file's name is its {'DEFDAT' if fmt == 'krl' else 'MODULE' if fmt == 'rapid' else 'program'} name: "
-                               f"a letter, then letters, digits or _, at most {limit} characters; rename the output file")
+        raise InvalidNameError(
+            f"{name!r}: a {fmt} file's name is its {'DEFDAT' if fmt == 'krl' else 'MODULE' if fmt == 'rapid' else 'program'} name: "
+            f"a letter, then letters, digits or _, at most {limit} characters; rename the output file"
+        )
     return name.upper() if fmt == "fanuc" else name
 
 
 def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
-    lines = [f"# videocal corrected task locations, {when}",
-             "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location"]
+    lines = [
+        f"# videocal corrected task locations, {when}",
+        "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location",
+    ]
     if tool is not None:
-        lines += ["# the tool (TCP) the targets are for, on the flange: set it before moving to them", f"set_tcp({urscript_pose(tool)})"]
+        lines += [
+            "# the tool (TCP) the targets are for, on the flange: set it before moving to them",
+            f"set_tcp({urscript_pose(tool)})",
+        ]
     for e in entries:
         lines += [f"# {e.note}", f"global {e.ident} = {urscript_pose(e.pose)}"]
         if isinstance(e.arm, ArmConfiguration):
             q = ", ".join(f"{v:.6f}" for v in np.radians(e.arm.axes_deg[:6]))
-            lines += [f"# the joints (rad) near which the arm stands there: movej(get_inverse_kin({e.ident}, qnear={e.ident}_qnear))" + (f"; near: {'; '.join(e.arm.near)}" if e.arm.near else ""),
-                      f"global {e.ident}_qnear = [{q}]"]
+            lines += [
+                f"# the joints (rad) near which the arm stands there: movej(get_inverse_kin({e.ident}, qnear={e.ident}_qnear))"
+                + (f"; near: {'; '.join(e.arm.near)}" if e.arm.near else ""),
+                f"global {e.ident}_qnear = [{q}]",
+            ]
     return lines
 
 
 def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
-    lines = [f"MODULE {name}", f"  ! videocal corrected task locations, {when}",
-             "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0), confdata [cf1, cf4, cf6, cfx]"]
+    lines = [
+        f"MODULE {name}",
+        f"  ! videocal corrected task locations, {when}",
+        "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0), confdata [cf1, cf4, cf6, cfx]",
+    ]
     if tool is not None:
-        lines += ["  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and centre of gravity",
-                  f"  PERS tooldata videocal_tool := {rapid_tooldata(tool)};"]
+        lines += [
+            "  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and centre of gravity",
+            f"  PERS tooldata videocal_tool := {rapid_tooldata(tool)};",
+        ]
     for e in entries:
         conf = abb_confdata(e.arm) if isinstance(e.arm, ArmConfiguration) else (0, 0, 0, 0)
-        lines += [f"  ! {e.note}; {e.arm_note('confdata')}", f"  CONST robtarget {e.ident} := {rapid_robtarget(e.pose, conf)};"]
+        lines += [
+            f"  ! {e.note}; {e.arm_note('confdata')}",
+            f"  CONST robtarget {e.ident} := {rapid_robtarget(e.pose, conf)};",
+        ]
     return lines + ["ENDMODULE"]
 
 
 def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
-    lines = [f"DEFDAT {name} PUBLIC", f"; videocal corrected task locations, {when}",
-             "; {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; a POS carries S and T"]
+    lines = [
+        f"DEFDAT {name} PUBLIC",
+        f"; videocal corrected task locations, {when}",
+        "; {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; a POS carries S and T",
+    ]
     if tool is not None:
-        lines += ["; the tool (TCP) the targets are for, on the flange: TOOL_DATA[n]=videocal_tool, then $TOOL=TOOL_DATA[n]",
-                  f"DECL GLOBAL FRAME videocal_tool={krl_frame(tool)}"]
+        lines += [
+            "; the tool (TCP) the targets are for, on the flange: TOOL_DATA[n]=videocal_tool, then $TOOL=TOOL_DATA[n]",
+            f"DECL GLOBAL FRAME videocal_tool={krl_frame(tool)}",
+        ]
     for e in entries:
         if isinstance(e.arm, ArmConfiguration):
-            lines += [f"; {e.note}; {e.arm_note('S and T')}", f"DECL GLOBAL POS {e.ident}={krl_frame(e.pose, kuka_status_turn(e.arm))}"]
+            lines += [
+                f"; {e.note}; {e.arm_note('S and T')}",
+                f"DECL GLOBAL POS {e.ident}={krl_frame(e.pose, kuka_status_turn(e.arm))}",
+            ]
         else:
             lines += [f"; {e.note}; {e.arm_note('S and T')}", f"DECL GLOBAL FRAME {e.ident}={krl_frame(e.pose)}"]
     return lines + ["ENDDAT"]
@@ -197,10 +232,27 @@ def _fanuc_attr(line_count: int, when: str) -> list[str]:
     """The ``/ATTR`` section every ``.ls`` file the controller writes has (dates as ``DATE yy-mm-dd TIME hh:mm:ss``)."""
     stamp = time.strptime(when, "%Y-%m-%d %H:%M:%S")
     date = f"DATE {time.strftime('%y-%m-%d', stamp)}  TIME {time.strftime('%H:%M:%S', stamp)}"
-    return ["/ATTR", "OWNER\t\t= MNEDITOR;", 'COMMENT\t\t= "videocal";', "PROG_SIZE\t= 0;", f"CREATE\t\t= {date};", f"MODIFIED\t= {date};",
-            "FILE_NAME\t= ;", "VERSION\t\t= 0;", f"LINE_COUNT\t= {line_count};", "MEMORY_SIZE\t= 0;", "PROTECT\t\t= READ_WRITE;",
-            "TCD:  STACK_SIZE\t= 0,", "      TASK_PRIORITY\t= 50,", "      TIME_SLICE\t= 0,", "      BUSY_LAMP_OFF\t= 0,",
-            "      ABORT_REQUEST\t= 0,", "      PAUSE_REQUEST\t= 0;", "DEFAULT_GROUP\t= 1,*,*,*,*;", "CONTROL_CODE\t= 00000000 00000000;"]
+    return [
+        "/ATTR",
+        "OWNER\t\t= MNEDITOR;",
+        'COMMENT\t\t= "videocal";',
+        "PROG_SIZE\t= 0;",
+        f"CREATE\t\t= {date};",
+        f"MODIFIED\t= {date};",
+        "FILE_NAME\t= ;",
+        "VERSION\t\t= 0;",
+        f"LINE_COUNT\t= {line_count};",
+        "MEMORY_SIZE\t= 0;",
+        "PROTECT\t\t= READ_WRITE;",
+        "TCD:  STACK_SIZE\t= 0,",
+        "      TASK_PRIORITY\t= 50,",
+        "      TIME_SLICE\t= 0,",
+        "      BUSY_LAMP_OFF\t= 0,",
+        "      ABORT_REQUEST\t= 0,",
+        "      PAUSE_REQUEST\t= 0;",
+        "DEFAULT_GROUP\t= 1,*,*,*,*;",
+        "CONTROL_CODE\t= 00000000 00000000;",
+    ]
 
 
 FANUC_UNTAUGHT = "TEACH ME"
@@ -208,27 +260,47 @@ FANUC_UNTAUGHT = "TEACH ME"
 controller refuses the listing rather than loading a guessed one (docs/decisions.md says why none is derived)."""
 
 
-def _fanuc(entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), tool: np.ndarray | None = None) -> list[str]:
-    notes = [f"videocal corrected task locations, {when}", "positions in the robot's world frame: X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W))",
-             f"CONFIG is not known: each P[n] says '{FANUC_UNTAUGHT}', which the controller refuses: teach it (TOUCHUP) before use"]
+def _fanuc(
+    entries: list[Entry], when: str, name: str = DEFAULT_NAME.upper(), tool: np.ndarray | None = None
+) -> list[str]:
+    notes = [
+        f"videocal corrected task locations, {when}",
+        "positions in the robot's world frame: X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W))",
+        f"CONFIG is not known: each P[n] says '{FANUC_UNTAUGHT}', which the controller refuses: teach it (TOUCHUP) before use",
+    ]
     if tool is not None:
         x, y, z, w, p, r = fanuc_position(tool)
-        notes += ["the tool frame (UTOOL 1) the targets are for, on the faceplate:", f"X {x:.3f} Y {y:.3f} Z {z:.3f} W {w:.3f} P {p:.3f} R {r:.3f}"]
+        notes += [
+            "the tool frame (UTOOL 1) the targets are for, on the faceplate:",
+            f"X {x:.3f} Y {y:.3f} Z {z:.3f} W {w:.3f} P {p:.3f} R {r:.3f}",
+        ]
     notes += [f"P[{k}] {e.ident}: {e.note}" for k, e in enumerate(entries, start=1)]
-    lines = [f"/PROG  {name}"] + _fanuc_attr(len(notes), when) + ["/MN"] + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)] + ["/POS"]
+    lines = (
+        [f"/PROG  {name}"]
+        + _fanuc_attr(len(notes), when)
+        + ["/MN"]
+        + [f"  {k:3d}:  ! {text} ;" for k, text in enumerate(notes, start=1)]
+        + ["/POS"]
+    )
     for k, e in enumerate(entries, start=1):
         x, y, z, w, p, r = fanuc_position(e.pose)
         lines += [
-            f'P[{k}:"{e.ident}"]{{', "   GP1:", f"\tUF : 0, UT : 1,\t\tCONFIG : '{FANUC_UNTAUGHT}',",
+            f'P[{k}:"{e.ident}"]{{',
+            "   GP1:",
+            f"\tUF : 0, UT : 1,\t\tCONFIG : '{FANUC_UNTAUGHT}',",
             f"\tX = {x:10.3f}  mm,\tY = {y:10.3f}  mm,\tZ = {z:10.3f}  mm,",
-            f"\tW = {w:10.3f} deg,\tP = {p:10.3f} deg,\tR = {r:10.3f} deg", "};",
+            f"\tW = {w:10.3f} deg,\tP = {p:10.3f} deg,\tR = {r:10.3f} deg",
+            "};",
         ]
     return lines + ["/END"]
 
 
 def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
-    lines = [f"-- videocal corrected task locations, {when}",
-             "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location", "VAR"]
+    lines = [
+        f"-- videocal corrected task locations, {when}",
+        "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location",
+        "VAR",
+    ]
     lines += [f"  {e.ident} : POSITION  -- {e.note}" for e in entries]
     body = [f"  {e.ident} := {pdl2_pos(e.pose)}" for e in entries]
     if tool is not None:
@@ -238,7 +310,11 @@ def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.nd
 
 # format -> (writer, longest variable name the language takes)
 LISTINGS: dict[str, tuple[Callable[[list[Entry], str], list[str]], int]] = {
-    "urscript": (_urscript, 63), "rapid": (_rapid, 32), "krl": (_krl, 24), "fanuc": (_fanuc, 16), "pdl2": (_pdl2, 24),
+    "urscript": (_urscript, 63),
+    "rapid": (_rapid, 32),
+    "krl": (_krl, 24),
+    "fanuc": (_fanuc, 16),
+    "pdl2": (_pdl2, 24),
 }
 FORMATS = tuple(LISTINGS)
 
@@ -273,8 +349,15 @@ def _arm_at(fmt: str, robot, joint_map, target: np.ndarray, look_joints) -> ArmC
         return str(exc)
 
 
-def controller_listing(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, tool: np.ndarray | None = None,
-                       robot=None, joint_map=None) -> str:
+def controller_listing(
+    fmt: str,
+    table: CorrectionTable,
+    tasks: dict[str, TaskLocation],
+    file_stem: str | None = None,
+    tool: np.ndarray | None = None,
+    robot=None,
+    joint_map=None,
+) -> str:
     """The corrected targets as a ``fmt`` listing (:data:`FORMATS`), one variable per task location,
     each with its measured displacement as a remark; named after the file it goes to (``file_stem``); with ``tool``
     (``tcp2flange`` (4, 4) mm), the tool data the targets are for, in the language's own form; with ``robot`` (the

@@ -17,9 +17,35 @@ from calib_core.workspace.controller_formats import FORMATS, controller_listing
 from calib_core.workspace.workspace import _correction_dict, _pose
 
 CSV_COLUMNS = (
-    "task", "time_s", "dx_mm", "dy_mm", "dz_mm", "rx_deg", "ry_deg", "rz_deg", "sd_dx_mm", "sd_dy_mm", "sd_dz_mm", "sd_rx_deg", "sd_ry_deg", "sd_rz_deg",
-    "target_x_mm", "target_y_mm", "target_z_mm", "target_roll_deg", "target_pitch_deg", "target_yaw_deg", "rms_px", "pairs", "source",
-    "tool_x_mm", "tool_y_mm", "tool_z_mm", "tool_roll_deg", "tool_pitch_deg", "tool_yaw_deg",
+    "task",
+    "time_s",
+    "dx_mm",
+    "dy_mm",
+    "dz_mm",
+    "rx_deg",
+    "ry_deg",
+    "rz_deg",
+    "sd_dx_mm",
+    "sd_dy_mm",
+    "sd_dz_mm",
+    "sd_rx_deg",
+    "sd_ry_deg",
+    "sd_rz_deg",
+    "target_x_mm",
+    "target_y_mm",
+    "target_z_mm",
+    "target_roll_deg",
+    "target_pitch_deg",
+    "target_yaw_deg",
+    "rms_px",
+    "pairs",
+    "source",
+    "tool_x_mm",
+    "tool_y_mm",
+    "tool_z_mm",
+    "tool_roll_deg",
+    "tool_pitch_deg",
+    "tool_yaw_deg",
 )
 """The ``tool_*`` columns: the TCP on the flange the targets are for (empty without the cell's robot)."""
 from calib_core.workspace.export_formats import EXPORT_FORMATS, LISTING_FORMATS  # noqa: E402,F401 (EXPORT_FORMATS: the formats by name, for those who import them from here)
@@ -35,7 +61,9 @@ def _target(c: Correction, tasks: dict[str, TaskLocation]):
     return concat(task.tcp2base, invert(c.delta_base))
 
 
-def corrections_json(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None) -> str:
+def corrections_json(
+    table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None
+) -> str:
     """Every correction; with ``tasks``, each also with ``target_to_command`` ({xyz mm, rpy deg} in base); with
     ``tool`` (``tcp2flange`` (4, 4) mm), ``tool_on_flange``: the TCP the targets are for."""
     rows = []
@@ -57,7 +85,9 @@ def _cell(text: str) -> str:
     return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
 
 
-def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None) -> str:
+def corrections_csv(
+    table: CorrectionTable, tasks: dict[str, TaskLocation] | None = None, tool: np.ndarray | None = None
+) -> str:
     """Every stored correction (history included), one row each, mm and degrees; the target columns
     are empty for a task location the workspace does not know, the tool columns without ``tool``
     (``tcp2flange`` (4, 4) mm: the TCP the targets are for)."""
@@ -75,8 +105,21 @@ def corrections_csv(table: CorrectionTable, tasks: dict[str, TaskLocation] | Non
             if target is not None:
                 xyz, rpy = xyz_rpy_from_transform(target)
                 pose = [f"{v:.4f}" for v in xyz] + [f"{v:.5f}" for v in rpy]
-            w.writerow([_cell(c.task), f"{c.time_s:.3f}", *(f"{v:.4f}" for v in c.displacement_mm), *(f"{v:.5f}" for v in c.rotation_deg), *(f"{v:.4f}" for v in c.std_displacement_mm),
-                        *(f"{v:.5f}" for v in c.std_rotation_deg), *pose, f"{c.rms_px:.3f}", c.pairs, _cell(c.source), *tool_cells])
+            w.writerow(
+                [
+                    _cell(c.task),
+                    f"{c.time_s:.3f}",
+                    *(f"{v:.4f}" for v in c.displacement_mm),
+                    *(f"{v:.5f}" for v in c.rotation_deg),
+                    *(f"{v:.4f}" for v in c.std_displacement_mm),
+                    *(f"{v:.5f}" for v in c.std_rotation_deg),
+                    *pose,
+                    f"{c.rms_px:.3f}",
+                    c.pairs,
+                    _cell(c.source),
+                    *tool_cells,
+                ]
+            )
     return out.getvalue()
 
 
@@ -85,7 +128,14 @@ def corrections_pdl2(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> 
     return controller_listing("pdl2", table, tasks)
 
 
-def export_corrections(fmt: str, table: CorrectionTable, tasks: dict[str, TaskLocation], file_stem: str | None = None, robot=None, joint_map=None) -> str:
+def export_corrections(
+    fmt: str,
+    table: CorrectionTable,
+    tasks: dict[str, TaskLocation],
+    file_stem: str | None = None,
+    robot=None,
+    joint_map=None,
+) -> str:
     """The correction table in ``fmt`` (:data:`EXPORT_FORMATS`); a controller listing is named after the file it
     goes to (``file_stem``, the name without its suffixes), as the controller requires, and with ``robot`` (the cell's
     :class:`~calib_core.robot.model.RobotModel`) carries the tool data the targets are for and the arm's

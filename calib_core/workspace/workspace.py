@@ -58,11 +58,21 @@ def _pose(T: np.ndarray) -> dict:
 
 def _correction_dict(c: Correction) -> dict:
     return {
-        "task": c.task, "time_s": c.time_s, "source": c.source, "joints_deg": c.joints_deg.tolist(),
-        "tcp2base_model": _pose(c.tcp2base_model), "tcp2base_measured": _pose(c.tcp2base_measured),
-        "displacement_mm": c.displacement_mm.tolist(), "rotation_deg": c.rotation_deg.tolist(),
-        "std_displacement_mm": c.std_displacement_mm.tolist(), "std_rotation_deg": c.std_rotation_deg.tolist(),
-        "rms_px": c.rms_px, "pairs": c.pairs, "verdict": c.verdict, "confirmation": c.confirmation, "kind": c.kind,
+        "task": c.task,
+        "time_s": c.time_s,
+        "source": c.source,
+        "joints_deg": c.joints_deg.tolist(),
+        "tcp2base_model": _pose(c.tcp2base_model),
+        "tcp2base_measured": _pose(c.tcp2base_measured),
+        "displacement_mm": c.displacement_mm.tolist(),
+        "rotation_deg": c.rotation_deg.tolist(),
+        "std_displacement_mm": c.std_displacement_mm.tolist(),
+        "std_rotation_deg": c.std_rotation_deg.tolist(),
+        "rms_px": c.rms_px,
+        "pairs": c.pairs,
+        "verdict": c.verdict,
+        "confirmation": c.confirmation,
+        "kind": c.kind,
     }
 
 
@@ -77,16 +87,37 @@ def workspace_to_dict(ws: Workspace) -> dict:
         "cell": ws.cell,
         "intrinsics": ws.intrinsics.to_dict(),
         "target": ws.target,
-        "task_locations": [{"name": t.name, "component": t.component, "approach_mm": t.approach_mm, "tolerance_mm": t.tolerance_mm, "tcp2base": _pose(t.tcp2base)} for t in ws.task_locations.values()],
+        "task_locations": [
+            {
+                "name": t.name,
+                "component": t.component,
+                "approach_mm": t.approach_mm,
+                "tolerance_mm": t.tolerance_mm,
+                "tcp2base": _pose(t.tcp2base),
+            }
+            for t in ws.task_locations.values()
+        ],
         "pairs": [pair_to_dict(p) for p in ws.pairs],
         "corrections": [_correction_dict(c) for task in ws.corrections.tasks() for c in ws.corrections.history(task)],
-        "verifications": [_verification_dict(v) for task in ws.corrections.tasks() for v in ws.corrections.verifications(task)],
+        "verifications": [
+            _verification_dict(v) for task in ws.corrections.tasks() for v in ws.corrections.verifications(task)
+        ],
     }
 
 
 def _verification_dict(v: Verification) -> dict:
-    return {"task": v.task, "time_s": v.time_s, "remaining_mm": v.remaining_mm.tolist(), "remaining_deg": v.remaining_deg.tolist(), "std_remaining_mm": v.std_remaining_mm.tolist(),
-            "disagreement_mm": v.disagreement_mm, "agree_within_mm": v.agree_within_mm, "rms_px": v.rms_px, "pairs": v.pairs, "tolerance_mm": v.tolerance_mm}
+    return {
+        "task": v.task,
+        "time_s": v.time_s,
+        "remaining_mm": v.remaining_mm.tolist(),
+        "remaining_deg": v.remaining_deg.tolist(),
+        "std_remaining_mm": v.std_remaining_mm.tolist(),
+        "disagreement_mm": v.disagreement_mm,
+        "agree_within_mm": v.agree_within_mm,
+        "rms_px": v.rms_px,
+        "pairs": v.pairs,
+        "tolerance_mm": v.tolerance_mm,
+    }
 
 
 def _correction_kind(value, field: str, f) -> str:
@@ -120,7 +151,10 @@ class _Fields:
             raise self.fail(f"{where}.{key}" if where else key, "missing")
         value = data[key]
         if kind is not None and not isinstance(value, kind):
-            raise self.fail(f"{where}.{key}" if where else key, f"must be {getattr(kind, '__name__', kind)}, got {type(value).__name__}")
+            raise self.fail(
+                f"{where}.{key}" if where else key,
+                f"must be {getattr(kind, '__name__', kind)}, got {type(value).__name__}",
+            )
         return value
 
     def name(self, data: dict, key: str, where: str) -> str:
@@ -146,7 +180,11 @@ class _Fields:
 
     def sigmas(self, value, n: int, where: str) -> np.ndarray:
         """``n`` 1-sigma values: non-negative numbers, or null / NaN for one that is not known."""
-        if not isinstance(value, list) or len(value) != n or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in value):
+        if (
+            not isinstance(value, list)
+            or len(value) != n
+            or not all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in value)
+        ):
             raise self.fail(where, f"must be {n} numbers (null for an unknown one), got {value!r}")
         arr = np.array([np.nan if v is None else v for v in value], dtype=float)
         if np.any(arr < 0) or np.any(np.isinf(arr)) or np.any(arr > MAX_SIGMA):
@@ -171,7 +209,10 @@ class _Fields:
         return self.vector(value, n, where)
 
     def pose(self, value, where: str) -> np.ndarray:
-        return transform_from_xyz_rpy(self.vector(self.get(value, "xyz", where), 3, f"{where}.xyz"), self.vector(self.get(value, "rpy", where), 3, f"{where}.rpy"))
+        return transform_from_xyz_rpy(
+            self.vector(self.get(value, "xyz", where), 3, f"{where}.xyz"),
+            self.vector(self.get(value, "rpy", where), 3, f"{where}.rpy"),
+        )
 
 
 def _tolerance(f, t: dict, where: str) -> float:
@@ -189,9 +230,14 @@ def load_workspace(path: str | Path) -> Workspace:
         raise f.fail("kind", f"not a videocal workspace (kind must be {KIND!r})")
     version = data.get("schema_version")
     if version not in _READABLE_VERSIONS:
-        raise f.fail("schema_version", f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {version!r}")
+        raise f.fail(
+            "schema_version",
+            f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {version!r}",
+        )
     cell = data.get("cell")
-    if cell is not None and not (isinstance(cell, dict) and isinstance(cell.get("name"), str) and isinstance(cell.get("content_hash"), str)):
+    if cell is not None and not (
+        isinstance(cell, dict) and isinstance(cell.get("name"), str) and isinstance(cell.get("content_hash"), str)
+    ):
         raise f.fail("cell", f"must be {{name, content_hash}} strings, got {cell!r}")
     try:
         intrinsics = Intrinsics.from_dict(f.get(data, "intrinsics", "", dict))
@@ -205,7 +251,13 @@ def load_workspace(path: str | Path) -> Workspace:
         if component is not None and not isinstance(component, str):
             raise f.fail(f"{where}.component", f"must be the name of one component, got {component!r}")
         approach = f.number(f.get(t, "approach_mm", where), f"{where}.approach_mm", 0.0, 10000.0)
-        tasks[name] = TaskLocation(name, f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"), approach, component, _tolerance(f, t, where))
+        tasks[name] = TaskLocation(
+            name,
+            f.pose(f.get(t, "tcp2base", where, dict), f"{where}.tcp2base"),
+            approach,
+            component,
+            _tolerance(f, t, where),
+        )
     pairs = []
     for i, p in enumerate(f.get(data, "pairs", "", list)):
         where = f"pairs[{i}]"
@@ -216,41 +268,71 @@ def load_workspace(path: str | Path) -> Workspace:
                 view = ViewStamp.from_dict(p["view"])
             except (KeyError, TypeError, ValueError) as exc:
                 raise f.fail(f"{where}.view", f"not a frame stamp: {exc}") from None
-        pairs.append(Correspondence(int(f.get(p, "number", where, int)), f.name(p, "component", where), None if p.get("feature") is None else f.name(p, "feature", where), tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")), None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")), bool(p.get("enabled", True)), view))
+        pairs.append(
+            Correspondence(
+                int(f.get(p, "number", where, int)),
+                f.name(p, "component", where),
+                None if p.get("feature") is None else f.name(p, "feature", where),
+                tuple(f.vector(f.get(p, "point_world_mm", where), 3, f"{where}.point_world_mm")),
+                None if pixel is None else tuple(f.vector(pixel, 2, f"{where}.pixel")),
+                bool(p.get("enabled", True)),
+                view,
+            )
+        )
     table = CorrectionTable()
     for i, c in enumerate(f.get(data, "corrections", "", list)):
         where = f"corrections[{i}]"
-        table.add(Correction(
-            task=f.name(c, "task", where),
-            tcp2base_model=f.pose(f.get(c, "tcp2base_model", where, dict), f"{where}.tcp2base_model"),
-            tcp2base_measured=f.pose(f.get(c, "tcp2base_measured", where, dict), f"{where}.tcp2base_measured"),
-            displacement_mm=f.vector(f.get(c, "displacement_mm", where), 3, f"{where}.displacement_mm"),
-            rotation_deg=f.vector(f.get(c, "rotation_deg", where), 3, f"{where}.rotation_deg"),
-            std_displacement_mm=f.sigmas(f.get(c, "std_displacement_mm", where), 3, f"{where}.std_displacement_mm"),
-            std_rotation_deg=f.sigmas(f.get(c, "std_rotation_deg", where), 3, f"{where}.std_rotation_deg"),
-            joints_deg=f.joints(f.get(c, "joints_deg", where), f"{where}.joints_deg"),
-            rms_px=f.number(f.get(c, "rms_px", where), f"{where}.rms_px", 0.0, 1e6, allow_nan=True),
-            pairs=int(f.get(c, "pairs", where, int)),
-            time_s=f.number(c.get("time_s", 0.0), f"{where}.time_s"),
-            source=str(c.get("source", "")),
-            verdict=str(c.get("verdict", "ok")),
-            confirmation=str(c.get("confirmation", "")),
-            kind=_correction_kind(c.get("kind", "correction"), f"{where}.kind", f),
-        ))
+        table.add(
+            Correction(
+                task=f.name(c, "task", where),
+                tcp2base_model=f.pose(f.get(c, "tcp2base_model", where, dict), f"{where}.tcp2base_model"),
+                tcp2base_measured=f.pose(f.get(c, "tcp2base_measured", where, dict), f"{where}.tcp2base_measured"),
+                displacement_mm=f.vector(f.get(c, "displacement_mm", where), 3, f"{where}.displacement_mm"),
+                rotation_deg=f.vector(f.get(c, "rotation_deg", where), 3, f"{where}.rotation_deg"),
+                std_displacement_mm=f.sigmas(f.get(c, "std_displacement_mm", where), 3, f"{where}.std_displacement_mm"),
+                std_rotation_deg=f.sigmas(f.get(c, "std_rotation_deg", where), 3, f"{where}.std_rotation_deg"),
+                joints_deg=f.joints(f.get(c, "joints_deg", where), f"{where}.joints_deg"),
+                rms_px=f.number(f.get(c, "rms_px", where), f"{where}.rms_px", 0.0, 1e6, allow_nan=True),
+                pairs=int(f.get(c, "pairs", where, int)),
+                time_s=f.number(c.get("time_s", 0.0), f"{where}.time_s"),
+                source=str(c.get("source", "")),
+                verdict=str(c.get("verdict", "ok")),
+                confirmation=str(c.get("confirmation", "")),
+                kind=_correction_kind(c.get("kind", "correction"), f"{where}.kind", f),
+            )
+        )
     verifications = data.get("verifications", []) or []
     if not isinstance(verifications, list):
         raise f.fail("verifications", f"must be a list, got {type(verifications).__name__}")
     for i, v in enumerate(verifications):
         where = f"verifications[{i}]"
         try:
-            table.add_verification(Verification(
-                str(v["task"]), np.asarray(v["remaining_mm"], float).reshape(3), np.asarray(v["remaining_deg"], float).reshape(3),
-                np.asarray(v["std_remaining_mm"], float).reshape(3), float(v["disagreement_mm"]), float(v["agree_within_mm"]), float(v["rms_px"]), int(v["pairs"]), float(v.get("time_s", 0.0)),
-                float(v.get("tolerance_mm", DEFAULT_TOLERANCE_MM)),
-            ))
+            table.add_verification(
+                Verification(
+                    str(v["task"]),
+                    np.asarray(v["remaining_mm"], float).reshape(3),
+                    np.asarray(v["remaining_deg"], float).reshape(3),
+                    np.asarray(v["std_remaining_mm"], float).reshape(3),
+                    float(v["disagreement_mm"]),
+                    float(v["agree_within_mm"]),
+                    float(v["rms_px"]),
+                    int(v["pairs"]),
+                    float(v.get("time_s", 0.0)),
+                    float(v.get("tolerance_mm", DEFAULT_TOLERANCE_MM)),
+                )
+            )
         except (KeyError, TypeError, ValueError) as exc:
             raise f.fail(where, f"not a verification: {exc}") from None
     target = data.get("target")
     if target is not None and not isinstance(target, str):
         raise f.fail("target", f"must be the name of one component, got {target!r}")
-    return Workspace(str(f.get(data, "workcell", "", str)), intrinsics, tasks, target, pairs, table, f.number(data.get("created_s", 0.0), "created_s"), cell)
+    return Workspace(
+        str(f.get(data, "workcell", "", str)),
+        intrinsics,
+        tasks,
+        target,
+        pairs,
+        table,
+        f.number(data.get("created_s", 0.0), "created_s"),
+        cell,
+    )

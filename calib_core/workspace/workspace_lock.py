@@ -35,8 +35,10 @@ class WorkspaceLock:
         except BlockingIOError:
             holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "another videocal window"
             os.close(fd)
-            raise WorkspaceInUse(f"{self.workspace} is open in {holder}: saving here would overwrite its work "
-                                 "(save this one under another name, or close the other window first)") from None
+            raise WorkspaceInUse(
+                f"{self.workspace} is open in {holder}: saving here would overwrite its work "
+                "(save this one under another name, or close the other window first)"
+            ) from None
         except OSError:
             os.close(fd)
             raise

@@ -41,13 +41,18 @@ def live_window(qtbot, tmp_path):
 @pytest.fixture
 def window(live_window):
     typical = RobotErrors.typical(0)
-    return live_window(RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
+    return live_window(
+        RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
+    )
 
 
 @pytest.fixture
 def launcher(tmp_path):
     """Opens windows as `videocal gui` does on the simulated site: each cell with its own simulator."""
-    return CellLauncher(lambda workcell, process=None: simulated_cell(workcell, process=process), settings=window_settings(tmp_path, "launcher"))
+    return CellLauncher(
+        lambda workcell, process=None: simulated_cell(workcell, process=process),
+        settings=window_settings(tmp_path, "launcher"),
+    )
 
 
 @pytest.fixture

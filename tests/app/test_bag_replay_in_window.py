@@ -25,7 +25,9 @@ T0 = 1_760_000_000_000_000_000  # the robot's clock, ns
 def arm_bag(tmp_path_factory):
     bed = TestBed.create()
     task = next(iter(bed.workcell.task_locations.values()))
-    look = solve_ik(bed.model_robot, task.approach2base, np.array(bed.workcell.home_joints_deg, float)).q_deg  # the camera on the fixture
+    look = solve_ik(
+        bed.model_robot, task.approach2base, np.array(bed.workcell.home_joints_deg, float)
+    ).q_deg  # the camera on the fixture
     turned = look + np.r_[0.5, 0.0, 0.0, 0.0, -1.5, 0.0][: len(look)]
     track, shots, moving = hold_and_move([look, turned], T0)
     camera = bed.camera()
@@ -76,8 +78,13 @@ def test_a_bag_replays_in_the_window_and_a_look_is_solved_on_it(qtbot, window, a
     # Picks on that frame carry the joints of its stamp; the solve uses them and finds the true camera pose (the
     # tool beyond it is the model's mounting: what one look can measure is the camera).
     fixture = wb.workcell.component(wb.task.component)
-    corners = apply(invert(bed.true_cam2world(joints[2])), apply(fixture.item2world, np.array([fixture.features[f] for f in FEATURES if f in fixture.features])))
-    assert wb.intrinsics.contains(project(corners, wb.intrinsics)).all()  # the features are on the frame, where they are picked
+    corners = apply(
+        invert(bed.true_cam2world(joints[2])),
+        apply(fixture.item2world, np.array([fixture.features[f] for f in FEATURES if f in fixture.features])),
+    )
+    assert wb.intrinsics.contains(
+        project(corners, wb.intrinsics)
+    ).all()  # the features are on the frame, where they are picked
     pick_all(wb, bed, joints[2])
     assert all(np.allclose(p.view.joints_deg, joints[2], atol=0.05) for p in wb.session.pairs)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)

@@ -17,7 +17,14 @@ from videocal_sim.sim_site import simulated_cell
 from tests.app.windows import confirm_move_if_asked, pick_pair, wait_for_settled_frame
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
-FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
+FEATURES = [
+    "plate_top_left",
+    "plate_top_right",
+    "plate_bottom_right",
+    "plate_bottom_left",
+    "boss_top_left",
+    "boss_bottom_right",
+]
 
 
 def _click_image(qtbot, view, u, v, zoom=None):
@@ -34,7 +41,9 @@ def _go_to_task(qtbot, win):
     task = wb.task
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
-    qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000)
+    qtbot.waitUntil(
+        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000
+    )
     # A frame taken with the robot settled there, and the virtual camera redrawn there.
     wait_for_settled_frame(qtbot, win)
     qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
@@ -79,10 +88,16 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     edges = win.camera.view.overlay.image
     assert edges is not None and edges.shape[:2] == (wb.intrinsics.height, wb.intrinsics.width)
     for name in ("plate_top_left", "plate_bottom_right"):
-        u, v = np.round(project(apply(invert(true_cam), apply(fixture.item2world, fixture.features[name])[None]), wb.intrinsics)[0]).astype(int)
+        u, v = np.round(
+            project(apply(invert(true_cam), apply(fixture.item2world, fixture.features[name])[None]), wb.intrinsics)[0]
+        ).astype(int)
         assert edges[v - 3 : v + 4, u - 3 : u + 4, 3].max() > 100, name
     # nothing drawn inside the flat plate face, between the bosses and the pin
-    u, v = np.round(project(apply(invert(true_cam), apply(fixture.item2world, np.array([0.0, -25.0, 25.0]))[None]), wb.intrinsics)[0]).astype(int)
+    u, v = np.round(
+        project(apply(invert(true_cam), apply(fixture.item2world, np.array([0.0, -25.0, 25.0]))[None]), wb.intrinsics)[
+            0
+        ]
+    ).astype(int)
     assert edges[v - 3 : v + 4, u - 3 : u + 4, 3].max() == 0
     OUTPUT.mkdir(exist_ok=True)
     win.grab().save(str(OUTPUT / "window_after_calibration.png"))
@@ -109,7 +124,9 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     qtbot.mouseClick(win.commands.go_corrected, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
     corrected = wb.session.corrections.corrected_target(wb.task.name, wb.task.tcp2base)
-    qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), corrected)[0]) < 0.01, timeout=20_000)
+    qtbot.waitUntil(
+        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), corrected)[0]) < 0.01, timeout=20_000
+    )
     miss = np.linalg.norm(pose_difference(bed.true_robot.fk(wb.joints_deg), wb.task.tcp2base)[0])
     miss_uncorrected = np.linalg.norm(d_true)
     assert miss < 0.5 and miss < miss_uncorrected / 10
@@ -158,7 +175,9 @@ def test_a_degenerate_point_set_is_explained_and_loses_no_pair(qtbot, window):
     # Four points on one straight line of the plate: no pose follows from them.
     wait_for_settled_frame(qtbot, win)
     for k, y in enumerate((-60.0, -20.0, 20.0, 60.0)):
-        pick_pair(wb, "oru_1_fixture", None, apply(fixture.item2world, np.array([0.0, y, 0.0])), (100.0 + 50 * k, 200.0))
+        pick_pair(
+            wb, "oru_1_fixture", None, apply(fixture.item2world, np.array([0.0, y, 0.0])), (100.0 + 50 * k, 200.0)
+        )
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
     text = win.results.status.text().lower()
     assert "line" in text or "degenerate" in text or "collinear" in text, text
@@ -207,7 +226,9 @@ def test_the_approach_is_edited_undone_and_the_overview_pans(qtbot, window):
     assert win.commands.approach.value() == pytest.approx(task.approach_mm)
     win.commands.approach.setValue(150.0)
     assert wb.workcell.task(task.name).approach_mm == 150.0 and wb.task.approach_mm == 150.0
-    np.testing.assert_allclose(wb.task.approach2base[:3, 3], (task.tcp2base @ np.array([0, 0, -150.0, 1]))[:3], atol=1e-9)
+    np.testing.assert_allclose(
+        wb.task.approach2base[:3, 3], (task.tcp2base @ np.array([0, 0, -150.0, 1]))[:3], atol=1e-9
+    )
     qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
     assert wb.workcell.task(task.name).approach_mm == task.approach_mm
     assert win.commands.approach.value() == pytest.approx(task.approach_mm)
@@ -256,7 +277,11 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     contents = read_recording(tmp_path / "session.mcap")
     assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
     # (link_state events may come and go with the controller; the operator's edits are these)
-    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC) if m.payload["kind"].startswith("pair_")] == ["pair_added", "pair_changed", "pair_accepted"]
+    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC) if m.payload["kind"].startswith("pair_")] == [
+        "pair_added",
+        "pair_changed",
+        "pair_accepted",
+    ]
     # Clear, then open the saved workspace: the pair comes back.
     wb.session.clear()
     assert len(wb.session.pairs) == 0
@@ -312,7 +337,12 @@ def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):
     view.underMouse = lambda: True
     shot = view.grab().toImage()
     # The loupe sits in the bottom corner away from the cursor and shows the red pixel magnified.
-    reds = [(i, j) for i in range(shot.width()) for j in range(shot.height() - 160, shot.height()) if shot.pixelColor(i, j).red() > 200 and shot.pixelColor(i, j).green() < 60]
+    reds = [
+        (i, j)
+        for i in range(shot.width())
+        for j in range(shot.height() - 160, shot.height())
+        if shot.pixelColor(i, j).red() > 200 and shot.pixelColor(i, j).green() < 60
+    ]
     assert len(reds) > 20
 
 
@@ -325,7 +355,17 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
     settings.setValue("window/ask_unsaved", False)
     cell, site = simulated_cell()
     (tmp_path / "recovery").mkdir()
-    save_workspace(tmp_path / "recovery" / "autosave.json", Workspace("cell", cell.intrinsics, {}, "oru_1_fixture", [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))], cell=cell.identity.to_dict()))
+    save_workspace(
+        tmp_path / "recovery" / "autosave.json",
+        Workspace(
+            "cell",
+            cell.intrinsics,
+            {},
+            "oru_1_fixture",
+            [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))],
+            cell=cell.identity.to_dict(),
+        ),
+    )
     wb = Workbench(cell, site)
     win = MainWindow(wb, settings=settings)
     qtbot.addWidget(win)
@@ -353,7 +393,9 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         assert asked == ["Save workspace"] and chosen.is_file()
         assert sorted(p.name for p in (tmp_path / "recovery").iterdir()) == ["recovered-autosave.json"]
         assert win.files.autosave.orphans() == []
-        assert not win.files.save_workspace(tmp_path / "recovery" / "w.json")  # the recovery folder holds autosaves only
+        assert not win.files.save_workspace(
+            tmp_path / "recovery" / "w.json"
+        )  # the recovery folder holds autosaves only
         assert "recovery folder" in win.results.status.text() and not (tmp_path / "recovery" / "w.json").exists()
     finally:
         win.close()

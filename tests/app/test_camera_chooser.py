@@ -30,14 +30,22 @@ def test_a_camera_is_chosen_while_the_window_runs(qtbot, window, tmp_path):
         cv2.imwrite(str(folder / f"shot_{k}.png"), np.full((240, 320, 3), 200, np.uint8))
     old_worker = win.worker
     _choose(qtbot, win, str(folder))
-    qtbot.waitUntil(lambda: wb.observations.latest is not None and wb.observations.latest.image.shape == (240, 320, 3), timeout=10_000)
+    qtbot.waitUntil(
+        lambda: wb.observations.latest is not None and wb.observations.latest.image.shape == (240, 320, 3),
+        timeout=10_000,
+    )
     assert win.worker is not old_worker and not old_worker.isRunning()  # the old camera was stopped, not left reading
     assert float(wb.observations.latest.image.mean()) == 200.0
-    qtbot.waitUntil(lambda: win.files.camera.recent()[:1] == [str(folder)], timeout=5_000)  # it gave a frame: remembered
+    qtbot.waitUntil(
+        lambda: win.files.camera.recent()[:1] == [str(folder)], timeout=5_000
+    )  # it gave a frame: remembered
     # a scheme nobody handles: refused by name, the folder camera goes on
     running = win.worker
     _choose(qtbot, win, "gopro://cam1")
-    assert "no camera connector for 'gopro://cam1'" in win.results.status.text() and "installed:" in win.results.status.text()
+    assert (
+        "no camera connector for 'gopro://cam1'" in win.results.status.text()
+        and "installed:" in win.results.status.text()
+    )
     assert win.worker is running and running.isRunning()
     # a camera that is not there: said in the results panel, the window stays up
     _choose(qtbot, win, str(tmp_path / "no_such_clip.mp4"))

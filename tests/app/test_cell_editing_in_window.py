@@ -39,7 +39,9 @@ def test_a_component_is_added_placed_by_numbers_and_undone_in_one_step(qtbot, wi
         box.setValue(value)
     panel.rpy[2].setValue(30.0)
     T = wb.workcell.component("crate").item2world
-    assert np.allclose(T[:3, 3], [1200.0, -150.0, 400.0]) and np.degrees(np.arctan2(T[1, 0], T[0, 0])) == pytest.approx(30.0)
+    assert np.allclose(T[:3, 3], [1200.0, -150.0, 400.0]) and np.degrees(np.arctan2(T[1, 0], T[0, 0])) == pytest.approx(
+        30.0
+    )
     qtbot.waitUntil(lambda: win.virtual.renders > renders, timeout=5_000)  # the views follow
     assert wb.session.undo.undo_label == "Place crate"
     win.actions.undo()  # every placement of the crate at once
@@ -53,14 +55,20 @@ def test_a_feature_named_by_a_click_snaps_to_the_boss_centre_and_the_cell_is_sav
     win, wb, panel = window, window.workbench, window.cell_panel
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
-    qtbot.waitUntil(lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), wb.task.tcp2base)[0]) < 0.01, timeout=20_000)
+    qtbot.waitUntil(
+        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), wb.task.tcp2base)[0]) < 0.01, timeout=20_000
+    )
     qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
     panel.component.setCurrentText("oru_1_fixture")
     panel.pick_features.setChecked(True)
     panel.feature_name.setText("boss_centre_check")
     fixture = wb.workcell.component("oru_1_fixture")
     boss = fixture.features["boss_top_left"]
-    uv = project(apply(invert(wb.model_cam2world()), apply(fixture.item2world, boss[None])), win.virtual.intrinsics, distort=False)[0]
+    uv = project(
+        apply(invert(wb.model_cam2world()), apply(fixture.item2world, boss[None])),
+        win.virtual.intrinsics,
+        distort=False,
+    )[0]
     x, y = win.virtual.view.image_to_widget(uv[0] + 3.0, uv[1] - 2.0)  # a click a little off the centre
     qtbot.mouseClick(win.virtual.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
     assert np.allclose(fixture.features["boss_centre_check"], boss, atol=1e-4), panel.feature_info.text()

@@ -72,5 +72,10 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
     (message,) = read_recording(tmp_path / "edges.mcap").topic(FOUND_TOPIC)  # Foxglove shows them on the frame found on
     annotations = ImageAnnotations.FromString(message.raw)
     assert len(annotations.circles) == len(found.result.proposals) and len(annotations.points[0].points) > 100
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(tmp_path / "edges.mcap")], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "replay", str(tmp_path / "edges.mcap")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 0 and "skipped (solved on the image's edges" in run.stdout, run.stdout + run.stderr

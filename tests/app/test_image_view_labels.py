@@ -38,7 +38,9 @@ def test_the_live_inset_leaves_the_corner_where_marks_are(qapp):
     corners = [QRectF(x, y, 20, 20) for x in (50, 100, 700, 750) for y in (100, 500)]
     between = _inset_box(bounds, 180, 135, corners)  # every corner taken: the middle of an edge
     assert not any(between.intersects(m) for m in corners) and 150 < between.center().y() < 450
-    everywhere = [QRectF(x, y, 20, 20) for x in range(0, 800, 60) for y in range(0, 600, 60)] + [QRectF(700, 500, 20, 20)]
+    everywhere = [QRectF(x, y, 20, 20) for x in range(0, 800, 60) for y in range(0, 600, 60)] + [
+        QRectF(700, 500, 20, 20)
+    ]
     fewest = _inset_box(bounds, 180, 135, everywhere)
     right_bottom = QRectF(bounds.right() - 188, bounds.bottom() - 169, 180, 135)
     assert sum(fewest.intersects(m) for m in everywhere) < sum(right_bottom.intersects(m) for m in everywhere)
@@ -50,11 +52,17 @@ def _blue_pixels(qtbot, labelled: bool) -> int:
     view.resize(640, 480)
     view.set_image(np.full((480, 640, 3), 40, np.uint8))
     blue = QColor("#50c8ff")
-    view.set_overlay(Overlay(points=[(320 + 3 * k, 240 + 2 * k, f"feature_{k}" if labelled else "", blue) for k in range(6)]))
+    view.set_overlay(
+        Overlay(points=[(320 + 3 * k, 240 + 2 * k, f"feature_{k}" if labelled else "", blue) for k in range(6)])
+    )
     view.show()
     qtbot.waitExposed(view)
     image = view.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
-    pixels = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()].reshape(image.height(), image.width(), 3)
+    pixels = (
+        np.frombuffer(image.constBits(), np.uint8)
+        .reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()]
+        .reshape(image.height(), image.width(), 3)
+    )
     return int(((pixels[..., 2] > 200) & (pixels[..., 0] < 150)).sum())
 
 
@@ -72,7 +80,11 @@ def test_a_view_with_crowded_marks_draws_four_labels_round_them(qtbot):
     view.show()
     qtbot.waitExposed(view)
     image = view.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
-    pixels = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()].reshape(image.height(), image.width(), 3)
+    pixels = (
+        np.frombuffer(image.constBits(), np.uint8)
+        .reshape(image.height(), image.bytesPerLine())[:, : 3 * image.width()]
+        .reshape(image.height(), image.width(), 3)
+    )
     one_mark_and_label = int(((pixels[..., 2] > 200) & (pixels[..., 0] < 150)).sum())
     one_label = one_mark_and_label - marks_only / 6
     ink = with_labels - marks_only

@@ -7,7 +7,14 @@ from PySide6.QtCore import Qt
 
 from tests.app.windows import answer_questions, go_and_settle, pick_features
 
-FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
+FEATURES = [
+    "plate_top_left",
+    "plate_top_right",
+    "plate_bottom_right",
+    "plate_bottom_left",
+    "boss_top_left",
+    "boss_bottom_right",
+]
 
 
 def test_a_look_from_the_approach_is_kept_as_a_measurement_and_moves_nothing(qtbot, window):
@@ -18,7 +25,9 @@ def test_a_look_from_the_approach_is_kept_as_a_measurement_and_moves_nothing(qtb
     assert wb.session.result is not None and wb.session.result.solution.status.value != "failed"
     asked = answer_questions(qtbot, ["Store as measurement"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
-    assert asked and "cannot be oru_1_grasp's correction" in asked[0] and "200.0 mm" in asked[0] and "moves by" in asked[0]
+    assert (
+        asked and "cannot be oru_1_grasp's correction" in asked[0] and "200.0 mm" in asked[0] and "moves by" in asked[0]
+    )
     table = wb.session.corrections
     assert table.latest(wb.task.name) is None and [c.kind for c in table.history(wb.task.name)] == ["measurement"]
     assert "no correction (0 stored, 1 measurement at other poses)" in win.commands.corrections.text()

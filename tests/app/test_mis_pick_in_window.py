@@ -5,8 +5,17 @@ from PySide6.QtCore import Qt
 
 from tests.app.windows import go_and_settle, pick_features
 
-NINE = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left",
-        "boss_top_right", "boss_bottom_left", "boss_bottom_right", "pin_tip"]
+NINE = [
+    "plate_top_left",
+    "plate_top_right",
+    "plate_bottom_right",
+    "plate_bottom_left",
+    "boss_top_left",
+    "boss_top_right",
+    "boss_bottom_left",
+    "boss_bottom_right",
+    "pin_tip",
+]
 
 
 def test_a_12_px_mis_pick_is_named_marked_and_not_stored(qtbot, window):
@@ -19,7 +28,9 @@ def test_a_12_px_mis_pick_is_named_marked_and_not_stored(qtbot, window):
     text = win.results.verdict.text() + " " + win.results.status.text()
     assert f"pair {number} " in text and ("does not fit the others" in text or "fits worst" in text), text
     row = next(r for r in range(win.table.rowCount()) if win.table.item(r, 0).text() == str(number))
-    assert win.table.item(row, 0).foreground().color().red() > 200 and "does not fit" in win.table.item(row, 7).toolTip()
+    assert (
+        win.table.item(row, 0).foreground().color().red() > 200 and "does not fit" in win.table.item(row, 7).toolTip()
+    )
     others = [r for r in range(win.table.rowCount()) if r != row]
     assert all(win.table.item(r, 0).foreground().color().red() < 200 for r in others)
     assert not win.commands.store.isEnabled() or wb.session.result.solution.status.value != "ok"

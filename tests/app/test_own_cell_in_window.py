@@ -77,6 +77,7 @@ def test_a_bug_is_logged_with_its_traceback_and_named_to_the_operator(qtbot, lau
     win = launcher.open(DEFAULT_WORKCELL)
     qtbot.addWidget(win)
     try:
+
         def broken():
             return {}["no such key"]
 
@@ -99,7 +100,9 @@ def test_a_failed_save_is_neither_recent_nor_saved(qtbot, launcher, tmp_path):
     try:
         wb, autosave = win.workbench, win.files.autosave
         assert not autosave.save_now()  # nothing changed: nothing written
-        wb.picking.pick_model_point("oru_1_fixture", "pin_tip", wb.workcell.component("oru_1_fixture").item2world[:3, 3])
+        wb.picking.pick_model_point(
+            "oru_1_fixture", "pin_tip", wb.workcell.component("oru_1_fixture").item2world[:3, 3]
+        )
         target = tmp_path / "no such folder" / "workspace.json"
         assert not win.files.save_workspace(target)
         assert str(target) not in win.files.recent.paths() and "no such folder" in win.results.status.text()
@@ -120,7 +123,10 @@ def test_each_window_autosaves_alone_and_an_unsaved_session_is_offered_once(qtbo
     for win, feature in ((first, "pin_tip"), (second, "plate_top_left")):
         win.workbench.picking.pick_model_point("oru_1_fixture", feature, fixture.item2world[:3, 3])
         assert win.files.autosave.save_now()
-    assert first.files.autosave.path != second.files.autosave.path and len(list((tmp_path / "recovery").glob("autosave-*.json"))) == 2
+    assert (
+        first.files.autosave.path != second.files.autosave.path
+        and len(list((tmp_path / "recovery").glob("autosave-*.json"))) == 2
+    )
     assert first.files.autosave.orphans() == []  # the other window is alive: its file is not an orphan
     # The first window quits with unsaved work (and, as a crash would, from another process id).
     first.close()

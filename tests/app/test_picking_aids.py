@@ -12,7 +12,11 @@ FEATURES = ["plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left
 
 def _pick_on_model(qtbot, win, model_cam, p_world) -> None:
     """The operator clicks the feature at ``p_world`` (3,) mm in the virtual camera."""
-    _click_image(qtbot, win.virtual.view, *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0])
+    _click_image(
+        qtbot,
+        win.virtual.view,
+        *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0],
+    )
 
 
 def _expected_mark(win):
@@ -90,7 +94,11 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
     p3 = np.array(wb.session.pairs.get(3).pixel)
     x3, y3 = view.image_to_widget(*p3)
     qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x3)), int(round(y3))))
-    assert win.table.selected_number() == 3 and np.allclose(wb.session.pairs.get(3).pixel, p3) and len(wb.session.pairs) == 3
+    assert (
+        win.table.selected_number() == 3
+        and np.allclose(wb.session.pairs.get(3).pixel, p3)
+        and len(wb.session.pairs) == 3
+    )
     # and in the virtual camera: a click on pair 1's mark selects it and starts no new pair
     _pick_on_model(qtbot, win, model_cam, np.array(wb.session.pairs.get(1).point_world_mm))
     assert win.table.selected_number() == 1 and len(wb.session.pairs) == 3 and wb.session.pairs.pending() is None

@@ -24,7 +24,9 @@ def test_a_full_disk_stops_rec_and_the_operator_records_on_as_jpeg(qtbot, window
     again = tmp_path / "session-jpeg.mcap"
     qtbot.waitUntil(lambda: win.workbench.recorder is not None and win.workbench.recorder.path == again, timeout=5_000)
     assert win.files.record_action.isChecked() and win.workbench.recorder.frames == "jpeg"
-    qtbot.waitUntil(lambda: win.workbench.recorder.messages > 0 and win.workbench.recorder.frames_written > 0, timeout=20_000)
+    qtbot.waitUntil(
+        lambda: win.workbench.recorder.messages > 0 and win.workbench.recorder.frames_written > 0, timeout=20_000
+    )
     win.files.stop_recording()
     assert win.workbench.recorder is None and not win.files.record_action.isChecked()
     contents = read_recording(again)

@@ -51,7 +51,9 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     k = truth.frame_index_at(t_mid)
     assert np.array_equal(win.camera.last_frame.image, truth.frames.image(k))
     assert np.allclose(wb.joints_deg, truth.joints_at(t_mid))
-    assert [p.number for p in wb.session.pairs] == [p.number for p in truth.pairs_at(t_mid)] and len(wb.session.pairs) >= 1
+    assert [p.number for p in wb.session.pairs] == [p.number for p in truth.pairs_at(t_mid)] and len(
+        wb.session.pairs
+    ) >= 1
     assert wb.session.result is None and t_mid < first_solve
 
     # After the solves: the last result appears, re-solved from its recorded inputs exactly.

@@ -25,7 +25,11 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     panel.show_board.setChecked(True)
     panel.poses.setValue(10)
     qtbot.mouseClick(panel.plan_button, Qt.MouseButton.LeftButton)
-    assert len(panel.plan.joints_deg) >= 8 and "board poses (of" in panel.plan_text.text() and "views of surveyed components" in panel.plan_text.text()
+    assert (
+        len(panel.plan.joints_deg) >= 8
+        and "board poses (of" in panel.plan_text.text()
+        and "views of surveyed components" in panel.plan_text.text()
+    )
     assert panel.run_button.isEnabled()
 
     # Cancel at the question: nothing moves.
@@ -67,7 +71,9 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     located = [k for k in r.per_view_rms_px if k.startswith("cell_")]
     assert len(located) >= 3 and "of surveyed components" in panel.result_text.text()
     d_base, rot_base = pose_difference(r.robot.fk(q, "camera"), bed.true_cam2world(q))
-    assert np.linalg.norm(d_base) < 0.1 * np.linalg.norm(d0) and np.linalg.norm(rot_base) < 0.2 * np.linalg.norm(rot0), (d_base, d0)
+    assert np.linalg.norm(d_base) < 0.1 * np.linalg.norm(d0) and np.linalg.norm(rot_base) < 0.2 * np.linalg.norm(
+        rot0
+    ), (d_base, d0)
 
     renders = win.virtual.renders
     before, intrinsics_before = wb.robot.fk(q, "camera"), wb.intrinsics
@@ -86,7 +92,9 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     panel.show_board.setChecked(False)  # the board taken down before the gripper works at the fixtures
     pins = {}
 
-    def move(q, what, allowed=frozenset()):  # awaited until the reported joints are there: the next preview starts from them
+    def move(
+        q, what, allowed=frozenset()
+    ):  # awaited until the reported joints are there: the next preview starts from them
         handle = wb.moves.move_joints(q, what, confirmed=True, allowed_contacts=allowed)
         qtbot.waitUntil(lambda: handle.finished and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=60_000)
 
@@ -103,7 +111,9 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
         pins[task.name] = (q_pin, task.tcp2base)
         move(q_approach, f"{task.name} approach", frozenset({task.component}))  # back out of the fixture
     assert len(wb.tool.grasps) == 2 and "2 grasps" in tool.text.text(), win.statusBar().currentMessage()
-    before_tool = {name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()}
+    before_tool = {
+        name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()
+    }
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
     assert tool.tool is not None and "TCP from 2 grasps (2 seen by the camera), spread" in tool.text.text()
     # each grasp was seen on the camera's frame (the held fixture's edges): the tool knows its own
@@ -132,7 +142,9 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     wait_for_settled_frame(qtbot, win)
     found = wb.finder.find_points()
     edges = found.result.edges
-    assert edges is not None and edges.settled, (edges.converged, edges.rms_px, edges.inlier_share) if edges else "no edges"
+    assert edges is not None and edges.settled, (
+        (edges.converged, edges.rms_px, edges.inlier_share) if edges else "no edges"
+    )
     look = wb.finder.calibrate_on_edges()
     fused = wb.robot_calibration.look_fused_with_robot(look)
     assert wb.session.verdict.ok and fused is not None and fused.agree, (wb.session.verdict, fused and fused.message)
@@ -163,5 +175,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
 
     qtbot.mouseClick(panel.revert_button, Qt.MouseButton.LeftButton)
     assert np.allclose(wb.robot.fk(q, "camera"), before)
-    assert np.allclose(wb.robot.fk(q, "tcp"), wb.workcell.load_robot().fk(q, "tcp"), atol=1e-6)  # the tool taken back too
+    assert np.allclose(
+        wb.robot.fk(q, "tcp"), wb.workcell.load_robot().fk(q, "tcp"), atol=1e-6
+    )  # the tool taken back too
     assert wb.intrinsics == intrinsics_before

@@ -10,9 +10,23 @@ from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QApplication
 
 from calib_core.frames import apply
-from tests.app.windows import answer_next_question as _answer, answer_questions, confirm_move_if_asked, go_and_settle, pick_features, wait_for_settled_frame
+from tests.app.windows import (
+    answer_next_question as _answer,
+    answer_questions,
+    confirm_move_if_asked,
+    go_and_settle,
+    pick_features,
+    wait_for_settled_frame,
+)
 
-FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "boss_top_left", "boss_bottom_right"]
+FEATURES = [
+    "plate_top_left",
+    "plate_top_right",
+    "plate_bottom_right",
+    "plate_bottom_left",
+    "boss_top_left",
+    "boss_bottom_right",
+]
 
 
 def _go(qtbot, win, button) -> None:
@@ -46,7 +60,9 @@ def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale
     wait_for_settled_frame(qtbot, win)
     overlay = win.camera.view.overlay
     assert "another robot pose" in overlay.banner
-    assert not any(c == (0, 220, 255) for *_, c in [(p[0], p[1], p[2], p[3].getRgb()[:3]) for p in overlay.points])  # no reprojected points
+    assert not any(
+        c == (0, 220, 255) for *_, c in [(p[0], p[1], p[2], p[3].getRgb()[:3]) for p in overlay.points]
+    )  # no reprojected points
     # Quit, start again (a new session on the same cell), the robot at home: the workspace's pairs solve as at the task.
     wb.session.clear()
     assert win.files.open_workspace(tmp_path / "w.json")
@@ -70,11 +86,21 @@ def test_an_implausible_result_is_stored_only_with_a_confirmation(qtbot, window)
     convert = f"Convert into {wb.task.name}'s correction"
     asked = answer_questions(qtbot, [convert, "Cancel"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
-    assert len(asked) == 2 and "cannot be" in asked[0] and "not OK" in asked[1] and wb.session.corrections.latest(wb.task.name) is None
+    assert (
+        len(asked) == 2
+        and "cannot be" in asked[0]
+        and "not OK" in asked[1]
+        and wb.session.corrections.latest(wb.task.name) is None
+    )
     asked = answer_questions(qtbot, [convert, "Store anyway"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     stored = wb.session.corrections.latest(wb.task.name)
-    assert len(asked) == 2 and stored is not None and stored.verdict == "implausible" and "confirmed in the window by" in stored.confirmation
+    assert (
+        len(asked) == 2
+        and stored is not None
+        and stored.verdict == "implausible"
+        and "confirmed in the window by" in stored.confirmation
+    )
     assert "converted in the window by" in stored.source
 
 
@@ -99,7 +125,11 @@ def test_a_click_while_the_robot_moves_picks_nothing(qtbot, window):
 def test_a_move_into_an_obstacle_is_refused_and_shown(qtbot, window, tmp_path):
     win, wb = window, window.workbench
     # A crate put where the arm passes on its way to the task location.
-    q_goal = wb.robot.check_joints(__import__("calib_core.robot", fromlist=["solve_ik"]).solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg).q_deg)
+    q_goal = wb.robot.check_joints(
+        __import__("calib_core.robot", fromlist=["solve_ik"])
+        .solve_ik(wb.robot, wb.task.approach2base, wb.joints_deg)
+        .q_deg
+    )
     elbow = wb.robot.fk((np.asarray(wb.joints_deg) + q_goal) / 2, "flange")[:3, 3]
     trimesh.creation.box((150.0, 150.0, 150.0)).export(tmp_path / "crate.stl")
     wb.editor.add_component(tmp_path / "crate.stl", "crate")
@@ -107,7 +137,11 @@ def test_a_move_into_an_obstacle_is_refused_and_shown(qtbot, window, tmp_path):
     before = np.array(wb.joints_deg)
     qtbot.mouseClick(win.commands.go_approach, Qt.MouseButton.LeftButton)
     assert "collision" in win.results.status.text() and "crate" in win.results.status.text()
-    assert win.overview.preview is not None and win.overview.preview.blocked and "refused" in win.overview.preview_text.text()
+    assert (
+        win.overview.preview is not None
+        and win.overview.preview.blocked
+        and "refused" in win.overview.preview_text.text()
+    )
     assert not win.overview.move_button.isVisible()
     # nothing was sent: no move handle exists, the robot stands where it stood
     assert wb.arm.pending_move is None and wb.motion.motion.value == "idle"

@@ -77,7 +77,9 @@ def _grab(widget) -> np.ndarray:
 
     image = widget.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
     w, h = image.width(), image.height()
-    array = np.frombuffer(image.constBits(), np.uint8).reshape(h, image.bytesPerLine())[:, : 3 * w].reshape(h, w, 3).copy()
+    array = (
+        np.frombuffer(image.constBits(), np.uint8).reshape(h, image.bytesPerLine())[:, : 3 * w].reshape(h, w, 3).copy()
+    )
     return array
 
 
@@ -96,12 +98,16 @@ def _compare(name: str, rgb: np.ndarray) -> None:
         return
     assert path.is_file(), f"no baseline {path}: run with VIDEOCAL_UPDATE_BASELINES=1, look at it, commit it"
     base = cv2.imread(str(path))[:, :, ::-1]
-    assert base.shape == shot.shape, f"{name}: {shot.shape[1]} x {shot.shape[0]} px, the baseline is {base.shape[1]} x {base.shape[0]}"
+    assert base.shape == shot.shape, (
+        f"{name}: {shot.shape[1]} x {shot.shape[0]} px, the baseline is {base.shape[1]} x {base.shape[0]}"
+    )
     diff = np.abs(shot.astype(int) - base.astype(int)).max(axis=2)
     cv2.imwrite(str(OUTPUT / f"{name}_diff.png"), np.clip(diff * 4, 0, 255).astype(np.uint8))
     mean_limit, share_limit = TOLERANCES[name]
     mean, share = float(diff.mean()), float((diff > 48).mean())
-    assert mean <= mean_limit and share <= share_limit, f"{name}: mean difference {mean:.2f} (limit {mean_limit}), {100 * share:.2f} % of pixels off by > 48 (limit {100 * share_limit:.1f} %); see tests/output/{name}_diff.png"
+    assert mean <= mean_limit and share <= share_limit, (
+        f"{name}: mean difference {mean:.2f} (limit {mean_limit}), {100 * share:.2f} % of pixels off by > 48 (limit {100 * share_limit:.1f} %); see tests/output/{name}_diff.png"
+    )
 
 
 def test_pane_and_window_baselines(calibrated_window):

@@ -29,7 +29,9 @@ def test_esc_withdraws_a_waiting_move_prompt(qtbot, window):
     win.actions.move(lambda confirmed: wb.moves.move_joints(q, "far", confirmed=confirmed))
     qtbot.mouseClick(win.overview.move_button, Qt.MouseButton.LeftButton)
     # arrived (the controller's DON) and the joints there: on a loaded machine the last sample may follow the DON
-    qtbot.waitUntil(lambda: wb.motion.motion.value == "arrived" and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=30_000)
+    qtbot.waitUntil(
+        lambda: wb.motion.motion.value == "arrived" and np.max(np.abs(wb.joints_deg - q)) < 1e-3, timeout=30_000
+    )
 
 
 def test_a_confirmation_given_before_a_stop_moves_nothing(qtbot, window):

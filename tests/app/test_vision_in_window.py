@@ -27,7 +27,10 @@ def window(live_window):
 def _fresh_still_frame(qtbot, win):
     """Wait until the camera shows a frame the core accepts: taken after the robot had settled."""
     wb = win.workbench
-    qtbot.waitUntil(lambda: win.camera.last_frame is not None and wb.observations.stillness(win.camera.last_frame).settled, timeout=10_000)
+    qtbot.waitUntil(
+        lambda: win.camera.last_frame is not None and wb.observations.stillness(win.camera.last_frame).settled,
+        timeout=10_000,
+    )
 
 
 def _visit_board_pose(qtbot, win, k: int) -> None:
@@ -38,7 +41,9 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
     try:
         qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
     except Exception:
-        raise AssertionError(f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; {win.overview.preview_text.text()}") from None
+        raise AssertionError(
+            f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; {win.overview.preview_text.text()}"
+        ) from None
     _fresh_still_frame(qtbot, win)
     assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3
 
@@ -93,7 +98,9 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     assert np.allclose(applied, vision.hand_eye_result.cam2flange)
     assert win.virtual.renders > renders
     qtbot.mouseClick(vision.apply_intrinsics_button, Qt.MouseButton.LeftButton)
-    assert wb.intrinsics == got and win.virtual.intrinsics.fu == pytest.approx(got.fu * win.virtual.intrinsics.width / got.width)
+    assert wb.intrinsics == got and win.virtual.intrinsics.fu == pytest.approx(
+        got.fu * win.virtual.intrinsics.width / got.width
+    )
 
     # Saved files read back.
     vision.save_intrinsics(tmp_path / "camera.yaml")
@@ -155,11 +162,18 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
         # however sparse the frames a loaded machine recorded
         # (the joints are recorded sparsely at rest: the first sample away from the pose is the departure)
         at = [t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if np.max(np.abs(rq - q)) < 1e-3]
-        left = [t for t, rq in zip(playback.joint_times_s, playback.joints_deg) if t > max(at) and np.max(np.abs(rq - q)) >= 1e-3]
+        left = [
+            t
+            for t, rq in zip(playback.joint_times_s, playback.joints_deg)
+            if t > max(at) and np.max(np.abs(rq - q)) >= 1e-3
+        ]
         win.replay.seek((min(left) if left else max(at)) - 0.05)
         qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
         messages.append(win.results.status.text())
-    assert len(vision.capture.views) == 4, ([vision.views.item(i).text() for i in range(vision.views.count())], messages)
+    assert len(vision.capture.views) == 4, (
+        [vision.views.item(i).text() for i in range(vision.views.count())],
+        messages,
+    )
     for recorded, q in zip(vision.capture.joints_deg, plan):
         assert np.max(np.abs(recorded - q)) < 1e-3
 
@@ -187,7 +201,9 @@ def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, 
     wb.event.connect(lambda kind, detail: events.append(kind))
     asked = _answer(qtbot, "Apply anyway")
     qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
-    assert asked and not np.array_equal(wb.robot.frame_placement("camera"), before) and "vision_result_confirmed" in events
+    assert (
+        asked and not np.array_equal(wb.robot.frame_placement("camera"), before) and "vision_result_confirmed" in events
+    )
 
 
 def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
@@ -211,6 +227,12 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
     assert len(refusals) >= 1 and len(vision.capture.views) == 1, refusals
     assert all("before the last move" in r or "cannot be used" in r for r in refusals), refusals
     _fresh_still_frame(qtbot, win)
-    qtbot.waitUntil(lambda: wb.observations.latest.t_host_s > wb.last_move_sent_s and wb.observations.stillness(wb.observations.newest_usable()).settled, timeout=10_000)
+    qtbot.waitUntil(
+        lambda: (
+            wb.observations.latest.t_host_s > wb.last_move_sent_s
+            and wb.observations.stillness(wb.observations.newest_usable()).settled
+        ),
+        timeout=10_000,
+    )
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert len(vision.capture.views) == 2

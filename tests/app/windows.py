@@ -93,7 +93,9 @@ def go_and_settle(qtbot, win, button) -> None:
     wait_for_settled_frame(qtbot, win)
 
 
-def pick_features(qtbot, win, features: list[str], component: str = "oru_1_fixture", off_px: dict | None = None) -> None:
+def pick_features(
+    qtbot, win, features: list[str], component: str = "oru_1_fixture", off_px: dict | None = None
+) -> None:
     """Pick each feature through the panes: on the virtual camera, then on the camera image where the
     truth puts it (the operator's eyes; ``off_px``: a feature's pick moved by (du, dv) px, a mis-pick), then
     Ctrl+Return."""
@@ -112,7 +114,9 @@ def pick_features(qtbot, win, features: list[str], component: str = "oru_1_fixtu
         uv_model = project(apply(invert(wb.model_cam2world()), p[None]), win.virtual.intrinsics, distort=False)[0]
         x, y = win.virtual.view.image_to_widget(*uv_model)
         qtbot.mouseClick(win.virtual.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
-        uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0] + np.asarray((off_px or {}).get(name, (0.0, 0.0)))
+        uv = project(apply(invert(true_cam), p[None]), wb.intrinsics)[0] + np.asarray(
+            (off_px or {}).get(name, (0.0, 0.0))
+        )
         x, y = win.camera.view.image_to_widget(*uv)
         qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
         qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)

@@ -25,7 +25,15 @@ def _limits() -> None:
 
 def _videocal(*args, cwd=None, preexec=_limits, timeout=120) -> subprocess.CompletedProcess:
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout, cwd=cwd, env=env, preexec_fn=preexec)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        cwd=cwd,
+        env=env,
+        preexec_fn=preexec,
+    )
 
 
 def _refused(run: subprocess.CompletedProcess, *expected: str) -> str:
@@ -136,12 +144,34 @@ def test_export_with_std_or_time_as_objects(tmp_path):
     table = CorrectionTable()
     measured = np.eye(4)
     measured[0, 3] = 1.0
-    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, 0, 0]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    table.add(
+        Correction(
+            "oru_1_grasp",
+            np.eye(4),
+            measured,
+            np.array([1.0, 0, 0]),
+            np.zeros(3),
+            np.full(3, 0.1),
+            np.full(3, 0.01),
+            np.zeros(6),
+            0.3,
+            6,
+        )
+    )
     path = tmp_path / "w.json"
-    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], table))
+    save_workspace(
+        path,
+        Workspace(
+            str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], table
+        ),
+    )
     assert _videocal("export", path).returncode == 0
     original = json.loads(path.read_text())
-    for field, value in (("std_displacement_mm", {"x": 1}), ("time_s", {"when": "now"}), ("std_rotation_deg", [0.1, 0.1])):
+    for field, value in (
+        ("std_displacement_mm", {"x": 1}),
+        ("time_s", {"when": "now"}),
+        ("std_rotation_deg", [0.1, 0.1]),
+    ):
         data = json.loads(json.dumps(original))
         data["corrections"][0][field] = value
         path.write_text(json.dumps(data))
@@ -159,16 +189,29 @@ def test_a_recorded_solve_without_its_result(tmp_path):
 
 
 # --- options out of range -------------------------------------------------------------------------
-@pytest.mark.parametrize("args, expected", [
-    (("calibrate-intrinsics", "sim", "--views", "0", "--out", "{tmp}/i.yaml"), "--views"),
-    (("calibrate-intrinsics", "sim", "--board", "charuco:100000x100000:30:22:DICT_5X5_100", "--out", "{tmp}/i.yaml"), "board"),
-    (("calibrate-hand-eye", "sim", "--poses", "1000000", "--out", "{tmp}/h.yaml"), "--poses"),
-    (("demo", "--offscreen", "--scale", "100", "--out", "{tmp}/demo"), "--scale"),
-    (("demo", "--offscreen", "--out", "{tmp}/a_file"), "a_file"),
-    (("monitor", "loop://", "--timeout", "nan"), "--timeout"),
-    (("monitor", "loop://", "--timeout", "inf"), "--timeout"),
-    (("render", "--scale", "1e6", "--out", "{tmp}/r.png"), "--scale"),
-])
+@pytest.mark.parametrize(
+    "args, expected",
+    [
+        (("calibrate-intrinsics", "sim", "--views", "0", "--out", "{tmp}/i.yaml"), "--views"),
+        (
+            (
+                "calibrate-intrinsics",
+                "sim",
+                "--board",
+                "charuco:100000x100000:30:22:DICT_5X5_100",
+                "--out",
+                "{tmp}/i.yaml",
+            ),
+            "board",
+        ),
+        (("calibrate-hand-eye", "sim", "--poses", "1000000", "--out", "{tmp}/h.yaml"), "--poses"),
+        (("demo", "--offscreen", "--scale", "100", "--out", "{tmp}/demo"), "--scale"),
+        (("demo", "--offscreen", "--out", "{tmp}/a_file"), "a_file"),
+        (("monitor", "loop://", "--timeout", "nan"), "--timeout"),
+        (("monitor", "loop://", "--timeout", "inf"), "--timeout"),
+        (("render", "--scale", "1e6", "--out", "{tmp}/r.png"), "--scale"),
+    ],
+)
 def test_options_out_of_range(tmp_path, args, expected):
     (tmp_path / "a_file").write_text("I am a file, not a folder")
     _refused(_videocal(*[a.format(tmp=tmp_path) for a in args]), expected)
@@ -198,15 +241,23 @@ def test_board_views_too_small_or_of_no_camera_s_shape_are_rejected_by_name(tmp_
     folder.mkdir()
     cv2.imwrite(str(folder / "one.png"), np.zeros((1, 1), np.uint8))
     cv2.imwrite(str(folder / "tall.jpg"), np.random.default_rng(0).integers(0, 255, (14304, 640), dtype=np.uint8))
-    line = _refused(_videocal("calibrate-intrinsics", folder, "--board", "chessboard:9x6:25", "--out", tmp_path / "camera.yaml"),
-                    "one.png: the image is 1 x 1 px: too small", "tall.jpg: the image is 640 x 14304 px: not a camera's picture")
+    line = _refused(
+        _videocal("calibrate-intrinsics", folder, "--board", "chessboard:9x6:25", "--out", tmp_path / "camera.yaml"),
+        "one.png: the image is 1 x 1 px: too small",
+        "tall.jpg: the image is 640 x 14304 px: not a camera's picture",
+    )
     assert "0 usable board views" in line and not (tmp_path / "camera.yaml").exists()
 
 
 def test_grab_into_a_folder_under_a_file_or_from_no_camera_leaves_nothing(tmp_path):
     (tmp_path / "afile").write_text("x")
-    _refused(_videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file")
-    _refused(_videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"), "missing.mp4")
+    _refused(
+        _videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file"
+    )
+    _refused(
+        _videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"),
+        "missing.mp4",
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]  # no folder made for a camera that did not open
 
 
@@ -227,12 +278,40 @@ def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_cam
     box.export(tmp_path / "box.stl")
     cv2.imwrite(str(tmp_path / "photo.png"), np.zeros((480, 640, 3), np.uint8))
     save_intrinsics(tmp_path / "camera.yaml", Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480))
-    (tmp_path / "ahead.json").write_text(json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 500], [0, 0, 0, 1]]}))
-    (tmp_path / "behind.json").write_text(json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -500], [0, 0, 0, 1]]}))
-    _refused(_videocal("locate", tmp_path / "photo.png", "--mesh", tmp_path / "nan.stl", "--intrinsics", tmp_path / "camera.yaml", "--prior", tmp_path / "ahead.json"),
-             "nan.stl", "not finite")
-    _refused(_videocal("locate", tmp_path / "photo.png", "--mesh", tmp_path / "box.stl", "--intrinsics", tmp_path / "camera.yaml", "--prior", tmp_path / "behind.json"),
-             "behind.json", "behind it")
+    (tmp_path / "ahead.json").write_text(
+        json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 500], [0, 0, 0, 1]]})
+    )
+    (tmp_path / "behind.json").write_text(
+        json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -500], [0, 0, 0, 1]]})
+    )
+    _refused(
+        _videocal(
+            "locate",
+            tmp_path / "photo.png",
+            "--mesh",
+            tmp_path / "nan.stl",
+            "--intrinsics",
+            tmp_path / "camera.yaml",
+            "--prior",
+            tmp_path / "ahead.json",
+        ),
+        "nan.stl",
+        "not finite",
+    )
+    _refused(
+        _videocal(
+            "locate",
+            tmp_path / "photo.png",
+            "--mesh",
+            tmp_path / "box.stl",
+            "--intrinsics",
+            tmp_path / "camera.yaml",
+            "--prior",
+            tmp_path / "behind.json",
+        ),
+        "behind.json",
+        "behind it",
+    )
 
 
 # --- numbers that parse but mean nothing --------------------------------------------------------------
@@ -254,7 +333,9 @@ def test_a_camera_mounting_10_km_from_the_flange_is_refused(tmp_path):
 
     path = tmp_path / "hand_eye.yaml"
     path.write_text(yaml.safe_dump({"cam2flange": {"xyz": [1e7, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}}))
-    with pytest.raises(FileFormatError, match=r"hand_eye.yaml: field 'cam2flange.xyz': the camera would be 10000000 mm from"):
+    with pytest.raises(
+        FileFormatError, match=r"hand_eye.yaml: field 'cam2flange.xyz': the camera would be 10000000 mm from"
+    ):
         load_mounting(path)
 
 
@@ -271,10 +352,33 @@ def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_
     table = CorrectionTable()
     measured = np.eye(4)
     measured[0, 3] = 1.0
-    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, 0, 0]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    table.add(
+        Correction(
+            "oru_1_grasp",
+            np.eye(4),
+            measured,
+            np.array([1.0, 0, 0]),
+            np.zeros(3),
+            np.full(3, 0.1),
+            np.full(3, 0.01),
+            np.zeros(6),
+            0.3,
+            6,
+        )
+    )
     pair = Correspondence(1, "oru_1_fixture", None, (100.0, 0.0, 0.0), None)
     path = tmp_path / "w.json"
-    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [pair], table))
+    save_workspace(
+        path,
+        Workspace(
+            str(cell.path),
+            load_intrinsics(cell.intrinsics_path),
+            dict(cell.task_locations),
+            "oru_1_fixture",
+            [pair],
+            table,
+        ),
+    )
     assert _videocal("export", path).returncode == 0
     original = json.loads(path.read_text())
     data = json.loads(json.dumps(original))
@@ -289,7 +393,12 @@ def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_
 
 def test_a_site_url_with_a_newline_or_a_nul_is_refused_by_field(cell):
     for url in ("socket://robot:30002\nmore", "ros2:///joint_states\x00"):
-        _refused(_render(cell(lambda d: d.update(site={"controller": url})), cell.folder), "edited.yaml", "site.controller", "control character")
+        _refused(
+            _render(cell(lambda d: d.update(site={"controller": url})), cell.folder),
+            "edited.yaml",
+            "site.controller",
+            "control character",
+        )
 
 
 def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothing(tmp_path):
@@ -306,7 +415,16 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
         resource.setrlimit(resource.RLIMIT_FSIZE, (1500, 1500))  # the workcell file and the target's STL are larger
 
     urdf = require(UR5)
-    run = _videocal("new-cell", tmp_path / "deep" / "cell", "--urdf", urdf, "--package-path", SHARE, preexec=small_files, timeout=300)
+    run = _videocal(
+        "new-cell",
+        tmp_path / "deep" / "cell",
+        "--urdf",
+        urdf,
+        "--package-path",
+        SHARE,
+        preexec=small_files,
+        timeout=300,
+    )
     _refused(run, "cell", "nothing was left behind")
     assert list(tmp_path.iterdir()) == []
     locked = tmp_path / "locked"
@@ -314,7 +432,9 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
     locked.chmod(stat.S_IRUSR | stat.S_IXUSR)
     try:
         if os.geteuid() != 0:  # root writes anywhere: the read-only case is a user's
-            _refused(_videocal("new-cell", locked / "cell", "--urdf", urdf, "--package-path", SHARE, timeout=300), "cell")
+            _refused(
+                _videocal("new-cell", locked / "cell", "--urdf", urdf, "--package-path", SHARE, timeout=300), "cell"
+            )
             assert list(locked.iterdir()) == []
     finally:
         locked.chmod(stat.S_IRWXU)

@@ -21,7 +21,10 @@ def test_the_cold_cell_is_wrong_where_a_real_one_is():
     assert 0.01 <= abs(truth.intrinsics.fu / nominal.fu - 1) <= 0.031
     assert 5 <= abs(truth.intrinsics.cx - nominal.cx) <= 20 and 5 <= abs(truth.intrinsics.cy - nominal.cy) <= 20
     assert truth.intrinsics.distortion[0] != nominal.distortion[0]
-    assert all(np.linalg.norm(d) <= SURVEY_MM + 1e-12 for d in truth.survey_error_mm.values()) and len(truth.survey_error_mm) >= 10
+    assert (
+        all(np.linalg.norm(d) <= SURVEY_MM + 1e-12 for d in truth.survey_error_mm.values())
+        and len(truth.survey_error_mm) >= 10
+    )
     moved = {c.name: c.item2world for c in bed.true_components}
     for c in bed.workcell.components:
         if c.name in truth.survey_error_mm:
@@ -30,14 +33,36 @@ def test_the_cold_cell_is_wrong_where_a_real_one_is():
 
 
 def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-robot", "sim", "--views", "12", "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-robot",
+            "sim",
+            "--views",
+            "12",
+            "--out",
+            str(tmp_path),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     summary = json.loads(run.stdout)
-    assert summary["board_views"] == 12 and summary["cell_views"] >= 3 and summary["start_rms_px"] > 2.0 and summary["rms_px"] < 0.2
+    assert (
+        summary["board_views"] == 12
+        and summary["cell_views"] >= 3
+        and summary["start_rms_px"] > 2.0
+        and summary["rms_px"] < 0.2
+    )
     score = summary["score"]
     # What board views determine: the camera relative to the board, at 20 poses not used.
-    assert score["camera_in_board_frame_mm_deg"][0] < 0.2 and score["camera_in_board_frame_mm_deg"][1] < 0.05  # 12 views; 40 in the bench
+    assert (
+        score["camera_in_board_frame_mm_deg"][0] < 0.2 and score["camera_in_board_frame_mm_deg"][1] < 0.05
+    )  # 12 views; 40 in the bench
     assert score["camera_nominal_model_mm_deg"][0] > 2.0
     # Tied to the cell by its surveyed components, with the tool from the grasps: the TCP in the base frame.
     assert score["tcp_in_base_frame_mm_deg"][0] < 0.2 * score["tcp_nominal_model_mm_deg"][0]
@@ -54,7 +79,12 @@ def test_calibrate_robot_sim_identifies_the_cold_robot(tmp_path):
 
 
 def test_demo_cold_reports_each_step_beside_the_truth(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--cold", "--out", str(tmp_path)], capture_output=True, text=True, timeout=900)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "demo", "--cold", "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((tmp_path / "report.json").read_text())
     steps = report["steps"]
@@ -76,6 +106,8 @@ def test_demo_cold_reports_each_step_beside_the_truth(tmp_path):
     # The look weighed against the model: agreeing with it, never worse than either, and honest about it.
     fused = look["fused"]
     assert fused["agree"] and fused["within_3_sigma"], fused["message"]
-    assert fused["after_mm_deg"][0] <= max(look["after_look_mm_deg"][0], look["calibrated_model_only_mm_deg"][0]) + 0.005
+    assert (
+        fused["after_mm_deg"][0] <= max(look["after_look_mm_deg"][0], look["calibrated_model_only_mm_deg"][0]) + 0.005
+    )
     assert (tmp_path / "robot_calibration.yaml").is_file() and (tmp_path / "videocal_arm_calibrated.urdf").is_file()
     assert "tcp2cam" in yaml.safe_load((tmp_path / "robot_calibration.yaml").read_text())

@@ -26,7 +26,9 @@ from tests.tool_on_pins import assert_tool_on_the_pins
 
 
 def _videocal(*args, timeout=600):
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout
+    )
 
 
 @pytest.fixture(scope="module")
@@ -35,14 +37,30 @@ def files(tmp_path_factory):
     bed, _ = cold_test_bed(seed=1)
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
-    plan = plan_poses(bed.model_robot, load_intrinsics(bed.workcell.intrinsics_path), spec, board2base, 16, start_deg=bed.workcell.home_joints_deg, candidates=48)
+    plan = plan_poses(
+        bed.model_robot,
+        load_intrinsics(bed.workcell.intrinsics_path),
+        spec,
+        board2base,
+        16,
+        start_deg=bed.workcell.home_joints_deg,
+        candidates=48,
+    )
     rows = ["image," + ",".join(bed.model_robot.joint_names)]
     for name, image, q in simulated_hand_eye_images(bed, spec, plan.joints_deg, board2base):
         cv2.imwrite(str(folder / f"{name}.png"), image[:, :, ::-1])
         rows.append(f"{name}.png," + ",".join(f"{v:.6f}" for v in q))
     (folder / "views.csv").write_text("\n".join(rows) + "\n")
-    grasps = {t.name: grasp_joints(bed, t.tcp2base, k, t.component) for k, t in enumerate(bed.workcell.task_locations.values())}
-    (folder / "grasps.csv").write_text("task," + ",".join(f"j{k + 1}" for k in range(6)) + "\n" + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items()))
+    grasps = {
+        t.name: grasp_joints(bed, t.tcp2base, k, t.component)
+        for k, t in enumerate(bed.workcell.task_locations.values())
+    }
+    (folder / "grasps.csv").write_text(
+        "task,"
+        + ",".join(f"j{k + 1}" for k in range(6))
+        + "\n"
+        + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items())
+    )
     # The same board views and views of the surveyed components (the component column), and each grasp
     # with the camera's frame while it held the pin (the image column)
     tied = rows[:1] + [r.replace(".png,", ".png,,", 1) for r in rows[1:]]
@@ -73,7 +91,15 @@ def test_component_views_tie_the_base_and_seen_grasps_give_the_tool(files, tmp_p
     to the cell) and the grasps CSV with the frame of each grasp: the pins within 0.1 mm, scored by the
     truth (the compliance put the true TCP on each pin as it truly stands)."""
     folder, bed, grasps, n_cell = files
-    run = _videocal("calibrate-robot", folder / "views_tied.csv", "--grasps", folder / "grasps_seen.csv", "--out", tmp_path, "--json")
+    run = _videocal(
+        "calibrate-robot",
+        folder / "views_tied.csv",
+        "--grasps",
+        folder / "grasps_seen.csv",
+        "--out",
+        tmp_path,
+        "--json",
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     summary = json.loads(run.stdout)
     assert summary["cell_views"] >= n_cell - 1 and summary["board_views"] >= 12, summary
@@ -87,15 +113,24 @@ def test_component_views_tie_the_base_and_seen_grasps_give_the_tool(files, tmp_p
         assert np.linalg.norm(d) < 0.1 and np.linalg.norm(r) < 0.01, (name, d, r)
 
 
-@pytest.mark.parametrize("text, message", [
-    ("task,j1,j2,j3,j4,j5,j6\nno_such_task,1,2,3,4,5,6\n", "row 2, task.*no task location 'no_such_task'.*oru_1_grasp"),
-    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,x,4,5,6\n", "row 2, j3.*not a number: 'x'"),
-    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,3,4,5\n", "row 2.*6 values, the header has 7"),
-    ("task,a,b,c,d,e,f\noru_1_grasp,1,2,3,4,5,6\n", "header.*not the robot's joints"),
-    ("joints,j1,j2,j3,j4,j5,j6\n", "the first column must be 'task'"),
-    ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,nan,4,5,6\n", "row 2, j3.*finite"),
-    ("task,image,j1,j2,j3,j4,j5,j6\noru_1_grasp,missing.png,1,2,3,4,5,6\n", "row 2, image.*no such image .*missing.png"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            "task,j1,j2,j3,j4,j5,j6\nno_such_task,1,2,3,4,5,6\n",
+            "row 2, task.*no task location 'no_such_task'.*oru_1_grasp",
+        ),
+        ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,x,4,5,6\n", "row 2, j3.*not a number: 'x'"),
+        ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,3,4,5\n", "row 2.*6 values, the header has 7"),
+        ("task,a,b,c,d,e,f\noru_1_grasp,1,2,3,4,5,6\n", "header.*not the robot's joints"),
+        ("joints,j1,j2,j3,j4,j5,j6\n", "the first column must be 'task'"),
+        ("task,j1,j2,j3,j4,j5,j6\noru_1_grasp,1,2,nan,4,5,6\n", "row 2, j3.*finite"),
+        (
+            "task,image,j1,j2,j3,j4,j5,j6\noru_1_grasp,missing.png,1,2,3,4,5,6\n",
+            "row 2, image.*no such image .*missing.png",
+        ),
+    ],
+)
 def test_a_wrong_grasps_file_is_named_before_any_work(files, tmp_path, text, message):
     folder, _, _, _ = files
     bad = tmp_path / "grasps.csv"
@@ -115,7 +150,9 @@ def test_a_view_of_a_component_the_cell_does_not_survey_is_named_before_any_work
     bad.write_text("\n".join(lines[:-1] + [f"{name},no_such_part,{rest}"]) + "\n")
     run = _videocal("calibrate-robot", bad, "--out", tmp_path / "out", timeout=120)
     assert run.returncode == 2 and "Traceback" not in run.stderr
-    assert re.search(r"views_bad_component.csv: view cell_\d+: no surveyed component 'no_such_part'.*oru_1_fixture", run.stderr), run.stderr
+    assert re.search(
+        r"views_bad_component.csv: view cell_\d+: no surveyed component 'no_such_part'.*oru_1_fixture", run.stderr
+    ), run.stderr
     assert not (tmp_path / "out").exists()
 
 
@@ -128,5 +165,9 @@ def test_a_folder_holds_the_views_and_the_grasps(files, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     run = _videocal("calibrate-robot", empty, "--out", tmp_path / "out", timeout=120)
-    assert run.returncode == 2 and "Traceback" not in run.stderr and "cal_data.yaml" in run.stderr and "views.csv" in run.stderr
-
+    assert (
+        run.returncode == 2
+        and "Traceback" not in run.stderr
+        and "cal_data.yaml" in run.stderr
+        and "views.csv" in run.stderr
+    )

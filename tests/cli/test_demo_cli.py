@@ -13,13 +13,35 @@ from videocal_sim.far_network import why_not_available
 @pytest.mark.parametrize("method", [None, "picks"], ids=["find points (the default)", "picks by hand"])
 def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--out", str(out), "--scale", "0.5", *(["--method", method] if method else [])],
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+            *(["--method", method] if method else []),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["method"] == (method or "find-points")
     assert report["status"] == "ok" and report["pairs"] >= 6
-    for key in ("estimated_displacement", "std", "true_displacement", "corrected_tcp_error_mm", "corrected_tcp_error_deg", "rms_px"):
+    for key in (
+        "estimated_displacement",
+        "std",
+        "true_displacement",
+        "corrected_tcp_error_mm",
+        "corrected_tcp_error_deg",
+        "rms_px",
+    ):
         assert key in report
     # Half-size images: a coarser look than the full-size demo, which reaches 0.1 mm (docs/benchmarks/gui.md).
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
@@ -37,8 +59,24 @@ def test_demo_on_the_workshop_camera_still_corrects_the_task_location(tmp_path):
     camera. Find points still finds the target and the correction removes most of the 8 mm; what is left is the
     parts' own deviation from their CAD, which no look can see (docs/benchmarks/find_points.md)."""
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--look", "workshop", "--out", str(out), "--scale", "0.5"],
-                         capture_output=True, text=True, timeout=400)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--look",
+            "workshop",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=400,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["camera_look"] == "workshop" and report["status"] == "ok" and report["pairs"] >= 5
@@ -49,8 +87,24 @@ def test_demo_with_a_gige_camera_reaches_the_same_accuracy(tmp_path):
     """``demo --site gige``: the camera is Aravis's fake GigE Vision camera on the loopback interface sending the
     simulated images; the window reads it through the ``aravis://`` connector (GVCP/GVSP over UDP)."""
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "gige", "--out", str(out), "--scale", "0.5"],
-                         capture_output=True, text=True, timeout=400)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--site",
+            "gige",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=400,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["connectors"]["camera"] == "aravis://127.0.0.1" and "GigE Vision" in report["site"]
@@ -66,11 +120,31 @@ def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
 
     out = tmp_path / "demo"
     env = {**os.environ, "ROS_DOMAIN_ID": str(56 + os.getpid() % 8)}
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "ros2", "--out", str(out), "--scale", "0.5"],
-                         capture_output=True, text=True, timeout=400, env=env)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--site",
+            "ros2",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=400,
+        env=env,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
-    assert report["connectors"] == {"controller": f"ros2:///joint_states?domain={env['ROS_DOMAIN_ID']}", "camera": "ros2:///camera/image_raw"}
+    assert report["connectors"] == {
+        "controller": f"ros2:///joint_states?domain={env['ROS_DOMAIN_ID']}",
+        "camera": "ros2:///camera/image_raw",
+    }
     assert "over ROS 2" in report["site"]
     assert report["status"] == "ok" and report["pairs"] >= 6
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
@@ -86,8 +160,27 @@ def test_demo_over_ros2_1_5_s_away_reaches_the_same_accuracy(tmp_path):
 
     out = tmp_path / "demo"
     env = {**os.environ, "ROS_DOMAIN_ID": str(56 + os.getpid() % 8)}
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "ros2", "--link-delay-ms", "1500", "--out", str(out),
-                          "--scale", "0.5"], capture_output=True, text=True, timeout=600, env=env)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--site",
+            "ros2",
+            "--link-delay-ms",
+            "1500",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=env,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert "over ROS 2" in report["site"] and "1500 ms away" in report["site"]
@@ -101,8 +194,24 @@ def test_demo_on_a_ur_controller_reaches_the_same_accuracy(tmp_path):
     """``demo --site ur``: the robot a simulated Universal Robots controller in another process; the window reaches
     it only through the ``ur-rtde://`` connector (ur_rtde's RTDE client for the joints, URScript for the moves)."""
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--site", "ur", "--out", str(out), "--scale", "0.5"],
-                         capture_output=True, text=True, timeout=400)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--site",
+            "ur",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=400,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["connectors"]["controller"].startswith("ur-rtde://127.") and "Universal Robots" in report["site"]
@@ -116,8 +225,24 @@ def test_demo_with_the_controller_1_5_s_away_reaches_the_same_accuracy(tmp_path)
     simulated camera's frames as late as the samples). The session opens, no move is stopped by the dead-man, the
     looks are made on frames the widened settle rule accepts, and the result is as good as near."""
     out = tmp_path / "demo"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "demo", "--offscreen", "--link-delay-ms", "1500", "--out", str(out), "--scale", "0.5"],
-                         capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "demo",
+            "--offscreen",
+            "--link-delay-ms",
+            "1500",
+            "--out",
+            str(out),
+            "--scale",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert "1500 ms away" in report["site"] and report["link"]["one_way_ms"] == 1500

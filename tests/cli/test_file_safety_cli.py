@@ -9,7 +9,9 @@ from calib_core.recording.recorder import SessionRecorder
 
 
 def _videocal(*args, timeout=60):
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def test_recover_writes_a_whole_file_over_an_existing_one(tmp_path):
@@ -35,5 +37,7 @@ def test_sim_controller_does_not_replace_a_file_with_its_link(tmp_path):
     precious = tmp_path / "notes.txt"
     precious.write_text("keep me")
     run = _videocal("sim-controller", "--pty", "--link", str(precious), timeout=30)
-    assert run.returncode == 2 and "error:" in run.stderr and "not a link" in run.stderr and "Traceback" not in run.stderr
+    assert (
+        run.returncode == 2 and "error:" in run.stderr and "not a link" in run.stderr and "Traceback" not in run.stderr
+    )
     assert precious.read_text() == "keep me"

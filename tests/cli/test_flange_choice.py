@@ -24,13 +24,16 @@ def _robot(urdf: Path, packages=(SHARE,)):
     return load_robot(RobotSpec(require(urdf) if urdf.suffix == ".urdf" else urdf, tuple(packages), {"base": None}))
 
 
-@pytest.mark.parametrize("urdf, packages, flange, turned", [
-    (JACO2, (SHARE,), "j2s6s200_end_effector", True),
-    (PANDA, (SHARE,), "panda_hand", False),  # the moving fingers branch off there; not the hand's TCP frame
-    (UR5, (SHARE,), "tool0", False),
-    (Z1, (SHARE,), "gripperStator", True),  # its jointGripper ends the arm
-    (KR6 / "kuka_kr6_support" / "urdf" / "kr6r900sixx.xacro", (KR6,), "tool0", False),
-])
+@pytest.mark.parametrize(
+    "urdf, packages, flange, turned",
+    [
+        (JACO2, (SHARE,), "j2s6s200_end_effector", True),
+        (PANDA, (SHARE,), "panda_hand", False),  # the moving fingers branch off there; not the hand's TCP frame
+        (UR5, (SHARE,), "tool0", False),
+        (Z1, (SHARE,), "gripperStator", True),  # its jointGripper ends the arm
+        (KR6 / "kuka_kr6_support" / "urdf" / "kr6r900sixx.xacro", (KR6,), "tool0", False),
+    ],
+)
 def test_the_flange_is_the_arm_s_last_link_never_a_finger(urdf, packages, flange, turned):
     robot = _robot(urdf, packages)
     choice = _choose_flange(robot, None)
@@ -49,10 +52,26 @@ def test_the_flange_is_the_arm_s_last_link_never_a_finger(urdf, packages, flange
 
 
 def test_new_cell_on_the_jaco2_says_which_flange_and_puts_the_tool_out_of_the_hand(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "new-cell", str(tmp_path / "jaco"), "--urdf", str(require(JACO2)), "--package-path", str(SHARE)],
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "new-cell",
+            str(tmp_path / "jaco"),
+            "--urdf",
+            str(require(JACO2)),
+            "--package-path",
+            str(SHARE),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
-    assert "flange j2s6s200_end_effector (" in run.stdout and "finger" in run.stdout  # the fingers it left out are named
+    assert (
+        "flange j2s6s200_end_effector (" in run.stdout and "finger" in run.stdout
+    )  # the fingers it left out are named
     assert "warning: the z axis of 'j2s6s200_end_effector'" in run.stdout
     cell = load_workcell(tmp_path / "jaco" / "workcell.yaml")
     robot = cell.load_robot()
@@ -72,8 +91,24 @@ def test_a_cell_name_and_a_urdf_file_name_with_a_newline_and_a_hash_are_written_
 
     odd = tmp_path / "ur5 #1\nrobot.urdf"
     shutil.copyfile(require(UR5), odd)
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "new-cell", str(tmp_path / "cell"), "--urdf", str(odd), "--package-path", str(SHARE),
-                          "--name", "line one\nname: injected # not a comment"], capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "new-cell",
+            str(tmp_path / "cell"),
+            "--urdf",
+            str(odd),
+            "--package-path",
+            str(SHARE),
+            "--name",
+            "line one\nname: injected # not a comment",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
     cell = load_workcell(tmp_path / "cell" / "workcell.yaml")
     assert cell.name == "line one\nname: injected # not a comment"

@@ -12,8 +12,13 @@ import numpy as np
 
 
 def _grab(*args, env=None, timeout=90):
-    return subprocess.Popen([sys.executable, "-m", "app.cli.main", "grab", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env={**os.environ, **(env or {})})
+    return subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "grab", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, **(env or {})},
+    )
 
 
 def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
@@ -26,7 +31,9 @@ def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
 
     domain = 41 + os.getpid() % 10  # within ROS 2's safe 0-101: ports below the ephemeral range
     out = tmp_path / "frames"
-    grab = _grab("ros2:///cam/image_raw", "--count", "6", "--out", str(out), "--wait", "20", env={"ROS_DOMAIN_ID": str(domain)})
+    grab = _grab(
+        "ros2:///cam/image_raw", "--count", "6", "--out", str(out), "--wait", "20", env={"ROS_DOMAIN_ID": str(domain)}
+    )
     stamps = []
 
     def publish(count, first):
@@ -38,7 +45,9 @@ def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
         for k in range(count):
             stamp = time.time_ns()
             stamps.append(stamp)
-            writer.write(msg.Image(msg.Header(msg.Time.of_ns(stamp), "cam"), 8, 8, "mono8", 0, 8, bytes([first + k] * 64)))
+            writer.write(
+                msg.Image(msg.Header(msg.Time.of_ns(stamp), "cam"), 8, 8, "mono8", 0, 8, bytes([first + k] * 64))
+            )
             time.sleep(0.25)  # slower than the reader: none is skipped
         del writer, dp
 
@@ -56,9 +65,23 @@ def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
 
 def test_grab_keeps_what_it_got_when_the_camera_stays_away(tmp_path):
     out = tmp_path / "frames"
-    grab = _grab("ros2:///nobody/image_raw", "--count", "3", "--out", str(out), "--wait", "1", env={"ROS_DOMAIN_ID": str(51 + os.getpid() % 5)})
+    grab = _grab(
+        "ros2:///nobody/image_raw",
+        "--count",
+        "3",
+        "--out",
+        str(out),
+        "--wait",
+        "1",
+        env={"ROS_DOMAIN_ID": str(51 + os.getpid() % 5)},
+    )
     _, err = grab.communicate(timeout=60)
-    assert grab.returncode == 4 and "no frame for" in err and "0 of 3 frames: nothing was left behind" in err and "Traceback" not in err
+    assert (
+        grab.returncode == 4
+        and "no frame for" in err
+        and "0 of 3 frames: nothing was left behind" in err
+        and "Traceback" not in err
+    )
     assert not out.exists()  # no empty folder, no empty frames.csv
 
 
@@ -68,11 +91,28 @@ def test_grab_from_a_folder_and_refusals(tmp_path):
     for k in range(2):
         cv2.imwrite(str(shots / f"{k}.png"), np.full((6, 9, 3), 30 * k, np.uint8))
     out = tmp_path / "out"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "grab", str(shots), "--count", "3", "--out", str(out)], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "grab", str(shots), "--count", "3", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0, run.stderr
     rows = list(csv.DictReader((out / "frames.csv").open()))
     assert len(rows) == 3 and all(r["t_device_ns"] == "" for r in rows)  # a folder has no device clock
-    again = subprocess.run([sys.executable, "-m", "app.cli.main", "grab", str(shots), "--count", "1", "--out", str(out)], capture_output=True, text=True, timeout=60)
+    again = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "grab", str(shots), "--count", "1", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert again.returncode == 2 and "frames.csv exists" in again.stderr
-    bad = subprocess.run([sys.executable, "-m", "app.cli.main", "grab", "nosuch://cam", "--count", "1", "--out", str(tmp_path / "x")], capture_output=True, text=True, timeout=60)
-    assert bad.returncode == 2 and "no camera connector for 'nosuch://cam'" in bad.stderr and "Traceback" not in bad.stderr
+    bad = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "grab", "nosuch://cam", "--count", "1", "--out", str(tmp_path / "x")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (
+        bad.returncode == 2 and "no camera connector for 'nosuch://cam'" in bad.stderr and "Traceback" not in bad.stderr
+    )

@@ -38,7 +38,13 @@ def _simulators_for(marker: Path) -> list[int]:
 
 def _gui(*args, env=None):
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen", **(env or {})}
-    return subprocess.Popen([sys.executable, "-m", "app.cli.main", "gui", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    return subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "gui", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
 
 
 def _wait_gone(marker: Path, timeout_s: float = 10.0) -> list[int]:
@@ -134,8 +140,23 @@ def test_a_signal_during_start_up_ends_it_and_leaves_no_simulator(cell_copy, tmp
 def test_a_relative_workcell_path_opens_the_window(cell_copy, tmp_path):
     """The simulator child ran in the project's folder with the path as given."""
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    done = subprocess.run([sys.executable, "-m", "app.cli.main", "gui", "--workcell", os.path.relpath(cell_copy, tmp_path), "--screenshot", "shot.png"],
-                          cwd=tmp_path, capture_output=True, text=True, env=env, timeout=180)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "gui",
+            "--workcell",
+            os.path.relpath(cell_copy, tmp_path),
+            "--screenshot",
+            "shot.png",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=180,
+    )
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "shot.png").stat().st_size > 10_000
     assert _wait_gone(cell_copy) == []

@@ -26,14 +26,26 @@ ROSI = Path(__file__).resolve().parents[1] / "data" / "third_party" / "ros_indus
 
 
 def _videocal(*args, timeout=300):
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def test_ros_industrial_static_camera_set_gives_the_camera_in_the_base(tmp_path):
     """The file says static_camera, the board and the intrinsics (no image size: the images give it).
     ROS-Industrial's own starting guess for this set puts the camera at (-19.6, 1278.4, 284.0) mm."""
     out = tmp_path / "he.yaml"
-    run = _videocal("calibrate-hand-eye", ROSI / "cal_data.yaml", "--out", out, "--out", tmp_path / "camera.launch.py", "--out", tmp_path / "camera.urdf", "--json")
+    run = _videocal(
+        "calibrate-hand-eye",
+        ROSI / "cal_data.yaml",
+        "--out",
+        out,
+        "--out",
+        tmp_path / "camera.launch.py",
+        "--out",
+        tmp_path / "camera.urdf",
+        "--json",
+    )
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
     # The same mounting for ROS 2: a static_transform_publisher launch file and a URDF (read alone) on the base link.
@@ -71,7 +83,9 @@ def joint_views(tmp_path_factory):
     folder = tmp_path_factory.mktemp("views")
     cell = load_workcell()
     typical = RobotErrors.typical(0, n_joints=6)
-    bed = TestBed.create(cell, errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
+    bed = TestBed.create(
+        cell, errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
+    )
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, cell, bed.model_robot)
     joints = hand_eye_poses(bed, spec, board2base, 8)
@@ -80,14 +94,24 @@ def joint_views(tmp_path_factory):
         cv2.imwrite(str(folder / f"{name}.png"), image[:, :, ::-1])
         rows.append(f"{name}.png," + ",".join(f"{v:.6f}" for v in q))
     (folder / "views.csv").write_text("\n".join(rows) + "\n")
-    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
+    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement(
+        "camera"
+    )
     return folder, true, bed
 
 
 def test_a_csv_of_joints_gives_the_simulated_mounting(joint_views, tmp_path):
     folder, true, bed = joint_views
     out = tmp_path / "he.yaml"
-    run = _videocal("calibrate-hand-eye", folder / "views.csv", "--intrinsics", "resources/camera/gripper_camera.yaml", "--out", out, "--json")
+    run = _videocal(
+        "calibrate-hand-eye",
+        folder / "views.csv",
+        "--intrinsics",
+        "resources/camera/gripper_camera.yaml",
+        "--out",
+        out,
+        "--json",
+    )
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
     found = transform_from_xyz_rpy(doc["cam2flange"]["xyz"], doc["cam2flange"]["rpy"])
@@ -97,10 +121,22 @@ def test_a_csv_of_joints_gives_the_simulated_mounting(joint_views, tmp_path):
     text = (folder / "views.csv").read_text().splitlines()
     generic = folder / "generic.csv"
     generic.write_text("\n".join(["image," + ",".join(f"j{k + 1}" for k in range(6))] + text[1:]) + "\n")
-    assert _videocal("calibrate-hand-eye", generic, "--intrinsics", "resources/camera/gripper_camera.yaml", "--out", tmp_path / "g.yaml").returncode == 0
+    assert (
+        _videocal(
+            "calibrate-hand-eye",
+            generic,
+            "--intrinsics",
+            "resources/camera/gripper_camera.yaml",
+            "--out",
+            tmp_path / "g.yaml",
+        ).returncode
+        == 0
+    )
     bad = folder / "bad.csv"
     bad.write_text("\n".join(["image,a1,a2,a3,a4,a5,a6"] + text[1:]) + "\n")
-    refused = _videocal("calibrate-hand-eye", bad, "--intrinsics", "resources/camera/gripper_camera.yaml", "--out", tmp_path / "b.yaml")
+    refused = _videocal(
+        "calibrate-hand-eye", bad, "--intrinsics", "resources/camera/gripper_camera.yaml", "--out", tmp_path / "b.yaml"
+    )
     assert refused.returncode == 2 and "bad.csv" in refused.stderr and "not the robot's joints" in refused.stderr
 
 
@@ -113,7 +149,15 @@ def test_a_view_with_a_wrong_pose_is_named(joint_views, tmp_path):
     lines[3] = ",".join(cells)
     moved = folder / "moved.csv"
     moved.write_text("\n".join(lines) + "\n")
-    run = _videocal("calibrate-hand-eye", moved, "--intrinsics", "resources/camera/gripper_camera.yaml", "--out", tmp_path / "m.yaml", "--json")
+    run = _videocal(
+        "calibrate-hand-eye",
+        moved,
+        "--intrinsics",
+        "resources/camera/gripper_camera.yaml",
+        "--out",
+        tmp_path / "m.yaml",
+        "--json",
+    )
     assert run.returncode == 0, run.stderr
     warnings = json.loads(run.stdout)["warnings"]
     assert any("do not agree" in w for w in warnings)
@@ -121,7 +165,17 @@ def test_a_view_with_a_wrong_pose_is_named(joint_views, tmp_path):
 
 
 def test_a_bag_s_options_on_a_file_that_is_no_bag_are_named(tmp_path):
-    run = _videocal("calibrate-hand-eye", ROSI, "--flange-from", "tf", "--flange-frame", "tool0", "--out", tmp_path / "x.yaml", timeout=120)
+    run = _videocal(
+        "calibrate-hand-eye",
+        ROSI,
+        "--flange-from",
+        "tf",
+        "--flange-frame",
+        "tool0",
+        "--out",
+        tmp_path / "x.yaml",
+        timeout=120,
+    )
     assert run.returncode == 2 and run.stderr.startswith("error: "), run.stderr
     assert "--flange-from, --flange-frame apply to a ROS bag" in run.stderr and str(ROSI) in run.stderr
     assert not (tmp_path / "x.yaml").exists()

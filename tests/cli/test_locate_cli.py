@@ -23,13 +23,22 @@ DATA = Path(__file__).resolve().parents[1] / "data" / "third_party" / "opencv_sa
 PHOTO, BOX = DATA / "resized_IMG_3875.JPG", DATA / "box.ply"
 TUTORIAL_CAMERA = Intrinsics(718 * 45 / 22.3, 480 * 45 / 14.9, 359.0, 240.0, 718, 480)
 # The box's pose from six of its corners picked by hand in the photo (about 4 px RMS: a rough prior)
-HAND_PRIOR = {"R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]], "t_obj2cam_mm": [-5.9, 110.7, 943.5]}
+HAND_PRIOR = {
+    "R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]],
+    "t_obj2cam_mm": [-5.9, 110.7, 943.5],
+}
 
 
 def _videocal(*args, cwd=None):
     env_cwd = cwd or Path.cwd()
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=300, cwd=env_cwd,
-                          env={**__import__("os").environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])})
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=env_cwd,
+        env={**__import__("os").environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])},
+    )
 
 
 @pytest.fixture(scope="module")
@@ -47,14 +56,33 @@ def _prior(folder: Path, name: str, pose: dict) -> Path:
 
 def _moved(pose: dict, mm: float, deg: float, rng) -> dict:
     d = rng.normal(size=3)
-    R = Rotation.from_rotvec(np.radians(deg) * Rotation.random(random_state=int(rng.integers(1 << 30))).as_rotvec() / np.pi).as_matrix() @ np.array(pose["R_obj2cam"])
-    return {"R_obj2cam": R.tolist(), "t_obj2cam_mm": (np.array(pose["t_obj2cam_mm"]) + mm * d / np.linalg.norm(d)).tolist()}
+    R = Rotation.from_rotvec(
+        np.radians(deg) * Rotation.random(random_state=int(rng.integers(1 << 30))).as_rotvec() / np.pi
+    ).as_matrix() @ np.array(pose["R_obj2cam"])
+    return {
+        "R_obj2cam": R.tolist(),
+        "t_obj2cam_mm": (np.array(pose["t_obj2cam_mm"]) + mm * d / np.linalg.norm(d)).tolist(),
+    }
 
 
 def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_files):
     overlay = photo_files / "located.png"
-    run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"),
-                    "--prior", str(_prior(photo_files, "prior.json", HAND_PRIOR)), "--overlay", str(overlay), "--indent", "0")
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "camera.yaml"),
+        "--prior",
+        str(_prior(photo_files, "prior.json", HAND_PRIOR)),
+        "--overlay",
+        str(overlay),
+        "--indent",
+        "0",
+    )
     assert run.returncode == 0, run.stderr
     out = json.loads(run.stdout)
     assert out["status"] == "ok", out["message"]
@@ -65,7 +93,9 @@ def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_fi
     assert out["starts_apart_px"] < 3.0 * out["edges"]["rms_px"]
     assert len(out["features"]) >= 6  # of the 7 corners in view
     std = np.array(out["std"]["translation_mm"])
-    assert np.all(std > 0.2) and np.all(std < 12.0)  # widened by the starts' spread (a nearly affine view: docs/find-points.md)
+    assert np.all(std > 0.2) and np.all(
+        std < 12.0
+    )  # widened by the starts' spread (a nearly affine view: docs/find-points.md)
     # the corners alone (no sample shared with the edges) put the box where its edges do, within their scatter
     assert out["features_pose"]["origin_from_edges_mm"] < 3.0 * np.linalg.norm(std)
     # a corner the detector is unsure of says why (the box's far bottom corner: its edges are no straight lines)
@@ -87,8 +117,22 @@ def test_starts_around_the_prior_end_at_one_pose(photo_files):
     poses, stds = [], []
     for k in range(4):
         prior = _prior(photo_files, f"prior{k}.json", _moved(HAND_PRIOR, 8.0, 0.7, rng))
-        run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(prior), "--indent", "0",
-                        "--reach-deg", "3")
+        run = _videocal(
+            "locate",
+            str(PHOTO),
+            "--mesh",
+            str(BOX),
+            "--units",
+            "cm",
+            "--intrinsics",
+            str(photo_files / "camera.yaml"),
+            "--prior",
+            str(prior),
+            "--indent",
+            "0",
+            "--reach-deg",
+            "3",
+        )
         assert run.returncode == 0, run.stderr + run.stdout
         out = json.loads(run.stdout)
         assert out["status"] == "ok", out["message"]
@@ -100,28 +144,72 @@ def test_starts_around_the_prior_end_at_one_pose(photo_files):
 
 
 def test_a_prior_too_far_says_not_located_with_exit_3(photo_files):
-    far = {"R_obj2cam": HAND_PRIOR["R_obj2cam"], "t_obj2cam_mm": [150.0, 110.7, 943.5]}  # 150 mm to the side: off the box
-    run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(_prior(photo_files, "far.json", far)))
+    far = {
+        "R_obj2cam": HAND_PRIOR["R_obj2cam"],
+        "t_obj2cam_mm": [150.0, 110.7, 943.5],
+    }  # 150 mm to the side: off the box
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "camera.yaml"),
+        "--prior",
+        str(_prior(photo_files, "far.json", far)),
+    )
     assert run.returncode == 3, run.stderr
     out = json.loads(run.stdout)
     assert out["status"] == "not found" and out["R_obj2cam"] is None and "prior" in out["message"]
 
 
-@pytest.mark.parametrize("bad, says", [
-    ({"t_obj2cam_mm": [0, 0, 900]}, "R_obj2cam"),
-    ({"R_obj2cam": [[1, 0], [0, 1]], "t_obj2cam_mm": [0, 0, 900]}, "3 x 3"),
-    ({"R_obj2cam": [[2, 0, 0], [0, 1, 0], [0, 0, 1]], "t_obj2cam_mm": [0, 0, 900]}, "rotation"),
-])
+@pytest.mark.parametrize(
+    "bad, says",
+    [
+        ({"t_obj2cam_mm": [0, 0, 900]}, "R_obj2cam"),
+        ({"R_obj2cam": [[1, 0], [0, 1]], "t_obj2cam_mm": [0, 0, 900]}, "3 x 3"),
+        ({"R_obj2cam": [[2, 0, 0], [0, 1, 0], [0, 0, 1]], "t_obj2cam_mm": [0, 0, 900]}, "rotation"),
+    ],
+)
 def test_a_bad_prior_is_one_error_line_naming_the_file(photo_files, bad, says):
     path = _prior(photo_files, "bad.json", bad)
-    run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "camera.yaml"), "--prior", str(path))
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "camera.yaml"),
+        "--prior",
+        str(path),
+    )
     assert run.returncode == 2 and run.stdout == ""
-    assert run.stderr.startswith("error: ") and str(path) in run.stderr and says in run.stderr and "Traceback" not in run.stderr
+    assert (
+        run.stderr.startswith("error: ")
+        and str(path) in run.stderr
+        and says in run.stderr
+        and "Traceback" not in run.stderr
+    )
 
 
 def test_a_photo_of_another_size_than_the_camera_file_is_refused(photo_files):
     save_intrinsics(photo_files / "other.yaml", Intrinsics(1000, 1000, 320, 240, 640, 480))
-    run = _videocal("locate", str(PHOTO), "--mesh", str(BOX), "--units", "cm", "--intrinsics", str(photo_files / "other.yaml"), "--prior", str(_prior(photo_files, "p.json", HAND_PRIOR)))
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "other.yaml"),
+        "--prior",
+        str(_prior(photo_files, "p.json", HAND_PRIOR)),
+    )
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert "718" in run.stderr and "640" in run.stderr
 
@@ -151,7 +239,19 @@ def test_the_simulated_camera_s_frame_is_located_where_the_truth_is(tmp_path):
     save_intrinsics(tmp_path / "camera.yaml", bed.intrinsics)
     _prior(tmp_path, "prior.json", {"R_obj2cam": model[:3, :3].tolist(), "t_obj2cam_mm": model[:3, 3].tolist()})
     # relative paths from the folder, as a user types them
-    run = _videocal("locate", "frame.png", "--mesh", "fixture.stl", "--intrinsics", "camera.yaml", "--prior", "prior.json", "--indent", "0", cwd=tmp_path)
+    run = _videocal(
+        "locate",
+        "frame.png",
+        "--mesh",
+        "fixture.stl",
+        "--intrinsics",
+        "camera.yaml",
+        "--prior",
+        "prior.json",
+        "--indent",
+        "0",
+        cwd=tmp_path,
+    )
     assert run.returncode == 0, run.stderr + run.stdout
     out = json.loads(run.stdout)
     t = np.array(out["t_obj2cam_mm"])

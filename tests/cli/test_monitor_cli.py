@@ -11,7 +11,9 @@ from tests.core.link.sim_process import SimProcess
 
 
 def _videocal(*args, timeout=60):
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def test_monitor_prints_count_samples_as_json(tmp_path):
@@ -108,21 +110,54 @@ def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch):
     from calib_core.workcell import DEFAULT_WORKCELL
 
     env = {**os.environ, "ROS_DOMAIN_ID": str(64 + os.getpid() % 6)}
-    arm = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-ros2", "--rate", "200", "--joints", "10,-20,30,-40,50,-60"],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    arm = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "sim-ros2", "--rate", "200", "--joints", "10,-20,30,-40,50,-60"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert arm.stdout.readline().strip() == "ready"
         before_ms = time.time() * 1000
-        run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ros2:///joint_states", "--workcell", str(DEFAULT_WORKCELL),
-                              "--count", "5", "--json", "--timeout", "20"], capture_output=True, text=True, timeout=60, env=env)
+        run = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "app.cli.main",
+                "monitor",
+                "ros2:///joint_states",
+                "--workcell",
+                str(DEFAULT_WORKCELL),
+                "--count",
+                "5",
+                "--json",
+                "--timeout",
+                "20",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            env=env,
+        )
         assert run.returncode == 0, run.stderr
         lines = [json.loads(line) for line in run.stdout.splitlines()]
         assert len(lines) == 5
         assert [round(v, 9) for v in lines[0]["joints_deg"]] == [10.0, -20.0, 30.0, -40.0, 50.0, -60.0]
         assert all(before_ms - 60_000 < x["t_ms"] < time.time() * 1000 + 1000 for x in lines)
         assert [x["t_ms"] for x in lines] == sorted(x["t_ms"] for x in lines)
-        no_cell = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ros2:///joint_states", "--count", "1"], capture_output=True, text=True, timeout=60, env=env)
-        assert no_cell.returncode == 2 and "give the cell (--workcell)" in no_cell.stderr and "Traceback" not in no_cell.stderr
+        no_cell = subprocess.run(
+            [sys.executable, "-m", "app.cli.main", "monitor", "ros2:///joint_states", "--count", "1"],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            env=env,
+        )
+        assert (
+            no_cell.returncode == 2
+            and "give the cell (--workcell)" in no_cell.stderr
+            and "Traceback" not in no_cell.stderr
+        )
     finally:
         arm.terminate()
         arm.wait(10)

@@ -28,7 +28,9 @@ ROBOTS = {"ur5": UR5, "panda": PANDA}
 
 
 def _videocal(*args, timeout=300):
-    return subprocess.run([sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli.main", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +45,9 @@ def cells(tmp_path_factory):
     return made
 
 
-@pytest.mark.parametrize("name, joints, held", [("ur5", 6, []), ("panda", 7, ["panda_finger_joint1", "panda_finger_joint2"])])
+@pytest.mark.parametrize(
+    "name, joints, held", [("ur5", 6, []), ("panda", 7, ["panda_finger_joint1", "panda_finger_joint2"])]
+)
 def test_new_cell_loads_with_vendor_meshes_and_reaches_its_task(cells, name, joints, held):
     cell = load_workcell(cells[name])
     robot = cell.load_robot()
@@ -58,7 +62,9 @@ def test_new_cell_loads_with_vendor_meshes_and_reaches_its_task(cells, name, joi
     from calib_core.camera.intrinsics_io import load_intrinsics
 
     intr = load_intrinsics(cell.intrinsics_path)
-    uv = project(apply(invert(robot.fk(q, "camera")), apply(target.item2world, np.array(list(target.features.values())))), intr)
+    uv = project(
+        apply(invert(robot.fk(q, "camera")), apply(target.item2world, np.array(list(target.features.values())))), intr
+    )
     assert np.all((uv > 20) & (uv < [intr.width - 20, intr.height - 20]))
 
 
@@ -66,7 +72,19 @@ def test_new_cell_loads_with_vendor_meshes_and_reaches_its_task(cells, name, joi
 @pytest.mark.parametrize("view", ["virtual", "overview", "true"])
 def test_the_three_views_render(cells, tmp_path, name, view):
     out = tmp_path / f"{name}_{view}.png"
-    run = _videocal("render", "--workcell", str(cells[name]), "--location", "target_grasp", "--view", view, "--scale", "0.5", "--out", str(out))
+    run = _videocal(
+        "render",
+        "--workcell",
+        str(cells[name]),
+        "--location",
+        "target_grasp",
+        "--view",
+        view,
+        "--scale",
+        "0.5",
+        "--out",
+        str(out),
+    )
     assert run.returncode == 0, run.stderr
     image = cv2.imread(str(out))
     assert image is not None and image.std() > 10
@@ -76,7 +94,7 @@ def test_the_three_views_render(cells, tmp_path, name, view):
     else:
         # The target fills the middle of the camera's view from its approach.
         h, w = image.shape[:2]
-        assert image[h // 4: 3 * h // 4, w // 4: 3 * w // 4].std() > 10
+        assert image[h // 4 : 3 * h // 4, w // 4 : 3 * w // 4].std() > 10
 
 
 def test_the_simulator_takes_the_cell_joint_count_limits_and_home(cells):
@@ -106,11 +124,22 @@ def test_the_simulator_takes_the_cell_joint_count_limits_and_home(cells):
 def test_the_controller_order_and_zero_offsets_apply_at_the_link(cells, tmp_path):
     # A controller that numbers the UR5's axes backwards and zeroes two of them elsewhere.
     data = yaml.safe_load(cells["ur5"].read_text())
-    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    names = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
     data["robot"]["controller"] = {"joints": names[::-1], "zero_offsets": [0, 0, 90, 0, -90, 0]}
     for key in ("urdf", "package_paths"):
         value = data["robot"][key]
-        data["robot"][key] = [str((cells["ur5"].parent / v).resolve()) for v in value] if isinstance(value, list) else str((cells["ur5"].parent / value).resolve())
+        data["robot"][key] = (
+            [str((cells["ur5"].parent / v).resolve()) for v in value]
+            if isinstance(value, list)
+            else str((cells["ur5"].parent / value).resolve())
+        )
     for c in data["components"]:
         c["mesh"] = str((cells["ur5"].parent / c["mesh"]).resolve())
     data["camera"]["intrinsics"] = str((cells["ur5"].parent / "camera.yaml").resolve())
@@ -145,7 +174,17 @@ def test_the_controller_order_and_zero_offsets_apply_at_the_link(cells, tmp_path
 @pytest.mark.parametrize("name, joints", [("ur5", 6), ("panda", 7)])
 def test_the_whole_calibration_through_the_window(cells, tmp_path, name, joints):
     out = tmp_path / "demo"
-    run = _videocal("demo", "--offscreen", "--workcell", str(cells[name]), "--location", "target_grasp", "--out", str(out), timeout=600)
+    run = _videocal(
+        "demo",
+        "--offscreen",
+        "--workcell",
+        str(cells[name]),
+        "--location",
+        "target_grasp",
+        "--out",
+        str(out),
+        timeout=600,
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     report = json.loads((out / "report.json").read_text())
     # How many of the target's features Find points proposes depends on which noisy frame the look holds (7 or 8 of 9

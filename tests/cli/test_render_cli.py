@@ -57,11 +57,15 @@ def test_at_task_renders_from_the_task_pose_itself(tmp_path):
     run_a = _videocal("render", "--location", "oru_1_grasp", "--scale", "0.25", "--out", str(a))
     run_t = _videocal("render", "--at-task", "oru_1_grasp", "--scale", "0.25", "--out", str(t))
     assert run_a.returncode == 0 and run_t.returncode == 0, run_t.stderr
-    joints = [np.array([float(v) for v in r.stdout.split("joints ")[1].split(" deg")[0].split(", ")]) for r in (run_a, run_t)]
+    joints = [
+        np.array([float(v) for v in r.stdout.split("joints ")[1].split(" deg")[0].split(", ")]) for r in (run_a, run_t)
+    ]
     cell = load_workcell()
     robot = cell.load_robot()
     task = cell.task("oru_1_grasp")
-    np.testing.assert_allclose(robot.fk(joints[1], "tcp")[:3, 3], task.tcp2base[:3, 3], atol=0.5)  # (joints printed to 0.01 deg)
+    np.testing.assert_allclose(
+        robot.fk(joints[1], "tcp")[:3, 3], task.tcp2base[:3, 3], atol=0.5
+    )  # (joints printed to 0.01 deg)
     np.testing.assert_allclose(robot.fk(joints[0], "tcp")[:3, 3], task.approach2base[:3, 3], atol=0.5)
     assert np.abs(cv2.imread(str(a)).astype(int) - cv2.imread(str(t)).astype(int)).mean() > 5.0  # another view
     both = _videocal("render", "--location", "oru_1_grasp", "--at-task", "oru_1_grasp", "--out", str(t))

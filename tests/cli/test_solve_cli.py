@@ -20,7 +20,15 @@ def _problem(n=6, seed=3):
     P = random_points(rng, n)
     c = GRIPPER_CAMERA
     data = {
-        "intrinsics": {"fu": c.fu, "fv": c.fv, "cx": c.cx, "cy": c.cy, "width": c.width, "height": c.height, "distortion": list(c.distortion)},
+        "intrinsics": {
+            "fu": c.fu,
+            "fv": c.fv,
+            "cx": c.cx,
+            "cy": c.cy,
+            "width": c.width,
+            "height": c.height,
+            "distortion": list(c.distortion),
+        },
         "points_3d": P.tolist(),
         "points_2d": pixels(P, truth, noise_px=0.3, rng=rng).tolist(),
     }
@@ -37,7 +45,17 @@ def test_solve_prints_the_pose_as_json(tmp_path):
     out = json.loads(run.stdout)
     assert out["status"] == "ok"
     assert np.linalg.norm(np.array(out["t_obj2cam_mm"]) - truth[:3, 3]) < 3.0
-    for key in ("R_obj2cam", "camera_position_mm", "fu", "fv", "iterations", "rms_px", "residuals_px", "candidates", "warnings"):
+    for key in (
+        "R_obj2cam",
+        "camera_position_mm",
+        "fu",
+        "fv",
+        "iterations",
+        "rms_px",
+        "residuals_px",
+        "candidates",
+        "warnings",
+    ):
         assert key in out
     assert set(out["std"]) >= {"t_obj2cam_mm", "rotation_deg", "camera_position_mm"}
 

@@ -13,7 +13,14 @@ BLOCK_SIMULATOR = "import sys; sys.modules['videocal_sim'] = None; from app.cli.
 
 def _videocal_without_simulator(*args, cwd) -> subprocess.CompletedProcess:
     env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    return subprocess.run([sys.executable, "-c", BLOCK_SIMULATOR, *map(str, args)], capture_output=True, text=True, timeout=300, cwd=cwd, env=env)
+    return subprocess.run(
+        [sys.executable, "-c", BLOCK_SIMULATOR, *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+        env=env,
+    )
 
 
 def test_the_commands_that_do_not_need_it_work(tmp_path):

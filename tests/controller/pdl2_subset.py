@@ -158,10 +158,28 @@ class Translator:
                 continue
             p = part.replace("<>", " != ").replace(":=", " := ")
             p = re.sub(r"(?<![<>!=:])=(?!=)", "==", p)
-            for word, py in (("AND", "&"), ("OR", "|"), ("XOR", "^"), ("NOT", "not"), ("DIV", "//"), ("MOD", "%"), ("TRUE", "True"), ("FALSE", "False"),
-                             ("STR_LEN", "len"), ("ORD", "_ord"), ("CHR", "_chr"), ("ABS", "abs"), ("TRUNC", "_trunc"), ("ROUND", "_round")):
+            for word, py in (
+                ("AND", "&"),
+                ("OR", "|"),
+                ("XOR", "^"),
+                ("NOT", "not"),
+                ("DIV", "//"),
+                ("MOD", "%"),
+                ("TRUE", "True"),
+                ("FALSE", "False"),
+                ("STR_LEN", "len"),
+                ("ORD", "_ord"),
+                ("CHR", "_chr"),
+                ("ABS", "abs"),
+                ("TRUNC", "_trunc"),
+                ("ROUND", "_round"),
+            ):
                 p = re.sub(rf"\b{word}\b", py, p)
-            p = re.sub(r"\b([a-z_][a-z0-9_]*)\b(?!\s*\()", lambda m: m.group(1) + "()" if m.group(1) in no_args else m.group(1), p)
+            p = re.sub(
+                r"\b([a-z_][a-z0-9_]*)\b(?!\s*\()",
+                lambda m: m.group(1) + "()" if m.group(1) in no_args else m.group(1),
+                p,
+            )
             if re.search(r"\b[A-Z][A-Z_]+\b", p.replace("True", "").replace("False", "")):
                 raise Pdl2SubsetError(f"unknown keyword in {text!r}")
             out.append(p)
@@ -186,7 +204,11 @@ class Translator:
                 depth += 1
             elif m := _FOR.match(line):
                 var, a, way, b = m.groups()
-                rng = f"range({self._expr(a)}, ({self._expr(b)}) + 1)" if way == "TO" else f"range({self._expr(a)}, ({self._expr(b)}) - 1, -1)"
+                rng = (
+                    f"range({self._expr(a)}, ({self._expr(b)}) + 1)"
+                    if way == "TO"
+                    else f"range({self._expr(a)}, ({self._expr(b)}) - 1, -1)"
+                )
                 out.append(f"{pad}for {var} in {rng}:")
                 depth += 1
             elif line == "RETURN":
@@ -240,6 +262,13 @@ def load(source: str, site: dict) -> dict:
     missing = set(t.site_routines) - set(site)
     if missing:
         raise Pdl2SubsetError(f"the harness lacks the site routines {sorted(missing)}")
-    namespace = {"_int32": _int32, "_round": _round, "_trunc": lambda x: int(x), "_ord": lambda s, i: ord(s[i - 1]), "_chr": chr, **site}
+    namespace = {
+        "_int32": _int32,
+        "_round": _round,
+        "_trunc": lambda x: int(x),
+        "_ord": lambda s, i: ord(s[i - 1]),
+        "_chr": chr,
+        **site,
+    }
     exec(compile(t.python(), "videocal_link.pdl (translated)", "exec"), namespace)
     return namespace

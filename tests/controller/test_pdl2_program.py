@@ -50,9 +50,14 @@ class ProgramOnPty:
         self.move: TrapezoidMove | None = None
         self.key = key
         site = {
-            "configure": self._configure, "link_read": self._read, "link_write": self._write, "now_ms": self._now_ms,
-            "boot_text": lambda: f"boot {self.t0:.6f}", "arm_joint": lambda j: float(self._position()[j - 1]),
-            "arm_start": self._start, "arm_moving": lambda: self.move is not None and not self.move.finished(time.monotonic()),
+            "configure": self._configure,
+            "link_read": self._read,
+            "link_write": self._write,
+            "now_ms": self._now_ms,
+            "boot_text": lambda: f"boot {self.t0:.6f}",
+            "arm_joint": lambda j: float(self._position()[j - 1]),
+            "arm_start": self._start,
+            "arm_moving": lambda: self.move is not None and not self.move.finished(time.monotonic()),
             "arm_stop": self._stop_arm,
         }
         self.ns = load(PROGRAM.read_text(), site)
@@ -114,22 +119,59 @@ def program():
 
 @pytest.mark.parametrize("length", [0, 3, 55, 56, 63, 64, 65, 119, 200, 440])
 def test_its_sha256_is_the_standards(length):
-    site = {n: (lambda *a: None) for n in ("configure", "link_read", "link_write", "now_ms", "boot_text", "arm_joint", "arm_start", "arm_moving", "arm_stop")}
+    site = {
+        n: (lambda *a: None)
+        for n in (
+            "configure",
+            "link_read",
+            "link_write",
+            "now_ms",
+            "boot_text",
+            "arm_joint",
+            "arm_start",
+            "arm_moving",
+            "arm_stop",
+        )
+    }
     ns = load(PROGRAM.read_text(), site)
     ns["sha_constants"]()
     data = bytes((7 * i + 3) % 256 for i in range(length))
-    ns["msg"][1:length + 1] = list(data)
+    ns["msg"][1 : length + 1] = list(data)
     ns["msg_len"] = length
     ns["sha256"]()
     assert bytes(ns["digest"][1:33]).hex() == hashlib.sha256(data).hexdigest()
 
 
-@pytest.mark.parametrize("key, data, expected", [
-    (b"\x0b" * 20, "Hi There", "b0344c61d8db38535ca8afceaf0bf12b881dc200c9833da726e9376c2e32cff7"),  # RFC 4231 test case 1
-    (b"Jefe", "what do ya want for nothing?", "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"),  # test case 2
-])
+@pytest.mark.parametrize(
+    "key, data, expected",
+    [
+        (
+            b"\x0b" * 20,
+            "Hi There",
+            "b0344c61d8db38535ca8afceaf0bf12b881dc200c9833da726e9376c2e32cff7",
+        ),  # RFC 4231 test case 1
+        (
+            b"Jefe",
+            "what do ya want for nothing?",
+            "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843",
+        ),  # test case 2
+    ],
+)
 def test_its_hmac_meets_rfc_4231(key, data, expected):
-    site = {n: (lambda *a: None) for n in ("configure", "link_read", "link_write", "now_ms", "boot_text", "arm_joint", "arm_start", "arm_moving", "arm_stop")}
+    site = {
+        n: (lambda *a: None)
+        for n in (
+            "configure",
+            "link_read",
+            "link_write",
+            "now_ms",
+            "boot_text",
+            "arm_joint",
+            "arm_start",
+            "arm_moving",
+            "arm_stop",
+        )
+    }
     ns = load(PROGRAM.read_text(), site)
     ns["sha_constants"]()
     ns["key_bytes"][1:33] = list(key.ljust(32, b"\0"))  # a short key is zero-padded, as HMAC does
@@ -168,9 +210,17 @@ class _ProgramBySentence:
 
     def __init__(self):
         self.t_ms, self.sent, self.q, self.moving = 0, [], np.zeros(6), False
-        site = {"configure": self._configure, "link_read": lambda: -1, "link_write": self.sent.append, "now_ms": lambda: self.t_ms,
-                "boot_text": lambda: "boot 1", "arm_joint": lambda j: float(self.q[j - 1]), "arm_start": self._start,
-                "arm_moving": lambda: self.moving, "arm_stop": self._stop}
+        site = {
+            "configure": self._configure,
+            "link_read": lambda: -1,
+            "link_write": self.sent.append,
+            "now_ms": lambda: self.t_ms,
+            "boot_text": lambda: "boot 1",
+            "arm_joint": lambda j: float(self.q[j - 1]),
+            "arm_start": self._start,
+            "arm_moving": lambda: self.moving,
+            "arm_stop": self._stop,
+        }
         self.ns = load(PROGRAM.read_text(), site)
         self.ns["startup"]()
 
@@ -189,12 +239,12 @@ class _ProgramBySentence:
     def handle(self, body: str) -> list:
         self.sent.clear()
         self.ns["handle"](body)
-        return [parse_body(s[1:s.index("*")]) for s in self.sent]
+        return [parse_body(s[1 : s.index("*")]) for s in self.sent]
 
     def tick(self) -> list:
         self.sent.clear()
         self.ns["tick"]()
-        return [parse_body(s[1:s.index("*")]) for s in self.sent]
+        return [parse_body(s[1 : s.index("*")]) for s in self.sent]
 
 
 def _session(program: _ProgramBySentence, round_trip_ms: int = 0):
@@ -202,7 +252,9 @@ def _session(program: _ProgramBySentence, round_trip_ms: int = 0):
     body at the program's clock now (or at ``t_ms``) and hands it over."""
     nonce = auth.new_nonce()
     (reply,) = program.handle(f"HEL,{nonce},{auth.hello_request(KEY, nonce)}")
-    assert reply.proof == auth.controller_proof(KEY, nonce, reply.nonce, reply.clock_ms) and reply.clock_ms == program.t_ms
+    assert (
+        reply.proof == auth.controller_proof(KEY, nonce, reply.nonce, reply.clock_ms) and reply.clock_ms == program.t_ms
+    )
     program.t_ms += round_trip_ms
     assert program.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}")[0].body() == "ACK,AUT,-"
     counter = iter(range(1, 10**6))
@@ -242,7 +294,13 @@ def test_a_hello_without_the_key_leaves_the_session_in_force():
 def test_it_refuses_a_move_held_back_and_released_after_the_workstation_died():
     """As the simulator (tests/core/link/test_link_attacks.py): seals carry the time; the program's bound is twice
     the handshake's round trip and half a second, at least 1 s."""
-    for held_ms, round_trip_ms, obeyed in ((8000, 0, False), (20000, 0, False), (900, 0, True), (3000, 2000, True), (5000, 2000, False)):
+    for held_ms, round_trip_ms, obeyed in (
+        (8000, 0, False),
+        (20000, 0, False),
+        (900, 0, True),
+        (3000, 2000, True),
+        (5000, 2000, False),
+    ):
         p = _ProgramBySentence()
         sealed = _session(p, round_trip_ms)
         assert sealed("HBT,60000") == []

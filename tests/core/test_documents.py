@@ -36,7 +36,14 @@ def test_an_alias_bomb_is_refused_before_it_is_built():
     assert parse_yaml("a: &x [1, 2]\nb: *x\n", "ok.yaml") == {"a": [1, 2], "b": [1, 2]}  # a few aliases are fine
 
 
-@pytest.mark.parametrize("text, kind", [("[" * 100 + "]" * 100, "json"), ("[" * 100 + "]" * 100, "yaml"), ("a:\n" + "".join("  " * i + "- \n" for i in range(1, 80)), "yaml")])
+@pytest.mark.parametrize(
+    "text, kind",
+    [
+        ("[" * 100 + "]" * 100, "json"),
+        ("[" * 100 + "]" * 100, "yaml"),
+        ("a:\n" + "".join("  " * i + "- \n" for i in range(1, 80)), "yaml"),
+    ],
+)
 def test_deep_nesting_is_refused(text, kind):
     parse = parse_json if kind == "json" else parse_yaml
     with pytest.raises(FileFormatError, match="nests deeper than 64 levels"):
@@ -61,7 +68,10 @@ def _hand_eye(tmp_path, doc) -> object:
 
 
 def test_hand_eye_files_with_non_finite_numbers_or_other_units_are_refused(tmp_path):
-    good = {"cam2flange": {"xyz": [81.0, -1.0, 88.0], "rpy": [-100.0, 0.0, -90.0]}, "units": {"length": "mm", "angle": "deg"}}
+    good = {
+        "cam2flange": {"xyz": [81.0, -1.0, 88.0], "rpy": [-100.0, 0.0, -90.0]},
+        "units": {"length": "mm", "angle": "deg"},
+    }
     assert load_cam2flange(_hand_eye(tmp_path, good))[0, 3] == pytest.approx(81.0)
     for value, field in ((".nan", "cam2flange.xyz[1]"), (".inf", "cam2flange.xyz[1]")):
         text = yaml.safe_dump(good).replace("- -1.0", f"- {value}")
@@ -82,6 +92,12 @@ def test_a_robot_description_with_a_nan_origin_or_limits_out_of_order_is_refused
         read_description(nan_origin)
     swapped = tmp_path / "limits.urdf"
     first = re.search(r'<limit[^>]*lower="([^"]+)"[^>]*upper="([^"]+)"', text)
-    swapped.write_text(text[: first.start()] + first.group(0).replace(f'lower="{first.group(1)}"', 'lower="9"').replace(f'upper="{first.group(2)}"', 'upper="-9"') + text[first.end():])
+    swapped.write_text(
+        text[: first.start()]
+        + first.group(0)
+        .replace(f'lower="{first.group(1)}"', 'lower="9"')
+        .replace(f'upper="{first.group(2)}"', 'upper="-9"')
+        + text[first.end() :]
+    )
     with pytest.raises(FileFormatError, match=r"limit lower \(9\) is above upper \(-9\)"):
         read_description(swapped)

@@ -20,12 +20,15 @@ def folder(tmp_path):
     return tmp_path
 
 
-@pytest.mark.parametrize("edit, field", [
-    (lambda d: d["components"][1].update(mesh_units=["mm"]), "components[1].mesh_units"),
-    (lambda d: d["components"][1].update(kind=[1]), "components[1].kind"),
-    (lambda d: d["components"][1]["placement"].update(xyz=[2**1100, 0, 0]), "components[1].placement.xyz[0]"),
-    (lambda d: d.update(schema_version=[2]), "schema_version"),
-])
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda d: d["components"][1].update(mesh_units=["mm"]), "components[1].mesh_units"),
+        (lambda d: d["components"][1].update(kind=[1]), "components[1].kind"),
+        (lambda d: d["components"][1]["placement"].update(xyz=[2**1100, 0, 0]), "components[1].placement.xyz[0]"),
+        (lambda d: d.update(schema_version=[2]), "schema_version"),
+    ],
+)
 def test_workcell_values_of_an_unexpected_type(folder, edit, field):
     path = folder / "workcell" / "workcell.yaml"
     data = yaml.safe_load(path.read_text())
@@ -36,11 +39,14 @@ def test_workcell_values_of_an_unexpected_type(folder, edit, field):
     assert info.value.field == field
 
 
-@pytest.mark.parametrize("edit, field", [
-    (lambda d: d.update(verifications=True), "verifications"),
-    (lambda d: d["task_locations"][0].update(approach_mm=2**70), "task_locations[0].approach_mm"),
-    (lambda d: d["corrections"][0].update(time_s=10**400), "corrections[0].time_s"),
-])
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda d: d.update(verifications=True), "verifications"),
+        (lambda d: d["task_locations"][0].update(approach_mm=2**70), "task_locations[0].approach_mm"),
+        (lambda d: d["corrections"][0].update(time_s=10**400), "corrections[0].time_s"),
+    ],
+)
 def test_workspace_values_of_an_unexpected_type(folder, edit, field):
     data = _workspace_doc(folder)
     edit(data)

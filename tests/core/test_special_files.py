@@ -17,6 +17,10 @@ def test_a_fifo_is_refused_not_read(tmp_path):
         read_text(fifo, "workcell file")
     with pytest.raises(FileFormatError, match="not a regular file"):
         read_text("/dev/zero", "workcell file")
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "render", "--workcell", str(fifo), "--out", str(tmp_path / "x.png")],
-                         capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "render", "--workcell", str(fifo), "--out", str(tmp_path / "x.png")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 2 and "not a regular file" in run.stderr and "Traceback" not in run.stderr

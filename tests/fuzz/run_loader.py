@@ -47,10 +47,33 @@ def _deep(depth: int):
 
 
 nasty_values = st.one_of(
-    st.none(), st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True),
-    st.sampled_from([0, -1, 1e308, -1e308, 10**12, 1e-320, "", "nan", ".inf", "1e12", "3", "../../etc/passwd", "<img src=x>", "\x00"]),
-    st.text(max_size=30), st.lists(st.integers(-5, 5), max_size=6), st.dictionaries(st.text(max_size=5), st.integers(), max_size=3),
-    st.integers(1, 120).map(_deep), st.integers(10_000, 200_000).map(lambda n: "x" * n),
+    st.none(),
+    st.booleans(),
+    st.integers(-(2**70), 2**70),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from(
+        [
+            0,
+            -1,
+            1e308,
+            -1e308,
+            10**12,
+            1e-320,
+            "",
+            "nan",
+            ".inf",
+            "1e12",
+            "3",
+            "../../etc/passwd",
+            "<img src=x>",
+            "\x00",
+        ]
+    ),
+    st.text(max_size=30),
+    st.lists(st.integers(-5, 5), max_size=6),
+    st.dictionaries(st.text(max_size=5), st.integers(), max_size=3),
+    st.integers(1, 120).map(_deep),
+    st.integers(10_000, 200_000).map(lambda n: "x" * n),
 )
 
 
@@ -101,7 +124,9 @@ def mutated_text(draw, text: str):
         return text[:at] + draw(st.text(max_size=20)) + text[at:]
     if op == "alias_bomb":
         levels = draw(st.integers(2, 12))
-        bomb = "x0: &x0 [lol]\n" + "".join(f"x{i}: &x{i} [" + ", ".join([f"*x{i - 1}"] * 9) + "]\n" for i in range(1, levels))
+        bomb = "x0: &x0 [lol]\n" + "".join(
+            f"x{i}: &x{i} [" + ", ".join([f"*x{i - 1}"] * 9) + "]\n" for i in range(1, levels)
+        )
         return bomb + text
     if op == "deep":
         n = draw(st.integers(50, 20_000))
@@ -145,16 +170,36 @@ def loaders(folder: Path) -> dict:
     workcell_doc = yaml.safe_load((folder / "workcell" / "workcell.yaml").read_text())
     ros_doc = yaml.safe_load((folder / "camera" / "gripper_camera_ros.yaml").read_text())
     opencv_text = (folder / "camera" / "gripper_camera.yaml").read_text()
-    hand_eye_doc = {"cam2flange": {"xyz": [81.0, -1.0, 88.0], "rpy": [-100.0, 0.0, -90.0]}, "units": {"length": "mm", "angle": "deg"}, "std": {"xyz_mm": [0.1, 0.1, 0.1]}}
+    hand_eye_doc = {
+        "cam2flange": {"xyz": [81.0, -1.0, 88.0], "rpy": [-100.0, 0.0, -90.0]},
+        "units": {"length": "mm", "angle": "deg"},
+        "std": {"xyz_mm": [0.1, 0.1, 0.1]},
+    }
     solve_doc = json.loads((ROOT / "resources" / "examples" / "pairs.json").read_text())
     workspace_doc = _workspace_doc(folder)
     out = folder / "workcell"
-    settings_doc = {"refine_markers": True, "aruco": {"adaptiveThreshWinSizeMax": 35, "cornerRefinementMethod": 1, "adaptiveThreshConstant": 7.0}, "circle_blobs": {"minArea": 25.0, "filterByConvexity": True}}
+    settings_doc = {
+        "refine_markers": True,
+        "aruco": {"adaptiveThreshWinSizeMax": 35, "cornerRefinementMethod": 1, "adaptiveThreshConstant": 7.0},
+        "circle_blobs": {"minArea": 25.0, "filterByConvexity": True},
+    }
     (out / "poses").mkdir(exist_ok=True)
-    (out / "poses" / "0.yaml").write_text("x: 0.11\ny: 0.59\nz: 0.65\nqx: -0.5186\nqy: 0.8156\nqz: 0.0932\nqw: 0.2390\n")
-    cal_data_doc = {"data": [{"image": "images/0.png", "pose": "poses/0.yaml"}, {"image": "images/1.png", "pose": "poses/0.yaml"}],
-                    "target_finder": {"type": "CharucoGridTargetFinder", "rows": 7, "cols": 5, "chessboard_dim": 0.036195, "aruco_marker_dim": 0.018256, "dictionary": 10},
-                    "intrinsics": {"fx": 1352.0, "fy": 1356.1, "cx": 789.7, "cy": 627.3}, "static_camera": True}
+    (out / "poses" / "0.yaml").write_text(
+        "x: 0.11\ny: 0.59\nz: 0.65\nqx: -0.5186\nqy: 0.8156\nqz: 0.0932\nqw: 0.2390\n"
+    )
+    cal_data_doc = {
+        "data": [{"image": "images/0.png", "pose": "poses/0.yaml"}, {"image": "images/1.png", "pose": "poses/0.yaml"}],
+        "target_finder": {
+            "type": "CharucoGridTargetFinder",
+            "rows": 7,
+            "cols": 5,
+            "chessboard_dim": 0.036195,
+            "aruco_marker_dim": 0.018256,
+            "dictionary": 10,
+        },
+        "intrinsics": {"fx": 1352.0, "fy": 1356.1, "cx": 789.7, "cy": 627.3},
+        "static_camera": True,
+    }
     csv_text = "image,x_mm,y_mm,z_mm,qx,qy,qz,qw\nimages/0.png,110.0,590.0,650.0,-0.5186,0.8156,0.0932,0.2390\nimages/1.png,120,600,640,0,0,0,1\n"
 
     from app.cli.cmd_locate import read_features, read_prior
@@ -165,7 +210,10 @@ def loaders(folder: Path) -> dict:
     urdf_text = (folder / "robot" / "videocal_arm.urdf").read_text()
     recording_bytes = (ROOT / "resources" / "recordings" / "sample_session.mcap").read_bytes()
     box_ply = (ROOT / "tests" / "data" / "third_party" / "opencv_samples" / "box.ply").read_text()
-    prior_doc = {"R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]], "t_obj2cam_mm": [-5.9, 110.7, 943.5]}
+    prior_doc = {
+        "R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]],
+        "t_obj2cam_mm": [-5.9, 110.7, 943.5],
+    }
     features_doc = {"top_left": [0.0, 25.8, 7.5], "top_right": [18.9, 25.8, 7.5], "corner": [0, 0, 0]}
 
     def binary_file(name: str, data: bytes) -> Path:
@@ -184,16 +232,28 @@ def loaders(folder: Path) -> dict:
         return path
 
     bag_folder, bag_mcap = _small_bag(out)
-    launch_xml = ('<launch>\n  <node pkg="tf2_ros" exec="static_transform_publisher" name="mounting" args="--x 0.081 --y -0.001 --z 0.088 '
-                  '--roll -1.745 --pitch 0.0 --yaw -1.571 --frame-id tool0 --child-frame-id camera_color_optical_frame"/>\n</launch>\n')
-    xacro_text = ('<robot name="fuzz" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <xacro:property name="l" value="0.3"/>\n'
-                  '  <xacro:macro name="link" params="n"><link name="${n}"/></xacro:macro>\n  <xacro:link n="base"/>\n  <xacro:link n="tip"/>\n'
-                  '  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 ${l}"/><axis xyz="0 0 1"/>'
-                  '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n</robot>\n')
+    launch_xml = (
+        '<launch>\n  <node pkg="tf2_ros" exec="static_transform_publisher" name="mounting" args="--x 0.081 --y -0.001 --z 0.088 '
+        '--roll -1.745 --pitch 0.0 --yaw -1.571 --frame-id tool0 --child-frame-id camera_color_optical_frame"/>\n</launch>\n'
+    )
+    xacro_text = (
+        '<robot name="fuzz" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <xacro:property name="l" value="0.3"/>\n'
+        '  <xacro:macro name="link" params="n"><link name="${n}"/></xacro:macro>\n  <xacro:link n="base"/>\n  <xacro:link n="tip"/>\n'
+        '  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 ${l}"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n</robot>\n'
+    )
     url_texts = st.one_of(
-        st.builds(lambda scheme, rest: scheme + rest, st.sampled_from(["ros2://", "ros2:///", "socket://", "rfc2217://", "loop://", "ur-rtde://", "aravis://", ""]),
-                  st.text(max_size=60)),
-        st.from_regex(r"ros2:///[a-z_/]{1,20}\?[a-z_]{1,12}=[-0-9.a-z\x00\n]{0,12}(&[a-z_]{1,12}=[-0-9.a-z]{0,8}){0,3}", fullmatch=True),
+        st.builds(
+            lambda scheme, rest: scheme + rest,
+            st.sampled_from(
+                ["ros2://", "ros2:///", "socket://", "rfc2217://", "loop://", "ur-rtde://", "aravis://", ""]
+            ),
+            st.text(max_size=60),
+        ),
+        st.from_regex(
+            r"ros2:///[a-z_/]{1,20}\?[a-z_]{1,12}=[-0-9.a-z\x00\n]{0,12}(&[a-z_]{1,12}=[-0-9.a-z]{0,8}){0,3}",
+            fullmatch=True,
+        ),
     )
 
     return {
@@ -201,28 +261,79 @@ def loaders(folder: Path) -> dict:
         "launch_file": (mutated_text(launch_xml), lambda t: _load_mounting(yaml_file("mounting.launch.xml", text=t))),
         "xacro": (mutated_text(xacro_text), lambda t: _expand(yaml_file("fuzz.urdf.xacro", text=t))),
         "connector_url": (url_texts, _open_url),
-        "workcell": (st.one_of(mutated(workcell_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(workcell_doc, sort_keys=False)).map(lambda t: ("text", t))),
-                     lambda v: load_workcell(yaml_file("fuzz.yaml", v[1]) if v[0] == "doc" else yaml_file("fuzz.yaml", text=v[1]))),
-        "intrinsics_ros": (st.one_of(mutated(ros_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(ros_doc)).map(lambda t: ("text", t))),
-                           lambda v: load_intrinsics(yaml_file("ros.yaml", v[1]) if v[0] == "doc" else yaml_file("ros.yaml", text=v[1]))),
+        "workcell": (
+            st.one_of(
+                mutated(workcell_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(workcell_doc, sort_keys=False)).map(lambda t: ("text", t)),
+            ),
+            lambda v: load_workcell(
+                yaml_file("fuzz.yaml", v[1]) if v[0] == "doc" else yaml_file("fuzz.yaml", text=v[1])
+            ),
+        ),
+        "intrinsics_ros": (
+            st.one_of(
+                mutated(ros_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(ros_doc)).map(lambda t: ("text", t)),
+            ),
+            lambda v: load_intrinsics(
+                yaml_file("ros.yaml", v[1]) if v[0] == "doc" else yaml_file("ros.yaml", text=v[1])
+            ),
+        ),
         "intrinsics_opencv": (mutated_text(opencv_text), lambda t: load_intrinsics(yaml_file("opencv.yaml", text=t))),
-        "hand_eye": (st.one_of(mutated(hand_eye_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(hand_eye_doc)).map(lambda t: ("text", t))),
-                     lambda v: load_cam2flange(yaml_file("he.yaml", v[1]) if v[0] == "doc" else yaml_file("he.yaml", text=v[1]))),
+        "hand_eye": (
+            st.one_of(
+                mutated(hand_eye_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(hand_eye_doc)).map(lambda t: ("text", t)),
+            ),
+            lambda v: load_cam2flange(yaml_file("he.yaml", v[1]) if v[0] == "doc" else yaml_file("he.yaml", text=v[1])),
+        ),
         "workspace": (mutated(workspace_doc), lambda d: load_workspace(json_file("ws.json", d))),
         "solve_inputs": (mutated(solve_doc), lambda d: read_solve_inputs(json_file("solve.json", d))),
-        "detector_settings": (st.one_of(mutated(settings_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(settings_doc)).map(lambda t: ("text", t))),
-                              lambda v: load_detector_settings(yaml_file("detector.yaml", v[1]) if v[0] == "doc" else yaml_file("detector.yaml", text=v[1]))),
-        "cal_data": (st.one_of(mutated(cal_data_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(cal_data_doc)).map(lambda t: ("text", t))),
-                     lambda v: load_posed_images(yaml_file("cal_data.yaml", v[1]) if v[0] == "doc" else yaml_file("cal_data.yaml", text=v[1]))),
+        "detector_settings": (
+            st.one_of(
+                mutated(settings_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(settings_doc)).map(lambda t: ("text", t)),
+            ),
+            lambda v: load_detector_settings(
+                yaml_file("detector.yaml", v[1]) if v[0] == "doc" else yaml_file("detector.yaml", text=v[1])
+            ),
+        ),
+        "cal_data": (
+            st.one_of(
+                mutated(cal_data_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(cal_data_doc)).map(lambda t: ("text", t)),
+            ),
+            lambda v: load_posed_images(
+                yaml_file("cal_data.yaml", v[1]) if v[0] == "doc" else yaml_file("cal_data.yaml", text=v[1])
+            ),
+        ),
         "pose_csv": (mutated_text(csv_text), lambda t: load_posed_images(yaml_file("views.csv", text=t))),
         "robot_urdf": (mutated_text(urdf_text), lambda t: load_robot(yaml_file("../robot/fuzz.urdf", text=t))),
         "recording": (mutated_bytes(recording_bytes), lambda b: read_recording(binary_file("fuzz.mcap", b))),
         "mesh_ply": (mutated_text(box_ply), lambda t: load_mesh(yaml_file("fuzz.ply", text=t), "cm")),
         "locate_prior": (mutated(prior_doc), lambda d: read_prior(json_file("prior.json", d))),
-        "locate_features": (st.one_of(mutated(features_doc).map(lambda d: ("doc", d)), mutated_text(yaml.safe_dump(features_doc)).map(lambda t: ("text", t))),
-                            lambda v: read_features(yaml_file("features.yaml", v[1]) if v[0] == "doc" else yaml_file("features.yaml", text=v[1]), 10.0)),
-        "board_spec": (st.one_of(st.text(max_size=60), st.from_regex(r"(charuco|aruco):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}(:legacy)?", fullmatch=True),
-                        st.from_regex(r"(chessboard|circles):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}(:asymmetric)?", fullmatch=True)), parse_board),
+        "locate_features": (
+            st.one_of(
+                mutated(features_doc).map(lambda d: ("doc", d)),
+                mutated_text(yaml.safe_dump(features_doc)).map(lambda t: ("text", t)),
+            ),
+            lambda v: read_features(
+                yaml_file("features.yaml", v[1]) if v[0] == "doc" else yaml_file("features.yaml", text=v[1]), 10.0
+            ),
+        ),
+        "board_spec": (
+            st.one_of(
+                st.text(max_size=60),
+                st.from_regex(
+                    r"(charuco|aruco):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}:[-0-9.e]{1,8}:DICT_[0-9A-Z_]{1,12}(:legacy)?",
+                    fullmatch=True,
+                ),
+                st.from_regex(
+                    r"(chessboard|circles):-?[0-9]{1,7}x-?[0-9]{1,7}:[-0-9.e]{1,8}(:asymmetric)?", fullmatch=True
+                ),
+            ),
+            parse_board,
+        ),
     }
 
 
@@ -286,11 +397,34 @@ def _workspace_doc(folder: Path) -> dict:
     table = CorrectionTable()
     measured = np.eye(4)
     measured[:3, 3] = [1.0, -2.0, 0.5]
-    table.add(Correction("oru_1_grasp", np.eye(4), measured, np.array([1.0, -2.0, 0.5]), np.zeros(3), np.full(3, 0.1), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    table.add(
+        Correction(
+            "oru_1_grasp",
+            np.eye(4),
+            measured,
+            np.array([1.0, -2.0, 0.5]),
+            np.zeros(3),
+            np.full(3, 0.1),
+            np.full(3, 0.01),
+            np.zeros(6),
+            0.3,
+            6,
+        )
+    )
     view = ViewStamp(3, 12.5, (0.0,) * 6, 0.01, "2026-12-01 12:00:00", "camera")
     pairs = [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (100.0, 200.0), True, view)]
     path = folder / "workcell" / "seed_workspace.json"
-    save_workspace(path, Workspace(str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", pairs, table))
+    save_workspace(
+        path,
+        Workspace(
+            str(cell.path),
+            load_intrinsics(cell.intrinsics_path),
+            dict(cell.task_locations),
+            "oru_1_fixture",
+            pairs,
+            table,
+        ),
+    )
     return json.loads(path.read_text())
 
 
@@ -306,14 +440,29 @@ def main(name: str, examples: int, seed: int = 0) -> dict:
     folder = _cell_folder()
     strategy, load = loaders(folder)[name]
     baseline = _rss_mb()
-    stats = {"loader": name, "examples": 0, "accepted": 0, "refused": 0, "unexpected": [], "slowest_s": 0.0, "baseline_rss_mb": baseline}
+    stats = {
+        "loader": name,
+        "examples": 0,
+        "accepted": 0,
+        "refused": 0,
+        "unexpected": [],
+        "slowest_s": 0.0,
+        "baseline_rss_mb": baseline,
+    }
 
     def alarm(*_):
         raise DocumentTimeout(f"no answer within {DOCUMENT_S} s")
 
     signal.signal(signal.SIGALRM, alarm)
 
-    @settings(max_examples=examples, deadline=None, database=None, derandomize=True, suppress_health_check=list(HealthCheck), print_blob=False)
+    @settings(
+        max_examples=examples,
+        deadline=None,
+        database=None,
+        derandomize=True,
+        suppress_health_check=list(HealthCheck),
+        print_blob=False,
+    )
     @given(strategy)
     def fuzz(value):
         stats["examples"] += 1
@@ -328,7 +477,13 @@ def main(name: str, examples: int, seed: int = 0) -> dict:
             if isinstance(exc, KeyboardInterrupt):
                 raise
             if len(stats["unexpected"]) < 10:
-                stats["unexpected"].append({"error": f"{type(exc).__name__}: {exc}"[:500], "traceback": traceback.format_exc()[-1500:], "input": repr(value)[:400]})
+                stats["unexpected"].append(
+                    {
+                        "error": f"{type(exc).__name__}: {exc}"[:500],
+                        "traceback": traceback.format_exc()[-1500:],
+                        "input": repr(value)[:400],
+                    }
+                )
             else:
                 stats["unexpected"].append({"error": f"{type(exc).__name__}"})
         finally:

@@ -13,8 +13,27 @@ import pytest
 
 from tests.fuzz.run_loader import ROOT
 
-LOADERS = ["workcell", "intrinsics_ros", "intrinsics_opencv", "hand_eye", "workspace", "solve_inputs", "board_spec", "detector_settings", "cal_data", "pose_csv",
-           "robot_urdf", "recording", "mesh_ply", "locate_prior", "locate_features", "ros2_bag", "launch_file", "xacro", "connector_url"]
+LOADERS = [
+    "workcell",
+    "intrinsics_ros",
+    "intrinsics_opencv",
+    "hand_eye",
+    "workspace",
+    "solve_inputs",
+    "board_spec",
+    "detector_settings",
+    "cal_data",
+    "pose_csv",
+    "robot_urdf",
+    "recording",
+    "mesh_ply",
+    "locate_prior",
+    "locate_features",
+    "ros2_bag",
+    "launch_file",
+    "xacro",
+    "connector_url",
+]
 EXAMPLES = int(os.environ.get("VIDEOCAL_FUZZ_EXAMPLES", "150"))
 PER_LOADER = {"xacro": 50}
 """Loaders whose every document costs a child process (a xacro is expanded in a bounded one: 0.9 s each) run fewer in
@@ -22,7 +41,13 @@ the suite (150 took 133 s, a tenth of it); the reliability bench runs 10,000 of 
 
 
 def run_fuzz(loader: str, examples: int, seed: int = 0, timeout: float = 1200) -> dict:
-    run = subprocess.run([sys.executable, "-m", "tests.fuzz.run_loader", loader, str(examples), str(seed)], capture_output=True, text=True, cwd=ROOT, timeout=timeout)
+    run = subprocess.run(
+        [sys.executable, "-m", "tests.fuzz.run_loader", loader, str(examples), str(seed)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=timeout,
+    )
     assert run.returncode == 0, f"the fuzzed process died ({run.returncode}): {run.stderr[-3000:]}"
     return json.loads(run.stdout.strip().splitlines()[-1])
 
@@ -53,6 +78,13 @@ def test_the_fuzzer_finds_a_loader_that_fails_unclearly(tmp_path):
         "r.loaders = broken\n"
         "print(json.dumps(r.main('hand_eye', 5)))\n"
     )
-    run = subprocess.run([sys.executable, str(probe)], capture_output=True, text=True, cwd=ROOT, timeout=300, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    run = subprocess.run(
+        [sys.executable, str(probe)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     stats = json.loads(run.stdout.strip().splitlines()[-1])
     assert stats["unexpected"] and "TypeError: an unclear failure" in stats["unexpected"][0]["error"]

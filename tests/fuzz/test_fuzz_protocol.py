@@ -18,10 +18,20 @@ KINDS = ["MVJ", "HEL", "AUT", "STP", "HBT", "STR", "RQJ", "VER", "STA", "JNT", "
 bodies = st.one_of(
     st.text(BODY_CHARS, max_size=300),
     st.builds(lambda k, rest: k + rest, st.sampled_from(KINDS), st.text(BODY_CHARS, max_size=200)),
-    st.builds(lambda k, fields: ",".join([k, *fields]), st.sampled_from(KINDS),
-              st.lists(st.one_of(st.text(BODY_CHARS.filter(lambda c: c != ","), max_size=40), st.floats().map(str),
-                                 st.integers().map(str), st.from_regex(r"#[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True),
-                                 st.from_regex(r"#[0-9]{1,11}:[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True)), max_size=20)),
+    st.builds(
+        lambda k, fields: ",".join([k, *fields]),
+        st.sampled_from(KINDS),
+        st.lists(
+            st.one_of(
+                st.text(BODY_CHARS.filter(lambda c: c != ","), max_size=40),
+                st.floats().map(str),
+                st.integers().map(str),
+                st.from_regex(r"#[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True),
+                st.from_regex(r"#[0-9]{1,11}:[0-9]{1,11}:[0-9a-f]{30,34}", fullmatch=True),
+            ),
+            max_size=20,
+        ),
+    ),
 )
 
 
@@ -50,7 +60,7 @@ def test_any_altered_character_of_a_sealed_move_is_refused(position, char):
     session = _session(logic)
     sealed = auth.seal(session, 1, logic.clock_ms(), "MVJ,m1.1,10.0000,-20.0000,30.0000,0.0000,5.5000,-1.0000")
     i = position % len(sealed)
-    altered = sealed[:i] + char + sealed[i + 1:]
+    altered = sealed[:i] + char + sealed[i + 1 :]
     replies = logic.handle(altered)
     moved = logic.move is not None
     assert moved == (altered == sealed), (altered, replies)

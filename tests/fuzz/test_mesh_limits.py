@@ -16,7 +16,9 @@ from calib_core.mesh_files import MAX_TRIANGLES, load_mesh
 
 def _binary_stl_claiming(path, triangles: int) -> None:
     """A binary STL header declaring ``triangles`` (followed by one triangle only: nothing large is written)."""
-    path.write_bytes(b"videocal test" + b" " * 67 + struct.pack("<I", triangles) + struct.pack("<12fH", *([0.0] * 12), 0))
+    path.write_bytes(
+        b"videocal test" + b" " * 67 + struct.pack("<I", triangles) + struct.pack("<12fH", *([0.0] * 12), 0)
+    )
 
 
 def test_a_huge_binary_stl_is_refused_from_its_header(tmp_path):
@@ -38,8 +40,12 @@ def test_absurd_or_empty_meshes_are_refused_and_a_good_one_is_read_in_mm(tmp_pat
     flat = trimesh.Trimesh(vertices=[[0, 0, 0], [1, 0, 0], [2, 0, 0]], faces=[[0, 1, 2]], process=False)
     flat.export(tmp_path / "flat.stl")
     (tmp_path / "text.stl").write_text("solid nothing\nendsolid nothing\n")
-    for name, why in (("far.stl", "beyond 1e\\+07 mm: are its units right"), ("flat.stl", "no area|no triangles"), ("text.stl", "no triangles|cannot read"),
-                      ("missing.stl", "no such mesh file")):
+    for name, why in (
+        ("far.stl", "beyond 1e\\+07 mm: are its units right"),
+        ("flat.stl", "no area|no triangles"),
+        ("text.stl", "no triangles|cannot read"),
+        ("missing.stl", "no such mesh file"),
+    ):
         with pytest.raises(FileFormatError, match=why) as info:
             load_mesh(tmp_path / name)
         assert info.value.path.name == name
@@ -53,7 +59,9 @@ def test_the_workcell_names_its_field_and_the_mesh(tmp_path):
     from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
     resources = tmp_path / "resources"  # the workcell names the robot and camera beside it
-    shutil.copytree(DEFAULT_WORKCELL.parents[1], resources, ignore=shutil.ignore_patterns("*.png", "*.mcap", "recordings"))
+    shutil.copytree(
+        DEFAULT_WORKCELL.parents[1], resources, ignore=shutil.ignore_patterns("*.png", "*.mcap", "recordings")
+    )
     cell = resources / DEFAULT_WORKCELL.parent.name
     text = (cell / DEFAULT_WORKCELL.name).read_text()
     first_mesh = next(line.split(":", 1)[1].strip() for line in text.splitlines() if line.strip().startswith("mesh:"))
@@ -64,13 +72,23 @@ def test_the_workcell_names_its_field_and_the_mesh(tmp_path):
 
 def _chain(n: int, axis: str = "0 0 1", xyz: str = "0 0 0.1") -> str:
     links = "".join(f'<link name="l{k}"/>' for k in range(n + 1))
-    joints = "".join(f'<joint name="j{k}" type="revolute"><parent link="l{k}"/><child link="l{k + 1}"/><origin xyz="{xyz}"/>'
-                     f'<axis xyz="{axis}"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>' for k in range(n))
+    joints = "".join(
+        f'<joint name="j{k}" type="revolute"><parent link="l{k}"/><child link="l{k + 1}"/><origin xyz="{xyz}"/>'
+        f'<axis xyz="{axis}"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        for k in range(n)
+    )
     return f'<robot name="chain">{links}{joints}</robot>'
 
 
-@pytest.mark.parametrize("text, why", [(_chain(2999), "2999 joints: over the limit of 500"), (_chain(3, axis="0 0 0"), "axis xyz='0 0 0' must be three finite numbers, not all zero"),
-                                       (_chain(3, xyz="0 0 1e308"), "over 1000 m away"), (_chain(3, axis="nan 0 1"), "axis")])
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        (_chain(2999), "2999 joints: over the limit of 500"),
+        (_chain(3, axis="0 0 0"), "axis xyz='0 0 0' must be three finite numbers, not all zero"),
+        (_chain(3, xyz="0 0 1e308"), "over 1000 m away"),
+        (_chain(3, axis="nan 0 1"), "axis"),
+    ],
+)
 def test_urdfs_beyond_a_robots_limits_are_refused_by_name(tmp_path, text, why):
     """A 2999-joint URDF ended in a MemoryError traceback; a zero axis and 1e308 m origins loaded."""
     from calib_core.robot.description import read_description

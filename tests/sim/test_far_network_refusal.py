@@ -10,7 +10,9 @@ from videocal_sim.delay_line import LinkWeather
 def test_without_root_the_far_network_is_refused_with_the_reason(monkeypatch):
     monkeypatch.setattr(far_network.os, "geteuid", lambda: 1000)
     assert "root" in far_network.why_not_available()
-    with pytest.raises(VideocalError, match="cannot make a far network here: network namespaces and TAP devices need root"):
+    with pytest.raises(
+        VideocalError, match="cannot make a far network here: network namespaces and TAP devices need root"
+    ):
         far_network.FarNetwork(LinkWeather(1.5, 0.3, 0.01))
 
 

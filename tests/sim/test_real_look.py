@@ -13,7 +13,9 @@ from videocal_sim.real_look import make_less_kind
 def test_the_form_error_reaches_its_amplitude_along_the_normals_smoothly_and_the_same_for_a_seed():
     sphere = trimesh.creation.icosphere(subdivisions=4, radius=100.0)
     moved = form_error(sphere, 1.0, seed=3)
-    radial = np.linalg.norm(moved.vertices, axis=1) - np.linalg.norm(sphere.vertices, axis=1)  # along the normal, on a sphere
+    radial = np.linalg.norm(moved.vertices, axis=1) - np.linalg.norm(
+        sphere.vertices, axis=1
+    )  # along the normal, on a sphere
     assert np.abs(radial).max() <= 1.0 + 1e-9 and np.abs(radial).max() > 0.999
     tangential = np.linalg.norm(np.cross(moved.vertices - sphere.vertices, sphere.vertex_normals), axis=1)
     assert tangential.max() < 1e-9
@@ -34,8 +36,10 @@ def test_each_face_takes_the_print_along_its_own_axis():
     for face, (n, pts) in enumerate(zip(normals, corners)):
         axis = int(np.abs(n).argmax())
         across = [k for k in range(3) if k != axis]
-        np.testing.assert_allclose(uv[3 * face:3 * face + 3], pts[:, across] / period)
-    np.testing.assert_array_equal(mesh.vertices[mesh.faces].reshape(-1, 3), box.vertices[box.faces].reshape(-1, 3))  # the same triangles
+        np.testing.assert_allclose(uv[3 * face : 3 * face + 3], pts[:, across] / period)
+    np.testing.assert_array_equal(
+        mesh.vertices[mesh.faces].reshape(-1, 3), box.vertices[box.faces].reshape(-1, 3)
+    )  # the same triangles
 
 
 def test_the_workshop_bed_renders_the_truth_and_leaves_the_cad_alone():

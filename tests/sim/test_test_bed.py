@@ -46,7 +46,15 @@ def test_hand_eye_error_moves_only_the_camera(bed):
 
 
 def _bright_dot_camera(points_world, look):
-    dots = [SceneItem(f"dot{i}", trimesh.creation.icosphere(radius=1.2, subdivisions=2), make_transform(np.eye(3), p), color=(1, 1, 1)) for i, p in enumerate(points_world)]
+    dots = [
+        SceneItem(
+            f"dot{i}",
+            trimesh.creation.icosphere(radius=1.2, subdivisions=2),
+            make_transform(np.eye(3), p),
+            color=(1, 1, 1),
+        )
+        for i, p in enumerate(points_world)
+    ]
     cam2world = np.eye(4)
     return SimulatedCamera(SMALL_LENS, lambda q: dots, lambda q: cam2world, lambda: np.zeros(6), look=look)
 
@@ -69,7 +77,9 @@ def test_features_land_where_the_distorted_projection_puts_them():
 
 
 def test_frames_are_deterministic_for_a_seed_and_report_truth(bed):
-    bed.joints_deg = solve_ik(bed.model_robot, bed.workcell.task("oru_1_grasp").approach2base, bed.workcell.home_joints_deg).q_deg
+    bed.joints_deg = solve_ik(
+        bed.model_robot, bed.workcell.task("oru_1_grasp").approach2base, bed.workcell.home_joints_deg
+    ).q_deg
     small = bed.intrinsics.scaled(0.25)
     a = bed.camera(seed=7, intrinsics=small)
     b = bed.camera(seed=7, intrinsics=small)
@@ -110,7 +120,11 @@ def test_pixels_integrate_the_light_over_their_area():
     pixel it crosses; a renderer's point sample per pixel moves the edge in whole pixels (the steps
     that tilted edge fits by up to 1.2 mrad)."""
     offsets = [0.1, 0.3, 0.45, 0.6, 0.85]
-    assert samples_per_pixel(CameraLook(), 640) == 4 and samples_per_pixel(CameraLook(), 1280) == 2 and samples_per_pixel(CameraLook(supersample=1), 640) == 1
+    assert (
+        samples_per_pixel(CameraLook(), 640) == 4
+        and samples_per_pixel(CameraLook(), 1280) == 2
+        and samples_per_pixel(CameraLook(supersample=1), 640) == 1
+    )
     point_sampled = [abs(_edge_column_px(1, 100.0 + f) - (100.0 + f)) for f in offsets]
     integrated = [abs(_edge_column_px(4, 100.0 + f) - (100.0 + f)) for f in offsets]
     assert max(point_sampled) > 0.25  # whole-pixel steps
@@ -124,10 +138,22 @@ def test_live_video_point_samples_a_moving_scene_and_integrates_it_at_rest():
     may deliver that frame after the robot has been still long enough to be measured on)."""
     lens = Intrinsics(280.0, 280.0, 160.0, 120.0, 320, 240)
     x_left = (100.3 - lens.cx) * 400.0 / lens.fu  # the card's edge 0.2 px into pixel 100's right half
-    card = SceneItem("card", trimesh.creation.box(extents=[200.0, 100.0, 1.0]), make_transform(np.eye(3), [x_left + 100.0, 0.0, 400.0]), color=(1, 1, 1))
+    card = SceneItem(
+        "card",
+        trimesh.creation.box(extents=[200.0, 100.0, 1.0]),
+        make_transform(np.eye(3), [x_left + 100.0, 0.0, 400.0]),
+        color=(1, 1, 1),
+    )
     look = CameraLook(noise_sigma=0.0, vignetting=0.0, gain=1.0, background=(0, 0, 0))
     ticks = iter(range(10**6))
-    moving = SimulatedCamera(lens, lambda q: [card], lambda q: np.eye(4), lambda: np.full(6, float(next(ticks))), look=look, coarse_while_moving=True)
+    moving = SimulatedCamera(
+        lens,
+        lambda q: [card],
+        lambda q: np.eye(4),
+        lambda: np.full(6, float(next(ticks))),
+        look=look,
+        coarse_while_moving=True,
+    )
     first, second, third = (moving.read().image[120, :, 1].astype(float) for _ in range(3))
     moving.close()
     bright = float(np.mean(second[112:130]))
@@ -135,7 +161,9 @@ def test_live_video_point_samples_a_moving_scene_and_integrates_it_at_rest():
     assert 0.1 * bright < second[100] < 0.3 * bright  # a fifth of the pixel is card
     assert np.array_equal(second, third)  # the same scene: the integrated render stays
 
-    resting = SimulatedCamera(lens, lambda q: [card], lambda q: np.eye(4), lambda: np.zeros(6), look=look, coarse_while_moving=True)
+    resting = SimulatedCamera(
+        lens, lambda q: [card], lambda q: np.eye(4), lambda: np.zeros(6), look=look, coarse_while_moving=True
+    )
     at_rest = resting.read().image[120, :, 1].astype(float)
     resting.close()
     assert np.array_equal(at_rest, second)

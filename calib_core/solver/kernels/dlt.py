@@ -113,7 +113,11 @@ def dlt_pose(P, xy, R_out, t_out):
     if m[2, 3] < 0.0:  # the centroid must lie in front of the camera
         m = -m
     B = np.ascontiguousarray(m[:, :3])
-    det = B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0]) + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0])
+    det = (
+        B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1])
+        - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
+        + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0])
+    )
     if not det > 0.0:  # a reflection: the points do not determine a camera
         return False
     lam = det ** (1.0 / 3.0)

@@ -60,7 +60,9 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     cov_centre = np.empty((3, 3))
     loo = np.empty(n)
     lengths = np.empty(n)
-    rms, sigma, source, condition = fit_summary(J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
+    rms, sigma, source, condition = fit_summary(
+        J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths
+    )
     scalars = np.array([iterations, outcome, rms, sigma, source, condition], dtype=np.float64)
     return R, t, r, J, cov, cov_centre, loo, scalars
 
@@ -74,7 +76,9 @@ def _same_pose(Ra, ta, Rb, tb, cos_limit, rel_translation):
 
 
 @njit(cache=True)
-def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, gate_px, margin_cost, same_cos, same_rel):
+def p3p_newton_summary(
+    P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, gate_px, margin_cost, same_cos, same_rel
+):
     """The whole solve for a few points (4 or 5, off a plane): P3P over every triplet, the roots
     that put all the points within ``gate_px`` (RMS) refined, summarised as
     :func:`dlt_newton_summary`. ``None`` when no root is near or no refinement converges, or when a
@@ -148,7 +152,9 @@ def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
         if again:
             continue
         f[0], f[1] = fu, fv
-        its[j], outcomes[j] = newton(PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, max_iterations, True, rs[j], Js[j])
+        its[j], outcomes[j] = newton(
+            PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, max_iterations, True, rs[j], Js[j]
+        )
         if outcomes[j] == CONVERGED or outcomes[j] == EXACT_FIT:
             costs[j] = np.sum(rs[j] ** 2)
             if best < 0 or costs[j] < costs[best]:
@@ -156,7 +162,11 @@ def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     if best < 0:
         return None
     for j in range(m):
-        if j != best and costs[j] <= costs[best] + margin_cost and not _same_pose(Rs[best], ts[best], Rs[j], ts[j], same_cos, same_rel):
+        if (
+            j != best
+            and costs[j] <= costs[best] + margin_cost
+            and not _same_pose(Rs[best], ts[best], Rs[j], ts[j], same_cos, same_rel)
+        ):
             return None
     R = Rs[best].copy()
     t = ts[best].copy()
@@ -166,6 +176,8 @@ def p3p_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     loo = np.empty(n)
     lengths = np.empty(n)
     J = Js[best].copy()
-    rms, sigma, source, condition = fit_summary(J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths)
+    rms, sigma, source, condition = fit_summary(
+        J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths
+    )
     scalars = np.array([its[best], outcomes[best], rms, sigma, source, condition], dtype=np.float64)
     return R, t, r, J, cov, cov_centre, loo, scalars

@@ -125,7 +125,10 @@ def _small(delta, p, scale, f):
 @njit(cache=True)
 def _focal_sane(f, f0):
     # A focal length running off to zero or infinity is the orthographic or degenerate limit, never a camera.
-    return FOCAL_RANGE[0] * f0[0] < f[0] < FOCAL_RANGE[1] * f0[0] and FOCAL_RANGE[0] * f0[1] < f[1] < FOCAL_RANGE[1] * f0[1]
+    return (
+        FOCAL_RANGE[0] * f0[0] < f[0] < FOCAL_RANGE[1] * f0[0]
+        and FOCAL_RANGE[0] * f0[1] < f[1] < FOCAL_RANGE[1] * f0[1]
+    )
 
 
 @njit(cache=True)
@@ -182,7 +185,9 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
             cost_new = np.inf
             if cholesky_solve(Aa, g, delta):
                 _step(R, t, f, delta, p, R_new, t_new, f_new)
-                zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r_new, J_new)
+                zmin = evaluate(
+                    model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r_new, J_new
+                )
                 if zmin > 0.0 and _focal_sane(f_new, f0):
                     cost_new = robust_cost(r_new, huber)
                 if cost_new <= cost:
@@ -208,6 +213,8 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
 def newton_batch(model, P, uv, R, t, f, cx, cy, dist, focal, max_iterations, r, J, iterations, outcomes):
     """:func:`newton` on each of ``b`` problems in parallel; arrays carry the batch index first."""
     for i in prange(P.shape[0]):
-        it, code = newton(model, P[i], uv[i], R[i], t[i], f[i], cx, cy, dist, focal, False, 0.0, max_iterations, True, r[i], J[i])
+        it, code = newton(
+            model, P[i], uv[i], R[i], t[i], f[i], cx, cy, dist, focal, False, 0.0, max_iterations, True, r[i], J[i]
+        )
         iterations[i] = it
         outcomes[i] = code

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+
 @njit(cache=True)
 def _cubic_real_roots(a, b, c, d, roots):
     """Real roots of ``a x^3 + b x^2 + c x + d`` (``a`` != 0) into ``roots`` (3,), ascending; how many."""
@@ -131,7 +132,14 @@ def p3p(Pw, bearings, Rs, ts):
     apc = (a2 + c2) / b2
     A4 = (amc - 1.0) ** 2 - 4.0 * c2 / b2 * ca * ca
     A3 = 4.0 * (amc * (1.0 - amc) * cb - (1.0 - apc) * ca * cg + 2.0 * c2 / b2 * ca * ca * cb)
-    A2 = 2.0 * (amc * amc - 1.0 + 2.0 * amc * amc * cb * cb + 2.0 * (b2 - c2) / b2 * ca * ca - 4.0 * apc * ca * cb * cg + 2.0 * (b2 - a2) / b2 * cg * cg)
+    A2 = 2.0 * (
+        amc * amc
+        - 1.0
+        + 2.0 * amc * amc * cb * cb
+        + 2.0 * (b2 - c2) / b2 * ca * ca
+        - 4.0 * apc * ca * cb * cg
+        + 2.0 * (b2 - a2) / b2 * cg * cg
+    )
     A1 = 4.0 * (-amc * (1.0 + amc) * cb + 2.0 * a2 / b2 * cg * cg * cb - (1.0 - apc) * ca * cg)
     A0 = (1.0 + amc) ** 2 - 4.0 * a2 / b2 * cg * cg
     vs = np.empty(4)

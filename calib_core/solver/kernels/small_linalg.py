@@ -112,7 +112,11 @@ def symmetric_eigenvalues(A):
 @njit(cache=True)
 def inverse3(B, out):
     """``out = B^-1`` for a 3 x 3 matrix (cofactors); returns the determinant (0: singular, out untouched)."""
-    det = B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0]) + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0])
+    det = (
+        B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1])
+        - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
+        + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0])
+    )
     if det == 0.0:
         return 0.0
     out[0, 0] = (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) / det

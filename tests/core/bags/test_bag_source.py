@@ -30,7 +30,10 @@ def test_topic_choice_and_what_a_bag_without_images_says(tmp_path):
     photos = chessboard_photos()[:2]
     jpegs = [cv2.imencode(".jpg", p)[1].tobytes() for p in photos]
     bag = write_bag(tmp_path / "two", "mcap", {"/left/image_raw": photos, "/right/image_raw/compressed": jpegs})
-    with pytest.raises(FileFormatError, match="several image topics: choose one with --topic: /left/image_raw .*/right/image_raw/compressed"):
+    with pytest.raises(
+        FileFormatError,
+        match="several image topics: choose one with --topic: /left/image_raw .*/right/image_raw/compressed",
+    ):
         choose_image_topic(bag)
     right = list(bag_images(bag, "/right/image_raw/compressed"))
     assert len(right) == 2 and np.abs(right[0][1][:, :, 0].astype(int) - photos[0]).mean() < 3  # JPEG
@@ -47,16 +50,47 @@ def test_calibrate_intrinsics_from_a_bag_matches_the_photos_folder(tmp_path):
     common = ["--board", "chessboard:9x6:25", "--json"]
     runs = {}
     for name, source in (("bag", bag), ("folder", OPENCV)):
-        done = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-intrinsics", str(source), "--out", str(tmp_path / f"{name}.yaml"), *common],
-                              capture_output=True, text=True, timeout=300)
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "app.cli.main",
+                "calibrate-intrinsics",
+                str(source),
+                "--out",
+                str(tmp_path / f"{name}.yaml"),
+                *common,
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert done.returncode == 0, done.stderr
         runs[name] = __import__("json").loads(done.stdout)
     assert runs["bag"]["views_used"] == runs["folder"]["views_used"] == 13
     for key in ("fu", "fv", "cx", "cy"):
         assert runs["bag"][key] == pytest.approx(runs["folder"][key], abs=1e-6)
-    wrong = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-intrinsics", str(bag), "--topic", "/nope", "--out", str(tmp_path / "x.yaml"), *common],
-                           capture_output=True, text=True, timeout=300)
-    assert wrong.returncode == 2 and "no topic /nope; image topics: /camera/image_raw (sensor_msgs/msg/Image, 13)" in wrong.stderr
+    wrong = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-intrinsics",
+            str(bag),
+            "--topic",
+            "/nope",
+            "--out",
+            str(tmp_path / "x.yaml"),
+            *common,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert (
+        wrong.returncode == 2
+        and "no topic /nope; image topics: /camera/image_raw (sensor_msgs/msg/Image, 13)" in wrong.stderr
+    )
 
 
 def test_a_bag_given_as_a_recording_is_refused_naming_what_it_holds(tmp_path):
@@ -70,12 +104,21 @@ def test_a_bag_given_as_a_recording_is_refused_naming_what_it_holds(tmp_path):
         writer = Writer(f)
         writer.start()
         writer.finish()
-    for source, expected in ((mcap_file, "not a videocal recording: no videocal message (its topics: /camera/camera_info (cdr)"),
-                             (bag, "a ROS bag folder, not a videocal recording"),
-                             (header_only, "not a videocal recording: no videocal message (it holds no messages)")):
-        run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(source)], capture_output=True, text=True, timeout=120)
+    for source, expected in (
+        (mcap_file, "not a videocal recording: no videocal message (its topics: /camera/camera_info (cdr)"),
+        (bag, "a ROS bag folder, not a videocal recording"),
+        (header_only, "not a videocal recording: no videocal message (it holds no messages)"),
+    ):
+        run = subprocess.run(
+            [sys.executable, "-m", "app.cli.main", "replay", str(source)], capture_output=True, text=True, timeout=120
+        )
         assert run.returncode == 2 and expected in run.stderr and "Traceback" not in run.stderr, run.stderr
-    recover = subprocess.run([sys.executable, "-m", "app.cli.main", "recover", str(header_only), str(tmp_path / "copy.mcap")], capture_output=True, text=True, timeout=120)
+    recover = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "recover", str(header_only), str(tmp_path / "copy.mcap")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert recover.returncode == 2 and not (tmp_path / "copy.mcap").exists()  # no empty copy
 
 
@@ -97,6 +140,22 @@ def test_a_bag_whose_messages_are_not_cdr_is_one_error_naming_the_topic_and_mess
         writer.write(connection, 1_700_000_000_000_000_000, b"\x00\x01 not a CDR image at all")
     with pytest.raises(FileFormatError, match=r"/camera/image_raw message 0: not a sensor_msgs/msg/Image in CDR"):
         list(bag_images(folder))
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-intrinsics", str(folder), "--board", "chessboard:9x6:25",
-                          "--out", str(tmp_path / "camera.yaml")], capture_output=True, text=True, timeout=120)
-    assert run.returncode == 2 and "Traceback" not in run.stderr and "not a sensor_msgs/msg/Image in CDR" in run.stderr, run.stderr[-2000:]
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-intrinsics",
+            str(folder),
+            "--board",
+            "chessboard:9x6:25",
+            "--out",
+            str(tmp_path / "camera.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (
+        run.returncode == 2 and "Traceback" not in run.stderr and "not a sensor_msgs/msg/Image in CDR" in run.stderr
+    ), run.stderr[-2000:]

@@ -31,7 +31,9 @@ T0 = 1_760_000_000_000_000_000  # the robot's clock, ns
 def recorded(tmp_path_factory):
     cell = load_workcell()
     typical = RobotErrors.typical(0, n_joints=cell.load_robot().n_joints)
-    bed = TestBed.create(cell, errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
+    bed = TestBed.create(
+        cell, errors=RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg)
+    )
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, cell, bed.model_robot)
     poses = hand_eye_poses(bed, spec, board2base, 8)
@@ -40,7 +42,9 @@ def recorded(tmp_path_factory):
     shots = [(t, image) for (t, _), (_, image, _) in zip(shot_at, rendered)]
     folder = tmp_path_factory.mktemp("bag")
     bag = write_arm_bag(folder / "hand_eye_bag", bed.intrinsics, bed.model_robot, shots, track)
-    tf_bag = write_arm_bag(folder / "tf_bag", bed.intrinsics, bed.model_robot, shots, track, joint_states=False, tf=True)
+    tf_bag = write_arm_bag(
+        folder / "tf_bag", bed.intrinsics, bed.model_robot, shots, track, joint_states=False, tf=True
+    )
     true_robot = bed.true_robot.robot
     truth = concat(true_robot.frame_placement("camera"), invert(true_robot.frame_placement("flange")))
     return bag, truth, len(poses), moving, tf_bag
@@ -49,8 +53,13 @@ def recorded(tmp_path_factory):
 def test_the_mounting_from_a_bag_of_images_and_joint_states(recorded, tmp_path):
     bag, truth, still, moving, _ = recorded
     out = tmp_path / "mount.yaml"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(bag), "--out", str(out), "--json"],
-                         capture_output=True, text=True, timeout=600, cwd=ROOT)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(bag), "--out", str(out), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
     assert doc["poses"] == still  # every still frame, no frame taken while the arm moved
@@ -64,9 +73,28 @@ def test_the_mounting_from_a_bag_of_images_and_joint_states(recorded, tmp_path):
 
 def test_a_bag_without_this_robot_s_joints_says_what_it_names(recorded, tmp_path):
     bag, *_ = recorded
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(bag), "--joint-topic", "/other_joint_states", "--out", str(tmp_path / "x.yaml")],
-                         capture_output=True, text=True, timeout=300, cwd=ROOT)
-    assert run.returncode == 2 and run.stderr.startswith("error: ") and "no JointState topic /other_joint_states" in run.stderr
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-hand-eye",
+            str(bag),
+            "--joint-topic",
+            "/other_joint_states",
+            "--out",
+            str(tmp_path / "x.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert (
+        run.returncode == 2
+        and run.stderr.startswith("error: ")
+        and "no JointState topic /other_joint_states" in run.stderr
+    )
     assert "/joint_states (sensor_msgs/msg/JointState)" in run.stderr  # what the bag holds, named
 
 
@@ -75,8 +103,13 @@ def test_the_mounting_from_a_bag_with_the_flange_on_tf(recorded, tmp_path):
     beside it), still frames only, as from the joints."""
     _, truth, still, moving, tf_bag = recorded
     out = tmp_path / "mount.yaml"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(tf_bag), "--out", str(out), "--json"],
-                         capture_output=True, text=True, timeout=600, cwd=ROOT)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(tf_bag), "--out", str(out), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
     assert run.returncode == 0, run.stderr
     assert "the flange (flange in base_link) from /tf" in run.stderr
     assert json.loads(run.stdout)["poses"] == still and run.stderr.count("not a still view") == moving
@@ -84,7 +117,25 @@ def test_the_mounting_from_a_bag_with_the_flange_on_tf(recorded, tmp_path):
 
     d, r = pose_difference(load_cam2flange(out), truth)
     assert np.linalg.norm(d) < 1.0 and np.linalg.norm(r) < 0.1, (d, r)
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", str(tf_bag), "--flange-frame", "tool0", "--out", str(tmp_path / "x.yaml")],
-                         capture_output=True, text=True, timeout=300, cwd=ROOT)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-hand-eye",
+            str(tf_bag),
+            "--flange-frame",
+            "tool0",
+            "--out",
+            str(tmp_path / "x.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
     assert run.returncode == 2 and run.stderr.startswith("error: "), run.stderr
-    assert "no chain of transforms from 'tool0' up to 'base_link'" in run.stderr and "frames: base_link, flange, forearm, world" in run.stderr
+    assert (
+        "no chain of transforms from 'tool0' up to 'base_link'" in run.stderr
+        and "frames: base_link, flange, forearm, world" in run.stderr
+    )

@@ -32,22 +32,56 @@ def recorded(tmp_path_factory):
     bed, _ = cold_test_bed(seed=1)
     spec = parse_board(DEFAULT_SPEC)
     board2base = board_in_cell(spec, bed.workcell, bed.model_robot)
-    nominal = load_intrinsics(bed.workcell.intrinsics_path)  # what the camera's driver publishes: its data sheet's, not the truth
-    plan = plan_poses(bed.model_robot, nominal, spec, board2base, 16, start_deg=bed.workcell.home_joints_deg, candidates=48)
+    nominal = load_intrinsics(
+        bed.workcell.intrinsics_path
+    )  # what the camera's driver publishes: its data sheet's, not the truth
+    plan = plan_poses(
+        bed.model_robot, nominal, spec, board2base, 16, start_deg=bed.workcell.home_joints_deg, candidates=48
+    )
     track, shot_at, moving = hold_and_move(plan.joints_deg, T0)
     rendered = simulated_hand_eye_images(bed, spec, [q for _, q in shot_at], board2base)
     folder = tmp_path_factory.mktemp("robot_bag")
-    bag = write_arm_bag(folder / "robot_bag", nominal, bed.model_robot, [(t, image) for (t, _), (_, image, _) in zip(shot_at, rendered)], track)
-    grasps = {t.name: grasp_joints(bed, t.tcp2base, k, t.component) for k, t in enumerate(bed.workcell.task_locations.values())}
+    bag = write_arm_bag(
+        folder / "robot_bag",
+        nominal,
+        bed.model_robot,
+        [(t, image) for (t, _), (_, image, _) in zip(shot_at, rendered)],
+        track,
+    )
+    grasps = {
+        t.name: grasp_joints(bed, t.tcp2base, k, t.component)
+        for k, t in enumerate(bed.workcell.task_locations.values())
+    }
     grasps_csv = folder / "grasps.csv"
-    grasps_csv.write_text("task," + ",".join(f"j{k + 1}" for k in range(6)) + "\n" + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items()))
+    grasps_csv.write_text(
+        "task,"
+        + ",".join(f"j{k + 1}" for k in range(6))
+        + "\n"
+        + "".join(f"{name}," + ",".join(f"{v:.6f}" for v in q) + "\n" for name, q in grasps.items())
+    )
     return bag, grasps_csv, bed, grasps, len(plan.joints_deg), moving
 
 
 def test_the_robot_from_a_bag_of_images_and_joint_states(recorded, tmp_path):
     bag, grasps_csv, bed, grasps, still, moving = recorded
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-robot", str(bag), "--grasps", str(grasps_csv), "--out", str(tmp_path), "--json"],
-                         capture_output=True, text=True, timeout=900, cwd=ROOT)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-robot",
+            str(bag),
+            "--grasps",
+            str(grasps_csv),
+            "--out",
+            str(tmp_path),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=900,
+        cwd=ROOT,
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     assert f"{still + moving} images, {still} taken while the arm stood still" in run.stderr
     assert run.stderr.count("skipped ") == moving and run.stderr.count("not a still view") == moving
@@ -59,7 +93,26 @@ def test_the_robot_from_a_bag_of_images_and_joint_states(recorded, tmp_path):
 
 def test_a_bag_with_no_still_board_view_is_an_error_not_an_empty_fit(recorded, tmp_path):
     bag, *_ = recorded
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-robot", str(bag), "--joint-topic", "/other_joint_states", "--out", str(tmp_path / "out")],
-                         capture_output=True, text=True, timeout=300, cwd=ROOT)
-    assert run.returncode == 2 and run.stderr.startswith("error: ") and "no JointState topic /other_joint_states" in run.stderr, run.stderr
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-robot",
+            str(bag),
+            "--joint-topic",
+            "/other_joint_states",
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    assert (
+        run.returncode == 2
+        and run.stderr.startswith("error: ")
+        and "no JointState topic /other_joint_states" in run.stderr
+    ), run.stderr
     assert not (tmp_path / "out").exists()

@@ -11,7 +11,16 @@ from calib_core.frames import make_transform
 from calib_core.solver.solve import solve_pose
 
 LENS = Intrinsics(1000.0, 1000.0, 640.0, 480.0, 1280, 960)
-POINTS = np.array([[-60.0, -40.0, 0.0], [60.0, -40.0, 0.0], [60.0, 40.0, 0.0], [-60.0, 40.0, 0.0], [0.0, 0.0, 25.0], [-30.0, 10.0, 10.0]])
+POINTS = np.array(
+    [
+        [-60.0, -40.0, 0.0],
+        [60.0, -40.0, 0.0],
+        [60.0, 40.0, 0.0],
+        [-60.0, 40.0, 0.0],
+        [0.0, 0.0, 25.0],
+        [-30.0, 10.0, 10.0],
+    ]
+)
 OBJ2CAM = make_transform(Rotation.from_euler("xyz", [170.0, 8.0, -5.0], degrees=True).as_matrix(), [10.0, -5.0, 300.0])
 
 

@@ -19,7 +19,9 @@ def _look(displacement_mm, rotation_deg, sigma_mm, sigma_deg):
     d, r = np.asarray(displacement_mm, float), np.asarray(rotation_deg, float)
     measured = make_transform(Rotation.from_rotvec(np.radians(r)).as_matrix() @ TCP[:3, :3], TCP[:3, 3] + d)
     cov = np.diag([sigma_mm**2] * 3 + [sigma_deg**2] * 3)
-    return EndEffectorEstimate(None, np.eye(4), np.eye(4), np.eye(4), TCP, measured, d, r, np.full(3, sigma_mm), np.full(3, sigma_deg), cov)
+    return EndEffectorEstimate(
+        None, np.eye(4), np.eye(4), np.eye(4), TCP, measured, d, r, np.full(3, sigma_mm), np.full(3, sigma_deg), cov
+    )
 
 
 def _model(sigma_mm, sigma_deg):
@@ -29,15 +31,21 @@ def _model(sigma_mm, sigma_deg):
 def test_equal_uncertainties_take_half_the_look_and_shrink_the_sigma():
     fused = fuse_look(_look([0.06, -0.03, 0.0], [0.01, 0.0, -0.01], 0.05, 0.01), _model(0.05, 0.01))
     assert fused.agree
-    assert np.allclose(fused.displacement_mm, [0.03, -0.015, 0.0]) and np.allclose(fused.rotation_deg, [0.005, 0.0, -0.005])
+    assert np.allclose(fused.displacement_mm, [0.03, -0.015, 0.0]) and np.allclose(
+        fused.rotation_deg, [0.005, 0.0, -0.005]
+    )
     assert np.allclose(np.sqrt(np.diag(fused.covariance)), [0.05 / np.sqrt(2)] * 3 + [0.01 / np.sqrt(2)] * 3)
     assert np.allclose(fused.look_weight, 0.5)
 
 
 def test_the_more_certain_side_wins():
     look = _look([0.08, 0.0, 0.0], [0.0, 0.02, 0.0], 0.01, 0.002)
-    assert fuse_look(look, _model(1.0, 0.2)).displacement_mm[0] == pytest.approx(0.08, rel=1e-3)  # an uncalibrated model: the look
-    assert abs(fuse_look(_look([0.01, 0, 0], [0, 0, 0], 1.0, 0.2), _model(0.01, 0.002)).displacement_mm[0]) < 1e-5  # a noisy look: the model
+    assert fuse_look(look, _model(1.0, 0.2)).displacement_mm[0] == pytest.approx(
+        0.08, rel=1e-3
+    )  # an uncalibrated model: the look
+    assert (
+        abs(fuse_look(_look([0.01, 0, 0], [0, 0, 0], 1.0, 0.2), _model(0.01, 0.002)).displacement_mm[0]) < 1e-5
+    )  # a noisy look: the model
 
 
 def test_a_look_that_disagrees_is_not_used_and_says_why():

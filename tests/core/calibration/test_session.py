@@ -12,7 +12,17 @@ from calib_core.solver import SolveStatus
 from videocal_sim.test_bed import TestBed
 from videocal_sim.true_robot import RobotErrors
 
-FEATURES = ["plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left", "boss_top_right", "boss_bottom_left", "boss_bottom_right"]
+FEATURES = [
+    "plate_top_left",
+    "plate_top_right",
+    "plate_bottom_left",
+    "plate_bottom_right",
+    "pin_tip",
+    "boss_top_left",
+    "boss_top_right",
+    "boss_bottom_left",
+    "boss_bottom_right",
+]
 
 
 @pytest.fixture(scope="module")
@@ -128,7 +138,9 @@ def test_a_solve_is_one_undo_step_that_puts_the_previous_result_back(bed):
     s.changed.connect(lambda: changes.append(s.result))
     assert s.undo.undo() == "Calibrate (9 pairs)"
     assert s.result is first and s.solved_numbers == [1, 2, 3, 4, 5] and changes == [first]
-    assert s.stale_reason is not None and "6, 7, 8, 9" in s.stale_reason  # the first answer, told apart from the pairs on screen
+    assert (
+        s.stale_reason is not None and "6, 7, 8, 9" in s.stale_reason
+    )  # the first answer, told apart from the pairs on screen
     s.undo.redo()
     assert s.result is second and s.verdict is not None and s.stale_reason is None
     for _ in range(9):  # the second solve and the second look's four pairs (3D and 2D each)
@@ -162,9 +174,15 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     assert agreeing.agree
     c = s.store_correction(task.name, fused=agreeing)
     assert np.allclose(c.displacement_mm, agreeing.displacement_mm) and np.allclose(c.delta_base, agreeing.delta_base)
-    assert np.all(c.std_displacement_mm < look.std_displacement_mm) and "look and model agree" in c.source and not c.confirmation
+    assert (
+        np.all(c.std_displacement_mm < look.std_displacement_mm)
+        and "look and model agree" in c.source
+        and not c.confirmation
+    )
     s.corrections.remove_last(task.name)
-    tight = fuse_look(look, np.diag([1e-6] * 3 + [1e-8] * 3))  # a model "certain" the TCP is where it says: millimetres away
+    tight = fuse_look(
+        look, np.diag([1e-6] * 3 + [1e-8] * 3)
+    )  # a model "certain" the TCP is where it says: millimetres away
     assert not tight.agree
     with pytest.raises(ConfirmationNeeded, match="sigma from the calibrated model"):
         s.store_correction(task.name, fused=tight)
@@ -182,4 +200,3 @@ def test_a_look_stored_alone_carries_the_measured_tool_s_uncertainty(bed):
     assert np.allclose(c.std_displacement_mm, np.sqrt(look.std_displacement_mm**2 + 0.05**2))
     assert np.allclose(c.std_rotation_deg, np.sqrt(look.std_rotation_deg**2 + 0.01**2))
     assert "measured tool" in c.source and np.allclose(c.displacement_mm, look.displacement_mm)
-

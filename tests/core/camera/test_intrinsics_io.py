@@ -86,7 +86,10 @@ BAD_FILES = {
         "   data: [ 500., 0., 0., 510. ]\n",
         "field 'camera_matrix': expected a 3x3 matrix",
     ),
-    "cv_broken.yaml": ("%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: [\n", "cannot parse|cannot open|camera_matrix"),
+    "cv_broken.yaml": (
+        "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: [\n",
+        "cannot parse|cannot open|camera_matrix",
+    ),
 }
 
 

@@ -14,7 +14,9 @@ from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy
 from calib_core.solver import solve_pose
 
-RATIONAL = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960, (-0.2, 0.05, 6e-4, -4e-4, -0.01, 0.12, -0.03, 0.01), "rational_polynomial")
+RATIONAL = Intrinsics(
+    1120.0, 1116.0, 645.2, 476.8, 1280, 960, (-0.2, 0.05, 6e-4, -4e-4, -0.01, 0.12, -0.03, 0.01), "rational_polynomial"
+)
 FISHEYE = Intrinsics(620.0, 618.0, 641.0, 479.0, 1280, 960, (-0.012, 0.004, -0.0015, 0.0002), "equidistant")
 RNG = np.random.default_rng(5)
 
@@ -35,7 +37,9 @@ def test_rational_projection_is_opencvs():
 def test_fisheye_projection_is_opencvs():
     p = _points()
     ours = project(p, FISHEYE)
-    theirs = cv2.fisheye.projectPoints(p.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), FISHEYE.K, FISHEYE.dist_coeffs.reshape(4, 1))[0].reshape(-1, 2)
+    theirs = cv2.fisheye.projectPoints(
+        p.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), FISHEYE.K, FISHEYE.dist_coeffs.reshape(4, 1)
+    )[0].reshape(-1, 2)
     assert np.allclose(ours, theirs, atol=1e-6)
     # a fisheye sees wider than a pinhole could: 50 deg off axis lands inside the image
     assert FISHEYE.contains(project(np.array([[np.tan(np.radians(50)) * 500, 0.0, 500.0]]), FISHEYE))[0]
@@ -69,16 +73,36 @@ def test_a_pose_is_solved_through_the_lens(lens):
 
 def test_camera_info_of_each_model_is_read_as_ros_writes_it(tmp_path):
     # camera_calibration's ost.yaml for a fisheye lens
-    ost = {"image_width": 1280, "image_height": 960, "camera_name": "wide", "camera_matrix": {"rows": 3, "cols": 3, "data": FISHEYE.K.ravel().tolist()},
-           "distortion_model": "equidistant", "distortion_coefficients": {"rows": 1, "cols": 4, "data": list(FISHEYE.distortion)},
-           "rectification_matrix": {"rows": 3, "cols": 3, "data": np.eye(3).ravel().tolist()},
-           "projection_matrix": {"rows": 3, "cols": 4, "data": np.c_[FISHEYE.K, np.zeros(3)].ravel().tolist()}}
+    ost = {
+        "image_width": 1280,
+        "image_height": 960,
+        "camera_name": "wide",
+        "camera_matrix": {"rows": 3, "cols": 3, "data": FISHEYE.K.ravel().tolist()},
+        "distortion_model": "equidistant",
+        "distortion_coefficients": {"rows": 1, "cols": 4, "data": list(FISHEYE.distortion)},
+        "rectification_matrix": {"rows": 3, "cols": 3, "data": np.eye(3).ravel().tolist()},
+        "projection_matrix": {"rows": 3, "cols": 4, "data": np.c_[FISHEYE.K, np.zeros(3)].ravel().tolist()},
+    }
     (tmp_path / "ost.yaml").write_text(yaml.safe_dump(ost))
     assert load_intrinsics(tmp_path / "ost.yaml") == FISHEYE
     # `ros2 topic echo --once /camera/camera_info` of a rational lens
-    echo = "\n".join(["header:", "  stamp:", "    sec: 0", "    nanosec: 0", "  frame_id: camera", "height: 960", "width: 1280",
-                      "distortion_model: rational_polynomial", "d:"] + [f"- {v}" for v in RATIONAL.distortion]
-                     + ["k:"] + [f"- {v}" for v in RATIONAL.K.ravel()] + ["---"])
+    echo = "\n".join(
+        [
+            "header:",
+            "  stamp:",
+            "    sec: 0",
+            "    nanosec: 0",
+            "  frame_id: camera",
+            "height: 960",
+            "width: 1280",
+            "distortion_model: rational_polynomial",
+            "d:",
+        ]
+        + [f"- {v}" for v in RATIONAL.distortion]
+        + ["k:"]
+        + [f"- {v}" for v in RATIONAL.K.ravel()]
+        + ["---"]
+    )
     (tmp_path / "echo.yaml").write_text(echo + "\n")
     assert load_intrinsics(tmp_path / "echo.yaml") == RATIONAL
     # a fisheye model with a plumb_bob's five coefficients is named, not guessed at

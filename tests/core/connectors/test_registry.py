@@ -13,11 +13,21 @@ from calib_core.connectors.joint_map import JointMap
 
 
 def _context(n=6):
-    return ControllerContext(tuple(f"j{i}" for i in range(n)), ("deg",) * n, JointMap(np.arange(n)[::-1].copy(), np.full(n, 10.0)))
+    return ControllerContext(
+        tuple(f"j{i}" for i in range(n)), ("deg",) * n, JointMap(np.arange(n)[::-1].copy(), np.full(n, 10.0))
+    )
 
 
-@pytest.mark.parametrize("url, scheme", [("/dev/ttyUSB0", "serial"), ("COM3", "serial"), ("socket://10.0.0.2:7000", "socket"),
-                                         ("ROS2:///joint_states", "ros2"), ("ur-rtde://192.168.1.10", "ur-rtde")])
+@pytest.mark.parametrize(
+    "url, scheme",
+    [
+        ("/dev/ttyUSB0", "serial"),
+        ("COM3", "serial"),
+        ("socket://10.0.0.2:7000", "socket"),
+        ("ROS2:///joint_states", "ros2"),
+        ("ur-rtde://192.168.1.10", "ur-rtde"),
+    ],
+)
 def test_controller_schemes(url, scheme):
     assert controller_scheme(url) == scheme
 
@@ -57,8 +67,7 @@ def test_a_folder_camera_plays_its_images(tmp_path):
 
 def test_a_users_package_adds_a_scheme(tmp_path, monkeypatch):
     """A package of the user's registers ``mycell://`` in ``videocal.controllers``: found, no fork."""
-    (tmp_path / "my_connector.py").write_text(
-        "def open(url, context):\n    return ('opened', url, context.n_joints)\n")
+    (tmp_path / "my_connector.py").write_text("def open(url, context):\n    return ('opened', url, context.n_joints)\n")
     info = tmp_path / "my_connector-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-connector\nVersion: 0.1\n")

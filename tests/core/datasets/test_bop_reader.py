@@ -42,7 +42,9 @@ def _render(mesh, obj2cam, seed=0):
     finally:
         renderer.close()
     rng = np.random.default_rng(seed)
-    background = cv2.resize(rng.uniform(0, 255, (12, 16, 3)).astype(np.uint8), (K.width, K.height), interpolation=cv2.INTER_CUBIC)
+    background = cv2.resize(
+        rng.uniform(0, 255, (12, 16, 3)).astype(np.uint8), (K.width, K.height), interpolation=cv2.INTER_CUBIC
+    )
     alpha = rgba[:, :, 3:4] / 255.0
     image = rgba[:, :, :3] * alpha + background * (1 - alpha) + rng.normal(0, 3, background.shape)
     return np.clip(image, 0, 255).astype(np.uint8)
@@ -66,8 +68,14 @@ def dataset(tmp_path_factory):
         cv2.imwrite(str(scene / "rgb" / f"{im_id:06d}.png"), _render(mesh, T, im_id)[:, :, ::-1])
     K9 = [K.fu, 0.0, K.cx, 0.0, K.fv, K.cy, 0.0, 0.0, 1.0]
     (scene / "scene_camera.json").write_text(json.dumps({str(i): {"cam_K": K9, "depth_scale": 0.1} for i in truths}))
-    (scene / "scene_gt.json").write_text(json.dumps({str(i): [{"cam_R_m2c": T[:3, :3].reshape(-1).tolist(), "cam_t_m2c": T[:3, 3].tolist(), "obj_id": 3}]
-                                                     for i, T in truths.items()}))
+    (scene / "scene_gt.json").write_text(
+        json.dumps(
+            {
+                str(i): [{"cam_R_m2c": T[:3, :3].reshape(-1).tolist(), "cam_t_m2c": T[:3, 3].tolist(), "obj_id": 3}]
+                for i, T in truths.items()
+            }
+        )
+    )
     (scene / "scene_gt_info.json").write_text(json.dumps({"0": [{"visib_fract": 0.93}], "1": [{"visib_fract": 0.31}]}))
     return root, mesh, truths
 
@@ -79,7 +87,12 @@ def test_the_reader_gives_each_annotated_object_with_its_camera_truth_and_visibi
     assert [(v.scene_id, v.im_id, v.obj_id) for v in views] == [(7, 0, 3), (7, 1, 3)]
     assert views[0].visib_fract == pytest.approx(0.93)
     np.testing.assert_allclose(views[1].obj2cam, truths[1], atol=1e-12)
-    assert (views[0].intrinsics.fu, views[0].intrinsics.cy, views[0].intrinsics.width, views[0].intrinsics.height) == (K.fu, K.cy, 640, 480)
+    assert (views[0].intrinsics.fu, views[0].intrinsics.cy, views[0].intrinsics.width, views[0].intrinsics.height) == (
+        K.fu,
+        K.cy,
+        640,
+        480,
+    )
     assert [v.im_id for v in data.views(min_visible=0.5)] == [0]
     model = data.models()[3]
     assert model.diameter_mm == 140.0 and model.path.name == "obj_000003.ply" and len(model.symmetries) == 1
@@ -117,7 +130,10 @@ def test_a_creaseless_mesh_gives_edge_samples_along_its_outline():
     uv = project_points(samples, pose, K)
     boundary = cv2.morphologyEx(mask, cv2.MORPH_GRADIENT, np.ones((3, 3), np.uint8))
     distance = cv2.distanceTransform(255 - boundary, cv2.DIST_L2, 3)
-    at = distance[np.clip(np.rint(uv[:, 1] - v0).astype(int), 0, mask.shape[0] - 1), np.clip(np.rint(uv[:, 0] - u0).astype(int), 0, mask.shape[1] - 1)]
+    at = distance[
+        np.clip(np.rint(uv[:, 1] - v0).astype(int), 0, mask.shape[0] - 1),
+        np.clip(np.rint(uv[:, 0] - u0).astype(int), 0, mask.shape[1] - 1),
+    ]
     assert np.all(at <= 1.5)  # every sample on the silhouette's boundary
 
 
@@ -128,7 +144,9 @@ def test_locate_finds_the_creaseless_object_from_a_prior_10_mm_and_3_deg_off(dat
     prior = view.obj2cam.copy()
     prior[:3, 3] += [6.0, -8.0, 0.0]
     prior[:3, :3] = Rotation.from_rotvec(np.radians(3.0) * np.array([0.6, 0.0, 0.8])).as_matrix() @ prior[:3, :3]
-    located = locate(np.ascontiguousarray(image), view.intrinsics, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={})
+    located = locate(
+        np.ascontiguousarray(image), view.intrinsics, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={}
+    )
     assert located.obj2cam is not None, located.message
     points = np.asarray(mesh.vertices)[::10]
     prior_error = mspd(prior, view.obj2cam, points, np.eye(4)[None], view.intrinsics)

@@ -10,7 +10,14 @@ from scipy.spatial.transform import Rotation
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.datasets.bop import symmetry_transforms
-from calib_core.datasets.pose_errors import MSPD_THRESHOLDS_PX, average_recall, mspd, mssd, rotation_error_deg, translation_error_mm
+from calib_core.datasets.pose_errors import (
+    MSPD_THRESHOLDS_PX,
+    average_recall,
+    mspd,
+    mssd,
+    rotation_error_deg,
+    translation_error_mm,
+)
 
 K = Intrinsics(572.4, 573.6, 325.3, 242.0, 640, 480)
 RNG = np.random.default_rng(3)
@@ -38,7 +45,13 @@ def test_a_pure_move_is_its_length_in_space_and_a_pixel_shift_in_the_image():
 
 
 def test_a_turn_about_a_continuous_symmetry_costs_nothing_and_about_another_axis_it_does():
-    cylinder = np.column_stack([30 * np.cos(np.linspace(0, 2 * np.pi, 200)), 30 * np.sin(np.linspace(0, 2 * np.pi, 200)), np.linspace(-50, 50, 200)])
+    cylinder = np.column_stack(
+        [
+            30 * np.cos(np.linspace(0, 2 * np.pi, 200)),
+            30 * np.sin(np.linspace(0, 2 * np.pi, 200)),
+            np.linspace(-50, 50, 200),
+        ]
+    )
     syms = symmetry_transforms({"symmetries_continuous": [{"axis": [0, 0, 1], "offset": [0, 0, 0]}]})
     assert len(syms) == int(np.ceil(np.pi / 0.01))
     truth = _pose([30, 0, 0], [10, 0, 700])

@@ -38,14 +38,17 @@ def test_settings_a_camera_refuses_are_named():
         open_camera("aravis://")
 
 
-@pytest.mark.parametrize("option, message", [
-    ("exposure_us=-5", "refuses exposure_us='-5': it offers 10-10000000 us"),
-    ("gain_db=1000", "refuses gain_db='1000': it offers 0-10 dB"),
-    ("width=99999", "refuses width='99999': it offers 1-2048 px"),
-    ("height=0", "refuses height='0': it offers 1-2048 px"),
-    ("exposure_us=fast", "exposure_us='fast' is not a number"),
-    ("gain_db=nan", "gain_db='nan' is not a finite number"),
-])
+@pytest.mark.parametrize(
+    "option, message",
+    [
+        ("exposure_us=-5", "refuses exposure_us='-5': it offers 10-10000000 us"),
+        ("gain_db=1000", "refuses gain_db='1000': it offers 0-10 dB"),
+        ("width=99999", "refuses width='99999': it offers 1-2048 px"),
+        ("height=0", "refuses height='0': it offers 1-2048 px"),
+        ("exposure_us=fast", "exposure_us='fast' is not a number"),
+        ("gain_db=nan", "gain_db='nan' is not a finite number"),
+    ],
+)
 def test_a_setting_outside_what_the_camera_offers_is_refused_with_its_range(option, message):
     with pytest.raises(VideoSourceError, match=re.escape(message)):
         open_camera(f"aravis://Fake_1?{option}")
@@ -63,7 +66,9 @@ def test_a_gige_camera_is_found_by_its_device_id_as_by_its_address_and_an_unknow
             assert np.array_equal(camera.read().image, scene)
         finally:
             camera.close()
-        with pytest.raises(VideoSourceError, match=r"no camera with that id; cameras found: .*Aravis-Fake-BYID01 \(127\.0\.0\.1\)"):
+        with pytest.raises(
+            VideoSourceError, match=r"no camera with that id; cameras found: .*Aravis-Fake-BYID01 \(127\.0\.0\.1\)"
+        ):
             open_camera("aravis://Basler-acA1300-000000")
     finally:
         server.close()

@@ -90,8 +90,14 @@ def far_controller(request):
     try:
         port = int(re.search(r":(\d+)", sim.device).group(1))
         moves_seen: list[str] = []
-        tap = lambda direction, data: moves_seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace"))) if direction == "up" else None
-        line = DelayLine(("127.0.0.1", 0), ("127.0.0.1", port), LinkWeather(1.5, 0.3, request.param), seed=7, tap=tap).start()
+        tap = lambda direction, data: (
+            moves_seen.extend(re.findall(r"MVJ,([\w.]+),", data.decode(errors="replace")))
+            if direction == "up"
+            else None
+        )
+        line = DelayLine(
+            ("127.0.0.1", 0), ("127.0.0.1", port), LinkWeather(1.5, 0.3, request.param), seed=7, tap=tap
+        ).start()
         try:
             yield f"socket://{line.address[0]}:{line.address[1]}", moves_seen, line
         finally:
@@ -107,10 +113,14 @@ def test_a_controller_1_5_s_away_opens_a_session_and_completes_a_move_sent_once(
     url, moves_seen, line = far_controller
     with ControllerLink(url, rate_hz=50, deadman_ms=1000) as link:
         assert link._auth.wait_settled(40.0) is AuthState.READY, link.auth_failure
-        assert 2.0 < link.round_trip.srtt_s < 10.0  # measured: 3 s of round trip, give or take the jitter (and the lost ones)
+        assert (
+            2.0 < link.round_trip.srtt_s < 10.0
+        )  # measured: 3 s of round trip, give or take the jitter (and the lost ones)
         # the delay shown: half the median round trip (1.5 s +-30 % one way; at 25 % lost most answers are late too)
         assert 1.0 < link.delay_s < (2.5 if line.weather.loss < 0.1 else 6.0)
-        assert link.deadman_sent_ms() >= 1000 + 1000 * link.round_trip.srtt_s  # the heartbeat's allowance covers the trip
+        assert (
+            link.deadman_sent_ms() >= 1000 + 1000 * link.round_trip.srtt_s
+        )  # the heartbeat's allowance covers the trip
         assert wait_until(lambda: link.state is LinkState.UP, 10.0)
         handles = []
         for target in ([150, -40, 45, 0, 50, 0], [-150, 40, -45, 0, -50, 0]):  # 2 and 4 s of motion

@@ -90,11 +90,14 @@ def test_a_hello_without_the_key_does_not_end_the_workstations_session():
     assert ws2.sealed("MVJ,b.1,0,0,0,0,0,0") == [Ack("MVJ", "b.1")]
 
 
-@pytest.mark.parametrize("body", [
-    "MVJ," + "m" * 250 + ",10,0,0,0,0,0",                         # a keyless move with a long id
-    "MVJ,x.1,1e308,-1e308,1e308,-1e308,1e308,-1e308",             # numbers whose refusal quotes 309 digits
-    "MVJ,x.1," + ",".join(["1e308"] * 16),
-])
+@pytest.mark.parametrize(
+    "body",
+    [
+        "MVJ," + "m" * 250 + ",10,0,0,0,0,0",  # a keyless move with a long id
+        "MVJ,x.1,1e308,-1e308,1e308,-1e308,1e308,-1e308",  # numbers whose refusal quotes 309 digits
+        "MVJ,x.1," + ",".join(["1e308"] * 16),
+    ],
+)
 def test_every_refusal_fits_the_protocols_limit(body):
     for key in (KEY, None):
         c = ControllerLogic(clock=_Clock(), key=key)
@@ -167,7 +170,9 @@ def test_a_dead_workstation_s_move_stops_whatever_heartbeats_others_send(sim):  
     samples = [r for r in replies if isinstance(r, JointSample)]
     assert any(isinstance(r, ErrorReply) and r.code == "AUTH" and r.text.startswith("heartbeat:") for r in replies)
     last = samples[-1].joints_deg[0]
-    assert 20.0 < last < 160.0 and np.allclose([x.joints_deg[0] for x in samples[-10:]], last)  # stopped short of its goal, at rest
+    assert 20.0 < last < 160.0 and np.allclose(
+        [x.joints_deg[0] for x in samples[-10:]], last
+    )  # stopped short of its goal, at rest
 
 
 def test_a_keyless_tcp_client_does_not_lock_the_workstation_out(sim):  # noqa: F811
@@ -230,7 +235,9 @@ def test_a_move_released_after_the_dead_man_ran_out_is_refused_even_when_fresh_e
     nonce = auth.new_nonce()
     (reply,) = c.handle(f"HEL,{nonce},{auth.hello_request(KEY, nonce)}")
     clock.t += 4.0
-    assert c.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}") == [Ack("AUT", "-")] and c.fresh_ms == 8500
+    assert (
+        c.handle(f"AUT,{auth.workstation_proof(KEY, nonce, reply.nonce)}") == [Ack("AUT", "-")] and c.fresh_ms == 8500
+    )
     session = auth.session_key(KEY, nonce, reply.nonce)
     assert c.handle(auth.seal(session, 1, c.clock_ms(), "HBT,1000")) == []
     move = auth.seal(session, 2, c.clock_ms(), "MVJ,a.1,90,0,0,0,0,0")
@@ -311,7 +318,11 @@ def test_a_relay_releasing_a_withheld_move_after_the_workstation_died_moves_noth
         port = probe.getsockname()[1]
     sim("--tcp", str(port), "--joints", "0,0,0,0,0,0", link=False)
     relay = WithholdingRelay(port)
-    ws = subprocess.Popen([sys.executable, "-c", _WORKSTATION_BEHIND_RELAY, f"socket://127.0.0.1:{relay.port}"], stdout=subprocess.PIPE, text=True)
+    ws = subprocess.Popen(
+        [sys.executable, "-c", _WORKSTATION_BEHIND_RELAY, f"socket://127.0.0.1:{relay.port}"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     try:
         assert ws.stdout.readline().strip() == "auth ready"
         assert ws.stdout.readline().strip() == "sent"
@@ -335,7 +346,9 @@ def test_a_relay_releasing_a_withheld_move_after_the_workstation_died_moves_noth
         ws.stdout.close()
         relay.close()
     refusals = [r for r in replies if isinstance(r, ErrorReply)]
-    assert any(r.code == "AUTH" and "stale: sealed" in r.text and r.text.startswith("move ") for r in refusals), refusals
+    assert any(r.code == "AUTH" and "stale: sealed" in r.text and r.text.startswith("move ") for r in refusals), (
+        refusals
+    )
     assert not any(isinstance(r, Ack) and r.cmd == "MVJ" for r in replies)
     samples = [r for r in replies if isinstance(r, JointSample)]
     assert len(samples) >= 10 and all(abs(s.joints_deg[0]) < 1e-6 for s in samples)  # joint 1 never left 0 deg

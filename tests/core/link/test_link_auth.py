@@ -48,7 +48,14 @@ def test_proofs_and_seals_are_rfc2104_hmacs_of_the_documented_texts():
     assert not auth.seal_is_valid(session, body.replace("10.0000", "90.0000"), s)
     assert not auth.seal_is_valid(session, inner, auth.Seal(7, 98766, s.mac))  # the time is sealed too
     assert auth.split_seal(body) == (body, None)
-    assert len(encode(auth.seal(session, 4_000_000_000, 9_999_999_999, "MVJ,mffff.99999," + ",".join(["-999999.9999"] * 16)))) <= 320
+    assert (
+        len(
+            encode(
+                auth.seal(session, 4_000_000_000, 9_999_999_999, "MVJ,mffff.99999," + ",".join(["-999999.9999"] * 16))
+            )
+        )
+        <= 320
+    )
 
 
 @pytest.mark.parametrize("round_trip_ms, bound_ms", [(0, 1000), (10, 1000), (400, 1300), (3700, 7900), (9000, 15000)])
@@ -260,7 +267,9 @@ def test_a_controller_with_another_key_refuses_our_hello_and_we_say_so():
     second = ws.hello()
     # its refusal of the earlier hello is not about the newest one; of the newest, it is
     assert ws.on_error(controller.handle(first)[0]) and ws.state is AuthState.PENDING
-    assert ws.on_error(controller.handle(second)[0]) and ws.state is AuthState.FAILED and "refused our hello" in ws.failure
+    assert (
+        ws.on_error(controller.handle(second)[0]) and ws.state is AuthState.FAILED and "refused our hello" in ws.failure
+    )
 
 
 def test_forged_hello_replies_and_refusals_of_others_hellos_do_not_fail_the_handshake():

@@ -46,7 +46,12 @@ def test_the_controller_stops_on_stp_and_on_a_silent_workstation():
     assert c.handle("MVJ,a.3,0,0,0,0,0,0") == [Ack("MVJ", "a.3")]
     clock.t += 0.01
     out = c.handle("STP")
-    assert out[0].code == "STOPPED" and out[0].text.startswith("move a.3:") and out[-1] == Ack("STP", "-") and c.move is None
+    assert (
+        out[0].code == "STOPPED"
+        and out[0].text.startswith("move a.3:")
+        and out[-1] == Ack("STP", "-")
+        and c.move is None
+    )
     c.handle("HBT,0")  # disarmed
     clock.t += 10.0
     assert c.handle("MVJ,a.4,1,0,0,0,0,0") == [Ack("MVJ", "a.4")]
@@ -82,7 +87,9 @@ def test_stop_ends_the_running_move_with_the_controllers_reason(sim):  # noqa: F
 
 
 def test_replies_are_matched_by_id_and_samples_going_back_are_not_fresh():
-    link = ControllerLink("loop://", rate_hz=10, deadman_ms=0, n_joints=1, key=None)  # no controller: nothing to authenticate with
+    link = ControllerLink(
+        "loop://", rate_hz=10, deadman_ms=0, n_joints=1, key=None
+    )  # no controller: nothing to authenticate with
     delivered = []
     link.sample_received.connect(delivered.append)
     link.start(wait_open=True)
@@ -99,7 +106,11 @@ def test_replies_are_matched_by_id_and_samples_going_back_are_not_fresh():
         assert first.finished and first.error is None
         for seq, t_ms in ((10, 5000), (11, 5020), (11, 5020), (9, 4980), (12, 5010), (0, 20)):
             link._dispatch(JointSample(seq, t_ms, (0.0,)).body(), now)
-        assert [d.sample.seq for d in delivered] == [10, 11, 0]  # a repeat, an older one, a time going back: dropped; a restart: fresh
+        assert [d.sample.seq for d in delivered] == [
+            10,
+            11,
+            0,
+        ]  # a repeat, an older one, a time going back: dropped; a restart: fresh
         assert link.stats.backwards_samples == 3 and link.stats.controller_restarts == 1
     finally:
         link.close()

@@ -90,7 +90,10 @@ def test_move_without_done_times_out(sim):
             handle.wait(5)
 
 
-@pytest.mark.parametrize("fault, counter", [("--corrupt-rate", "bad_checksum"), ("--noise-rate", "garbage_bytes"), ("--drop-rate", "missing_samples")])
+@pytest.mark.parametrize(
+    "fault, counter",
+    [("--corrupt-rate", "bad_checksum"), ("--noise-rate", "garbage_bytes"), ("--drop-rate", "missing_samples")],
+)
 def test_fault_injection_is_survived_and_counted(sim, fault, counter):
     s = sim("--pty", fault, "0.2", "--seed", "3")
     with ControllerLink(s.url, rate_hz=200) as link:

@@ -17,7 +17,9 @@ def sample(core, joints_deg, t_s: float) -> None:
     core.observe_sample(TimedSample(JointSample(next(_seq), int(t_s * 1000), tuple(float(v) for v in q)), t_s))
 
 
-def still_for(core, seconds: float = 0.6, joints_deg=None, rate_hz: float = 50.0, start_s: float | None = None) -> float:
+def still_for(
+    core, seconds: float = 0.6, joints_deg=None, rate_hz: float = 50.0, start_s: float | None = None
+) -> float:
     """Samples of a robot standing at ``joints_deg`` (default: the core's joints) for ``seconds``
     from ``start_s`` (default: the last ``seconds`` up to now); returns the time of the last one."""
     q = core.joints_deg if joints_deg is None else joints_deg

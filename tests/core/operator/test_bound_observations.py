@@ -16,7 +16,6 @@ from tests.core.operator.perfect_operator import FEATURES, pick_all as _pick_all
 from tests.core.operator.still_robot import frame_now, sample, still_for
 
 
-
 @pytest.fixture
 def cell_and_site():
     return simulated_cell(image_scale=0.5)
@@ -75,7 +74,9 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
     core, _ = _picked_at_task(cell, site)
     obj2world = core.workcell.component(core.session.target).item2world
     home = cell.home_joints
-    result = core.session.calibrate(core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home)
+    result = core.session.calibrate(
+        core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home
+    )
     assert np.linalg.norm(result.displacement_mm) > 100.0
     verdict = core.session.verdict
     assert verdict.verdict is Verdict.IMPLAUSIBLE and "beyond the cell's stated model error of 25 mm" in verdict.text
@@ -89,7 +90,10 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
     core.event.connect(lambda kind, detail: events.append((kind, detail)))
     stored = core.desk.store_correction(convert=converted, confirmation="confirmed by a test: the cell was moved")
     assert stored.verdict == "implausible" and stored.confirmation == "confirmed by a test: the cell was moved"
-    assert ("correction_confirmed", {"task": core.task.name, "verdict": "implausible", "confirmation": stored.confirmation}) in events
+    assert (
+        "correction_confirmed",
+        {"task": core.task.name, "verdict": "implausible", "confirmation": stored.confirmation},
+    ) in events
 
 
 def test_a_result_whose_pairs_changed_is_stale_and_cannot_be_stored(cell_and_site):
@@ -118,7 +122,9 @@ def test_a_frame_taken_while_the_robot_moves_is_refused_with_the_reason(cell_and
         sample(core, q, t + 0.02 * k)
     frame_now(core, t_s=t + 0.2)
     core.picking.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
-    with pytest.raises(NotSettledError, match=rf"moving when the frame was taken \({core.robot.joint_names[1]} at 10.00 deg/s"):
+    with pytest.raises(
+        NotSettledError, match=rf"moving when the frame was taken \({core.robot.joint_names[1]} at 10.00 deg/s"
+    ):
         core.picking.pick_image_point((10.0, 10.0))
     assert core.observations.still is None and core.session.pairs.pending() is not None
     # Still again for the settle time: the next frame is usable.

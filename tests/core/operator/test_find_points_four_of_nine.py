@@ -23,7 +23,9 @@ JOINTS = np.array([-20.5127, 2.3659, 0.8087, -0.0012, -3.1746, 0.0012])  # the t
 
 def test_find_points_on_the_demo_s_frame_12_finds_the_target_where_it_is():
     typical = RobotErrors.typical(0)  # the demo's true robot: typical errors, the camera mounted as modelled
-    cell, site = simulated_cell(errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
+    cell, site = simulated_cell(
+        errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
+    )
     core = OperatorCore(cell, site)
     still_for(core, joints_deg=JOINTS)
     frame_now(core, index=12, image=cv2.cvtColor(cv2.imread(str(FRAME)), cv2.COLOR_BGR2RGB))
@@ -44,7 +46,9 @@ def test_a_fit_on_half_its_edges_proposes_nothing_and_offers_no_edge_calibration
 
     monkeypatch.setattr(find_points_module, "_STARTS", 3)
     typical = RobotErrors.typical(0)
-    cell, site = simulated_cell(errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg))
+    cell, site = simulated_cell(
+        errors=RobotErrors(typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg)
+    )
     core = OperatorCore(cell, site)
     still_for(core, joints_deg=JOINTS)
     frame_now(core, index=12, image=cv2.cvtColor(cv2.imread(str(FRAME)), cv2.COLOR_BGR2RGB))

@@ -34,14 +34,18 @@ def fisheye_look():
 
 def _camera_error(core, site, q, estimate) -> tuple[float, float]:
     true_cam = site.bed.true_cam2world(q)
-    return (float(np.linalg.norm(estimate.cam2world_measured[:3, 3] - true_cam[:3, 3])),
-            float(np.linalg.norm(estimate.cam2world_model[:3, 3] - true_cam[:3, 3])))
+    return (
+        float(np.linalg.norm(estimate.cam2world_measured[:3, 3] - true_cam[:3, 3])),
+        float(np.linalg.norm(estimate.cam2world_model[:3, 3] - true_cam[:3, 3])),
+    )
 
 
 def test_the_lens_moves_a_feature_by_pixels_and_the_cell_uses_it(fisheye_look):
     core, site, q, frame = fisheye_look
     fixture = core.workcell.component(core.task.component)
-    corner = apply(invert(site.bed.true_cam2world(q)), apply(fixture.item2world, fixture.features["plate_top_left"])[None])
+    corner = apply(
+        invert(site.bed.true_cam2world(q)), apply(fixture.item2world, fixture.features["plate_top_left"])[None]
+    )
     # the same point through the fisheye and through a pinhole of its focal length lands pixels apart
     assert np.linalg.norm(project(corner, FISHEYE) - project(corner, FISHEYE.without_distortion())) > 5.0
     assert core.intrinsics.model == "equidistant" and frame.image.shape == (960, 1280, 3)

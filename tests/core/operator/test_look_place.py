@@ -72,8 +72,12 @@ def test_converted_explicitly_it_becomes_the_correction_with_what_the_operator_s
     assert "converted: the look was made 200" in c.source and "converted by a test" in c.source
     assert [k for k, _ in events] == ["look_converted"]
     # what the window said would change is what changed
-    d, r = pose_difference(core.session.corrections.corrected_target(core.task.name, core.task.tcp2base), core.task.tcp2base)
-    assert np.linalg.norm(d) == pytest.approx(refused.value.change_mm, abs=1e-6) and np.linalg.norm(r) == pytest.approx(refused.value.change_deg, abs=1e-6)
+    d, r = pose_difference(
+        core.session.corrections.corrected_target(core.task.name, core.task.tcp2base), core.task.tcp2base
+    )
+    assert np.linalg.norm(d) == pytest.approx(refused.value.change_mm, abs=1e-6) and np.linalg.norm(r) == pytest.approx(
+        refused.value.change_deg, abs=1e-6
+    )
 
 
 def test_looks_at_the_task_and_at_its_corrected_pose_count(cell_and_site):
@@ -98,7 +102,10 @@ def test_a_look_on_a_recording_is_not_the_live_tasks_correction(cell_and_site):
     core = OperatorCore(cell, site)
     q = _at_task(core)
     times = np.arange(0.0, 1.0, 0.02)  # a still robot on the recording's time axis, then a frame of it
-    core.picking.begin_replay(JointHistory.from_arrays(times, np.tile(q, (len(times), 1)), core.workcell.safety.settle_rule), "sample_session.mcap")
+    core.picking.begin_replay(
+        JointHistory.from_arrays(times, np.tile(q, (len(times), 1)), core.workcell.safety.settle_rule),
+        "sample_session.mcap",
+    )
     core.picking.observe_frame(Frame(np.zeros((480, 640, 3), np.uint8), 3, float(times[-1])), replayed=True)
     _pick_all(core, site.bed, q)
     core.picking.calibrate()
@@ -114,7 +121,10 @@ def _task(tolerance_mm=1.0):
     return TaskLocation("t", make_transform(np.eye(3), [500.0, 0.0, 300.0]), 200.0, None, tolerance_mm)
 
 
-@pytest.mark.parametrize("shift_mm, turn_deg, at", [(0.0, 0.0, "task"), (0.9, 0.0, "task"), (1.1, 0.0, "elsewhere"), (0.0, 0.5, "task"), (0.0, 0.6, "elsewhere")])
+@pytest.mark.parametrize(
+    "shift_mm, turn_deg, at",
+    [(0.0, 0.0, "task"), (0.9, 0.0, "task"), (1.1, 0.0, "elsewhere"), (0.0, 0.5, "task"), (0.0, 0.6, "elsewhere")],
+)
 def test_place_of_a_look_against_the_tasks_tolerance(shift_mm, turn_deg, at):
     task = _task()
     look = task.tcp2base @ transform_from_rotvec_deg([0.0, 0.0, turn_deg], [shift_mm, 0.0, 0.0])
@@ -132,7 +142,9 @@ def test_the_nearest_of_task_and_corrected_pose_is_reported():
     assert place_of_look(task, look, None, ("live",)).at == "elsewhere"
 
 
-def test_the_stored_correction_exports_as_a_krl_data_list_named_after_its_file_with_the_cells_tool(cell_and_site, tmp_path):
+def test_the_stored_correction_exports_as_a_krl_data_list_named_after_its_file_with_the_cells_tool(
+    cell_and_site, tmp_path
+):
     """*File > Export corrections* of the core: the listing is named after its file and carries the cell's tool."""
     import re
 

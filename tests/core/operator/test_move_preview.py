@@ -54,6 +54,8 @@ def test_a_box_in_the_way_blocks_the_move_and_a_large_change_needs_a_confirmatio
     assert p.blocked and "crate" in p.problems[0] and 0 < p.contact_step < len(p.path_deg) - 1
     ok = preview_move(robot, free, home, goal, "around", SafetyLimits())
     assert not ok.blocked and ok.needs_confirmation and "joint_1 +40.0 deg" in ok.confirm_reasons[0]
-    assert not preview_move(robot, free, home, goal, "around", SafetyLimits(confirm_joint_change_deg=45.0)).needs_confirmation
+    assert not preview_move(
+        robot, free, home, goal, "around", SafetyLimits(confirm_joint_change_deg=45.0)
+    ).needs_confirmation
     near = preview_move(robot, free, home, home + np.array([1.0, 0, 0, 0, 0, 0]), "a nudge", SafetyLimits())
     assert any("near a singularity" in w for w in near.warnings)  # home has the wrist straight

@@ -29,7 +29,10 @@ def test_one_model_across_a_replay_and_the_still_told_only_on_change():
 
     core.picking.hold_frame()
     times = np.linspace(0.0, 2.0, 101)
-    core.picking.begin_replay(JointHistory.from_arrays(times, np.tile(core.joints_deg, (len(times), 1)), core.workcell.safety.settle_rule), "take.mcap")
+    core.picking.begin_replay(
+        JointHistory.from_arrays(times, np.tile(core.joints_deg, (len(times), 1)), core.workcell.safety.settle_rule),
+        "take.mcap",
+    )
     assert core.observations is obs and core.picking.replaying and sources == ["take.mcap"]
     assert stills[-1] is None and obs.still is None  # a replay lets the live still go
     assert obs.latest is None  # the live frames are not the recording's

@@ -57,7 +57,9 @@ def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
     assert core.cell.identity.content_hash != before.content_hash and core.editor.dirty
     labels = [core.undo() for _ in range(4)]
     assert labels == ["Add task location over_crate", "Add feature crate/corner", "Place crate", "Add component crate"]
-    assert "crate" not in [c.name for c in core.workcell.components] and "over_crate" not in core.workcell.task_locations
+    assert (
+        "crate" not in [c.name for c in core.workcell.components] and "over_crate" not in core.workcell.task_locations
+    )
     assert core.cell.identity == before  # back to the cell as loaded
     with pytest.raises(OperatorError, match="component name"):
         core.editor.add_component(mesh, "a: b")

@@ -36,7 +36,9 @@ def picked():
     true_cam = site.bed.true_cam2world(q)
     for k, name in enumerate(FEATURES):
         p = apply(fixture.item2world, fixture.features[name])
-        uv = project(apply(invert(true_cam), p[None]), core.intrinsics)[0] + (np.array([15.0, -12.0]) if k == 3 else 0.0)  # pair 7 mis-clicked
+        uv = project(apply(invert(true_cam), p[None]), core.intrinsics)[0] + (
+            np.array([15.0, -12.0]) if k == 3 else 0.0
+        )  # pair 7 mis-clicked
         core.picking.pick_model_point(fixture.name, name, p)
         core.picking.pick_image_point(uv)
         core.picking.accept_pair()
@@ -48,7 +50,9 @@ def test_a_failed_solve_names_the_mis_clicked_pair_by_its_table_number(picked):
     assert [p.number for p in core.session.pairs] == [4, 5, 6, 7, 8, 9]
     core.session.robust = False
     estimate = core.picking.calibrate()
-    assert estimate.solution.status.value == "failed" and "pair 7 fits worst" in estimate.solution.reason, estimate.solution.reason
+    assert estimate.solution.status.value == "failed" and "pair 7 fits worst" in estimate.solution.reason, (
+        estimate.solution.reason
+    )
     core.session.robust = True
     estimate = core.picking.calibrate()
     assert any("pair 7 rejected as outliers" in w for w in estimate.solution.warnings), estimate.solution.warnings

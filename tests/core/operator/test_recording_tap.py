@@ -20,7 +20,14 @@ from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.operator.core import OperatorCore
 from calib_core.recording.reader import read_recording
-from calib_core.recording.schemas import ANNOTATIONS_TOPIC, CALIBRATION_TOPIC, JOINTS_TOPIC, SCENE_TOPIC, TRANSFORMS_TOPIC, VIDEO_TOPIC
+from calib_core.recording.schemas import (
+    ANNOTATIONS_TOPIC,
+    CALIBRATION_TOPIC,
+    JOINTS_TOPIC,
+    SCENE_TOPIC,
+    TRANSFORMS_TOPIC,
+    VIDEO_TOPIC,
+)
 from videocal_sim.sim_site import simulated_cell
 from tests.core.operator.still_robot import frame_now, still_for
 from tests.core.operator.test_bound_observations import _pick_all, _task_joints
@@ -75,7 +82,9 @@ def test_the_camera_calibration_is_the_intrinsics_in_use(recorded):
     i = core.intrinsics
     assert (cal.width, cal.height, cal.frame_id) == (i.width, i.height, core.robot.roles["camera"])
     assert np.allclose(np.reshape(cal.K, (3, 3)), [[i.fu, 0, i.cx], [0, i.fv, i.cy], [0, 0, 1]])
-    assert np.allclose(np.reshape(cal.P, (3, 4))[:, :3], np.reshape(cal.K, (3, 3))) and cal.distortion_model == "plumb_bob"
+    assert (
+        np.allclose(np.reshape(cal.P, (3, 4))[:, :3], np.reshape(cal.K, (3, 3))) and cal.distortion_model == "plumb_bob"
+    )
     assert np.allclose(cal.D[: len(i.distortion)], i.distortion)
 
 
@@ -133,4 +142,6 @@ def test_the_scene_has_the_robot_on_its_links_and_the_cell_in_the_world(recorded
         z_up = mesh.vertices @ Rotation.from_euler("x", 90, degrees=True).as_matrix().T
         assert len(mesh.vertices) == len(item.mesh.vertices)
         assert np.allclose(np.sort(z_up * 1000.0, axis=0), np.sort(item.mesh.vertices, axis=0), atol=1e-3)
-    assert [a[0] for a in contents.attachments] == ["robot.urdf"] and contents.attachments[0][2].decode() == core.robot.urdf_xml
+    assert [a[0] for a in contents.attachments] == ["robot.urdf"] and contents.attachments[0][
+        2
+    ].decode() == core.robot.urdf_xml

@@ -35,7 +35,9 @@ pytestmark = pytest.mark.skipif(_node_missing() is not None, reason=_node_missin
 
 
 def _read_indexed(*paths) -> list[dict]:
-    run = subprocess.run(["node", str(NODE_DIR / "read_indexed.mjs"), *map(str, paths)], capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        ["node", str(NODE_DIR / "read_indexed.mjs"), *map(str, paths)], capture_output=True, text=True, timeout=300
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     return [json.loads(line) for line in run.stdout.splitlines()]
 
@@ -73,9 +75,18 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     core.stop_recording()
     (result,) = _read_indexed(path)
     _agrees_with_ours(result, path)
-    assert result["schemas"]["/camera/video"] == "foxglove.CompressedVideo" and result["schemas"]["/tf"] == "foxglove.FrameTransforms"
-    assert result["schemas"]["/camera/calibration"] == "foxglove.CameraCalibration" and result["schemas"]["/camera/annotations"] == "foxglove.ImageAnnotations"
-    assert result["schemas"]["/videocal/scene"] == "foxglove.SceneUpdate" and "/camera/image/compressed" not in result["schemas"]
+    assert (
+        result["schemas"]["/camera/video"] == "foxglove.CompressedVideo"
+        and result["schemas"]["/tf"] == "foxglove.FrameTransforms"
+    )
+    assert (
+        result["schemas"]["/camera/calibration"] == "foxglove.CameraCalibration"
+        and result["schemas"]["/camera/annotations"] == "foxglove.ImageAnnotations"
+    )
+    assert (
+        result["schemas"]["/videocal/scene"] == "foxglove.SceneUpdate"
+        and "/camera/image/compressed" not in result["schemas"]
+    )
     assert result["schemas"]["/camera/found_points"] == "foxglove.ImageAnnotations"
     assert [a["name"] for a in result["attachments"]] == ["robot.urdf"]
 

@@ -63,7 +63,9 @@ SAVER = textwrap.dedent(
 
 
 def _start(script: str, *args) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, "-c", script, *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.Popen(
+        [sys.executable, "-c", script, *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
 
 
 def _read_until(proc: subprocess.Popen, enough) -> str:
@@ -92,7 +94,9 @@ def test_a_recorder_killed_mid_recording_keeps_every_reported_message(tmp_path):
     assert len(contents.messages) >= reported_messages
     # the file is chunked: what the kill lost is the chunk in progress, at most the last second
     assert max(m.log_time_ns for m in contents.messages) >= killed_at_ns - 1_000_000_000
-    assert len(contents.topic(VIDEO_TOPIC)) >= reported_frames and len(contents.topic(JOINTS_TOPIC)) >= 3 * (reported_frames - 1)
+    assert len(contents.topic(VIDEO_TOPIC)) >= reported_frames and len(contents.topic(JOINTS_TOPIC)) >= 3 * (
+        reported_frames - 1
+    )
     fixed = tmp_path / "fixed.mcap"
     recover(path, fixed)
     again = read_recording(fixed)

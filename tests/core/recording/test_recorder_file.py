@@ -20,7 +20,10 @@ def _indexed(path):
     with open(path, "rb") as f:
         reader = make_reader(f)
         summary = reader.get_summary()
-        messages = [(channel.topic, message.log_time, message.sequence) for _, channel, message in reader.iter_messages(log_time_order=False)]
+        messages = [
+            (channel.topic, message.log_time, message.sequence)
+            for _, channel, message in reader.iter_messages(log_time_order=False)
+        ]
     return summary, messages
 
 
@@ -51,7 +54,9 @@ def test_a_frame_is_logged_at_its_capture_and_samples_that_came_while_it_was_enc
     messages = read_recording(tmp_path / "o.mcap").messages
     assert [m.topic for m in messages if m.topic in (VIDEO_TOPIC, JOINTS_TOPIC)] == [VIDEO_TOPIC, JOINTS_TOPIC]
     frame = next(m for m in messages if m.topic == VIDEO_TOPIC)
-    assert frame.log_time_ns == rec.unix_ns(1.0) and frame.payload["timestamp"]["sec"] * 10**9 + frame.payload["timestamp"]["nsec"] == rec.unix_ns(1.0)
+    assert frame.log_time_ns == rec.unix_ns(1.0) and frame.payload["timestamp"]["sec"] * 10**9 + frame.payload[
+        "timestamp"
+    ]["nsec"] == rec.unix_ns(1.0)
     assert rec.late_messages == 0
 
 

@@ -66,7 +66,11 @@ def test_round_trip(tmp_path):
     path = _record(tmp_path / "s.mcap")
     contents = read_recording(path)
     assert contents.complete and contents.problem is None
-    assert len(contents.topic(FRAME_TOPIC)) == 3 and len(contents.topic(JOINTS_TOPIC)) == 3 and len(contents.topic(EVENT_TOPIC)) == 3
+    assert (
+        len(contents.topic(FRAME_TOPIC)) == 3
+        and len(contents.topic(JOINTS_TOPIC)) == 3
+        and len(contents.topic(EVENT_TOPIC)) == 3
+    )
     frame = contents.topic(FRAME_TOPIC)[0].payload
     assert frame["format"] == "jpeg" and decode_frame(frame).shape == (48, 64, 3)
     assert contents.topic(JOINTS_TOPIC)[2].payload["joints_deg"][-1] == 2.0
@@ -101,7 +105,11 @@ def test_video_frames_use_foxglove_compressed_video(tmp_path):
         summary = make_reader(f).get_summary()
     channel = next(c for c in summary.channels.values() if c.topic == VIDEO_TOPIC)
     schema = summary.schemas[channel.schema_id]
-    assert (schema.name, schema.encoding, channel.message_encoding) == ("foxglove.CompressedVideo", "protobuf", "protobuf")
+    assert (schema.name, schema.encoding, channel.message_encoding) == (
+        "foxglove.CompressedVideo",
+        "protobuf",
+        "protobuf",
+    )
     files = FileDescriptorSet.FromString(schema.data)
     assert any(m.name == "CompressedVideo" for fd in files.file for m in fd.message_type)
     first = read_recording(path).topic(VIDEO_TOPIC)[0]
@@ -164,13 +172,20 @@ def test_replay_agrees_exactly_and_finds_a_tampered_result(tmp_path):
     results = replay(tampered)
     assert [r.agree for r in results] == [True, False]
     assert results[1].translation_diff_mm == pytest.approx(0.001, rel=1e-6)
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(tampered), "--json"], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "replay", str(tampered), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 5
     assert [s["agree"] for s in json.loads(run.stdout)["solves"]] == [True, False]
 
 
 def test_the_bundled_sample_recording_replays():
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(SAMPLE)], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "replay", str(SAMPLE)], capture_output=True, text=True, timeout=120
+    )
     assert run.returncode == 0, run.stdout + run.stderr
     assert "2 solves" in run.stdout and "agrees" in run.stdout
     contents = read_recording(SAMPLE)
@@ -184,5 +199,7 @@ def test_foreign_and_missing_files(tmp_path):
         read_recording(junk)
     with pytest.raises(FileFormatError, match="no such recording"):
         read_recording(tmp_path / "none.mcap")
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "replay", str(junk)], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "replay", str(junk)], capture_output=True, text=True, timeout=60
+    )
     assert run.returncode == 2 and run.stderr.startswith("error: ")

@@ -5,7 +5,9 @@ from calib_core.recording.replay import ReplayedSolve
 
 
 def _replayed(dt, dr, drms, status="ok"):
-    return ReplayedSolve(1, {"status": "ok"}, {"status": status}, status == "ok" and dt == dr == drms == 0.0, dt, dr, drms)
+    return ReplayedSolve(
+        1, {"status": "ok"}, {"status": status}, status == "ok" and dt == dr == drms == 0.0, dt, dr, drms
+    )
 
 
 def test_round_off_is_equivalent_and_a_real_change_is_not():

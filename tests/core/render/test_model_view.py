@@ -25,10 +25,20 @@ def test_an_item_riding_on_the_camera_stays_put_in_the_image_while_the_cell_move
     by f 10 / z in the image, a finger riding with the camera does not; without ``riding`` the finger
     would stay in the cell and move as the target does (what Find points' model view did before)."""
     intrinsics = Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480)
-    target = SceneItem(name="target", mesh=trimesh.creation.box((60.0, 60.0, 5.0)), item2world=make_transform(np.eye(3), [0.0, 0.0, 300.0]), color=(1.0, 0.1, 0.1))
+    target = SceneItem(
+        name="target",
+        mesh=trimesh.creation.box((60.0, 60.0, 5.0)),
+        item2world=make_transform(np.eye(3), [0.0, 0.0, 300.0]),
+        color=(1.0, 0.1, 0.1),
+    )
     cam2world_model = np.eye(4)  # looking along +z at the target
-    finger = SceneItem(name="robot/finger", mesh=trimesh.creation.box((8.0, 30.0, 8.0)), item2world=make_transform(np.eye(3), [25.0, 20.0, 100.0]),
-                       color=(0.1, 0.1, 1.0), kind="robot")
+    finger = SceneItem(
+        name="robot/finger",
+        mesh=trimesh.creation.box((8.0, 30.0, 8.0)),
+        item2world=make_transform(np.eye(3), [25.0, 20.0, 100.0]),
+        color=(0.1, 0.1, 1.0),
+        kind="robot",
+    )
     view = ModelView(intrinsics)
     try:
         obj2cam_model = np.linalg.inv(cam2world_model) @ target.item2world
@@ -57,9 +67,18 @@ def test_a_box_rendered_alone_matches_the_whole_image_there_through_a_distorting
     pixels there, with the lens's distortion: the box's pinhole camera sees exactly the ideal pixels
     the distortion map samples. Outside the box the image is black."""
     intrinsics = Intrinsics(900.0, 900.0, 330.0, 250.0, 640, 480, distortion=(-0.25, 0.1, 0.001, -0.001, 0.0))
-    plate = SceneItem(name="plate", mesh=trimesh.creation.box((120.0, 80.0, 10.0)), item2world=make_transform(np.eye(3), [30.0, -20.0, 400.0]), color=(0.8, 0.5, 0.2))
-    boss = SceneItem(name="boss", mesh=trimesh.creation.cylinder(radius=12.0, height=20.0), item2world=make_transform(np.eye(3), [40.0, -10.0, 385.0]),
-                     color=(0.2, 0.6, 0.9))
+    plate = SceneItem(
+        name="plate",
+        mesh=trimesh.creation.box((120.0, 80.0, 10.0)),
+        item2world=make_transform(np.eye(3), [30.0, -20.0, 400.0]),
+        color=(0.8, 0.5, 0.2),
+    )
+    boss = SceneItem(
+        name="boss",
+        mesh=trimesh.creation.cylinder(radius=12.0, height=20.0),
+        item2world=make_transform(np.eye(3), [40.0, -10.0, 385.0]),
+        color=(0.2, 0.6, 0.9),
+    )
     view = ModelView(intrinsics)
     try:
         expected = view.of([plate, boss], plate.item2world)
@@ -85,11 +104,21 @@ def test_a_supersampled_box_integrates_its_pixels_and_a_coarse_one_keeps_its_edg
     area), with its place unchanged; at half resolution the edge blurs but stays within a pixel."""
     intrinsics = Intrinsics(900.0, 900.0, 320.0, 240.0, 640, 480)
     turn = np.array([[np.cos(0.087), -np.sin(0.087), 0.0], [np.sin(0.087), np.cos(0.087), 0.0], [0.0, 0.0, 1.0]])
-    plate = SceneItem(name="plate", mesh=trimesh.creation.box((200.0, 200.0, 5.0)), item2world=make_transform(turn, [0.0, 80.0, 500.0]), color=(0.9, 0.9, 0.9))
+    plate = SceneItem(
+        name="plate",
+        mesh=trimesh.creation.box((200.0, 200.0, 5.0)),
+        item2world=make_transform(turn, [0.0, 80.0, 500.0]),
+        color=(0.9, 0.9, 0.9),
+    )
     view = ModelView(intrinsics)
     try:
         expected = view.of([plate], plate.item2world)
-        box = (200, 150, 440, 280)  # across the plate's top edge (v about 204 at the centre, slanting 21 px over the box)
+        box = (
+            200,
+            150,
+            440,
+            280,
+        )  # across the plate's top edge (v about 204 at the centre, slanting 21 px over the box)
         plain = expected(plate.item2world, box_px=box).mean(axis=2)[150:280, 200:440]
         fine = expected(plate.item2world, box_px=box, supersample=2).mean(axis=2)[150:280, 200:440]
         coarse = expected(plate.item2world, box_px=box, supersample=0.5).mean(axis=2)[150:280, 200:440]

@@ -15,8 +15,12 @@ OVERHEAD = pose(np.diag([1.0, -1.0, -1.0]), [0.0, 0.0, 1000.0])  # looking strai
 
 
 def _plate_and_block() -> list[SceneItem]:
-    plate = SceneItem("plate", trimesh.creation.box((800.0, 800.0, 10.0)), pose(np.eye(3), [0, 0, -5.0]), color=(0.8, 0.8, 0.8))
-    block = SceneItem("block", trimesh.creation.box((100.0, 100.0, 200.0)), pose(np.eye(3), [0, 0, 100.0]), color=(0.5, 0.5, 0.6))
+    plate = SceneItem(
+        "plate", trimesh.creation.box((800.0, 800.0, 10.0)), pose(np.eye(3), [0, 0, -5.0]), color=(0.8, 0.8, 0.8)
+    )
+    block = SceneItem(
+        "block", trimesh.creation.box((100.0, 100.0, 200.0)), pose(np.eye(3), [0, 0, 100.0]), color=(0.5, 0.5, 0.6)
+    )
     return [plate, block]
 
 

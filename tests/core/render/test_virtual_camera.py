@@ -23,7 +23,9 @@ def renderer():
 
 
 def _far_dummy():
-    return SceneItem("dummy", trimesh.creation.box(extents=(1, 1, 1)), make_transform(np.eye(3), [0, 0, -1e4]), kind="fixture")
+    return SceneItem(
+        "dummy", trimesh.creation.box(extents=(1, 1, 1)), make_transform(np.eye(3), [0, 0, -1e4]), kind="fixture"
+    )
 
 
 def _marker_centroid(img, channel):
@@ -45,13 +47,19 @@ def test_markers_land_on_projected_pixels_all_over_the_image(renderer, intrinsic
     renderer.set_items([_far_dummy()])
     cam2world = make_transform(np.eye(3), [10.0, -20.0, 30.0])
     rng = np.random.default_rng(0)
-    targets = np.column_stack([rng.uniform(0.08, 0.92, 12) * intrinsics.width, rng.uniform(0.08, 0.92, 12) * intrinsics.height])
+    targets = np.column_stack(
+        [rng.uniform(0.08, 0.92, 12) * intrinsics.width, rng.uniform(0.08, 0.92, 12) * intrinsics.height]
+    )
     depth = rng.uniform(300, 3000, 12)
     points_cam = unproject(targets, intrinsics, undistort=False, depth_mm=depth)
     points_world = apply(cam2world, points_cam)
     errors = []
     for p in points_world:
-        img = renderer.render_view(intrinsics, cam2world, RenderOptions(markers=[(p, (1.0, 0.0, 0.0))], feature_size_px=5, background=(0, 0, 0)))
+        img = renderer.render_view(
+            intrinsics,
+            cam2world,
+            RenderOptions(markers=[(p, (1.0, 0.0, 0.0))], feature_size_px=5, background=(0, 0, 0)),
+        )
         expected = project(apply(np.linalg.inv(cam2world), p[None]), intrinsics, distort=False)[0]
         errors.append(np.linalg.norm(_marker_centroid(img, 0) - expected))
     assert max(errors) < 0.5, errors
@@ -59,7 +67,12 @@ def test_markers_land_on_projected_pixels_all_over_the_image(renderer, intrinsic
 
 def test_depth_buffer_gives_camera_depth(renderer):
     intr = Intrinsics(300.0, 300.0, 160.0, 120.0, 320, 240)
-    wall = SceneItem("wall", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 1505.0]), kind="fixture")
+    wall = SceneItem(
+        "wall",
+        trimesh.creation.box(extents=(4000, 4000, 10)),
+        make_transform(np.eye(3), [0, 0, 1505.0]),
+        kind="fixture",
+    )
     renderer.set_items([wall])
     renderer.render_view(intr, np.eye(4))
     depth = renderer.depth_mm()
@@ -69,7 +82,12 @@ def test_depth_buffer_gives_camera_depth(renderer):
 
 def test_render_options(renderer):
     intr = Intrinsics(300.0, 300.0, 160.0, 120.0, 320, 240)
-    box = SceneItem("box", trimesh.creation.box(extents=(200, 200, 200)), make_transform(np.eye(3), [0, 0, 1000.0]), color=(0.2, 0.2, 0.9))
+    box = SceneItem(
+        "box",
+        trimesh.creation.box(extents=(200, 200, 200)),
+        make_transform(np.eye(3), [0, 0, 1000.0]),
+        color=(0.2, 0.2, 0.9),
+    )
     renderer.set_items([box])
     plain = renderer.render_view(intr, np.eye(4), RenderOptions(background=(0, 0, 0)))
     lit = renderer.render_view(intr, np.eye(4), RenderOptions(highlight="box", background=(0, 0, 0)))
@@ -87,8 +105,12 @@ def test_render_options(renderer):
 
 def test_depth_read_back_survives_another_window_rendering_in_between():
     intr = Intrinsics(300.0, 300.0, 160.0, 120.0, 320, 240)
-    near = SceneItem("near", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 805.0]), kind="fixture")
-    far = SceneItem("far", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 3005.0]), kind="fixture")
+    near = SceneItem(
+        "near", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 805.0]), kind="fixture"
+    )
+    far = SceneItem(
+        "far", trimesh.creation.box(extents=(4000, 4000, 10)), make_transform(np.eye(3), [0, 0, 3005.0]), kind="fixture"
+    )
     a, b = SceneRenderer(), SceneRenderer()
     a.set_items([near])
     b.set_items([far])

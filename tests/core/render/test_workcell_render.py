@@ -27,7 +27,9 @@ def scene():
     renderer = SceneRenderer()
     renderer.set_items(cell.components + RobotVisuals.from_robot(robot).scene_items(q))
     cam2world = robot.fk(q, "camera")
-    image = renderer.render_view(intr, cam2world, RenderOptions(highlight="oru_1_fixture", show_features=True, feature_names=True))
+    image = renderer.render_view(
+        intr, cam2world, RenderOptions(highlight="oru_1_fixture", show_features=True, feature_names=True)
+    )
     OUTPUT.mkdir(exist_ok=True)
     cv2.imwrite(str(OUTPUT / "render_virtual_oru_1.png"), image[:, :, ::-1])
     overview = renderer.render_overview(options=RenderOptions(highlight="oru_1"))
@@ -40,7 +42,9 @@ def scene():
 def test_the_target_fills_the_middle_of_the_view(scene):
     cell, intr, cam2world, _, image = scene
     oru = cell.component("oru_1_fixture")
-    px = project(apply(invert(cam2world), apply(oru.item2world, np.array(list(oru.features.values())))), intr, distort=False)
+    px = project(
+        apply(invert(cam2world), apply(oru.item2world, np.array(list(oru.features.values())))), intr, distort=False
+    )
     assert intr.contains(px, margin_px=10).all()
     u, v = np.round(px[list(oru.features).index("pin_tip")]).astype(int)
     assert image[v, u].tolist() != [0, 0, 0]
@@ -48,7 +52,12 @@ def test_the_target_fills_the_middle_of_the_view(scene):
 
 def test_picking_a_feature_pixel_returns_that_feature(scene):
     cell, intr, cam2world, renderer, _ = scene
-    for component, name in (("oru_1_fixture", "plate_top_left"), ("oru_1_fixture", "boss_bottom_right"), ("oru_1_fixture", "pin_tip"), ("oru_1_fixture", "plate_bottom_right")):
+    for component, name in (
+        ("oru_1_fixture", "plate_top_left"),
+        ("oru_1_fixture", "boss_bottom_right"),
+        ("oru_1_fixture", "pin_tip"),
+        ("oru_1_fixture", "plate_bottom_right"),
+    ):
         item = cell.component(component)
         p_world = apply(item.item2world, item.features[name])
         u, v = project(apply(invert(cam2world), p_world[None]), intr, distort=False)[0]

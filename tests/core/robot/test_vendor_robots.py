@@ -58,7 +58,12 @@ def test_new_frames_are_placed_on_their_parent_without_editing_the_urdf():
 
 
 def test_panda_seven_axes_and_held_prismatic_fingers():
-    spec = RobotSpec(require(PANDA), (SHARE,), {"flange": "panda_hand", "tcp": NewFrame("panda_hand", make_transform(np.eye(3), [0, 0, 103.4]))}, held_joints={"panda_finger_joint1": 20.0, "panda_finger_joint2": 20.0})
+    spec = RobotSpec(
+        require(PANDA),
+        (SHARE,),
+        {"flange": "panda_hand", "tcp": NewFrame("panda_hand", make_transform(np.eye(3), [0, 0, 103.4]))},
+        held_joints={"panda_finger_joint1": 20.0, "panda_finger_joint2": 20.0},
+    )
     robot = load_robot(spec)
     assert robot.n_joints == 7 and robot.joint_units == ["deg"] * 7
     assert robot.joint_names[-1] == "panda_joint7"
@@ -79,7 +84,14 @@ def test_panda_seven_axes_and_held_prismatic_fingers():
 
 
 def test_panda_jacobian_matches_finite_differences_in_user_units():
-    robot = load_robot(RobotSpec(require(PANDA), (SHARE,), {"flange": "panda_hand", "tcp": "panda_hand_tcp"}, held_joints={"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0}))
+    robot = load_robot(
+        RobotSpec(
+            require(PANDA),
+            (SHARE,),
+            {"flange": "panda_hand", "tcp": "panda_hand_tcp"},
+            held_joints={"panda_finger_joint1": 0.0, "panda_finger_joint2": 0.0},
+        )
+    )
     q = np.array([20.0, -35.0, 10.0, -110.0, 15.0, 80.0, 30.0])
     J = robot.jacobian(q, "tcp") * robot.internal_per_user  # per degree
     h = 1e-4
@@ -93,7 +105,14 @@ def test_panda_jacobian_matches_finite_differences_in_user_units():
 
 def test_five_driven_axes_and_ik_round_trip():
     # The UR5 with its last wrist joint held: a 5-axis arm.
-    robot = load_robot(RobotSpec(require(UR5), (SHARE,), {"base": "base", "flange": "tool0", "tcp": NewFrame("tool0", make_transform(np.eye(3), [0, 0, 150]))}, held_joints={"wrist_3_joint": 30.0}))
+    robot = load_robot(
+        RobotSpec(
+            require(UR5),
+            (SHARE,),
+            {"base": "base", "flange": "tool0", "tcp": NewFrame("tool0", make_transform(np.eye(3), [0, 0, 150]))},
+            held_joints={"wrist_3_joint": 30.0},
+        )
+    )
     assert robot.n_joints == 5
     q = np.array([20.0, -70.0, 80.0, -100.0, -80.0])
     target = robot.fk(q, "tcp")
@@ -162,7 +181,12 @@ def test_meshes_from_the_disk_cache_are_the_loaders_own(tmp_path, monkeypatch):
     from calib_core.robot import mesh_cache
 
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    spec = RobotSpec(require(PANDA), (SHARE,), {"flange": "panda_hand", "tcp": "panda_hand_tcp"}, held_joints={"panda_finger_joint1": 10.0, "panda_finger_joint2": 10.0})
+    spec = RobotSpec(
+        require(PANDA),
+        (SHARE,),
+        {"flange": "panda_hand", "tcp": "panda_hand_tcp"},
+        held_joints={"panda_finger_joint1": 10.0, "panda_finger_joint2": 10.0},
+    )
     q = np.array([10.0, -30.0, 5.0, -100.0, 20.0, 70.0, 30.0])
     robot = load_robot(spec)
     fresh = RobotVisuals.from_robot(robot)  # through Pinocchio's loader: fills the cache
@@ -170,7 +194,14 @@ def test_meshes_from_the_disk_cache_are_the_loaders_own(tmp_path, monkeypatch):
     visuals_module._GEOMETRY_CACHE.clear()
     cached = RobotVisuals.from_robot(load_robot(spec))  # the description with placeholders, meshes from disk
     assert id(cached.geometry_model) in visuals_module._CACHED_MESHES
-    for a, b, pa, pb, ga, gb in zip(fresh.meshes, cached.meshes, fresh.poses(q), cached.poses(q), fresh.geometry_model.geometryObjects, cached.geometry_model.geometryObjects):
+    for a, b, pa, pb, ga, gb in zip(
+        fresh.meshes,
+        cached.meshes,
+        fresh.poses(q),
+        cached.poses(q),
+        fresh.geometry_model.geometryObjects,
+        cached.geometry_model.geometryObjects,
+    ):
         assert ga.name == gb.name and np.allclose(ga.meshColor, gb.meshColor)
         assert np.array_equal(a.faces, b.faces) and np.allclose(a.vertices, b.vertices)
         assert np.allclose(pa, pb, atol=1e-9)

@@ -48,9 +48,17 @@ def _origins_to_tool0(urdf_text: str) -> np.ndarray:
     for joint in reversed(chain):
         origin = joint.find("origin")
         xyz = [float(v) for v in (origin.get("xyz") if origin is not None else "0 0 0").split()]
-        r, p, y = [float(v) for v in (origin.get("rpy") if origin is not None and origin.get("rpy") else "0 0 0").split()]
+        r, p, y = [
+            float(v) for v in (origin.get("rpy") if origin is not None and origin.get("rpy") else "0 0 0").split()
+        ]
         cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-        R = np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr], [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], [-sp, cp * sr, cp * cr]])
+        R = np.array(
+            [
+                [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                [-sp, cp * sr, cp * cr],
+            ]
+        )
         step = np.eye(4)
         step[:3, :3], step[:3, 3] = R, xyz
         T = T @ step
@@ -101,11 +109,15 @@ def test_xacro_arguments(tmp_path):
 
 def test_runaway_expressions_are_bounded(tmp_path):
     slow = tmp_path / "slow.xacro"
-    slow.write_text('<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>')
+    slow.write_text(
+        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>'
+    )
     with pytest.raises(FileFormatError, match="slow.xacro.*took longer than 2 s"):
         expand_xacro(slow, [], timeout_s=2)
     big = tmp_path / "big.xacro"
-    big.write_text("""<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${'a'*10**10}"/><link name="${x}"/></robot>""")
+    big.write_text(
+        """<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${'a'*10**10}"/><link name="${x}"/></robot>"""
+    )
     with pytest.raises(FileFormatError, match="big.xacro.*needed more than 512 MB"):
         expand_xacro(big, [], memory_mb=512)
 
@@ -119,7 +131,9 @@ def test_a_calibrated_kr6_keeps_its_package_meshes_and_its_corrected_joint(tmp_p
     nominal = load_robot(spec)
     calibrated = nominal.copy()
     k = calibrated.model.getJointId("joint_a2")
-    calibrated.model.jointPlacements[k].translation = calibrated.model.jointPlacements[k].translation + np.array([0.0004, -0.0002, 0.0003])
+    calibrated.model.jointPlacements[k].translation = calibrated.model.jointPlacements[k].translation + np.array(
+        [0.0004, -0.0002, 0.0003]
+    )
     text, left = calibrated_urdf(nominal, calibrated, camera_frame="tool0")
     meshes = [m.get("filename") for m in ET.fromstring(text).iter("mesh")]
     assert meshes and all(m.startswith("package://kuka_kr6_support/meshes/") for m in meshes), meshes[:3]
@@ -139,14 +153,26 @@ def test_the_xacro_child_ends_with_its_parent(tmp_path):
     import time
 
     slow = tmp_path / "slow.xacro"
-    slow.write_text('<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>')
-    parent = subprocess.Popen([sys.executable, "-c", "import sys; from pathlib import Path; from calib_core.robot.xacro_expand import expand_xacro; "
-                               "print('expanding', flush=True); expand_xacro(Path(sys.argv[1]), [], timeout_s=120)", str(slow)],
-                              stdout=subprocess.PIPE, text=True)
+    slow.write_text(
+        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>'
+    )
+    parent = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from pathlib import Path; from calib_core.robot.xacro_expand import expand_xacro; "
+            "print('expanding', flush=True); expand_xacro(Path(sys.argv[1]), [], timeout_s=120)",
+            str(slow),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
     assert parent.stdout.readline().strip() == "expanding"
 
     def children() -> list[str]:
-        found = subprocess.run(["pgrep", "-P", str(parent.pid), "-f", "xacro_child"], capture_output=True, text=True).stdout.split()
+        found = subprocess.run(
+            ["pgrep", "-P", str(parent.pid), "-f", "xacro_child"], capture_output=True, text=True
+        ).stdout.split()
         return found
 
     deadline = time.monotonic() + 20

@@ -23,7 +23,9 @@ def test_a_grasp_gives_the_tool_in_the_camera_frame_exactly():
     truth = CorrectedRobot(model)
     truth.set(np.random.default_rng(2).normal(0, 0.3, truth.layout.size))
     real = truth.robot
-    real.set_frame_placement("tcp", model.frame_placement("tcp") @ transform_from_xyz_rpy([1.2, -1.5, 0.6], [0.2, -0.1, 0.15]))
+    real.set_frame_placement(
+        "tcp", model.frame_placement("tcp") @ transform_from_xyz_rpy([1.2, -1.5, 0.6], [0.2, -0.1, 0.15])
+    )
     grasps = []
     for task in list(cell.task_locations.values())[:2]:
         q = solve_ik(real, task.tcp2base, np.array(cell.home_joints_deg, float)).q_deg

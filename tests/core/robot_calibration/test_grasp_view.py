@@ -28,8 +28,16 @@ def test_the_tool_s_covariance_follows_the_view_s_by_its_jacobian():
         for sign in (1.0, -1.0):
             step = np.zeros(6)
             step[k] = sign * h
-            moved = make_transform(Rotation.from_rotvec(step[3:]).as_matrix() @ obj2cam[:3, :3], obj2cam[:3, 3] + step[:3]) @ tcp2obj
-            out.append(np.r_[moved[:3, 3] - base[:3, 3], np.degrees(Rotation.from_matrix(moved[:3, :3] @ base[:3, :3].T).as_rotvec())])
+            moved = (
+                make_transform(Rotation.from_rotvec(step[3:]).as_matrix() @ obj2cam[:3, :3], obj2cam[:3, 3] + step[:3])
+                @ tcp2obj
+            )
+            out.append(
+                np.r_[
+                    moved[:3, 3] - base[:3, 3],
+                    np.degrees(Rotation.from_matrix(moved[:3, :3] @ base[:3, :3].T).as_rotvec()),
+                ]
+            )
         J[:, k] = (out[0] - out[1]) / (2 * h)
     assert np.allclose(tcp_covariance_in_camera(obj2cam, tcp2obj, pose_cov), J @ pose_cov @ J.T, rtol=1e-5, atol=1e-14)
 
@@ -63,8 +71,14 @@ def test_a_seen_grasp_measures_the_tool_without_the_fixture_s_survey_error(moved
     assert np.linalg.norm(r_seen) < 3 * np.linalg.norm(sigma[3:]) + 1e-4
     surveyed = camera_to_tool(bed.true_robot, [Grasp(task.name, q, task.tcp2base)])
     assert np.linalg.norm(pose_difference(surveyed.tcp2cam, true_tcp2cam)[0]) > 0.06
-    tool = camera_to_tool(bed.model_robot, [Grasp(task.name, q, task.tcp2base), Grasp(task.name + " seen", q, task.tcp2base, seen)])
-    assert tool.seen_grasps == 1 and np.allclose(tool.tcp2cam, seen.tcp2cam) and np.allclose(tool.covariance, seen.covariance)
+    tool = camera_to_tool(
+        bed.model_robot, [Grasp(task.name, q, task.tcp2base), Grasp(task.name + " seen", q, task.tcp2base, seen)]
+    )
+    assert (
+        tool.seen_grasps == 1
+        and np.allclose(tool.tcp2cam, seen.tcp2cam)
+        and np.allclose(tool.covariance, seen.covariance)
+    )
 
 
 def test_a_grasp_the_camera_cannot_see_says_so(moved_fixture_bed):

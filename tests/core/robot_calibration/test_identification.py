@@ -60,7 +60,9 @@ def test_the_board_absorbs_the_first_joint_and_the_report_says_so(setup):
     """A board at an unknown pose cannot tell where the robot's base is: every correction of the
     first joint's placement is a move of the whole robot, which the board's placement takes up."""
     bed, board2base, joints = setup
-    result = identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics))
+    result = identify(
+        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+    )
     names = result.names
     unidentified = {names[k] for k in result.observability.unidentified}
     assert {f"joint_1.{a}" for a in ("x_mm", "y_mm", "z_mm", "rx_mrad", "ry_mrad", "rz_mrad")} <= unidentified
@@ -73,7 +75,9 @@ def test_parameters_come_back_from_views_made_with_them_and_their_sigmas_are_hon
     """The round trip in the model's own parameters: a robot made with random corrections of the
     identified subset, seen with 0.1 px noise, gives them back within their 1-sigma's reach."""
     bed, board2base, joints = setup
-    probe = identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics))
+    probe = identify(
+        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+    )
     rng = np.random.default_rng(5)
     truth = np.zeros(len(probe.names))
     truth[probe.observability.identified] = rng.normal(0.0, 0.5, len(probe.observability.identified))
@@ -81,7 +85,12 @@ def test_parameters_come_back_from_views_made_with_them_and_their_sigmas_are_hon
     made.set(truth)
     z = []
     for seed in range(3):
-        result = identify(bed.model_robot, bed.intrinsics, _views(made.cam2base, joints[:30], board2base, bed.intrinsics, 0.1, seed), parameters=probe.identified_names)
+        result = identify(
+            bed.model_robot,
+            bed.intrinsics,
+            _views(made.cam2base, joints[:30], board2base, bed.intrinsics, 0.1, seed),
+            parameters=probe.identified_names,
+        )
         assert result.observability.identified == probe.observability.identified
         ids = result.observability.identified
         z.extend(((result.values[ids] - truth[ids]) / result.sigmas[ids]).tolist())
@@ -109,7 +118,9 @@ def test_surveyed_cell_features_tie_the_robot_to_the_cell(setup):
 
 def test_the_calibrated_urdf_loads_and_moves_like_the_calibrated_model(setup, tmp_path):
     bed, board2base, joints = setup
-    result = identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics))
+    result = identify(
+        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+    )
     yaml_path, urdf_path = save_robot_calibration(tmp_path, result, bed.model_robot)
     assert yaml_path.is_file() and urdf_path.name == "videocal_arm_calibrated.urdf"
     text, left = calibrated_urdf(bed.model_robot, result.robot)
@@ -138,8 +149,14 @@ def test_the_planned_poses_see_the_board_and_inform_more_than_arbitrary_ones(set
         px = project(apply(invert(bed.model_robot.fk(q, "camera")) @ board2base, SPEC.corners_mm()), bed.intrinsics)
         assert np.all(bed.intrinsics.contains(px, 30.0))
     arbitrary = plan_poses(bed.model_robot, bed.intrinsics, SPEC, board2base, 40, start_deg=np.zeros(6), candidates=40)
-    first12 = identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, arbitrary.joints_deg[:12], board2base, bed.intrinsics, 0.1))
-    chosen = identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, plan.joints_deg, board2base, bed.intrinsics, 0.1))
+    first12 = identify(
+        bed.model_robot,
+        bed.intrinsics,
+        _views(bed.true_cam2world, arbitrary.joints_deg[:12], board2base, bed.intrinsics, 0.1),
+    )
+    chosen = identify(
+        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, plan.joints_deg, board2base, bed.intrinsics, 0.1)
+    )
     # The D-optimal set determines the parameters better: smaller sigmas on what both identify.
     common = sorted(set(first12.observability.identified) & set(chosen.observability.identified))
     assert np.median(chosen.sigmas[common] / first12.sigmas[common]) < 1.0
@@ -157,7 +174,15 @@ def test_the_plan_reaches_the_image_corners(setup, monkeypatch):
 
     def covered():
         plan = plan_poses(bed.model_robot, bed.intrinsics, SPEC, board2base, 20, start_deg=np.zeros(6), candidates=60)
-        views = [BoardView(str(k), project(apply(invert(bed.model_robot.fk(q, "camera")) @ board2base, SPEC.corners_mm()), bed.intrinsics), np.arange(len(SPEC.corners_mm())), size) for k, q in enumerate(plan.joints_deg)]
+        views = [
+            BoardView(
+                str(k),
+                project(apply(invert(bed.model_robot.fk(q, "camera")) @ board2base, SPEC.corners_mm()), bed.intrinsics),
+                np.arange(len(SPEC.corners_mm())),
+                size,
+            )
+            for k, q in enumerate(plan.joints_deg)
+        ]
         return coverage(views, size)
 
     turned = covered()

@@ -26,8 +26,12 @@ def board_views():
     board2base = board_in_cell(SPEC, cell, bed.model_robot)
     joints = board_view_joints(bed.model_robot, cell.home_joints_deg, SPEC, board2base, 30, seed=3)
     pts = SPEC.corners_mm()
-    views = [PoseView(f"v{k}", np.asarray(q), pts, project(apply(invert(bed.true_cam2world(q)) @ board2base, pts), bed.intrinsics))
-             for k, q in enumerate(joints)]
+    views = [
+        PoseView(
+            f"v{k}", np.asarray(q), pts, project(apply(invert(bed.true_cam2world(q)) @ board2base, pts), bed.intrinsics)
+        )
+        for k, q in enumerate(joints)
+    ]
     return cell, bed, views
 
 
@@ -36,10 +40,18 @@ def test_a_component_not_seen_is_a_named_warning_and_the_fit_is_the_boards(board
     component = cell.components[0].name
     blank = np.full((bed.intrinsics.height, bed.intrinsics.width), 90, dtype=np.uint8)  # a frame with no edges
     told = []
-    identified = identify_robot(bed.model_robot, bed.intrinsics, cell, views, [CellFrame(component, cell.home_joints_deg, blank, "look_at_nothing")],
-                                progress=lambda done, total, text: told.append((done, total)))
+    identified = identify_robot(
+        bed.model_robot,
+        bed.intrinsics,
+        cell,
+        views,
+        [CellFrame(component, cell.home_joints_deg, blank, "look_at_nothing")],
+        progress=lambda done, total, text: told.append((done, total)),
+    )
     assert identified.board_views == len(views) and identified.cell_views == 0
-    assert len(identified.not_located) == 1 and identified.not_located[0].startswith(f"look_at_nothing: {component} not located")
+    assert len(identified.not_located) == 1 and identified.not_located[0].startswith(
+        f"look_at_nothing: {component} not located"
+    )
     assert identified.not_located[0] in identified.result.warnings
     assert told == [(0, 2), (1, 2)]  # one component to locate, then the fit
     direct = identify(bed.model_robot, bed.intrinsics, views)

@@ -32,7 +32,10 @@ def setup():
     board2base = board_in_cell(SPEC, cell, bed.model_robot)
     joints = board_view_joints(bed.model_robot, cell.home_joints_deg, SPEC, board2base, 52, seed=5)
     # Three components about the board, off one line: the base's six degrees of freedom from positions.
-    components = [board2base @ make_transform(np.eye(3), offset) for offset in ([20.0, 20.0, 0.0], [160.0, 30.0, 0.0], [40.0, 110.0, 0.0])]
+    components = [
+        board2base @ make_transform(np.eye(3), offset)
+        for offset in ([20.0, 20.0, 0.0], [160.0, 30.0, 0.0], [40.0, 110.0, 0.0])
+    ]
     return bed, board2base, joints, components
 
 
@@ -43,14 +46,27 @@ def _start_intrinsics(truth: Intrinsics) -> Intrinsics:
 
 def _board_views(bed, joints, board2base):
     pts = SPEC.corners_mm()
-    return [PoseView(f"b{k}", np.asarray(q), pts, project(apply(invert(bed.true_cam2world(q)) @ board2base, pts), bed.intrinsics)) for k, q in enumerate(joints)]
+    return [
+        PoseView(
+            f"b{k}", np.asarray(q), pts, project(apply(invert(bed.true_cam2world(q)) @ board2base, pts), bed.intrinsics)
+        )
+        for k, q in enumerate(joints)
+    ]
 
 
 def _measured(obj2cam_true, truth: Intrinsics, start: Intrinsics) -> np.ndarray:
     """The pose a measurement through ``start`` finds for the object the true camera sees at ``obj2cam_true``."""
     px = project(apply(obj2cam_true, FEATURES), truth)
     rvec0 = cv2.Rodrigues(obj2cam_true[:3, :3])[0]
-    _, rvec, tvec = cv2.solvePnP(FEATURES, px, start.K, start.dist_coeffs, rvec0, obj2cam_true[:3, 3].reshape(3, 1).copy(), useExtrinsicGuess=True)
+    _, rvec, tvec = cv2.solvePnP(
+        FEATURES,
+        px,
+        start.K,
+        start.dist_coeffs,
+        rvec0,
+        obj2cam_true[:3, 3].reshape(3, 1).copy(),
+        useExtrinsicGuess=True,
+    )
     return make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel())
 
 
@@ -59,7 +75,16 @@ def _object_views(bed, joints, components, start, with_points=True):
     for k, q in enumerate(joints):
         obj2base = components[k % len(components)]
         true = invert(bed.true_cam2world(q)) @ obj2base
-        out.append(ObjectPoseView(f"component_{k}", np.asarray(q), _measured(true, bed.intrinsics, start), COVARIANCE, obj2base, points_mm=FEATURES if with_points else None))
+        out.append(
+            ObjectPoseView(
+                f"component_{k}",
+                np.asarray(q),
+                _measured(true, bed.intrinsics, start),
+                COVARIANCE,
+                obj2base,
+                points_mm=FEATURES if with_points else None,
+            )
+        )
     return out
 
 
@@ -94,9 +119,18 @@ def test_component_poses_follow_the_corrected_intrinsics(setup):
     bed, board2base, joints, components = setup
     start = _start_intrinsics(bed.intrinsics)
     board = _board_views(bed, joints[:30], board2base)
-    carried = identify(bed.model_robot, start, board + _object_views(bed, joints[30:42], components, start), with_intrinsics=True)
-    fixed = identify(bed.model_robot, start, board + _object_views(bed, joints[30:42], components, start, with_points=False), with_intrinsics=True)
-    assert abs(carried.intrinsics.fu - bed.intrinsics.fu) < 0.05 and abs(carried.intrinsics.cx - bed.intrinsics.cx) < 0.05
+    carried = identify(
+        bed.model_robot, start, board + _object_views(bed, joints[30:42], components, start), with_intrinsics=True
+    )
+    fixed = identify(
+        bed.model_robot,
+        start,
+        board + _object_views(bed, joints[30:42], components, start, with_points=False),
+        with_intrinsics=True,
+    )
+    assert (
+        abs(carried.intrinsics.fu - bed.intrinsics.fu) < 0.05 and abs(carried.intrinsics.cx - bed.intrinsics.cx) < 0.05
+    )
     assert _camera_error_mm(carried, bed, joints[42:]) < 0.01
     assert _camera_error_mm(fixed, bed, joints[42:]) > 5 * _camera_error_mm(carried, bed, joints[42:])
     assert carried.left_out == {}
@@ -107,10 +141,12 @@ def test_a_component_view_that_disagrees_is_left_out_by_name(setup):
     board = _board_views(bed, joints[:30], board2base)
     objects = _object_views(bed, joints[30:42], components, bed.intrinsics)
     bad = objects[4]
-    wrong = make_transform(cv2.Rodrigues(np.array([0.003, 0.0, 0.0]))[0], [0.8, 0.0, 0.0]) @ bad.obj2cam  # an edge fit on the wrong edges
+    wrong = (
+        make_transform(cv2.Rodrigues(np.array([0.003, 0.0, 0.0]))[0], [0.8, 0.0, 0.0]) @ bad.obj2cam
+    )  # an edge fit on the wrong edges
     objects[4] = ObjectPoseView(bad.name, bad.joints_deg, wrong, bad.covariance, bad.obj2base, points_mm=FEATURES)
     result = identify(bed.model_robot, bed.intrinsics, board + objects)
     assert list(result.left_out) == ["component_4"]
     assert any(w.startswith("component_4 left out: its pose is") for w in result.warnings)
-    assert result.residual_weights[-6 * 8:-6 * 7].max() == 0.0  # its rows carry no weight
+    assert result.residual_weights[-6 * 8 : -6 * 7].max() == 0.0  # its rows carry no weight
     assert _camera_error_mm(result, bed, joints[42:]) < 0.01

@@ -15,15 +15,22 @@ from videocal_sim.ros2_arm import SimulatedRos2Arm
 from tests.waiting import wait_until
 
 
-
-
 def test_go_to_task_over_ros2_and_pose_unknown_when_the_states_stop(domain):
     cell = Cell.open()
     robot = cell.robot
     start = cell.home_joints + 3.0
-    arm = SimulatedRos2Arm(robot.joint_names, user_per_si(robot.joint_units), robot.lower_limits_deg, robot.upper_limits_deg, start,
-                           rate_hz=100.0, domain=domain).start()
-    core = OperatorCore(cell, RealSite("ros2:///joint_states?stale_after_s=0.3", controller_options={"speed_deg_s": 90}))
+    arm = SimulatedRos2Arm(
+        robot.joint_names,
+        user_per_si(robot.joint_units),
+        robot.lower_limits_deg,
+        robot.upper_limits_deg,
+        start,
+        rate_hz=100.0,
+        domain=domain,
+    ).start()
+    core = OperatorCore(
+        cell, RealSite("ros2:///joint_states?stale_after_s=0.3", controller_options={"speed_deg_s": 90})
+    )
     try:
         assert core.start_controller() == "ros2:///joint_states?stale_after_s=0.3"
         assert wait_until(lambda: core.link_up and np.allclose(core.joints_deg, start, atol=1e-6))
@@ -52,14 +59,25 @@ def test_the_camera_mounting_and_targets_on_tf_static_for_a_late_subscriber(doma
 
     cell = Cell.open()
     robot = cell.robot
-    arm = SimulatedRos2Arm(robot.joint_names, user_per_si(robot.joint_units), robot.lower_limits_deg, robot.upper_limits_deg, cell.home_joints,
-                           rate_hz=50.0, domain=domain).start()
+    arm = SimulatedRos2Arm(
+        robot.joint_names,
+        user_per_si(robot.joint_units),
+        robot.lower_limits_deg,
+        robot.upper_limits_deg,
+        cell.home_joints,
+        rate_hz=50.0,
+        domain=domain,
+    ).start()
     core = OperatorCore(cell, RealSite("ros2:///joint_states"))
     try:
         core.start_controller()
-        mounting = concat(robot.fk(cell.home_joints, "camera"), invert(robot.fk(cell.home_joints, "flange")))  # cam2base, base2flange
+        mounting = concat(
+            robot.fk(cell.home_joints, "camera"), invert(robot.fk(cell.home_joints, "flange"))
+        )  # cam2base, base2flange
         # the same mounting a second way: both frames' placements on their common parent joint
-        assert np.allclose(mounting, np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera"), atol=1e-9)
+        assert np.allclose(
+            mounting, np.linalg.inv(robot.frame_placement("flange")) @ robot.frame_placement("camera"), atol=1e-9
+        )
         moved = mounting.copy()
         moved[:3, 3] += [1.5, -2.0, 0.5]
         core.apply_cam2flange(moved)
@@ -77,8 +95,15 @@ def test_the_camera_mounting_and_targets_on_tf_static_for_a_late_subscriber(doma
         task = next(iter(cell.workcell.task_locations.values()))
         target = by_child[f"videocal/{task.name}"]
         assert target.header.frame_id == "base_link"
-        assert np.allclose([target.transform.translation.x * 1000, target.transform.translation.y * 1000, target.transform.translation.z * 1000],
-                           task.tcp2base[:3, 3], atol=1e-6)
+        assert np.allclose(
+            [
+                target.transform.translation.x * 1000,
+                target.transform.translation.y * 1000,
+                target.transform.translation.z * 1000,
+            ],
+            task.tcp2base[:3, 3],
+            atol=1e-6,
+        )
     finally:
         core.close()
         arm.close()

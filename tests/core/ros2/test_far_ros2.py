@@ -39,8 +39,10 @@ def test_a_far_network_delays_and_drops_udp_between_its_two_sides():
         receiver.bind((net.near_ip, 0))
         receiver.settimeout(3.0)
         port = receiver.getsockname()[1]
-        sender = (f"import socket, time\ns = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)\n"
-                  f"for i in range(200):\n    s.sendto(f'{{i}} {{time.monotonic()}}'.encode(), ('{net.near_ip}', {port}))\n    time.sleep(0.002)\n")
+        sender = (
+            f"import socket, time\ns = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)\n"
+            f"for i in range(200):\n    s.sendto(f'{{i}} {{time.monotonic()}}'.encode(), ('{net.near_ip}', {port}))\n    time.sleep(0.002)\n"
+        )
         subprocess.run(net.far_command([sys.executable, "-c", sender]), check=True, timeout=30)
         got = []
         try:
@@ -61,13 +63,30 @@ def test_the_ros2_connector_moves_an_arm_seconds_away_once_along_its_line(domain
     robot = cell.robot
     with FarNetwork(weather, seed=5) as net:
         configure(domain, net.cyclone_config("near"))
-        cmd = [sys.executable, "-m", "app.cli.main", "sim-ros2", "--domain", str(domain), "--joints", ",".join("0" for _ in range(robot.n_joints))]
-        arm = subprocess.Popen(net.far_command(cmd), cwd=_PROJECT, env=dict(os.environ, CYCLONEDDS_URI=net.cyclone_config("far")),
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        cmd = [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "sim-ros2",
+            "--domain",
+            str(domain),
+            "--joints",
+            ",".join("0" for _ in range(robot.n_joints)),
+        ]
+        arm = subprocess.Popen(
+            net.far_command(cmd),
+            cwd=_PROJECT,
+            env=dict(os.environ, CYCLONEDDS_URI=net.cyclone_config("far")),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         link = None
         try:
             assert arm.stdout.readline().strip() == "ready", arm.stderr.read()
-            context = ControllerContext(robot.joint_names, robot.joint_units, JointMap.identity(robot.n_joints), 100.0, {})
+            context = ControllerContext(
+                robot.joint_names, robot.joint_units, JointMap.identity(robot.n_joints), 100.0, {}
+            )
             link = open_controller(f"ros2:///joint_states?domain={domain}", context)
             states, samples = [], []
             link.state_changed.connect(lambda state, why: states.append(state))

@@ -24,14 +24,24 @@ ACTION = "/arm_controller/follow_joint_trajectory"
 
 @pytest.fixture
 def arm(domain):
-    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 3, [-170.0] * 3, [170.0] * 3, [0.0, 10.0, 20.0], rate_hz=200.0, domain=domain,
-                           controller="arm_controller").start()
+    arm = SimulatedRos2Arm(
+        NAMES,
+        [180 / math.pi] * 3,
+        [-170.0] * 3,
+        [170.0] * 3,
+        [0.0, 10.0, 20.0],
+        rate_hz=200.0,
+        domain=domain,
+        controller="arm_controller",
+    ).start()
     yield arm
     arm.close()
 
 
 def _goal(positions_deg, seconds=0.5, names=NAMES):
-    point = msg.JointTrajectoryPoint(positions=[math.radians(v) for v in positions_deg], time_from_start=msg.Duration.of_s(seconds))
+    point = msg.JointTrajectoryPoint(
+        positions=[math.radians(v) for v in positions_deg], time_from_start=msg.Duration.of_s(seconds)
+    )
     return at.FollowJointTrajectoryGoal(trajectory=msg.JointTrajectory(msg.Header(), list(names), [point]))
 
 
@@ -121,14 +131,20 @@ def test_a_goal_the_controller_aborts_ends_the_move_with_its_reason(arm):
     from calib_core.ros2.participant import participant
     from calib_core.ros2.wire import dds_topic, default_qos
 
-    link = open_controller("ros2:///joint_states", ControllerContext(NAMES, ("deg",) * 3, JointMap.identity(3), 100.0,
-                                                                   {"controller": "arm_controller", "speed_deg_s": 10})).start()
+    link = open_controller(
+        "ros2:///joint_states",
+        ControllerContext(
+            NAMES, ("deg",) * 3, JointMap.identity(3), 100.0, {"controller": "arm_controller", "speed_deg_s": 10}
+        ),
+    ).start()
     try:
         assert wait_until(lambda: link.state is LinkState.UP and link._goals.client.server_ready())
         handle = link.move_joints([100.0, 10.0, 20.0], timeout_s=60)
         assert wait_until(lambda: arm.action.accepted >= 1)
         dp = participant(arm.domain)
-        other = DataWriter(dp, Topic(dp, dds_topic("/arm_controller/joint_trajectory"), msg.JointTrajectory), qos=default_qos(1))
+        other = DataWriter(
+            dp, Topic(dp, dds_topic("/arm_controller/joint_trajectory"), msg.JointTrajectory), qos=default_qos(1)
+        )
         assert wait_until(lambda: other.get_publication_matched_status().current_count > 0)
         other.write(_goal([0.0, 10.0, 20.0], 0.2).trajectory)
         with pytest.raises(MoveError, match="the controller aborted the move"):
@@ -138,10 +154,22 @@ def test_a_goal_the_controller_aborts_ends_the_move_with_its_reason(arm):
 
 
 def test_insisting_on_the_action_without_a_server_is_not_sent(domain):
-    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 3, [-170.0] * 3, [170.0] * 3, [0.0] * 3, domain=domain, controller="arm_controller",
-                           action=False).start()
-    link = open_controller("ros2:///joint_states", ControllerContext(NAMES, ("deg",) * 3, JointMap.identity(3), 100.0,
-                                                                   {"controller": "arm_controller", "interface": "action"})).start()
+    arm = SimulatedRos2Arm(
+        NAMES,
+        [180 / math.pi] * 3,
+        [-170.0] * 3,
+        [170.0] * 3,
+        [0.0] * 3,
+        domain=domain,
+        controller="arm_controller",
+        action=False,
+    ).start()
+    link = open_controller(
+        "ros2:///joint_states",
+        ControllerContext(
+            NAMES, ("deg",) * 3, JointMap.identity(3), 100.0, {"controller": "arm_controller", "interface": "action"}
+        ),
+    ).start()
     try:
         assert wait_until(lambda: link.state is LinkState.UP)
         handle = link.move_joints([1.0, 0.0, 0.0])

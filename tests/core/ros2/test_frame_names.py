@@ -28,7 +28,10 @@ def test_without_a_site_the_defaults_are_the_flange_and_videocal_s_optical_frame
     parent, child = camera_frames(cell, flange_frame="flange")
     assert child == DEFAULT_CAMERA_FRAME == "videocal_camera_optical_frame"
     assert parent == str(cell.robot_spec.frames.get("flange") or "flange")
-    assert camera_frames(None) == ("tool0", DEFAULT_CAMERA_FRAME) and camera_frames(None, static_camera=True)[0] == "base_link"
+    assert (
+        camera_frames(None) == ("tool0", DEFAULT_CAMERA_FRAME)
+        and camera_frames(None, static_camera=True)[0] == "base_link"
+    )
 
 
 @pytest.mark.parametrize("bad", ["'9camera'", "'camera frame'", "'cam\\nera'", "[a]"])

@@ -49,7 +49,9 @@ class PeerImage(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
 
 def _image(rgb, stamp_ns=None):
     h, w = rgb.shape[:2]
-    return msg.Image(msg.Header(msg.Time.of_ns(stamp_ns or time.time_ns()), "camera"), h, w, "rgb8", 0, w * 3, rgb.tobytes())
+    return msg.Image(
+        msg.Header(msg.Time.of_ns(stamp_ns or time.time_ns()), "camera"), h, w, "rgb8", 0, w * 3, rgb.tobytes()
+    )
 
 
 def _matched(writer):

@@ -59,23 +59,38 @@ def test_moveit2_s_launch_file_with_a_quaternion(tmp_path):
 
 def test_roll_pitch_yaw_are_tf2_s_fixed_axes(tmp_path):
     path = tmp_path / "rpy.launch.py"
-    path.write_text(MOVEIT2_QUATERNION.replace('"--qx", "0.0087", "--qy", "-0.0123", "--qz", "0.7070", "--qw", "0.7071",',
-                                               '"--roll", "0.3", "--pitch", "-0.2", "--yaw", "1.1",'))
+    path.write_text(
+        MOVEIT2_QUATERNION.replace(
+            '"--qx", "0.0087", "--qy", "-0.0123", "--qz", "0.7070", "--qw", "0.7071",',
+            '"--roll", "0.3", "--pitch", "-0.2", "--yaw", "1.1",',
+        )
+    )
     R = read_static_transform(path).child2parent_mm[:3, :3]
     # tf2's setRPY: R = Rz(yaw) Ry(pitch) Rx(roll)
-    Rz, Ry, Rx = (Rotation.from_rotvec(np.array(a) * v).as_matrix() for a, v in (([0, 0, 1], 1.1), ([0, 1, 0], -0.2), ([1, 0, 0], 0.3)))
+    Rz, Ry, Rx = (
+        Rotation.from_rotvec(np.array(a) * v).as_matrix()
+        for a, v in (([0, 0, 1], 1.1), ([0, 1, 0], -0.2), ([1, 0, 0], 0.3))
+    )
     np.testing.assert_allclose(R, Rz @ Ry @ Rx, atol=1e-12)
 
 
 def test_an_xml_launch_with_positional_arguments(tmp_path):
     euler = tmp_path / "a.launch"
-    euler.write_text('<launch>\n  <node pkg="tf2_ros" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 1.1 -0.2 0.3 flange cam_optical_frame" />\n</launch>\n')
+    euler.write_text(
+        '<launch>\n  <node pkg="tf2_ros" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 1.1 -0.2 0.3 flange cam_optical_frame" />\n</launch>\n'
+    )
     quat = tmp_path / "b.launch.xml"
-    quat.write_text('<launch><node pkg="tf" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 0 0 0.7071068 0.7071068 flange cam_optical_frame 100"/></launch>')
+    quat.write_text(
+        '<launch><node pkg="tf" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 0 0 0.7071068 0.7071068 flange cam_optical_frame 100"/></launch>'
+    )
     a, b = read_static_transform(euler), read_static_transform(quat)
     np.testing.assert_allclose(a.child2parent_mm[:3, 3], [100.0, 20.0, -30.0])
-    np.testing.assert_allclose(a.child2parent_mm[:3, :3], Rotation.from_euler("xyz", [0.3, -0.2, 1.1]).as_matrix(), atol=1e-12)  # yaw pitch roll given
-    np.testing.assert_allclose(b.child2parent_mm[:3, :3], Rotation.from_rotvec([0, 0, np.pi / 2]).as_matrix(), atol=1e-6)
+    np.testing.assert_allclose(
+        a.child2parent_mm[:3, :3], Rotation.from_euler("xyz", [0.3, -0.2, 1.1]).as_matrix(), atol=1e-12
+    )  # yaw pitch roll given
+    np.testing.assert_allclose(
+        b.child2parent_mm[:3, :3], Rotation.from_rotvec([0, 0, np.pi / 2]).as_matrix(), atol=1e-6
+    )
     assert (b.parent, b.child) == ("flange", "cam_optical_frame")
 
 
@@ -100,14 +115,17 @@ def test_the_python_launch_file_is_never_run(tmp_path):
         read_static_transform(computed)
 
 
-@pytest.mark.parametrize("text, says", [
-    ("from launch import LaunchDescription\n", "no static_transform_publisher"),
-    (MOVEIT2_QUATERNION.replace('"--qw", "0.7071"', '"--qw", "0.9"'), "unit quaternion"),
-    (MOVEIT2_QUATERNION.replace('"--x", "0.0412"', '"--x", "abc"'), "x must be a number"),
-    (MOVEIT2_QUATERNION.replace('"--frame-id", "tool0",', ""), "--frame-id"),
-    (MOVEIT2_QUATERNION.replace('"--x", "0.0412",', '"--x", "0.0412", "--speed", "3",'), "unknown"),
-    ("def f(:\n", "not a Python launch file"),
-])
+@pytest.mark.parametrize(
+    "text, says",
+    [
+        ("from launch import LaunchDescription\n", "no static_transform_publisher"),
+        (MOVEIT2_QUATERNION.replace('"--qw", "0.7071"', '"--qw", "0.9"'), "unit quaternion"),
+        (MOVEIT2_QUATERNION.replace('"--x", "0.0412"', '"--x", "abc"'), "x must be a number"),
+        (MOVEIT2_QUATERNION.replace('"--frame-id", "tool0",', ""), "--frame-id"),
+        (MOVEIT2_QUATERNION.replace('"--x", "0.0412",', '"--x", "0.0412", "--speed", "3",'), "unknown"),
+        ("def f(:\n", "not a Python launch file"),
+    ],
+)
 def test_bad_launch_files_are_refused_by_name(tmp_path, text, says):
     path = tmp_path / "bad.launch.py"
     path.write_text(text)
@@ -130,9 +148,13 @@ def test_a_mounting_on_another_frame_of_the_flange_s_link_is_moved_onto_the_flan
     cam2tcp = make_transform(Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix(), [10.0, 20.0, 30.0])
     cam2flange = robot.on_flange(cam2tcp, robot.roles.get("tcp", "tcp"), "test")
     q = np.zeros(robot.n_joints)
-    np.testing.assert_allclose(concat(cam2flange, robot.fk(q, "flange")), concat(cam2tcp, robot.fk(q, "tcp")), atol=1e-9)
+    np.testing.assert_allclose(
+        concat(cam2flange, robot.fk(q, "flange")), concat(cam2tcp, robot.fk(q, "tcp")), atol=1e-9
+    )
     flange_joint = robot.model.frames[robot.frame_id("flange")].parentJoint
-    elbow = next(f.name for f in robot.model.frames if 0 < f.parentJoint < flange_joint)  # a link a joint moves against the flange
+    elbow = next(
+        f.name for f in robot.model.frames if 0 < f.parentJoint < flange_joint
+    )  # a link a joint moves against the flange
     with pytest.raises(VideocalError, match="not fixed to the flange"):
         robot.on_flange(cam2tcp, elbow, "test")
     with pytest.raises(VideocalError, match="not on this cell's robot"):

@@ -46,7 +46,8 @@ def test_the_xacro_macro_included_in_a_description_places_the_driver_s_frame(tmp
     (tmp_path / "robot.urdf.xacro").write_text(
         '<?xml version="1.0"?><robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
         '<link name="tool0"/><xacro:include filename="camera_mounting.urdf.xacro"/>'
-        '<xacro:videocal_camera_mounting child="camera_color_optical_frame"/></robot>')
+        '<xacro:videocal_camera_mounting child="camera_color_optical_frame"/></robot>'
+    )
     urdf = xacro.process_file(str(tmp_path / "robot.urdf.xacro")).toxml()
     placed = _placed(urdf, "camera_color_optical_frame")
     np.testing.assert_allclose(placed.rotation, camera2flange[:3, :3], atol=1e-8)
@@ -77,8 +78,12 @@ def test_the_launch_file_publishes_the_mounting_as_tf2_reads_it(k):
 def test_the_suffix_chooses_the_form_and_a_bad_transform_is_refused():
     T = np.eye(4)
     assert "static_transform_publisher" in mounting_text_for("cam.launch.py", T, "tool0")
-    assert "<xacro:macro" in mounting_text_for("cam.urdf.xacro", T, "tool0") and '<robot name="videocal_camera_mounting">' in mounting_text_for("cam.urdf", T, "tool0")
-    assert '"--child-frame-id", "camera_link_optical"' in mounting_text_for("cam.launch.py", T, "tool0", child="camera_link_optical")
+    assert "<xacro:macro" in mounting_text_for(
+        "cam.urdf.xacro", T, "tool0"
+    ) and '<robot name="videocal_camera_mounting">' in mounting_text_for("cam.urdf", T, "tool0")
+    assert '"--child-frame-id", "camera_link_optical"' in mounting_text_for(
+        "cam.launch.py", T, "tool0", child="camera_link_optical"
+    )
     assert mounting_text_for("cam.yaml", T, "tool0") is None
     mirrored = np.diag([1.0, 1.0, -1.0, 1.0])
     with pytest.raises(ValueError, match="reflection"):

@@ -1,7 +1,6 @@
 """The ROS 2 controller connector against a publisher of our own (its own IDL, written from the ROS message
 definitions, not videocal's) and against the simulated ros2_control arm."""
 
-
 import math
 import time
 from dataclasses import dataclass
@@ -55,11 +54,11 @@ def _context(**options):
     return ControllerContext(NAMES, UNITS, JointMap.identity(6), 100.0, options)
 
 
-
-
 def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(domain):
     dp = DomainParticipant(domain)
-    qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10))
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10)
+    )
     writer = DataWriter(dp, Topic(dp, "rt/joint_states", Joints), qos=qos)
     link = open_controller("ros2:///joint_states", _context())
     assert isinstance(link, Ros2TrajectoryController)
@@ -70,13 +69,23 @@ def test_joint_states_by_name_in_si_become_the_cells_joints_with_their_stamp(dom
         assert wait_until(lambda: writer.get_publication_matched_status().current_count > 0)
         # Another order, an extra gripper joint, radians and metres, a stamp of the publisher's clock.
         order = ["slide", "gripper", "wrist_2", "elbow", "shoulder_pan", "wrist_1", "shoulder_lift"]
-        values = {"slide": 0.125, "gripper": 0.02, "wrist_2": -math.pi / 2, "elbow": 1.0, "shoulder_pan": 0.1, "wrist_1": 0.0, "shoulder_lift": -0.5}
+        values = {
+            "slide": 0.125,
+            "gripper": 0.02,
+            "wrist_2": -math.pi / 2,
+            "elbow": 1.0,
+            "shoulder_pan": 0.1,
+            "wrist_1": 0.0,
+            "shoulder_lift": -0.5,
+        }
         writer.write(Joints(Hdr(Stamp(1_700_000_000, 250_000_000), "base"), order, [values[n] for n in order], [], []))
         # A message with the arm's joints missing (a gripper's own states) is not the arm's sample.
         writer.write(Joints(Hdr(Stamp(1_700_000_000, 260_000_000), "base"), ["gripper"], [0.01], [], []))
         # An older stamp after a newer one is not the robot now.
         writer.write(Joints(Hdr(Stamp(1_700_000_000, 200_000_000), "base"), order, [values[n] for n in order], [], []))
-        assert wait_until(lambda: link.stats_snapshot()["wrong_joint_count"] == 1 and link.stats_snapshot()["backwards_samples"] == 1)
+        assert wait_until(
+            lambda: link.stats_snapshot()["wrong_joint_count"] == 1 and link.stats_snapshot()["backwards_samples"] == 1
+        )
         assert len(got) == 1 and link.state is LinkState.UP
         sample = got[0].sample
         assert sample.t_ms == 1_700_000_000_250
@@ -101,8 +110,16 @@ def test_no_joint_states_is_stale_and_the_reason_says_where(domain):
 
 @pytest.fixture
 def arm(domain):
-    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 5 + [1000.0], [-170.0] * 5 + [0.0], [170.0] * 5 + [500.0], [0, -30, 60, 0, 45, 100],
-                           rate_hz=200.0, domain=domain, controller="arm_controller").start()
+    arm = SimulatedRos2Arm(
+        NAMES,
+        [180 / math.pi] * 5 + [1000.0],
+        [-170.0] * 5 + [0.0],
+        [170.0] * 5 + [500.0],
+        [0, -30, 60, 0, 45, 100],
+        rate_hz=200.0,
+        domain=domain,
+        controller="arm_controller",
+    ).start()
     yield arm
     arm.close()
 
@@ -114,8 +131,14 @@ def interface(request):
 
 
 def _connected(interface="topic", **options):
-    link = open_controller("ros2:///joint_states", _context(controller="arm_controller", interface=interface, **options)).start()
-    ready = (lambda: link._goals.client.server_ready()) if interface == "action" else (lambda: link._writer.get_publication_matched_status().current_count > 0)
+    link = open_controller(
+        "ros2:///joint_states", _context(controller="arm_controller", interface=interface, **options)
+    ).start()
+    ready = (
+        (lambda: link._goals.client.server_ready())
+        if interface == "action"
+        else (lambda: link._writer.get_publication_matched_status().current_count > 0)
+    )
     assert wait_until(lambda: link.state is LinkState.UP and ready())
     return link
 
@@ -209,7 +232,9 @@ def test_a_workstation_that_dies_mid_move_stops_the_arm_within_the_horizon(arm, 
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[3]
-    station = subprocess.Popen([sys.executable, "-c", _WORKSTATION, interface], cwd=root, stdout=subprocess.PIPE, text=True)
+    station = subprocess.Popen(
+        [sys.executable, "-c", _WORKSTATION, interface], cwd=root, stdout=subprocess.PIPE, text=True
+    )
     try:
         assert station.stdout.readline().strip() == "moving"
         assert wait_until(lambda: arm.position(time.monotonic())[0] > 20.0, 10.0)
@@ -244,7 +269,9 @@ def test_the_simulated_arm_refuses_an_empty_trajectory_as_the_controller_does():
     Stop must therefore be a trajectory that holds, which is what the connector sends."""
     from calib_core.ros2 import messages as msg
 
-    arm = SimulatedRos2Arm(NAMES, [180 / math.pi] * 5 + [1000.0], [-360.0] * 5 + [0.0], [360.0] * 5 + [500.0], [0, -30, 60, 0, 45, 100])
+    arm = SimulatedRos2Arm(
+        NAMES, [180 / math.pi] * 5 + [1000.0], [-360.0] * 5 + [0.0], [360.0] * 5 + [500.0], [0, -30, 60, 0, 45, 100]
+    )
     point = msg.JointTrajectoryPoint(positions=[0.1, 0, 0, 0, 0, 0.1], time_from_start=msg.Duration.of_s(1.0))
     assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), [point]), 0.0) is None
     assert arm.follow(msg.JointTrajectory(msg.Header(), list(NAMES), []), 0.5) == "Empty trajectory received."
@@ -272,7 +299,9 @@ def test_joint_states_of_other_names_say_which_came_and_which_renaming_fits(doma
     not have (only the statistics counted them). The link's state now names what came and what is missing, and the
     renaming when the names are this robot's with a prefix."""
     dp = DomainParticipant(domain)
-    qos = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10))
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile, Policy.History.KeepLast(10)
+    )
     writer = DataWriter(dp, Topic(dp, "rt/joint_states", Joints), qos=qos)
     link = open_controller("ros2:///joint_states", _context())
     states = []
@@ -308,7 +337,10 @@ def test_a_topic_of_another_message_type_is_said_not_waited_for(domain):
     link.start()
     try:
         writer.write(Text("hello"))
-        assert wait_until(lambda: any("carries std_msgs/msg/String, not sensor_msgs/msg/JointState" in why for _, why in states), timeout_s=10)
+        assert wait_until(
+            lambda: any("carries std_msgs/msg/String, not sensor_msgs/msg/JointState" in why for _, why in states),
+            timeout_s=10,
+        )
         assert link.state is LinkState.CONNECTING and f"joint_states on ROS domain {domain}" in states[-1][1]
     finally:
         link.close()
@@ -324,6 +356,9 @@ def test_dds_type_names_read_as_ros_names():
 def test_a_renaming_is_suggested_only_when_it_is_one_to_one():
     from calib_core.ros2.trajectory_connector import suggest_joint_names
 
-    assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "left_b_joint"]) == {"a_joint": "left_a_joint", "b_joint": "left_b_joint"}
+    assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "left_b_joint"]) == {
+        "a_joint": "left_a_joint",
+        "b_joint": "left_b_joint",
+    }
     assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "right_a_joint", "left_b_joint"]) is None
     assert suggest_joint_names(["a_joint"], ["finger"]) is None

@@ -8,7 +8,10 @@ from calib_core.ros2.wire import Ros2NameError, dds_topic, domain_id
 
 def test_topics_take_rt_prefix():
     assert dds_topic("/joint_states") == "rt/joint_states"
-    assert dds_topic("/arm/joint_trajectory_controller/joint_trajectory") == "rt/arm/joint_trajectory_controller/joint_trajectory"
+    assert (
+        dds_topic("/arm/joint_trajectory_controller/joint_trajectory")
+        == "rt/arm/joint_trajectory_controller/joint_trajectory"
+    )
     assert dds_topic("tf_static") == "rt/tf_static"
 
 

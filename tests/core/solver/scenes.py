@@ -28,7 +28,13 @@ def random_points(rng: np.random.Generator, n: int, size_mm: float = 120.0, plan
     return P
 
 
-def pixels(P: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics = GRIPPER_CAMERA, noise_px: float = 0.0, rng: np.random.Generator | None = None) -> np.ndarray:
+def pixels(
+    P: np.ndarray,
+    obj2cam: np.ndarray,
+    intrinsics: Intrinsics = GRIPPER_CAMERA,
+    noise_px: float = 0.0,
+    rng: np.random.Generator | None = None,
+) -> np.ndarray:
     """Observed pixels (n, 2) of points ``P`` at pose ``obj2cam``, with Gaussian noise."""
     uv = project_points(P, obj2cam, intrinsics)
     if noise_px:

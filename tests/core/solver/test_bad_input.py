@@ -66,7 +66,10 @@ def test_one_3d_point_at_two_pixels_is_allowed_and_a_disagreement_is_named():
     twice = solve_pose(np.vstack([P[:4], P[1]]), np.vstack([UV[:4], UV[1]]), GRIPPER_CAMERA)
     once = solve_pose(P[:4], UV[:4], GRIPPER_CAMERA)
     assert twice.status is once.status and np.allclose(twice.obj2cam, once.obj2cam)
-    assert "1 pair given again (the same 3D point at the same pixel), each counted once: point 5 = point 2" in twice.warnings
+    assert (
+        "1 pair given again (the same 3D point at the same pixel), each counted once: point 5 = point 2"
+        in twice.warnings
+    )
     assert twice.residuals_px.shape == (5, 2) and np.array_equal(twice.residuals_px[4], twice.residuals_px[1])
     # in the window's numbers, and so is every message of the solve on the distinct pairs
     P8 = random_points(np.random.default_rng(8), 8)

@@ -5,7 +5,13 @@ import numpy as np
 import pytest
 
 from calib_core.solver.kernels.diagnostics import flags_a_misfit
-from calib_core.solver.misfit import FALSE_FLAG_PER_SOLVE, OWN_SCALE_MIN_DOF, fisher_quantile, flag_misfits, misfit_statistics
+from calib_core.solver.misfit import (
+    FALSE_FLAG_PER_SOLVE,
+    OWN_SCALE_MIN_DOF,
+    fisher_quantile,
+    flag_misfits,
+    misfit_statistics,
+)
 
 
 @pytest.mark.parametrize("n", [4, 5, 6, 8, 12, 30])

@@ -24,7 +24,10 @@ def test_a_focal_length_at_the_search_limit_is_named_as_the_cause():
     P, uv = _picks(6.0)  # a lens six times longer than the camera file says
     solution = solve_pose(P, uv, FILE, estimate_focal=True)
     assert solution.status.value == "failed"
-    assert "focal lengths ran to the edge of their search range" in solution.reason and "5.00 x the camera file's" in solution.reason
+    assert (
+        "focal lengths ran to the edge of their search range" in solution.reason
+        and "5.00 x the camera file's" in solution.reason
+    )
     assert "fits worst" not in solution.reason
 
 

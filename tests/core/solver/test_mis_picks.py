@@ -17,7 +17,9 @@ CAM = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
 
 
 def _scene(rng, n=10, noise_px=0.5):
-    T = make_transform(Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix(), [rng.uniform(-40, 40), rng.uniform(-30, 30), 500.0])
+    T = make_transform(
+        Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix(), [rng.uniform(-40, 40), rng.uniform(-30, 30), 500.0]
+    )
     P = rng.uniform(-75, 75, (n, 3))
     return T, P, project_points(P, T, CAM) + rng.normal(0, noise_px, (n, 2))
 
@@ -51,7 +53,10 @@ def test_a_5_px_mis_pick_that_leaves_the_rms_fine_is_named():
 def test_clean_picks_are_rarely_flagged_and_coarse_hand_picks_not_all_called_mis_picks():
     rng = np.random.default_rng(8)
     for noise in (0.5, 2.0):  # the noise model's 0.5 px; hand picks on a photo at 2 px
-        flagged = sum("does not fit the others" in (solve_pose(P, uv, CAM).reason or "") for _, P, uv in (_scene(rng, 10, noise) for _ in range(300)))
+        flagged = sum(
+            "does not fit the others" in (solve_pose(P, uv, CAM).reason or "")
+            for _, P, uv in (_scene(rng, 10, noise) for _ in range(300))
+        )
         assert flagged <= 3, (noise, flagged)  # one solve in a thousand by design
 
 
@@ -66,7 +71,7 @@ def test_the_statistic_matches_a_real_leave_one_out_solve():
     for i in range(8):
         keep = np.arange(8) != i
         without = solve_pose(P[keep], uv[keep], CAM)
-        miss = np.linalg.norm(project_points(P[i:i + 1], without.obj2cam, CAM)[0] - uv[i])
+        miss = np.linalg.norm(project_points(P[i : i + 1], without.obj2cam, CAM)[0] - uv[i])
         assert full.leave_one_out_px[i] == pytest.approx(miss, rel=0.05, abs=0.05)
     J = _jacobian(full, P, uv)
     stats = misfit_statistics(J, full.residuals_px, np.ones(8, bool))

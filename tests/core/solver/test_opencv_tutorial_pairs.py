@@ -72,7 +72,9 @@ def test_robust_finds_the_pose_through_a_third_of_wrong_pairs(pairs):
     assert len(flagged & truly) >= 0.97 * len(truly)  # a wrong match that lands near its true pixel is no outlier
     assert len(flagged - truly) <= 0.01 * len(P)
     dt, dr = pose_error(sol.obj2cam, clean.obj2cam)
-    assert dt < 3 * np.linalg.norm(sol.uncertainty.std_t_obj2cam_mm) and dr < 0.05  # within its own 3 sigma of the clean pose
+    assert (
+        dt < 3 * np.linalg.norm(sol.uncertainty.std_t_obj2cam_mm) and dr < 0.05
+    )  # within its own 3 sigma of the clean pose
 
 
 def test_robust_on_seven_coarse_picks_of_the_photo_gives_the_plain_answer(pairs):

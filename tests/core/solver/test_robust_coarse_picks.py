@@ -34,7 +34,10 @@ def test_robust_on_clean_coarse_picks_gives_the_plain_answer(n):
         robust_ok += robust.status.value == "ok" and not robust.outliers.any()
         if plain.status.value == "ok":
             plain_ok += 1
-            assert robust.status.value == "ok" and not robust.outliers.any(), (robust.reason, np.flatnonzero(robust.outliers))
+            assert robust.status.value == "ok" and not robust.outliers.any(), (
+                robust.reason,
+                np.flatnonzero(robust.outliers),
+            )
             mm, deg = pose_error(robust.obj2cam, plain.obj2cam)
             assert mm < 1e-6 and deg < 1e-6
     assert robust_ok >= plain_ok and robust_ok >= 58  # the plain solve refuses some 2 px sets (RMS over 5 x 0.5 px)
@@ -96,8 +99,12 @@ def test_a_rival_is_the_same_size_swap_that_fits():
         from calib_core.solver.consensus import consensus_refine
 
         problem = make_problem(P, uv, CAM)
-        chosen = consensus_refine(problem, s.obj2cam[:3, :3], s.obj2cam[:3, 3], CAM.fu, CAM.fv, 2.0, inliers=~s.outliers)
+        chosen = consensus_refine(
+            problem, s.obj2cam[:3, :3], s.obj2cam[:3, 3], CAM.fu, CAM.fv, 2.0, inliers=~s.outliers
+        )
         rivals = rival_consensus(problem, chosen, 0.5)
-        assert rivals and all(r.inliers.sum() == chosen.inliers.sum() and not np.array_equal(r.inliers, chosen.inliers) for r in rivals)
+        assert rivals and all(
+            r.inliers.sum() == chosen.inliers.sum() and not np.array_equal(r.inliers, chosen.inliers) for r in rivals
+        )
         return
     pytest.fail("no ambiguous scene with a rejected pair among 300")

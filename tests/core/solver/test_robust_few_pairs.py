@@ -47,7 +47,12 @@ def test_poselib_agrees_on_the_ok_poses():
         s = solve_pose(P, uv, PINHOLE_CAMERA, robust=True)
         if s.status.value != "ok":
             continue
-        cam = {"model": "PINHOLE", "width": 1280, "height": 960, "params": [PINHOLE_CAMERA.fu, PINHOLE_CAMERA.fv, PINHOLE_CAMERA.cx, PINHOLE_CAMERA.cy]}
+        cam = {
+            "model": "PINHOLE",
+            "width": 1280,
+            "height": 960,
+            "params": [PINHOLE_CAMERA.fu, PINHOLE_CAMERA.fv, PINHOLE_CAMERA.cx, PINHOLE_CAMERA.cy],
+        }
         pose, _ = poselib.estimate_absolute_pose(uv, P, cam, {"max_reproj_error": 2.0}, {})
         theirs = np.eye(4)
         theirs[:3, :3], theirs[:3, 3] = pose.R, pose.t
@@ -70,7 +75,9 @@ def test_three_agreeing_pairs_are_not_an_answer():
     uv = pixels(P, T, PINHOLE_CAMERA, noise_px=0.3, rng=rng)
     uv[[1, 3]] += [[90.0, -40.0], [-60.0, 120.0]]  # two of five off: three left, which fit exactly whatever they are
     s = solve_pose(P, uv, PINHOLE_CAMERA, robust=True)
-    assert s.status.value == "failed" and "only 3 pairs agree" in s.reason and "too few to check one another" in s.reason
+    assert (
+        s.status.value == "failed" and "only 3 pairs agree" in s.reason and "too few to check one another" in s.reason
+    )
 
 
 def test_two_subsets_that_fit_equally_well_make_an_ambiguous_answer():
@@ -95,9 +102,24 @@ def test_a_rival_four_out_of_reach_of_the_chosen_pose_still_makes_it_ambiguous()
     from calib_core.camera.intrinsics import Intrinsics
 
     camera = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
-    P = np.array([[-35.905896, 52.055352, -21.071675], [12.041144, 49.739748, 34.206684], [24.547664, 6.219168, 37.769843],
-                  [-14.902368, -56.907612, 53.323548], [-12.253889, -22.164908, 56.784119]])
-    uv = np.array([[793.334861, 496.300391], [775.661902, 587.054799], [770.6505, 515.046118], [664.426848, 400.261524], [697.674255, 453.172955]])
+    P = np.array(
+        [
+            [-35.905896, 52.055352, -21.071675],
+            [12.041144, 49.739748, 34.206684],
+            [24.547664, 6.219168, 37.769843],
+            [-14.902368, -56.907612, 53.323548],
+            [-12.253889, -22.164908, 56.784119],
+        ]
+    )
+    uv = np.array(
+        [
+            [793.334861, 496.300391],
+            [775.661902, 587.054799],
+            [770.6505, 515.046118],
+            [664.426848, 400.261524],
+            [697.674255, 453.172955],
+        ]
+    )
     truth_t = np.array([23.228729075, 37.891095468, 529.898783715])
     s = solve_pose(P, uv, camera, robust=True)
     assert s.status.value != "ok" or np.linalg.norm(s.obj2cam[:3, 3] - truth_t) < 5.0

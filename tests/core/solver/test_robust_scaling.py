@@ -20,7 +20,9 @@ CAM = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
 
 
 def _scene(rng, n, outlier_share=0.0, noise_px=0.5):
-    T = make_transform(Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix(), [rng.uniform(-40, 40), rng.uniform(-30, 30), 500.0])
+    T = make_transform(
+        Rotation.from_rotvec(rng.normal(0, 0.3, 3)).as_matrix(), [rng.uniform(-40, 40), rng.uniform(-30, 30), 500.0]
+    )
     P = rng.uniform(-75, 75, (n, 3))
     uv = project_points(P, T, CAM) + rng.normal(0, noise_px, (n, 2))
     bad = rng.random(n) < outlier_share
@@ -36,8 +38,12 @@ def test_five_thousand_pairs_with_30_percent_outliers_are_sorted_out_in_little_m
     peak_mb = tracemalloc.get_traced_memory()[1] / 1e6
     tracemalloc.stop()
     assert solution.status.value == "ok"
-    far_off = np.linalg.norm(uv - project_points(P, T, CAM), axis=1) > 4 * 0.5 * 1.2  # drawn as outliers and far from the truth
-    assert np.array_equal(solution.outliers[far_off], np.ones(far_off.sum(), bool)) and not solution.outliers[~bad].any()
+    far_off = (
+        np.linalg.norm(uv - project_points(P, T, CAM), axis=1) > 4 * 0.5 * 1.2
+    )  # drawn as outliers and far from the truth
+    assert (
+        np.array_equal(solution.outliers[far_off], np.ones(far_off.sum(), bool)) and not solution.outliers[~bad].any()
+    )
     assert np.linalg.norm(solution.obj2cam[:3, 3] - T[:3, 3]) < 0.1
     assert peak_mb < 200  # all triplets of 5000 points would be 2e10 of them
 

@@ -33,7 +33,13 @@ def test_p3p_finds_the_roots_opencv_finds():
         P = random_points(rng, 3)
         Rs, ts = np.zeros((4, 3, 3)), np.zeros((4, 3))
         n = p3p(P, _rays(P, truth), Rs, ts)
-        m, rvecs, tvecs = cv2.solveP3P(P.reshape(3, 1, 3), pixels(P, truth, intrinsics=PINHOLE_CAMERA).reshape(3, 1, 2), K, None, flags=cv2.SOLVEPNP_P3P)
+        m, rvecs, tvecs = cv2.solveP3P(
+            P.reshape(3, 1, 3),
+            pixels(P, truth, intrinsics=PINHOLE_CAMERA).reshape(3, 1, 2),
+            K,
+            None,
+            flags=cv2.SOLVEPNP_P3P,
+        )
         assert n == m
         ours = [np.concatenate([Rs[k].ravel(), ts[k] / 500.0]) for k in range(n)]
         for rv, tv in zip(rvecs[:m], tvecs[:m]):
@@ -42,7 +48,10 @@ def test_p3p_finds_the_roots_opencv_finds():
             compared += 1
         # the truth is one of them (a seed, to a micrometre: near a double root, where two poses
         # merge, the quartic's root loses digits), and every root puts the three points on their rays
-        assert min(pose_error(np.vstack([np.column_stack([Rs[k], ts[k]]), [0, 0, 0, 1]]), truth)[0] for k in range(n)) < 1e-3
+        assert (
+            min(pose_error(np.vstack([np.column_stack([Rs[k], ts[k]]), [0, 0, 0, 1]]), truth)[0] for k in range(n))
+            < 1e-3
+        )
         rays = _rays(P, truth)
         for k in range(n):
             X = P @ Rs[k].T + ts[k]
@@ -104,7 +113,11 @@ def _ambiguous_fourth_point(P3, pose_a, pose_b):
         b = (F[0, 1] + F[1, 0]) * u + F[1, 2] + F[2, 1]
         c = F[0, 0] * u * u + (F[0, 2] + F[2, 0]) * u + F[2, 2]
         for v in np.roots([a, b, c]):
-            if abs(v.imag) > 1e-9 or not 20 < v.real < PINHOLE_CAMERA.height - 20 or not 20 < u < PINHOLE_CAMERA.width - 20:
+            if (
+                abs(v.imag) > 1e-9
+                or not 20 < v.real < PINHOLE_CAMERA.height - 20
+                or not 20 < u < PINHOLE_CAMERA.width - 20
+            ):
                 continue
             p = np.array([u, v.real])
             Pa = K @ pose_a[:3]

@@ -23,15 +23,18 @@ def _context(**options):
     return ControllerContext(NAMES, ("deg",) * 6, JointMap.identity(6), 500.0, options)
 
 
-
-
 class SimUR:
     """``videocal sim-ur`` on a loopback address of its own (UR's ports are fixed)."""
 
     def __init__(self, host):
         self.host = host
-        self.process = subprocess.Popen([sys.executable, "-m", "app.cli.main", "sim-ur", "--host", host, "--joints", ",".join(map(str, HOME))],
-                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "app.cli.main", "sim-ur", "--host", host, "--joints", ",".join(map(str, HOME))],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
         line = self.process.stdout.readline().strip()
         assert line == "ready", self.process.stderr.read()
 
@@ -95,13 +98,20 @@ def test_a_move_then_a_stop_on_the_way(link):
 def test_monitor_without_a_workcell_prints_the_ur_s_own_six_joints(sim):
     """``videocal monitor ur-rtde://HOST`` with no cell: the UR's six joints in its order (the cell's robot had 0
     joints and the connector refused: "the cell's robot has 0 ()")."""
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", f"ur-rtde://{sim.host}", "--count", "2", "--json"], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "monitor", f"ur-rtde://{sim.host}", "--count", "2", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0, run.stderr
     import json
 
     samples = [json.loads(line) for line in run.stdout.splitlines() if line.startswith("{")]
     # six joints in degrees, within the robot's range (earlier tests moved it from HOME)
-    assert len(samples) == 2 and all(len(s["joints_deg"]) == 6 and np.all(np.abs(s["joints_deg"]) <= 360.0) for s in samples)
+    assert len(samples) == 2 and all(
+        len(s["joints_deg"]) == 6 and np.all(np.abs(s["joints_deg"]) <= 360.0) for s in samples
+    )
 
 
 def test_protective_stop_and_local_control_refuse_moves_and_say_so(sim, link):
@@ -186,8 +196,23 @@ def test_an_unreachable_controller_is_one_error_line_without_the_library_s_noise
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[3]
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "monitor", "ur-rtde://127.0.0.1", "--count", "1", "--workcell", str(root / "resources" / "workcell" / "workcell.yaml")],
-                         capture_output=True, text=True, timeout=60, cwd=root)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "monitor",
+            "ur-rtde://127.0.0.1",
+            "--count",
+            "1",
+            "--workcell",
+            str(root / "resources" / "workcell" / "workcell.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=root,
+    )
     lines = [line for line in run.stderr.splitlines() if line.strip()]
     assert lines[0].startswith("error: ") and "cannot reach 127.0.0.1:30004" in lines[0], run.stderr
     assert "connect: Connection refused" not in run.stderr

@@ -33,7 +33,13 @@ class MjpegCamera:
                 jpeg = cv2.imencode(".jpg", np.full((120, 160, 3), camera.level, np.uint8))[1].tobytes()
                 try:
                     while not camera.stopped.wait(0.05):
-                        self.wfile.write(b"--frame\r\nContent-Type: image/jpeg\r\nContent-Length: " + str(len(jpeg)).encode() + b"\r\n\r\n" + jpeg + b"\r\n")
+                        self.wfile.write(
+                            b"--frame\r\nContent-Type: image/jpeg\r\nContent-Length: "
+                            + str(len(jpeg)).encode()
+                            + b"\r\n\r\n"
+                            + jpeg
+                            + b"\r\n"
+                        )
                         self.wfile.flush()
                 except OSError:
                     pass

@@ -31,7 +31,9 @@ def _luma(rgb) -> float:
 def _painted_look(target_rgb, behind_rgb):
     cell = load_workcell()
     paint = {TARGET: target_rgb, "oru_1": behind_rgb}
-    cell = dataclasses.replace(cell, components=[dataclasses.replace(c, color=paint.get(c.name, c.color)) for c in cell.components])
+    cell = dataclasses.replace(
+        cell, components=[dataclasses.replace(c, color=paint.get(c.name, c.color)) for c in cell.components]
+    )
     bed = TestBed.create(workcell=cell, errors=_errors_times(1.0))
     q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").tcp2base, np.array(cell.home_joints_deg, float)).q_deg
     bed.joints_deg = q
@@ -61,10 +63,16 @@ def test_the_outline_is_an_edge_in_colour_and_not_in_grey(equal_grey):
     grey = cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
     in_grey = matched_share(outline, edge_distance_map(grey))
     in_colour = matched_share(outline, edge_distance_map(image))
-    assert in_colour > 0.5 and in_grey < 0.3, (in_grey, in_colour)  # 0.61 and 0.27: the hidden and inner edges never match
+    assert in_colour > 0.5 and in_grey < 0.3, (
+        in_grey,
+        in_colour,
+    )  # 0.61 and 0.27: the hidden and inner edges never match
     # the colour gradient of a grey image is the grey gradient: nothing changes for a monochrome camera
     g = cv2.GaussianBlur(grey, (3, 3), 0.8).astype(np.float32)
-    np.testing.assert_array_equal(colour_contrast.gradient_magnitude(grey), np.hypot(cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3)))
+    np.testing.assert_array_equal(
+        colour_contrast.gradient_magnitude(grey),
+        np.hypot(cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3), cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3)),
+    )
     assert np.array_equal(colour_contrast.edges(grey), cv2.Canny(cv2.GaussianBlur(grey, (5, 5), 1.0), 20, 60))
 
 

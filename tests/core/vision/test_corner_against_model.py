@@ -14,7 +14,9 @@ def _plate(shift_px, size=120, samples=8) -> np.ndarray:
     big = np.full((size * samples, size * samples), 200, np.uint8)
     # the coarse pixel u covers the fine ones samples u .. samples u + samples - 1; vertices to 1/16 of a fine
     # pixel (the fill covers whole fine pixels: shifts in eighths of a pixel are drawn exactly)
-    s = lambda pts: np.round(((np.asarray(pts, float) + shift_px) * samples + (samples - 1) / 2.0) * 16).astype(np.int32)  # noqa: E731
+    s = lambda pts: np.round(((np.asarray(pts, float) + shift_px) * samples + (samples - 1) / 2.0) * 16).astype(
+        np.int32
+    )  # noqa: E731
     plate = [(60.0, 63.0), (63.0, 60.0), (115.0, 60.0), (115.0, 115.0), (60.0, 115.0)]
     cv2.fillPoly(big, [s(plate)], 40, shift=4)
     cv2.fillPoly(big, [s([(63.0, 60.0), (115.0, 60.0), (115.0, 62.0), (63.0, 62.0)])], 90, shift=4)
@@ -29,7 +31,10 @@ def test_a_chamfered_corner_moves_with_the_image_by_the_known_shift():
         image = gradient_magnitude(_plate(shift))
         found = detect_corner_against_model(image, model, corner, arms, search_px=2.0)
         assert isinstance(found, Detection)
-        assert np.linalg.norm(found.uv_px - (corner + shift)) < 0.08, (shift, found.uv_px - corner)  # the profile match's pixel locking: 0.04 a direction
+        assert np.linalg.norm(found.uv_px - (corner + shift)) < 0.08, (
+            shift,
+            found.uv_px - corner,
+        )  # the profile match's pixel locking: 0.04 a direction
 
 
 def test_one_arm_is_not_enough_and_says_so():

@@ -7,7 +7,9 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project, undistort_pixels, unproject
 from calib_core.vision.feature_detectors import Detection, detect_corner_from_edges
 
-LENS = Intrinsics(fu=600.0, fv=600.0, cx=320.0, cy=240.0, width=640, height=480, distortion=(-0.45, 0.15, 0.0, 0.0, 0.0))
+LENS = Intrinsics(
+    fu=600.0, fv=600.0, cx=320.0, cy=240.0, width=640, height=480, distortion=(-0.45, 0.15, 0.0, 0.0, 0.0)
+)
 
 
 def _distorted(ideal_px: np.ndarray) -> np.ndarray:
@@ -22,7 +24,9 @@ def _image_of_a_corner(corner_ideal: np.ndarray) -> np.ndarray:
     total = np.zeros_like(u)
     for du in s:
         for dv in s:
-            ideal = undistort_pixels(np.column_stack([(u + du).ravel(), (v + dv).ravel()]), LENS).reshape(u.shape + (2,))
+            ideal = undistort_pixels(np.column_stack([(u + du).ravel(), (v + dv).ravel()]), LENS).reshape(
+                u.shape + (2,)
+            )
             total += (ideal[..., 0] > corner_ideal[0]) & (ideal[..., 1] > corner_ideal[1])
     return (40 + 160 * total / 16).astype(np.uint8)
 
@@ -31,7 +35,10 @@ def test_a_corner_far_from_the_centre_is_found_where_its_straight_edges_meet():
     corner_ideal = np.array([90.0, 70.0])
     image = _image_of_a_corner(corner_ideal)
     truth = _distorted(corner_ideal[None])[0]
-    arms = [_distorted(np.array([corner_ideal + [60.0, 0.0]]))[0], _distorted(np.array([corner_ideal + [0.0, 60.0]]))[0]]
+    arms = [
+        _distorted(np.array([corner_ideal + [60.0, 0.0]]))[0],
+        _distorted(np.array([corner_ideal + [0.0, 60.0]]))[0],
+    ]
     through_lens = detect_corner_from_edges(image, truth, arms, search_px=3.0, lens=LENS)
     plain = detect_corner_from_edges(image, truth, arms, search_px=3.0)
     assert isinstance(through_lens, Detection) and isinstance(plain, Detection)

@@ -31,7 +31,10 @@ def test_the_eye_on_base_one_and_a_broken_one_are_refused_by_field(tmp_path):
         load_cam2flange(DATA / "easy_handeye2_demo_eob.calib")
     assert info.value.field == "parameters.calibration_type"
     text = (DATA / "easy_handeye2_demo_eih.calib").read_text()
-    for old, new, field in (("w: 0.9999999952309185", "w: 0.5", "transform.rotation"), ("x: 0.12009306887856315", "x: .nan", "transform.translation.x")):
+    for old, new, field in (
+        ("w: 0.9999999952309185", "w: 0.5", "transform.rotation"),
+        ("x: 0.12009306887856315", "x: .nan", "transform.translation.x"),
+    ):
         broken = tmp_path / "broken.calib"
         broken.write_text(text.replace(old, new))
         with pytest.raises(FileFormatError) as info:

@@ -27,5 +27,9 @@ def test_the_normal_jacobian_matches_central_differences_of_the_pose_through_a_d
     assert np.allclose(J, numeric, rtol=1e-5, atol=1e-4 * np.abs(numeric).max())
     # and a small motion predicts the offsets it makes (first order)
     xi = np.array([2e-4, -1e-4, 3e-4, 0.05, -0.03, 0.1])
-    moved = np.einsum("ij,ij->i", project_points(points, _perturbed(obj2cam, xi), intrinsics) - project_points(points, obj2cam, intrinsics), normals)
+    moved = np.einsum(
+        "ij,ij->i",
+        project_points(points, _perturbed(obj2cam, xi), intrinsics) - project_points(points, obj2cam, intrinsics),
+        normals,
+    )
     assert np.allclose(J @ xi, moved, atol=2e-3)

@@ -26,12 +26,14 @@ def test_a_key_is_the_same_both_ways():
 
 
 def test_clearance_is_the_distance_along_the_normal_to_the_nearest_other_edge():
-    ends = np.array([
-        [[0.0, 0.0], [100.0, 0.0]],   # the sample's own edge
-        [[0.0, 2.5], [100.0, 2.5]],   # a parallel one 2.5 px away
-        [[50.0, -5.0], [50.0, 5.0]],  # a crossing one, beside the sample, not across its normal
-        [[0.0, -7.0], [30.0, -7.0]],  # a short parallel one, not across the second sample's normal
-    ])
+    ends = np.array(
+        [
+            [[0.0, 0.0], [100.0, 0.0]],  # the sample's own edge
+            [[0.0, 2.5], [100.0, 2.5]],  # a parallel one 2.5 px away
+            [[50.0, -5.0], [50.0, 5.0]],  # a crossing one, beside the sample, not across its normal
+            [[0.0, -7.0], [30.0, -7.0]],  # a short parallel one, not across the second sample's normal
+        ]
+    )
     samples = np.array([[20.0, 0.0], [80.0, 0.0]])
     clearance = _clearance(samples, ends, np.array([0, 0]), np.array([True, True]))
     np.testing.assert_allclose(clearance, [2.5, 2.5])

@@ -24,7 +24,14 @@ TARGET = "oru_1_fixture"
 
 def _errors_times(factor: float) -> RobotErrors:
     e = RobotErrors.typical(0, n_joints=6)
-    return RobotErrors(e.joint_offsets_deg * factor, e.link_errors_mm * factor, e.base_xyz_mm * factor, e.base_rpy_deg * factor, e.hand_eye_xyz_mm * factor, e.hand_eye_rpy_deg * factor)
+    return RobotErrors(
+        e.joint_offsets_deg * factor,
+        e.link_errors_mm * factor,
+        e.base_xyz_mm * factor,
+        e.base_rpy_deg * factor,
+        e.hand_eye_xyz_mm * factor,
+        e.hand_eye_rpy_deg * factor,
+    )
 
 
 def _look(factor: float, place: str = "approach"):
@@ -34,7 +41,11 @@ def _look(factor: float, place: str = "approach"):
     bed = TestBed.create(errors=_errors_times(factor))
     cell = bed.workcell
     task = cell.task("oru_1_grasp")
-    q = solve_ik(bed.model_robot, task.approach2base if place == "approach" else task.tcp2base, np.array(cell.home_joints_deg, float)).q_deg
+    q = solve_ik(
+        bed.model_robot,
+        task.approach2base if place == "approach" else task.tcp2base,
+        np.array(cell.home_joints_deg, float),
+    ).q_deg
     bed.joints_deg = q
     camera = bed.camera()
     frame = camera.read()
@@ -62,9 +73,19 @@ def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
     image, intrinsics, item, model, truth, expected = look
     assert _pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
     grey = image.mean(axis=2).astype(np.uint8)
-    samples, _, _, _ = edge_points(item.mesh, model, intrinsics, gradient_magnitude(expected(model).mean(axis=2).astype(np.uint8)))
-    start = rank_starts(edge_distance_map(grey, TRUNCATE_PX), intrinsics, samples, model, reach_mm=20.0, reach_deg=1.5)[0]
-    fit = refine_to_edges(grey, intrinsics, item.mesh, start, expected_magnitude=gradient_magnitude(expected(start).mean(axis=2).astype(np.uint8)))
+    samples, _, _, _ = edge_points(
+        item.mesh, model, intrinsics, gradient_magnitude(expected(model).mean(axis=2).astype(np.uint8))
+    )
+    start = rank_starts(edge_distance_map(grey, TRUNCATE_PX), intrinsics, samples, model, reach_mm=20.0, reach_deg=1.5)[
+        0
+    ]
+    fit = refine_to_edges(
+        grey,
+        intrinsics,
+        item.mesh,
+        start,
+        expected_magnitude=gradient_magnitude(expected(start).mean(axis=2).astype(np.uint8)),
+    )
     assert fit.converged and fit.samples > 300
     errors = _pixel_errors(item, fit.obj2cam, truth, intrinsics)
     assert errors.max() < 0.2, errors
@@ -99,7 +120,10 @@ def test_close_up_the_camera_s_move_is_found_not_only_its_turn(factor):
         assert result.edges.settled and result.edges.inlier_share > 0.75
         camera_error_mm = np.linalg.norm(np.linalg.inv(result.edges.obj2cam)[:3, 3] - np.linalg.inv(truth)[:3, 3])
         assert camera_error_mm < 0.1
-        errors = {p.feature: float(np.linalg.norm(p.uv_px - project_points(p.point_mm[None], truth, intrinsics)[0])) for p in result.proposals}
+        errors = {
+            p.feature: float(np.linalg.norm(p.uv_px - project_points(p.point_mm[None], truth, intrinsics)[0]))
+            for p in result.proposals
+        }
         assert len(errors) >= 7 and max(errors.values()) < 1.0, errors
 
 

@@ -37,7 +37,9 @@ def test_recovers_the_true_mounting():
     bed = TestBed.create(errors=errors, intrinsics=TestBed.create().intrinsics.scaled(0.5))
     views, flanges = _views(bed)
     result = calibrate_hand_eye(views, flanges, SPEC, bed.intrinsics)
-    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement("camera")
+    true = np.linalg.inv(bed.true_robot.robot.frame_placement("flange")) @ bed.true_robot.robot.frame_placement(
+        "camera"
+    )
     model = np.linalg.inv(bed.model_robot.frame_placement("flange")) @ bed.model_robot.frame_placement("camera")
     d, r = pose_difference(result.cam2flange, true)
     d0, _ = pose_difference(model, true)
@@ -48,9 +50,13 @@ def test_recovers_the_true_mounting():
 
 
 def test_poor_pose_sets_and_bad_input_are_reported():
-    same_axis = [make_transform(Rotation.from_euler("z", a, degrees=True).as_matrix(), [0, 0, 0]) for a in (0, 20, 40, 60)]
+    same_axis = [
+        make_transform(Rotation.from_euler("z", a, degrees=True).as_matrix(), [0, 0, 0]) for a in (0, 20, 40, 60)
+    ]
     assert any("parallel axes" in w for w in pose_set_warnings(same_axis))
-    tiny = [make_transform(Rotation.from_euler("xyz", [a, a, 0], degrees=True).as_matrix(), [0, 0, 0]) for a in (0, 1, 2)]
+    tiny = [
+        make_transform(Rotation.from_euler("xyz", [a, a, 0], degrees=True).as_matrix(), [0, 0, 0]) for a in (0, 1, 2)
+    ]
     assert any("at most" in w for w in pose_set_warnings(tiny))
     with pytest.raises(CalibrationInputError, match="2 views but 3 robot poses"):
         calibrate_hand_eye([None, None], tiny, SPEC, TestBed.create().intrinsics)
@@ -58,7 +64,12 @@ def test_poor_pose_sets_and_bad_input_are_reported():
 
 def test_command_line(tmp_path):
     out = tmp_path / "hand_eye.yaml"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", "sim", "--poses", "6", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "calibrate-hand-eye", "sim", "--poses", "6", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, run.stderr
     doc = yaml.safe_load(out.read_text())
     assert len(doc["cam2flange"]["xyz"]) == 3 and doc["units"] == {"length": "mm", "angle": "deg"}

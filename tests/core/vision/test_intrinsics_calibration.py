@@ -11,7 +11,12 @@ import pytest
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.vision.board import BoardSpec
-from calib_core.vision.intrinsics_calibration import CalibrationInputError, calibrate_intrinsics, detect_view, detect_views
+from calib_core.vision.intrinsics_calibration import (
+    CalibrationInputError,
+    calibrate_intrinsics,
+    detect_view,
+    detect_views,
+)
 from videocal_sim.board_views import simulated_board_images
 
 # Half the gripper camera's resolution keeps the test quick; the distortion is the real lens's.
@@ -64,13 +69,20 @@ def test_bad_views_are_rejected_with_reasons(images):
     x1, y1 = np.ceil(keep.max(axis=0) + 45).astype(int)
     partial = np.full_like(board, 90)
     partial[max(y0, 0) : y1, max(x0, 0) : x1] = board[max(y0, 0) : y1, max(x0, 0) : x1]
-    views, rejected = detect_views([("blank", blank), ("partial", partial), ("ok", board), ("small", cv2.resize(board, (320, 240)))], SPEC)
+    views, rejected = detect_views(
+        [("blank", blank), ("partial", partial), ("ok", board), ("small", cv2.resize(board, (320, 240)))], SPEC
+    )
     reasons = {r.name: r.reason for r in rejected}
     assert reasons["blank"] == "no board found"
-    assert "corners seen (at least 8 needed)" in reasons["partial"] or "markers seen but no chessboard corner" in reasons["partial"]
+    assert (
+        "corners seen (at least 8 needed)" in reasons["partial"]
+        or "markers seen but no chessboard corner" in reasons["partial"]
+    )
     assert "differs from the first view" in reasons["small"]
     assert [v.name for v in views] == ["ok"]
-    with pytest.raises(CalibrationInputError, match="1 usable board views, at least 3 needed .rejected: blank: no board found"):
+    with pytest.raises(
+        CalibrationInputError, match="1 usable board views, at least 3 needed .rejected: blank: no board found"
+    ):
         calibrate_intrinsics(views, SPEC, rejected=rejected)
 
 
@@ -78,7 +90,11 @@ def test_a_wrong_board_spec_finds_nothing(images):
     other = BoardSpec.parse("charuco:9x7:30:22:DICT_4X4_50")
     result = detect_view(*images[0], other)
     assert not hasattr(result, "corners_px")
-    for bad, msg in (("charuco:9x7:30", "expected charuco"), ("charuco:2x7:30:22:DICT_5X5_100", "at least 3 x 3"), ("charuco:9x7:30:22:DICT_NOPE", "unknown ArUco dictionary")):
+    for bad, msg in (
+        ("charuco:9x7:30", "expected charuco"),
+        ("charuco:2x7:30:22:DICT_5X5_100", "at least 3 x 3"),
+        ("charuco:9x7:30:22:DICT_NOPE", "unknown ArUco dictionary"),
+    ):
         with pytest.raises(ValueError, match=msg):
             BoardSpec.parse(bad)
 
@@ -91,7 +107,22 @@ def test_command_line_writes_a_loadable_file(tmp_path, images):
     (folder / "notes.txt").write_text("not an image")
     cv2.imwrite(str(folder / "zz_blank.png"), np.full((480, 640, 3), 90, np.uint8))
     out = tmp_path / "cam_ros.yaml"
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "calibrate-intrinsics", str(folder), "--out", str(out), "--format", "ros"], capture_output=True, text=True, timeout=120)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "calibrate-intrinsics",
+            str(folder),
+            "--out",
+            str(out),
+            "--format",
+            "ros",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 0, run.stderr
     assert "rejected zz_blank.png: no board found" in run.stderr
     loaded = load_intrinsics(out)

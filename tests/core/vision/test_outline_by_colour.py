@@ -59,15 +59,22 @@ def test_locate_calls_the_printed_box_ok_only_where_it_is(scene):
     image, mesh = scene
     for seed in (3, 4, 5):
         located = locate(image, CAMERA, mesh, _prior(seed), reach_mm=10.0, reach_deg=3.0, features={})
-        error = np.inf if located.obj2cam is None else mspd(located.obj2cam, TRUTH, np.asarray(mesh.vertices), IDENTITY, CAMERA)
+        error = (
+            np.inf
+            if located.obj2cam is None
+            else mspd(located.obj2cam, TRUTH, np.asarray(mesh.vertices), IDENTITY, CAMERA)
+        )
         if located.status == "ok":
             assert error < 2.0, (seed, error, located.message)
         else:
             pytest.fail(f"seed {seed}: {located.status}: {located.message}")
 
 
-@pytest.mark.parametrize("colour, offset_px", [((200, 150, 120), (-150, 40)), ((110, 110, 120), (140, -20)), ((40, 40, 50), (0, -150))],
-                         ids=["skin-coloured, left", "grey, right", "dark, over the top"])
+@pytest.mark.parametrize(
+    "colour, offset_px",
+    [((200, 150, 120), (-150, 40)), ((110, 110, 120), (140, -20)), ((40, 40, 50), (0, -150))],
+    ids=["skin-coloured, left", "grey, right", "dark, over the top"],
+)
 def test_an_occluder_over_a_third_of_the_outline_does_not_pull_the_fit(scene, colour, offset_px):
     """An ellipse 140 x 220 px in front of the box, over one side of its outline: the visible rest carries the fit
     (the occluder's edge is a step from box to something that is not the table either, which the colour step and the

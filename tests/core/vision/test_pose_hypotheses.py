@@ -45,7 +45,9 @@ def test_a_turned_camera_moves_the_image_by_the_shift_where_it_is_measured():
     before = project_points(point, obj2cam, INTRINSICS)[0]
     after = project_points(point, turned_camera(obj2cam, np.array([12.0, -7.0]), INTRINSICS), INTRINSICS)[0]
     assert np.allclose(after - before, [12.0, -7.0], atol=0.05)
-    assert np.allclose(_centre_in_object(turned_camera(obj2cam, np.array([12.0, -7.0]), INTRINSICS)), _centre_in_object(obj2cam))
+    assert np.allclose(
+        _centre_in_object(turned_camera(obj2cam, np.array([12.0, -7.0]), INTRINSICS)), _centre_in_object(obj2cam)
+    )
 
 
 def _edge_image(mesh, obj2cam) -> np.ndarray:
@@ -65,10 +67,18 @@ def test_the_best_start_is_near_the_true_pose_where_a_two_d_shift_is_not():
     model = moved_cameras(truth, np.array([[12.0, -6.0, 4.0]]), np.array([1.0]))[0]
     model = turned_camera(model, np.array([-15.0, 10.0]), INTRINSICS)
     distance = edge_distance_map(_edge_image(mesh, truth), TRUNCATE_PX)
-    samples = np.concatenate([a + (b - a) * np.linspace(0.05, 0.95, 12)[:, None] for a, b in mesh.vertices[mesh.edges_unique]])
+    samples = np.concatenate(
+        [a + (b - a) * np.linspace(0.05, 0.95, 12)[:, None] for a, b in mesh.vertices[mesh.edges_unique]]
+    )
 
     def miss_px(pose):
-        return float(np.mean(np.linalg.norm(project_points(samples, pose, INTRINSICS) - project_points(samples, truth, INTRINSICS), axis=1)))
+        return float(
+            np.mean(
+                np.linalg.norm(
+                    project_points(samples, pose, INTRINSICS) - project_points(samples, truth, INTRINSICS), axis=1
+                )
+            )
+        )
 
     assert miss_px(model) > 40.0
     starts = rank_starts(distance, INTRINSICS, samples, model, reach_mm=20.0, reach_deg=1.5)
@@ -78,4 +88,11 @@ def test_the_best_start_is_near_the_true_pose_where_a_two_d_shift_is_not():
     assert miss_px(starts[0]) < min(12.0, miss_px(model) / 4), [miss_px(s) for s in starts]
     # the others differ from it in the image
     for s in starts[1:]:
-        assert np.mean(np.linalg.norm(project_points(samples, s, INTRINSICS) - project_points(samples, starts[0], INTRINSICS), axis=1)) > 5.0
+        assert (
+            np.mean(
+                np.linalg.norm(
+                    project_points(samples, s, INTRINSICS) - project_points(samples, starts[0], INTRINSICS), axis=1
+                )
+            )
+            > 5.0
+        )

@@ -38,19 +38,28 @@ def test_a_thin_line_s_offset_is_measured_where_the_strongest_peak_is_not():
 
 def test_offsets_round_trip_a_known_shift_of_a_step_edge_both_ways():
     for shift in (-1.3, -0.4, 0.0, 0.6, 1.7):
-        model = gradient_magnitude(np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 39.5), (80, 1)).astype(np.uint8))
+        model = gradient_magnitude(
+            np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 39.5), (80, 1)).astype(np.uint8)
+        )
         step = 100.0 + 80.0 * _step(np.arange(80, dtype=float), 39.5 + shift)
         image = gradient_magnitude(np.tile(step, (80, 1)).astype(np.uint8))
         points = np.column_stack([np.full(10, 40.0), np.arange(35.0, 45.0)])
         offset, _ = match_profiles(image, model, points, np.tile([1.0, 0.0], (10, 1)), search_px=2.5)
-        assert np.allclose(offset, shift, atol=0.08), (shift, offset)  # a parabola through half-pixel samples (pixel locking): 0.04-0.07
+        assert np.allclose(offset, shift, atol=0.08), (
+            shift,
+            offset,
+        )  # a parabola through half-pixel samples (pixel locking): 0.04-0.07
         back, _ = match_profiles(model, image, points, np.tile([1.0, 0.0], (10, 1)), search_px=2.5)
         assert np.allclose(back, -shift, atol=0.08), (shift, back)
 
 
 def test_an_edge_beyond_the_search_is_not_measured():
-    model = gradient_magnitude(np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 39.5), (80, 1)).astype(np.uint8))
-    image = gradient_magnitude(np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 44.5), (80, 1)).astype(np.uint8))
+    model = gradient_magnitude(
+        np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 39.5), (80, 1)).astype(np.uint8)
+    )
+    image = gradient_magnitude(
+        np.tile(100.0 + 80.0 * _step(np.arange(80, dtype=float), 44.5), (80, 1)).astype(np.uint8)
+    )
     _, alike = match_profiles(image, model, np.array([[40.0, 40.0]]), np.array([[1.0, 0.0]]), search_px=2.0)
     assert alike[0] == 0.0
 

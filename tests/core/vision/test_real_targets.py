@@ -86,7 +86,16 @@ def test_ros_industrial_target_finder_images_meet_their_own_expectations(tmp_pat
     assert np.mean(np.linalg.norm(mapped - found.corners_px, axis=1)) < 3.0
 
 
-@pytest.mark.parametrize("text", ["chessboard:9x6:25", "circles:4x11:20:asymmetric", "circles:7x5:30", "aruco:5x4:40:8:DICT_4X4_50", "charuco:6x8:30:22:DICT_5X5_100:legacy"])
+@pytest.mark.parametrize(
+    "text",
+    [
+        "chessboard:9x6:25",
+        "circles:4x11:20:asymmetric",
+        "circles:7x5:30",
+        "aruco:5x4:40:8:DICT_4X4_50",
+        "charuco:6x8:30:22:DICT_5X5_100:legacy",
+    ],
+)
 def test_every_kind_finds_its_own_printed_sheet_where_its_points_say(text):
     """A round trip: the sheet a target prints, detected, gives its points where corners_mm() puts them
     (the sheet at 4 px/mm, so a point at (x, y) mm is at 4 (x, y) px)."""
@@ -103,10 +112,19 @@ def test_every_kind_finds_its_own_printed_sheet_where_its_points_say(text):
         assert np.max(d) < 0.6
 
 
-@pytest.mark.parametrize("bad, says", [
-    ("chessboard:9x6", "expected charuco"), ("chessboard:1x6:25", "at least 2 x 2"), ("circles:4x11:20:diagonal", "expected"),
-    ("aruco:5x4:40:8:DICT_4X4_NOPE", "unknown ArUco dictionary"), ("aruco:20x20:35:10:DICT_4X4_50", "only 50"),
-    ("charuco:9x7:30:22:DICT_5X5_100:old", "expected"), ("squares:9x7:30", "expected"), ("chessboard:9x6:-3", "more than 0")])
+@pytest.mark.parametrize(
+    "bad, says",
+    [
+        ("chessboard:9x6", "expected charuco"),
+        ("chessboard:1x6:25", "at least 2 x 2"),
+        ("circles:4x11:20:diagonal", "expected"),
+        ("aruco:5x4:40:8:DICT_4X4_NOPE", "unknown ArUco dictionary"),
+        ("aruco:20x20:35:10:DICT_4X4_50", "only 50"),
+        ("charuco:9x7:30:22:DICT_5X5_100:old", "expected"),
+        ("squares:9x7:30", "expected"),
+        ("chessboard:9x6:-3", "more than 0"),
+    ],
+)
 def test_a_bad_board_text_says_what_the_forms_are(bad, says):
     with pytest.raises(BoardSpecError, match=says):
         parse_board(bad)
@@ -114,12 +132,18 @@ def test_a_bad_board_text_says_what_the_forms_are(bad, says):
 
 def test_detector_settings_come_from_a_file_and_name_a_wrong_field(tmp_path):
     path = tmp_path / "detector.yaml"
-    path.write_text("refine_markers: false\naruco:\n  adaptiveThreshWinSizeMax: 35\n  adaptiveThreshConstant: 9\ncircle_blobs:\n  minArea: 25.0\n")
+    path.write_text(
+        "refine_markers: false\naruco:\n  adaptiveThreshWinSizeMax: 35\n  adaptiveThreshConstant: 9\ncircle_blobs:\n  minArea: 25.0\n"
+    )
     settings = load_detector_settings(path)
     assert settings.refine_markers is False and settings.aruco.adaptiveThreshWinSizeMax == 35
     assert settings.aruco.adaptiveThreshConstant == 9.0 and settings.circle_blobs.minArea == 25.0
-    for text, field in (("aruco:\n  adaptiveThreshWinSizeMaks: 35\n", "aruco.adaptiveThreshWinSizeMaks"), ("aruco:\n  adaptiveThreshWinSizeMax: 3.5\n", "aruco.adaptiveThreshWinSizeMax"),
-                        ("refine_markers: yes please\n", "refine_markers"), ("blobs: {}\n", "blobs")):
+    for text, field in (
+        ("aruco:\n  adaptiveThreshWinSizeMaks: 35\n", "aruco.adaptiveThreshWinSizeMaks"),
+        ("aruco:\n  adaptiveThreshWinSizeMax: 3.5\n", "aruco.adaptiveThreshWinSizeMax"),
+        ("refine_markers: yes please\n", "refine_markers"),
+        ("blobs: {}\n", "blobs"),
+    ):
         path.write_text(text)
         with pytest.raises(FileFormatError, match=field.replace(".", r"\.")):
             load_detector_settings(path)
@@ -128,7 +152,9 @@ def test_detector_settings_come_from_a_file_and_name_a_wrong_field(tmp_path):
 def test_an_intrinsics_file_without_the_image_size_takes_the_images_size(tmp_path):
     text = (OPENCV / "left_intrinsics.yml").read_text()
     stripped = tmp_path / "no_size.yml"
-    stripped.write_text("\n".join(line for line in text.splitlines() if not line.startswith(("image_width", "image_height"))) + "\n")
+    stripped.write_text(
+        "\n".join(line for line in text.splitlines() if not line.startswith(("image_width", "image_height"))) + "\n"
+    )
     with pytest.raises(FileFormatError, match="image_width.*missing.*give the images"):
         load_intrinsics(stripped)
     camera = load_intrinsics(stripped, image_size=(640, 480))

@@ -18,7 +18,10 @@ def _cell_with(tmp_path, site_text: str):
 
 
 def test_a_site_section_is_read_with_its_camera_path_made_absolute(tmp_path):
-    path = _cell_with(tmp_path, "site:\n  controller: ros2:///joint_states\n  camera: shots\n  controller_options: {trajectory_controller: arm_controller}")
+    path = _cell_with(
+        tmp_path,
+        "site:\n  controller: ros2:///joint_states\n  camera: shots\n  controller_options: {trajectory_controller: arm_controller}",
+    )
     section = load_site_section(path)
     assert section.controller == "ros2:///joint_states"
     assert section.camera == str((tmp_path / "shots").resolve())
@@ -30,11 +33,16 @@ def test_a_bundled_cell_has_no_site_section():
     assert load_workcell(DEFAULT_WORKCELL).site is None
 
 
-@pytest.mark.parametrize("site, field", [("site:\n  controller: 42", "site.controller"),
-                                         ("site:\n  camera: ''", "site.camera"),
-                                         ("site:\n  cameras: 0", "site"),
-                                         ("site:\n  camera_options: [1, 2]", "site.camera_options"),
-                                         ("site:\n  controller_options: {speed: [1]}", "site.controller_options.speed")])
+@pytest.mark.parametrize(
+    "site, field",
+    [
+        ("site:\n  controller: 42", "site.controller"),
+        ("site:\n  camera: ''", "site.camera"),
+        ("site:\n  cameras: 0", "site"),
+        ("site:\n  camera_options: [1, 2]", "site.camera_options"),
+        ("site:\n  controller_options: {speed: [1]}", "site.controller_options.speed"),
+    ],
+)
 def test_a_wrong_site_section_names_its_field(tmp_path, site, field):
     with pytest.raises(FileFormatError) as info:
         load_site_section(_cell_with(tmp_path, site))

@@ -22,8 +22,11 @@ def _mounting_bottom_mm(cell) -> float:
     robot = cell.load_robot()
     visuals = RobotVisuals.from_robot(robot)
     poses = visuals.poses(cell.home_joints_deg)
-    return min(float(trimesh.transform_points(trimesh.bounds.corners(m.bounds), p)[:, 2].min())
-               for g, m, p in zip(visuals.geometry_model.geometryObjects, visuals.meshes, poses) if g.parentJoint == 0)
+    return min(
+        float(trimesh.transform_points(trimesh.bounds.corners(m.bounds), p)[:, 2].min())
+        for g, m, p in zip(visuals.geometry_model.geometryObjects, visuals.meshes, poses)
+        if g.parentJoint == 0
+    )
 
 
 @pytest.mark.parametrize("base_height_m", [0.0, 0.330])
@@ -32,7 +35,11 @@ def test_the_floor_is_under_the_robot_s_mounting(tmp_path, base_height_m):
     shutil.copytree(KUKA, package)
     macro = package / "kuka_kr6_support" / "urdf" / "kr6r900sixx_macro.xacro"
     text = macro.read_text()
-    text, n = re.subn(r'(<joint name="\$\{prefix\}base_link-base" type="fixed">\s*<origin xyz=")0 0 0(")', rf"\g<1>0 0 {base_height_m}\g<2>", text)
+    text, n = re.subn(
+        r'(<joint name="\$\{prefix\}base_link-base" type="fixed">\s*<origin xyz=")0 0 0(")',
+        rf"\g<1>0 0 {base_height_m}\g<2>",
+        text,
+    )
     assert n == 1
     macro.write_text(text)
     made = write_starter_cell(tmp_path / "cell", package / "kuka_kr6_support" / "urdf" / "kr6r900sixx.xacro", [package])

@@ -30,8 +30,11 @@ def _kr6(tmp_path, tool0_roll_deg: float = 0.0) -> Path:
     macro = package / "kuka_kr6_support" / "urdf" / "kr6r900sixx_macro.xacro"
     # the shipped tool0 (pitch 90 deg on the flange), then turned about its own z
     rpy = Rotation.from_euler("YZ", [90.0, tool0_roll_deg], degrees=True).as_euler("xyz")
-    text, n = re.subn(r'(<child link="\$\{prefix\}tool0"/>\s*<origin xyz="0 0 0" rpy=")0 \$\{radians\(90\)\} 0(")',
-                      rf"\g<1>{' '.join(repr(float(v)) for v in rpy)}\g<2>", macro.read_text())
+    text, n = re.subn(
+        r'(<child link="\$\{prefix\}tool0"/>\s*<origin xyz="0 0 0" rpy=")0 \$\{radians\(90\)\} 0(")',
+        rf"\g<1>{' '.join(repr(float(v)) for v in rpy)}\g<2>",
+        macro.read_text(),
+    )
     assert n == 1
     macro.write_text(text)
     return package
@@ -77,7 +80,9 @@ def test_the_new_cell_reaches_its_task_unfolded_with_the_wrist_not_turned_over(k
 def test_the_tcp_is_the_flange_moved_along_its_z_whatever_way_the_vendor_turns_tool0(tmp_path, kr6_cell):
     made, cell = kr6_cell
     turned_pkg = _kr6(tmp_path, tool0_roll_deg=90.0)
-    turned = write_starter_cell(tmp_path / "turned", turned_pkg / "kuka_kr6_support" / "urdf" / "kr6r900sixx.xacro", [turned_pkg])
+    turned = write_starter_cell(
+        tmp_path / "turned", turned_pkg / "kuka_kr6_support" / "urdf" / "kr6r900sixx.xacro", [turned_pkg]
+    )
     turned_cell = load_workcell(turned.workcell_path)
     for c in (cell, turned_cell):
         robot = c.load_robot()

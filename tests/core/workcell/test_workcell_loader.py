@@ -49,31 +49,87 @@ def _write(path: Path, data) -> Path:
     [
         (lambda d: d["components"][1].update(colour=[1, 0, 0]), "components[1]", "unknown key(s) colour"),
         (lambda d: d["components"][1].update(mesh="meshes/nothing.stl"), "components[1].mesh", "file not found"),
-        (lambda d: d["components"][1].update(mesh_units="inch"), "components[1].mesh_units", "must be one of cm, m, mm"),
+        (
+            lambda d: d["components"][1].update(mesh_units="inch"),
+            "components[1].mesh_units",
+            "must be one of cm, m, mm",
+        ),
         (lambda d: d["components"][2].update(name="rack_1"), "components[2].name", "duplicate component name"),
-        (lambda d: d["components"][1]["placement"].update(rpy=[0, "ten", 0]), "components[1].placement.rpy[1]", "finite number"),
-        (lambda d: d["components"][1]["placement"].update(xyz=[0, 0]), "components[1].placement.xyz", "list of 3 numbers"),
+        (
+            lambda d: d["components"][1]["placement"].update(rpy=[0, "ten", 0]),
+            "components[1].placement.rpy[1]",
+            "finite number",
+        ),
+        (
+            lambda d: d["components"][1]["placement"].update(xyz=[0, 0]),
+            "components[1].placement.xyz",
+            "list of 3 numbers",
+        ),
         (lambda d: d.update(units={"length": "m", "angle": "deg"}), "units", "mm and deg"),
         (lambda d: d.update(schema_version=7), "schema_version", "versions 1, 2"),
-        (lambda d: d["task_locations"][0].update(component="oru_9"), "task_locations[0].component", "no component called 'oru_9'"),
-        (lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]), "components[2].features.pin_tip", "list of 3 numbers"),
-        (lambda d: d["components"][2].update(form_tolerance_mm=-0.5), "components[2].form_tolerance_mm", "must lie in [0, 20] mm"),
-        (lambda d: d["components"][2].update(form_tolerance_mm="1 mm"), "components[2].form_tolerance_mm", "finite number"),
+        (
+            lambda d: d["task_locations"][0].update(component="oru_9"),
+            "task_locations[0].component",
+            "no component called 'oru_9'",
+        ),
+        (
+            lambda d: d["components"][2]["features"].update(pin_tip=[1, 2]),
+            "components[2].features.pin_tip",
+            "list of 3 numbers",
+        ),
+        (
+            lambda d: d["components"][2].update(form_tolerance_mm=-0.5),
+            "components[2].form_tolerance_mm",
+            "must lie in [0, 20] mm",
+        ),
+        (
+            lambda d: d["components"][2].update(form_tolerance_mm="1 mm"),
+            "components[2].form_tolerance_mm",
+            "finite number",
+        ),
         (lambda d: d["robot"]["frames"].update(flange="tool0"), "robot.frames.flange", "the URDF has no frame 'tool0'"),
-        (lambda d: d["robot"]["frames"].update(tcp={"parent": "wrist", "xyz": [0, 0, 1], "rpy": [0, 0, 0]}), "robot.frames.tcp.parent", "no frame 'wrist'"),
+        (
+            lambda d: d["robot"]["frames"].update(tcp={"parent": "wrist", "xyz": [0, 0, 1], "rpy": [0, 0, 0]}),
+            "robot.frames.tcp.parent",
+            "no frame 'wrist'",
+        ),
         (lambda d: d["robot"]["frames"].update(tool="flange"), "robot.frames", "unknown key(s) tool"),
         (lambda d: d["robot"]["frames"].update(base="link_2"), "robot.frames.base", "moves with joint"),
-        (lambda d: d["robot"].update(home_joints_deg=[0, 0, 0, 0, 0, 0, 0]), "robot.home_joints_deg", "drives 6 joints (joint_1"),
-        (lambda d: d["robot"].update(home_joints_deg=[0, 0, 300, 0, 0, 0]), "robot.home_joints_deg[2]", "outside joint 'joint_3' limits"),
+        (
+            lambda d: d["robot"].update(home_joints_deg=[0, 0, 0, 0, 0, 0, 0]),
+            "robot.home_joints_deg",
+            "drives 6 joints (joint_1",
+        ),
+        (
+            lambda d: d["robot"].update(home_joints_deg=[0, 0, 300, 0, 0, 0]),
+            "robot.home_joints_deg[2]",
+            "outside joint 'joint_3' limits",
+        ),
         (lambda d: d["robot"].update(held_joints={"finger": 3}), "robot.held_joints", "no joint 'finger'"),
         (lambda d: d["robot"].update(package_paths=["nowhere"]), "robot.package_paths[0]", "folder not found"),
-        (lambda d: d["robot"].update(controller={"joints": ["joint_1", "joint_2"]}), "robot.controller.joints", "must name each driven joint once"),
-        (lambda d: d["robot"].update(controller={"joints": ["joint_1"], "zero_offsets": [1, 2]}), "robot.controller.zero_offsets", "one value per controller joint"),
+        (
+            lambda d: d["robot"].update(controller={"joints": ["joint_1", "joint_2"]}),
+            "robot.controller.joints",
+            "must name each driven joint once",
+        ),
+        (
+            lambda d: d["robot"].update(controller={"joints": ["joint_1"], "zero_offsets": [1, 2]}),
+            "robot.controller.zero_offsets",
+            "one value per controller joint",
+        ),
         (lambda d: d.update(hand_eye_board={"xyz": [1, 2]}), "hand_eye_board", "missing key(s) rpy"),
         # names become controller code and YAML keys: no control characters
-        (lambda d: d["task_locations"][0].update(name="oru_1\n  x := 0; END; DELETE"), "task_locations[0].name", "control character U+000A"),
+        (
+            lambda d: d["task_locations"][0].update(name="oru_1\n  x := 0; END; DELETE"),
+            "task_locations[0].name",
+            "control character U+000A",
+        ),
         (lambda d: d["components"][1].update(name="rack\u202e1"), "components[1].name", "control character U+202E"),
-        (lambda d: d["components"][2]["features"].update({"pin\ttip": [1, 2, 3]}), "components[2].features.'pin\\ttip'", "control character U+0009"),
+        (
+            lambda d: d["components"][2]["features"].update({"pin\ttip": [1, 2, 3]}),
+            "components[2].features.'pin\\ttip'",
+            "control character U+0009",
+        ),
     ],
 )
 def test_bad_files_name_file_and_field(cell_copy, mutate, field, message):
@@ -139,19 +195,24 @@ def test_feature_kinds_are_read_written_back_and_checked(tmp_path):
     assert reread.feature_kinds["plate_top_left"].kind == "point" and reread.feature_kinds["boss_top_left"] == boss
 
 
-@pytest.mark.parametrize("entry, message", [
-    ("{at: [0, 0, 0], kind: circle}", "a circle needs radius_mm"),
-    ("{at: [0, 0, 0], kind: circle, radius_mm: -1, normal: [1, 0, 0]}", "radius_mm in"),
-    ("{at: [0, 0, 0], kind: circle, radius_mm: 5, normal: [0, 0, 0]}", "not all zero"),
-    ("{at: [0, 0, 0], kind: edge}", "kind"),
-    ("{at: [0, 0, 0], kind: corner, radius_mm: 3}", "applies to a circle only"),
-    ("{kind: point}", "missing key(s) at"),
-])
+@pytest.mark.parametrize(
+    "entry, message",
+    [
+        ("{at: [0, 0, 0], kind: circle}", "a circle needs radius_mm"),
+        ("{at: [0, 0, 0], kind: circle, radius_mm: -1, normal: [1, 0, 0]}", "radius_mm in"),
+        ("{at: [0, 0, 0], kind: circle, radius_mm: 5, normal: [0, 0, 0]}", "not all zero"),
+        ("{at: [0, 0, 0], kind: edge}", "kind"),
+        ("{at: [0, 0, 0], kind: corner, radius_mm: 3}", "applies to a circle only"),
+        ("{kind: point}", "missing key(s) at"),
+    ],
+)
 def test_a_bad_feature_kind_names_its_field(tmp_path, entry, message):
     from calib_core.errors import FileFormatError
     from calib_core.workcell import DEFAULT_WORKCELL, load_workcell
 
-    text = DEFAULT_WORKCELL.read_text().replace("pin_tip: {at: [45, 0, 0], kind: circle, radius_mm: 20, normal: [1, 0, 0]}", f"pin_tip: {entry}", 1)
+    text = DEFAULT_WORKCELL.read_text().replace(
+        "pin_tip: {at: [45, 0, 0], kind: circle, radius_mm: 20, normal: [1, 0, 0]}", f"pin_tip: {entry}", 1
+    )
     path = DEFAULT_WORKCELL.parent / f".test-{tmp_path.name}.yaml"
     path.write_text(text)
     try:
@@ -171,4 +232,6 @@ def test_a_parts_form_tolerance_is_read_and_new_components_write_it(cell_copy, t
     cell = load_workcell(_write(path, data))
     assert cell.components[2].form_tolerance_mm == 0.4 and cell.components[1].form_tolerance_mm == 0.0
     entry = _component_entry(cell.components[2], (path.parent / "meshes" / "rack.stl", "mm"), path.parent)
-    assert entry["form_tolerance_mm"] == 0.4 and "form_tolerance_mm" not in _component_entry(cell.components[1], (path.parent / "meshes" / "rack.stl", "mm"), path.parent)
+    assert entry["form_tolerance_mm"] == 0.4 and "form_tolerance_mm" not in _component_entry(
+        cell.components[1], (path.parent / "meshes" / "rack.stl", "mm"), path.parent
+    )

@@ -21,7 +21,12 @@ from calib_core.robot.model import load_robot
 from calib_core.robot.spec import RobotSpec
 from calib_core.robot.xacro_expand import expand_xacro
 from calib_core.workcell.model import TaskLocation
-from calib_core.workspace.arm_configuration import NotASixAxisArmError, abb_confdata, arm_configuration, kuka_status_turn
+from calib_core.workspace.arm_configuration import (
+    NotASixAxisArmError,
+    abb_confdata,
+    arm_configuration,
+    kuka_status_turn,
+)
 from calib_core.workspace.controller_formats import REFERENCE_POSES, controller_listing
 from tests.vendor_robots import SHARE, UR5, require
 
@@ -41,7 +46,9 @@ def kr6():
 def irb1200():
     """The IRB 1200 xacro expanded as shipped; its meshes (7 MB, not kept here) left out: the kinematics are the joints'."""
     abb = ROS_I / "abb"
-    root = ET.fromstring(expand_xacro(abb / "abb_irb1200_support" / "urdf" / "irb1200_5_90.xacro", package_search_roots([abb])))
+    root = ET.fromstring(
+        expand_xacro(abb / "abb_irb1200_support" / "urdf" / "irb1200_5_90.xacro", package_search_roots([abb]))
+    )
     for link in root.iter("link"):
         for tag in ("visual", "collision"):
             for element in link.findall(tag):
@@ -59,13 +66,20 @@ def _abb(robot, q):
     return arm_configuration(robot, JointMap.identity(6), q, ABB_ZERO)
 
 
-@pytest.mark.parametrize("q, status, turn", [
-    ((0, -90, 90, 0, 45, 0), 2, 2),  # home, the wrist bent down: basic area, normal elbow, A5 positive; A2 negative
-    ((0, -90, 90, 0, -45, 0), 6, 18),  # the wrist bent the other way: bit 2, and A5's turn bit
-    ((0, -150, 60, 0, 45, 0), 3, 2),  # the lower arm leant back past the upright: the wrist centre behind axis 1 (overhead)
-    ((0, -30, -60, 0, 45, 0), 0, 6),  # the forearm folded past the stretched arm: elbow bit clear
-    ((-20, -90, 90, -10, 45, -200), 2, 43),  # turns: A1, A2, A4 and A6 negative
-])
+@pytest.mark.parametrize(
+    "q, status, turn",
+    [
+        ((0, -90, 90, 0, 45, 0), 2, 2),  # home, the wrist bent down: basic area, normal elbow, A5 positive; A2 negative
+        ((0, -90, 90, 0, -45, 0), 6, 18),  # the wrist bent the other way: bit 2, and A5's turn bit
+        (
+            (0, -150, 60, 0, 45, 0),
+            3,
+            2,
+        ),  # the lower arm leant back past the upright: the wrist centre behind axis 1 (overhead)
+        ((0, -30, -60, 0, 45, 0), 0, 6),  # the forearm folded past the stretched arm: elbow bit clear
+        ((-20, -90, 90, -10, 45, -200), 2, 43),  # turns: A1, A2, A4 and A6 negative
+    ],
+)
 def test_kuka_status_and_turn_at_poses_the_definition_decides(kr6, q, status, turn):
     assert kuka_status_turn(_kuka(kr6, q)) == (status, turn)
 
@@ -77,7 +91,14 @@ def test_kuka_by_the_data_sheet(kr6):
     rng = np.random.default_rng(7)
     phi = math.degrees(math.atan2(35.0, 420.0))
     for _ in range(40):
-        q = np.r_[rng.uniform(-170, 170), rng.uniform(-190, 45), rng.uniform(-119, 155), rng.uniform(-185, 185), rng.uniform(-119, 119), rng.uniform(-350, 350)]
+        q = np.r_[
+            rng.uniform(-170, 170),
+            rng.uniform(-190, 45),
+            rng.uniform(-119, 155),
+            rng.uniform(-185, 185),
+            rng.uniform(-119, 119),
+            rng.uniform(-350, 350),
+        ]
         a2, a3 = np.radians(q[1]), np.radians(q[2])
         x = 25.0 + 455.0 * math.cos(a2) + 420.0 * math.cos(a2 + a3) + 35.0 * math.sin(a2 + a3)
         side = 420.0 * math.sin(a3) - 35.0 * math.cos(a3)
@@ -87,13 +108,16 @@ def test_kuka_by_the_data_sheet(kr6):
         assert status & 1 == (x < 0) and (status >> 1) & 1 == (q[2] >= phi)
 
 
-@pytest.mark.parametrize("q, confdata", [
-    ((0, 0, 0, 0, 30, 0), (0, 0, 0, 0)),  # the calibration pose, the wrist bent down
-    ((0, 0, 0, 0, -30, 0), (0, 0, 0, 1)),  # axis 5 negative
-    ((100, 0, 0, 200, 30, -10), (1, 2, -1, 0)),  # quadrants: 90..180, 180..270, -90..0
-    ((0, -90, 0, 0, 30, 0), (0, 0, 0, 4)),  # the lower arm laid back: the wrist centre 490 mm behind axis 1
-    ((0, 0, -150, 0, 30, 0), (0, 0, 0, 6)),  # the forearm folded back over: behind axis 1 and behind the lower arm
-])
+@pytest.mark.parametrize(
+    "q, confdata",
+    [
+        ((0, 0, 0, 0, 30, 0), (0, 0, 0, 0)),  # the calibration pose, the wrist bent down
+        ((0, 0, 0, 0, -30, 0), (0, 0, 0, 1)),  # axis 5 negative
+        ((100, 0, 0, 200, 30, -10), (1, 2, -1, 0)),  # quadrants: 90..180, 180..270, -90..0
+        ((0, -90, 0, 0, 30, 0), (0, 0, 0, 4)),  # the lower arm laid back: the wrist centre 490 mm behind axis 1
+        ((0, 0, -150, 0, 30, 0), (0, 0, 0, 6)),  # the forearm folded back over: behind axis 1 and behind the lower arm
+    ],
+)
 def test_abb_confdata_at_poses_the_definition_decides(irb1200, q, confdata):
     assert abb_confdata(_abb(irb1200, q)) == confdata
 
@@ -103,7 +127,14 @@ def test_abb_by_the_data_sheet(irb1200):
     forward. The wrist centre's x (in front of axis 1) and its side of the lower arm, by hand; cfx from them."""
     rng = np.random.default_rng(11)
     for _ in range(40):
-        q = np.r_[rng.uniform(-170, 170), rng.uniform(-100, 130), rng.uniform(-200, 70), rng.uniform(-270, 270), rng.uniform(-130, 130), rng.uniform(-360, 360)]
+        q = np.r_[
+            rng.uniform(-170, 170),
+            rng.uniform(-100, 130),
+            rng.uniform(-200, 70),
+            rng.uniform(-270, 270),
+            rng.uniform(-130, 130),
+            rng.uniform(-360, 360),
+        ]
         a2, a3 = np.radians(q[1]), np.radians(q[2])
         x = 448.0 * math.sin(a2) + 451.0 * math.cos(a2 + a3) + 42.0 * math.sin(a2 + a3)
         side = 451.0 * math.cos(a3) + 42.0 * math.sin(a3)
@@ -136,12 +167,27 @@ def _table(robot, look: np.ndarray) -> tuple[CorrectionTable, dict]:
     task = TaskLocation("pick", tcp, 100.0, None)
     measured = transform_from_xyz_rpy([1.5, -0.8, 0.6], [0.1, -0.05, 0.02]) @ tcp
     table = CorrectionTable()
-    table.add(Correction("pick", tcp, measured, np.array([1.5, -0.8, 0.6]), np.array([0.1, -0.05, 0.02]), np.full(3, 0.1), np.full(3, 0.01), look, 0.3, 8))
+    table.add(
+        Correction(
+            "pick",
+            tcp,
+            measured,
+            np.array([1.5, -0.8, 0.6]),
+            np.array([0.1, -0.05, 0.02]),
+            np.full(3, 0.1),
+            np.full(3, 0.01),
+            look,
+            0.3,
+            8,
+        )
+    )
     return table, {"pick": task}
 
 
 def test_a_krl_listing_carries_the_status_and_turn_of_the_arm_at_the_corrected_target(kr6):
-    look = np.array([-25.0, -110.0, 100.0, -20.0, -50.0, -150.0])  # basic area, A5 negative; A1, A2, A4, A5 and A6 negative
+    look = np.array(
+        [-25.0, -110.0, 100.0, -20.0, -50.0, -150.0]
+    )  # basic area, A5 negative; A1, A2, A4, A5 and A6 negative
     table, tasks = _table(kr6, look)
     text = controller_listing("krl", table, tasks, robot=kr6)
     found = re.search(r"DECL GLOBAL POS pick_c=\{X [^}]*,S (\d+),T (\d+)\}", text)
@@ -167,5 +213,7 @@ def test_a_urscript_listing_gives_the_joints_the_controller_solves_near(ur5):
     table, tasks = _table(ur5, look)
     text = controller_listing("urscript", table, tasks, robot=ur5)
     qnear = [float(v) for v in re.search(r"global pick_c_qnear = \[([^\]]*)\]", text).group(1).split(",")]
-    assert np.allclose(np.degrees(qnear), look, atol=1.0)  # the corrected target is 1.8 mm away: the same branch, a little turned
+    assert np.allclose(
+        np.degrees(qnear), look, atol=1.0
+    )  # the corrected target is 1.8 mm away: the same branch, a little turned
     assert "movej(get_inverse_kin(pick_c, qnear=pick_c_qnear))" in text

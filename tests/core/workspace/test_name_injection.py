@@ -24,14 +24,40 @@ T = make_transform(np.eye(3), [500.0, 0.0, 300.0])
 def _table(name: str) -> tuple[CorrectionTable, dict]:
     table = CorrectionTable()
     delta = make_transform(np.eye(3), [1.0, 0.0, 0.0])
-    table.add(Correction(name, T, delta @ T, np.array([1.0, 0, 0]), np.zeros(3), np.full(3, 0.05), np.full(3, 0.01), np.zeros(6), 0.3, 6))
+    table.add(
+        Correction(
+            name,
+            T,
+            delta @ T,
+            np.array([1.0, 0, 0]),
+            np.zeros(3),
+            np.full(3, 0.05),
+            np.full(3, 0.01),
+            np.zeros(6),
+            0.3,
+            6,
+        )
+    )
     return table, {name: TaskLocation(name, T, 100.0)}
 
 
-@pytest.mark.parametrize("name, ok", [
-    ("oru_1_grasp", True), ("Pick 2 (left)", True), ("Greifer-Ä", True),
-    (EVIL, False), ("a\rb", False), ("tab\there", False), ("bidi\u202eevil", False), ("", False), ("  ", False), (" lead", False), ("x" * 101, False), (3, False),
-])
+@pytest.mark.parametrize(
+    "name, ok",
+    [
+        ("oru_1_grasp", True),
+        ("Pick 2 (left)", True),
+        ("Greifer-Ä", True),
+        (EVIL, False),
+        ("a\rb", False),
+        ("tab\there", False),
+        ("bidi\u202eevil", False),
+        ("", False),
+        ("  ", False),
+        (" lead", False),
+        ("x" * 101, False),
+        (3, False),
+    ],
+)
 def test_check_name(name, ok):
     if ok:
         assert check_name(name, "task location") == name
@@ -80,6 +106,11 @@ def test_a_workspace_with_such_a_name_is_refused_naming_the_field(tmp_path):
 def test_videocal_export_refuses_it_and_writes_nothing(tmp_path):
     path = _workspace_with_task(tmp_path, EVIL)
     out = tmp_path / "corr.pdl"
-    done = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "pdl2", "--out", str(out)], capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "pdl2", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 2 and "task_locations[0].name" in done.stderr and "Traceback" not in done.stderr
     assert not out.exists()

@@ -37,7 +37,9 @@ def workspace():
     for _ in range(2):
         s.calibrate(bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q), q)
         s.store_correction(task.name)
-    return Workspace(str(cell.path), bed.intrinsics, dict(cell.task_locations), s.target, s.pairs.pairs(), s.corrections)
+    return Workspace(
+        str(cell.path), bed.intrinsics, dict(cell.task_locations), s.target, s.pairs.pairs(), s.corrections
+    )
 
 
 def test_round_trip(tmp_path, workspace):
@@ -47,10 +49,14 @@ def test_round_trip(tmp_path, workspace):
     assert back.intrinsics == workspace.intrinsics and back.target == "oru_1_fixture"
     assert back.pairs == workspace.pairs and back.pairs[-1].pixel is None
     assert list(back.task_locations) == list(workspace.task_locations)
-    assert np.allclose(back.task_locations["oru_1_grasp"].tcp2base, workspace.task_locations["oru_1_grasp"].tcp2base, atol=1e-9)
+    assert np.allclose(
+        back.task_locations["oru_1_grasp"].tcp2base, workspace.task_locations["oru_1_grasp"].tcp2base, atol=1e-9
+    )
     assert len(back.corrections.history("oru_1_grasp")) == 2
     a, b = back.corrections.latest("oru_1_grasp"), workspace.corrections.latest("oru_1_grasp")
-    assert np.allclose(a.displacement_mm, b.displacement_mm) and np.allclose(a.tcp2base_measured, b.tcp2base_measured, atol=1e-9)
+    assert np.allclose(a.displacement_mm, b.displacement_mm) and np.allclose(
+        a.tcp2base_measured, b.tcp2base_measured, atol=1e-9
+    )
 
 
 def test_a_failed_save_leaves_the_old_file_whole(tmp_path, workspace, monkeypatch):
@@ -73,12 +79,28 @@ def test_a_failed_save_leaves_the_old_file_whole(tmp_path, workspace, monkeypatc
     [
         (lambda t: t[: len(t) // 2], None, "not valid JSON"),
         (lambda t: json.dumps({"hello": 1}), "kind", "not a videocal workspace"),
-        (lambda t: t.replace('"schema_version": 2', '"schema_version": 9'), "schema_version", "versions 1, 2, the file is version 9"),
-        (lambda t: _edit(t, lambda d: d["corrections"][0].update(joints_deg=[])), "corrections[0].joints_deg", "1 to 16 joint values"),
+        (
+            lambda t: t.replace('"schema_version": 2', '"schema_version": 9'),
+            "schema_version",
+            "versions 1, 2, the file is version 9",
+        ),
+        (
+            lambda t: _edit(t, lambda d: d["corrections"][0].update(joints_deg=[])),
+            "corrections[0].joints_deg",
+            "1 to 16 joint values",
+        ),
         (lambda t: _edit(t, lambda d: d.update(cell="my cell")), "cell", "name, content_hash"),
-        (lambda t: _edit(t, lambda d: d["pairs"][0].update(point_world_mm=[1, 2])), "pairs[0].point_world_mm", "3 finite numbers"),
+        (
+            lambda t: _edit(t, lambda d: d["pairs"][0].update(point_world_mm=[1, 2])),
+            "pairs[0].point_world_mm",
+            "3 finite numbers",
+        ),
         (lambda t: _edit(t, lambda d: d["corrections"][1].pop("rms_px")), "corrections[1].rms_px", "missing"),
-        (lambda t: _edit(t, lambda d: d["task_locations"][0]["tcp2base"].update(rpy=[0, "x", 0])), "task_locations[0].tcp2base.rpy", "3 finite numbers"),
+        (
+            lambda t: _edit(t, lambda d: d["task_locations"][0]["tcp2base"].update(rpy=[0, "x", 0])),
+            "task_locations[0].tcp2base.rpy",
+            "3 finite numbers",
+        ),
     ],
 )
 def test_bad_files_name_the_field(tmp_path, workspace, mutate, field, message):
@@ -107,13 +129,58 @@ def test_exports(tmp_path, workspace):
     assert listing.splitlines()[2] == "VAR" and "END" in listing
     path = tmp_path / "w.json"
     save_workspace(path, workspace)
-    run = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "pdl2"], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "pdl2"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 0 and "oru_1_grasp_c := POS(" in run.stdout
-    bad = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(tmp_path / "nope.json")], capture_output=True, text=True, timeout=60)
+    bad = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "export", str(tmp_path / "nope.json")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert bad.returncode == 2 and "no such workspace file" in bad.stderr
     # a KRL data list named after its file; a file name KRL cannot take is one error line, and nothing is written
-    krl = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "krl", "--out", str(tmp_path / "cell_targets.dat")], capture_output=True, text=True, timeout=60)
+    krl = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "export",
+            str(path),
+            "--format",
+            "krl",
+            "--out",
+            str(tmp_path / "cell_targets.dat"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert krl.returncode == 0 and (tmp_path / "cell_targets.dat").read_text().startswith("DEFDAT cell_targets PUBLIC")
-    dashed = subprocess.run([sys.executable, "-m", "app.cli.main", "export", str(path), "--format", "krl", "--out", str(tmp_path / "cell-targets.dat")], capture_output=True, text=True, timeout=60)
-    assert dashed.returncode == 2 and dashed.stderr.startswith("error:") and "rename the output file" in dashed.stderr and "Traceback" not in dashed.stderr
+    dashed = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "export",
+            str(path),
+            "--format",
+            "krl",
+            "--out",
+            str(tmp_path / "cell-targets.dat"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (
+        dashed.returncode == 2
+        and dashed.stderr.startswith("error:")
+        and "rename the output file" in dashed.stderr
+        and "Traceback" not in dashed.stderr
+    )
     assert not (tmp_path / "cell-targets.dat").exists()
