@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
-from scipy.stats import chi2
+from scipy.special import chdtri
 
 from calib_core.calibration.end_effector import EndEffectorEstimate
 from calib_core.frames import concat, invert, make_transform
@@ -71,7 +71,7 @@ def fuse_look(
     C_model = np.asarray(model_covariance, dtype=float) + np.diag([placement_sigma_mm**2] * 3 + [0.0] * 3)
     S = C_model + C_look
     m2 = float(x @ np.linalg.solve(S, x))
-    agree = m2 <= chi2.ppf(AGREEMENT, 6)
+    agree = m2 <= chdtri(6, 1.0 - AGREEMENT)  # chi-square's AGREEMENT quantile, 6 dof
     if agree:
         K = C_model @ np.linalg.inv(S)
         fused, cov = K @ x, C_model - K @ C_model
