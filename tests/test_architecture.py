@@ -209,3 +209,43 @@ def test_the_operator_parts_are_given_what_they_need():
         if isinstance(n, ast.ClassDef) and n.name == "OperatorCore"
     ]
     assert bases and bases[0].bases == []  # composed of its parts, not mixed from them
+
+
+def _widgets_taking_the_core(source: str) -> list[str]:
+    """Classes whose ``__init__`` takes the whole core (a parameter named ``workbench`` or ``core``)."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ClassDef):
+            for item in node.body:
+                if (
+                    isinstance(item, ast.FunctionDef)
+                    and item.name == "__init__"
+                    and any(a.arg in ("workbench", "core") for a in item.args.args)
+                ):
+                    found.append(node.name)
+    return found
+
+
+# The window's panes not yet given only the parts they show; none may join them. The window (main_window.py)
+# alone assembles the panes from the core.
+PANES_STILL_TAKING_THE_CORE = {
+    "camera_pane.py", "cell_panel.py", "command_panel.py", "overview_pane.py", "replay_bar.py", "robot_panel.py",
+    "status_line.py", "virtual_pane.py",
+    "workflow_actions.py",  # the window's menu and shortcut actions: every workflow's buttons
+}  # fmt: skip
+
+
+def test_the_panes_are_given_the_parts_they_show():
+    assert _widgets_taking_the_core("class P:\n    def __init__(self, workbench, parent=None):\n        pass\n") == [
+        "P"
+    ]
+    taking = {
+        p.name
+        for p in (ROOT / "app" / "gui").glob("*.py")
+        if p.name != "main_window.py" and _widgets_taking_the_core(p.read_text())
+    }
+    assert taking <= PANES_STILL_TAKING_THE_CORE, (
+        f"given the whole core: {sorted(taking - PANES_STILL_TAKING_THE_CORE)}"
+    )
+    # the vision panel shows the core's camera calibration part, the pairs table the session, and so on
+    assert {"vision_panel.py", "pairs_table.py", "results_panel.py", "tool_group.py"}.isdisjoint(taking)

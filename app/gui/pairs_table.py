@@ -7,15 +7,15 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
-from app.gui.workbench import Workbench
+from calib_core.calibration.session import CalibrationSession
 
 COLUMNS = ("#", "feature", "X mm", "Y mm", "Z mm", "u px", "v px", "residual px", "use")
 
 
 class PairsTable(QTableWidget):
-    def __init__(self, workbench: Workbench, parent=None):
+    def __init__(self, session: CalibrationSession, parent=None):
         super().__init__(0, len(COLUMNS), parent)
-        self.workbench = workbench
+        self.session = session
         self.setHorizontalHeaderLabels(COLUMNS)
         self.verticalHeader().setVisible(False)
         self.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
@@ -25,8 +25,8 @@ class PairsTable(QTableWidget):
         self.horizontalHeader().setStretchLastSection(True)
         self._updating = False
         self.itemChanged.connect(self._on_item_changed)
-        workbench.session.pairs.changed.connect(lambda *_: self.refresh())
-        workbench.session.changed.connect(self.refresh)
+        session.pairs.changed.connect(lambda *_: self.refresh())
+        session.changed.connect(self.refresh)
 
     def selected_number(self) -> int | None:
         rows = self.selectionModel().selectedRows()
@@ -44,27 +44,27 @@ class PairsTable(QTableWidget):
                 return
 
     def _residuals(self) -> dict[int, float]:
-        result = self.workbench.session.result
+        result = self.session.result
         if result is None:
             return {}
-        numbers = self.workbench.session.solved_numbers
+        numbers = self.session.solved_numbers
         norms = result.solution.residual_norms_px
         return {n: float(r) for n, r in zip(numbers, norms)}
 
     def _suspects(self) -> set[int]:
         """The pairs the last solve rejected or found not to fit the others (drawn red, with why)."""
-        result = self.workbench.session.result
+        result = self.session.result
         if result is None:
             return set()
         s = result.solution
         flags = np.asarray(s.outliers, dtype=bool) | (
             np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False
         )
-        return {n for n, f in zip(self.workbench.session.solved_numbers, flags) if f}
+        return {n for n, f in zip(self.session.solved_numbers, flags) if f}
 
     def refresh(self) -> None:
         self._updating = True
-        pairs = self.workbench.session.pairs.pairs()
+        pairs = self.session.pairs.pairs()
         residuals = self._residuals()
         suspects = self._suspects()
         self.setRowCount(len(pairs))
@@ -103,5 +103,5 @@ class PairsTable(QTableWidget):
             return
         number = int(self.item(item.row(), 0).text())
         enabled = item.checkState() == Qt.CheckState.Checked
-        if self.workbench.session.pairs.get(number).enabled != enabled:
-            self.workbench.session.set_enabled(number, enabled)
+        if self.session.pairs.get(number).enabled != enabled:
+            self.session.set_enabled(number, enabled)

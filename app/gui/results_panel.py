@@ -11,7 +11,8 @@ from PySide6.QtCore import QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QPainter
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
-from app.gui.workbench import Workbench
+from calib_core.calibration.session import CalibrationSession
+from calib_core.operator.arm import Arm
 from calib_core.calibration.verdict import Verdict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.solver import SolveStatus
@@ -68,9 +69,9 @@ class ResultsPanel(QWidget):
 
     candidate_chosen = Signal(int)
 
-    def __init__(self, workbench: Workbench, parent=None):
+    def __init__(self, session: CalibrationSession, arm: Arm, parent=None):
         super().__init__(parent)
-        self.workbench = workbench
+        self.session, self.arm = session, arm
         self.verdict = QLabel("No solve yet.")
         self.verdict.setObjectName("verdict")
         self.verdict.setWordWrap(True)
@@ -92,17 +93,17 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.details)
         layout.addLayout(self.candidates)
         layout.addWidget(self.chart, 1)
-        workbench.session.changed.connect(self.refresh)
-        workbench.session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
+        session.changed.connect(self.refresh)
+        session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
         self._elsewhere = False
-        workbench.arm.joints_changed.connect(self._joints_changed)
+        arm.joints_changed.connect(self._joints_changed)
 
     def _solved_elsewhere(self) -> bool:
         """The last result was solved from another robot pose than the robot's now."""
-        context = self.workbench.session.context
-        if context is None or context.joints_deg is None or self.workbench.session.result is None:
+        context = self.session.context
+        if context is None or context.joints_deg is None or self.session.result is None:
             return False
-        now = np.asarray(self.workbench.joints_deg, float)
+        now = np.asarray(self.arm.joints_deg, float)
         return context.joints_deg.shape != now.shape or float(np.max(np.abs(context.joints_deg - now))) > SAME_STATE_DEG
 
     def _joints_changed(self, _q) -> None:
@@ -136,7 +137,7 @@ class ResultsPanel(QWidget):
         self._fit_text()
 
     def refresh(self) -> None:
-        session = self.workbench.session
+        session = self.session
         r = session.result
         while self.candidates.count():
             w = self.candidates.takeAt(0).widget()

@@ -56,7 +56,7 @@ class RobotPanel(QWidget):
         self.show_board.setToolTip(
             "Put the board up where the cell's hand_eye_board says (the simulated camera sees it)"
         )
-        self.show_board.toggled.connect(guard(lambda on: self.workbench.show_calibration_board(self._spec(), on)))
+        self.show_board.toggled.connect(guard(lambda on: self.workbench.vision.show_board(self._spec(), on)))
         pl.addWidget(self.show_board)
         row = QHBoxLayout()
         row.addWidget(QLabel("Poses"))
@@ -135,7 +135,7 @@ class RobotPanel(QWidget):
             row.addWidget(b)
         vl.addLayout(row)
 
-        self.tool = ToolGroup(workbench, show_error, self._refresh)
+        self.tool = ToolGroup(workbench.tool, show_error, self._refresh)
         layout = QVBoxLayout(self)
         layout.addWidget(plan)
         layout.addWidget(run)

@@ -14,9 +14,9 @@ from app.gui.error_boundary import guarded
 class ToolGroup(QGroupBox):
     """``changed`` is called after the robot's TCP changed (the panel's buttons follow)."""
 
-    def __init__(self, workbench, show_error: Callable[[str], None], changed: Callable[[], None], parent=None):
+    def __init__(self, measuring, show_error: Callable[[str], None], changed: Callable[[], None], parent=None):
         super().__init__("Camera to tool", parent)
-        self.workbench = workbench
+        self.measuring = measuring  # the core's ToolMeasuring
         self.changed = changed
         self.tool = None
         guard = guarded(show_error)
@@ -53,18 +53,18 @@ class ToolGroup(QGroupBox):
         self.refresh()
 
     def refresh(self) -> None:
-        n = len(self.workbench.tool.grasps)
+        n = len(self.measuring.grasps)
         self.measure_button.setEnabled(n > 0)
         self.clear_button.setEnabled(n > 0)
 
     def record(self) -> None:
-        g = self.workbench.tool.record_grasp()
-        self.text.setText(f"{len(self.workbench.tool.grasps)} grasps (last: {g.name})")
+        g = self.measuring.record_grasp()
+        self.text.setText(f"{len(self.measuring.grasps)} grasps (last: {g.name})")
         self.text.setToolTip("joints " + " ".join(f"{v:.3f}" for v in g.joints_deg) + " deg")
         self.refresh()
 
     def measure(self) -> None:
-        t = self.tool = self.workbench.tool.measure_tool()
+        t = self.tool = self.measuring.measure_tool()
         self.text.setText(
             f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: "
             "in use (Revert takes it back)"
@@ -76,6 +76,6 @@ class ToolGroup(QGroupBox):
         self.changed()
 
     def clear(self) -> None:
-        self.workbench.tool.clear_grasps()
+        self.measuring.clear_grasps()
         self.text.setText("No grasp recorded.")
         self.refresh()

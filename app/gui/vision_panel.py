@@ -1,6 +1,7 @@
-"""The Vision mode: capture ChArUco board views (live or from a recording being replayed), see each
-detection and the image coverage so far, calibrate the intrinsics and the camera's mounting on the
-flange, and apply or save the results.
+"""The Vision mode: the view of the core's camera calibration (``core.vision``,
+:class:`~calib_core.operator.camera_calibrating.CameraCalibrating`): capture ChArUco board views (live or from a
+recording being replayed), see each detection and the image coverage so far, calibrate the intrinsics and the
+camera's mounting on the flange, and apply or save the results.
 
 In the simulated cell the board can be put up in front of the robot and the robot stepped through
 planned viewing poses; with a real camera the operator holds up or places a board and moves the robot.
@@ -27,38 +28,36 @@ from PySide6.QtWidgets import (
 from app.gui.buttons import button
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
-from calib_core.camera.intrinsics_io import save_intrinsics
-from calib_core.frames import concat, invert, pose_difference
-from calib_core.vision.board import DEFAULT_SPEC, parse_board
-from calib_core.vision.capture import BoardCapture
-from calib_core.vision.hand_eye import HandEyeCalibration
-from calib_core.vision.hand_eye_io import save_hand_eye
-from calib_core.vision.intrinsics_calibration import IntrinsicsCalibration, RejectedView
-from calib_core.vision.result_checks import hand_eye_problems, intrinsics_problems, views_with_lost_corners
 from calib_core.errors import OperatorError
+from calib_core.operator.camera_calibrating import CameraCalibrating
+from calib_core.operator.moves import Moves
+from calib_core.vision.board import DEFAULT_SPEC
+from calib_core.vision.intrinsics_calibration import RejectedView
+from calib_core.vision.result_checks import views_with_lost_corners
 
 
 class VisionPanel(QWidget):
-    """Captures take the core's newest frame (:meth:`frame_to_capture`); ``board_detected(corners
-    (n, 2) px or None, text)`` tells the camera pane what to draw; ``show_error`` puts a failed step's
-    reason in the window; progress goes to the workbench's messages (the status bar)."""
+    """Shows and drives ``vision`` (the core's camera calibration), stepping the robot through its board poses with
+    ``moves``; ``board_detected(corners (n, 2) px or None,
+    text)`` tells the camera pane what to draw; ``show_error`` puts a failed step's reason in the window; ``move``
+    sends a move through the window's preview and confirmation. Progress goes to the core's log (the status bar)."""
 
     board_detected = Signal(object, str)
 
-    def __init__(self, workbench, show_error: Callable[[str], None], move: Callable | None = None, parent=None):
+    def __init__(
+        self,
+        vision: CameraCalibrating,
+        moves: Moves,
+        show_error: Callable[[str], None],
+        move: Callable | None = None,
+        parent=None,
+    ):
         super().__init__(parent)
-        self.workbench = workbench
+        self.vision, self.moves = vision, moves
         self._move = move or (lambda send: send(False))  # the window previews and confirms moves
-        self._report = workbench.message.emit
         guard = guarded(show_error)
-        self.capture: BoardCapture | None = None
-        self.intrinsics_result: IntrinsicsCalibration | None = None
-        self.hand_eye_result: HandEyeCalibration | None = None
         self._intrinsics_text = ""  # both results stay on screen, one under the other
         self._hand_eye_text = ""
-        self.hand_eye_problems: list[str] = []
-        self._plan: list[np.ndarray] = []
-        self._plan_index = 0
 
         board = QGroupBox("Board")
         bl = QVBoxLayout(board)
@@ -156,76 +155,64 @@ class VisionPanel(QWidget):
         layout.addWidget(cal)
         self._spec_changed()
 
+    # --- what the core holds, for tests and scripts ----------------------------------------------
+    @property
+    def capture(self):
+        return self.vision.capture
+
+    @property
+    def intrinsics_result(self):
+        return self.vision.intrinsics_result
+
+    @property
+    def hand_eye_result(self):
+        return None if self.vision.mounting is None else self.vision.mounting.calibration
+
+    @property
+    def hand_eye_problems(self) -> list[str]:
+        return [] if self.vision.mounting is None else self.vision.mounting.problems
+
+    @property
+    def _plan(self) -> list[np.ndarray]:
+        return self.vision.plan
+
     # --- board ---------------------------------------------------------------------------------
     def _spec_changed(self) -> None:
         try:
-            spec = parse_board(self.spec.text().strip())
+            self.vision.set_board(self.spec.text())
         except ValueError:
             self.spec.setStyleSheet("color: #ff6060")
             raise
         self.spec.setStyleSheet("")
-        if self.capture is not None and str(spec) == str(self.capture.spec):
-            return
-        if self.capture is not None and self.capture.views:
-            self._report(
-                f"board changed to {spec}: the {len(self.capture.views)} views of the old board were set aside"
-            )
-        self.capture = BoardCapture(spec)
-        self._plan, self._plan_index = [], 0
-        if self.show_board.isChecked():
-            self.workbench.show_calibration_board(spec, True)
         self._refresh()
 
     def _show_board_toggled(self, on: bool) -> None:
-        self.workbench.show_calibration_board(self.capture.spec, on)
-        self._report("calibration board put up in front of the robot" if on else "calibration board taken down")
+        self.vision.show_board(None, on)
+        self.vision.log.say("calibration board put up in front of the robot" if on else "calibration board taken down")
 
     def _next_pose(self) -> None:
-        if not self._plan:
-            self._plan = self.workbench.board_view_plan(self.capture.spec)
-            if not self._plan:
-                raise OperatorError("no reachable robot pose sees the board")
-        q = self._plan[self._plan_index % len(self._plan)]
-        self._plan_index += 1
-        what = f"board pose {(self._plan_index - 1) % len(self._plan) + 1} of {len(self._plan)}"
-        self._move(lambda confirmed: self.workbench.moves.move_joints(q, what, confirmed=confirmed))
+        q, what = self.vision.next_board_pose()
+        self._move(lambda confirmed: self.moves.move_joints(q, what, confirmed=confirmed))
 
     # --- capturing -----------------------------------------------------------------------------
     def capture_view(self) -> None:
         """Detect the board in the current frame; keep it (with the joints) or say why not."""
-        # The newest frame (not the still held for picking), taken after the last move and once the
-        # robot had settled, with the joints then: a refusal says why, nothing is captured.
-        frame, stamp = self.workbench.picking.frame_to_capture()
-        joints = None if stamp is None else np.array(stamp.joints_deg)
-        view = self.capture.add(
-            frame.image, joints, frame_key=(self.workbench.observations.source, frame.index, frame.t_host_s)
-        )
+        view = self.vision.capture_view()
         if isinstance(view, RejectedView):
             self.board_detected.emit(None, "")
-            self._report(f"{view.name} rejected: {view.reason}")
         else:
             self.board_detected.emit(view.corners_px, f"{view.name}: {len(view.ids)} board corners")
-            lost = views_with_lost_corners([len(v.ids) for v in self.capture.views]).get(len(self.capture.views) - 1)
-            self._report(
-                f"{view.name}: {len(view.ids)} corners"
-                + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
-                + (
-                    ""
-                    if lost is None
-                    else f"; it lost corners against its neighbours ({lost:.0f}): look at it, remove it if the board was cut off or blurred"
-                )
-            )
         self._refresh()
 
     def _remove_selected(self) -> None:
         item = self.views.currentItem()
         if item is None or item.data(Qt.ItemDataRole.UserRole) is None:
             raise OperatorError("select an accepted view to remove")
-        self.capture.remove(item.data(Qt.ItemDataRole.UserRole))
+        self.vision.remove_view(item.data(Qt.ItemDataRole.UserRole))
         self._refresh()
 
     def _refresh(self) -> None:
-        c = self.capture
+        c = self.vision.capture
         self.views.clear()
         lost = views_with_lost_corners([len(v.ids) for v in c.views])
         for k, (v, q) in enumerate(zip(c.views, c.joints_deg)):
@@ -245,14 +232,15 @@ class VisionPanel(QWidget):
         )
         self.calibrate_intrinsics_button.setEnabled(n >= 3)
         self.calibrate_hand_eye_button.setEnabled(n >= 3 and all(q is not None for q in c.joints_deg))
-        self.apply_intrinsics_button.setEnabled(self.intrinsics_result is not None)
-        self.save_intrinsics_button.setEnabled(self.intrinsics_result is not None)
-        self.apply_hand_eye_button.setEnabled(self.hand_eye_result is not None)
-        self.save_hand_eye_button.setEnabled(self.hand_eye_result is not None)
+        has_intrinsics, has_mounting = self.vision.intrinsics_result is not None, self.vision.mounting is not None
+        self.apply_intrinsics_button.setEnabled(has_intrinsics)
+        self.save_intrinsics_button.setEnabled(has_intrinsics)
+        self.apply_hand_eye_button.setEnabled(has_mounting)
+        self.save_hand_eye_button.setEnabled(has_mounting)
 
     # --- calibrating ---------------------------------------------------------------------------
     def calibrate_intrinsics(self) -> None:
-        r = self.intrinsics_result = self.capture.calibrate_intrinsics()
+        r = self.vision.calibrate_intrinsics()
         i, s = r.intrinsics, r.std
         lines = [
             f"<b>Intrinsics</b> from {len(r.used)} views, RMS {r.rms_px:.3f} px",
@@ -261,9 +249,7 @@ class VisionPanel(QWidget):
             f"{' '.join(i.distortion_names)}: " + ", ".join(f"{v:+.4f}" for v in i.dist_coeffs),
         ]
         lines += [f"&bull; {a}" for a in r.advice]
-        lines += [
-            f"<span style='color:#e0a030'>check: {p}</span>" for p in intrinsics_problems(r, self.workbench.intrinsics)
-        ]
+        lines += [f"<span style='color:#e0a030'>check: {p}</span>" for p in self.vision.intrinsics_problems()]
         self._intrinsics_text = "<br>".join(lines)
         self._show_results()
         self._refresh()
@@ -272,14 +258,8 @@ class VisionPanel(QWidget):
         self.result.setText("<br><br>".join(t for t in (self._intrinsics_text, self._hand_eye_text) if t))
 
     def calibrate_hand_eye(self) -> None:
-        intrinsics = (
-            self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.workbench.intrinsics
-        )
-        r = self.hand_eye_result = self.capture.calibrate_hand_eye(self.workbench.robot, intrinsics)
-        modelled = concat(
-            self.workbench.robot.frame_placement("camera"), invert(self.workbench.robot.frame_placement("flange"))
-        )
-        d, rot = pose_difference(r.cam2flange, modelled)
+        m = self.vision.calibrate_mounting()
+        r = m.calibration
         lines = [
             f"<b>Camera mounting</b> from {r.views} poses, RMS {r.rms_px:.3f} px",
             "position "
@@ -287,59 +267,44 @@ class VisionPanel(QWidget):
             + " mm (1-sigma "
             + ", ".join(f"{v:.3f}" for v in r.std_xyz_mm)
             + ")",
-            f"differs from the model by {np.linalg.norm(d):.2f} mm and {np.linalg.norm(rot):.3f} deg",
+            f"differs from the model by {m.off_model_mm:.2f} mm and {m.off_model_deg:.3f} deg",
         ]
-        noise = self.intrinsics_result.rms_px if self.intrinsics_result is not None else None
-        self.hand_eye_problems = hand_eye_problems(
-            r, (float(np.linalg.norm(d)), float(np.linalg.norm(rot))), noise, self.workbench.workcell.safety
-        )
-        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in self.hand_eye_problems]
+        lines += [f"<span style='color:#e0a030'>warning: {w}</span>" for w in m.problems]
         self._hand_eye_text = "<br>".join(lines)
         self._show_results()
         self._refresh()
 
-    def _confirmed(self, what: str, problems: list[str]) -> bool:
-        """A result that fails its own checks is applied only when the operator says so (recorded)."""
+    def _confirmed(self, what: str, problems: list[str]) -> list[str] | None:
+        """The problems the operator accepted (none to accept: an empty list); ``None`` when they declined."""
         if not problems:
-            return True
+            return []
         text = "\n".join(
             [f"The {what} failed its checks:", *[f"- {p}" for p in problems], "", f"Use this {what} anyway?"]
         )
         if not ask(self, f"Apply a {what} that failed its checks?", text, "Apply anyway"):
-            self._report(f"{what} not applied")
-            return False
-        self.workbench.record_event("vision_result_confirmed", what=what, problems=problems)
-        return True
+            self.vision.log.say(f"{what} not applied")
+            return None
+        return list(problems)
 
     def apply_intrinsics(self) -> None:
-        if self.intrinsics_result is None:
+        if self.vision.intrinsics_result is None:
             raise OperatorError("calibrate the intrinsics first")
-        if not self._confirmed(
-            "intrinsics calibration", intrinsics_problems(self.intrinsics_result, self.workbench.intrinsics)
-        ):
-            return
-        self.workbench.apply_intrinsics(
-            self.intrinsics_result.intrinsics,
-            f"calibrated intrinsics in use (RMS {self.intrinsics_result.rms_px:.3f} px)",
-        )
+        accepted = self._confirmed("intrinsics calibration", self.vision.intrinsics_problems())
+        if accepted is not None:
+            self.vision.apply_calibrated_intrinsics(accepted)
 
     def apply_hand_eye(self) -> None:
-        if self.hand_eye_result is None:
+        if self.vision.mounting is None:
             raise OperatorError("calibrate the hand-eye first")
-        if not self._confirmed("camera mounting", self.hand_eye_problems):
-            return
-        self.workbench.apply_cam2flange(
-            self.hand_eye_result.cam2flange,
-            f"measured camera mounting in use (RMS {self.hand_eye_result.rms_px:.3f} px)",
-        )
+        accepted = self._confirmed("camera mounting", self.vision.mounting.problems)
+        if accepted is not None:
+            self.vision.apply_calibrated_mounting(accepted)
 
     def save_intrinsics(self, path, fmt: str = "opencv") -> None:
-        save_intrinsics(path, self.intrinsics_result.intrinsics, fmt)
-        self._report(f"intrinsics saved to {path}")
+        self.vision.save_intrinsics(path, fmt)
 
     def save_hand_eye(self, path) -> None:
-        save_hand_eye(path, self.hand_eye_result)
-        self._report(f"camera mounting saved to {path}")
+        self.vision.save_mounting(path)
 
     def _save_intrinsics_dialog(self) -> None:
         path, chosen = QFileDialog.getSaveFileName(

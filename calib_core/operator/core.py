@@ -26,11 +26,11 @@ from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.link.joint_history import JointHistory
 from calib_core.connectors.link_types import TimedSample
 from calib_core.operator.arm import Arm
+from calib_core.operator.camera_calibrating import CameraCalibrating
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.correction_desk import CorrectionDesk
 from calib_core.operator.motion import MotionState
-from calib_core.operator.move_preview import joint_path
 from calib_core.operator.moves import Moves
 from calib_core.operator.observations import Observations
 from calib_core.operator.operator_log import OperatorLog
@@ -104,6 +104,10 @@ class OperatorCore:
         self.desk = CorrectionDesk(
             cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log
         )
+        self.vision = CameraCalibrating(
+            cell, self.picking, self.observations, self.arm, self.log, put_up_on_site=self._put_up_on_site
+        )
+        """The camera's calibration: board views, intrinsics and mounting, the board in the cell."""
         self.files = SessionFiles(cell, self.session, self.log)
         self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
@@ -241,6 +245,10 @@ class OperatorCore:
         except Exception as exc:  # the ROS side is an output: its failure must not stop the calibration
             self.log.say(f"could not publish /tf_static: {exc}")
 
+    def _put_up_on_site(self, extras: list) -> None:
+        if self.site is not None:
+            self.site.put_up(extras)
+
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
         self.log.record(kind, **detail)
@@ -298,56 +306,7 @@ class OperatorCore:
         from calib_core.vision.hand_eye_io import load_mounting
 
         cam2frame, frame = load_mounting(path)
-        self.apply_cam2flange(self.robot.on_flange(cam2frame, frame, str(path)), f"camera mounting from {path}")
-
-    def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
-        """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
-        flange = self.robot.frame_placement("flange")
-        self.robot.set_frame_placement("camera", concat(cam2flange, flange))
-        self.cell.robot_edited()
-        self.log.say(why)
-
-    def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
-        """Use calibrated intrinsics for picking, solving and the virtual camera (the size must match)."""
-        if (intrinsics.width, intrinsics.height) != (self.intrinsics.width, self.intrinsics.height):
-            raise CalibrationError(
-                f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives {self.intrinsics.width} x {self.intrinsics.height} px"
-            )
-        self.cell.use_intrinsics(intrinsics)
-        self.log.say(why)
-
-    # --- the calibration board --------------------------------------------------------------------
-    def board_placement(self, spec) -> np.ndarray:
-        """Where the hand-eye board stands: the workcell's ``hand_eye_board`` placement, or upright
-        in front of the robot within its reach. ``board2base`` (4, 4) mm."""
-        from calib_core.vision.board_placement import board_in_cell
-
-        return board_in_cell(spec, self.workcell, self.robot)
-
-    def show_calibration_board(self, spec, on: bool = True) -> np.ndarray:
-        """Put a ChArUco board up in the cell (or take it down). Returns its ``board2base`` (4, 4) mm."""
-        from calib_core.vision.board import board_item
-
-        board2base = self.board_placement(spec)
-        extras = [board_item(spec, board2base)] if on else []
-        if self.site is not None:
-            self.site.put_up(list(extras))
-        self.cell.put_up(extras)
-        return board2base
-
-    def board_view_plan(self, spec, n: int = 16) -> list[np.ndarray]:
-        """Joint vectors (deg/mm) from which the modelled camera sees the board from different
-        directions, in an order whose every move (from the current joints on) is free of collisions
-        with the robot itself and the cell (the board among it); a pose without such a path is left out."""
-        from calib_core.vision.board_placement import board_view_joints
-
-        world = self.cell.collision_world()
-        plan, q = [], np.asarray(self.joints_deg, dtype=float)
-        for goal in board_view_joints(self.robot, self.cell.home_joints, spec, self.board_placement(spec), n):
-            if not any(world.check(p) for p in joint_path(q, goal)):
-                plan.append(goal)
-                q = goal
-        return plan
+        self.vision.apply_cam2flange(self.robot.on_flange(cam2frame, frame, str(path)), f"camera mounting from {path}")
 
     def start_recording(self, path, **options) -> None:
         """Record the session to ``path`` (MCAP); ``options`` go to the

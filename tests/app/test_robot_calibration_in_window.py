@@ -60,7 +60,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert r.start_rms_px > 1.0 and r.rms_px < 0.3 and "parameters identified" in panel.result_text.text()
     # The camera relative to the board at a pose of the plan, against the test bed's truth.
     bed = wb.site.bed
-    board2base = wb.board_placement(panel._spec())
+    board2base = wb.vision.board_placement(panel._spec())
     q = panel.plan.joints_deg[-1]
     d, rot = pose_difference(invert(r.board2base) @ r.robot.fk(q, "camera"), invert(board2base) @ bed.true_cam2world(q))
     d0, rot0 = pose_difference(wb.robot.fk(q, "camera"), bed.true_cam2world(q))

@@ -80,7 +80,7 @@ def test_the_camera_mounting_and_targets_on_tf_static_for_a_late_subscriber(doma
         )
         moved = mounting.copy()
         moved[:3, 3] += [1.5, -2.0, 0.5]
-        core.apply_cam2flange(moved)
+        core.vision.apply_cam2flange(moved)
         peer = DomainParticipant(domain)  # joins after both publications
         reader = DataReader(peer, Topic(peer, "rt/tf_static", msg.TFMessage), qos=static_tf_qos())
         got = []

@@ -1,0 +1,70 @@
+"""The core's camera calibration (``core.vision``) without a window: the board, where it stands and the poses that see
+it, and the gates on using a result (the image size, checks that failed only when confirmed)."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from calib_core.calibration.session import CalibrationError
+from calib_core.errors import OperatorError
+from calib_core.frames import concat, invert, transform_from_xyz_rpy
+from calib_core.operator.camera_calibrating import MountingResult
+from calib_core.operator.cell import Cell
+from calib_core.operator.core import OperatorCore
+
+
+@pytest.fixture
+def core():
+    return OperatorCore(Cell.open())
+
+
+def test_a_board_goes_up_in_the_cell_and_a_new_one_sets_the_old_views_aside(core):
+    said = []
+    core.message.connect(said.append)
+    vision = core.vision
+    with pytest.raises(ValueError):
+        vision.set_board("charuco:nonsense")
+    board2base = vision.show_board(None, True)
+    assert len(core.cell.extras) == 1 and np.allclose(board2base, vision.board_placement())
+    vision.set_board("charuco:7x5:30:22:DICT_5X5_100")
+    assert str(vision.capture.spec) == "charuco:7x5:30:22:DICT_5X5_100"
+    assert len(core.cell.extras) == 1  # the shown board replaced by the new one
+    vision.show_board(None, False)
+    assert core.cell.extras == [] and not vision.board_shown
+
+
+def test_the_board_poses_are_planned_once_and_stepped_through(core):
+    q1, what1 = core.vision.next_board_pose()
+    q2, what2 = core.vision.next_board_pose()
+    n = len(core.vision.plan)
+    assert n >= 2 and what1 == f"board pose 1 of {n}" and what2 == f"board pose 2 of {n}"
+    assert not np.allclose(q1, q2)
+    # each planned pose's modelled camera looks at the board (its centre in front of the camera)
+    board2base = core.vision.board_placement()
+    for q in core.vision.plan[:3]:
+        board_in_cam = concat(board2base, invert(core.robot.fk(q, "camera")))
+        assert board_in_cam[2, 3] > 100.0
+
+
+def test_intrinsics_of_another_image_size_are_refused_by_name(core):
+    other = core.intrinsics.scaled(0.5)
+    with pytest.raises(CalibrationError, match=f"{other.width} x {other.height} px images"):
+        core.vision.apply_intrinsics(other)
+
+
+def test_a_mounting_that_failed_its_checks_is_used_only_with_those_checks_confirmed(core):
+    events = []
+    core.event.connect(lambda kind, detail: events.append(kind))
+    before = core.robot.frame_placement("camera")
+    flange = core.robot.frame_placement("flange")
+    moved = concat(concat(before, invert(flange)), transform_from_xyz_rpy([2.0, 0.0, 0.0], [0.0, 0.0, 0.0]))
+    core.vision.mounting = MountingResult(SimpleNamespace(cam2flange=moved, rms_px=0.9), 2.0, 0.0, ["poses disagree"])
+    with pytest.raises(OperatorError, match="failed its checks \\(poses disagree\\): confirm it"):
+        core.vision.apply_calibrated_mounting()
+    with pytest.raises(OperatorError, match="confirm it"):
+        core.vision.apply_calibrated_mounting(["another problem"])
+    assert np.allclose(core.robot.frame_placement("camera"), before)  # nothing applied
+    core.vision.apply_calibrated_mounting(["poses disagree"])
+    assert np.allclose(concat(core.robot.frame_placement("camera"), invert(flange)), moved)
+    assert "vision_result_confirmed" in events
