@@ -44,7 +44,7 @@ class MainWindow(QMainWindow):
         self.table = PairsTable(workbench.session)
         self.results = ResultsPanel(workbench.session, workbench.arm)
         self.commands = CommandPanel(workbench)
-        self.replay = ReplayBar(workbench, lambda frame: workbench.picking.observe_frame(frame, replayed=True))
+        self.replay = ReplayBar(workbench.replay, lambda frame: workbench.picking.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(
             workbench.vision, workbench.moves, self.show_error, lambda send: self.actions.move(send)
         )

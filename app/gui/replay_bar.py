@@ -1,32 +1,19 @@
-"""The replay timeline: a recording, or a ROS 2 bag, played back in the window.
-
-The camera pane shows the recorded frames, the CAD views follow the recorded joints, and the point
-pairs and the last solve appear as they stood at the timeline's position. The first edit the
-operator makes (a pick, a delete, a solve...) branches a new session from that instant: the pairs
-stop following the recording and the operator works on the recorded frames. The recording file is
-only ever read. While it plays, the window uses the intrinsics the recording was made with. Closing the
-replay gives the live camera's intrinsics back, and the live session as it was unless it was branched.
+"""The replay timeline: the view and the clock of the core's replay (``core.replay``,
+:class:`~calib_core.operator.replaying.Replaying`): play, pause and scrub a recording or a ROS 2 bag; the camera pane
+shows the recorded frames, the CAD views follow the recorded joints, the pairs and the last solve appear as they
+stood, and the first edit branches a new session (the part says what that means).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QSlider, QStyle, QToolButton, QWidget
 
-from calib_core.bags.bag_playback import BagPlayback, is_bag
-from calib_core.camera.intrinsics import Intrinsics
-from calib_core.errors import FileFormatError
-from calib_core.link.joint_history import JointHistory
-from calib_core.recording.playback import RecordedSolve, RecordingPlayback
-from calib_core.recording.reader import read_recording, recover
-from calib_core.recording.replay import solve_from_inputs
-from calib_core.ros2.joint_units import user_per_si
 from calib_core.connectors.frame import Frame
+from calib_core.operator.replaying import Replaying
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0)
 
@@ -37,18 +24,10 @@ class ReplayBar(QWidget):
 
     closed = Signal()
 
-    def __init__(self, workbench, show_frame: Callable[[Frame], None], parent=None):
+    def __init__(self, replay: Replaying, show_frame: Callable[[Frame], None], parent=None):
         super().__init__(parent)
-        self.workbench = workbench
+        self.replay = replay
         self._show_frame = show_frame
-        self.playback: RecordingPlayback | None = None
-        self.path: Path | None = None
-        self.position_s = 0.0
-        self.branched_at_s: float | None = None
-        self._applying = False
-        self._shown_frame: int | None = None
-        self._shown_solve: int | None = None
-        self._live_state = None
         self._last_tick = 0.0
 
         self.play_button = QToolButton()
@@ -91,120 +70,55 @@ class ReplayBar(QWidget):
         self._timer.setInterval(33)
         self._timer.timeout.connect(self._tick)
         self._set_play_icon()
-        workbench.session.undo.changed.connect(self._on_edit)
+        replay.branched.connect(lambda _t: self._update_state())
         self.hide()
+
+    # --- what the core holds, for the window and tests --------------------------------------------
+    @property
+    def playback(self):
+        return self.replay.playback
+
+    @property
+    def path(self):
+        return self.replay.path
+
+    @property
+    def position_s(self) -> float:
+        return self.replay.position_s
+
+    @property
+    def branched_at_s(self) -> float | None:
+        return self.replay.branched_at_s
 
     # --- opening and closing -------------------------------------------------------------------
     def open(self, path) -> None:
         """Open a recording at its start. Raises ``FileFormatError`` (the window says why) and changes
         nothing when the file is not a readable recording."""
-        path = Path(path)
-        if is_bag(path):  # a ROS 2 bag: its frames, with the arm's joints at each frame's stamp
-            robot = self.workbench.robot
-            playback, complete, problem = (
-                BagPlayback(path, robot.joint_names, user_per_si(robot.joint_units)),
-                True,
-                None,
-            )
-            if not len(playback.frames):
-                playback.close()
-                raise FileFormatError(path, f"no image on {playback.frames.topic}")
-        else:
-            contents = read_recording(path)
-            if not contents.messages:
-                raise FileFormatError(path, "the recording holds no messages")
-            playback, complete, problem = RecordingPlayback(contents, path.name), contents.complete, contents.problem
-        recorded_intrinsics = None
-        if playback.setup.get("intrinsics"):
-            try:
-                recorded_intrinsics = Intrinsics.from_dict(playback.setup["intrinsics"])
-            except (KeyError, TypeError, ValueError) as exc:
-                getattr(playback, "close", lambda: None)()
-                raise FileFormatError(path, f"its intrinsics cannot be read ({exc})", "/videocal/setup") from None
-        self._close_playback()
-        if self.playback is None:
-            s = self.workbench.session
-            self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.workbench.intrinsics)
-        # Picks and solves on the recorded frames need the camera they were recorded with.
-        if recorded_intrinsics is not None:
-            self.workbench.cell.use_intrinsics(recorded_intrinsics)
-        self.playback, self.path = playback, path
-        history = JointHistory.from_arrays(
-            playback.joint_times_s,
-            playback.joints_deg,
-            self.workbench.workcell.safety.settle_rule,
-            self.workbench.robot.joint_names,
-        )
-        self.workbench.picking.begin_replay(history, path.name)
-        self.branched_at_s = None
-        self._shown_frame = self._shown_solve = None
-        self._applying = True  # clearing the live session's undo history is not an operator edit
-        try:
-            self.workbench.session.undo.clear()
-        finally:
-            self._applying = False
+        self.replay.open(path)
+        playback = self.replay.playback
         self.slider.blockSignals(True)
         self.slider.setRange(0, max(1, int(round(playback.duration_s * 1000))))
         self.slider.setValue(0)
         self.slider.blockSignals(False)
-        self.recover_button.setVisible(not complete)
+        self.recover_button.setVisible(not self.replay.complete)
         self.show()
         self.seek(0.0)
-        note = "" if complete else f" - cut off: {problem}; Recover... writes a complete copy"
-        if isinstance(playback, BagPlayback):
-            joints = (
-                f"joints from {playback.joint_topic}"
-                if playback.joint_topic
-                else "no joint states: a camera alone, nothing robot-bound"
-            )
-            note = f" (ROS 2 bag, {playback.frames.topic}; {joints})"
-        self.workbench.message.emit(
-            f"replaying {path.name}: {playback.duration_s:.1f} s, {len(playback.frames)} frames, {len(playback.solves)} solves{note}"
-        )
 
     def close_replay(self) -> None:
-        if self.playback is None:
+        if self.replay.playback is None:
             return
         self.pause()
-        branched = self.branched_at_s is not None
-        if self._live_state is not None:
-            self.workbench.cell.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
-        if not branched and self._live_state is not None:
-            pairs, result, _ = self._live_state
-            s = self.workbench.session
-            self._applying = True
-            try:
-                s.pairs.replace_all(pairs)
-                s.restore_result(result)
-                s.undo.clear()
-            finally:
-                self._applying = False
-        self._close_playback()
-        self.playback = self.path = self._live_state = None
-        self.workbench.picking.end_replay()
+        self.replay.close()
         self.hide()
-        self.workbench.message.emit(
-            "replay closed: "
-            + ("the branched session stays open" if branched else "the live session is back as it was")
-        )
         self.closed.emit()
-
-    def _close_playback(self) -> None:
-        close = getattr(self.playback, "close", None)  # a bag keeps its file open while it is replayed
-        if close is not None:
-            close()
 
     def release_file(self) -> None:
         """Let go of the file being replayed (the window closes); nothing else changes."""
-        self._close_playback()
+        self.replay.release_file()
 
     def _recover(self) -> None:
-        if self.path is None:
-            return
-        out = self.path.with_name(self.path.stem + "-recovered.mcap")
-        contents = recover(self.path, out)
-        self.recover_button.hide()
-        self.workbench.message.emit(f"recovered {len(contents.messages)} messages into {out}")
+        if self.replay.recover() is not None:
+            self.recover_button.hide()
 
     # --- playing -------------------------------------------------------------------------------
     @property
@@ -249,85 +163,21 @@ class ReplayBar(QWidget):
 
     def seek(self, t_s: float) -> None:
         """Show the recording as it was at ``t_s`` (s from its start)."""
-        pb = self.playback
+        pb = self.replay.playback
         if pb is None:
             return
-        t_s = min(max(0.0, t_s), pb.duration_s)
-        self.position_s = t_s
+        frame = self.replay.seek(t_s)
+        t_s = self.replay.position_s
         self.slider.blockSignals(True)
         self.slider.setValue(int(round(t_s * 1000)))
         self.slider.blockSignals(False)
         self.time_label.setText(f"{t_s:.1f} / {pb.duration_s:.1f} s")
-        k = pb.frame_index_at(t_s)
-        if k is not None and k != self._shown_frame:
-            image = pb.frames.image(k)
-            if image is not None:
-                self._shown_frame = k
-                # on the recording's time axis, the clock of its joint history
-                self._show_frame(Frame(image, k, float(pb.frames.times_s[k]), float(pb.frames.times_s[k])))
-        q = pb.joints_at(t_s)
-        if q is not None:
-            self.workbench.show_replayed_joints(q)
-        if self.branched_at_s is None:
-            self._apply_session(t_s)
+        if frame is not None:
+            self._show_frame(frame)
         self._update_state()
-
-    def _apply_session(self, t_s: float) -> None:
-        pb, s = self.playback, self.workbench.session
-        self._applying = True
-        try:
-            pairs = pb.pairs_at(t_s)
-            if pairs != s.pairs.pairs():
-                s.pairs.replace_all(pairs)
-            solve = pb.solve_at(t_s)
-            if solve is None and self._shown_solve is not None:
-                s.clear_result()
-            elif solve is not None and solve.id != self._shown_solve:
-                self._show_solve(solve)
-            self._shown_solve = None if solve is None else solve.id
-        finally:
-            self._applying = False
-
-    def _show_solve(self, solve: RecordedSolve) -> None:
-        c = solve.context
-        if not c:
-            self.workbench.message.emit(
-                f"solve {solve.id} was recorded without its robot context: its camera pose only is in the file"
-            )
-            return
-        solution = solve_from_inputs(solve.inputs)  # deterministic: the same answer as recorded
-        numbers = [p.number for p in self.workbench.session.pairs.usable()]
-        obj2world, cam_model, tcp_model = (
-            np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model")
-        )
-        self.workbench.session.show_result(
-            solution,
-            obj2world,
-            cam_model,
-            tcp_model,
-            c.get("joints_deg"),
-            numbers,
-            points_obj_mm=solve.inputs.get("points_3d"),
-            intrinsics=Intrinsics.from_dict(solve.inputs["intrinsics"]),
-        )
-
-    # --- branching -----------------------------------------------------------------------------
-    def _on_edit(self) -> None:
-        if self.playback is None or self._applying or self.branched_at_s is not None:
-            return
-        self.branched_at_s = self.position_s
-        self._update_state()
-        self.workbench.message.emit(
-            f"new session branched from {self.path.name} at {self.position_s:.1f} s; the recording is not changed"
-        )
 
     def _update_state(self) -> None:
-        pb = self.playback
-        if pb is None:
-            return
-        if self.branched_at_s is not None:
-            self.state_label.setText(f"<span style='color:#e0a030'>branched at {self.branched_at_s:.1f} s</span>")
-        else:
-            self.state_label.setText(
-                f"{len(self.workbench.session.pairs)} pairs, {sum(1 for s in pb.solves if s.t_s <= self.position_s)} solves so far"
-            )
+        text = self.replay.state_text()
+        if self.replay.branched_at_s is not None:
+            text = f"<span style='color:#e0a030'>{text}</span>"
+        self.state_label.setText(text)

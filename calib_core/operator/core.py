@@ -35,6 +35,7 @@ from calib_core.operator.moves import Moves
 from calib_core.operator.observations import Observations
 from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.picking import Picking
+from calib_core.operator.replaying import Replaying
 from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.session_files import SessionFiles
@@ -108,6 +109,8 @@ class OperatorCore:
             cell, self.picking, self.observations, self.arm, self.log, put_up_on_site=self._put_up_on_site
         )
         """The camera's calibration: board views, intrinsics and mounting, the board in the cell."""
+        self.replay = Replaying(cell, self.session, self.picking, self.arm, self.log)
+        """A recording or bag played back in place of the live camera."""
         self.files = SessionFiles(cell, self.session, self.log)
         self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
@@ -214,10 +217,6 @@ class OperatorCore:
     def observe_sample(self, sample: TimedSample) -> None:
         """A joint sample from the link (or a test standing in for it)."""
         self.arm.observe_sample(sample)
-
-    def show_replayed_joints(self, joints_deg) -> None:
-        """Joints from a recording being replayed: the CAD views follow them, the robot does not move."""
-        self.arm.show_joints(joints_deg)
 
     def static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
         """What the cell's ROS side is told: ``(parent, child, child2parent_mm)`` for the camera mounting in use
