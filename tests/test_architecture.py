@@ -229,7 +229,7 @@ def _widgets_taking_the_core(source: str) -> list[str]:
 # The window's panes not yet given only the parts they show; none may join them. The window (main_window.py)
 # alone assembles the panes from the core.
 PANES_STILL_TAKING_THE_CORE = {
-    "camera_pane.py", "cell_panel.py", "command_panel.py", "overview_pane.py", "robot_panel.py",
+    "cell_panel.py", "command_panel.py", "overview_pane.py", "robot_panel.py",
     "status_line.py", "virtual_pane.py",
     "workflow_actions.py",  # the window's menu and shortcut actions: every workflow's buttons
 }  # fmt: skip

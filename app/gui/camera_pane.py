@@ -11,7 +11,12 @@ from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QSlider, QVBoxLayo
 from app.gui.error_boundary import attempt
 from app.gui.image_view import ImageView, Overlay
 from app.gui.solved_edges import SolvedEdges
-from app.gui.workbench import Workbench
+from calib_core.calibration.session import CalibrationSession
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
+from calib_core.operator.observations import Observations
+from calib_core.operator.picking import Picking
+from calib_core.operator.point_finding import PointFinding
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.camera.projection import project_points
 from calib_core.errors import OperatorError
@@ -41,9 +46,19 @@ class CameraPane(QWidget):
     pick_rejected = Signal(str)  # a click or a drag that picks nothing, and why
     pair_selected = Signal(int)  # a click on a pair's point
 
-    def __init__(self, workbench: Workbench, parent=None):
+    def __init__(
+        self,
+        cell: Cell,
+        observations: Observations,
+        picking: Picking,
+        session: CalibrationSession,
+        arm: Arm,
+        finder: PointFinding,
+        parent=None,
+    ):
         super().__init__(parent)
-        self.workbench = workbench
+        # what it shows: the cell's camera and parts, the frames, the pairs being made, the result's overlay
+        self.cell, self.observations, self.picking, self.session, self.arm = cell, observations, picking, session, arm
         self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
         self.view.grabber = self._grab
         self.view.dragged.connect(self._dragging)
@@ -85,25 +100,25 @@ class CameraPane(QWidget):
         self._board_joints: np.ndarray | None = None  # the robot state it was detected at
         self._board_text = ""
         self._edges_image: np.ndarray | None = None
-        self.solved_edges = SolvedEdges(workbench.intrinsics)
+        self.solved_edges = SolvedEdges(cell.intrinsics)
         self.edges_drawn = 0  # the solves whose CAD edges were drawn (tests and the bench wait on it)
         self._drawn_state: tuple | None = None
         self.view.clicked.connect(self._on_click)
         self.freeze.toggled.connect(self._hold_toggled)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
         self.opacity.valueChanged.connect(lambda _: self.refresh_overlay())
-        workbench.observations.frame_observed.connect(self.show_frame)
-        workbench.observations.still_changed.connect(self._still_changed)
-        workbench.session.pairs.changed.connect(lambda *_: self.refresh_overlay())
-        workbench.session.changed.connect(self._on_solved)
-        workbench.arm.joints_changed.connect(self._joints_changed)
-        workbench.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.workbench.intrinsics))
-        workbench.points_found.connect(self._points_found)
+        observations.frame_observed.connect(self.show_frame)
+        observations.still_changed.connect(self._still_changed)
+        session.pairs.changed.connect(lambda *_: self.refresh_overlay())
+        session.changed.connect(self._on_solved)
+        arm.joints_changed.connect(self._joints_changed)
+        cell.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.cell.intrinsics))
+        finder.points_found.connect(self._points_found)
 
     # --- frames ---------------------------------------------------------------------------------
     @property
     def held(self):
-        return self.workbench.observations.still
+        return self.observations.still
 
     def show_frame(self, frame) -> None:
         self.last_frame_received = frame
@@ -116,14 +131,14 @@ class CameraPane(QWidget):
     def _hold_toggled(self, on: bool) -> None:
         if on and self.held is None:
             try:
-                self.workbench.picking.hold_frame()
+                self.picking.hold_frame()
             except OperatorError as exc:
                 self.freeze.blockSignals(True)
                 self.freeze.setChecked(False)
                 self.freeze.blockSignals(False)
                 self.pick_rejected.emit(str(exc))
         elif not on and self.held is not None:
-            self.workbench.picking.release_frame()
+            self.picking.release_frame()
 
     def _still_changed(self, held) -> None:
         self.freeze.blockSignals(True)
@@ -154,7 +169,7 @@ class CameraPane(QWidget):
         # The core holds the newest frame at the first pick of a set and refines on it.
         attempt(
             lambda text: self.pick_rejected.emit(f"nothing picked: {text}"),
-            self.workbench.picking.pick_image_point,
+            self.picking.pick_image_point,
             (u, v),
             refine=self.subpixel.isChecked(),
         )
@@ -163,11 +178,11 @@ class CameraPane(QWidget):
     def _grab(self, u: float, v: float, radius_px: float) -> bool:
         """Take hold of the complete pair whose point lies within ``radius_px`` of (u, v) on the image
         shown (picked at the robot state it shows). Not while a pair waits for its point: the click is its."""
-        if self.workbench.session.pairs.pending() is not None:
+        if self.session.pairs.pending() is not None:
             return False
         near = [
             (np.hypot(p.pixel[0] - u, p.pixel[1] - v), p.number)
-            for p in self.workbench.session.pairs
+            for p in self.session.pairs
             if p.pixel is not None and (p.view is None or self._same_state(p.view.joints_deg))
         ]
         near = [n for n in near if n[0] <= radius_px]
@@ -186,7 +201,7 @@ class CameraPane(QWidget):
         if moved:
             attempt(
                 self.pick_rejected.emit,
-                self.workbench.picking.move_pair_pixel,
+                self.picking.move_pair_pixel,
                 number,
                 (u, v),
                 refine=self.subpixel.isChecked(),
@@ -197,7 +212,7 @@ class CameraPane(QWidget):
         """Show a board detection (n, 2) px over the image (``None`` hides it); it belongs to the
         robot state it was detected at and is hidden when the robot moves."""
         self._board_corners = None if corners_px is None else np.asarray(corners_px, dtype=float)
-        self._board_joints = None if corners_px is None else np.array(self.workbench.joints_deg, dtype=float)
+        self._board_joints = None if corners_px is None else np.array(self.arm.joints_deg, dtype=float)
         self._board_text = text
         self.refresh_overlay()
 
@@ -223,18 +238,19 @@ class CameraPane(QWidget):
     def _on_solved(self) -> None:
         # The reprojected points and residuals are drawn at once; the CAD edges take a render, so they
         # follow on the next turn of the event loop, after that repaint.
-        if self.workbench.session.result is None:
+        if self.session.result is None:
             self._edges_image = None
         else:
             QTimer.singleShot(0, self._draw_solved_edges)
         self.refresh_overlay()
 
     def _draw_solved_edges(self) -> None:
-        wb = self.workbench
-        r = wb.session.result
+        r = self.session.result
         if r is None:
             return
-        self.set_edges_image(self.solved_edges.render(wb.workcell.components, r.cam2world_measured, wb.session.target))
+        self.set_edges_image(
+            self.solved_edges.render(self.cell.workcell.components, r.cam2world_measured, self.session.target)
+        )
         self.edges_drawn += 1
 
     def close_renderer(self) -> None:
@@ -244,9 +260,7 @@ class CameraPane(QWidget):
     def shown_joints(self) -> np.ndarray:
         """The joints (deg/mm) of the robot state the image shows: the held frame's, else the robot's now."""
         held = self.held
-        return (
-            np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.workbench.joints_deg, dtype=float)
-        )
+        return np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.arm.joints_deg, dtype=float)
 
     def _same_state(self, joints) -> bool:
         if joints is None:
@@ -255,7 +269,7 @@ class CameraPane(QWidget):
         return a.shape == b.shape and float(np.max(np.abs(a - b))) <= SAME_STATE_DEG
 
     def _state_key(self) -> tuple:
-        session = self.workbench.session
+        session = self.session
         context = session.context
         pairs = tuple(
             p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None
@@ -270,7 +284,7 @@ class CameraPane(QWidget):
             self.refresh_overlay()
 
     def refresh_overlay(self) -> None:
-        session = self.workbench.session
+        session = self.session
         self._drawn_state = (pairs_current, result_current, board_current) = self._state_key()
         overlay = Overlay()
         banner = []
@@ -294,7 +308,7 @@ class CameraPane(QWidget):
                 banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
-            expected = self.workbench.picking.expected_pixel()
+            expected = self.picking.expected_pixel()
             if expected is not None:
                 (u, v), basis = expected
                 overlay.points.append((u, v, "expected", EXPECTED_COLOR))
@@ -323,7 +337,7 @@ class CameraPane(QWidget):
             if pair.pixel is None or pair.number not in used:
                 continue
             p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-            uv = project_points(p_obj, obj2cam, self.workbench.intrinsics)[0]
+            uv = project_points(p_obj, obj2cam, self.cell.intrinsics)[0]
             if np.all(np.isfinite(uv)):
                 overlay.points.append((uv[0], uv[1], "", REPROJECTED_COLOR))
                 end = np.array(pair.pixel) + RESIDUAL_SCALE * (np.array(pair.pixel) - uv)
@@ -337,7 +351,7 @@ class CameraPane(QWidget):
                     continue
                 for pair in session.pairs:
                     p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-                    uv = project_points(p_obj, candidate.obj2cam, self.workbench.intrinsics)[0]
+                    uv = project_points(p_obj, candidate.obj2cam, self.cell.intrinsics)[0]
                     if np.all(np.isfinite(uv)):
                         overlay.points.append((uv[0], uv[1], f"s{k + 1}", GHOST_COLOR))
             overlay.text = f"{len(candidates)} poses fit: magenta ghosts show the others; choose one in Results"

@@ -38,7 +38,14 @@ class MainWindow(QMainWindow):
         self.launcher = launcher  # opens another cell in a new window (File > Open cell); None: this window's cell only
         self.settings = settings or QSettings("videocal", "videocal")
         self.setWindowTitle(f"videocal - {workbench.workcell.name}")
-        self.camera = CameraPane(workbench)
+        self.camera = CameraPane(
+            workbench.cell,
+            workbench.observations,
+            workbench.picking,
+            workbench.session,
+            workbench.arm,
+            workbench.finder,
+        )
         self.virtual = VirtualPane(workbench)
         self.overview = OverviewPane(workbench)
         self.table = PairsTable(workbench.session)
