@@ -46,7 +46,7 @@ class MainWindow(QMainWindow):
             workbench.arm,
             workbench.finder,
         )
-        self.virtual = VirtualPane(workbench)
+        self.virtual = VirtualPane(workbench.cell, workbench.session, workbench.arm, workbench.picking)
         self.overview = OverviewPane(workbench)
         self.table = PairsTable(workbench.session)
         self.results = ResultsPanel(workbench.session, workbench.arm)
