@@ -47,7 +47,7 @@ class MainWindow(QMainWindow):
             workbench.finder,
         )
         self.virtual = VirtualPane(workbench.cell, workbench.session, workbench.arm, workbench.picking)
-        self.overview = OverviewPane(workbench)
+        self.overview = OverviewPane(workbench.cell, workbench.session, workbench.arm, workbench.moves)
         self.table = PairsTable(workbench.session)
         self.results = ResultsPanel(workbench.session, workbench.arm)
         self.commands = CommandPanel(workbench)
