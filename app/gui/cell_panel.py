@@ -27,7 +27,11 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.gui.workbench import Workbench
+from calib_core.calibration.session import CalibrationSession
+from calib_core.operator.arm import Arm
+from calib_core.operator.cell import Cell
+from calib_core.operator.cell_editor import CellEditor
+from calib_core.operator.operator_log import OperatorLog
 from calib_core.frames import apply, transform_from_xyz_rpy, xyz_rpy_from_transform
 
 SNAP_RADIUS_PX = 12.0
@@ -50,9 +54,19 @@ class CellPanel(QWidget):
 
     feature_mode_changed = Signal(object)
 
-    def __init__(self, workbench: Workbench, attempt, parent=None):
+    def __init__(
+        self,
+        cell: Cell,
+        editor: CellEditor,
+        session: CalibrationSession,
+        arm: Arm,
+        log: OperatorLog,
+        attempt,
+        parent=None,
+    ):
         super().__init__(parent)
-        self.workbench = workbench
+        # what it shows and edits: the cell's components, features and task locations (through its editor)
+        self.cell, self.editor, self.session, self.arm, self.log = cell, editor, session, arm, log
         self._attempt = attempt
         layout = QVBoxLayout(self)
 
@@ -132,8 +146,8 @@ class CellPanel(QWidget):
         self.add_component.clicked.connect(self._add_component_dialog)
         self.take_pose.clicked.connect(self.fill_current_pose)
         self.add_task.clicked.connect(lambda: self._attempt(self.add_task_location))
-        self.save.clicked.connect(lambda: self._attempt(self.workbench.editor.save))
-        workbench.scene_changed.connect(self._sync)
+        self.save.clicked.connect(lambda: self._attempt(self.editor.save))
+        cell.scene_changed.connect(self._sync)
         self.pick_features.toggled.connect(self._feature_mode)
         self.component.currentTextChanged.connect(lambda _: self._feature_mode(self.picking_features))
         self._sync()
@@ -141,20 +155,20 @@ class CellPanel(QWidget):
 
     # --- the core's state into the widgets ------------------------------------------------------
     def _sync(self) -> None:
-        names = [c.name for c in self.workbench.workcell.components]
+        names = [c.name for c in self.cell.workcell.components]
         current = self.component.currentText()
         if [self.component.itemText(i) for i in range(self.component.count())] != names:
             self.component.blockSignals(True)
             self.component.clear()
             self.component.addItems(names)
-            self.component.setCurrentText(current if current in names else (self.workbench.session.target or names[0]))
+            self.component.setCurrentText(current if current in names else (self.session.target or names[0]))
             self.component.blockSignals(False)
         self._show_component(self.component.currentText())
 
     def _show_component(self, name: str) -> None:
         if not name:
             return
-        xyz, rpy = xyz_rpy_from_transform(self.workbench.workcell.component(name).item2world)
+        xyz, rpy = xyz_rpy_from_transform(self.cell.workcell.component(name).item2world)
         for box, v in zip(self.xyz + self.rpy, list(xyz) + list(rpy)):
             with QSignalBlocker(box):  # showing the core's placement is not an edit of it
                 box.setValue(float(v))
@@ -162,15 +176,13 @@ class CellPanel(QWidget):
     # --- edits ------------------------------------------------------------------------------------
     def _placement_edited(self) -> None:
         name = self.component.currentText()
-        self._attempt(
-            self.workbench.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy]
-        )
+        self._attempt(self.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
 
     def _add_component_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
             self,
             "Add component",
-            str(self.workbench.workcell.path.parent),
+            str(self.cell.workcell.path.parent),
             "Meshes (*.stl *.obj *.dae *.glb *.gltf *.ply)",
         )
         if not path:
@@ -181,21 +193,20 @@ class CellPanel(QWidget):
 
     def add_component_file(self, path, name: str) -> None:
         """Add the component and select it, so its placement can be typed at once."""
-        if self._attempt(self.workbench.editor.add_component, path, name):
+        if self._attempt(self.editor.add_component, path, name):
             self.component.setCurrentText(name.strip())
 
     def fill_current_pose(self) -> None:
-        xyz, rpy = xyz_rpy_from_transform(self.workbench.model_tcp2base())
+        xyz, rpy = xyz_rpy_from_transform(self.cell.robot.fk(self.arm.joints_deg, "tcp"))
         for box, v in zip(self.task_xyz + self.task_rpy, list(xyz) + list(rpy)):
             box.setValue(float(v))
 
     def add_task_location(self) -> None:
-        wb = self.workbench
-        name = self.task_name.text().strip() or f"location_{len(wb.workcell.task_locations) + 1}"
+        name = self.task_name.text().strip() or f"location_{len(self.cell.workcell.task_locations) + 1}"
         T = transform_from_xyz_rpy([b.value() for b in self.task_xyz], [b.value() for b in self.task_rpy])
-        wb.editor.add_task_location(name, T, self.task_approach.value())
+        self.editor.add_task_location(name, T, self.task_approach.value())
         self.task_name.clear()
-        wb.message.emit(f"task location {name} added")
+        self.log.say(f"task location {name} added")
 
     def _feature_mode(self, on: bool) -> None:
         self.feature_mode_changed.emit(self.component.currentText() if on else None)
@@ -206,12 +217,11 @@ class CellPanel(QWidget):
 
     def feature_clicked(self, hit, cam2world: np.ndarray, focal_px: float) -> None:
         """A click on the chosen component in the virtual camera: snap it, name it, add it."""
-        wb = self.workbench
         depth_mm = float(np.linalg.norm(hit.point_world_mm - cam2world[:3, 3]))
-        snap = wb.editor.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
-        item = wb.workcell.component(hit.component)
+        snap = self.editor.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
+        item = self.cell.workcell.component(hit.component)
         name = self.feature_name.text().strip() or f"feature_{len(item.features) + 1}"
-        wb.editor.add_feature(hit.component, name, snap.point_mm)
+        self.editor.add_feature(hit.component, name, snap.point_mm)
         self.feature_name.clear()
         world = apply(item.item2world, np.asarray(snap.point_mm)[None])[0]
         self.feature_info.setText(

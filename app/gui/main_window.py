@@ -56,8 +56,17 @@ class MainWindow(QMainWindow):
             workbench.vision, workbench.moves, self.show_error, lambda send: self.actions.move(send)
         )
         self.vision.board_detected.connect(self.camera.set_board_corners)
-        self.robot_calibration = RobotPanel(workbench, self.show_error)
-        self.cell_panel = CellPanel(workbench, lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k))
+        self.robot_calibration = RobotPanel(
+            workbench.robot_calibration, workbench.vision, workbench.tool, workbench.log, self.show_error
+        )
+        self.cell_panel = CellPanel(
+            workbench.cell,
+            workbench.editor,
+            workbench.session,
+            workbench.arm,
+            workbench.log,
+            lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k),
+        )
         for panel, title in ((self.vision, "Vision"), (self.robot_calibration, "Robot"), (self.cell_panel, "Cell")):
             scroll = QScrollArea()  # the panels are taller than a small screen
             scroll.setWidgetResizable(True)
