@@ -20,7 +20,10 @@ from PySide6.QtWidgets import (
 
 from app.gui.buttons import button
 from app.gui.error_boundary import attempt
-from app.gui.workbench import Workbench
+from calib_core.calibration.session import CalibrationSession
+from calib_core.operator.cell import Cell
+from calib_core.operator.cell_editor import CellEditor
+from calib_core.operator.task_choice import TaskChoice
 
 
 class CommandPanel(QTabWidget):
@@ -31,9 +34,11 @@ class CommandPanel(QTabWidget):
 
     error = Signal(str)
 
-    def __init__(self, workbench: Workbench, parent=None):
+    def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, editor: CellEditor, parent=None):
         super().__init__(parent)
-        self.workbench = workbench
+        # what it shows and sets: the task locations (the choice, their approach through the cell's editor), the
+        # target and the solve options (the session)
+        self.cell, self.session, self.task_choice, self.editor = cell, session, tasks, editor
         self.setMinimumWidth(250)
         # Six tabs (the paper's four modes, Vision and Cell) fit the panel without scroll arrows.
         self.setStyleSheet("QTabBar::tab { padding: 4px 5px; }")
@@ -47,7 +52,7 @@ class CommandPanel(QTabWidget):
         pl.addWidget(QLabel("Task locations"))
         self.tasks = QListWidget()
         self.tasks.setObjectName("tasks")
-        for name in workbench.workcell.task_locations:
+        for name in cell.workcell.task_locations:
             self.tasks.addItem(name)
         pl.addWidget(self.tasks, 1)
         approach_row = QFormLayout()
@@ -86,11 +91,11 @@ class CommandPanel(QTabWidget):
         form = QFormLayout()
         self.target = QComboBox()
         self.target.setObjectName("target")
-        for c in workbench.workcell.components:
+        for c in cell.workcell.components:
             if c.kind == "component":
                 self.target.addItem(c.name)
-        if workbench.session.target:
-            self.target.setCurrentText(workbench.session.target)
+        if session.target:
+            self.target.setCurrentText(session.target)
         form.addRow("Target object", self.target)
         cl.addLayout(form)
         steps = QGroupBox("Point pairs")
@@ -155,38 +160,38 @@ class CommandPanel(QTabWidget):
         el.addStretch(1)
         self.addTab(ex, "Execute")
         self.setCurrentIndex(2)
-        workbench.task_changed.connect(self._sync_tasks)
-        workbench.scene_changed.connect(self._sync_targets)
-        self._bind(workbench)
+        tasks.changed.connect(self._sync_tasks)
+        cell.scene_changed.connect(self._sync_targets)
+        self._bind()
 
-    def _bind(self, wb: Workbench) -> None:
+    def _bind(self) -> None:
         def run(fn, *args):
             attempt(self.error.emit, fn, *args)
 
-        self.clear.clicked.connect(lambda: run(wb.session.clear))
-        self.target.currentTextChanged.connect(lambda name: run(wb.session.set_target, name))
-        self.estimate_focal.toggled.connect(lambda on: run(wb.session.set_option, "estimate_focal", on))
-        self.robust.toggled.connect(lambda on: run(wb.session.set_option, "robust", on))
-        wb.session.option_changed.connect(self.show_option)  # an undo sets the box back
+        self.clear.clicked.connect(lambda: run(self.session.clear))
+        self.target.currentTextChanged.connect(lambda name: run(self.session.set_target, name))
+        self.estimate_focal.toggled.connect(lambda on: run(self.session.set_option, "estimate_focal", on))
+        self.robust.toggled.connect(lambda on: run(self.session.set_option, "robust", on))
+        self.session.option_changed.connect(self.show_option)  # an undo sets the box back
 
         def task_chosen(name: str) -> None:
             if name:
-                run(wb.set_task, name)
+                run(self.task_choice.choose, name)
 
         def approach_edited(mm: float) -> None:
-            if wb.task is not None:
-                run(wb.set_task_approach, wb.task.name, mm)
+            if self.task_choice.task is not None:
+                run(self.editor.set_task_approach, self.task_choice.task.name, mm)
 
         self.tasks.currentTextChanged.connect(task_chosen)
         self.approach.valueChanged.connect(approach_edited)
-        wb.task_changed.connect(self._show_task)
-        if wb.task is not None:
-            self._show_task(wb.task.name)
-        wb.session.corrections.changed.connect(lambda task: self.show_corrections(wb.session.corrections))
+        self.task_choice.changed.connect(self._show_task)
+        if self.task_choice.task is not None:
+            self._show_task(self.task_choice.task.name)
+        self.session.corrections.changed.connect(lambda task: self.show_corrections(self.session.corrections))
 
     def _show_task(self, name: str) -> None:
         """The approach box shows the chosen task location's approach distance (without sending it back)."""
-        task = self.workbench.task
+        task = self.task_choice.task
         if task is None or task.name != name:
             return
         with QSignalBlocker(self.approach):
@@ -226,7 +231,7 @@ class CommandPanel(QTabWidget):
 
     def _sync_tasks(self, name: str = "") -> None:
         """The task list follows the cell (a location added or undone)."""
-        names = list(self.workbench.workcell.task_locations)
+        names = list(self.cell.workcell.task_locations)
         if [self.tasks.item(i).text() for i in range(self.tasks.count())] == names:
             return
         current = self.tasks.currentItem().text() if self.tasks.currentItem() else None
@@ -239,12 +244,12 @@ class CommandPanel(QTabWidget):
 
     def _sync_targets(self) -> None:
         """The target choice follows the cell's components (one added or undone)."""
-        names = [c.name for c in self.workbench.workcell.components if c.kind == "component"]
+        names = [c.name for c in self.cell.workcell.components if c.kind == "component"]
         if [self.target.itemText(i) for i in range(self.target.count())] == names:
             return
         self.target.blockSignals(True)
         self.target.clear()
         self.target.addItems(names)
-        if self.workbench.session.target in names:
-            self.target.setCurrentText(self.workbench.session.target)
+        if self.session.target in names:
+            self.target.setCurrentText(self.session.target)
         self.target.blockSignals(False)

@@ -50,7 +50,7 @@ class MainWindow(QMainWindow):
         self.overview = OverviewPane(workbench.cell, workbench.session, workbench.arm, workbench.moves)
         self.table = PairsTable(workbench.session)
         self.results = ResultsPanel(workbench.session, workbench.arm)
-        self.commands = CommandPanel(workbench)
+        self.commands = CommandPanel(workbench.cell, workbench.session, workbench.tasks, workbench.editor)
         self.replay = ReplayBar(workbench.replay, lambda frame: workbench.picking.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(
             workbench.vision, workbench.moves, self.show_error, lambda send: self.actions.move(send)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationSession
 from calib_core.errors import OperatorError
 from calib_core.frames import transform_from_xyz_rpy
@@ -46,6 +47,12 @@ class CellEditor:
             self.tasks.edited(name)
         else:
             self.cell.scene_edited()
+
+    def set_task_approach(self, name: str, approach_mm: float) -> None:
+        """Edit a task location's approach distance (mm): an undoable edit."""
+        if abs(self.cell.workcell.task(name).approach_mm - approach_mm) < 1e-9:
+            return
+        self.session.undo.push(SetTaskApproach(self.cell.workcell.task_locations, name, approach_mm, self.tasks.edited))
 
     def add_task_location(
         self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None

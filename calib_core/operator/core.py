@@ -18,7 +18,6 @@ from collections.abc import Callable
 import numpy as np
 from psygnal import Signal
 
-from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
@@ -251,12 +250,6 @@ class OperatorCore:
     def record_event(self, kind: str, **detail) -> None:
         """An operator action or a link change worth keeping in a recording."""
         self.log.record(kind, **detail)
-
-    def set_task_approach(self, name: str, approach_mm: float) -> None:
-        """Edit a task location's approach distance (mm): an undoable edit."""
-        if abs(self.workcell.task(name).approach_mm - approach_mm) < 1e-9:
-            return
-        self.session.undo.push(SetTaskApproach(self.workcell.task_locations, name, approach_mm, self.tasks.edited))
 
     def set_task(self, name: str) -> None:
         """Work at task location ``name``: its component becomes the target."""
