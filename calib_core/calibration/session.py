@@ -19,6 +19,7 @@ from calib_core.calibration.end_effector import EndEffectorEstimate, end_effecto
 from calib_core.calibration.form_error import form_error_covariance
 from calib_core.undo import Command, UndoStack
 from calib_core.calibration.verdict import ResultVerdict, judge
+from calib_core.workcell.safety import SafetyLimits
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
@@ -125,9 +126,10 @@ class CalibrationSession:
     last_solve_inputs: dict | None = None
     verdict: ResultVerdict | None = None
     """The last result's verdict (``None`` before a solve)."""
-    judge: object = None
-    """``judge(estimate) -> ResultVerdict`` (the operator core sets the cell's limits and the task's
-    tolerance); ``None``: the defaults of :func:`~calib_core.calibration.verdict.judge`."""
+    limits: SafetyLimits | None = None
+    """The cell's limits a result is judged against (:meth:`judge_by`; ``None``: the defaults)."""
+    tolerance_mm: float | None = None
+    """The task location's tolerance a result is judged against (``None``: the default)."""
 
     changed = Signal()
     """After every solve, candidate choice, cleared result or target change."""
@@ -290,8 +292,16 @@ class CalibrationSession:
             self.undo.push(_ShowResult(self, solved, label))
         return result
 
+    def judge_by(self, limits: SafetyLimits | None, tolerance_mm: float | None) -> None:
+        """Judge results against the cell's ``limits`` and the task's ``tolerance_mm`` (mm; ``None``: the default);
+        the result shown is judged again."""
+        self.limits, self.tolerance_mm = limits, tolerance_mm
+        self.rejudge()
+
     def _judge(self, estimate) -> ResultVerdict:
-        return (self.judge or judge)(estimate)
+        if self.tolerance_mm is None:
+            return judge(estimate, self.limits)
+        return judge(estimate, self.limits, self.tolerance_mm)
 
     def rejudge(self) -> None:
         """Judge the result again (the task, and with it the tolerance, changed)."""

@@ -21,7 +21,6 @@ from psygnal import Signal
 from calib_core.calibration.session import CalibrationError, CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
-from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.link.joint_history import JointHistory
 from calib_core.connectors.link_types import TimedSample
 from calib_core.operator.arm import Arm
@@ -115,7 +114,7 @@ class OperatorCore:
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
         for signal in (self.picking.solved, self.finder.solved):
             signal.connect(self.solved.emit)
-        self.session.judge = self._judge
+        self._judge_by_the_task()
 
     # The events of the parts, where a listener to the whole program finds them.
     @property
@@ -257,18 +256,15 @@ class OperatorCore:
 
     def _task_chosen(self, name: str) -> None:
         task = self.task
-        if task is not None and task.name == name:
+        if task is None:
+            self._judge_by_the_task()  # the chosen task location was removed: the default tolerance
+        elif task.name == name:
             if task.component and task.component != self.session.target:
                 self.session.set_target(task.component)
-            self.session.rejudge()  # the task's tolerance is part of the verdict
+            self._judge_by_the_task()  # the task's tolerance is part of the verdict
 
-    def _judge(self, estimate) -> ResultVerdict:
-        tolerance = self.task.tolerance_mm if self.task is not None else None
-        return (
-            judge(estimate, self.workcell.safety, tolerance)
-            if tolerance is not None
-            else judge(estimate, self.workcell.safety)
-        )
+    def _judge_by_the_task(self) -> None:
+        self.session.judge_by(self.workcell.safety, self.task.tolerance_mm if self.task is not None else None)
 
     def undo(self) -> str | None:
         """Undo the last edit (its label, None if there was none); the pair being made is let go."""
