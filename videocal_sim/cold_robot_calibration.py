@@ -233,7 +233,7 @@ def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -
     parameters the fit puts the unidentified ones' share into the identified (to first order
     ``p_id + (J_id^+ J_unid) p_unid``, the board's placement a nuisance). ``within_3_sigma`` is the share
     of identified parameters within 3 of their sigmas of it."""
-    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, _Problem
+    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, IdentificationProblem
 
     truth = truth_in_model_parameters(bed)
     with_intrinsics = len(result.names) > truth.size
@@ -247,7 +247,9 @@ def parameters_against_truth(result: RobotCalibration, bed, views, intrinsics) -
             t.cy - intrinsics.cy,
             1000.0 * (np.asarray(t.distortion[:4]) - np.asarray(intrinsics.distortion[:4])),
         ]
-    problem = _Problem(result.nominal, intrinsics, views, result.camera_frame, with_intrinsics, SURVEY_SIGMA_MM)
+    problem = IdentificationProblem(
+        result.nominal, intrinsics, views, result.camera_frame, with_intrinsics, SURVEY_SIGMA_MM
+    )
     problem.board0 = result.board2base if result.board2base is not None else np.eye(4)
     ids, unid = result.observability.identified, result.observability.unidentified
     J, Jb = problem.jacobian(result.values, np.zeros(6), list(range(problem.size)))

@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QFileDialog, QMenu
 from app.gui.camera_chooser import CameraChooser
 from app.gui.confirm import ask, ask_save
 from app.gui.error_boundary import attempt
-from app.gui.session_files import Autosave, RecentFiles
+from app.gui.file_memory import Autosave, RecentFiles
 from calib_core.errors import OperatorError
 
 EXPORT_FILTERS = {

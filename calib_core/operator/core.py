@@ -36,7 +36,7 @@ from calib_core.operator.picking import Picking
 from calib_core.operator.replaying import Replaying
 from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
-from calib_core.operator.session_files import SessionFiles
+from calib_core.operator.workspace_files import WorkspaceFiles
 from calib_core.operator.site import Site
 from calib_core.operator.task_choice import TaskChoice
 from calib_core.operator.tool_measuring import ToolMeasuring
@@ -109,7 +109,7 @@ class OperatorCore:
         """The camera's calibration: board views, intrinsics and mounting, the board in the cell."""
         self.replay = Replaying(cell, self.session, self.picking, self.arm, self.log)
         """A recording or bag played back in place of the live camera."""
-        self.files = SessionFiles(cell, self.session, self.log)
+        self.files = WorkspaceFiles(cell, self.session, self.log)
         self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
         """Edits of the cell (components, features, task locations), undoable, saved back to its file."""
         for signal in (self.picking.solved, self.finder.solved):

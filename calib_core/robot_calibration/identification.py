@@ -105,7 +105,11 @@ def pose_residual(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
     return np.r_[Rotation.from_matrix(R).as_rotvec(), measured[:3, 3] - R @ predicted[:3, 3]]
 
 
-class _Problem:
+class IdentificationProblem:
+    """The least-squares problem of a robot calibration: the corrected robot's parameters (and the intrinsics when
+    ``with_intrinsics``) against the ``views`` of a board or surveyed objects, whitened by each view's covariance (the
+    survey's ``survey_sigma_mm`` added). Used by the identification, and by the pose planner for observability."""
+
     def __init__(
         self,
         robot: RobotModel,
@@ -243,7 +247,7 @@ def identify(
     started = time.perf_counter()
     if len(views) < MIN_VIEWS:
         raise RobotCalibrationError(f"{len(views)} views, at least {MIN_VIEWS} needed (30-40 recommended)")
-    problem = _Problem(robot, intrinsics, views, camera_frame, with_intrinsics, survey_sigma_mm)
+    problem = IdentificationProblem(robot, intrinsics, views, camera_frame, with_intrinsics, survey_sigma_mm)
     if problem.has_board:
         problem.board0 = initial_board2base(robot, intrinsics, views, camera_frame)
     p0, b0 = np.zeros(problem.size), np.zeros(6)

@@ -23,7 +23,7 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project
 from calib_core.frames import apply, concat, invert
 from calib_core.robot.model import RobotModel
-from calib_core.robot_calibration.identification import _Problem
+from calib_core.robot_calibration.identification import IdentificationProblem
 from calib_core.robot_calibration.observations import PoseView
 from calib_core.vision.board_placement import board_view_joints
 
@@ -88,7 +88,7 @@ def plan_poses(
         )
         for k, q in enumerate(kept)
     ]
-    problem = _Problem(robot, intrinsics, views, "camera", True)
+    problem = IdentificationProblem(robot, intrinsics, views, "camera", True)
     problem.board0 = board2base
     J, Jb = problem.jacobian(np.zeros(problem.size), np.zeros(6), list(range(problem.size)))
     rows = 2 * len(corners)

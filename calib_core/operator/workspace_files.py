@@ -11,7 +11,7 @@ from calib_core.operator.cell import Cell
 from calib_core.operator.operator_log import OperatorLog
 
 
-class SessionFiles:
+class WorkspaceFiles:
     def __init__(self, cell: Cell, session: CalibrationSession, log: OperatorLog):
         self.cell, self.session, self.log = cell, session, log
         self._lock = None  # the workspace file this window holds (one window at a time on a file)
