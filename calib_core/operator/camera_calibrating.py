@@ -3,13 +3,13 @@ the joints then, the camera's intrinsics and its mounting on the flange calibrat
 to the cell or saved; the board put up in the cell and the robot poses that see it.
 
 A part of :class:`~calib_core.operator.core.OperatorCore`, given the cell, the picking (the frame a view is taken
-from), the observations (which source it came from), the arm (where the robot stands) and the log; ``put_up_on_site``
-shows the board to the site's camera (the simulated cell's), when there is one. The window's Vision mode is its view.
+from), the observations (which source it came from), the arm (where the robot stands) and the log; ``board_put_up``
+tells whoever shows the cell to a camera (the simulated site) what now stands in it. The window's Vision mode is its
+view.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,9 +42,11 @@ class MountingResult:
 
 class CameraCalibrating:
     """``capture`` (the board's views), ``intrinsics_result`` and ``mounting`` (the last calibrations, or ``None``),
-    ``plan`` (robot poses that see the board). ``changed`` after every capture, removal, calibration or new board."""
+    ``plan`` (robot poses that see the board). ``changed`` after every capture, removal, calibration or new board;
+    ``board_put_up(extras)`` when a board goes up in the cell or comes down (``[]``)."""
 
     changed = Signal()
+    board_put_up = Signal(list)
 
     def __init__(
         self,
@@ -53,10 +55,8 @@ class CameraCalibrating:
         observations: Observations,
         arm: Arm,
         log: OperatorLog,
-        put_up_on_site: Callable[[list], None] = lambda extras: None,
     ):
         self.cell, self.picking, self.observations, self.arm, self.log = cell, picking, observations, arm, log
-        self._put_up_on_site = put_up_on_site
         self.capture = BoardCapture(parse_board(DEFAULT_SPEC))
         self.intrinsics_result = None
         self.mounting: MountingResult | None = None
@@ -96,7 +96,7 @@ class CameraCalibrating:
         spec = spec or self.capture.spec
         board2base = self.board_placement(spec)
         extras = [board_item(spec, board2base)] if on else []
-        self._put_up_on_site(list(extras))
+        self.board_put_up.emit(list(extras))
         self.cell.put_up(extras)
         self.board_shown = on
         return board2base

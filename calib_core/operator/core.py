@@ -103,9 +103,8 @@ class OperatorCore:
         self.desk = CorrectionDesk(
             cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log
         )
-        self.vision = CameraCalibrating(
-            cell, self.picking, self.observations, self.arm, self.log, put_up_on_site=self._put_up_on_site
-        )
+        self.vision = CameraCalibrating(cell, self.picking, self.observations, self.arm, self.log)
+        self.vision.board_put_up.connect(self._put_up_on_site)
         """The camera's calibration: board views, intrinsics and mounting, the board in the cell."""
         self.replay = Replaying(cell, self.session, self.picking, self.arm, self.log)
         """A recording or bag played back in place of the live camera."""
