@@ -47,8 +47,8 @@ class Ros2ArmProcess:
             str(domain),
             "--rate",
             f"{rate_hz:g}",
-            "--joints",
-            ",".join(f"{v:.6f}" for v in joints_deg),
+            # one token: a first joint below zero would otherwise read as an option ("expected one argument")
+            "--joints=" + ",".join(f"{v:.6f}" for v in joints_deg),
         ]
         env = None
         if network is not None:  # on the far side of the link, with its own address and the workstation as its peer

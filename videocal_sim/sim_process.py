@@ -73,7 +73,8 @@ class SimulatorProcess:
         where = ["--tcp", "0"] if tcp else ["--pty", "--link", str(self.link_path)]
         cmd = [sys.executable, "-m", "app.cli.main", "sim-controller", *where, "--workcell", str(workcell_path)]
         if joints_controller is not None:
-            cmd += ["--joints", ",".join(f"{v:.4f}" for v in joints_controller)]
+            # one token: a first joint below zero would otherwise read as an option ("expected one argument")
+            cmd += ["--joints=" + ",".join(f"{v:.4f}" for v in joints_controller)]
         with open(self._stderr_path, "w") as err:
             self.process = subprocess.Popen(
                 cmd,

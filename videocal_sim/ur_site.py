@@ -54,8 +54,7 @@ class URSimulatedSite(SimulatedSite):
                 self.host,
                 "--workcell",
                 str(Path(self.bed.workcell.path).resolve()),
-                "--joints",
-                ",".join(f"{v:.6f}" for v in self.bed.joints_deg),
+                "--joints=" + ",".join(f"{v:.6f}" for v in self.bed.joints_deg),  # one token: may start with "-"
             ]
             with open(stderr_path, "w") as err:
                 self.ur = subprocess.Popen(

@@ -90,6 +90,10 @@ _register_plugins()
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2, as for every bad input
         self.print_usage(sys.stderr)
+        if message.endswith("expected one argument"):
+            # "--joints -20,10,..." reads "-20,..." as an option: say how a value that starts with "-" is given
+            option = message.removeprefix("argument ").split(":")[0].split("/")[-1]
+            message += f" (a value that starts with '-' is given as {option}=VALUE, e.g. {option}=-20,10,30)"
         print(f"error: {message}", file=sys.stderr)
         raise SystemExit(2)
 

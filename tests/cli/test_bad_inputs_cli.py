@@ -438,3 +438,8 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
             assert list(locked.iterdir()) == []
     finally:
         locked.chmod(stat.S_IRWXU)
+
+
+def test_joints_whose_first_is_negative_given_as_two_tokens_say_how_to_write_them():
+    run = _videocal("render", "--joints", "-5,0,0,0,0,0", "--out", "never.png")
+    _refused(run, "argument --joints: expected one argument", "--joints=VALUE", "--joints=-20,10,30")
