@@ -65,6 +65,32 @@ def _launch(tmp: Path, tag: str, *args: str) -> tuple[float, float]:
     return shown, ready
 
 
+def _turn_the_base(wb) -> None:
+    """A move long enough to follow (the simulated controllers move at their robot's speeds: a task's approach is
+    reached in a fifth of a second): axis 1 turned by up to 150 deg within its limits, the other joints kept."""
+    q = np.asarray(wb.joints_deg, dtype=float).copy()
+    lo, hi = wb.robot.lower_limits_deg[0], wb.robot.upper_limits_deg[0]
+    q[0] = min(q[0] + 150.0, hi - 1.0) if hi - q[0] > q[0] - lo else max(q[0] - 150.0, lo + 1.0)
+    wb.moves.move_joints(q, "a turn of the base", confirmed=True)
+
+
+def _redraws_while_moving(app, wb, view, timeout_s: float = 20.0) -> float:
+    """The view's redraws per second from the move's start until the robot arrives (a move that ends in a second
+    must not be averaged over the seconds the robot then stands still)."""
+    from calib_core.operator.motion import Motion
+
+    t_start = time.monotonic()
+    while wb.motion.motion is not Motion.MOVING and time.monotonic() - t_start < 2.0:
+        app.processEvents()
+        time.sleep(0.002)
+    t_moving, redraws_moving = time.monotonic(), view.redraws
+    while wb.motion.motion is Motion.MOVING and time.monotonic() - t_start < timeout_s:
+        app.processEvents()
+        time.sleep(0.002)
+    elapsed = time.monotonic() - t_moving
+    return (view.redraws - redraws_moving) / elapsed if elapsed > 0.2 else float("nan")
+
+
 def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
     """Overview redraws per second while the robot moves to the first task's approach (50 Hz joint stream)."""
 
@@ -78,10 +104,8 @@ def _overview_fps_following(app, workcell: Path, tmp: Path) -> float:
     win.resize(1600, 1000)
     win.show()
     _spin(app, 2.0)
-    wb.moves.go_to_task(approach=True)
-    redraws0, t_start = win.overview.redraws, time.monotonic()
-    _spin(app, 3.0)
-    fps = (win.overview.redraws - redraws0) / (time.monotonic() - t_start)
+    _turn_the_base(wb)
+    fps = _redraws_while_moving(app, wb, win.overview)
     win.close()
     return fps
 
@@ -168,13 +192,16 @@ def main() -> str:
     # 2. Camera pane fps on a 30 fps 1280 x 960 file while the overview follows a 50 Hz joint stream and the robot moves.
     shown_frames = []
     win.worker.frame.connect(lambda f: shown_frames.append(time.monotonic()))
-    wb.moves.go_to_task(approach=True)
-    redraws0 = win.overview.redraws
+    q_start = np.asarray(wb.joints_deg, dtype=float).copy()
+    _turn_the_base(wb)
     t_start = time.monotonic()
-    _spin(app, 4.0)
+    overview_fps = _redraws_while_moving(app, wb, win.overview)
+    wb.moves.move_joints(q_start, "back", confirmed=True)
+    _redraws_while_moving(app, wb, win.overview)
+    wb.moves.go_to_task(approach=True)  # where the picks below are made
+    _spin(app, max(0.0, 4.0 - (time.monotonic() - t_start)))
     elapsed = time.monotonic() - t_start
     camera_fps = len(shown_frames) / elapsed
-    overview_fps = (win.overview.redraws - redraws0) / elapsed
     # 3. A joint sample reaching the overview on screen: from its arrival to the redraw that shows it.
     lat = []
     for _ in range(10):
@@ -263,9 +290,9 @@ def main() -> str:
         f"| launch to the full window with every pane, the simulator and the link running | {ready_s:.2f} s | |",
         f"| UR5 cell (vendor DAE meshes): launch to window on screen | {launch_ur5:.2f} s | <= 3 s |",
         f"| UR5 cell: launch to the full window | {ready_ur5:.2f} s | <= 3 s |",
-        f"| UR5 cell: overview redraws while following the 50 Hz joint stream | {overview_ur5:.1f} fps | >= 15 fps |",
+        f"| UR5 cell: overview redraws while following the 50 Hz joint stream (during the move) | {overview_ur5:.1f} fps | >= 15 fps |",
         f"| camera pane, 30 fps 1280 x 960 video file, while the robot moves | {camera_fps:.1f} fps | >= 25 fps |",
-        f"| overview redraws while following the 50 Hz joint stream | {overview_fps:.1f} fps | >= 15 fps |",
+        f"| overview redraws while following the 50 Hz joint stream (during the move) | {overview_fps:.1f} fps | >= 15 fps |",
         f"| joint sample to the overview redrawn, median of 10 | {1000 * float(np.median(lat)):.0f} ms | <= 100 ms |",
         f"| last pick to the solved overlays drawn (solve, reprojected points and residuals, repaint), median | {float(np.median(pick_ms)):.0f} ms | <= 100 ms |",
         f"| ... and to the CAD edges from the solved pose drawn over the video (a render of the cell), median | {float(np.median(edges_ms)):.0f} ms | |",
