@@ -239,7 +239,7 @@ def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarra
 
 
 def _model_field(path: Path, model) -> str:
-    if model not in DISTORTION_MODELS:
+    if not isinstance(model, str) or model not in DISTORTION_MODELS:  # a list or a mapping is not a model's name
         raise FileFormatError(
             path,
             f"unsupported distortion model {model!r}; videocal reads {', '.join(DISTORTION_MODELS)}",

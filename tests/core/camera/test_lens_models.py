@@ -114,6 +114,11 @@ def test_camera_info_of_each_model_is_read_as_ros_writes_it(tmp_path):
     (tmp_path / "unknown.yaml").write_text(yaml.safe_dump(ost))
     with pytest.raises(FileFormatError, match="unsupported distortion model 'kannala_brandt_8'"):
         load_intrinsics(tmp_path / "unknown.yaml")
+    # a list where the model's name belongs (a fuzzed document: it raised TypeError "unhashable type")
+    ost["distortion_model"] = ["plumb_bob"]
+    (tmp_path / "listed.yaml").write_text(yaml.safe_dump(ost))
+    with pytest.raises(FileFormatError, match="listed.yaml.*unsupported distortion model \\['plumb_bob'\\]"):
+        load_intrinsics(tmp_path / "listed.yaml")
 
 
 @pytest.mark.parametrize("fmt", ["opencv", "ros"])
