@@ -7,6 +7,8 @@ normal window class on a desktop); the panes show the returned images. Multisamp
 
 from __future__ import annotations
 
+import threading
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -63,8 +65,15 @@ class PickResult:
     distance_px: float
 
 
+GL_TURNS = threading.RLock()
+"""Every render, read-back and context of the process takes its turn here: OpenGL through OSMesa and VTK's GL state are
+shared by the process, and two renders at once on two threads (the simulated camera's worker and the window's
+overview) crashed the window (a segmentation fault inside both ``Render`` calls)."""
+
+
 class SceneRenderer:
-    """Renders a set of scene items offscreen. Not thread-safe: use from one thread."""
+    """Renders a set of scene items offscreen. One object is used from one thread; objects on several threads take turns
+    at the GL (:data:`GL_TURNS`)."""
 
     def __init__(self, width: int = 640, height: int = 480):
         self.window = vtk.vtkRenderWindow()
@@ -264,12 +273,13 @@ class SceneRenderer:
         """The image (h, w, 3) uint8 RGB (RGBA with a transparent background) seen by the
         calibrated camera at ``cam2world`` (4, 4, mm, OpenCV axes), without lens distortion."""
         options = options or RenderOptions()
-        self.window.SetSize(intrinsics.width, intrinsics.height)
-        self._style(options)
-        set_vtk_camera(self.renderer.GetActiveCamera(), intrinsics, cam2world)
-        self.window.Render()
-        self._last = (intrinsics, np.asarray(cam2world, dtype=float))
-        return self._read_back(options.transparent_background)
+        with GL_TURNS:
+            self.window.SetSize(intrinsics.width, intrinsics.height)
+            self._style(options)
+            set_vtk_camera(self.renderer.GetActiveCamera(), intrinsics, cam2world)
+            self.window.Render()
+            self._last = (intrinsics, np.asarray(cam2world, dtype=float))
+            return self._read_back(options.transparent_background)
 
     def render_overview(
         self,
@@ -284,28 +294,30 @@ class SceneRenderer:
     ) -> np.ndarray:
         """The image (h, w, 3) uint8 from an ordinary perspective camera at ``eye_mm`` looking at ``target_mm``."""
         options = options or RenderOptions()
-        self.window.SetSize(width, height)
-        self._style(options)
-        cam = self.renderer.GetActiveCamera()
-        cam.SetUseExplicitProjectionTransformMatrix(False)
-        cam.SetPosition(*eye_mm)
-        cam.SetFocalPoint(*target_mm)
-        cam.SetViewUp(*up)
-        cam.SetViewAngle(view_angle_deg)
-        cam.SetWindowCenter(0.0, 0.0)
-        self.renderer.ResetCameraClippingRange()
-        self.window.Render()
-        self._last = None
-        return self._read_back(options.transparent_background)
+        with GL_TURNS:
+            self.window.SetSize(width, height)
+            self._style(options)
+            cam = self.renderer.GetActiveCamera()
+            cam.SetUseExplicitProjectionTransformMatrix(False)
+            cam.SetPosition(*eye_mm)
+            cam.SetFocalPoint(*target_mm)
+            cam.SetViewUp(*up)
+            cam.SetViewAngle(view_angle_deg)
+            cam.SetWindowCenter(0.0, 0.0)
+            self.renderer.ResetCameraClippingRange()
+            self.window.Render()
+            self._last = None
+            return self._read_back(options.transparent_background)
 
     def depth_mm(self) -> np.ndarray:
         """Camera-frame depth Z (h, w) mm of the last virtual-camera render; inf on the background."""
         if self._last is None:
             raise RuntimeError("depth is available after render_view only")
         w, h = self.window.GetSize()
-        self.window.MakeCurrent()  # several render windows share the thread: read this one's buffers
         z = vtk.vtkFloatArray()
-        self.window.GetZbufferData(0, 0, w - 1, h - 1, z)
+        with GL_TURNS:
+            self.window.MakeCurrent()  # several render windows share the thread: read this one's buffers
+            self.window.GetZbufferData(0, 0, w - 1, h - 1, z)
         zbuf = numpy_support.vtk_to_numpy(z).reshape(h, w)[::-1]
         return depth_from_zbuffer(zbuf)
 
@@ -337,14 +349,15 @@ class SceneRenderer:
 
     def _ray_hit(self, u: float, v: float) -> tuple[str | None, np.ndarray | None]:
         _, h = self.window.GetSize()
-        self.window.MakeCurrent()
         picker = vtk.vtkCellPicker()
         picker.SetTolerance(0.0)
         for actor in self._actors.values():
             picker.AddPickList(actor.surface)
         picker.PickFromListOn()
-        if not picker.Pick(u + 0.5, h - (v + 0.5), 0.0, self.renderer):
-            return None, None
+        with GL_TURNS:
+            self.window.MakeCurrent()
+            if not picker.Pick(u + 0.5, h - (v + 0.5), 0.0, self.renderer):
+                return None, None
         hit = picker.GetActor()
         name = next((n for n, a in self._actors.items() if a.surface is hit), None)
         return name, np.array(picker.GetPickPosition())
@@ -384,4 +397,5 @@ class SceneRenderer:
         return PickResult(item.name, point, apply(item.item2world, point), feature, d)
 
     def close(self) -> None:
-        self.window.Finalize()
+        with GL_TURNS:
+            self.window.Finalize()
