@@ -48,6 +48,7 @@ from calib_core.connectors.joint_map import JointMap
 from calib_core.connectors.link_types import LinkError, LinkState, LinkStats, MoveError, MoveHandle, TimedSample
 from calib_core.connectors.link_types import JointSample
 from calib_core.link.sample_order import SampleOrder
+from calib_core.ros2.joint_names import foreign_joints_text
 from calib_core.ros2.joint_units import user_per_si
 
 DEFAULT_CONTROLLER = "joint_trajectory_controller"
@@ -408,32 +409,3 @@ class Ros2TrajectoryController(ConnectorEvents):
 def open_ros2(url: str, context: ControllerContext) -> Ros2TrajectoryController:
     """Entry point of ``videocal.controllers`` for ``ros2://``."""
     return Ros2TrajectoryController(url, context)
-
-
-def foreign_joints_text(topic: str, received: list[str], wanted: list[str]) -> str:
-    """What to tell a user whose joint states name other joints than the cell's robot: which names came, which are
-    missing, and the renaming that would match them when one does (a prefix the driver adds, say)."""
-    missing = [n for n in wanted if n not in received]
-    text = (
-        f"{topic} arrives without this cell's joints: it names {', '.join(received[:8]) or 'no joint'}"
-        f"{' ...' if len(received) > 8 else ''}; missing {', '.join(missing[:6])}{' ...' if len(missing) > 6 else ''}"
-    )
-    mapping = suggest_joint_names(wanted, received)
-    if mapping:
-        pairs = ", ".join(f"{a} -> {b}" for a, b in list(mapping.items())[:3])
-        text += f"; they look like this robot's with other names ({pairs}{' ...' if len(mapping) > 3 else ''}): use the driver's URDF for the cell"
-    else:
-        text += ": is this the cell's robot (another arm, a gripper's group)?"
-    return text
-
-
-def suggest_joint_names(wanted: list[str], received: list[str]) -> dict[str, str] | None:
-    """Each wanted joint's received name when every one is found by a name that ends with it or that it ends with
-    (``ur10e_shoulder_pan_joint`` for ``shoulder_pan_joint``), one to one; else None."""
-    found = {}
-    for name in wanted:
-        matches = [r for r in received if r != name and (r.endswith(name) or name.endswith(r))]
-        if len(matches) != 1:
-            return None
-        found[name] = matches[0]
-    return found if len(set(found.values())) == len(found) else None

@@ -354,7 +354,7 @@ def test_dds_type_names_read_as_ros_names():
 
 
 def test_a_renaming_is_suggested_only_when_it_is_one_to_one():
-    from calib_core.ros2.trajectory_connector import suggest_joint_names
+    from calib_core.ros2.joint_names import suggest_joint_names
 
     assert suggest_joint_names(["a_joint", "b_joint"], ["left_a_joint", "left_b_joint"]) == {
         "a_joint": "left_a_joint",
