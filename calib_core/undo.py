@@ -22,9 +22,11 @@ class Command:
 
 
 class UndoStack:
-    """Executes commands and keeps them for undo and redo. Event: ``changed()`` after every push,
-    undo, redo or clear."""
+    """Executes commands and keeps them for undo and redo. Events (psygnal): ``applied(command)`` after a command
+    was done, undone or redone (its effects in place: whoever keeps other state in step with an edit listens here);
+    ``changed()`` after every push, undo, redo or clear."""
 
+    applied = Signal(object)
     changed = Signal()
 
     def __init__(self, limit: int = 500):
@@ -39,6 +41,7 @@ class UndoStack:
         """Do ``command`` and record it (clears the redo history). A command the last one can
         :meth:`~Command.merge` (the same spin box turned again) joins it as one undo step."""
         command.do()
+        self.applied.emit(command)
         if self._done and not self._undone and self._done[-1].merge(command):
             self._changed()
             return
@@ -53,6 +56,7 @@ class UndoStack:
             return None
         command = self._done.pop()
         command.undo()
+        self.applied.emit(command)
         self._undone.append(command)
         self._changed()
         return command.label
@@ -62,6 +66,7 @@ class UndoStack:
             return None
         command = self._undone.pop()
         command.do()
+        self.applied.emit(command)
         self._done.append(command)
         self._changed()
         return command.label

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from calib_core.calibration.session import ConfirmationNeeded
+from calib_core.calibration.errors import ConfirmationNeeded
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.connectors.link_types import TimedSample
@@ -79,7 +79,7 @@ def main() -> None:
                 core.pick_image_point(true_pixel + rng.normal(0, 0.3, 2))  # an operator's click, 0.3 px off
                 core.accept_pair()
             elif kind == "solve":
-                core.session.robust = arg
+                core.session.options.robust = arg
                 core.calibrate()
             elif kind == "store":
                 try:

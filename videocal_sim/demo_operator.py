@@ -289,7 +289,7 @@ def run_demo(
                     )
                 _click(dialog.accept_button, 10, 10)
                 _click(win.commands.calibrate, 10, 10)
-            _wait(app, lambda: wb.session.result is not None, 30, "the solve")
+            _wait(app, lambda: wb.session.result.estimate is not None, 30, "the solve")
             shot(f"{round_name}_calibrated")
             store()
 
@@ -351,7 +351,7 @@ def run_demo(
                 )
             shot(f"{round_name}_pairs_picked")
             _click(win.commands.calibrate, 10, 10)
-            _wait(app, lambda: wb.session.result is not None, 30, "the solve")
+            _wait(app, lambda: wb.session.result.estimate is not None, 30, "the solve")
             shot(f"{round_name}_calibrated")
             store()
 
@@ -364,7 +364,7 @@ def run_demo(
         shot("at_task")
         q_first = wb.joints_deg.copy()
         pick_and_calibrate("first")
-        first = wb.session.result
+        first = wb.session.result.estimate
         go(win.commands.go_corrected)
         once = wb.session.corrections.corrected_target(task.name, task.tcp2base)
         _wait(app, lambda: at(once), 60, "the robot at the corrected task location", where(once))
@@ -375,7 +375,7 @@ def run_demo(
         corrected = wb.session.corrections.corrected_target(task.name, task.tcp2base)
         _wait(app, lambda: at(corrected), 60, "the robot at the twice-corrected task location", where(corrected))
         shot("at_corrected_task")
-        r = wb.session.result
+        r = wb.session.result.estimate
         d_true, r_true = pose_difference(bed.true_robot.fk(q_measured), bed.model_robot.fk(q_measured))
         d_first, r_first = pose_difference(bed.true_robot.fk(q_first), bed.model_robot.fk(q_first))
         miss_d, miss_r = pose_difference(bed.true_robot.fk(wb.joints_deg), task.tcp2base)

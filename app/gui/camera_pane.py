@@ -110,7 +110,7 @@ class CameraPane(QWidget):
         observations.frame_observed.connect(self.show_frame)
         observations.still_changed.connect(self._still_changed)
         session.pairs.changed.connect(lambda *_: self.refresh_overlay())
-        session.changed.connect(self._on_solved)
+        session.result.changed.connect(self._on_solved)
         arm.joints_changed.connect(self._joints_changed)
         cell.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.cell.intrinsics))
         finder.points_found.connect(self._points_found)
@@ -238,14 +238,14 @@ class CameraPane(QWidget):
     def _on_solved(self) -> None:
         # The reprojected points and residuals are drawn at once; the CAD edges take a render, so they
         # follow on the next turn of the event loop, after that repaint.
-        if self.session.result is None:
+        if self.session.result.estimate is None:
             self._edges_image = None
         else:
             QTimer.singleShot(0, self._draw_solved_edges)
         self.refresh_overlay()
 
     def _draw_solved_edges(self) -> None:
-        r = self.session.result
+        r = self.session.result.estimate
         if r is None:
             return
         self.set_edges_image(
@@ -270,7 +270,7 @@ class CameraPane(QWidget):
 
     def _state_key(self) -> tuple:
         session = self.session
-        context = session.context
+        context = session.result.context
         pairs = tuple(
             p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None
         )
@@ -298,7 +298,7 @@ class CameraPane(QWidget):
             banner.append(
                 f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)"
             )
-        result = session.result
+        result = session.result.estimate
         stale = session.stale_reason
         if result is not None and not result_current:
             banner.append("the last result was solved at another robot pose: not drawn")
@@ -332,7 +332,7 @@ class CameraPane(QWidget):
 
     def _draw_result(self, overlay: Overlay, session, result) -> None:
         obj2cam = concat(result.obj2world, invert(result.cam2world_measured))
-        used = set(session.solved_numbers)
+        used = set(session.result.solved_numbers)
         for pair in session.pairs:
             if pair.pixel is None or pair.number not in used:
                 continue
@@ -347,7 +347,7 @@ class CameraPane(QWidget):
         if len(candidates) > 1:
             # Ghosts of the other poses that fit as well, so the operator can tell them apart.
             for k, candidate in enumerate(candidates):
-                if k == session.chosen_candidate:
+                if k == session.result.chosen_candidate:
                     continue
                 for pair in session.pairs:
                     p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])

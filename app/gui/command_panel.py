@@ -172,7 +172,7 @@ class CommandPanel(QTabWidget):
         self.target.currentTextChanged.connect(lambda name: run(self.session.set_target, name))
         self.estimate_focal.toggled.connect(lambda on: run(self.session.set_option, "estimate_focal", on))
         self.robust.toggled.connect(lambda on: run(self.session.set_option, "robust", on))
-        self.session.option_changed.connect(self.show_option)  # an undo sets the box back
+        self.session.options.changed.connect(self.show_option)  # an undo sets the box back
 
         def task_chosen(name: str) -> None:
             if name:

@@ -111,7 +111,8 @@ class OverviewPane(QWidget):
         self._shown_joints: np.ndarray | None = None  # the animation's joints now shown, or None: the robot's
         self._path_timer = QTimer(self)
         self._path_timer.timeout.connect(self._path_step)
-        session.changed.connect(self.mark_dirty)
+        session.result.changed.connect(self.mark_dirty)
+        session.target_changed.connect(self.mark_dirty)
         cell.scene_changed.connect(self.mark_dirty)
         cell.camera_model_changed.connect(self.mark_dirty)
         session.pairs.changed.connect(lambda *_: self.mark_dirty())
@@ -271,10 +272,10 @@ class OverviewPane(QWidget):
         ]
         if self.preview is not None and self.preview.tcp_path_mm is not None and len(self.preview.tcp_path_mm) > 1:
             lines.append((self.preview.tcp_path_mm, (1.0, 0.7, 0.3)))
-        if self.session.result is not None:
+        if self.session.result.estimate is not None:
             lines.append(
                 (
-                    frustum_polyline(self.cell.intrinsics, self.session.result.cam2world_measured, 300.0),
+                    frustum_polyline(self.cell.intrinsics, self.session.result.estimate.cam2world_measured, 300.0),
                     MEASURED_FRUSTUM,
                 )
             )

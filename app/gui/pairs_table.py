@@ -26,7 +26,7 @@ class PairsTable(QTableWidget):
         self._updating = False
         self.itemChanged.connect(self._on_item_changed)
         session.pairs.changed.connect(lambda *_: self.refresh())
-        session.changed.connect(self.refresh)
+        session.result.changed.connect(self.refresh)
 
     def selected_number(self) -> int | None:
         rows = self.selectionModel().selectedRows()
@@ -44,23 +44,23 @@ class PairsTable(QTableWidget):
                 return
 
     def _residuals(self) -> dict[int, float]:
-        result = self.session.result
+        result = self.session.result.estimate
         if result is None:
             return {}
-        numbers = self.session.solved_numbers
+        numbers = self.session.result.solved_numbers
         norms = result.solution.residual_norms_px
         return {n: float(r) for n, r in zip(numbers, norms)}
 
     def _suspects(self) -> set[int]:
         """The pairs the last solve rejected or found not to fit the others (drawn red, with why)."""
-        result = self.session.result
+        result = self.session.result.estimate
         if result is None:
             return set()
         s = result.solution
         flags = np.asarray(s.outliers, dtype=bool) | (
             np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False
         )
-        return {n for n, f in zip(self.session.solved_numbers, flags) if f}
+        return {n for n, f in zip(self.session.result.solved_numbers, flags) if f}
 
     def refresh(self) -> None:
         self._updating = True

@@ -93,15 +93,15 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.details)
         layout.addLayout(self.candidates)
         layout.addWidget(self.chart, 1)
-        session.changed.connect(self.refresh)
+        session.result.changed.connect(self.refresh)
         session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
         self._elsewhere = False
         arm.joints_changed.connect(self._joints_changed)
 
     def _solved_elsewhere(self) -> bool:
         """The last result was solved from another robot pose than the robot's now."""
-        context = self.session.context
-        if context is None or context.joints_deg is None or self.session.result is None:
+        context = self.session.result.context
+        if context is None or context.joints_deg is None or self.session.result.estimate is None:
             return False
         now = np.asarray(self.arm.joints_deg, float)
         return context.joints_deg.shape != now.shape or float(np.max(np.abs(context.joints_deg - now))) > SAME_STATE_DEG
@@ -138,19 +138,21 @@ class ResultsPanel(QWidget):
 
     def refresh(self) -> None:
         session = self.session
-        r = session.result
+        r = session.result.estimate
         while self.candidates.count():
             w = self.candidates.takeAt(0).widget()
             if w is not None:
                 w.deleteLater()
         if r is None:
-            self.verdict.setText("No solve yet. Pick at least %d pairs, then Calibrate." % session.required_pairs)
+            self.verdict.setText(
+                "No solve yet. Pick at least %d pairs, then Calibrate." % session.options.required_pairs
+            )
             self._fit_text()
             self.details.setText("")
             self.chart.set_values([])
             return
         sol = r.solution
-        verdict = session.verdict
+        verdict = session.result.verdict
         stale = session.stale_reason
         if stale:
             text = (
@@ -186,7 +188,7 @@ class ResultsPanel(QWidget):
             "</table>"
         )
         self._fit_text()
-        numbers = session.solved_numbers
+        numbers = session.result.solved_numbers
         present = {p.number for p in session.pairs.usable()}
         # bars only for pairs that still exist as they were solved; a stale result shows none
         bars = (
@@ -206,6 +208,6 @@ class ResultsPanel(QWidget):
                 )
                 button.setObjectName(f"candidate_{i}")
                 button.setCheckable(True)
-                button.setChecked(i == session.chosen_candidate)
+                button.setChecked(i == session.result.chosen_candidate)
                 button.clicked.connect(functools.partial(self._choose, i))
                 self.candidates.addWidget(button)

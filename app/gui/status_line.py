@@ -46,7 +46,8 @@ class StatusLine:
         workbench.arm.link_state.connect(self.show_link_state)
         for signal in (
             workbench.session.pairs.changed,
-            workbench.session.changed,
+            workbench.session.result.changed,
+            workbench.session.target_changed,
         ):  # pairs change outside the undo stack too
             signal.connect(self.show_pairs)
         self.show_pairs()
@@ -125,7 +126,7 @@ class StatusLine:
 
     def show_pairs(self, *_) -> None:
         session = self.workbench.session
-        self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.required_pairs} needed")
+        self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.options.required_pairs} needed")
 
     def show_link_state(self, text: str) -> None:
         self.link_label.setText(

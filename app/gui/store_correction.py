@@ -11,7 +11,7 @@ from PySide6.QtWidgets import QWidget
 
 from app.gui.confirm import ask, ask_choice
 from calib_core.calibration.look_place import LookNotAtTask
-from calib_core.calibration.session import ConfirmationNeeded
+from calib_core.calibration.errors import ConfirmationNeeded
 
 
 def _who() -> str:

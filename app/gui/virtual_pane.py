@@ -56,7 +56,7 @@ class VirtualPane(QWidget):
         self.intrinsics = cell.intrinsics.without_distortion().scaled(RENDER_SCALE)
         self.view.clicked.connect(self._on_click)
         session.pairs.changed.connect(lambda *_: self.refresh())
-        session.changed.connect(self.refresh)
+        session.target_changed.connect(self.refresh)
         cell.camera_model_changed.connect(self._camera_model_changed)
         cell.scene_changed.connect(self.refresh)
         self._last_joints = None

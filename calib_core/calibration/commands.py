@@ -6,7 +6,6 @@ from dataclasses import replace
 
 from calib_core.calibration.correspondences import Correspondence, CorrespondenceSet, with_pixel
 from calib_core.undo import Command
-from calib_core.errors import OperatorError
 
 
 class AddPoint3D(Command):
@@ -86,31 +85,6 @@ class ClearPairs(Command):
 
     def undo(self) -> None:
         self.pairs._reset(self.old)
-
-
-class SetTaskApproach(Command):
-    """Change a task location's approach distance (mm back along the tool's z axis)."""
-
-    def __init__(self, task_locations: dict, name: str, approach_mm: float, on_change=None):
-        if approach_mm < 0:
-            raise OperatorError(f"the approach of {name} must be >= 0 mm, got {approach_mm}")
-        self.tasks = task_locations
-        self.name = name
-        self.new = float(approach_mm)
-        self.old = float(task_locations[name].approach_mm)
-        self.on_change = on_change
-        self.label = f"Approach of {name} {self.old:g} -> {self.new:g} mm"
-
-    def _set(self, value: float) -> None:
-        self.tasks[self.name] = replace(self.tasks[self.name], approach_mm=value)
-        if self.on_change is not None:
-            self.on_change(self.name)
-
-    def do(self) -> None:
-        self._set(self.new)
-
-    def undo(self) -> None:
-        self._set(self.old)
 
 
 class AddPairs(Command):

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from calib_core.frames import concat, invert
+from calib_core.undo import Command
 
 
 @dataclass(frozen=True)
@@ -101,3 +102,17 @@ class CorrectionTable:
         ``Δ^-1 @ target``, with ``Δ`` the latest correction (the target itself when there is none)."""
         c = self.latest(task)
         return target2base.copy() if c is None else concat(target2base, invert(c.delta_base))
+
+
+class StoreCorrection(Command):
+    """Store ``correction`` in ``table``; undo takes it away again."""
+
+    def __init__(self, table: CorrectionTable, correction: Correction):
+        self.table, self.correction = table, correction
+        self.label = f"Store {correction.kind} for {correction.task}"
+
+    def do(self) -> None:
+        self.table.add(self.correction)
+
+    def undo(self) -> None:
+        self.table.remove_last(self.correction.task)

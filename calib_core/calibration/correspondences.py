@@ -124,6 +124,12 @@ class CorrespondenceSet:
         pairs shown at an instant of its replay. Operator edits go through the commands instead."""
         self._reset(pairs)
 
+    def open(self, pairs: list[Correspondence]) -> None:
+        """A saved set in place of this one (a workspace opened), outside the undo stack; new pairs are numbered
+        on from its highest."""
+        self._next_number = 1
+        self._reset(pairs)
+
     def _reset(self, pairs: list[Correspondence]) -> list[Correspondence]:
         old, self._pairs = self._pairs, list(pairs)
         # New pairs are numbered after every pair ever shown: a pick in a replay's branch once took

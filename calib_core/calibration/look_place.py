@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.frames import pose_difference
 
 LEVER_MM = 100.0

@@ -16,10 +16,9 @@ from collections.abc import Callable
 import numpy as np
 from psygnal import Signal
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.connectors.controller import ControllerConnector, ControllerContext
 from calib_core.connectors.registry import open_controller
-from calib_core.link.joint_history import ControllerClock
 from calib_core.connectors.link_types import LinkState, MoveHandle, TimedSample
 from calib_core.operator.cell import Cell
 from calib_core.operator.motion import Motion, MotionState, ended
@@ -58,7 +57,7 @@ class Arm:
         self.joints_deg = cell.home_joints
         """The joints the views show (model joints, deg/mm): the newest sample's, or a replay's."""
         self.state = MotionState()
-        self.controller_clock = ControllerClock()
+        self.controller_clock = observations.live_clock
         """Stamps each joint sample with its controller time on the host clock (not its arrival)."""
         self.last_sample_s: float | None = None  # host monotonic s
         self.last_move_sent_s: float | None = None  # host monotonic s: frames from before it show the old pose

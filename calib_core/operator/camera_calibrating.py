@@ -16,7 +16,7 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.errors import OperatorError
 from calib_core.frames import concat, invert, pose_difference
 from calib_core.operator.arm import Arm

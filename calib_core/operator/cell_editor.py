@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.calibration.commands import SetTaskApproach
 from calib_core.calibration.session import CalibrationSession
 from calib_core.errors import OperatorError
 from calib_core.frames import transform_from_xyz_rpy
@@ -25,7 +24,9 @@ from calib_core.workcell.edits import (
     AddComponent,
     AddFeature,
     AddTaskLocation,
+    CellEdit,
     PlaceComponent,
+    SetTaskApproach,
     check_name,
     load_component_mesh,
 )
@@ -39,12 +40,15 @@ class CellEditor:
     def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, arm: Arm, log: OperatorLog):
         self.cell, self.session, self.tasks, self.arm, self.log = cell, session, tasks, arm, log
         self.dirty = False
+        session.undo.applied.connect(self._applied)
 
-    def _edited(self, kind: str, name: str) -> None:
+    def _applied(self, command) -> None:
+        if not isinstance(command, CellEdit):
+            return
         self.cell.refresh_identity()
         self.dirty = True
-        if kind == "task":
-            self.tasks.edited(name)
+        if command.kind == "task":
+            self.tasks.edited(command.name)
         else:
             self.cell.scene_edited()
 
@@ -52,7 +56,7 @@ class CellEditor:
         """Edit a task location's approach distance (mm): an undoable edit."""
         if abs(self.cell.workcell.task(name).approach_mm - approach_mm) < 1e-9:
             return
-        self.session.undo.push(SetTaskApproach(self.cell.workcell.task_locations, name, approach_mm, self.tasks.edited))
+        self.session.undo.push(SetTaskApproach(self.cell.workcell, name, approach_mm))
 
     def add_task_location(
         self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None
@@ -65,7 +69,7 @@ class CellEditor:
             float(approach_mm),
             component or self.session.target,
         )
-        self.session.undo.push(AddTaskLocation(self.cell.workcell, task, self._edited))
+        self.session.undo.push(AddTaskLocation(self.cell.workcell, task))
         return task
 
     def add_component(
@@ -89,14 +93,12 @@ class CellEditor:
             else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
         )
         item = SceneItem(name, mesh, placement, tuple(float(c) for c in color), kind, {})
-        self.session.undo.push(AddComponent(self.cell.workcell, item, mesh_file, units, self._edited))
+        self.session.undo.push(AddComponent(self.cell.workcell, item, mesh_file, units))
 
     def place_component(self, name: str, xyz_mm, rpy_deg) -> None:
         """Place a component by numbers (its surveyed placement: mm, deg, in base). Successive
         placements of one component are one undo step."""
-        self.session.undo.push(
-            PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg), self._edited)
-        )
+        self.session.undo.push(PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg)))
 
     def snap_feature(self, component: str, point_component_mm, radius_mm: float) -> Snap:
         """Where a click on ``component`` defines a feature (circle centre, corner, vertex or the surface point)."""
@@ -104,7 +106,7 @@ class CellEditor:
 
     def add_feature(self, component: str, name: str, point_component_mm) -> None:
         """A named feature ``point_component_mm`` (3,) in the component's frame. Undoable."""
-        self.session.undo.push(AddFeature(self.cell.workcell, component, name, point_component_mm, self._edited))
+        self.session.undo.push(AddFeature(self.cell.workcell, component, name, point_component_mm))
 
     def save(self, path=None):
         """Write the edited cell back into its workcell YAML (comments and untouched entries kept)."""

@@ -18,7 +18,8 @@ from collections.abc import Callable
 import numpy as np
 from psygnal import Signal
 
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
 from calib_core.link.joint_history import JointHistory
@@ -79,13 +80,13 @@ class OperatorCore:
             self.session.pairs.changed,
             self.session.corrections.changed,
             self.session.undo.changed,
-            self.session.changed,
+            self.session.result.changed,
+            self.session.target_changed,
             self.tasks.changed,
         ):
             signal.connect(self._count_change)
         self.observations = Observations(
-            JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names),
-            margin_s=lambda: self.arm.controller_clock.spread_s,
+            JointHistory(rule=self.workcell.safety.settle_rule, joint_names=self.robot.joint_names)
         )
         """The frames (live, or a recording's while it is replayed), the held one, and the joint history
         that stamps them."""
@@ -263,7 +264,7 @@ class OperatorCore:
             self._judge_by_the_task()  # the task's tolerance is part of the verdict
 
     def _judge_by_the_task(self) -> None:
-        self.session.judge_by(self.workcell.safety, self.task.tolerance_mm if self.task is not None else None)
+        self.session.result.judge_by(self.workcell.safety, self.task.tolerance_mm if self.task is not None else None)
 
     def undo(self) -> str | None:
         """Undo the last edit (its label, None if there was none); the pair being made is let go."""

@@ -13,7 +13,8 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.calibration.look_place import LookNotAtTask, LookPlace, place_of_look
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.calibration.verification import Verification, verify
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.frames import concat, invert, pose_difference
@@ -58,7 +59,7 @@ class CorrectionDesk:
     def look_place(self) -> LookPlace | None:
         """Where the last result's look was made against the chosen task location (``None`` before a
         solve, without a task location or for a look that carries no robot pose)."""
-        context = self.session.context
+        context = self.session.result.context
         if self.task is None or context is None or context.joints_deg is None:
             return None
         corrected = None
@@ -75,7 +76,7 @@ class CorrectionDesk:
         measured tool (:meth:`~calib_core.operator.tool_measuring.ToolMeasuring.measure_tool`) its covariance is in the stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        if self.session.result is None:
+        if self.session.result.estimate is None:
             raise CalibrationError("calibrate first")
         if self.session.stale_reason:  # said first: a look that changed since is no look at all
             raise CalibrationError(f"the result is from an earlier state ({self.session.stale_reason}); nothing stored")
@@ -86,7 +87,7 @@ class CorrectionDesk:
             )
         if not place.counts and not convert.strip():
             raise LookNotAtTask(place, *self._conversion_change())
-        tool, context = self.robot_calibration.measured_tool, self.session.context
+        tool, context = self.robot_calibration.measured_tool, self.session.result.context
         tool_covariance = None
         if tool is not None and context.joints_deg is not None:
             tool_covariance = tool.covariance_in_base(self.cell.robot.fk(context.joints_deg, "camera"))
@@ -97,7 +98,7 @@ class CorrectionDesk:
             self.task.name,
             source,
             confirmation=confirmation,
-            fused=self.robot_calibration.look_fused_with_robot(self.session.result),
+            fused=self.robot_calibration.look_fused_with_robot(self.session.result.estimate),
             tool_covariance=tool_covariance,
         )
         if not place.counts:
@@ -132,7 +133,7 @@ class CorrectionDesk:
 
     def _conversion_change(self) -> tuple[float, float]:
         """How far the target commanded for the task would move (mm, deg) if the last result became its correction."""
-        r, task = self.session.result, self.task
+        r, task = self.session.result.estimate, self.task
         now = self.session.corrections.corrected_target(task.name, task.tcp2base)
         delta = concat(
             invert(r.tcp2base_model), r.tcp2base_measured

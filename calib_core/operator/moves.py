@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.connectors.link_types import MoveHandle
 from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell

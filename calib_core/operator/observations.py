@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 
@@ -19,7 +18,7 @@ from psygnal import Signal
 
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
-from calib_core.link.joint_history import JointHistory, Stillness
+from calib_core.link.joint_history import ControllerClock, JointHistory, Stillness
 from calib_core.connectors.frame import Frame
 
 
@@ -56,13 +55,14 @@ class Observations:
     still_changed = Signal(object)
     source_changed = Signal(str)
 
-    def __init__(self, live_history: JointHistory, margin_s: Callable[[], float] = lambda: 0.0):
+    def __init__(self, live_history: JointHistory, live_clock: ControllerClock | None = None):
         self.live_history = live_history
         """The link's joints in time: written by every joint sample, replay or not."""
-        self._live_margin_s = margin_s
+        self.live_clock = live_clock or ControllerClock()
+        """Stamps the link's joint samples with their controller time; its spread is how much older than its stamp
+        a live frame's content may be on the joints' time base."""
         self.history = live_history
-        self.margin_s = margin_s
-        """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread."""
+        self._clock: ControllerClock | None = self.live_clock
         self.source = "live"
         self.latest: Frame | None = None
         self._recent: deque[Frame] = deque()
@@ -84,7 +84,7 @@ class Observations:
         # than the frame, and a fixed count of frames at a high rate would all be waiting at once.
         self._recent.append(frame)
         self._recent_bytes += frame.image.nbytes
-        window_s = 2.0 * self.margin_s() + 0.5
+        window_s = 2.0 * self.margin_s + 0.5
         while len(self._recent) > RECENT_FRAMES:
             oldest = self._recent[0]
             if frame.t_host_s - oldest.t_host_s <= window_s and self._recent_bytes <= RECENT_BYTES:
@@ -95,16 +95,22 @@ class Observations:
     def replay(self, history: JointHistory, name: str) -> None:
         """A recording ``name`` stands in for the live source: its frames, stamped by its ``history``
         (on the recording's time axis, which has no link spread)."""
-        self._switch(history, name, lambda: 0.0)
+        self._switch(history, name, None)
 
     def go_live(self) -> None:
         """Back to the camera and the link's joints. Frames seen before the replay are not kept: their
         joints are minutes old by now."""
-        self._switch(self.live_history, "live", self._live_margin_s)
+        self._switch(self.live_history, "live", self.live_clock)
 
-    def _switch(self, history: JointHistory, source: str, margin_s: Callable[[], float]) -> None:
+    @property
+    def margin_s(self) -> float:
+        """How much older than its stamp a frame's content may be on the joints' time base (s): the link's spread
+        (none for a recording's frames, stamped on the recording's own time axis)."""
+        return 0.0 if self._clock is None else self._clock.spread_s
+
+    def _switch(self, history: JointHistory, source: str, clock: ControllerClock | None) -> None:
         self.release()
-        self.history, self.source, self.margin_s = history, source, margin_s
+        self.history, self.source, self._clock = history, source, clock
         self.latest = None
         self._recent.clear()
         self._recent_bytes = 0
@@ -114,7 +120,7 @@ class Observations:
         return self.stillness_at(frame.t_host_s)
 
     def stillness_at(self, t_s: float) -> Stillness:
-        return self.history.stillness(t_s, self.margin_s())
+        return self.history.stillness(t_s, self.margin_s)
 
     def stamp(self, frame: Frame) -> ViewStamp:
         """The frame's stamp; :class:`NotSettledError` when the robot was not still before it or

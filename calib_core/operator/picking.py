@@ -15,7 +15,8 @@ import time
 import numpy as np
 from psygnal import Signal
 
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert

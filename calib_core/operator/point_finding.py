@@ -16,7 +16,8 @@ import numpy as np
 from psygnal import Signal
 
 from calib_core.calibration.commands import AddPairs
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
@@ -124,7 +125,6 @@ class PointFinding:
             prior=concat(item.item2world, invert(cam2world_model)),
         )
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
-        self.session.last_solve_inputs = inputs
         self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
         estimate = self.session.show_result(
@@ -139,6 +139,7 @@ class PointFinding:
             view_sources=(found.view.source,),
             label="Calibrate on edges",
             form_tolerance_mm=item.form_tolerance_mm,
+            inputs=inputs,
         )
         self.solved.emit()
         return estimate

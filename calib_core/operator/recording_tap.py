@@ -126,7 +126,7 @@ class RecordingTap:
         self.recorder.record_event(kind, **detail)
 
     def _solved(self) -> None:
-        core, result = self.core, self.core.session.result
+        core, result = self.core, self.core.session.result.estimate
         context = {
             "obj2world": core.workcell.component(core.session.target).item2world,
             "cam2world_model": result.cam2world_model,
@@ -134,7 +134,7 @@ class RecordingTap:
             "joints_deg": core.joints_deg,
             "target": core.session.target,
         }
-        inputs = core.session.last_solve_inputs
+        inputs = core.session.result.inputs
         self.recorder.record_solve(inputs, result.solution.to_dict(), context=context)
         if result.solution.method == "edges":  # no pairs to draw reprojections of
             self._reprojected = None

@@ -85,7 +85,7 @@ class Replaying:
         self._close_playback()
         if self.playback is None:
             s = self.session
-            self._live_state = (s.pairs.pairs(), s.result_snapshot(), self.cell.intrinsics)
+            self._live_state = (s.pairs.pairs(), s.result.solved, self.cell.intrinsics)
         # Picks and solves on the recorded frames need the camera they were recorded with.
         if recorded_intrinsics is not None:
             self.cell.use_intrinsics(recorded_intrinsics)
@@ -127,7 +127,7 @@ class Replaying:
 
             def restore():
                 self.session.pairs.replace_all(pairs)
-                self.session.restore_result(result)
+                self.session.result.show(result)
                 self.session.undo.clear()
 
             self._as_replay(restore)
@@ -200,7 +200,7 @@ class Replaying:
             s.pairs.replace_all(pairs)
         solve = pb.solve_at(t_s)
         if solve is None and self._shown_solve is not None:
-            s.clear_result()
+            s.result.clear()
         elif solve is not None and solve.id != self._shown_solve:
             self._show_solve(solve)
         self._shown_solve = None if solve is None else solve.id

@@ -160,7 +160,7 @@ class RobotCalibrating:
         component placed to the survey's sigma); ``None`` without an applied robot calibration or a
         look without covariance."""
         result = self.applied_robot_calibration
-        context = self.session.context
+        context = self.session.result.context
         if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
             return None
         from calib_core.calibration.look_fusion import fuse_look, tcp_covariance_from_camera

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.operator.cell import Cell
 from calib_core.operator.operator_log import OperatorLog
 
@@ -74,8 +75,7 @@ class WorkspaceFiles:
         self.cell.workcell.task_locations.update(ws.task_locations)
         if ws.target:
             self.session.set_target(ws.target)
-        self.session.pairs.replace_all(ws.pairs)
-        self.session.pairs._next_number = max([p.number for p in ws.pairs], default=0) + 1
+        self.session.pairs.open(ws.pairs)
         self.session.corrections.replace_with(ws.corrections)
         self.session.undo.clear()
         self.log.say(

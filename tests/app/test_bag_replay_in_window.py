@@ -88,7 +88,7 @@ def test_a_bag_replays_in_the_window_and_a_look_is_solved_on_it(qtbot, window, a
     pick_all(wb, bed, joints[2])
     assert all(np.allclose(p.view.joints_deg, joints[2], atol=0.05) for p in wb.session.pairs)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    result = wb.session.result
+    result = wb.session.result.estimate
     assert result is not None and result.solution.rms_px < 0.5, win.results.status.text()
     true_cam = bed.true_cam2world(joints[2])
     assert np.linalg.norm(result.cam2world_measured[:3, 3] - true_cam[:3, 3]) < 0.3

@@ -76,7 +76,7 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     assert win.table.rowCount() == len(FEATURES)
     assert win.commands.calibrate.isEnabled()
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    result = wb.session.result
+    result = wb.session.result.estimate
     assert result is not None and result.solution.status is SolveStatus.OK, win.results.status.text()
     assert result.solution.rms_px < 1.0
     d_true, r_true = pose_difference(bed.true_robot.fk(wb.joints_deg), bed.model_robot.fk(wb.joints_deg))
@@ -105,11 +105,11 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     # The solve is an edit like the picks: Undo takes it (and its edges) back, Redo shows the same answer.
     assert win.undo_action.text() == f"&Undo Calibrate ({len(FEATURES)} pairs)"
     qtbot.mouseClick(win.commands.undo, Qt.MouseButton.LeftButton)
-    assert wb.session.result is None and win.camera.view.overlay.image is None
+    assert wb.session.result.estimate is None and win.camera.view.overlay.image is None
     assert "OK" not in win.results.verdict.text()
     drawn = win.camera.edges_drawn
     qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
-    assert wb.session.result is result and "OK" in win.results.verdict.text()
+    assert wb.session.result.estimate is result and "OK" in win.results.verdict.text()
     qtbot.waitUntil(lambda: win.camera.edges_drawn > drawn, timeout=5_000)
 
     # Store the correction, undo it, redo it.
@@ -304,19 +304,19 @@ def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
         p = apply(fixture.item2world, fixture.features[name])
         pick_pair(wb, "oru_1_fixture", name, p, project(apply(invert(true_cam), p[None]), wb.intrinsics)[0])
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    solution = wb.session.result.solution
+    solution = wb.session.result.estimate.solution
     if solution.status is not SolveStatus.AMBIGUOUS:
         pytest.skip("this configuration has a single P3P root")
     ghosts = [p for p in win.camera.view.overlay.points if p[2].startswith("s")]
     assert ghosts and "poses fit" in win.camera.view.overlay.text
     button = win.results.findChild(type(win.commands.calibrate), "candidate_1")
     assert button is not None
-    before = wb.session.result.cam2world_measured.copy()
+    before = wb.session.result.estimate.cam2world_measured.copy()
     qtbot.mouseClick(button, Qt.MouseButton.LeftButton)
-    assert wb.session.chosen_candidate == 1
-    assert not np.allclose(wb.session.result.cam2world_measured, before)
+    assert wb.session.result.chosen_candidate == 1
+    assert not np.allclose(wb.session.result.estimate.cam2world_measured, before)
     qtbot.keyClick(win, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
-    assert wb.session.chosen_candidate == 0
+    assert wb.session.result.chosen_candidate == 0
 
 
 def test_camera_pane_loupe_and_crosshair_are_drawn(qtbot, window):

@@ -44,7 +44,9 @@ def test_f6_proposes_points_and_accept_checked_adds_them_in_one_undo_step(qtbot,
     assert len(wb.session.pairs) == 0  # one undo step
     qtbot.mouseClick(win.commands.redo, Qt.MouseButton.LeftButton)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    assert wb.session.result is not None and wb.session.result.solution.status.value == "ok", win.results.status.text()
+    assert wb.session.result.estimate is not None and wb.session.result.estimate.solution.status.value == "ok", (
+        win.results.status.text()
+    )
 
 
 def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot, window, tmp_path):
@@ -59,7 +61,7 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
     qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
     assert win.finder.dialog.edges_button.isEnabled()
     qtbot.mouseClick(win.finder.dialog.edges_button, Qt.MouseButton.LeftButton)
-    result = wb.session.result
+    result = wb.session.result.estimate
     assert result is not None and result.solution.method == "edges" and "OK" in win.results.verdict.text()
     assert "edge samples" in win.results.details.text()
     found = win.finder.dialog.found

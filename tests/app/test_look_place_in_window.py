@@ -22,7 +22,7 @@ def test_a_look_from_the_approach_is_kept_as_a_measurement_and_moves_nothing(qtb
     go_and_settle(qtbot, win, win.commands.go_approach)
     pick_features(qtbot, win, FEATURES)
     qtbot.keyClick(win, Qt.Key.Key_F5)
-    assert wb.session.result is not None and wb.session.result.solution.status.value != "failed"
+    assert wb.session.result.estimate is not None and wb.session.result.estimate.solution.status.value != "failed"
     asked = answer_questions(qtbot, ["Store as measurement"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     assert (

@@ -24,7 +24,7 @@ def test_a_12_px_mis_pick_is_named_marked_and_not_stored(qtbot, window):
     pick_features(qtbot, win, NINE, off_px={"boss_top_right": (12.0, 0.0)})
     number = next(p.number for p in wb.session.pairs.pairs() if p.feature == "boss_top_right")
     qtbot.keyClick(win, Qt.Key.Key_F5)
-    qtbot.waitUntil(lambda: wb.session.result is not None, timeout=30_000)
+    qtbot.waitUntil(lambda: wb.session.result.estimate is not None, timeout=30_000)
     text = win.results.verdict.text() + " " + win.results.status.text()
     assert f"pair {number} " in text and ("does not fit the others" in text or "fits worst" in text), text
     row = next(r for r in range(win.table.rowCount()) if win.table.item(r, 0).text() == str(number))
@@ -33,7 +33,7 @@ def test_a_12_px_mis_pick_is_named_marked_and_not_stored(qtbot, window):
     )
     others = [r for r in range(win.table.rowCount()) if r != row]
     assert all(win.table.item(r, 0).foreground().color().red() < 200 for r in others)
-    assert not win.commands.store.isEnabled() or wb.session.result.solution.status.value != "ok"
+    assert not win.commands.store.isEnabled() or wb.session.result.estimate.solution.status.value != "ok"
     assert wb.session.corrections.latest(wb.task.name) is None
     # Unticked, the eight good pairs solve: the verdict is OK and nothing is marked any more.
     win.table.item(row, win.table.columnCount() - 1).setCheckState(Qt.CheckState.Unchecked)

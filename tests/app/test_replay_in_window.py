@@ -54,18 +54,18 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     assert [p.number for p in wb.session.pairs] == [p.number for p in truth.pairs_at(t_mid)] and len(
         wb.session.pairs
     ) >= 1
-    assert wb.session.result is None and t_mid < first_solve
+    assert wb.session.result.estimate is None and t_mid < first_solve
 
     # After the solves: the last result appears, re-solved from its recorded inputs exactly.
     bar.seek(truth.duration_s)
-    result = wb.session.result
+    result = wb.session.result.estimate
     assert result is not None and win.commands.calibrate.isEnabled()
     assert np.array_equal(result.solution.to_dict()["t_obj2cam_mm"], truth.solves[-1].result["t_obj2cam_mm"])
     assert "OK" in win.results.verdict.text() and "mm" in win.results.details.text()
 
     # Back before the first pick: no pairs, no result.
     bar.seek(0.0)
-    assert len(wb.session.pairs) == 0 and wb.session.result is None
+    assert len(wb.session.pairs) == 0 and wb.session.result.estimate is None
 
     # The robot is not moved while the views show a recording.
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
@@ -99,7 +99,7 @@ def test_an_edit_branches_a_new_session_and_leaves_the_file_alone(qtbot, window,
     assert len(wb.session.pairs) == n - 1
     assert bar.branched_at_s == pytest.approx(truth.duration_s) and "branched" in bar.state_label.text()
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    assert wb.session.result is not None and wb.session.result.solution.rms_px < 2.0
+    assert wb.session.result.estimate is not None and wb.session.result.estimate.solution.rms_px < 2.0
     # Scrubbing moves the frames but no longer the branched pairs.
     bar.seek(0.0)
     assert len(wb.session.pairs) == n - 1 and win.camera.last_frame.index == 0
@@ -204,7 +204,7 @@ def test_a_look_from_the_recording_is_never_stored_as_the_task_s_correction_by_i
     win.files.open_recording(recording)
     bar = win.replay
     bar.seek(truth.duration_s)
-    assert wb.session.result is not None
+    assert wb.session.result.estimate is not None
     assert all(p.view is None or p.view.source == "session.mcap" for p in wb.session.pairs)
     asked = answer_questions(qtbot, ["Cancel"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
@@ -213,7 +213,7 @@ def test_a_look_from_the_recording_is_never_stored_as_the_task_s_correction_by_i
     win.table.selectRow(0)
     qtbot.mouseClick(win.commands.delete, Qt.MouseButton.LeftButton)
     qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
-    assert bar.branched_at_s is not None and wb.session.result is not None
+    assert bar.branched_at_s is not None and wb.session.result.estimate is not None
     asked = answer_questions(qtbot, ["Cancel"])
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     assert asked and "recording session.mcap" in asked[0], asked

@@ -147,14 +147,17 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     )
     look = wb.finder.calibrate_on_edges()
     fused = wb.robot_calibration.look_fused_with_robot(look)
-    assert wb.session.verdict.ok and fused is not None and fused.agree, (wb.session.verdict, fused and fused.message)
+    assert wb.session.result.verdict.ok and fused is not None and fused.agree, (
+        wb.session.result.verdict,
+        fused and fused.message,
+    )
     qtbot.mouseClick(win.commands.store, Qt.MouseButton.LeftButton)
     stored = wb.session.corrections.latest(task.name)
     assert stored is not None, win.statusBar().currentMessage()
     assert "look and model agree" in stored.source, stored.source
     # the fused correction is known better than the look alone through the same tool (the tool's error,
     # shared by look and model, is in both), and no better than the tool itself
-    tool_cov = tool.tool.covariance_in_base(wb.robot.fk(wb.session.context.joints_deg, "camera"))
+    tool_cov = tool.tool.covariance_in_base(wb.robot.fk(wb.session.result.context.joints_deg, "camera"))
     look_with_tool = np.sqrt(np.diag(look.covariance + tool_cov))
     assert np.linalg.norm(stored.std_displacement_mm) < np.linalg.norm(look_with_tool[:3])
     assert np.linalg.norm(stored.std_rotation_deg) < np.linalg.norm(look_with_tool[3:])

@@ -44,7 +44,7 @@ def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale
     assert win.camera.held is not None and "held: frame" in win.camera.info.text()  # picked on a still
     q_task = np.array(wb.joints_deg)
     qtbot.keyClick(win, Qt.Key.Key_F5)
-    at_task = wb.session.result
+    at_task = wb.session.result.estimate
     assert "OK" in win.results.verdict.text()
     win.files.save_workspace(tmp_path / "w.json")
     # A refused click (outside the image) says why on its own line; the verdict stays.
@@ -67,9 +67,9 @@ def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale
     wb.session.clear()
     assert win.files.open_workspace(tmp_path / "w.json")
     qtbot.keyClick(win, Qt.Key.Key_F5)
-    restored = wb.session.result
+    restored = wb.session.result.estimate
     np.testing.assert_allclose(restored.displacement_mm, at_task.displacement_mm, atol=1e-9)
-    np.testing.assert_allclose(wb.session.context.joints_deg, q_task, atol=1e-9)
+    np.testing.assert_allclose(wb.session.result.context.joints_deg, q_task, atol=1e-9)
     assert np.linalg.norm(restored.displacement_mm) < 25.0 and "OK" in win.results.verdict.text()
 
 
@@ -162,7 +162,7 @@ def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_p
     qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # joint samples and frames flow in
     _pick_features(qtbot, win)
     qtbot.keyClick(win, Qt.Key.Key_F5)
-    live = wb.session.result.displacement_mm.copy()
+    live = wb.session.result.estimate.displacement_mm.copy()
     done = wb.recorder.messages
     qtbot.waitUntil(lambda: wb.recorder.messages > done + 20, timeout=10_000)
     win.files.stop_recording()
@@ -174,7 +174,7 @@ def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_p
     win.replay.seek(win.replay.playback.duration_s)
     assert all(p.view is not None for p in wb.session.pairs)
     qtbot.keyClick(win, Qt.Key.Key_F5)  # a solve in the replay: the pairs' recorded joints, not the robot's
-    np.testing.assert_allclose(wb.session.result.displacement_mm, live, atol=1e-9)
+    np.testing.assert_allclose(wb.session.result.estimate.displacement_mm, live, atol=1e-9)
 
 
 def test_quit_with_unsaved_work_asks(qtbot, window):

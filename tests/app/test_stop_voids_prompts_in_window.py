@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.operator.move_preview import MoveNeedsConfirmation
 
 

@@ -4,7 +4,8 @@ redo, the solve, the end-effector displacement against the truth, the stored cor
 import numpy as np
 import pytest
 
-from calib_core.calibration.session import CalibrationError, CalibrationSession
+from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.session import CalibrationSession
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot import solve_ik
@@ -76,7 +77,7 @@ def test_estimated_displacement_matches_the_truth(bed):
 
 def test_stored_correction_brings_the_real_tool_to_the_target(bed):
     task, s, _ = _look_at_the_approach(bed, noise_px=0.0)
-    q_app = s.context.joints_deg
+    q_app = s.result.context.joints_deg
     s.store_correction(task.name)
     # Uncorrected: the real tool misses the grasp by millimetres; corrected: by far less.
     q_plain = solve_ik(bed.model_robot, task.tcp2base, q_app).q_deg
@@ -133,21 +134,21 @@ def test_a_solve_is_one_undo_step_that_puts_the_previous_result_back(bed):
     assert s.undo.undo_label == "Calibrate (5 pairs)"
     _pick_all(s, bed, q, names=FEATURES[5:], seed=2)
     second = _calibrate(s, bed, q)
-    assert s.result is second and s.solved_numbers == list(range(1, 10))
+    assert s.result.estimate is second and s.result.solved_numbers == list(range(1, 10))
     changes = []
-    s.changed.connect(lambda: changes.append(s.result))
+    s.result.changed.connect(lambda: changes.append(s.result.estimate))
     assert s.undo.undo() == "Calibrate (9 pairs)"
-    assert s.result is first and s.solved_numbers == [1, 2, 3, 4, 5] and changes == [first]
+    assert s.result.estimate is first and s.result.solved_numbers == [1, 2, 3, 4, 5] and changes == [first]
     assert (
         s.stale_reason is not None and "6, 7, 8, 9" in s.stale_reason
     )  # the first answer, told apart from the pairs on screen
     s.undo.redo()
-    assert s.result is second and s.verdict is not None and s.stale_reason is None
+    assert s.result.estimate is second and s.result.verdict is not None and s.stale_reason is None
     for _ in range(9):  # the second solve and the second look's four pairs (3D and 2D each)
         s.undo.undo()
     assert s.undo.undo_label == "Calibrate (5 pairs)"
     s.undo.undo()
-    assert s.result is None and s.verdict is None and s.solved_numbers == []
+    assert s.result.estimate is None and s.result.verdict is None and s.result.solved_numbers == []
 
 
 def test_listeners_hear_every_change():
@@ -166,7 +167,7 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     toward the model's, sigmas smaller); one that disagrees needs a confirmation, then is stored alone
     with the reason kept."""
     from calib_core.calibration.look_fusion import fuse_look
-    from calib_core.calibration.session import ConfirmationNeeded
+    from calib_core.calibration.errors import ConfirmationNeeded
 
     task, s, look = _look_at_the_approach(bed)
     sigma = np.sqrt(np.diag(look.covariance))

@@ -10,7 +10,7 @@ import queue
 import numpy as np
 import pytest
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.link.joint_history import JointHistory
 from calib_core.operator.core import OperatorCore
 from calib_core.operator.motion import Motion

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from calib_core.calibration.look_place import LookNotAtTask
-from calib_core.calibration.session import CalibrationError, ConfirmationNeeded
+from calib_core.calibration.errors import CalibrationError, ConfirmationNeeded
 from calib_core.calibration.verdict import Verdict
 from calib_core.frames import apply
 from calib_core.operator.core import OperatorCore
@@ -46,7 +46,7 @@ def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_a
     assert len(stamps) == 1 and next(iter(stamps)).frame_index == 7  # one still for the whole set
     np.testing.assert_allclose(next(iter(stamps)).joints_deg, q_task, atol=1e-9)
     at_task = core.picking.calibrate()
-    assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
+    assert core.session.result.verdict.verdict is Verdict.OK, core.session.result.verdict.text
     # The truth scores the estimate (nothing above read it): the measured camera pose is the real one.
     true_cam = site.bed.true_cam2world(q_task)
     assert np.linalg.norm(at_task.cam2world_measured[:3, 3] - true_cam[:3, 3]) < 0.01
@@ -58,7 +58,7 @@ def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_a
     again.files.open_workspace(tmp_path / "w.json")
     restored = again.picking.calibrate()
     np.testing.assert_allclose(restored.displacement_mm, at_task.displacement_mm, atol=1e-9)
-    np.testing.assert_allclose(again.session.context.joints_deg, q_task, atol=1e-9)
+    np.testing.assert_allclose(again.session.result.context.joints_deg, q_task, atol=1e-9)
     assert np.linalg.norm(restored.displacement_mm) < 25.0
     # A new pick on a frame of the home pose joins pairs of the task pose: refused, naming them.
     frame_now(again, index=8)
@@ -78,7 +78,7 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
         core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home
     )
     assert np.linalg.norm(result.displacement_mm) > 100.0
-    verdict = core.session.verdict
+    verdict = core.session.result.verdict
     assert verdict.verdict is Verdict.IMPLAUSIBLE and "beyond the cell's stated model error of 25 mm" in verdict.text
     with pytest.raises(LookNotAtTask, match="from .*'s pose"):  # the home joints are not the task location's pose
         core.desk.store_correction()

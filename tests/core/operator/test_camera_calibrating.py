@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from calib_core.calibration.session import CalibrationError
+from calib_core.calibration.errors import CalibrationError
 from calib_core.errors import OperatorError
 from calib_core.frames import concat, invert, transform_from_xyz_rpy
 from calib_core.operator.camera_calibrating import MountingResult

@@ -35,7 +35,7 @@ def test_find_points_on_the_demo_s_frame_12_finds_the_target_where_it_is():
     core.finder.accept_found_points()
     estimate = core.picking.calibrate()
     error = np.linalg.norm(estimate.cam2world_measured[:3, 3] - site.bed.true_cam2world(JOINTS)[:3, 3])
-    assert error < 0.1, (error, core.session.verdict.text)
+    assert error < 0.1, (error, core.session.result.verdict.text)
 
 
 def test_a_fit_on_half_its_edges_proposes_nothing_and_offers_no_edge_calibration(monkeypatch):

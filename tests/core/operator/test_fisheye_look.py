@@ -67,7 +67,7 @@ def test_find_points_and_the_edge_fit_work_through_the_fisheye(fisheye_look):
     assert found.result.found, found.result.message
     core.finder.accept_found_points()
     estimate = core.picking.calibrate()
-    assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
+    assert core.session.result.verdict.verdict is Verdict.OK, core.session.result.verdict.text
     error, model_error = _camera_error(core, site, q, estimate)
     assert error < 2.0 and error < 0.3 * model_error, (error, model_error)
     core.finder.find_points()

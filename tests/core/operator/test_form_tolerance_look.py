@@ -20,7 +20,7 @@ def _look(form_tolerance_mm: float):
     frame_now(core)
     pick_all(core, site.bed, q)
     result = core.picking.calibrate()
-    return result, core.session.verdict, core.session.context
+    return result, core.session.result.verdict, core.session.result.context
 
 
 def test_the_same_picks_are_less_certain_on_a_part_off_its_cad_and_uncertain_beyond_the_task_tolerance():

@@ -26,11 +26,11 @@ def test_solve_options_are_undoable_and_announced():
     cell, site = simulated_cell(image_scale=0.25)
     core = OperatorCore(cell, site)
     changes = []
-    core.session.option_changed.connect(lambda name, value: changes.append((name, value)))
+    core.session.options.changed.connect(lambda name, value: changes.append((name, value)))
     core.session.set_option("robust", True)
     core.session.set_option("robust", True)  # no change: no event, no undo entry
-    assert core.session.robust and changes == [("robust", True)]
+    assert core.session.options.robust and changes == [("robust", True)]
     assert core.undo() == "Use the robust option"
-    assert not core.session.robust and changes[-1] == ("robust", False)
+    assert not core.session.options.robust and changes[-1] == ("robust", False)
     core.redo()
-    assert core.session.robust
+    assert core.session.options.robust

@@ -4,6 +4,8 @@ events, and a workspace bound to its cell."""
 import numpy as np
 import pytest
 
+from calib_core.undo import Command
+
 from calib_core.errors import OperatorError
 from calib_core.operator.cell import Cell, CellMismatchError
 from calib_core.operator.core import OperatorCore
@@ -63,6 +65,32 @@ def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
     assert core.cell.identity == before  # back to the cell as loaded
     with pytest.raises(OperatorError, match="component name"):
         core.editor.add_component(mesh, "a: b")
+
+
+def test_an_approach_edit_tells_the_task_choice_on_do_undo_and_redo(core):
+    task = core.workcell.task("oru_1_grasp")
+    told = []
+    core.task_changed.connect(told.append)
+    before = task.approach_mm
+    core.editor.set_task_approach(task.name, before + 25.0)
+    assert core.workcell.task(task.name).approach_mm == before + 25.0 and core.editor.dirty
+    core.undo()
+    assert core.workcell.task(task.name).approach_mm == before
+    core.session.undo.redo()
+    assert core.workcell.task(task.name).approach_mm == before + 25.0
+    assert told == [task.name] * 3
+    core.session.undo.push(_Nothing())  # an edit of something else: the cell is not told
+    assert told == [task.name] * 3
+
+
+class _Nothing(Command):
+    label = "nothing"
+
+    def do(self) -> None:
+        pass
+
+    def undo(self) -> None:
+        pass
 
 
 def test_a_workspace_opens_on_its_own_cell_only(core, tmp_path):

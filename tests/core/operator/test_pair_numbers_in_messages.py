@@ -48,11 +48,11 @@ def picked():
 def test_a_failed_solve_names_the_mis_clicked_pair_by_its_table_number(picked):
     core = picked
     assert [p.number for p in core.session.pairs] == [4, 5, 6, 7, 8, 9]
-    core.session.robust = False
+    core.session.options.robust = False
     estimate = core.picking.calibrate()
     assert estimate.solution.status.value == "failed" and "pair 7 fits worst" in estimate.solution.reason, (
         estimate.solution.reason
     )
-    core.session.robust = True
+    core.session.options.robust = True
     estimate = core.picking.calibrate()
     assert any("pair 7 rejected as outliers" in w for w in estimate.solution.warnings), estimate.solution.warnings

@@ -39,7 +39,7 @@ def test_found_points_are_accepted_in_one_step_and_solve_like_picks(found_core):
     assert core.session.undo.undo() == f"Accept {len(numbers)} found points" and len(core.session.pairs) == 0
     core.session.undo.redo()
     estimate = core.picking.calibrate()
-    assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
+    assert core.session.result.verdict.verdict is Verdict.OK, core.session.result.verdict.text
     # The truth scores: the found points put the camera far nearer the true one than the model does.
     # (About 1 mm today against 8 mm: the detectors carry 0.2-0.8 px of bias that the solve's noise
     # estimate does not see; Calibrate on edges is within 0.1 mm. See docs/find-points.md.)
@@ -67,8 +67,8 @@ def test_calibrate_on_edges_puts_the_tcp_within_a_tenth_of_a_millimetre(found_co
     core.solved.connect(lambda: solved.append(True))
     estimate = core.finder.calibrate_on_edges()
     assert solved and estimate.solution.method == "edges" and estimate.solution.status.value == "ok"
-    assert core.session.verdict.verdict is Verdict.OK, core.session.verdict.text
-    assert core.session.last_solve_inputs["method"] == "edges" and core.session.last_solve_inputs["frame_index"] == 3
+    assert core.session.result.verdict.verdict is Verdict.OK, core.session.result.verdict.text
+    assert core.session.result.inputs["method"] == "edges" and core.session.result.inputs["frame_index"] == 3
     # The camera is what a look measures (the TCP follows through the camera's mounting, which this cell
     # has with its typical error: the robot calibration's business): within a tenth of a millimetre of the true one.
     true_cam = site.bed.true_cam2world(q)

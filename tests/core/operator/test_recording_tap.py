@@ -50,7 +50,7 @@ def recorded(tmp_path_factory):
     frame_now(core, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 90, np.uint8))
     _pick_all(core, site.bed, q)
     core.picking.calibrate()
-    solution = core.session.result.solution
+    solution = core.session.result.estimate.solution
     points_obj, _, numbers = core.session.pairs.arrays()
     obj2world = core.workcell.component(core.session.target).item2world
     core.stop_recording()

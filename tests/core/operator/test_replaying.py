@@ -44,9 +44,9 @@ def test_the_recording_as_it_stood_then_and_the_live_session_back_after(core, re
     core.replay.seek(t_mid)
     assert np.allclose(core.joints_deg, truth.joints_at(t_mid))
     assert [p.number for p in core.session.pairs] == [p.number for p in truth.pairs_at(t_mid)]
-    assert core.session.result is None
+    assert core.session.result.estimate is None
     core.replay.seek(truth.duration_s)
-    assert core.session.result is not None and core.replay.branched_at_s is None
+    assert core.session.result.estimate is not None and core.replay.branched_at_s is None
 
     branched = []
     core.replay.branched.connect(branched.append)
