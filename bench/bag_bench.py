@@ -128,7 +128,9 @@ elif what == "peer_joint_track":
 seconds = time.perf_counter() - t
 # VmHWM, not ru_maxrss: the latter keeps the forking parent's high-water mark across exec
 hwm_kb = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmHWM:"))
-extra = {"opened_s": opened, "seek_median_s": sorted(seeks)[len(seeks) // 2], "seek_max_s": max(seeks)} if what.endswith("_seek") else {}
+extra = {}
+if what.endswith("_seek"):
+    extra = {"opened_s": opened, "seek_median_s": sorted(seeks)[len(seeks) // 2], "seek_max_s": max(seeks)}
 print(json.dumps({"seconds": seconds, "peak_mb": hwm_kb / 1024, "shape": list(shape), **extra}))
 """
 
@@ -166,12 +168,17 @@ def main() -> str:
     lines = [
         "# Reading ROS 2 bags",
         "",
-        f"`python -m bench bag_bench` on {platform.processor() or platform.machine()}, Python {platform.python_version()}. A bag of 1280 x 960 JPEG frames "
-        f"({len(jpeg) / 1000:.0f} kB each, a simulated camera frame) at {FPS} fps and 6-joint JointState at {JOINT_HZ} Hz, MCAP written by `rosbags`. "
-        "Each figure from a fresh process (time from the call, peak resident memory of the process, Python and the libraries included). "
-        "The peer is `rosbags` read by hand: its `AnyReader` and OpenCV's JPEG decoder, the path videocal takes, without videocal's checks.",
+        f"`python -m bench bag_bench` on {platform.processor() or platform.machine()}, Python "
+        f"{platform.python_version()}. A bag of 1280 x 960 JPEG frames "
+        f"({len(jpeg) / 1000:.0f} kB each, a simulated camera frame) at {FPS} fps and 6-joint JointState at {JOINT_HZ} "
+        "Hz, MCAP written by `rosbags`. "
+        "Each figure from a fresh process (time from the call, peak resident memory of the process, Python and the "
+        "libraries included). "
+        "The peer is `rosbags` read by hand: its `AnyReader` and OpenCV's JPEG decoder, the path videocal takes, "
+        "without videocal's checks.",
         "",
-        "| bag | size | first frame: videocal | peer | ratio | peak MB videocal / peer | joint track: videocal | peer | ratio | peak MB videocal / peer |",
+        "| bag | size | first frame: videocal | peer | ratio | peak MB videocal / peer | joint track: videocal | peer "
+        "| ratio | peak MB videocal / peer |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for minutes, size_mb, _, r in rows:
@@ -182,17 +189,25 @@ def main() -> str:
             r["peer_joint_track"],
         )
         lines.append(
-            f"| {minutes} min | {size_mb:.0f} MB | {f['seconds']:.2f} s | {pf['seconds']:.2f} s | {f['seconds'] / pf['seconds']:.2f} | {f['peak_mb']:.0f} / {pf['peak_mb']:.0f} "
-            f"| {j['seconds']:.1f} s | {pj['seconds']:.1f} s | {j['seconds'] / pj['seconds']:.2f} | {j['peak_mb']:.0f} / {pj['peak_mb']:.0f} |"
+            f"| {minutes} min | {size_mb:.0f} MB | {f['seconds']:.2f} s | {pf['seconds']:.2f} s | "
+            f"{f['seconds'] / pf['seconds']:.2f} | {f['peak_mb']:.0f} / {pf['peak_mb']:.0f} "
+            f"| {j['seconds']:.1f} s | {pj['seconds']:.1f} s | {j['seconds'] / pj['seconds']:.2f} | {j['peak_mb']:.0f} "
+            f"/ {pj['peak_mb']:.0f} |"
         )
     one, ten = rows[0][3], rows[1][3]
+    per_sample_kb = (
+        (ten["videocal_joint_track"]["peak_mb"] - one["videocal_joint_track"]["peak_mb"]) * 1024 / (9 * 60 * JOINT_HZ)
+    )
     lines += [
         "",
-        f"The first frame of the 10-minute bag comes in {ten['videocal_first_frame']['seconds']:.2f} s (target: under 1 s), with "
-        f"{ten['videocal_first_frame']['peak_mb'] - one['videocal_first_frame']['peak_mb']:+.0f} MB of peak memory against the 1-minute bag: "
-        "images are read one at a time. The joint track is read whole (every JointState, for the settled check at any image): "
+        f"The first frame of the 10-minute bag comes in {ten['videocal_first_frame']['seconds']:.2f} s (target: under "
+        "1 s), with "
+        f"{ten['videocal_first_frame']['peak_mb'] - one['videocal_first_frame']['peak_mb']:+.0f} MB of peak memory "
+        "against the 1-minute bag: "
+        "images are read one at a time. The joint track is read whole (every JointState, for the settled check at any "
+        "image): "
         f"its time grows with the bag's length, and so does its peak memory while it is read "
-        f"({(ten['videocal_joint_track']['peak_mb'] - one['videocal_joint_track']['peak_mb']) * 1024 / (9 * 60 * JOINT_HZ):.2f} kB a sample: a row per message, "
+        f"({per_sample_kb:.2f} kB a sample: a row per message, "
         "as the peer's), the track kept after it 56 bytes a sample (6 doubles and a stamp). "
         "",
     ]
@@ -200,24 +215,32 @@ def main() -> str:
         "",
         "## Seeking, as the window's replay timeline does",
         "",
-        "Opening a bag on the timeline indexes its image topic (each message's stamp, read from the first bytes of its CDR "
-        "without decoding the picture); a seek then reads the one image at its record time (`rosbags`' `messages(start=, stop=)`) "
+        "Opening a bag on the timeline indexes its image topic (each message's stamp, read from the first bytes of its "
+        "CDR "
+        "without decoding the picture); a seek then reads the one image at its record time (`rosbags`' "
+        "`messages(start=, stop=)`) "
         "and decodes it. 20 seeks to random frames; the peer indexes the record times and seeks the same way by hand.",
         "",
-        "| bag | index: videocal | peer | ratio | seek median: videocal | peer | ratio | seek max: videocal | peak MB videocal / peer |",
+        "| bag | index: videocal | peer | ratio | seek median: videocal | peer | ratio | seek max: videocal | peak MB "
+        "videocal / peer |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for minutes, size_mb, _, r in rows:
         v, p = r["videocal_seek"], r["peer_seek"]
         lines.append(
-            f"| {minutes} min | {v['opened_s']:.1f} s | {p['opened_s']:.1f} s | {v['opened_s'] / p['opened_s']:.2f} | {v['seek_median_s'] * 1000:.0f} ms | "
-            f"{p['seek_median_s'] * 1000:.0f} ms | {v['seek_median_s'] / p['seek_median_s']:.2f} | {v['seek_max_s'] * 1000:.0f} ms | {v['peak_mb']:.0f} / {p['peak_mb']:.0f} |"
+            f"| {minutes} min | {v['opened_s']:.1f} s | {p['opened_s']:.1f} s | {v['opened_s'] / p['opened_s']:.2f} | "
+            f"{v['seek_median_s'] * 1000:.0f} ms | "
+            f"{p['seek_median_s'] * 1000:.0f} ms | {v['seek_median_s'] / p['seek_median_s']:.2f} | "
+            f"{v['seek_max_s'] * 1000:.0f} ms | {v['peak_mb']:.0f} / {p['peak_mb']:.0f} |"
         )
     lines += [
         "",
-        f"A seek in the 10-minute bag takes {rows[-1][3]['videocal_seek']['seek_median_s'] * 1000:.0f} ms (target: under 0.2 s); the index is kept, not the images, so the "
-        "replay's memory stays flat. Indexing reads the whole image topic once; the window also reads the joint track whole when it "
-        "opens a bag (the first table), so a 10-minute bag with 500 Hz joint states opens on the timeline in about 8 s, the joints' share by far the larger.",
+        f"A seek in the 10-minute bag takes {rows[-1][3]['videocal_seek']['seek_median_s'] * 1000:.0f} ms (target: "
+        "under 0.2 s); the index is kept, not the images, so the "
+        "replay's memory stays flat. Indexing reads the whole image topic once; the window also reads the joint track "
+        "whole when it "
+        "opens a bag (the first table), so a 10-minute bag with 500 Hz joint states opens on the timeline in about 8 "
+        "s, the joints' share by far the larger.",
         "",
     ]
     OUT.write_text("\n".join(lines))

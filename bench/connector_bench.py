@@ -224,26 +224,35 @@ def main() -> str:
     lines = [
         "# Connectors",
         "",
-        f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}; the other side in another process on the same "
+        f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}; the other side in "
+        "another process on the same "
         f"machine; {SECONDS:g} s per figure. Each connector beside a bare client of the same library in the same run.",
         "",
         "| what | connector | bare client | ratio |",
         "|---|---|---|---|",
-        f"| ROS 2 `/joint_states` at 500 Hz: samples/s delivered | {c['rate']:.0f} | {b['rate']:.0f} (cyclonedds reader) | {c['rate'] / b['rate']:.2f} |",
+        f"| ROS 2 `/joint_states` at 500 Hz: samples/s delivered | {c['rate']:.0f} | {b['rate']:.0f} (cyclonedds "
+        f"reader) | {c['rate'] / b['rate']:.2f} |",
         f"| ROS 2: samples lost (from the stamps' span; +-1: stamps are whole ms) | {c['lost']} | {b['lost']} | |",
-        f"| ROS 2: stamp to delivery, median / 99th percentile | {c['p50']:.2f} / {c['p99']:.2f} ms | {b['p50']:.2f} / {b['p99']:.2f} ms | {c['p50'] / max(b['p50'], 1e-6):.2f} |",
-        f"| UR RTDE at 500 Hz: controller samples/s seen | {rtde['connector']:.0f} | {rtde['bare']:.0f} (ur_rtde polled) | {rtde['connector'] / rtde['bare']:.2f} |",
-        f"| GigE Vision 1280 x 960 RGB8: frames/s at the connector | {g['fps']:.1f} | {gige['bare']:.1f} (Aravis stream) | {g['fps'] / gige['bare']:.2f} |",
-        f"| GigE: frame age at the connector, median / 99th percentile | {g['age_p50']:.1f} / {g['age_p99']:.1f} ms | | |",
+        f"| ROS 2: stamp to delivery, median / 99th percentile | {c['p50']:.2f} / {c['p99']:.2f} ms | {b['p50']:.2f} / "
+        f"{b['p99']:.2f} ms | {c['p50'] / max(b['p50'], 1e-6):.2f} |",
+        f"| UR RTDE at 500 Hz: controller samples/s seen | {rtde['connector']:.0f} | {rtde['bare']:.0f} (ur_rtde "
+        f"polled) | {rtde['connector'] / rtde['bare']:.2f} |",
+        f"| GigE Vision 1280 x 960 RGB8: frames/s at the connector | {g['fps']:.1f} | {gige['bare']:.1f} (Aravis "
+        f"stream) | {g['fps'] / gige['bare']:.2f} |",
+        f"| GigE: frame age at the connector, median / 99th percentile | {g['age_p50']:.1f} / {g['age_p99']:.1f} ms | "
+        "| |",
         "",
         "Notes: the simulated UR controller and the fake GigE camera are Python/Aravis programs on the same two cores; "
-        f"their own rates bound the figures (the bare clients show them). The fake GigE camera's frame rate: {g['camera_fps']:.0f} fps; "
+        "their own rates bound the figures (the bare clients show them). The fake GigE camera's frame rate: "
+        f"{g['camera_fps']:.0f} fps; "
         f"frames passed over for a newer one at the connector: {g['skipped']}.",
         "",
         "## The whole calibration through each connector",
         "",
-        "`videocal demo --offscreen --site SITE`: the window drives the simulated cell through that connector (`sim`: videocal's own "
-        "link and the in-process camera, today's default). The error is the corrected tool's distance from the task location, "
+        "`videocal demo --offscreen --site SITE`: the window drives the simulated cell through that connector (`sim`: "
+        "videocal's own "
+        "link and the in-process camera, today's default). The error is the corrected tool's distance from the task "
+        "location, "
         "scored against the simulator's truth, which nothing in the run reads.",
         "",
         "| site | reached through | status | corrected tool error | before | run time | ratio to `sim` |",
@@ -256,7 +265,8 @@ def main() -> str:
             continue
         ratio = f"{d['seconds'] / base:.2f}" if base else ""
         lines.append(
-            f"| `{d['site']}` | {d['via']} | {d['status']} | {d['error_mm']:.3f} mm, {d['error_deg']:.3f} deg | {d['before_mm']:.2f} mm | "
+            f"| `{d['site']}` | {d['via']} | {d['status']} | {d['error_mm']:.3f} mm, {d['error_deg']:.3f} deg | "
+            f"{d['before_mm']:.2f} mm | "
             f"{d['seconds']:.0f} s | {ratio} |"
         )
     lines.append("")

@@ -188,7 +188,8 @@ def box_photo_rows() -> list[str]:
     t0 = time.perf_counter()
     reference = locate(image, camera, mesh, hand, reach_deg=3.0)
     rows = [
-        f"From the hand prior: `{reference.status}`, {reference.edge_samples} samples, {100 * (reference.edge_share or 0):.0f} % on their edges, "
+        f"From the hand prior: `{reference.status}`, {reference.edge_samples} samples, "
+        f"{100 * (reference.edge_share or 0):.0f} % on their edges, "
         f"RMS {reference.edge_rms_px} px, {time.perf_counter() - t0:.1f} s.",
         "",
         "| prior off by | status | seen edges from the hand prior's answer | s |",
@@ -232,9 +233,12 @@ def peer_rows(n_priors: int = 5) -> list[str]:
     cv2.ellipse(occluded, (int(cu) - 150, int(cv) + 40), (70, 110), 20, 0, 360, (200, 150, 120), -1)
     identity = np.eye(4)[None]
     rows = [
-        f"Peer: {what if python else 'not run: ' + what}. Priors: the truth moved 10 mm and turned 3 deg (seeded), {n_priors} a scene; "
-        "each OpenCV tracker called as its documentation shows (200 control points, 15 px search) and iterated 10 times from the prior, "
-        "untuned; videocal's locate searching 10 mm / 3 deg. From the truth itself the OpenCV trackers end 12-15 px away even on the "
+        f"Peer: {what if python else 'not run: ' + what}. Priors: the truth moved 10 mm and turned 3 deg (seeded), "
+        f"{n_priors} a scene; "
+        "each OpenCV tracker called as its documentation shows (200 control points, 15 px search) and iterated 10 "
+        "times from the prior, "
+        "untuned; videocal's locate searching 10 mm / 3 deg. From the truth itself the OpenCV trackers end 12-15 px "
+        "away even on the "
         "plain box, so their rows say how they behave as called here, not the best their methods can do.",
         "",
         "| scene (render, truth known) | method | within MSPD 5 px | median MSPD | median s |",
@@ -294,7 +298,8 @@ def peer_rows(n_priors: int = 5) -> list[str]:
         for method, rs in results.items():
             errors = np.array([e for e, _ in rs])
             rows.append(
-                f"| {label} | {method} | {int(np.sum(errors < 5.0))} of {len(rs)} | {np.median(errors):.1f} px | {np.median([t for _, t in rs]):.2f} |"
+                f"| {label} | {method} | {int(np.sum(errors < 5.0))} of {len(rs)} | {np.median(errors):.1f} px | "
+                f"{np.median([t for _, t in rs]):.2f} |"
             )
     return rows
 
@@ -303,7 +308,8 @@ def table(rows: list[Row]) -> list[str]:
     from calib_core.datasets.pose_errors import MSPD_THRESHOLDS_PX, MSSD_THRESHOLDS, average_recall
 
     out = [
-        "| data set | prior | views | ok | within MSPD 5 px | wrong ok | AR MSPD | AR MSSD | median t / r error (ok) | s a view (median, max) |",
+        "| data set | prior | views | ok | within MSPD 5 px | wrong ok | AR MSPD | AR MSSD | median t / r error (ok) | "
+        "s a view (median, max) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name in sorted({r.dataset for r in rows}):
@@ -320,8 +326,10 @@ def table(rows: list[Row]) -> list[str]:
             rdeg = np.median([r.r_deg for r in ok]) if ok else float("nan")
             secs = np.array([r.seconds for r in rs])
             out.append(
-                f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {len(rs)} | {len(ok)} | {100 * within:.0f} % | {wrong} | "
-                f"{average_recall(mspd_all, MSPD_THRESHOLDS_PX):.2f} | {average_recall(mssd_all, MSSD_THRESHOLDS):.2f} | "
+                f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {len(rs)} | {len(ok)} | {100 * within:.0f} % | "
+                f"{wrong} | "
+                f"{average_recall(mspd_all, MSPD_THRESHOLDS_PX):.2f} | {average_recall(mssd_all, MSSD_THRESHOLDS):.2f} "
+                "| "
                 f"{t:.1f} mm / {rdeg:.2f} deg | {np.median(secs):.1f}, {secs.max():.1f} |"
             )
     return out
@@ -335,11 +343,14 @@ def main(argv: list[str] | None = None) -> str:
     lines = [
         "# Real photographs with ground truth",
         "",
-        f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, {os.cpu_count()} cores, one process (`python -m bench real_photos`).",
+        f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, {os.cpu_count()} cores, one process (`python "
+        "-m bench real_photos`).",
         "Every figure here is from real camera images; the truth is the data set's own annotation and only scores.",
         "",
-        "Priors: the truth moved by the stated distance in a random direction and turned by the stated angle about a random "
-        "axis (seeded), `locate` searching that far. *Wrong ok*: an answer called `ok` whose MSPD is over 5 px at 640 px width. "
+        "Priors: the truth moved by the stated distance in a random direction and turned by the stated angle about a "
+        "random "
+        "axis (seeded), `locate` searching that far. *Wrong ok*: an answer called `ok` whose MSPD is over 5 px at 640 "
+        "px width. "
         "AR: BOP's average recall (MSPD 5-50 px at 640 px width; MSSD 5-50 % of the diameter).",
         "",
     ]
@@ -351,15 +362,18 @@ def main(argv: list[str] | None = None) -> str:
         )
     else:
         lines += [
-            f"**No real data set with ground truth was found on this machine** (looked in `{datasets_root()}`): nothing is "
+            f"**No real data set with ground truth was found on this machine** (looked in `{datasets_root()}`): "
+            "nothing is "
             "measured here, and no figure elsewhere in videocal's docs comes from real photographs with ground truth."
         ]
     lines += [
         "",
         "## A real photograph without ground truth",
         "",
-        "OpenCV's real-time pose tutorial photo (a cookie box printed all over, on a wooden table; 718 x 480; the tutorial's "
-        "nominal camera, no calibration known). Its truth is not known: the check is that every answer called `ok` puts the "
+        "OpenCV's real-time pose tutorial photo (a cookie box printed all over, on a wooden table; 718 x 480; the "
+        "tutorial's "
+        "nominal camera, no calibration known). Its truth is not known: the check is that every answer called `ok` "
+        "puts the "
         "box where the others do.",
         "",
     ] + box_photo_rows()
@@ -368,15 +382,18 @@ def main(argv: list[str] | None = None) -> str:
         "",
         "## Where the data comes from",
         "",
-        "The bench reads BOP-format data sets (the BOP toolkit's layout: `models/models_info.json` and `obj_NNNNNN.ply` in mm, "
+        "The bench reads BOP-format data sets (the BOP toolkit's layout: `models/models_info.json` and "
+        "`obj_NNNNNN.ply` in mm, "
         "`<split>/<scene>/scene_camera.json`, `scene_gt.json`, `scene_gt_info.json`, `rgb/` or `gray/`) from "
         "`$VIDEOCAL_DATASETS`, one folder per data set named as BOP names it (`tless`, `itodd`, `hope`, `ycbv`, `lm`). "
         "To run it: download a data set's base archive, models and test images from the BOP site "
         "(bop.felk.cvut.cz/datasets, mirrored on Hugging Face as `bop-benchmark/<name>`), unpack them into "
-        "`$VIDEOCAL_DATASETS/<name>/`, and run `.venv/bin/python -m bench real_photos`. LM-O (`lmo`) and LM's scene 2 are "
+        "`$VIDEOCAL_DATASETS/<name>/`, and run `.venv/bin/python -m bench real_photos`. LM-O (`lmo`) and LM's scene 2 "
+        "are "
         "skipped: they are held back for a final check.",
         "",
-        "Searched for this run, from this machine (which reaches PyPI, Debian's and npm's registries and stored copies of "
+        "Searched for this run, from this machine (which reaches PyPI, Debian's and npm's registries and stored copies "
+        "of "
         "public GitHub repositories, not the web):",
         "",
     ]

@@ -151,7 +151,8 @@ def window_demo(one_way_s: float, site: str = "sim") -> dict:
 
 _FAKE_CAMERA = (
     "import gi, time\ngi.require_version('Aravis', '0.8')\nfrom gi.repository import Aravis\n"
-    "camera = Aravis.GvFakeCamera.new('vcfar0', 'FAR01')\nprint('serving' if camera.is_running() else 'failed', flush=True)\ntime.sleep(900)\n"
+    "camera = Aravis.GvFakeCamera.new('vcfar0', 'FAR01')\nprint('serving' if camera.is_running() else 'failed', "
+    "flush=True)\ntime.sleep(900)\n"
 )
 
 
@@ -191,7 +192,8 @@ def gige_far(one_way_s: float, seconds: float = 20.0) -> dict:
 def _demo_table(demos: list[dict]) -> list[str]:
     """The window demos' table, ratios against the first row (0 s)."""
     lines = [
-        "| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool error | status |",
+        "| one-way delay | Go -> usable frame, per look | median | ratio to 0 s | measured one-way | corrected tool "
+        "error | status |",
         "|---|---|---|---|---|---|---|",
     ]
     near = np.median(demos[0].get("looks") or [np.nan])
@@ -201,7 +203,8 @@ def _demo_table(demos: list[dict]) -> list[str]:
             continue
         median = np.median(d["looks"])
         lines.append(
-            f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | {median / near:.1f} | "
+            f"| {d['one_way']:g} s | {', '.join(f'{v:.1f} s' for v in d['looks'])} | {median:.1f} s | "
+            f"{median / near:.1f} | "
             f"{d['measured'] or 0:.2f} s | {d['error_mm']:.3f} mm | {d['status']} |"
         )
     return lines
@@ -219,29 +222,37 @@ def main() -> str:
     lines = [
         "# A far controller",
         "",
-        f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}. videocal's own protocol through "
-        "`videocal_sim/delay_line.py` (one-way delay, +-30 % jitter, 1 % of the chunks lost once and delivered a round trip "
-        "late, as TCP does) to the controller simulator in another process. A look: Go -> DON -> the joint history at the "
-        f"workstation shows the robot still for the settle rule's hold; {LOOKS} looks between two poses 40-60 deg apart. "
+        f"`make bench` on {platform.machine()}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}. videocal's own "
+        "protocol through "
+        "`videocal_sim/delay_line.py` (one-way delay, +-30 % jitter, 1 % of the chunks lost once and delivered a round "
+        "trip "
+        "late, as TCP does) to the controller simulator in another process. A look: Go -> DON -> the joint history at "
+        "the "
+        f"workstation shows the robot still for the settle rule's hold; {LOOKS} looks between two poses 40-60 deg "
+        "apart. "
         "Peer: the same program through the line at 0 s.",
         "",
-        "| one-way delay | handshake | measured one-way | time per look (median) | ratio to 0 s | moves sent / reaching the controller | sent twice | dead-man stops | chunks lost once |",
+        "| one-way delay | handshake | measured one-way | time per look (median) | ratio to 0 s | moves sent / "
+        "reaching the controller | sent twice | dead-man stops | chunks lost once |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         look = np.median(r["looks"]) if r["looks"] else float("nan")
         measured = "-" if r["delay_s"] is None else f"{r['delay_s']:.2f} s"
         lines.append(
-            f"| {r['one_way']:g} s | {r['handshake_s']:.1f} s{'' if r['ready'] else ' (FAILED)'} | {measured} | {look:.2f} s ({len(r['looks'])}/{LOOKS}) | "
+            f"| {r['one_way']:g} s | {r['handshake_s']:.1f} s{'' if r['ready'] else ' (FAILED)'} | {measured} | "
+            f"{look:.2f} s ({len(r['looks'])}/{LOOKS}) | "
             f"{look / peer:.1f} | {r['sent']} / {r['seen']} | {r['duplicates']} | {r['stops']} | {r['late']} |"
         )
     lines += [
         "",
         "## Through the window",
         "",
-        "`videocal demo --offscreen --scale 0.5 --link-delay-ms MS` (the same delay line on the controller link; the simulated "
+        "`videocal demo --offscreen --scale 0.5 --link-delay-ms MS` (the same delay line on the controller link; the "
+        "simulated "
         "camera follows the joints the link delivers, so its frames come as late as the samples, as a gripper camera's "
-        "would). A look: Go pressed -> a frame the core accepts for picks (the settle rule widened by the link's spread of "
+        "would). A look: Go pressed -> a frame the core accepts for picks (the settle rule widened by the link's "
+        "spread of "
         "delays). The corrected tool's error is scored against the simulator's truth.",
         "",
         *_demo_table(demos),
@@ -251,10 +262,14 @@ def main() -> str:
         lines.append(f"Not measured on this machine: {no_far_network}.")
     else:
         lines += [
-            "`videocal demo --offscreen --scale 0.5 --site ros2 --link-delay-ms MS`: the simulated ros2_control arm in a network "
-            "namespace of its own behind `videocal_sim/far_network.py`, every DDS packet to and from it delayed (one way, +-30 %, in "
-            "order) and 1 % dropped; the camera's frames follow the joint states as they arrive and carry their stamps. At 0 s there "
-            "is no relay: DDS on the loopback (the peer). The measured one-way delay is the joint states' arrival minus their "
+            "`videocal demo --offscreen --scale 0.5 --site ros2 --link-delay-ms MS`: the simulated ros2_control arm in "
+            "a network "
+            "namespace of its own behind `videocal_sim/far_network.py`, every DDS packet to and from it delayed (one "
+            "way, +-30 %, in "
+            "order) and 1 % dropped; the camera's frames follow the joint states as they arrive and carry their "
+            "stamps. At 0 s there "
+            "is no relay: DDS on the loopback (the peer). The measured one-way delay is the joint states' arrival "
+            "minus their "
             "stamps (a FIFO path with +-30 % jitter delivers near its upper end).",
             "",
             *_demo_table(ros2),
@@ -264,11 +279,16 @@ def main() -> str:
         lines.append(f"Not measured on this machine: {no_far_network}.")
     else:
         lines += [
-            "Aravis's own fake GigE Vision camera (its test pattern, 25 fps) on the robot's side of `videocal_sim/far_network.py` "
-            "(one way, +-30 %, 1 % of the frames dropped), read through `aravis://` with Aravis 0.8 on this side. GigE Vision is a "
-            "LAN protocol: Aravis waits a fixed time for each control answer (no setting for it in 0.8), so the camera opens "
-            "slowly at 0.3 s and not at all when a round trip outlasts that wait. A frame counts only if all its packets arrive: "
-            "the fake camera resent none of the 1 % lost here, so even at 0 s most frames are incomplete (a real camera "
+            "Aravis's own fake GigE Vision camera (its test pattern, 25 fps) on the robot's side of "
+            "`videocal_sim/far_network.py` "
+            "(one way, +-30 %, 1 % of the frames dropped), read through `aravis://` with Aravis 0.8 on this side. GigE "
+            "Vision is a "
+            "LAN protocol: Aravis waits a fixed time for each control answer (no setting for it in 0.8), so the camera "
+            "opens "
+            "slowly at 0.3 s and not at all when a round trip outlasts that wait. A frame counts only if all its "
+            "packets arrive: "
+            "the fake camera resent none of the 1 % lost here, so even at 0 s most frames are incomplete (a real "
+            "camera "
             "resends on request). Far away, send the frames on from the robot's side (docs/real-cell.md).",
             "",
             "| one-way delay | opened after | frames/s after | |",
@@ -282,16 +302,25 @@ def main() -> str:
                 lines.append(f"| {g['one_way']:g} s | {g['opened_s']:.1f} s | {g['fps']:.1f} | |")
     lines += [
         "",
-        "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored against "
-        "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is judged "
-        "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a round "
-        "trip late every two seconds or so, so the spread stays near 4 s (1.5 s +-30 % plus a lost segment's 3.2 s) and a far "
-        "look waits about that twice, on top of the link-level look above. That is the price of never taking a frame whose "
+        "Measured: every figure, at the workstation (the delay line's weather is the only input; the error is scored "
+        "against "
+        "the truth). The settle rule asks for stillness over the hold plus the link's spread of delays, and a frame is "
+        "judged "
+        "only once the samples of its time are in: at 1 % of the segments lost, one of the fifty samples a second is a "
+        "round "
+        "trip late every two seconds or so, so the spread stays near 4 s (1.5 s +-30 % plus a lost segment's 3.2 s) "
+        "and a far "
+        "look waits about that twice, on top of the link-level look above. That is the price of never taking a frame "
+        "whose "
         "content may be from before the robot stopped. The measured one-way delay is half TCP's "
-        "smoothed round trip, which the lost segments' late answers raise above the mean delay. The move's own duration "
-        "(the simulator's trapezoid) and the hold are in every row; what the delay adds is about one round trip (the move "
-        "out, its DON and the samples of the hold back). The handshake is two round trips once the first hello's answer "
-        "is in; at 1.5 s the first try (1.5 s) is over before it, so a second hello goes out and its answer opens the session.",
+        "smoothed round trip, which the lost segments' late answers raise above the mean delay. The move's own "
+        "duration "
+        "(the simulator's trapezoid) and the hold are in every row; what the delay adds is about one round trip (the "
+        "move "
+        "out, its DON and the samples of the hold back). The handshake is two round trips once the first hello's "
+        "answer "
+        "is in; at 1.5 s the first try (1.5 s) is over before it, so a second hello goes out and its answer opens the "
+        "session.",
         "",
     ]
     OUT.write_text("\n".join(lines))

@@ -55,7 +55,8 @@ def table1_section() -> list[str]:
         worst_r = max((r.max_rotation_error_deg for r in conv), default=float("nan"))
         label = f"{model}" + (" (derivatives as printed, undamped)" if printed else "")
         lines.append(
-            f"| {label} | {worst_t:.1e} | {worst_r:.1e} | {min(r.iterations for r in rows)}-{max(r.iterations for r in rows)} | {len(conv)}/10 |"
+            f"| {label} | {worst_t:.1e} | {worst_r:.1e} | "
+            f"{min(r.iterations for r in rows)}-{max(r.iterations for r in rows)} | {len(conv)}/10 |"
         )
     # OpenCV on the same three points from the same starts: its iterative solver needs 4 points.
     from calib_core.solver.paper_table1 import CAMERA, FIXTURE_POINTS_MM, TRUE_OBJ2CAM, PAPER_STARTS
@@ -117,16 +118,23 @@ def _paper_pixels(P, truth):
 
 def convergence_section(rng) -> list[str]:
     lines = [
-        f"## Convergence from random starts ({TRIALS} each, exact pixels; success = within {SUCCESS_MM} mm and {SUCCESS_DEG} deg of the truth)",
+        f"## Convergence from random starts ({TRIALS} each, exact pixels; success = within {SUCCESS_MM} mm and "
+        f"{SUCCESS_DEG} deg of the truth)",
         "",
-        "Starts are the true pose moved by the stated distance along a random direction and turned by the stated angle about a random axis. "
-        "With focal estimation the focal lengths also start 3 % off. Columns: `Newton` is videocal's damped Newton iteration from the start "
-        "alone (the batch form with `starts`), counted as a success when it reaches the true pose; `exact` counts it converging to *a* pose "
-        "that fits the pixels exactly (with 4 points and unknown focal lengths, 8 equations in 8 unknowns have several exact solutions, so "
-        "reaching another one is not a failure of the iteration); `solve_pose` is the full solver with the start given as the prior (the "
+        "Starts are the true pose moved by the stated distance along a random direction and turned by the stated angle "
+        "about a random axis. "
+        "With focal estimation the focal lengths also start 3 % off. Columns: `Newton` is videocal's damped Newton "
+        "iteration from the start "
+        "alone (the batch form with `starts`), counted as a success when it reaches the true pose; `exact` counts it "
+        "converging to *a* pose "
+        "that fits the pixels exactly (with 4 points and unknown focal lengths, 8 equations in 8 unknowns have several "
+        "exact solutions, so "
+        "reaching another one is not a failure of the iteration); `solve_pose` is the full solver with the start given "
+        "as the prior (the "
         "modelled camera pose): its first-ranked answer reaching the truth, and how often it reports `ambiguous`.",
         "",
-        "| start error | points | focal | Newton: truth | Newton: exact fit | solve_pose + prior: truth | ambiguous | paper's method (undamped, its model) | OpenCV ITERATIVE + guess |",
+        "| start error | points | focal | Newton: truth | Newton: exact fit | solve_pose + prior: truth | ambiguous | "
+        "paper's method (undamped, its model) | OpenCV ITERATIVE + guess |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for dist, ang in ((40, 15), (100, 30), (250, 60)):
@@ -159,9 +167,12 @@ def convergence_section(rng) -> list[str]:
                 cv_rate = "n/a (no focal estimation)"
             else:
                 ok = [(_opencv("iterative+guess", P[i], uv[i], starts[i])) for i in range(TRIALS)]
-                cv_rate = f"{100 * np.mean([T is not None and _errors(T, scenes[i][0])[0] < SUCCESS_MM for i, T in enumerate(ok)]):.1f} %"
+                reached = [T is not None and _errors(T, scenes[i][0])[0] < SUCCESS_MM for i, T in enumerate(ok)]
+                cv_rate = f"{100 * np.mean(reached):.1f} %"
             lines.append(
-                f"| {dist} mm / {ang} deg | {n} | {'estimated' if focal else 'known'} | {100 * ours:.1f} % | {100 * exact:.1f} % | {100 * full_truth:.1f} % | {100 * ambiguous:.1f} % | {100 * paper:.1f} % | {cv_rate} |"
+                f"| {dist} mm / {ang} deg | {n} | {'estimated' if focal else 'known'} | {100 * ours:.1f} % | "
+                f"{100 * exact:.1f} % | {100 * full_truth:.1f} % | {100 * ambiguous:.1f} % | {100 * paper:.1f} % | "
+                f"{cv_rate} |"
             )
     lines.append("")
     return lines
@@ -182,13 +193,17 @@ def accuracy_section(rng) -> list[str]:
     lines = [
         f"## Accuracy at {NOISE_PX} px noise ({TRIALS} random scenes each)",
         "",
-        "RMS translation error over the Cramer-Rao bound, each scene's squared error divided by its own bound before averaging "
-        "(1.00 is optimal); gross failures are errors above 10 times the bound. `sigma ratio` is videocal's reported translation "
+        "RMS translation error over the Cramer-Rao bound, each scene's squared error divided by its own bound before "
+        "averaging "
+        "(1.00 is optimal); gross failures are errors above 10 times the bound. `sigma ratio` is videocal's reported "
+        "translation "
         "sigma over its actual error, normalised the same way (1.00 means honest). "
-        "videocal is given the modelled camera pose as its prior, as in the window (the truth moved 5 mm and turned 1 deg: a robot's "
+        "videocal is given the modelled camera pose as its prior, as in the window (the truth moved 5 mm and turned 1 "
+        "deg: a robot's "
         "model error); the prior only ranks candidates that fit equally well. `no prior` is the same solve without it.",
         "",
-        "| points | videocal RMS/CRB | gross | sigma ratio | no prior RMS/CRB | gross | SQPnP+LM RMS/CRB | gross | EPnP RMS/CRB | gross | ITERATIVE RMS/CRB | gross |",
+        "| points | videocal RMS/CRB | gross | sigma ratio | no prior RMS/CRB | gross | SQPnP+LM RMS/CRB | gross | "
+        "EPnP RMS/CRB | gross | ITERATIVE RMS/CRB | gross |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for n, planar in ((4, False), (6, False), (20, False), (4, True)):
@@ -291,7 +306,10 @@ def _robust_row(label: str, cases, cam, noise_px: float, tol: float, reps: int) 
     peak = tracemalloc.get_traced_memory()[1] / 1e6
     tracemalloc.stop()
     share_ok = " / ".join(f"{100 * v / len(cases):.0f} %" for v in ok)
-    return f"| {label} | {ours * 1e3:.2f} ms | {cv * 1e3:.2f} ms | {pl * 1e3:.2f} ms | {ours / cv:.2f} | {share_ok} | {peak:.1f} MB |"
+    return (
+        f"| {label} | {ours * 1e3:.2f} ms | {cv * 1e3:.2f} ms | {pl * 1e3:.2f} ms | {ours / cv:.2f} | {share_ok} | "
+        f"{peak:.1f} MB |"
+    )
 
 
 def _tutorial_cases(rng) -> list:
@@ -318,9 +336,11 @@ def robust_section(rng) -> list[str]:
         "Time is the best of 5 runs of a whole call; `ok` counts solves within 1 mm and 0.5 deg of the truth over 100 "
         "scenes (10 for the large ones; for the tutorial's pairs, in cm, within 0.05 cm of their least-squares pose); "
         "peak memory is tracemalloc's peak during one call (Python allocations: OpenCV's and PoseLib's own "
-        "C++ allocations are not seen). PoseLib runs with its defaults (at least 1000 hypotheses, its own bundle adjustment).",
+        "C++ allocations are not seen). PoseLib runs with its defaults (at least 1000 hypotheses, its own bundle "
+        "adjustment).",
         "",
-        "| problem | videocal robust | OpenCV solvePnPRansac (AP3P) | PoseLib | videocal / OpenCV (target <= 1.0) | ok: videocal / OpenCV / PoseLib | videocal peak memory |",
+        "| problem | videocal robust | OpenCV solvePnPRansac (AP3P) | PoseLib | videocal / OpenCV (target <= 1.0) | "
+        "ok: videocal / OpenCV / PoseLib | videocal peak memory |",
         "|---|---|---|---|---|---|---|",
     ]
     for n, share, reps in ((20, 0.2, 200), (5000, 0.3, 5)):
@@ -369,7 +389,8 @@ def main() -> str:
         "# Pose solver benchmarks",
         "",
         f"Generated by `make bench` (bench/solver_bench.py) on {platform.machine()}, {platform.python_version()}, "
-        f"OpenCV {cv2.__version__}, PoseLib {poselib.__version__}, numpy {np.__version__}; {time.time() - t0:.0f} s. Camera: fu 1120, fv 1116 px, 1280 x 960, no distortion; "
+        f"OpenCV {cv2.__version__}, PoseLib {poselib.__version__}, numpy {np.__version__}; {time.time() - t0:.0f} s. "
+        "Camera: fu 1120, fv 1116 px, 1280 x 960, no distortion; "
         "objects of 150 mm seen from 400-600 mm with every point inside the image.",
         "",
     ]

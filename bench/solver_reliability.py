@@ -64,14 +64,20 @@ def _peers(P, uv):
 
 def robust_reliability_section(rng: np.random.Generator) -> list[str]:
     lines = [
-        "## Robust solves: wrong `ok` and success (outliers uniform over the image, 0.5 px noise, the noise model's default)",
+        "## Robust solves: wrong `ok` and success (outliers uniform over the image, 0.5 px noise, the noise model's "
+        "default)",
         "",
-        f"{SCENES} scenes per row; the outliers are round(share x N) pairs (at least one). `right` = within 5 sigma + 0.5 mm of the truth "
-        "(sigma: the least-squares pose of the good pairs with the noise known). videocal's `wrong ok` is an `ok` whose pose is not right "
-        "(target 0); its success is an `ok` that is right; the peers return a pose or nothing, so their `wrong` is any pose returned that is "
-        "not right. With 5 pairs and 2 outliers only 3 good pairs are left: no pose can be checked, the right answer is `failed`.",
+        f"{SCENES} scenes per row; the outliers are round(share x N) pairs (at least one). `right` = within 5 sigma + "
+        "0.5 mm of the truth "
+        "(sigma: the least-squares pose of the good pairs with the noise known). videocal's `wrong ok` is an `ok` "
+        "whose pose is not right "
+        "(target 0); its success is an `ok` that is right; the peers return a pose or nothing, so their `wrong` is any "
+        "pose returned that is "
+        "not right. With 5 pairs and 2 outliers only 3 good pairs are left: no pose can be checked, the right answer "
+        "is `failed`.",
         "",
-        "| N | outliers | videocal wrong ok | videocal ok and right | ambiguous / failed | OpenCV RANSAC wrong / right | PoseLib wrong / right |",
+        "| N | outliers | videocal wrong ok | videocal ok and right | ambiguous / failed | OpenCV RANSAC wrong / right "
+        "| PoseLib wrong / right |",
         "|---|---|---|---|---|---|---|",
     ]
     for n in (5, 6, 8, 10, 20):
@@ -100,7 +106,8 @@ def robust_reliability_section(rng: np.random.Generator) -> list[str]:
             pct = {key: 100.0 * v / SCENES for key, v in counts.items()}
             lines.append(
                 f"| {n} | {k} ({share:.0%}) | {counts['wrong']} | {pct['right']:.0f} % | {pct['unsure']:.0f} % | "
-                f"{pct['cv_wrong']:.0f} % / {pct['cv_right']:.0f} % | {pct['pl_wrong']:.0f} % / {pct['pl_right']:.0f} % |"
+                f"{pct['cv_wrong']:.0f} % / {pct['cv_right']:.0f} % | {pct['pl_wrong']:.0f} % / {pct['pl_right']:.0f} "
+                "% |"
             )
     return lines + [""]
 
@@ -109,7 +116,8 @@ def mis_pick_section(rng: np.random.Generator) -> list[str]:
     lines = [
         "## Mis-picks caught (one pick moved by the stated distance among N good ones at 0.5 px)",
         "",
-        f"{SCENES} scenes per cell. Plain: the solve is not `ok` and names that pair (its misfit test); robust: that pair is rejected "
+        f"{SCENES} scenes per cell. Plain: the solve is not `ok` and names that pair (its misfit test); robust: that "
+        "pair is rejected "
         "(and no good one). The clean column is the share of clean sets where a good pair is named (false flags).",
         "",
         "| N | mode | clean: false flags | 5 px | 10 px | 20 px |",

@@ -36,14 +36,19 @@ def _poselib_plain(P, uv):
 
 def speed_section(rng) -> list[str]:
     lines = [
-        f"## Speed ({SPEED_SCENES} different scenes a row at {NOISE_PX} px noise, no prior; mean per solve, best of 3 passes; a whole solve: "
+        f"## Speed ({SPEED_SCENES} different scenes a row at {NOISE_PX} px noise, no prior; mean per solve, best of 3 "
+        "passes; a whole solve: "
         "checks, seeds, refinement, covariance, leave-one-out and the mis-pick test)",
         "",
-        "Every solver sees the same problems after a warm-up (videocal's compiled kernels loaded, the full search run once). PoseLib runs "
-        "`estimate_absolute_pose` (P3P/LO-RANSAC and its bundle adjustment) with `min_iterations` 0, so that a clean set ends after its first "
-        "hypotheses: its fastest use for a plain solve. `full search` counts videocal's solves that left the compiled fast path.",
+        "Every solver sees the same problems after a warm-up (videocal's compiled kernels loaded, the full search run "
+        "once). PoseLib runs "
+        "`estimate_absolute_pose` (P3P/LO-RANSAC and its bundle adjustment) with `min_iterations` 0, so that a clean "
+        "set ends after its first "
+        "hypotheses: its fastest use for a plain solve. `full search` counts videocal's solves that left the compiled "
+        "fast path.",
         "",
-        "| problem | videocal solve_pose | full search | OpenCV SQPnP + RefineLM | PoseLib | videocal / OpenCV (target <= 1.0) | videocal / PoseLib (target <= 2.0) |",
+        "| problem | videocal solve_pose | full search | OpenCV SQPnP + RefineLM | PoseLib | videocal / OpenCV (target "
+        "<= 1.0) | videocal / PoseLib (target <= 2.0) |",
         "|---|---|---|---|---|---|---|",
     ]
     import calib_core.solver.solve as solve_module
@@ -67,7 +72,8 @@ def speed_section(rng) -> list[str]:
         cv = _mean_per_solve(lambda P, uv: _opencv("sqpnp+lm", P, uv), problems)
         pl = _mean_per_solve(_poselib_plain, problems)
         lines.append(
-            f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us | {ours / cv:.2f} | {ours / pl:.2f} |"
+            f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us "
+            f"| {ours / cv:.2f} | {ours / pl:.2f} |"
         )
     scenes = [_scene(rng, 6) for _ in range(1000)]
     P = np.stack([s[1] for s in scenes])

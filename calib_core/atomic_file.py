@@ -52,7 +52,8 @@ def atomic_path(
             except Exception as exc:  # whatever the reader raises, the file is not what was meant
                 raise FileWriteError(
                     target,
-                    f"not written (the old file, if any, is unchanged): what reached the disk does not read back ({exc})",
+                    "not written (the old file, if any, is unchanged): what reached the disk does not read back "
+                    f"({exc})",
                 ) from None
         _keep_mode(target, tmp)
         os.replace(tmp, target)

@@ -82,7 +82,8 @@ def parse_yaml(text: str, path: str | Path, *, max_depth: int = MAX_DEPTH, max_a
                 if aliases > max_aliases:
                     raise FileFormatError(
                         path,
-                        f"uses more than {max_aliases} YAML aliases (*name); write the values out (line {event.start_mark.line + 1})",
+                        f"uses more than {max_aliases} YAML aliases (*name); write the values out (line "
+                        f"{event.start_mark.line + 1})",
                     )
         return yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as exc:

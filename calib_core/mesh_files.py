@@ -40,7 +40,8 @@ def _stl_header_triangles(path: Path) -> int | None:
 
 
 def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> trimesh.Trimesh:
-    """The mesh at ``path`` in mm (``units``: the file's, ``mm``, ``cm`` or ``m``). :class:`FileFormatError` names the file (and
+    """The mesh at ``path`` in mm (``units``: the file's, ``mm``, ``cm`` or ``m``). :class:`FileFormatError` names the
+    file (and
     ``field``, the workcell key that named it) for an unknown format, a file or mesh over the limits, an unreadable
     file, no triangles, non-finite or absurd coordinates, or no area."""
     path = Path(path)

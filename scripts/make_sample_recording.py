@@ -92,7 +92,8 @@ def main() -> None:
     camera.close()
     duration = clock.t_s - start
     print(
-        f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, {n_joint} joint samples at {JOINT_HZ:g} Hz)"
+        f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, "
+        f"{n_joint} joint samples at {JOINT_HZ:g} Hz)"
     )
 
 

@@ -32,15 +32,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--cold",
         action="store_true",
-        help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each beside the truth (no window)",
+        help="the cold cell: intrinsics, robot and mounting, camera to tool, then one look at the task location, each "
+        "beside the truth (no window)",
     )
     parser.add_argument(
         "--site",
         choices=("sim", "ros2", "gige", "ur"),
         default="sim",
-        help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default); ROS 2 "
-        "(a simulated ros2_control arm and a camera topic on Cyclone DDS, on ROS_DOMAIN_ID when set, else a private domain 71-100); or gige (the camera "
-        "served as a GigE Vision camera on the loopback interface, read through Aravis); or ur (the robot a simulated Universal "
+        help="how the window reaches the simulated cell: videocal's own link and the in-process camera (default); ROS "
+        "2 "
+        "(a simulated ros2_control arm and a camera topic on Cyclone DDS, on ROS_DOMAIN_ID when set, else a private "
+        "domain 71-100); or gige (the camera "
+        "served as a GigE Vision camera on the loopback interface, read through Aravis); or ur (the robot a simulated "
+        "Universal "
         "Robots controller: RTDE through ur_rtde, moves as URScript)",
     )
     parser.add_argument(
@@ -48,7 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=bounded_float(0.0, 5000.0),
         default=0.0,
         metavar="MS",
-        help="put the controller far away: this one-way delay, +-30 %% jitter, 1 %% lost, on videocal's link (--site sim: a TCP "
+        help="put the controller far away: this one-way delay, +-30 %% jitter, 1 %% lost, on videocal's link (--site "
+        "sim: a TCP "
         "delay line) or ROS 2's (--site ros2: the arm in a network namespace of its own, every DDS packet delayed; "
         "needs root); the frames follow the link's samples, as a gripper camera's would",
     )
@@ -56,15 +61,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--look",
         choices=("plain", "workshop"),
         default="plain",
-        help="how the simulated camera's images look: plain (the parts as their CAD, one key light; default) or workshop "
-        "(the parts printed and up to a millimetre off their CAD, three lamps casting shadows, highlights, a noisier and "
+        help="how the simulated camera's images look: plain (the parts as their CAD, one key light; default) or "
+        "workshop "
+        "(the parts printed and up to a millimetre off their CAD, three lamps casting shadows, highlights, a noisier "
+        "and "
         "softer camera: what a real camera shows)",
     )
     parser.add_argument(
         "--method",
         choices=("find-points", "picks", "edges"),
         default="find-points",
-        help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find points and Calibrate on edges",
+        help="how each look is made: Find points and Accept all (default), the operator's picks by hand, or Find "
+        "points and Calibrate on edges",
     )
 
 

@@ -27,7 +27,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--workcell",
         type=Path,
-        help="simulate the controller of this cell's robot: its joint count, limits, speeds, axis order and home (default: the bundled cell)",
+        help="simulate the controller of this cell's robot: its joint count, limits, speeds, axis order and home "
+        "(default: the bundled cell)",
     )
     parser.add_argument(
         "--robot",
@@ -37,7 +38,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--joints",
-        help="initial joints in the controller's axis order, degrees or mm, separated by commas (default: the cell's home)",
+        help="initial joints in the controller's axis order, degrees or mm, separated by commas (default: the cell's "
+        "home)",
     )
     parser.add_argument(
         "--noise-rate", type=float, default=0.0, help="probability of random garbage bytes before a sentence"
@@ -58,12 +60,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--key-file",
         type=Path,
-        help="the link key to require on motion sentences (default: the user's, made on first use; see `videocal link-key`)",
+        help="the link key to require on motion sentences (default: the user's, made on first use; see `videocal "
+        "link-key`)",
     )
     parser.add_argument(
         "--open",
         action="store_true",
-        help="no link key: a protocol-3 controller that obeys any client's MVJ (to test a workstation against an old controller)",
+        help="no link key: a protocol-3 controller that obeys any client's MVJ (to test a workstation against an old "
+        "controller)",
     )
 
 
@@ -133,7 +137,8 @@ def run(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise VideocalError(f"cannot serve: {exc}") from None
     print(
-        f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} dropped",
+        f"sent with faults: {faults.noise_bursts} garbage bursts, {faults.corrupted} corrupted, {faults.dropped} "
+        "dropped",
         file=sys.stderr,
     )
     return 0

@@ -11,7 +11,10 @@ import threading
 
 from app.cli.options import resolved_path
 
-HELP = "serve a cell's robot as a simulated Universal Robots controller (RTDE on 30004, URScript on 30002, dashboard on 29999)"
+HELP = (
+    "serve a cell's robot as a simulated Universal Robots controller (RTDE on 30004, URScript on 30002, dashboard "
+    "on 29999)"
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -44,7 +47,8 @@ def run(args: argparse.Namespace) -> int:
     robot = cell.robot
     if robot.n_joints != 6 or any(u != "deg" for u in robot.joint_units):
         raise VideocalError(
-            f"a UR controller drives 6 revolute joints; {cell.workcell.path}'s robot has {robot.n_joints} ({', '.join(robot.joint_units)})"
+            f"a UR controller drives 6 revolute joints; {cell.workcell.path}'s robot has {robot.n_joints} "
+            f"({', '.join(robot.joint_units)})"
         )
     initial = joints_option(args.joints, 6, cell.home_joints)
     lower = np.radians(np.where(np.isfinite(robot.lower_limits_deg), robot.lower_limits_deg, -360.0))

@@ -128,7 +128,8 @@ def calibrate_cold_cell(
         )
         robot = with_tool(result.robot, tool.tcp2cam)
         say(
-            f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)"
+            f"camera to tool from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} "
+            f"mm, {tool.spread_deg:.4f} deg)"
         )
     score = score_against_truth(result, bed, truth, held_out, board2base, robot)
     score["parameters_against_truth"] = parameters_against_truth(result, bed, identified.views, intrinsics.intrinsics)

@@ -39,7 +39,8 @@ def look_at_task(
 ) -> dict:
     """Figures of one look at ``task_name`` (default: the cell's first task) with the calibrated
     ``robot`` and ``intrinsics``, made from the task location itself (``from_where="task"``, as the
-    paper and ``videocal demo`` do) or from its approach (``"approach"``): the TCP's true error at the task commanded through the calibrated
+    paper and ``videocal demo`` do) or from its approach (``"approach"``): the TCP's true error at the task commanded
+    through the calibrated
     model without the look and with it, the look's own 1-sigma, and whether the error is within 3 sigma.
     ``model_covariance(q_deg)``: the calibrated model's TCP covariance (6, 6: mm, deg) at joints; with
     it the look is also fused with the model (:mod:`calib_core.calibration.look_fusion`), the

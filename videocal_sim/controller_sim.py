@@ -181,7 +181,8 @@ class ControllerLogic:
                 out.append(
                     ErrorReply(
                         "DEADMAN",
-                        f"move {msg.id}: no heartbeat from the workstation for {1000 * (now - self._last_heartbeat_t):.0f} ms: not moving",
+                        f"move {msg.id}: no heartbeat from the workstation for "
+                        f"{1000 * (now - self._last_heartbeat_t):.0f} ms: not moving",
                     )
                 )
             else:

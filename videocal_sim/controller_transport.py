@@ -49,7 +49,8 @@ class _PtyEndpoint:
         if link_path is not None:
             if link_path.exists() and not link_path.is_symlink():
                 raise FileExistsError(
-                    f"--link {link_path}: a file is there and it is not a link; give another path (nothing was replaced)"
+                    f"--link {link_path}: a file is there and it is not a link; give another path (nothing was "
+                    "replaced)"
                 )
             tmp = Path(str(link_path) + ".tmp")
             if tmp.is_symlink() or tmp.exists():

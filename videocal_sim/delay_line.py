@@ -56,7 +56,8 @@ class LinkWeather:
 
 @dataclass
 class DelayStats:
-    """What crossed: ``chunks`` and ``bytes`` per direction (``up``: workstation to cell), ``late``: chunks lost once."""
+    """What crossed: ``chunks`` and ``bytes`` per direction (``up``: workstation to cell), ``late``: chunks lost
+    once."""
 
     chunks: dict = field(default_factory=lambda: {"up": 0, "down": 0})
     bytes: dict = field(default_factory=lambda: {"up": 0, "down": 0})

@@ -144,7 +144,8 @@ def run_demo(
         weather = LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01)
         if site_kind not in ("sim", "ros2"):
             raise ValueError(
-                f"--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site {site_kind}"
+                "--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site "
+                f"{site_kind}"
             )
     if site_kind == "ros2":  # the same simulated cell, its robot and camera reached through ROS 2
         from videocal_sim.ros2_site import Ros2SimulatedSite
@@ -205,7 +206,8 @@ def run_demo(
             60,
             "the controller link and the camera",
             lambda: (
-                f"link {'up' if wb.link_up else 'not up'}; camera {'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
+                f"link {'up' if wb.link_up else 'not up'}; camera "
+                f"{'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
                 f"status: {win.results.status.text()!r}"
             ),
         )
@@ -218,7 +220,8 @@ def run_demo(
         def where(target):
             """What a move's timeout reports: the motion's state, the distance left, the status line."""
             return lambda: (
-                f"motion {wb.motion.motion.value}, {np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]):.3f} mm from the target; "
+                f"motion {wb.motion.motion.value}, "
+                f"{np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), target)[0]):.3f} mm from the target; "
                 f"status: {win.results.status.text()!r}"
             )
 
@@ -271,7 +274,8 @@ def run_demo(
                 win.finder.dialog is None or not win.finder.dialog.isVisible()
             ):  # Find points runs in the click: it showed why not
                 raise OperatorError(
-                    f"demo ({round_name} look): Find points proposed nothing: {win.statusBar().currentMessage() or win.results.status.text()}"
+                    f"demo ({round_name} look): Find points proposed nothing: "
+                    f"{win.statusBar().currentMessage() or win.results.status.text()}"
                 )
             dialog = win.finder.dialog
             shot(f"{round_name}_points_found")
@@ -279,7 +283,8 @@ def run_demo(
             if method == "edges":
                 if not dialog.edges_button.isEnabled():
                     raise OperatorError(
-                        f"demo ({round_name} look): Find points found no settled edge fit: {dialog.found.result.message}"
+                        f"demo ({round_name} look): Find points found no settled edge fit: "
+                        f"{dialog.found.result.message}"
                     )
                 _click(dialog.edges_button, 10, 10)
             else:
@@ -333,8 +338,10 @@ def run_demo(
                     ]
                     frame = win.camera.last_frame_received
                     raise RuntimeError(
-                        f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; {wb.motion.text}; "
-                        f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events {moves_seen}"
+                        f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; "
+                        f"{wb.motion.text}; "
+                        f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events "
+                        f"{moves_seen}"
                     )
                 if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
@@ -347,7 +354,8 @@ def run_demo(
                 app.processEvents()
             if len(picked) < _MIN_FEATURES:
                 raise RuntimeError(
-                    f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} ({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}"
+                    f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} "
+                    f"({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}"
                 )
             shot(f"{round_name}_pairs_picked")
             _click(win.commands.calibrate, 10, 10)
@@ -425,9 +433,12 @@ def run_demo(
             "hand_eye": "exact",
             "estimate_within_3_sigma": bool(np.all(np.abs(r.displacement_mm - d_true) <= 3 * r.std_displacement_mm)),
             "screenshots": shots,
-            "note": "the true robot has typical joint, link and base errors and the modelled camera mounting (hand_eye exact: a hand-eye "
-            "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they are); the "
-            "correction is measured at the task location, then again from the corrected location, and the second one is stored last",
+            "note": "the true robot has typical joint, link and base errors and the modelled camera mounting (hand_eye "
+            "exact: a hand-eye "
+            "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they "
+            "are); the "
+            "correction is measured at the task location, then again from the corrected location, and the second one "
+            "is stored last",
         }
         wb.files.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
         report["workspace"] = "workspace.json"

@@ -12,7 +12,8 @@ passes through here, whatever the protocol says.
 One process (``python -m videocal_sim.far_network``, root: namespaces and TAP devices need CAP_NET_ADMIN)
 makes the near TAP device in its own namespace, then moves into a new namespace of its own and makes the far
 one there (a TAP device stays in the namespace it was made in). Each side has a /24 address with a broadcast (a
-GigE Vision camera is found by broadcast) and the other's MAC set outright (ARP would give up across seconds). Programs of the far side join it with
+GigE Vision camera is found by broadcast) and the other's MAC set outright (ARP would give up across seconds). Programs
+of the far side join it with
 ``nsenter --net=/proc/PID/ns/net`` (:meth:`FarNetwork.far_command`). Nothing is left behind: the namespace
 lives while the relay or a far program runs in it, the TAP devices while the relay holds them open.
 
@@ -295,7 +296,8 @@ def main(argv: list[str] | None = None) -> int:
     relay.close()
     s = relay.stats
     print(
-        f"relayed up {s.packets['up']} (dropped {s.dropped['up']}), down {s.packets['down']} (dropped {s.dropped['down']})",
+        f"relayed up {s.packets['up']} (dropped {s.dropped['up']}), down {s.packets['down']} (dropped "
+        f"{s.dropped['down']})",
         file=sys.stderr,
     )
     return 0

@@ -1,4 +1,5 @@
-"""A printed box on a wood-grained table, rendered by videocal's renderer with its truth known (for tests and the real-photo bench): the difficulties
+"""A printed box on a wood-grained table, rendered by videocal's renderer with its truth known (for tests and the
+real-photo bench): the difficulties
 of OpenCV's photographed cookie box (a frame printed 12 mm inside every face's edge, lettering, a table with
 grain and a shadow-dark patch) where the truth can score. A render, not a photograph."""
 

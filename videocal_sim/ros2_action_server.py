@@ -1,4 +1,5 @@
-"""The simulated arm's ``FollowJointTrajectory`` action server, as ros2_controllers' joint_trajectory_controller serves it.
+"""The simulated arm's ``FollowJointTrajectory`` action server, as ros2_controllers' joint_trajectory_controller serves
+it.
 
 On Cyclone DDS with ``rmw_cyclonedds_cpp``'s service framing (:mod:`calib_core.ros2.action_types`). What the
 controller does, and so this server:
@@ -22,7 +23,8 @@ from calib_core.ros2 import action_types as at
 
 
 class FollowJointTrajectoryServer:
-    """Serves ``/<arm.controller>/follow_joint_trajectory`` for ``arm`` (:class:`videocal_sim.ros2_arm.SimulatedRos2Arm`)."""
+    """Serves ``/<arm.controller>/follow_joint_trajectory`` for ``arm``
+    (:class:`videocal_sim.ros2_arm.SimulatedRos2Arm`)."""
 
     def __init__(self, arm, *, feedback_hz: float = 20.0):
         self.arm = arm

@@ -6,7 +6,8 @@ the operator core reaches both only through its ROS 2 connectors (``ros2:///join
 The camera publisher runs here (it renders the test bed's true view, which is the truth and stays in
 ``videocal_sim``); it poses the camera from the joint states the core receives, as the simulated site does.
 
-Far away (``weather``): the arm runs in a network namespace of its own behind :class:`~videocal_sim.far_network.FarNetwork`,
+Far away (``weather``): the arm runs in a network namespace of its own behind
+:class:`~videocal_sim.far_network.FarNetwork`,
 every DDS packet between it and the workstation delayed, jittered and some dropped; the camera publisher stays on the
 workstation's side and renders where the joint states put the robot as they arrive, each frame stamped with the
 stamp of the joint state it shows (so the picture and its stamp agree however late the states came).
@@ -73,7 +74,8 @@ class Ros2ArmProcess:
                 self.process.wait(timeout=5)
                 why = self._stderr_path.read_text().strip().splitlines()
                 raise SiteError(
-                    f"the simulated ROS 2 arm did not start: {why[-1] if why else f'exit code {self.process.returncode}'}"
+                    "the simulated ROS 2 arm did not start: "
+                    f"{why[-1] if why else f'exit code {self.process.returncode}'}"
                 )
             self._ready = True
 

@@ -95,7 +95,8 @@ class SimulatorProcess:
                 self.process.wait(timeout=5)
                 why = self._stderr_path.read_text().strip().splitlines()
                 raise SiteError(
-                    f"the controller simulator did not start: {why[-1] if why else f'exit code {self.process.returncode}'}"
+                    "the controller simulator did not start: "
+                    f"{why[-1] if why else f'exit code {self.process.returncode}'}"
                 )
             self.device = line
         return self.device if self.tcp else str(self.link_path)

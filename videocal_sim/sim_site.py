@@ -71,12 +71,14 @@ def simulated_cell(
     less_kind: bool = False,
 ) -> tuple[Cell, SimulatedSite]:
     """The cell at ``workcell_path`` and a simulated site for it: the true robot has ``errors``
-    (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels); ``intrinsics``: another
+    (typical ones by default); ``image_scale`` shrinks the camera (0.5: a quarter of the pixels); ``intrinsics``:
+    another
     camera than the workcell's (its lens, a fisheye), the same for the simulated camera and the cell's model."""
     workcell = load_workcell(workcell_path)
     if workcell.intrinsics_path is None and intrinsics is None:
         raise VideocalError(
-            f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated camera needs one"
+            f"{workcell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): the simulated "
+            "camera needs one"
         )
     nominal: Intrinsics = intrinsics or load_intrinsics(workcell.intrinsics_path)
     if image_scale != 1.0:

@@ -55,7 +55,8 @@ class TestBed:
         true = TrueRobot(model, RobotErrors.typical(0, n_joints=model.n_joints) if errors is None else errors)
         if intrinsics is None and cell.intrinsics_path is None:
             raise VideocalError(
-                f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+                f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the "
+                "camera first (videocal calibrate-intrinsics)"
             )
         intr = intrinsics or load_intrinsics(cell.intrinsics_path)
         return cls(

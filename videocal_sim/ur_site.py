@@ -70,7 +70,8 @@ class URSimulatedSite(SimulatedSite):
                 self.ur.wait(timeout=5)
                 why = stderr_path.read_text().strip().splitlines()
                 raise SiteError(
-                    f"the simulated UR controller did not start: {why[-1] if why else f'exit code {self.ur.returncode}'}"
+                    "the simulated UR controller did not start: "
+                    f"{why[-1] if why else f'exit code {self.ur.returncode}'}"
                 )
         return f"ur-rtde://{self.host}"
 

@@ -3,7 +3,8 @@
 SOURCE is ``sim`` (the simulated test bed, its truth printed beside the result), a ROS-Industrial
 ``cal_data.yaml`` (or its folder), a CSV of images with flange poses or joints, or a ROS 2 bag (the flange pose at
 each image's stamp from ``/joint_states`` through the cell's robot, only where the arm stood still; the
-intrinsics from its CameraInfo unless ``--intrinsics``) (docs/calibration.md). A camera on the robot gives ``cam2flange``; a static camera
+intrinsics from its CameraInfo unless ``--intrinsics``) (docs/calibration.md). A camera on the robot gives
+``cam2flange``; a static camera
 (``--static-camera``, or the data file's ``static_camera``) gives ``cam2base``.
 """
 
@@ -36,7 +37,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--flange-from",
         choices=("auto", "joints", "tf"),
         default="auto",
-        help="with a bag: the flange pose from the joint states through the cell's robot, or from /tf (default: the joints when the bag has a JointState topic, else /tf)",
+        help="with a bag: the flange pose from the joint states through the cell's robot, or from /tf (default: the "
+        "joints when the bag has a JointState topic, else /tf)",
     )
     parser.add_argument(
         "--base-frame", help="with a bag's /tf: the robot's base frame (default: the workcell's base link)"
@@ -47,7 +49,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--workcell",
         type=Path,
-        help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are simulated (sim)",
+        help="the cell whose robot turns joints into flange poses (a CSV of joints), or whose robot and camera are "
+        "simulated (sim)",
     )
     parser.add_argument(
         "--board", help="the board (default: the data file's target_finder, else charuco:9x7:30:22:DICT_5X5_100)"
@@ -55,7 +58,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--intrinsics",
         type=Path,
-        help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); default: the data file's intrinsics",
+        help="the camera's intrinsics file (OpenCV or ROS YAML; without an image size the images' size is taken); "
+        "default: the data file's intrinsics",
     )
     parser.add_argument(
         "--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)"
@@ -92,7 +96,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         required=True,
         action="append",
-        help="where to write the mounting, in the form the name asks (repeat for several): .yaml videocal's (xyz mm, rpy deg, "
+        help="where to write the mounting, in the form the name asks (repeat for several): .yaml videocal's (xyz mm, "
+        "rpy deg, "
         "1-sigma); .launch.py a ROS 2 launch file running tf2_ros's static_transform_publisher; .urdf or .xacro a "
         "fixed-joint snippet for the robot's description",
     )
@@ -109,7 +114,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--robot-errors",
         action="store_true",
-        help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration needs accurate kinematics)",
+        help="with 'sim': give the simulated robot its joint, link and base errors too (shows why hand-eye calibration "
+        "needs accurate kinematics)",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
 
@@ -132,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
     camera = "cam2base" if result.static_camera else "cam2flange"
     print(f"{result.views} poses, RMS {result.rms_px:.3f} px (the corners' own noise {result.noise_px:.3f} px)")
     print(
-        f"{camera} xyz {', '.join(f'{v:.3f}' for v in result.camera2mount[:3, 3])} mm (1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})"
+        f"{camera} xyz {', '.join(f'{v:.3f}' for v in result.camera2mount[:3, 3])} mm (1-sigma "
+        f"{', '.join(f'{v:.3f}' for v in result.std_xyz_mm)})"
     )
     if truth is not None:
         print(f"error against the test bed's truth: {truth['mm']:.3f} mm, {truth['deg']:.4f} deg")
@@ -158,7 +165,10 @@ def _write_outputs(args, result) -> list[Path]:
         workcell = load_workcell(args.workcell)
     parent, child = camera_frames(workcell, static_camera=result.static_camera)
     parent, child = args.parent_frame or parent, args.camera_frame or child
-    note = f"{result.views} poses, RMS {result.rms_px:.3f} px, 1-sigma {', '.join(f'{v:.3f}' for v in result.std_xyz_mm)} mm"
+    note = (
+        f"{result.views} poses, RMS {result.rms_px:.3f} px, 1-sigma "
+        f"{', '.join(f'{v:.3f}' for v in result.std_xyz_mm)} mm"
+    )
     for path in args.out:
         text = mounting_text_for(path, result.camera2mount, parent, child=child, note=note)
         if text is None:
@@ -175,7 +185,8 @@ def _detector(args, spec):
 
 
 def _from_bag(args, source: Path):
-    """Hand-eye from a ROS 2 bag: the board's images on ``--topic`` (the only image topic by default), the flange pose at
+    """Hand-eye from a ROS 2 bag: the board's images on ``--topic`` (the only image topic by default), the flange pose
+    at
     each image's stamp from ``/joint_states`` through the cell's robot or from ``/tf``, taken only where the arm stood
     still; the camera's intrinsics from ``--intrinsics`` or the bag's CameraInfo."""
     from calib_core.bags.bag_source import bag_intrinsics, bag_topics
@@ -256,7 +267,8 @@ def _from_files(args):
     ]
     if bag_only:
         raise VideocalError(
-            f"{', '.join(bag_only)} appl{'ies' if len(bag_only) == 1 else 'y'} to a ROS bag; {source} is not one (a bag folder, .mcap or .db3)"
+            f"{', '.join(bag_only)} appl{'ies' if len(bag_only) == 1 else 'y'} to a ROS bag; {source} is not one (a "
+            "bag folder, .mcap or .db3)"
         )
     data = load_posed_images(source)
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
@@ -272,7 +284,8 @@ def _from_files(args):
     for posed in data.views:
         if posed.component is not None:
             print(
-                f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; calibrate-robot uses both)",
+                f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; "
+                "calibrate-robot uses both)",
                 file=sys.stderr,
             )
             continue
@@ -281,7 +294,8 @@ def _from_files(args):
             size = (image.shape[1], image.shape[0])
         elif (image.shape[1], image.shape[0]) != size:
             raise VideocalError(
-                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode"
+                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
+                "px: one calibration is for one camera mode"
             )
         v = detect_view(posed.name, image, spec, detect)
         if not isinstance(v, BoardView):

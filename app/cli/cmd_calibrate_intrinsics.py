@@ -25,7 +25,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--board",
         default="charuco:9x7:30:22:DICT_5X5_100",
-        help="charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM (inner corners), circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT",
+        help="charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM (inner corners), "
+        "circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT",
     )
     parser.add_argument(
         "--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)"
@@ -38,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=int,
         choices=(2, 3),
         default=2,
-        help="radial distortion terms: 2 (k1 k2, k3 held at 0; the default, as ROS's camera_calibration) or 3 (wide lenses, with views reaching the image's corners)",
+        help="radial distortion terms: 2 (k1 k2, k3 held at 0; the default, as ROS's camera_calibration) or 3 (wide "
+        "lenses, with views reaching the image's corners)",
     )
     parser.add_argument(
         "--every",
@@ -120,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write("\n")
     else:
         print(
-            f"{len(result.used)} views used, {len(rejected)} rejected; RMS {result.rms_px:.3f} px; corners cover {100 * result.coverage:.0f} % of the image"
+            f"{len(result.used)} views used, {len(rejected)} rejected; RMS {result.rms_px:.3f} px; corners cover "
+            f"{100 * result.coverage:.0f} % of the image"
         )
         for name in ("fu", "fv", "cx", "cy"):
             t = f"   (truth {getattr(truth, name):.2f})" if truth is not None else ""

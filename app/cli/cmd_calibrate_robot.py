@@ -26,7 +26,8 @@ from calib_core.errors import VideocalError
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "source",
-        help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, a folder holding views.csv (and grasps.csv), "
+        help="'sim' (the cold cell of the simulated test bed), a CSV of image[,component],<joints> views, a folder "
+        "holding views.csv (and grasps.csv), "
         "or a ROS 2 bag (a bag folder, .mcap or .db3: board images, /joint_states, CameraInfo)",
     )
     parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
@@ -42,7 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--fixed-intrinsics",
         action="store_true",
-        help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of refining them with the robot",
+        help="keep the camera's intrinsics as calibrated from the same views (or given by --intrinsics) instead of "
+        "refining them with the robot",
     )
     parser.add_argument(
         "--seed",
@@ -57,12 +59,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--intrinsics",
         type=Path,
-        help="with a CSV or a bag: the camera's intrinsics file (default: a bag's CameraInfo, else calibrated from the same views)",
+        help="with a CSV or a bag: the camera's intrinsics file (default: a bag's CameraInfo, else calibrated from the "
+        "same views)",
     )
     parser.add_argument(
         "--grasps",
         type=Path,
-        help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)",
+        help="with a CSV: a CSV of task[,image],<joints> reported with the gripper closed in compliance on each task "
+        "location's fixture pin: the TCP measured from the camera (default: the folder's grasps.csv)",
     )
     parser.add_argument(
         "--detector-params", type=Path, help="detector settings YAML (refine_markers, aruco, circle_blobs)"
@@ -151,7 +155,10 @@ def run(args: argparse.Namespace) -> int:
         sys.stdout.write("\n")
         return 0
     print(
-        f"{counts['board_views']} board views, {counts['cell_views']} views of surveyed components; RMS {result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of {summary['of']} parameters identified (condition {result.observability.condition:.0f}) in {result.seconds:.1f} s"
+        f"{counts['board_views']} board views, {counts['cell_views']} views of surveyed components; RMS "
+        f"{result.start_rms_px:.2f} px with the nominal model -> {result.rms_px:.3f} px; {summary['identified']} of "
+        f"{summary['of']} parameters identified (condition {result.observability.condition:.0f}) in "
+        f"{result.seconds:.1f} s"
     )
     for w in result.warnings:
         print(f"warning: {w}")
@@ -185,7 +192,8 @@ def _from_files(args):
     data = load_posed_images(source)
     if data.joint_columns is None:
         raise VideocalError(
-            f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or j1..jn>), not flange poses"
+            f"{data.source}: a robot calibration needs the joints of every view (a CSV of image,<joint names or "
+            "j1..jn>), not flange poses"
         )
     cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
     robot = cell.load_robot()
@@ -194,13 +202,15 @@ def _from_files(args):
     for posed in data.views:  # before any work: a view of a component the cell does not survey
         if posed.component is not None and posed.component not in components:
             raise VideocalError(
-                f"{data.source}: view {posed.name}: no surveyed component {posed.component!r} in {cell.path.name} (components with features: "
+                f"{data.source}: view {posed.name}: no surveyed component {posed.component!r} in {cell.path.name} "
+                "(components with features: "
                 f"{', '.join(sorted(components)) or 'none'})"
             )
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     if not spec.unambiguous:
         raise VideocalError(
-            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
+            "board"
         )
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
@@ -211,7 +221,8 @@ def _from_files(args):
             size = (image.shape[1], image.shape[0])
         elif (image.shape[1], image.shape[0]) != size:
             raise VideocalError(
-                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one camera mode"
+                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
+                "px: one calibration is for one camera mode"
             )
         if posed.component is not None:
             of_components.append(posed)  # located once the intrinsics are known
@@ -254,7 +265,8 @@ def _from_bag(args, source: Path):
     spec = parse_board(args.board or DEFAULT_SPEC)
     if not spec.unambiguous:
         raise VideocalError(
-            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
+            "board"
         )
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     found = bag_board_views(

@@ -20,8 +20,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--format",
         choices=EXPORT_FORMATS + (BAG_FORMAT,),
         default="csv",
-        help="csv, json (every correction, with the target to command), a controller listing: urscript (UR), rapid (ABB), krl (KUKA), "
-        "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: images, "
+        help="csv, json (every correction, with the target to command), a controller listing: urscript (UR), rapid "
+        "(ABB), krl (KUKA), "
+        "fanuc (FANUC TP), pdl2 (COMAU), named after --out's file; or ros2-bag (a recording as a ROS 2 bag folder: "
+        "images, "
         "joint states in rad and m, camera_info)",
     )
     parser.add_argument("--out", type=Path)
@@ -92,7 +94,8 @@ def _robot(workcell: str | Path | None):
     no workcell or it is not there."""
     if not workcell or not Path(workcell).is_file():
         print(
-            f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not there (give --workcell)",
+            f"note: no tool data or arm configurations in the export: the workcell {workcell or '(not named)'} is not "
+            "there (give --workcell)",
             file=sys.stderr,
         )
         return None, None

@@ -70,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
                     print(f"waiting: {exc}", file=sys.stderr, flush=True)
                 if now - silent_since > args.wait:
                     print(
-                        f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); {_kept(rows, args)}",
+                        f"error: {args.spec}: no frame for {now - silent_since:.1f} s (--wait {args.wait:g}); "
+                        f"{_kept(rows, args)}",
                         file=sys.stderr,
                     )
                     code = EXIT_SILENT
@@ -78,7 +79,8 @@ def run(args: argparse.Namespace) -> int:
                 continue
             if frame is None:
                 print(
-                    f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames ({_kept(rows, args)})",
+                    f"error: {args.spec}: the stream ended after {len(rows) - 1} of {args.count} frames "
+                    f"({_kept(rows, args)})",
                     file=sys.stderr,
                 )
                 code = EXIT_SILENT

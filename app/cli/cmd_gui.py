@@ -20,28 +20,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--port",
-        help="a real controller's connector URL (a serial port, socket://host:port, ros2:///joint_states, ...; see docs/connectors.md)",
+        help="a real controller's connector URL (a serial port, socket://host:port, ros2:///joint_states, ...; see "
+        "docs/connectors.md)",
     )
     parser.add_argument(
         "--camera",
-        help="a real camera's spec (an OpenCV device index, a video file, a stream URL, a folder of images, aravis://ID, ...)",
+        help="a real camera's spec (an OpenCV device index, a video file, a stream URL, a folder of images, "
+        "aravis://ID, ...)",
     )
     parser.add_argument(
         "--site",
         choices=("auto", "sim", "real"),
         default="auto",
-        help="sim: the simulated cell; real: the controller and camera of --port/--camera or the workcell's site: section; "
+        help="sim: the simulated cell; real: the controller and camera of --port/--camera or the workcell's site: "
+        "section; "
         "auto (default): real when either is given, else simulated",
     )
     parser.add_argument(
         "--hand-eye",
         type=resolved_path,
-        help="the measured camera mounting that replaces the modelled one: videocal calibrate-hand-eye's file, easy_handeye2's .calib, or a static_transform_publisher launch file (MoveIt 2's hand-eye result)",
+        help="the measured camera mounting that replaces the modelled one: videocal calibrate-hand-eye's file, "
+        "easy_handeye2's .calib, or a static_transform_publisher launch file (MoveIt 2's hand-eye result)",
     )
     parser.add_argument(
         "--recording",
         type=resolved_path,
-        help="open this videocal recording (.mcap), or a ROS 2 bag (a bag folder, .mcap or .db3: its images with the joints at each stamp), on the replay timeline at start",
+        help="open this videocal recording (.mcap), or a ROS 2 bag (a bag folder, .mcap or .db3: its images with the "
+        "joints at each stamp), on the replay timeline at start",
     )
     parser.add_argument(
         "--screenshot", type=Path, help="write a PNG of the window after start-up and quit (for tests and docs)"

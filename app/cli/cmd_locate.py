@@ -74,7 +74,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def read_prior(path: Path) -> np.ndarray:
-    """The prior pose (4, 4) mm from JSON: ``R_obj2cam`` + ``t_obj2cam_mm``, or ``obj2cam``; the error names the field."""
+    """The prior pose (4, 4) mm from JSON: ``R_obj2cam`` + ``t_obj2cam_mm``, or ``obj2cam``; the error names the
+    field."""
     from calib_core.frames import check_transform, make_transform  # scipy: loaded for a run, not for --help
 
     data = read_json(path, "prior pose file")
@@ -137,14 +138,16 @@ def run(args: argparse.Namespace) -> int:
         value = getattr(args, name)
         if not (np.isfinite(value) and 0.0 < value <= (500.0 if name == "reach_mm" else 30.0)):
             raise ValueError(
-                f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got {value:g}"
+                f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got "
+                f"{value:g}"
             )
     image = read_image(args.photo)
     intrinsics = load_intrinsics(args.intrinsics, image_size=(image.shape[1], image.shape[0]))
     if (intrinsics.width, intrinsics.height) != (image.shape[1], image.shape[0]):
         raise FileFormatError(
             args.photo,
-            f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x {intrinsics.height} px",
+            f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x "
+            f"{intrinsics.height} px",
         )
     from calib_core.mesh_files import load_mesh  # trimesh: loaded for a run, not for --help
 

@@ -21,12 +21,14 @@ EXIT_TIMEOUT = 4
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "url",
-        help="a controller connector URL: a serial port (/dev/ttyUSB0), a pty, socket://host:port, rfc2217://host:port, loop://, ros2:///joint_states, ...",
+        help="a controller connector URL: a serial port (/dev/ttyUSB0), a pty, socket://host:port, "
+        "rfc2217://host:port, loop://, ros2:///joint_states, ...",
     )
     parser.add_argument(
         "--workcell",
         type=resolved_path,
-        help="the cell's workcell file: samples in its robot's joint order and zero, its joint count checked (needed by connectors that name joints, such as ros2://)",
+        help="the cell's workcell file: samples in its robot's joint order and zero, its joint count checked (needed "
+        "by connectors that name joints, such as ros2://)",
     )
     rate = parser.add_mutually_exclusive_group()
     rate.add_argument(
@@ -51,7 +53,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json",
         action="store_true",
-        help="one JSON object per line: seq, t_ms (ms since the epoch), t_controller_ms (the controller's own stamp), joints_deg",
+        help="one JSON object per line: seq, t_ms (ms since the epoch), t_controller_ms (the controller's own stamp), "
+        "joints_deg",
     )
     parser.add_argument(
         "--baud", type=bounded_int(50, 20_000_000), help="serial baud rate (videocal's protocol; default 115200)"
@@ -137,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
                 if time.monotonic() - last > args.timeout:
                     why = getattr(link, "last_error", None) or (reasons[-1] if reasons else "no reply")
                     print(
-                        f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: {why})",
+                        f"error: no joint sample from {args.url} for {args.timeout:g} s (link {link.state.value}: "
+                        f"{why})",
                         file=sys.stderr,
                     )
                     code = EXIT_TIMEOUT
@@ -150,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
                 if len(q) != expected:
                     skipped += 1
                     print(
-                        f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not shown",
+                        f"warning: sample {s.sample.seq} has {len(q)} joint values, the robot has {expected}: not "
+                        "shown",
                         file=sys.stderr,
                     )
                     continue

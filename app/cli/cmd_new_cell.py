@@ -17,7 +17,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="P",
-        help="a folder that holds the packages $(find) and package:// name, or a checkout holding them (repeat for more; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too)",
+        help="a folder that holds the packages $(find) and package:// name, or a checkout holding them (repeat for "
+        "more; ROS_PACKAGE_PATH and AMENT_PREFIX_PATH are searched too)",
     )
     parser.add_argument(
         "--xacro-arg",
@@ -49,12 +50,14 @@ def run(args: argparse.Namespace) -> int:
     )
     print(f"wrote {made.workcell_path}")
     print(
-        f"  flange {made.flange} ({made.flange_why}), base {made.base or '(URDF root)'}, held joints: {', '.join(made.held_joints) or 'none'}"
+        f"  flange {made.flange} ({made.flange_why}), base {made.base or '(URDF root)'}, held joints: "
+        f"{', '.join(made.held_joints) or 'none'}"
     )
     if made.tool_axis_warning:
         print(f"  warning: {made.tool_axis_warning}")
     print(f"  home joints: {', '.join(f'{v:.1f}' for v in made.home_joints)}")
     print(
-        f"next: videocal render --workcell {made.workcell_path} --location target_grasp --view overview --out overview.png"
+        f"next: videocal render --workcell {made.workcell_path} --location target_grasp --view overview --out "
+        "overview.png"
     )
     return 0

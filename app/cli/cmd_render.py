@@ -80,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
     cell = load_workcell(args.workcell)
     if cell.intrinsics_path is None:
         raise VideocalError(
-            f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+            f"{cell.path}: field 'camera': the workcell names no camera file (camera.intrinsics): calibrate the camera "
+            "first (videocal calibrate-intrinsics)"
         )
     robot = cell.load_robot()
     highlight = args.highlight
@@ -133,6 +134,7 @@ def run(args: argparse.Namespace) -> int:
         raise VideocalError("could not encode the image as PNG")
     atomic_write_bytes(args.out, png.tobytes())
     print(
-        f"wrote {args.out} ({image.shape[1]} x {image.shape[0]}, {args.view} view, joints {', '.join(f'{v:.2f}' for v in q)} deg)"
+        f"wrote {args.out} ({image.shape[1]} x {image.shape[0]}, {args.view} view, joints "
+        f"{', '.join(f'{v:.2f}' for v in q)} deg)"
     )
     return 0

@@ -1,6 +1,7 @@
 """``videocal replay FILE``: re-solve every calibration in a recording and compare.
 
-Exit 0 when every re-computed result agrees with the recorded one (exactly, or to round-off: a newer solver reaching the same minimum), 5 when any differs,
+Exit 0 when every re-computed result agrees with the recorded one (exactly, or to round-off: a newer solver reaching the
+same minimum), 5 when any differs,
 2 for a file that cannot be read (one ``error:`` line).
 """
 
@@ -68,9 +69,13 @@ def run(args: argparse.Namespace) -> int:
                     f"agrees to round-off ({r.translation_diff_mm:.1g} mm: not bit for bit, another solver version)"
                 )
             else:
-                verdict = f"DIFFERS (translation {r.translation_diff_mm:.3g} mm, rotation {r.rotation_diff:.3g}, rms {r.rms_diff_px:.3g} px)"
+                verdict = (
+                    f"DIFFERS (translation {r.translation_diff_mm:.3g} mm, rotation {r.rotation_diff:.3g}, rms "
+                    f"{r.rms_diff_px:.3g} px)"
+                )
             rms = "n/a" if r.recorded["rms_px"] is None else f"{r.recorded['rms_px']:.3f} px"
             print(
-                f"  solve {r.id}: recorded {r.recorded['status']} rms {rms}, re-computed {r.recomputed['status']}: {verdict}"
+                f"  solve {r.id}: recorded {r.recorded['status']} rms {rms}, re-computed {r.recomputed['status']}: "
+                f"{verdict}"
             )
     return 0 if all(r.equivalent for r in results) else EXIT_DIFFERS

@@ -71,7 +71,8 @@ def run(args: argparse.Namespace) -> int:
             else "pinhole model"
         )
         print(
-            f"Table 1 of the paper, re-run with the {title}: initial displacement, final error here, paper's final error"
+            f"Table 1 of the paper, re-run with the {title}: initial displacement, final error here, paper's final "
+            "error"
         )
         print(
             f"{'':<10}"
@@ -89,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
         worst_t = max(r.max_translation_error for r in rows)
         worst_r = max(r.max_rotation_error_deg for r in rows)
         print(
-            f"largest final error here: {worst_t:.2e} mm, {worst_r:.2e} deg; {sum(r.converged for r in rows)} of {len(rows)} converged"
+            f"largest final error here: {worst_t:.2e} mm, {worst_r:.2e} deg; {sum(r.converged for r in rows)} of "
+            f"{len(rows)} converged"
         )
     return 0 if all(r.converged for r in rows) else 1

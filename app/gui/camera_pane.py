@@ -69,12 +69,14 @@ class CameraPane(QWidget):
         self._drag_at: tuple[float, float] | None = None
         self.freeze = QCheckBox("Hold")
         self.freeze.setToolTip(
-            "Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the corner"
+            "Pick on a still: the frame is held (only when the robot had settled) and the live video goes on in the "
+            "corner"
         )
         self.subpixel = QCheckBox("Sub-pixel")
         self.subpixel.setChecked(True)
         self.subpixel.setToolTip(
-            "Refine each pick: a round feature to the centre of its rim, anything else to the nearest corner (cv2.cornerSubPix)"
+            "Refine each pick: a round feature to the centre of its rim, anything else to the nearest corner "
+            "(cv2.cornerSubPix)"
         )
         self.edges = QCheckBox("CAD edges")
         self.edges.setToolTip("After a solve, draw the model's edges from the measured camera pose")
@@ -296,7 +298,8 @@ class CameraPane(QWidget):
             overlay.points.append((u, v, str(pair.number) if current else f"{pair.number}?", color))
         if not all(pairs_current):
             banner.append(
-                f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at another robot pose (grey)"
+                f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at "
+                "another robot pose (grey)"
             )
         result = session.result.estimate
         stale = session.stale_reason

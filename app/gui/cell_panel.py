@@ -95,7 +95,8 @@ class CellPanel(QWidget):
         self.pick_features = QCheckBox("Name features by clicking (virtual camera)")
         self.pick_features.setObjectName("pick_features")
         self.pick_features.setToolTip(
-            "A click on the chosen component in the virtual camera adds a feature, snapped to a circle centre, a corner or a vertex"
+            "A click on the chosen component in the virtual camera adds a feature, snapped to a circle centre, a "
+            "corner or a vertex"
         )
         fl.addWidget(self.pick_features)
         name_row = QFormLayout()
@@ -225,6 +226,7 @@ class CellPanel(QWidget):
         self.feature_name.clear()
         world = apply(item.item2world, np.asarray(snap.point_mm)[None])[0]
         self.feature_info.setText(
-            f"{hit.component}/{name}: {snap.kind.replace('_', ' ')} at ({', '.join(f'{v:.1f}' for v in snap.point_mm)}) mm, "
+            f"{hit.component}/{name}: {snap.kind.replace('_', ' ')} at "
+            f"({', '.join(f'{v:.1f}' for v in snap.point_mm)}) mm, "
             f"{snap.distance_mm:.1f} mm from the click; base ({', '.join(f'{v:.1f}' for v in world)})"
         )

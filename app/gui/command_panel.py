@@ -151,7 +151,8 @@ class CommandPanel(QTabWidget):
         self.verify = button(
             "Verify: look again",
             "verify",
-            "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is from the task location and whether the two looks agree",
+            "After Go to task, corrected: pick the pairs from there, then Verify reports how far the tool still is "
+            "from the task location and whether the two looks agree",
         )
         el.addWidget(self.verify)
         self.corrections = QLabel("No corrections stored.")
@@ -225,7 +226,10 @@ class CommandPanel(QTabWidget):
             looks = table.verifications(task)
             if looks:
                 v = looks[-1]
-                line += f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma {np.linalg.norm(v.std_remaining_mm):.2f}), {v.judgement}"
+                line += (
+                    f"; verified: {np.linalg.norm(v.remaining_mm):.2f} mm left (1-sigma "
+                    f"{np.linalg.norm(v.std_remaining_mm):.2f}), {v.judgement}"
+                )
             lines.append(line)
         self.corrections.setText("\n".join(lines) or "No corrections stored.")
 

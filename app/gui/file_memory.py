@@ -110,7 +110,8 @@ class Autosave:
         self.path.unlink(missing_ok=True)
 
     def finish(self) -> None:
-        """The window closes: unsaved work stays in the recovery file (offered at the next start); saved work leaves none."""
+        """The window closes: unsaved work stays in the recovery file (offered at the next start); saved work leaves
+        none."""
         self.timer.stop()
         if self._revision() == self._saved:
             self.path.unlink(missing_ok=True)

@@ -306,7 +306,10 @@ class FileMenu:
         if str(w.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
             return True
         s = w.workbench.session
-        what = f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored corrections"
+        what = (
+            f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored "
+            "corrections"
+        )
         choice = ask_save(
             w,
             "Unsaved work",

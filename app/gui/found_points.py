@@ -1,5 +1,6 @@
 """*Find points* in the window (F6): the core finds the target's features on the held frame; a list
-shows each proposal (feature, kind, confidence, distance from the fitted pose, and why a detector was unsure) with a check box and
+shows each proposal (feature, kind, confidence, distance from the fitted pose, and why a detector was unsure) with a
+check box and
 each feature not found with the reason; *Accept checked* adds the checked ones as pairs, one undo
 step. The camera pane draws the proposals (it hears ``points_found``) while the list is open."""
 

@@ -77,7 +77,8 @@ class ImageView(QWidget):
         self._shrunk = _Shrunk()
         self._array: np.ndarray | None = None
         self.grabber = None
-        """``grabber(u, v, radius_px) -> bool``: a left press there takes hold of a point (a drag) instead of a click."""
+        """``grabber(u, v, radius_px) -> bool``: a left press there takes hold of a point (a drag) instead of a
+        click."""
         self._grab_from: QPointF | None = None
         self._overlay_image: QImage | None = None
         self._overlay_shrunk = _Shrunk()

@@ -133,7 +133,8 @@ class OverviewPane(QWidget):
             )
             color = "#ff6b6b" if preview.blocked else ("#ffb347" if send is not None else "#9ad0ff")
             self.preview_text.setText(
-                f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - {html.escape(preview.summary, quote=False)}"
+                f"<span style='color:{color}'><b>{html.escape(state)}</b></span> - "
+                f"{html.escape(preview.summary, quote=False)}"
             )
             self.move_button.setVisible(send is not None and not preview.blocked)
             self.cancel_button.setText("Cancel" if send is not None else ("Hide" if preview.blocked else "Stop"))
@@ -173,7 +174,8 @@ class OverviewPane(QWidget):
             elif state.motion.value in ("refused", "failed", "unknown"):
                 self.cancel_button.setText("Hide")
                 self.preview_text.setText(
-                    f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - {html.escape(state.text, quote=False)}"
+                    f"<span style='color:#ff6b6b'><b>{html.escape(state.motion.value)}</b></span> - "
+                    f"{html.escape(state.text, quote=False)}"
                 )
 
     def _ghost_items(self) -> list:

@@ -158,10 +158,14 @@ class ResultsPanel(QWidget):
             text = (
                 f"<span style='color:#9a9a9a'><b>FROM AN EARLIER STATE</b></span> - {html.escape(stale, quote=False)}"
             )
-            text += f"<br><span style='color:#9a9a9a'>it was: {html.escape(verdict.text if verdict else sol.status.value, quote=False)}</span>"
+            text += (
+                "<br><span style='color:#9a9a9a'>it was: "
+                f"{html.escape(verdict.text if verdict else sol.status.value, quote=False)}</span>"
+            )
         else:
             color = _VERDICT_COLORS[verdict.verdict if verdict else Verdict(sol.status.value)]
-            text = f"<span style='color:{color}'><b>{(verdict.verdict.value if verdict else sol.status.value).upper()}</b></span>"
+            word = (verdict.verdict.value if verdict else sol.status.value).upper()
+            text = f"<span style='color:{color}'><b>{word}</b></span>"
             reasons = list(verdict.reasons) if verdict else ([sol.reason] if sol.reason else [])
             if sol.reason and sol.reason not in reasons:
                 reasons.append(sol.reason)
@@ -171,19 +175,26 @@ class ResultsPanel(QWidget):
             text += f"<br><span style='color:#ccb'>note: {html.escape(w, quote=False)}</span>"
         self._elsewhere = self._solved_elsewhere()
         if self._elsewhere:
-            text += "<br><span style='color:#ff9a30'>solved from another robot pose than the robot's now (the pairs' frame): it describes that pose</span>"
+            text += (
+                "<br><span style='color:#ff9a30'>solved from another robot pose than the robot's now (the pairs' "
+                "frame): it describes that pose</span>"
+            )
         self.verdict.setText(text)
         self._fit_text()
         d, rv, sd, sr = r.displacement_mm, r.rotation_deg, r.std_displacement_mm, r.std_rotation_deg
         cam = r.cam2world_measured[:3, 3]
         self.details.setText(
             "<table cellspacing=4>"
-            f"<tr><td>end-effector displacement</td><td>dx {d[0]:+.2f}</td><td>dy {d[1]:+.2f}</td><td>dz {d[2]:+.2f} mm</td><td>|d| {np.linalg.norm(d):.2f} mm</td></tr>"
+            f"<tr><td>end-effector displacement</td><td>dx {d[0]:+.2f}</td><td>dy {d[1]:+.2f}</td><td>dz {d[2]:+.2f} "
+            f"mm</td><td>|d| {np.linalg.norm(d):.2f} mm</td></tr>"
             f"<tr><td>1-sigma</td><td>{sd[0]:.2f}</td><td>{sd[1]:.2f}</td><td>{sd[2]:.2f} mm</td><td></td></tr>"
-            f"<tr><td>rotation (base axes)</td><td>rx {rv[0]:+.3f}</td><td>ry {rv[1]:+.3f}</td><td>rz {rv[2]:+.3f} deg</td><td>{np.linalg.norm(rv):.3f} deg</td></tr>"
+            f"<tr><td>rotation (base axes)</td><td>rx {rv[0]:+.3f}</td><td>ry {rv[1]:+.3f}</td><td>rz {rv[2]:+.3f} "
+            f"deg</td><td>{np.linalg.norm(rv):.3f} deg</td></tr>"
             f"<tr><td>1-sigma</td><td>{sr[0]:.3f}</td><td>{sr[1]:.3f}</td><td>{sr[2]:.3f} deg</td><td></td></tr>"
-            f"<tr><td>camera (base frame)</td><td>{cam[0]:.1f}</td><td>{cam[1]:.1f}</td><td>{cam[2]:.1f} mm</td><td></td></tr>"
-            f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} {'edge samples' if sol.method == 'edges' else 'pairs'}</td>"
+            f"<tr><td>camera (base frame)</td><td>{cam[0]:.1f}</td><td>{cam[1]:.1f}</td><td>{cam[2]:.1f} "
+            "mm</td><td></td></tr>"
+            f"<tr><td>RMS residual</td><td>{sol.rms_px:.2f} px</td><td>{len(sol.residuals_px)} "
+            f"{'edge samples' if sol.method == 'edges' else 'pairs'}</td>"
             f"<td>{'on the edges' if sol.method == 'edges' else f'{sol.iterations} iterations'}</td><td></td></tr>"
             "</table>"
         )
@@ -204,7 +215,8 @@ class ResultsPanel(QWidget):
         if sol.status is SolveStatus.AMBIGUOUS:
             for i, c in enumerate(sol.candidates):
                 button = QPushButton(
-                    f"Use solution {i + 1} ({c.rms_px:.2f} px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})"
+                    f"Use solution {i + 1} ({c.rms_px:.2f} "
+                    f"px{'' if c.distance_to_prior_mm is None else f', {c.distance_to_prior_mm:.0f} mm from model'})"
                 )
                 button.setObjectName(f"candidate_{i}")
                 button.setCheckable(True)

@@ -62,7 +62,8 @@ class RobotPanel(QWidget):
         pl = QVBoxLayout(plan)
         self.spec = QLineEdit(DEFAULT_SPEC)
         self.spec.setToolTip(
-            "a ChArUco or ArUco board: charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
+            "a ChArUco or ArUco board: charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], "
+            "aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
         )
         pl.addWidget(self.spec)
         self.show_board = QCheckBox("Board in the simulated cell")
@@ -124,7 +125,8 @@ class RobotPanel(QWidget):
         self.fit_intrinsics = QCheckBox("Refine the camera's intrinsics with the robot")
         self.fit_intrinsics.setChecked(True)
         self.fit_intrinsics.setToolTip(
-            "The board views correct fu, fv, cx, cy, k1, k2, p1, p2 together with the robot; Apply uses them too, Revert takes them back"
+            "The board views correct fu, fv, cx, cy, k1, k2, p1, p2 together with the robot; Apply uses them too, "
+            "Revert takes them back"
         )
         vl.addWidget(self.fit_intrinsics)
         self.result_text = QLabel("")
@@ -161,7 +163,8 @@ class RobotPanel(QWidget):
         spec = parse_board(self.spec.text().strip())
         if not spec.unambiguous:
             raise OperatorError(
-                f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco board"
+                f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
+                "board"
             )
         return spec
 
@@ -202,7 +205,8 @@ class RobotPanel(QWidget):
             self,
             "Drive the robot through the calibration poses?",
             f"The robot will move through {n} poses, one after the other, stopping at each "
-            "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep the emergency stop at hand; "
+            "until a view is taken. Every path was checked against the cell's collision bodies with the model. Keep "
+            "the emergency stop at hand; "
             "Stop ends the run after the current move.",
             "Run",
         ):
@@ -250,8 +254,11 @@ class RobotPanel(QWidget):
             self._refresh()
         obs = r.observability
         lines = [
-            f"<b>Robot</b> from {len(r.per_view_rms_px)} views ({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS {r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
-            f"{len(obs.identified)} of {len(r.names)} parameters identified (condition {obs.condition:.0f}); {len(obs.directions)} combinations the views do not determine"
+            f"<b>Robot</b> from {len(r.per_view_rms_px)} views "
+            f"({sum(k.startswith('cell_') for k in r.per_view_rms_px)} of surveyed components): RMS "
+            f"{r.start_rms_px:.2f} px with the model, {r.rms_px:.3f} px calibrated",
+            f"{len(obs.identified)} of {len(r.names)} parameters identified (condition {obs.condition:.0f}); "
+            f"{len(obs.directions)} combinations the views do not determine"
             + (f", e.g. {', '.join(f'{w:+.2f} {n}' for n, w in obs.directions[0][:3])}" if obs.directions else ""),
             f"{len(obs.correlations)} pairs correlated above 0.9"
             if obs.correlations

@@ -1,7 +1,8 @@
 """The status bar's permanent fields: recording, link, camera, pairs; refreshed once a second.
 
 The link shows its state, sample rate, rejected lines and its measured one-way delay (a far controller),
-and turns orange when it is up but no joint sample came for ``STALE_LINK_S`` (plus a far link's spread); the camera shows its frame rate, and turns orange when no
+and turns orange when it is up but no joint sample came for ``STALE_LINK_S`` (plus a far link's spread); the camera
+shows its frame rate, and turns orange when no
 frame came for ``STALE_CAMERA_S`` while live.
 """
 
@@ -80,7 +81,10 @@ class StatusLine:
             rate = f"{(s['samples'] - prev[1]) / (clock[1] - prev[0][1]):.0f} Hz, " if same_clock else ""
             delay = getattr(link, "delay_s", None)
             delay_text = "" if delay is None else f", delay {delay:.2f} s" if delay >= 0.01 else ", delay < 0.01 s"
-            text = f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} rejected{delay_text}"
+            text = (
+                f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} "
+                f"rejected{delay_text}"
+            )
             last = self.workbench.arm.last_sample_s
             # a far link delivers its samples in bursts: late only past its own spread of delays
             late_after = STALE_LINK_S + (link.stale_after_now_s() if hasattr(link, "stale_after_now_s") else 0.0)

@@ -30,10 +30,12 @@ def store_with_consent(parent: QWidget, core, say) -> None:
             [
                 f"This look cannot be {task}'s correction as it is: {exc.place.text}.",
                 "",
-                "A robot's error changes with its pose: a look made elsewhere corrects that pose, not the task location.",
+                "A robot's error changes with its pose: a look made elsewhere corrects that pose, not the task "
+                "location.",
                 "",
                 f"Store as measurement: kept in {task}'s history at its own pose; nothing the robot does changes.",
-                f"Convert into {task}'s correction: the target commanded for {task} moves by {exc.change_mm:.2f} mm and {exc.change_deg:.3f} deg. "
+                f"Convert into {task}'s correction: the target commanded for {task} moves by {exc.change_mm:.2f} mm "
+                f"and {exc.change_deg:.3f} deg. "
                 "Your conversion is kept with the correction.",
             ]
         )

@@ -22,7 +22,8 @@ class ToolGroup(QGroupBox):
         guard = guarded(show_error)
         layout = QVBoxLayout(self)
         how = QLabel(
-            "Gripper closed on the task's pin in compliance (pendant), the camera seeing its fixture, then Record grasp; "
+            "Gripper closed on the task's pin in compliance (pendant), the camera seeing its fixture, then Record "
+            "grasp; "
             "two tasks give the spread."
         )
         how.setWordWrap(True)
@@ -37,7 +38,8 @@ class ToolGroup(QGroupBox):
         self.measure_button = button(
             "Measure tool",
             "tool_measure",
-            "The TCP in the camera frame from the grasps, through the robot as it is now (calibrate it first); Revert takes it back",
+            "The TCP in the camera frame from the grasps, through the robot as it is now (calibrate it first); Revert "
+            "takes it back",
         )
         self.measure_button.clicked.connect(guard(self.measure))
         self.clear_button = button("Clear", "tool_clear", "Forget the recorded grasps")
@@ -66,11 +68,13 @@ class ToolGroup(QGroupBox):
     def measure(self) -> None:
         t = self.tool = self.measuring.measure_tool()
         self.text.setText(
-            f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, {t.spread_deg:.4f} deg: "
+            f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, "
+            f"{t.spread_deg:.4f} deg: "
             "in use (Revert takes it back)"
         )
         self.text.setToolTip(
-            f"TCP in the camera frame: {t.tcp2cam[0, 3]:.3f} {t.tcp2cam[1, 3]:.3f} {t.tcp2cam[2, 3]:.3f} mm; saved with the robot calibration"
+            f"TCP in the camera frame: {t.tcp2cam[0, 3]:.3f} {t.tcp2cam[1, 3]:.3f} {t.tcp2cam[2, 3]:.3f} mm; saved "
+            "with the robot calibration"
         )
         self.refresh()
         self.changed()

@@ -63,7 +63,8 @@ class VisionPanel(QWidget):
         bl = QVBoxLayout(board)
         self.spec = QLineEdit(DEFAULT_SPEC)
         self.spec.setToolTip(
-            "charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM, circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
+            "charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT[:legacy], chessboard:COLSxROWS:SQUARE_MM, "
+            "circles:COLSxROWS:SPACING_MM[:asymmetric], aruco:COLSxROWS:MARKER_MM:GAP_MM:DICT"
         )
         self.spec.editingFinished.connect(guard(self._spec_changed))
         bl.addWidget(self.spec)
@@ -227,7 +228,8 @@ class VisionPanel(QWidget):
             + (
                 ""
                 if n >= 10
-                else f" Add views with the board in every part of the image, tilted 20-40 deg ({max(0, 10 - n)} more for a stable calibration)."
+                else f" Add views with the board in every part of the image, tilted 20-40 deg ({max(0, 10 - n)} more "
+                "for a stable calibration)."
             )
         )
         self.calibrate_intrinsics_button.setEnabled(n >= 3)

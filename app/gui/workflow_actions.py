@@ -122,7 +122,8 @@ class WorkflowActions(QObject):
         result = self.workbench.picking.calibrate()
         s = result.solution
         self.say(
-            f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement {np.linalg.norm(result.displacement_mm):.2f} mm",
+            f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement "
+            f"{np.linalg.norm(result.displacement_mm):.2f} mm",
             10000,
         )
 

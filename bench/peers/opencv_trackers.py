@@ -1,5 +1,6 @@
 """OpenCV contrib's model-based trackers (``cv2.rapid``: RAPID's edges, OLS and GOS's colour-region searches) on one
-view, as the real-photo bench's peer. Runs in its own environment (``bench/peer_env.py``: opencv-contrib-python-headless,
+view, as the real-photo bench's peer. Runs in its own environment (``bench/peer_env.py``:
+opencv-contrib-python-headless,
 which cannot share a Python environment with videocal's opencv-python-headless), so it imports nothing of videocal.
 
 Reads JSON on stdin: ``{"image": PNG path, "K": 3x3, "vertices": (n, 3) mm, "faces": (m, 3), "views": [{"rvec", "tvec"}]

@@ -213,7 +213,8 @@ def _units_from_workcell(recording: Path, workcell: str | None, n: int) -> list[
     if not workcell or not Path(workcell).is_file():
         raise FileFormatError(
             recording,
-            f"the joints' units (deg or mm) come from the recording's workcell, {workcell or 'not named'}, which is not there: "
+            f"the joints' units (deg or mm) come from the recording's workcell, {workcell or 'not named'}, which is "
+            "not there: "
             "give --workcell",
         )
     units = list(load_workcell(workcell).load_robot().joint_units)

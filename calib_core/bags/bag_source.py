@@ -60,7 +60,8 @@ def open_reader(path: str | Path):
     except Exception as exc:  # rosbags raises its own errors per storage and profile
         raise FileFormatError(
             path,
-            f"not a ROS bag rosbags can read: {str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}",
+            "not a ROS bag rosbags can read: "
+            f"{str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__}",
         ) from None
     return reader
 
@@ -120,7 +121,8 @@ def choose_image_topic(path: str | Path, topic: str | None = None) -> Topic:
                 if t.msgtype not in IMAGE_TYPES:
                     raise FileFormatError(
                         Path(path),
-                        f"topic {topic} holds {t.msgtype}, not images; image topics: {', '.join(map(str, images)) or 'none'}",
+                        f"topic {topic} holds {t.msgtype}, not images; image topics: "
+                        f"{', '.join(map(str, images)) or 'none'}",
                     )
                 return t
         raise FileFormatError(Path(path), f"no topic {topic}; image topics: {', '.join(map(str, images)) or 'none'}")

@@ -1,7 +1,9 @@
-"""Board views from a ROS 2 bag with the arm's pose at each (its joints, or its flange from ``/tf``): what the hand-eye and the robot calibration take
+"""Board views from a ROS 2 bag with the arm's pose at each (its joints, or its flange from ``/tf``): what the hand-eye
+and the robot calibration take
 from a user's recording (images, ``/joint_states``, CameraInfo) with no conversion.
 
-A frame counts only where the arm stood still around its header stamp (:func:`~calib_core.bags.joint_track.settled_joints`):
+A frame counts only where the arm stood still around its header stamp
+(:func:`~calib_core.bags.joint_track.settled_joints`):
 the joints interpolated at a frame taken mid-move would pair the image with a pose the camera was not at.
 """
 
@@ -24,7 +26,8 @@ from calib_core.vision.intrinsics_calibration import BoardView, detect_view
 @dataclass
 class BagBoardViews:
     """The board views of a bag. ``views``: each detected view with the arm's pose at its stamp (the model
-    joints, deg/mm in the robot's order, or ``flange2base`` (4, 4) mm, as the ``settled`` rule gives it); ``skipped``: frames taken while the arm moved, with why; ``rejected``: still frames
+    joints, deg/mm in the robot's order, or ``flange2base`` (4, 4) mm, as the ``settled`` rule gives it); ``skipped``:
+    frames taken while the arm moved, with why; ``rejected``: still frames
     without the board, with why; ``images``: frames read; ``size``: (width, height) px."""
 
     views: list[tuple[BoardView, np.ndarray]] = field(default_factory=list)
@@ -35,7 +38,10 @@ class BagBoardViews:
 
     @property
     def summary(self) -> str:
-        return f"{self.images} images, {self.images - len(self.skipped)} taken while the arm stood still, {len(self.views)} with the board"
+        return (
+            f"{self.images} images, {self.images - len(self.skipped)} taken while the arm stood still, "
+            f"{len(self.views)} with the board"
+        )
 
 
 def bag_board_views(
@@ -60,7 +66,8 @@ def bag_board_views(
             out.size = size
         elif size != out.size:
             raise VideocalError(
-                f"{source} {name}: {size[0]} x {size[1]} px, the first image is {out.size[0]} x {out.size[1]} px: one calibration is for one camera mode"
+                f"{source} {name}: {size[0]} x {size[1]} px, the first image is {out.size[0]} x {out.size[1]} px: one "
+                "calibration is for one camera mode"
             )
         pose, why = settled(stamp)
         if pose is None:
@@ -86,6 +93,7 @@ def joints_settled(
 
 
 def flange_settled(source: Path, base: str, flange: str) -> Callable[[int], tuple[np.ndarray | None, str | None]]:
-    """``settled`` for :func:`bag_board_views` from the bag's ``/tf``: ``flange2base`` (4, 4) mm where it stood still."""
+    """``settled`` for :func:`bag_board_views` from the bag's ``/tf``: ``flange2base`` (4, 4) mm where it stood
+    still."""
     track = read_tf_track(source, base, flange)
     return lambda stamp: settled_flange(track, stamp)

@@ -31,7 +31,8 @@ class JointTrack:
     joints: np.ndarray
 
     def at(self, stamp_ns: int) -> np.ndarray | None:
-        """The joints (n,) at ``stamp_ns``, linear between the samples around it; ``None`` outside the track or in a gap."""
+        """The joints (n,) at ``stamp_ns``, linear between the samples around it; ``None`` outside the track or in a
+        gap."""
         t = self.stamps_ns
         k = int(np.searchsorted(t, stamp_ns, side="right"))
         if k == 0 or k == len(t):
@@ -96,7 +97,8 @@ def read_joint_track(path: str | Path, joint_names, per_si, topic: str | None = 
             held = ", ".join(sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})) or "no messages"
             raise FileFormatError(
                 path,
-                f"no JointState topic{' ' + topic if topic else ''} in this bag (it holds {held}): the flange poses come from the joints",
+                f"no JointState topic{' ' + topic if topic else ''} in this bag (it holds {held}): the flange poses "
+                "come from the joints",
             )
         if len(topics) > 1:
             chosen = "/joint_states" if "/joint_states" in topics else None

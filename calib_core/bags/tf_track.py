@@ -100,12 +100,14 @@ def settled_flange(track: TfTrack, stamp_ns: int, half_window_s: float = 0.25) -
     if moved is None:
         return (
             None,
-            f"no transform from {track.flange} to {track.base} all round it (within {half_window_s:g} s, no gap over {MAX_GAP_S:g} s)",
+            f"no transform from {track.flange} to {track.base} all round it (within {half_window_s:g} s, no gap over "
+            f"{MAX_GAP_S:g} s)",
         )
     if moved[0] > STILL_MM or moved[1] > STILL_DEG:
         return (
             None,
-            f"the flange moved {moved[0]:.2f} mm, {moved[1]:.3f} deg within {half_window_s:g} s of it: not a still view",
+            f"the flange moved {moved[0]:.2f} mm, {moved[1]:.3f} deg within {half_window_s:g} s of it: not a still "
+            "view",
         )
     return track.at(stamp_ns), None
 
@@ -138,7 +140,8 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
                 if child in samples and samples[child][0] != parent:
                     raise FileFormatError(
                         path,
-                        f"the frame {child!r} has two parents in /tf ({samples[child][0]!r} and {parent!r}): tf2 would refuse this tree",
+                        f"the frame {child!r} has two parents in /tf ({samples[child][0]!r} and {parent!r}): tf2 would "
+                        "refuse this tree",
                     )
                 rows = samples.setdefault(child, (parent, []))[1]
                 if connection.topic == "/tf_static":
@@ -150,7 +153,8 @@ def read_tf_track(path: str | Path, base: str, flange: str) -> TfTrack:
             frames = sorted(set(samples) | {p for p, _ in samples.values()})
             raise FileFormatError(
                 path,
-                f"no chain of transforms from {flange!r} up to {base!r} in /tf (it stops at {frame!r}; frames: {', '.join(frames)}): "
+                f"no chain of transforms from {flange!r} up to {base!r} in /tf (it stops at {frame!r}; frames: "
+                f"{', '.join(frames)}): "
                 "name them with --base-frame and --flange-frame",
             )
         parent, rows = samples[frame]

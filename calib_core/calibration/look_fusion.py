@@ -76,11 +76,16 @@ def fuse_look(
         K = C_model @ np.linalg.inv(S)
         fused, cov = K @ x, C_model - K @ C_model
         weight = np.clip(np.diag(K), 0.0, 1.0)
-        message = f"look and model agree (squared distance {m2:.1f}); the look weighs {100 * float(np.mean(weight[:3])):.0f} % in position, {100 * float(np.mean(weight[3:])):.0f} % in rotation"
+        message = (
+            f"look and model agree (squared distance {m2:.1f}); the look weighs "
+            f"{100 * float(np.mean(weight[:3])):.0f} % in position, {100 * float(np.mean(weight[3:])):.0f} % in "
+            "rotation"
+        )
     else:
         fused, cov, weight = np.zeros(6), C_model, np.zeros(6)
         message = (
-            f"the look is {np.sqrt(m2):.1f} sigma from the calibrated model (its displacement {np.linalg.norm(x[:3]):.3f} mm, "
+            f"the look is {np.sqrt(m2):.1f} sigma from the calibrated model (its displacement "
+            f"{np.linalg.norm(x[:3]):.3f} mm, "
             f"{np.linalg.norm(x[3:]):.4f} deg): not used; look again or pick the points by hand"
         )
     tcp = look.tcp2base_model

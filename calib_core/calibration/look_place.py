@@ -92,6 +92,7 @@ class LookNotAtTask(CalibrationError):
     def __init__(self, place: LookPlace, change_mm: float, change_deg: float):
         self.place, self.change_mm, self.change_deg = place, change_mm, change_deg
         super().__init__(
-            f"{place.text}: it is not {place.task}'s correction. Store it as a measurement at that pose, or convert it explicitly "
+            f"{place.text}: it is not {place.task}'s correction. Store it as a measurement at that pose, or convert it "
+            "explicitly "
             f"(the target commanded for {place.task} would move by {change_mm:.2f} mm, {change_deg:.3f} deg)"
         )

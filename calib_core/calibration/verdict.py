@@ -63,11 +63,13 @@ def judge(estimate, limits: SafetyLimits | None = None, tolerance_mm: float = DE
     implausible = []
     if d_mm > limits.model_error_mm:
         implausible.append(
-            f"the end effector would be {d_mm:.1f} mm from the model, beyond the cell's stated model error of {limits.model_error_mm:g} mm"
+            f"the end effector would be {d_mm:.1f} mm from the model, beyond the cell's stated model error of "
+            f"{limits.model_error_mm:g} mm"
         )
     if r_deg > limits.model_error_deg:
         implausible.append(
-            f"it would be turned {r_deg:.2f} deg from the model, beyond the cell's stated {limits.model_error_deg:g} deg"
+            f"it would be turned {r_deg:.2f} deg from the model, beyond the cell's stated {limits.model_error_deg:g} "
+            "deg"
         )
     if implausible:
         implausible.append("check that the pairs belong to this robot pose and object, and the camera mounting")
@@ -85,7 +87,8 @@ def judge(estimate, limits: SafetyLimits | None = None, tolerance_mm: float = DE
         return ResultVerdict(
             Verdict.UNCERTAIN,
             (
-                f"its 1-sigma of {sigma_mm:.2f} mm is over the task's tolerance of {tolerance_mm:g} mm: add pairs spread over the object",
+                f"its 1-sigma of {sigma_mm:.2f} mm is over the task's tolerance of {tolerance_mm:g} mm: add pairs "
+                "spread over the object",
             ),
         )
     return ResultVerdict(Verdict.OK)

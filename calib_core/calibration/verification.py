@@ -65,10 +65,13 @@ class Verification:
         d, s = self.remaining_mm, self.std_remaining_mm
         limit = min(self.agree_within_mm, self.tolerance_mm)
         return (
-            f"{self.task}: the tool is {np.linalg.norm(d):.2f} mm (1-sigma {np.linalg.norm(s):.2f} mm) and {np.linalg.norm(self.remaining_deg):.3f} deg "
-            f"from the task location, {'within' if self.within_tolerance else 'OUTSIDE'} its {self.tolerance_mm:g} mm tolerance; "
+            f"{self.task}: the tool is {np.linalg.norm(d):.2f} mm (1-sigma {np.linalg.norm(s):.2f} mm) and "
+            f"{np.linalg.norm(self.remaining_deg):.3f} deg "
+            f"from the task location, {'within' if self.within_tolerance else 'OUTSIDE'} its {self.tolerance_mm:g} mm "
+            "tolerance; "
             f"the two looks {'agree' if self.agree else 'DISAGREE'} ({self.disagreement_mm:.2f} mm apart, "
-            f"{'within' if self.agree else 'over'} {limit:.2f} mm: 3 x their 1-sigma {self.agree_within_mm:.2f} mm, the tolerance {self.tolerance_mm:g} mm)"
+            f"{'within' if self.agree else 'over'} {limit:.2f} mm: 3 x their 1-sigma {self.agree_within_mm:.2f} mm, "
+            f"the tolerance {self.tolerance_mm:g} mm)"
         )
 
 

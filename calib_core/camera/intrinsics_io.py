@@ -177,7 +177,8 @@ def _load_ros(path: Path, data: dict, image_size: tuple[int, int] | None = None)
 
 
 def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
-    """A ``sensor_msgs/CameraInfo`` message as YAML: ROS 2's lower-case fields (``k``, ``d``) or ROS 1's (``K``, ``D``)."""
+    """A ``sensor_msgs/CameraInfo`` message as YAML: ROS 2's lower-case fields (``k``, ``d``) or ROS 1's (``K``,
+    ``D``)."""
 
     def field(name: str):
         return data.get(name, data.get(name.upper()))

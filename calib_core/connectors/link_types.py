@@ -50,10 +50,12 @@ class TimedSample:
 class LinkStats:
     """Counters since the link started. Sentences: ``sentences`` verified, ``garbage_bytes``,
     ``bad_checksum``, ``too_long``, ``malformed`` (framing or fields), ``non_finite``,
-    ``unknown`` types, ``wrong_joint_count`` (samples for another robot). Samples: ``samples`` delivered, ``seq_gaps`` (times the sequence
+    ``unknown`` types, ``wrong_joint_count`` (samples for another robot). Samples: ``samples`` delivered, ``seq_gaps``
+    (times the sequence
     jumped) and ``missing_samples`` (how many it skipped), ``backwards_samples`` (a repeated or
     older sequence number or time: not delivered), ``controller_restarts`` (its clock went back over
-    1 s, or to its first 0.5 s: counted, delivered). Link: ``reconnects``, ``errors`` (ERR replies, a DON without its ACK,
+    1 s, or to its first 0.5 s: counted, delivered). Link: ``reconnects``, ``errors`` (ERR replies, a DON without its
+    ACK,
     callback failures)."""
 
     sentences: int = 0

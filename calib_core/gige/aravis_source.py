@@ -110,7 +110,8 @@ class AravisSource(FrameSource):
                 or "none"
             )
             raise VideoSourceError(
-                f"{self.description}: no camera with that id; cameras found: {seen} (an id is Vendor-Model-Serial, as `arv-tool-0.8` lists them)"
+                f"{self.description}: no camera with that id; cameras found: {seen} (an id is Vendor-Model-Serial, as "
+                "`arv-tool-0.8` lists them)"
             )
 
     def _configure(self, camera) -> None:
@@ -233,7 +234,8 @@ class AravisSource(FrameSource):
                 self._close_device()  # gone quiet for long: open it afresh on the next read
             if now >= deadline:
                 raise FrameTimeout(
-                    f"{self.description}: no frame for {now - self._last_frame_s:.1f} s (waiting; reconnecting after {self.reopen_after_s:g} s)"
+                    f"{self.description}: no frame for {now - self._last_frame_s:.1f} s (waiting; reconnecting after "
+                    f"{self.reopen_after_s:g} s)"
                 )
 
     def _reopen(self) -> None:

@@ -60,7 +60,8 @@ MODES = ("poll", "stream")
 
 class ControllerLink(ConnectorEvents):
     """The connector of videocal's own protocol (``videocal.controllers``: a port path, ``serial://``,
-    ``socket://``, ``rfc2217://``, ``loop://``): a link to one controller. ``mode``: ``poll`` or ``stream`` at ``rate_hz``;
+    ``socket://``, ``rfc2217://``, ``loop://``): a link to one controller. ``mode``: ``poll`` or ``stream`` at
+    ``rate_hz``;
     ``stale_after_s``: no sample for this long marks the link stale (default: five periods,
     at least 0.25 s); ``n_joints``: how many joints the robot has (samples with another count are
     counted in ``stats.wrong_joint_count`` and not delivered; ``None`` takes any count).
@@ -407,7 +408,10 @@ class ControllerLink(ConnectorEvents):
             if self.n_joints is not None and len(msg.joints_deg) != self.n_joints:
                 with self._lock:
                     self.stats.wrong_joint_count += 1
-                self.last_error = f"the controller reports {len(msg.joints_deg)} joints, the robot has {self.n_joints}: is this the cell's controller?"
+                self.last_error = (
+                    f"the controller reports {len(msg.joints_deg)} joints, the robot has "
+                    f"{self.n_joints}: is this the cell's controller?"
+                )
                 return False
             self._deliver(TimedSample(msg, t_host))
             return True

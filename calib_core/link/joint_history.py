@@ -197,7 +197,8 @@ class JointHistory:
         if t_s - times[-1] > unknown_after_s:
             return Stillness(
                 False,
-                f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is unknown",
+                f"no joint sample in the {t_s - times[-1]:.2f} s before the frame: the robot's pose at the frame is "
+                "unknown",
                 0.0,
             )
         if t_s < times[0]:
@@ -237,7 +238,8 @@ class JointHistory:
         if times[k] - times[k - 1] > rule.max_gap_s:
             return Stillness(
                 False,
-                f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the robot may have moved unseen",
+                f"the joint samples stop for {times[k] - times[k - 1]:.2f} s {still_for:.2f} s before the frame: the "
+                "robot may have moved unseen",
                 still_for,
             )
         # moving: the fastest joint speed in the hold window, over sample pairs >= 0.1 s apart
@@ -253,7 +255,8 @@ class JointHistory:
         when = "when the frame was taken" if still_for < 0.05 else f"{still_for:.2f} s before the frame"
         return Stillness(
             False,
-            f"the robot was moving {when} ({self._name(joint)} at {speed:.2f} deg/s; settled means under {rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)",
+            f"the robot was moving {when} ({self._name(joint)} at {speed:.2f} deg/s; settled means under "
+            f"{rule.speed_deg_s:g} deg/s for {rule.hold_s:g} s)",
             still_for,
             speed,
             joint,

@@ -43,7 +43,8 @@ def read_key(path: str | Path | None = None) -> bytes:
         raise LinkKeyError(f"{path}: cannot read the link key: {getattr(exc, 'strerror', None) or exc}") from None
     if stat.S_IMODE(info.st_mode) & 0o077:
         raise LinkKeyError(
-            f"{path}: the link key is readable by others (mode {stat.S_IMODE(info.st_mode):o}); `chmod 600 {path}`, and make a new key if others may have read it"
+            f"{path}: the link key is readable by others (mode {stat.S_IMODE(info.st_mode):o}); `chmod 600 {path}`, "
+            "and make a new key if others may have read it"
         )
     lines = [line.strip() for line in text.splitlines() if line.strip() and not line.strip().startswith("#")]
     if len(lines) != 1:

@@ -38,7 +38,8 @@ class MoveBook:
             self._awaiting_ack.remove(handle)
 
     def acknowledged(self, move_id: str) -> MoveHandle | None:
-        """An ``ACK,MVJ``: the move it names, now acknowledged (``None``: no such move in flight, or acknowledged before)."""
+        """An ``ACK,MVJ``: the move it names, now acknowledged (``None``: no such move in flight, or acknowledged
+        before)."""
         with self._lock:
             handle = self._moves.get(move_id)
             if handle is None or handle.acked:

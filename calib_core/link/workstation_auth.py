@@ -150,8 +150,10 @@ class WorkstationAuth:
         ):
             self._set(
                 AuthState.FAILED,
-                f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): videocal moves only a "
-                "controller that holds the link key; install the controller program (resources/controller/videocal_link.pdl, protocol 6) "
+                f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): "
+                "videocal moves only a "
+                "controller that holds the link key; install the controller program "
+                "(resources/controller/videocal_link.pdl, protocol 6) "
                 "with `videocal link-key`'s key",
             )
             return True
@@ -189,7 +191,8 @@ class WorkstationAuth:
         waited = now_s - min([self._sent_s, *self._earlier.values()])
         self._set(
             AuthState.FAILED,
-            f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:.1f} s; a protocol-3 controller?); the robot is not moved",
+            f"the controller did not answer the handshake ({HANDSHAKE_ATTEMPTS} tries in {waited:.1f} s; a protocol-3 "
+            "controller?); the robot is not moved",
         )
         return False
 

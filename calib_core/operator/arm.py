@@ -197,7 +197,8 @@ class Arm:
         script's), or the prompt's :class:`Confirmation`, void once a Stop was sent after it."""
         if self.observations.replaying:
             raise CalibrationError(
-                "a recording is being replayed: the views show it, not the robot; close the replay before moving the robot"
+                "a recording is being replayed: the views show it, not the robot; close the replay before moving the "
+                "robot"
             )
         if self.link is None:
             raise CalibrationError("no controller link: connect one first")
@@ -207,7 +208,8 @@ class Arm:
         if len(outside):
             j = int(outside[0])
             raise CalibrationError(
-                f"not moving to {what}: joint {robot.joint_names[j]} target {q[j]:.2f} {robot.joint_units[j]} is outside its limits "
+                f"not moving to {what}: joint {robot.joint_names[j]} target {q[j]:.2f} {robot.joint_units[j]} is "
+                "outside its limits "
                 f"[{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]"
             )
         if self.state.motion is Motion.UNKNOWN:

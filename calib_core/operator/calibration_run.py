@@ -25,7 +25,8 @@ from calib_core.vision.intrinsics_calibration import RejectedView
 
 IDLE, MOVING, SETTLING, DONE, STOPPED = "idle", "moving", "settling", "done", "stopped"
 VIA = "via"
-"""In a plan's ``cell_views``: a pose passed through on the way to the next (home, round an obstacle), nothing captured."""
+"""In a plan's ``cell_views``: a pose passed through on the way to the next (home, round an obstacle), nothing
+captured."""
 MAX_FRAMES_PER_POSE = 60
 """Settled frames tried at a pose before it is given up (the board not found in any)."""
 
@@ -76,7 +77,8 @@ class CalibrationRun:
             return
         self._end(
             STOPPED,
-            f"calibration run stopped at pose {self.index + 1} of {len(self.plan)}: {why}; {len(self.capture.views)} views kept",
+            f"calibration run stopped at pose {self.index + 1} of {len(self.plan)}: {why}; {len(self.capture.views)} "
+            "views kept",
         )
 
     def _end(self, phase: str, text: str) -> None:
@@ -94,7 +96,8 @@ class CalibrationRun:
         if self.index >= len(self.plan):
             self._end(
                 DONE,
-                f"calibration run done: {len(self.capture.views)} board views and {len(self.cell_frames)} of the surveyed components from {len(self.plan)} poses"
+                f"calibration run done: {len(self.capture.views)} board views and {len(self.cell_frames)} of the "
+                f"surveyed components from {len(self.plan)} poses"
                 + (f" ({len(self.skipped)} skipped)" if self.skipped else ""),
             )
             return

@@ -94,7 +94,8 @@ class Cell:
         if intrinsics is None:
             if workcell.intrinsics_path is None:
                 raise VideocalError(
-                    f"{workcell.path}: the workcell names no camera file (camera.intrinsics): calibrate the camera first (videocal calibrate-intrinsics)"
+                    f"{workcell.path}: the workcell names no camera file (camera.intrinsics): calibrate the camera "
+                    "first (videocal calibrate-intrinsics)"
                 )
             intrinsics = load_intrinsics(workcell.intrinsics_path)
         return cls(
@@ -171,5 +172,6 @@ class Cell:
         if other.get("content_hash") != self.identity.content_hash:
             raise CellMismatchError(
                 f"{what} belongs to the cell {other.get('name')!r} (content {str(other.get('content_hash'))[:12]}), "
-                f"the open cell is {self.name!r} (content {self.identity.content_hash[:12]}): open its cell first (File > Open cell)"
+                f"the open cell is {self.name!r} (content {self.identity.content_hash[:12]}): open its cell first "
+                "(File > Open cell)"
             )

@@ -288,7 +288,8 @@ class OperatorCore:
 
     # --- the camera model ------------------------------------------------------------------------
     def apply_hand_eye_file(self, path) -> None:
-        """Use a measured camera mounting in place of the model's: ``videocal calibrate-hand-eye`` output, easy_handeye2's
+        """Use a measured camera mounting in place of the model's: ``videocal calibrate-hand-eye`` output,
+        easy_handeye2's
         ``.calib``, or a ``static_transform_publisher`` launch file (MoveIt 2's hand-eye result) on any frame of the arm
         fixed to the flange's link (``tool0`` for a cell whose flange is ``flange``)."""
         from calib_core.vision.hand_eye_io import load_mounting
@@ -324,7 +325,8 @@ class OperatorCore:
             rec.close()
             if rec.failure is not None:
                 self.log.say(
-                    f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal recover` completes it"
+                    f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal "
+                    "recover` completes it"
                 )
             elif not rec.finished:
                 self.log.say(f"recording {rec.path}: the file is being finished in the background")

@@ -72,8 +72,10 @@ class CorrectionDesk:
         pose (or its corrected pose) counts (:mod:`~calib_core.calibration.look_place`); any other raises
         :class:`LookNotAtTask` unless ``convert`` says who converted it and why (kept with the correction
         and recorded). One that is not ``ok`` needs ``confirmation`` likewise. With a robot calibration
-        applied, the look is stored fused with the calibrated model (:meth:`~calib_core.operator.robot_calibrating.RobotCalibrating.look_fused_with_robot`); with a
-        measured tool (:meth:`~calib_core.operator.tool_measuring.ToolMeasuring.measure_tool`) its covariance is in the stored 1-sigma either way."""
+        applied, the look is stored fused with the calibrated model
+        (:meth:`~calib_core.operator.robot_calibrating.RobotCalibrating.look_fused_with_robot`); with a
+        measured tool (:meth:`~calib_core.operator.tool_measuring.ToolMeasuring.measure_tool`) its covariance is in the
+        stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
         if self.session.result.estimate is None:
@@ -115,7 +117,8 @@ class CorrectionDesk:
             self.log.record("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)
         self.log.say(
-            f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg"
+            f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, "
+            f"{np.linalg.norm(c.rotation_deg):.3f} deg"
         )
         return c
 
@@ -156,7 +159,8 @@ class CorrectionDesk:
         motion = self.arm.state
         if motion.motion is not Motion.ARRIVED or motion.what != executed:
             raise CalibrationError(
-                f"execute the task with its correction first (Go to task, corrected), then pick the pairs from there and Verify ({motion.text})"
+                "execute the task with its correction first (Go to task, corrected), then pick the pairs from there "
+                f"and Verify ({motion.text})"
             )
         use = self.session.pairs.usable()
         here = [

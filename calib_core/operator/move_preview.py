@@ -135,7 +135,8 @@ def preview_move(
     problems, warnings, confirm = [], [], []
     for j in np.flatnonzero(margin < 0):
         problems.append(
-            f"joint {robot.joint_names[j]} would go {-margin[j]:.2f} {robot.joint_units[j]} beyond its limits [{lower[j]:g}, {upper[j]:g}]"
+            f"joint {robot.joint_names[j]} would go {-margin[j]:.2f} {robot.joint_units[j]} beyond its limits "
+            f"[{lower[j]:g}, {upper[j]:g}]"
         )
     singular = np.array([scaled_min_singular(robot, q) for q in path])
     near = np.flatnonzero(singular < limits.singularity_margin)
@@ -147,7 +148,8 @@ def preview_move(
             else ("from the start" if k_sing == 0 else f"{100 * k_sing / (len(path) - 1):.0f} % along the path")
         )
         warnings.append(
-            f"near a singularity {where} (smallest singular value {singular.min():.3f} < {limits.singularity_margin:g}): small tool motions turn the wrist a lot"
+            f"near a singularity {where} (smallest singular value {singular.min():.3f} < "
+            f"{limits.singularity_margin:g}): small tool motions turn the wrist a lot"
         )
     contact_step, contacts = None, []
     if world is not None:

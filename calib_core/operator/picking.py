@@ -1,7 +1,8 @@
 """The paper's *Point*, *Accept* and *Calibrate* on frames bound to the robot state they were captured in.
 
 A part of :class:`~calib_core.operator.core.OperatorCore` (``core.picking``), given the cell, the session, the
-frames (:class:`~calib_core.operator.observations.Observations`), the arm and the log it writes to. Frames arrive through
+frames (:class:`~calib_core.operator.observations.Observations`), the arm and the log it writes to. Frames arrive
+through
 :meth:`Picking.observe_frame` (live, or from a recording being replayed); the first image pick of
 a set holds the newest frame, only when the robot had settled before it; every image pick
 carries that frame's :class:`~calib_core.calibration.view_stamp.ViewStamp`; pairs of two robot
@@ -56,8 +57,10 @@ class Picking:
         unbound = [p.number for p in use if p.view is None]
         if unbound:
             raise CalibrationError(
-                f"pair{'s' if len(unbound) > 1 else ''} {', '.join(map(str, unbound))} {'carry' if len(unbound) > 1 else 'carries'} no robot pose "
-                "(picked outside the program's frames, or saved by an older videocal): pick the image point again, on a frame of this pose"
+                f"pair{'s' if len(unbound) > 1 else ''} {', '.join(map(str, unbound))} "
+                f"{'carry' if len(unbound) > 1 else 'carries'} no robot pose "
+                "(picked outside the program's frames, or saved by an older videocal): pick the image point again, on "
+                "a frame of this pose"
             )
         self.check_same_state(use)
         joints = np.array(use[0].view.joints_deg) if use else self.arm.joints_deg
@@ -117,7 +120,8 @@ class Picking:
         held = self.observations.still
         if view is not None and held is not None and not held.stamp.same_state(view):
             raise CalibrationError(
-                f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move its point"
+                f"pair {number} was picked with the robot at another pose ({view.label}): go back to that pose to move "
+                "its point"
             )
         shown = held.frame if held is not None else self.observations.latest
         if refine and shown is not None:
@@ -219,7 +223,8 @@ class Picking:
             worst = max(other, key=lambda p: p.view.joint_difference(reference))
             names = ", ".join(str(p.number) for p in other)
             raise CalibrationError(
-                f"pair{'s' if len(other) > 1 else ''} {names} {'were' if len(other) > 1 else 'was'} picked with the robot at another pose "
+                f"pair{'s' if len(other) > 1 else ''} {names} {'were' if len(other) > 1 else 'was'} picked with the "
+                "robot at another pose "
                 f"(a joint differs by {worst.view.joint_difference(reference):.2f} deg from {reference.label}): "
                 "one set of pairs must come from one robot pose. Delete them (or Clear), or go back to that pose"
             )
@@ -246,7 +251,8 @@ class Picking:
         sent_s = self.arm.last_move_sent_s
         if not self.replaying and sent_s is not None and frame.t_host_s <= sent_s:
             raise NotSettledError(
-                f"frame {frame.index} was taken before the last move ({self.arm.state.what}) was sent: wait for a frame from where the robot stands now"
+                f"frame {frame.index} was taken before the last move ({self.arm.state.what}) was sent: wait for a "
+                "frame from where the robot stands now"
             )
         has_robot = self.replaying or self.arm.link is not None
         return frame, (self.observations.stamp(frame) if has_robot else None)
@@ -277,7 +283,8 @@ class Picking:
         pending = self.session.pairs.pending()
         if pending is not None:
             raise OperatorError(
-                f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: click it there, then Accept"
+                f"pair {pending.number} ({pending.feature or 'surface point'}) has no point on the camera image yet: "
+                "click it there, then Accept"
             )
         if self.current_pair is None:
             raise OperatorError(

@@ -47,7 +47,8 @@ class PointFinding:
     def __init__(self, cell: Cell, session: CalibrationSession, picking: Picking, log: OperatorLog):
         self.cell, self.session, self.picking, self.log = cell, session, picking, log
         self.found: FoundOnFrame | None = None
-        """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or dismissed)."""
+        """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or
+        dismissed)."""
         self._model_view = None
 
     def find_points(self) -> FoundOnFrame:
@@ -109,7 +110,8 @@ class PointFinding:
             raise OperatorError("Find points (F6) first: the edges are fitted on its frame")
         if not found.result.edges.settled:
             raise OperatorError(
-                f"the target's edges did not settle on this frame (RMS {found.result.edges.rms_px:.2f} px): pick the points by hand"
+                f"the target's edges did not settle on this frame (RMS {found.result.edges.rms_px:.2f} px): pick the "
+                "points by hand"
             )
         from calib_core.solver.solve_inputs import solve_inputs
         from calib_core.vision.edge_solution import edge_solution
@@ -154,7 +156,8 @@ class PointFinding:
         pending = session.pairs.pending()
         if pending is not None:
             raise OperatorError(
-                f"pair {pending.number} still waits for its point on the camera image: click it there, or delete it, then accept"
+                f"pair {pending.number} still waits for its point on the camera image: click it there, or delete it, "
+                "then accept"
             )
         chosen = [p for p in found.result.proposals if features is None or p.feature in features]
         unknown = set(features or ()) - {p.feature for p in found.result.proposals}

@@ -54,7 +54,8 @@ class Replaying:
 
     # --- opening and closing -------------------------------------------------------------------
     def open(self, path) -> None:
-        """Open a recording or bag (:meth:`seek` shows a position: its start first). Raises :class:`FileFormatError` (naming the file and why) and
+        """Open a recording or bag (:meth:`seek` shows a position: its start first). Raises :class:`FileFormatError`
+        (naming the file and why) and
         changes nothing when it is not a readable one."""
         from calib_core.recording.playback import RecordingPlayback
         from calib_core.recording.reader import read_recording

@@ -71,7 +71,8 @@ class ToolMeasuring:
             raise OperatorError("the controller link is down: a grasp needs the joints the controller reports")
         if self.arm.state.motion in (Motion.MOVING, Motion.UNKNOWN):
             raise OperatorError(
-                f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed on the pin"
+                f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed "
+                "on the pin"
             )
         q = np.array(self.arm.joints_deg, dtype=float)
         seen, how = None, "no camera frame: taken through the robot and the fixture's survey"
@@ -138,6 +139,7 @@ class ToolMeasuring:
         self.robot_calibration.use_tool(tool)
         self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
         self.log.say(
-            f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, {tool.spread_deg:.4f} deg)"
+            f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, "
+            f"{tool.spread_deg:.4f} deg)"
         )
         return tool

@@ -45,7 +45,8 @@ class RecordingPlayback:
         rows = [m.payload["joints_deg"] for m in joints]
         if len({len(r) for r in rows}) > 1:
             raise ValueError(
-                f"the joint samples of the recording have {' and '.join(str(n) for n in sorted({len(r) for r in rows}))} values"
+                "the joint samples of the recording have "
+                f"{' and '.join(str(n) for n in sorted({len(r) for r in rows}))} values"
             )
         # A recording of a camera alone has no joint samples: its frames replay, nothing is robot-bound.
         self.joints_deg = np.array(rows, dtype=float).reshape(len(rows), len(rows[0]) if rows else 0)

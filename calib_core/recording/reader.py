@@ -116,7 +116,8 @@ def read_recording(path: str | Path) -> RecordingContents:
         what = "a ROS bag folder" if (path / "metadata.yaml").is_file() else "a folder"
         raise FileFormatError(
             path,
-            f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)",
+            f"{what}, not a videocal recording (an .mcap file); ROS bags are read by calibrate-intrinsics, "
+            "calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)",
         )
     try:
         handle = open(path, "rb")
@@ -170,7 +171,8 @@ def read_recording(path: str | Path) -> RecordingContents:
             else "it holds no messages"
         )
         hint = (
-            "; a ROS 2 bag is read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's replay (gui --recording)"
+            "; a ROS 2 bag is read by calibrate-intrinsics, calibrate-hand-eye, calibrate-robot and the window's "
+            "replay (gui --recording)"
             if any("cdr" in t or "ros" in t for t in topics)
             else ""
         )

@@ -101,12 +101,14 @@ JOINT_SAMPLE = {
 EVENT = {
     "title": "videocal.Event",
     "type": "object",
-    "description": "an operator or link event: pair edits (pair_added, pair_changed, pair_removed, pair_reset), link_state, move_*, frame_held, verified, ...",
+    "description": "an operator or link event: pair edits (pair_added, pair_changed, pair_removed, pair_reset), "
+    "link_state, move_*, frame_held, verified, ...",
     "properties": {
         "kind": {"type": "string"},
         "detail": {
             "type": "object",
-            "description": "fields of the event; pair events carry the pair (number, target, feature, point_world_mm, pixel, view)",
+            "description": "fields of the event; pair events carry the pair (number, target, feature, point_world_mm, "
+            "pixel, view)",
         },
     },
     "required": ["kind", "detail"],
@@ -163,7 +165,8 @@ SOLVE_RESULT = {
         "method": {
             "type": "string",
             "enum": ["points", "edges"],
-            "description": "points: from the pairs; edges: from the target's edges on the image (residuals: one per edge sample)",
+            "description": "points: from the pairs; edges: from the target's edges on the image (residuals: one per "
+            "edge sample)",
         },
     },
     "required": ["status", "R_obj2cam", "t_obj2cam_mm", "rms_px"],

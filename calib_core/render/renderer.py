@@ -132,7 +132,8 @@ class SceneRenderer:
         self._lights(intensity, key_direction)
 
     def set_studio(self, studio: Studio) -> None:
-        """Light the scene by ``studio``'s lamps, with their shadows and glossy surfaces (a workshop, not a CAD view)."""
+        """Light the scene by ``studio``'s lamps, with their shadows and glossy surfaces (a workshop, not a CAD
+        view)."""
         light_with(self.renderer, studio)
         self._material = (studio.ambient, 1.0 - studio.ambient, studio.specular, studio.specular_power)
 

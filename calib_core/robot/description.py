@@ -156,7 +156,8 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
                 if attr == "xyz" and max(abs(v) for v in values) > MAX_ORIGIN_M:
                     raise FileFormatError(
                         path,
-                        f"{owner}: origin xyz={origin.get(attr)!r} is over {MAX_ORIGIN_M:g} m away: a URDF is in metres (mm written as m?)",
+                        f"{owner}: origin xyz={origin.get(attr)!r} is over {MAX_ORIGIN_M:g} m away: a URDF is in "
+                        "metres (mm written as m?)",
                     )
     for joint in root.iter("joint"):
         axis = joint.find("axis")
@@ -165,7 +166,8 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
             if values is None or not all(math.isfinite(v) for v in values) or math.hypot(*values) < 1e-9:
                 raise FileFormatError(
                     path,
-                    f"joint '{joint.get('name')}': axis xyz={axis.get('xyz')!r} must be three finite numbers, not all zero",
+                    f"joint '{joint.get('name')}': axis xyz={axis.get('xyz')!r} must be three finite numbers, not all "
+                    "zero",
                 )
         limit = joint.find("limit")
         if limit is None or joint.get("type") not in ("revolute", "prismatic"):
@@ -174,7 +176,8 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
         if lo is None or hi is None or not all(math.isfinite(v) for v in lo + hi):
             raise FileFormatError(
                 path,
-                f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be finite numbers",
+                f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be "
+                "finite numbers",
             )
         if lo[0] > hi[0]:
             raise FileFormatError(

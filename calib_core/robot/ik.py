@@ -113,7 +113,8 @@ def solve_ik(
             best_miss = (pos, rot)
     if not found:
         raise UnreachableTargetError(
-            f"the {frame} cannot reach the target within the joint limits (closest: {best_miss[0]:.1f} mm, {best_miss[1]:.2f} deg away)",
+            f"the {frame} cannot reach the target within the joint limits (closest: {best_miss[0]:.1f} mm, "
+            f"{best_miss[1]:.2f} deg away)",
             best_miss,
         )
     q, e, iterations = min(found, key=lambda f: float(np.max(np.abs(f[0] - q_current))))

@@ -82,7 +82,8 @@ class RobotModel:
             if kind is None:
                 raise FileFormatError(
                     self.urdf_path,
-                    f"joint '{self.model.names[i]}' is of a kind videocal cannot drive ({self.model.joints[i].shortname()}); mark it held in the workcell (robot.held_joints)",
+                    f"joint '{self.model.names[i]}' is of a kind videocal cannot drive "
+                    f"({self.model.joints[i].shortname()}); mark it held in the workcell (robot.held_joints)",
                 )
             kinds.append(kind)
         self.joint_kinds: list[str] = kinds
@@ -245,7 +246,8 @@ class RobotModel:
             return np.asarray(pose_on_frame_mm, dtype=float)
         if not self.model.existFrame(frame):
             raise VideocalError(
-                f"{source}: frame {frame!r} is not on this cell's robot (its flange is {self.roles.get('flange', 'flange')!r})"
+                f"{source}: frame {frame!r} is not on this cell's robot (its flange is "
+                f"{self.roles.get('flange', 'flange')!r})"
             )
         if (
             self.model.frames[self.frame_id(frame)].parentJoint
@@ -324,7 +326,8 @@ def _assign_roles(model: pin.Model, frames: dict, path: Path) -> dict[str, str]:
         elif role in frames:  # named on purpose but absent: say so now rather than at the first FK
             raise RobotSpecError(
                 f"robot.frames.{role}",
-                f"the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: [...]}}",
+                f"the URDF has no frame {spec!r}; give a URDF frame, or a new one as {{parent: FRAME, xyz: [...], rpy: "
+                "[...]}",
                 path,
             )
     return roles
@@ -356,7 +359,8 @@ def load_robot(source: str | Path | RobotSpec = DEFAULT_URDF) -> RobotModel:
     if model.frames[base_id].parentJoint != 0:
         raise RobotSpecError(
             "robot.frames.base",
-            f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base must be fixed to the world",
+            f"frame {roles['base']!r} moves with joint {model.names[model.frames[base_id].parentJoint]!r}; the base "
+            "must be fixed to the world",
             path,
         )
     pin.framesForwardKinematics(model, data, pin.neutral(model))

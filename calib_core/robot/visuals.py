@@ -60,7 +60,8 @@ def _mesh_of(g: pin.GeometryObject, where: str) -> trimesh.Trimesh:
         return _MESH_CACHE[key]
     raise FileFormatError(
         g.meshPath or "(URDF)",
-        f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres or capsules)",
+        f"{where}: geometry of type {type(geometry).__name__} is not supported (use meshes, boxes, cylinders, spheres "
+        "or capsules)",
     )
 
 

@@ -82,7 +82,8 @@ def camera_to_tool(
     """``tcp2cam`` from ``grasps``: a seen grasp's own, the others' with ``robot`` (calibrated)
     placing the camera.
 
-    A seen grasp carries its covariance. For the others, with ``placement_sigma_mm`` (the survey's 1-sigma per axis of each grasped fixture) the tool gets a
+    A seen grasp carries its covariance. For the others, with ``placement_sigma_mm`` (the survey's 1-sigma per axis of
+    each grasped fixture) the tool gets a
     covariance: the fixture's survey error goes whole into its grasp's estimate (the gripper centres the
     TCP on the fixture as it truly stands, the estimate takes it where the workcell file places it), and
     ``camera_covariance(joints_deg)`` (6, 6: mm, mrad, base axes; the calibrated model's camera) adds the
@@ -132,7 +133,8 @@ def with_tool(
     tcp_id, cam_id = robot.frame_id(tcp_frame), robot.frame_id(camera_frame)
     if robot.model.frames[tcp_id].parentJoint != robot.model.frames[cam_id].parentJoint:
         raise CameraToToolError(
-            f"the {tcp_frame} and {camera_frame} frames move with different joints: the camera must ride on the tool's joint"
+            f"the {tcp_frame} and {camera_frame} frames move with different joints: the camera must ride on the tool's "
+            "joint"
         )
     out = robot.copy()
     out.set_frame_placement(tcp_frame, concat(tcp2cam, robot.frame_placement(camera_frame)))

@@ -65,7 +65,8 @@ def load_grasps(path: str | Path, joint_names: list[str], workcell) -> list[Gras
     else:
         raise FileFormatError(
             path,
-            f"the joint columns {', '.join(columns) or '(none)'} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}",
+            f"the joint columns {', '.join(columns) or '(none)'} are not the robot's joints ({', '.join(joint_names)}) "
+            f"nor {', '.join(generic)}",
             "header",
         )
     if not 1 <= len(rows) - 1 <= MAX_GRASPS:

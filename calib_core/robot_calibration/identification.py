@@ -396,7 +396,8 @@ def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray,
             return out
         kept[bounds[worst] : bounds[worst + 1]] = False
         out[views[worst].name] = (
-            f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} (median)"
+            f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} "
+            "(median)"
         )
 
 

@@ -65,7 +65,8 @@ def calibrated_urdf(nominal: RobotModel, calibrated: RobotModel, camera_frame: s
             _set_origin(element, concat(after, invert(folded)))
         else:
             left.append(
-                f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml ({'camera_on_parent' if role == camera_frame else 'tcp2cam'})"
+                f"the {role} frame {frame!r} is not a URDF link: its calibrated placement is in robot_calibration.yaml "
+                f"({'camera_on_parent' if role == camera_frame else 'tcp2cam'})"
             )
     for mesh in root.iter("mesh"):  # package:// meshes as the description named them, not where this machine found them
         original = nominal.mesh_uris.get(mesh.get("filename", ""), "")
@@ -86,7 +87,8 @@ def calibration_document(result: RobotCalibration, nominal: RobotModel, camera_f
     i = result.intrinsics
     return {
         "units": {"length": "mm", "angle": "mrad for corrections, deg for rpy", "pixels": "px"},
-        "model": "each joint's placement in its parent, and the camera's on its joint, corrected by a small transform applied before it, in the parent's frame",
+        "model": "each joint's placement in its parent, and the camera's on its joint, corrected by a small transform "
+        "applied before it, in the parent's frame",
         "parameters": {
             name: {
                 "value": round(float(v), 5),

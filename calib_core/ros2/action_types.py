@@ -44,7 +44,8 @@ CANCEL_ERROR_NONE, CANCEL_ERROR_REJECTED, CANCEL_ERROR_UNKNOWN_GOAL_ID, CANCEL_E
 
 @dataclass
 class RequestHeader(IdlStruct, typename="videocal::cdds_request_header"):
-    """``rmw_cyclonedds_cpp``'s header before every request and reply: who asked (``guid``) and which request (``seq``)."""
+    """``rmw_cyclonedds_cpp``'s header before every request and reply: who asked (``guid``) and which request
+    (``seq``)."""
 
     guid: uint64 = 0
     seq: int64 = 0

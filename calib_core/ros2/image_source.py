@@ -7,7 +7,8 @@ is that instant on the host's monotonic clock (the stamp's age subtracted from t
 the arrival), so picks are bound to the joints when the image was taken, not when it arrived. The reader is best
 effort (it hears both best-effort and reliable publishers, as ``rclcpp``'s sensor-data subscriptions do) and keeps
 only the newest image: a slow window skips frames, it never queues them. A camera that goes quiet gives
-:class:`~calib_core.connectors.frame.FrameTimeout` (the pane keeps waiting and says so); when it comes back, so do frames.
+:class:`~calib_core.connectors.frame.FrameTimeout` (the pane keeps waiting and says so); when it comes back, so do
+frames.
 """
 
 from __future__ import annotations
@@ -98,7 +99,8 @@ class Ros2ImageSource(FrameSource):
         with self._ready:
             if not self._ready.wait_for(lambda: self._newest is not None or self._stop.is_set(), self.timeout_s):
                 raise FrameTimeout(
-                    f"{self.description}: no image for {self.timeout_s:g} s (waiting for it; check the camera driver and ROS_DOMAIN_ID={self.domain})"
+                    f"{self.description}: no image for {self.timeout_s:g} s (waiting for it; check the camera driver "
+                    f"and ROS_DOMAIN_ID={self.domain})"
                 )
             if self._newest is None:
                 raise VideoSourceError(f"{self.description}: closed")

@@ -15,7 +15,10 @@ def foreign_joints_text(topic: str, received: list[str], wanted: list[str]) -> s
     mapping = suggest_joint_names(wanted, received)
     if mapping:
         pairs = ", ".join(f"{a} -> {b}" for a, b in list(mapping.items())[:3])
-        text += f"; they look like this robot's with other names ({pairs}{' ...' if len(mapping) > 3 else ''}): use the driver's URDF for the cell"
+        text += (
+            f"; they look like this robot's with other names ({pairs}{' ...' if len(mapping) > 3 else ''}): use "
+            "the driver's URDF for the cell"
+        )
     else:
         text += ": is this the cell's robot (another arm, a gripper's group)?"
     return text

@@ -58,7 +58,8 @@ def is_launch_file(path: str | Path) -> bool:
 
 
 def read_static_transform(path: str | Path) -> StaticTransform:
-    """The one ``static_transform_publisher`` of a ROS 2 Python or an XML launch file. :class:`FileFormatError` names the
+    """The one ``static_transform_publisher`` of a ROS 2 Python or an XML launch file. :class:`FileFormatError` names
+    the
     file for no such node, several, or arguments that are not a transform."""
     path = Path(path)
     text = read_text(path, "launch file", max_bytes=1024 * 1024)

@@ -1,7 +1,9 @@
 """The measured camera mounting in the two forms a ROS 2 system takes it: a launch file that runs
-``tf2_ros``'s ``static_transform_publisher`` (ROS 2 Humble's named arguments: metres and a quaternion), and a URDF (a document a
+``tf2_ros``'s ``static_transform_publisher`` (ROS 2 Humble's named arguments: metres and a quaternion), and a URDF (a
+document a
 parser reads alone) or a xacro macro to include, with a fixed joint from the mount's link to the camera's (metres,
-URDF's fixed-axis roll-pitch-yaw in radians). Plain text: no ROS needed to write them. The camera frame is videocal's (z along
+URDF's fixed-axis roll-pitch-yaw in radians). Plain text: no ROS needed to write them. The camera frame is videocal's (z
+along
 the optical axis, x right, y down), which is ROS's optical frame convention (REP 103: ``*_optical_frame``).
 """
 
@@ -59,7 +61,10 @@ def _origin(camera2mount_mm) -> str:
 
 
 def _header(note: str) -> str:
-    return f"<!-- Written by videocal on {date.today().isoformat()}: the camera mounting{': ' + note if note else ''}. Metres and radians. -->\n"
+    return (
+        f"<!-- Written by videocal on {date.today().isoformat()}: the camera mounting{': ' + note if note else ''}. "
+        "Metres and radians. -->\n"
+    )
 
 
 def urdf_document(camera2mount_mm, parent: str, child: str = DEFAULT_CAMERA_FRAME, note: str = "") -> str:

@@ -17,7 +17,8 @@ a pause; when they stop (the workstation gone, the network cut, the joint states
 the workstation. The commanded point only moves forward along the line, so a late joint state never turns the
 arm back. Through the action each renewal is a goal that preempts the last
 (:mod:`calib_core.ros2.trajectory_goals`): a refused or aborted goal ends the move with the controller's reason, and
-Stop cancels the running goal. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target; *refused* at
+Stop cancels the running goal. A move is *done* when the joint states stand within ``done_tolerance_deg`` of the target;
+*refused* at
 once when no trajectory controller subscribes to the topic; *stopped* by Stop, which sends a trajectory that
 holds the current position. No joint states for ``stale_after_s``: the link is ``stale``, the robot's pose
 unknown, and a move under way ends with that error (it is not renewed: the arm stops within its horizon).
@@ -250,7 +251,10 @@ class Ros2TrajectoryController(ConnectorEvents):
             return f"the link is {self._state.value} (no fresh joint states on {self.joint_states_topic[2:]})"
         if self.interface == "action":
             if not self._goals.client.server_ready():
-                return f"no FollowJointTrajectory action server at {self.action_name} (is '{self.controller}' loaded and active?)"
+                return (
+                    f"no FollowJointTrajectory action server at {self.action_name} (is '{self.controller}' loaded "
+                    "and active?)"
+                )
         elif self._writer.get_publication_matched_status().current_count == 0 and not (
             self._goals and self._goals.client.server_ready()
         ):
@@ -323,7 +327,8 @@ class Ros2TrajectoryController(ConnectorEvents):
             self._hear_the_controller()
 
     def _hear_the_controller(self) -> None:
-        """The action's answers: a refused or aborted goal of the move under way ends it with the controller's reason."""
+        """The action's answers: a refused or aborted goal of the move under way ends it with the controller's
+        reason."""
         if self._goals is None or not self._through_action:
             return
         try:
@@ -363,7 +368,8 @@ class Ros2TrajectoryController(ConnectorEvents):
         foreign = self._types.foreign(self.joint_states_topic, msg.JointState.__idl_typename__)
         if foreign:
             self.last_error = (
-                f"{self.joint_states_topic[2:]} on ROS domain {self.domain} carries {', '.join(foreign)}, not sensor_msgs/msg/JointState: "
+                f"{self.joint_states_topic[2:]} on ROS domain {self.domain} carries {', '.join(foreign)}, not "
+                "sensor_msgs/msg/JointState: "
                 "name the topic of the arm's joint states (ros2:///TOPIC)"
             )
             self._restate(self.last_error)

@@ -55,12 +55,16 @@ class GoalStream:
                 continue
             if event.kind == "refused":
                 reason = (
-                    f"the controller refused the goal on {self.client.name} (its log says why: joints it does not have, a point "
+                    f"the controller refused the goal on {self.client.name} (its log says why: joints it does not "
+                    "have, a point "
                     "past a limit, or the controller not active)"
                 )
             elif event.kind == "ended" and event.status in (at.ABORTED, at.CANCELED):
                 code = at.ERROR_NAMES.get(event.error_code, str(event.error_code))
-                reason = f"the controller {at.STATUS_NAMES[event.status]} the move ({code}{': ' + event.error_string if event.error_string else ''})"
+                reason = (
+                    f"the controller {at.STATUS_NAMES[event.status]} the move "
+                    f"({code}{': ' + event.error_string if event.error_string else ''})"
+                )
         if reason is not None:
             self.release()
         return reason

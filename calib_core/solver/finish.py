@@ -39,24 +39,29 @@ def operator_warnings(problem: PoseProblem, condition_number: float, noise: floa
         apart = float(np.linalg.norm(problem.points_2d[i] - problem.points_2d[j]))
         if apart > 3.0 * np.sqrt(2.0) * noise:  # two picks of one point differ by more than their noise allows
             warnings.append(
-                f"{point_label(i)} and {point_label(j)} are the same 3D point picked {apart:.1f} px apart: one of the two picks is off"
+                f"{point_label(i)} and {point_label(j)} are the same 3D point picked {apart:.1f} px apart: one of the "
+                "two picks is off"
             )
     intr = problem.intrinsics
     if not (0.0 <= intr.cx <= intr.width and 0.0 <= intr.cy <= intr.height):
         warnings.append(
-            f"the principal point ({intr.cx:.1f}, {intr.cy:.1f}) px lies outside the {intr.width}x{intr.height} image: check the camera file"
+            f"the principal point ({intr.cx:.1f}, {intr.cy:.1f}) px lies outside the {intr.width}x{intr.height} image: "
+            "check the camera file"
         )
     if problem.n_points * 2 <= problem.n_params:
         warnings.append(
-            f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by construction and cannot reveal a mis-click"
+            f"{problem.n_points} pairs for {problem.n_params} unknowns: no redundancy, the residuals are zero by "
+            "construction and cannot reveal a mis-click"
         )
     if condition_number > _POOR_CONDITION:
         warnings.append(
-            f"the pose is poorly determined (condition number {condition_number:.3g}): spread the points over more of the object and the image"
+            f"the pose is poorly determined (condition number {condition_number:.3g}): spread the points over more of "
+            "the object and the image"
         )
     if problem.off_image:
         warnings.append(
-            f"{points_label(problem.off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} image"
+            f"{points_label(problem.off_image)} lie outside the {problem.intrinsics.width}x{problem.intrinsics.height} "
+            "image"
         )
     if problem.model == "paper" and problem.intrinsics.has_distortion:
         warnings.append("the paper's model ignores lens distortion: the picks were undistorted first")
@@ -150,7 +155,8 @@ def finish_solution(
         # would pass unseen (5 pairs, one off: three fitted exactly, two good ones rejected, 550 mm wrong).
         status = SolveStatus.FAILED
         reason = (
-            f"only {agreeing} pairs agree after rejecting {points_label(np.flatnonzero(outliers))}: too few to check one another; "
+            f"only {agreeing} pairs agree after rejecting {points_label(np.flatnonzero(outliers))}: too few to check "
+            "one another; "
             "pick the rejected pairs again or add pairs"
         )
     elif rms > limit_px:
@@ -159,7 +165,10 @@ def finish_solution(
         advice = (
             "check that pick" if huber_px is not None else "check that pick, or use robust"
         )  # (robust is on already)
-        reason = f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; {point_label(worst)} fits worst ({advice})"
+        reason = (
+            f"reprojection RMS {rms:.2f} px exceeds {limit_px:.2f} px: the picks do not fit one pose; "
+            f"{point_label(worst)} fits worst ({advice})"
+        )
     elif misfits.any():
         # A single mis-pick among good ones barely moves the RMS (12 px among 9 good: 0.92 px) but tilts the pose.
         worst = _worst(statistics, loo, e)
@@ -168,8 +177,10 @@ def finish_solution(
             f" (also {points_label([i for i in np.flatnonzero(misfits) if i != worst])})" if misfits.sum() > 1 else ""
         )
         reason = (
-            f"{point_label(worst)} does not fit the others: the pose from the other pairs misses it by {loo[worst]:.1f} px, "
-            f"where picks good to {sigma_test[worst]:.2g} px allow about {np.sqrt(limit) * sigma_test[worst]:.1f} px{others}; check that pick or untick it"
+            f"{point_label(worst)} does not fit the others: the pose from the other pairs misses it by "
+            f"{loo[worst]:.1f} px, "
+            f"where picks good to {sigma_test[worst]:.2g} px allow about {np.sqrt(limit) * sigma_test[worst]:.1f} "
+            f"px{others}; check that pick or untick it"
         )
     elif len(candidates) > 1:
         status = SolveStatus.AMBIGUOUS

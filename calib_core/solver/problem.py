@@ -118,7 +118,8 @@ def make_problem(
     repeated = _repeated_points(p3, p2, _DUPLICATE_REL_3D * max(spread, 1.0))
     if len(p3) - len({j for _, j in repeated}) < needed:
         raise TooFewPointsError(
-            f"{len(p3)} point pairs given but only {len(p3) - len({j for _, j in repeated})} distinct 3D points, at least {needed} needed"
+            f"{len(p3)} point pairs given but only {len(p3) - len({j for _, j in repeated})} distinct 3D points, at "
+            f"least {needed} needed"
         )
     if code == COLLINEAR:
         raise DegenerateGeometryError(

@@ -199,7 +199,8 @@ def solve_pose(
         suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
         solution = replace(
             solution,
-            reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the others fit as well); "
+            reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the "
+            "others fit as well); "
             "pick them again or add a point",
         )
     return solution
@@ -308,7 +309,10 @@ def _solve_distinct(first: np.ndarray, points_3d, points_2d, intrinsics, **optio
     shown = ", ".join(f"{point_label(int(r))} = {point_label(int(first[r]))}" for r in repeats[:5]) + (
         f" and {len(repeats) - 5} more" if len(repeats) > 5 else ""
     )
-    note = f"{len(repeats)} pair{'s' if len(repeats) > 1 else ''} given again (the same 3D point at the same pixel), each counted once: {shown}"
+    note = (
+        f"{len(repeats)} pair{'s' if len(repeats) > 1 else ''} given again (the same 3D point at the same pixel), "
+        f"each counted once: {shown}"
+    )
     return replace(
         solution,
         residuals_px=solution.residuals_px[place],

@@ -68,7 +68,8 @@ class URRtdeController(ConnectorEvents):
             )
         if context.n_joints != 6 or any(u != "deg" for u in context.joint_units):
             raise LinkError(
-                f"{url}: a UR robot has 6 revolute joints; the cell's robot has {context.n_joints} ({', '.join(context.joint_units)})"
+                f"{url}: a UR robot has 6 revolute joints; the cell's robot has {context.n_joints} "
+                f"({', '.join(context.joint_units)})"
             )
         options = dict(context.options or {})
         options.update({k: v[-1] for k, v in parse_qs(parts.query).items()})
@@ -146,7 +147,8 @@ class URRtdeController(ConnectorEvents):
         why = self._why_not_sendable()
         program = (
             "def videocal_move():\n"
-            f"  movej([{', '.join(f'{v:.6f}' for v in np.radians(q))}], a={math.radians(self.acceleration_deg_s2):.4f}, v={math.radians(self.speed_deg_s):.4f})\n"
+            f"  movej([{', '.join(f'{v:.6f}' for v in np.radians(q))}], "
+            f"a={math.radians(self.acceleration_deg_s2):.4f}, v={math.radians(self.speed_deg_s):.4f})\n"
             "end\n"
         )
         if why is None:
@@ -172,9 +174,15 @@ class URRtdeController(ConnectorEvents):
         if self._state is not LinkState.UP or self._latest is None:
             return f"the link is {self._state.value} (no fresh RTDE data from {self.host})"
         if not self._dashboard_asked.is_set():
-            return f"the dashboard server {self.host}:{DASHBOARD_PORT} has not said yet whether the robot is in remote control"
+            return (
+                f"the dashboard server {self.host}:{DASHBOARD_PORT} has not said yet whether the robot is in remote "
+                "control"
+            )
         if self.protective_stop:
-            return "the robot is in a protective stop: clear it on the teach pendant (or the dashboard's 'unlock protective stop')"
+            return (
+                "the robot is in a protective stop: clear it on the teach pendant (or the dashboard's 'unlock "
+                "protective stop')"
+            )
         if self.remote_control is False:
             return "the robot is in local control: switch it to remote control on the teach pendant"
         return None

@@ -32,7 +32,8 @@ class StreamSource(FrameSource):
         self._cap = self._open()
         if self._cap is None:
             raise VideoSourceError(
-                f"cannot open {self.description} with OpenCV's FFmpeg back end (wrong URL, or the camera is not serving?)"
+                f"cannot open {self.description} with OpenCV's FFmpeg back end (wrong URL, or the camera is not "
+                "serving?)"
             )
 
     def _open(self):
@@ -64,7 +65,8 @@ class StreamSource(FrameSource):
         return frame
 
     def _reopen(self) -> None:
-        """One try to open the stream again (after ``reopen_every_s`` since the last); FrameTimeout if it is still gone."""
+        """One try to open the stream again (after ``reopen_every_s`` since the last); FrameTimeout if it is still
+        gone."""
         wait = self._last_try_s + self.reopen_every_s - time.monotonic()
         if wait > 0:
             time.sleep(wait)  # the reader's thread: nothing to read until the next try
@@ -73,7 +75,8 @@ class StreamSource(FrameSource):
         if self._cap is None:
             gone = time.monotonic() - (self._down_since or self._last_try_s)
             raise FrameTimeout(
-                f"{self.description}: no frame for {gone:.0f} s (the stream is gone; opening it again every {self.reopen_every_s:g} s)"
+                f"{self.description}: no frame for {gone:.0f} s (the stream is gone; opening it again every "
+                f"{self.reopen_every_s:g} s)"
             )
         self.reconnects += 1
 

@@ -42,12 +42,14 @@ class BoardCapture:
         frame are one view, not four."""
         if frame_key is not None and frame_key in self._captured:
             raise CalibrationInputError(
-                f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next pose"
+                f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next "
+                "pose"
             )
         if self.views and (image_rgb.shape[1], image_rgb.shape[0]) != self.views[0].image_size:
             w, h = self.views[0].image_size
             raise CalibrationInputError(
-                f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one calibration is for one camera mode"
+                f"this frame is {image_rgb.shape[1]} x {image_rgb.shape[0]} px, the views so far are {w} x {h} px: one "
+                "calibration is for one camera mode"
             )
         self._count += 1
         result = detect_view(f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
@@ -80,7 +82,8 @@ class BoardCapture:
         posed = [(v, q) for v, q in zip(self.views, self.joints_deg) if q is not None]
         if len(posed) < len(self.views):
             raise CalibrationInputError(
-                f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a controller link)"
+                f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a "
+                "controller link)"
             )
         return calibrate_hand_eye(
             [v for v, _ in posed], [robot.fk(q, "flange") for _, q in posed], self.spec, intrinsics

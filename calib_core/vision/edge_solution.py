@@ -41,7 +41,8 @@ def edge_solution(fit: EdgeFit, intrinsics: Intrinsics) -> PoseSolution:
         None
         if settled
         else (
-            f"the edges did not settle: RMS {fit.rms_px:.2f} px, {100 * fit.inlier_share:.0f} % of {fit.samples} samples on their edges"
+            f"the edges did not settle: RMS {fit.rms_px:.2f} px, {100 * fit.inlier_share:.0f} % of {fit.samples} "
+            "samples on their edges"
             if fit.converged
             else "the edge refinement did not converge"
         )

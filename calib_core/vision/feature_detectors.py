@@ -227,7 +227,8 @@ def detect_circle_against_model(
     usable = inside & (model_strength >= 12.0) & (np.abs(model_offset) <= 1.5) & (alike >= _ALIKE)
     if usable.sum() < 6:
         return NotDetected(
-            f"its rim is outside the image, stands beside another edge in the model's view or looks unlike it ({int(usable.sum())} of {len(rim_px)} rim points clear)"
+            "its rim is outside the image, stands beside another edge in the model's view or looks unlike it "
+            f"({int(usable.sum())} of {len(rim_px)} rim points clear)"
         )
     floor = max(8.0, 0.35 * float(np.median(strength[usable])))
     strong = usable & (strength >= floor)

@@ -43,9 +43,13 @@ from calib_core.vision.search_reach import REACH_DEG, REACH_MM  # noqa: E402 (na
 
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
-_FIT_SHARE = 0.6  # a fit settles (is proposed from) with this share of its samples on their edges: wrong minima seen held 52-56 %, the least right one 65 % (the bench)
+# a fit settles (is proposed from) with this share of its samples on their edges: wrong minima seen held 52-56 %, the
+# least right one 65 % (the bench)
+_FIT_SHARE = 0.6
 _CLEAR_SHARE = 0.75  # a settled fit with this share ends the search (the right pose of the demo's frame 12 held 90 %)
-_STARTS = 8  # starts tried at most: on one frame of the demo the right one ranked fourth, the first three settling 1.6-1.9 mm off at 55 %
+# starts tried at most: on one frame of the demo the right one ranked fourth, the first three settling 1.6-1.9 mm off at
+# 55 %
+_STARTS = 8
 _REUSE_PX = 0.25  # the second pass's view serves the detectors when its fit moved the target less than this
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put a feature further apart
@@ -240,12 +244,14 @@ def find_points(
         share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
         if share < _MATCHED_SHARE:
             message = (
-                f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an edge of the image): "
+                f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet "
+                "an edge of the image): "
                 "pick the points by hand"
             )
         else:
             message = (
-                f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, {100 * edge_fit.inlier_share:.0f} % of "
+                f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, "
+                f"{100 * edge_fit.inlier_share:.0f} % of "
                 f"{edge_fit.samples} edge samples on their edges): pick the points by hand"
             )
         return FoundPoints(
@@ -281,7 +287,8 @@ def find_points(
         for i, d in list(first.items()):
             if isinstance(d, Detection) and np.linalg.norm(d.uv_px - uv_edges[i]) > agreement:
                 first[i] = NotDetected(
-                    f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges put it "
+                    f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's "
+                    "edges put it "
                     "(another edge in front of it?)"
                 )
     pose, fit = _robust_fit(first, points, intrinsics, start)
@@ -315,7 +322,8 @@ def find_points(
         return FoundPoints(
             item.name,
             False,
-            f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for a pose: "
+            f"{item.name}: only {sum(isinstance(d, Detection) for d in first.values())} features detected, too few for "
+            "a pose: "
             "pick the points by hand, or Calibrate on edges (its edges settled)",
             missed=tuple(Missed(n, r) for n, r in missed.items()),
             offset_px=shift,

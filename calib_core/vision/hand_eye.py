@@ -118,7 +118,8 @@ def pose_set_warnings(flange2base: list[np.ndarray]) -> list[str]:
         s = np.linalg.svd(np.array(axes), compute_uv=False)
         if s[1] < 0.2 * s[0]:
             out.append(
-                "the rotations between poses are about nearly parallel axes: the mounting is then undetermined along that axis; tilt about two different axes"
+                "the rotations between poses are about nearly parallel axes: the mounting is then undetermined along "
+                "that axis; tilt about two different axes"
             )
     elif angles:
         out.append("too few rotations between poses to determine the mounting")
@@ -147,7 +148,8 @@ def calibrate_hand_eye(
         raise CalibrationInputError(f"{len(views)} poses, at least {MIN_POSES} needed (10 or more recommended)")
     if not spec.unambiguous:
         raise CalibrationInputError(
-            f"a {spec.kind} target looks the same turned half a turn, so a view does not say which corner is the first: use a ChArUco or ArUco board for the camera's mounting"
+            f"a {spec.kind} target looks the same turned half a turn, so a view does not say which corner is the "
+            "first: use a ChArUco or ArUco board for the camera's mounting"
         )
     warnings = pose_set_warnings(flange2base)
     # The camera on the robot sees the board at X^-1 A^-1 Y; a static camera at X^-1 A Y.
@@ -170,8 +172,10 @@ def calibrate_hand_eye(
     limit = disagreement_limit_px(noise, pose_px)
     if rms > limit:
         warnings.append(
-            f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' noise of {noise:.2f} px "
-            f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration takes the robot's poses as exact, and these are not accurate enough; "
+            f"the views do not agree on one mounting (RMS {rms:.2f} px, over the {limit:.2f} px that the corners' "
+            f"noise of {noise:.2f} px "
+            f"and robot poses good to {pose_sigma_mm:g} mm at {distance_mm:.0f} mm explain): hand-eye calibration "
+            "takes the robot's poses as exact, and these are not accurate enough; "
             "calibrate the robot first, or use poses close together"
         )
         # One bad pose pulls every view: name it when leaving it out makes the rest agree.
@@ -192,7 +196,8 @@ def calibrate_hand_eye(
                 r_rest = None
             if r_rest is not None and _rms(r_rest, [views[k] for k in keep])[0] <= limit:
                 warnings.append(
-                    f"view {views[worst].name} disagrees with the others: without it the RMS is {_rms(r_rest, [views[k] for k in keep])[0]:.2f} px; "
+                    f"view {views[worst].name} disagrees with the others: without it the RMS is "
+                    f"{_rms(r_rest, [views[k] for k in keep])[0]:.2f} px; "
                     "a wrong robot pose for it, or the board moved: remove it"
                 )
     return HandEyeCalibration(
@@ -229,14 +234,18 @@ def _fit(views, moving, board2cam, spec, intrinsics, static_camera, method):
             method=method,
         )
     except cv2.error:
+        other = (
+            "is the camera on the robot?" if static_camera else "is it a static camera (the robot holding the board)?"
+        )
         raise CalibrationInputError(
-            f"the robot poses and the board views fit no {'static camera' if static_camera else 'camera on the robot'}: "
-            f"{'is the camera on the robot?' if static_camera else 'is it a static camera (the robot holding the board)?'} "
+            "the robot poses and the board views fit no "
+            f"{'static camera' if static_camera else 'camera on the robot'}: {other} "
             "Are the poses the flange's in the base, in the views' order?"
         ) from None
     if not np.all(np.isfinite(R_cam2flange)) or abs(np.linalg.det(R_cam2flange) - 1.0) > 1e-3:
         raise CalibrationInputError(
-            "the robot poses and the board views give no rotation for the camera's mounting: are the poses the flange's in the base, in the views' order?"
+            "the robot poses and the board views give no rotation for the camera's mounting: are the poses the "
+            "flange's in the base, in the views' order?"
         )
     start = make_transform(R_cam2flange, np.asarray(t_cam2flange).ravel())
     # The board's placement from the start: average over views of flange2base . cam2flange . board2cam.

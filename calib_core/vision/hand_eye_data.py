@@ -73,7 +73,8 @@ class PosedImages:
         if sorted(columns) != sorted(joint_names):
             raise FileFormatError(
                 self.source,
-                f"the joint columns {', '.join(columns)} are not the robot's joints ({', '.join(joint_names)}) nor {', '.join(generic)}",
+                f"the joint columns {', '.join(columns)} are not the robot's joints ({', '.join(joint_names)}) nor "
+                f"{', '.join(generic)}",
                 "header",
             )
         return [columns.index(n) for n in joint_names]
@@ -92,7 +93,8 @@ def load_posed_images(path: str | Path) -> PosedImages:
         if not found:
             raise FileFormatError(
                 path,
-                "a folder of views holds cal_data.yaml (ROS-Industrial's layout) or views.csv (image[,component],<joints>)",
+                "a folder of views holds cal_data.yaml (ROS-Industrial's layout) or views.csv "
+                "(image[,component],<joints>)",
             )
         path = found[0]
     if path.suffix.lower() == ".csv":
@@ -134,14 +136,17 @@ def _board_from_target_finder(finder, path: Path) -> str:
 
     if kind == "CharucoGridTargetFinder":
         # ROS-Industrial builds CharucoBoard(cols, rows) with OpenCV before 4.6: the legacy layout.
-        return f"charuco:{whole('cols')}x{whole('rows')}:{1000 * number('chessboard_dim'):g}:{1000 * number('aruco_marker_dim'):g}:{dictionary()}:legacy"
+        square_mm, marker_mm = 1000 * number("chessboard_dim"), 1000 * number("aruco_marker_dim")
+        return f"charuco:{whole('cols')}x{whole('rows')}:{square_mm:g}:{marker_mm:g}:{dictionary()}:legacy"
     if kind == "ArucoGridTargetFinder":
-        return f"aruco:{whole('cols')}x{whole('rows')}:{1000 * number('aruco_marker_dim'):g}:{1000 * number('aruco_marker_gap'):g}:{dictionary()}"
+        marker_mm, gap_mm = 1000 * number("aruco_marker_dim"), 1000 * number("aruco_marker_gap")
+        return f"aruco:{whole('cols')}x{whole('rows')}:{marker_mm:g}:{gap_mm:g}:{dictionary()}"
     if kind == "ModifiedCircleGridTargetFinder":
         return f"circles:{whole('cols')}x{whole('rows')}:{1000 * number('spacing'):g}"
     raise FileFormatError(
         path,
-        f"videocal reads CharucoGridTargetFinder, ArucoGridTargetFinder and ModifiedCircleGridTargetFinder, not {kind!r}",
+        "videocal reads CharucoGridTargetFinder, ArucoGridTargetFinder and ModifiedCircleGridTargetFinder, not "
+        f"{kind!r}",
         "target_finder.type",
     )
 

@@ -115,7 +115,8 @@ def load_cam2flange(path: str | Path) -> np.ndarray:
 
 
 def _easy_handeye2(path: Path, doc: dict) -> np.ndarray:
-    """easy_handeye2's ``.calib``: ``transform`` is the tracking frame (the camera) in the robot's effector frame, metres
+    """easy_handeye2's ``.calib``: ``transform`` is the tracking frame (the camera) in the robot's effector frame,
+    metres
     and a unit quaternion (x, y, z, w), as its publisher puts it on tf. Only an ``eye_in_hand`` calibration is a
     camera mounting on the flange; the tracking frame is taken as the camera's optical frame (z along the axis)."""
     kind = doc["parameters"].get("calibration_type")

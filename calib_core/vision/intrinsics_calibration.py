@@ -84,12 +84,14 @@ def detect_view(name: str, image: np.ndarray, spec, detector=None) -> BoardView 
             return RejectedView(name, "no board found")
         return RejectedView(
             name,
-            f"{found.markers_seen} markers seen but no chessboard corner: wrong board spec, or the board is too small or blurred",
+            f"{found.markers_seen} markers seen but no chessboard corner: wrong board spec, or the board is too small "
+            "or blurred",
         )
     if len(found.ids) < MIN_CORNERS:
         return RejectedView(
             name,
-            f"only {len(found.ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the image or hidden",
+            f"only {len(found.ids)} corners seen (at least {MIN_CORNERS} needed): the board is mostly outside the "
+            "image or hidden",
         )
     return BoardView(name, found.corners_px, found.ids, size)
 
@@ -109,7 +111,8 @@ def detect_views(
                 rejected.append(
                     RejectedView(
                         name,
-                        f"image size {result.image_size[0]}x{result.image_size[1]} differs from the first view's {size[0]}x{size[1]}",
+                        f"image size {result.image_size[0]}x{result.image_size[1]} differs from the first view's "
+                        f"{size[0]}x{size[1]}",
                     )
                 )
                 continue
@@ -197,7 +200,8 @@ def advice(result: IntrinsicsCalibration) -> list[str]:
     out = []
     if result.coverage < 0.7:
         out.append(
-            f"the corners cover {100 * result.coverage:.0f} % of the image: add views with the board near the image corners and edges, where distortion is strongest"
+            f"the corners cover {100 * result.coverage:.0f} % of the image: add views with the board near the image "
+            "corners and edges, where distortion is strongest"
         )
     if len(result.used) < 10:
         out.append(f"{len(result.used)} views: 10-20 views at different tilts give a stable calibration")
@@ -211,7 +215,8 @@ def advice(result: IntrinsicsCalibration) -> list[str]:
     worst = max(result.per_view_rms_px.items(), key=lambda kv: kv[1])
     if worst[1] > 3 * max(result.rms_px, 0.05):
         out.append(
-            f"view {worst[0]} fits poorly ({worst[1]:.2f} px against {result.rms_px:.2f} px overall): blurred or mis-detected, consider removing it"
+            f"view {worst[0]} fits poorly ({worst[1]:.2f} px against {result.rms_px:.2f} px overall): blurred or "
+            "mis-detected, consider removing it"
         )
     if not out:
         out.append("good enough: every parameter is well determined and the image is covered")

@@ -275,10 +275,11 @@ def _verdict(fits: list[Located], mesh, intrinsics: Intrinsics, prior: np.ndarra
     return with_fields(
         located,
         status="uncertain",
-        message=f"uncertain: another start settled with the object {d:.1f} px away in the image (more than {bound:.1f} px), "
+        message=f"uncertain: another start settled with the object {d:.1f} px away in the image (more than {bound:.1f} "
+        "px), "
         f"{100 * (rival.edge_share or 0.0):.0f} % of its samples on their edges against this answer's "
-        f"{100 * (best.edge_share or 0.0):.0f} %: an inner, printed or neighbouring edge explains the outline about as well; "
-        + located.message,
+        f"{100 * (best.edge_share or 0.0):.0f} %: an inner, printed or neighbouring edge explains the outline about as "
+        "well; " + located.message,
     )
 
 
@@ -318,7 +319,10 @@ def _with_spread(located: Located, ends: list[np.ndarray], starts: int = 5) -> L
     apart = float(np.max(np.linalg.norm(t - t[0], axis=1)))
     note = f"; {len(ends)} of {starts} settled fits put it here, within {apart:.1f} mm of one another"
     if np.any(np.abs(t - t[0]).max(axis=0) > 3.0 * np.maximum(located.std_translation_mm, 1e-6)):
-        note += " (more than the edges' own 1-sigma allows: the photo fixes the pose less well than one fit says; the 1-sigma includes the starts' spread)"
+        note += (
+            " (more than the edges' own 1-sigma allows: the photo fixes the pose less well than one fit says; the "
+            "1-sigma includes the starts' spread)"
+        )
     return with_fields(
         located,
         message=located.message + note,
@@ -383,7 +387,8 @@ def _report(
         return Located(
             "not found",
             f"the edges settled {moved:.0f} mm and {turned:.1f} deg from the prior, beyond three times the reach "
-            f"({reach_mm:g} mm, {reach_deg:g} deg) the search covered: give a prior nearer the object, or a larger reach",
+            f"({reach_mm:g} mm, {reach_deg:g} deg) the search covered: give a prior nearer the object, or a larger "
+            "reach",
             None,
             None,
             None,
@@ -409,7 +414,8 @@ def _report(
             features_pose = solution.obj2cam
             apart = round(float(np.linalg.norm(features_pose[:3, 3] - edges.obj2cam[:3, 3])), 3)
     message = (
-        f"located by its edges: {edges.samples} samples, {100 * edges.inlier_share:.0f} % on their edges, RMS {edges.rms_px:.2f} px; "
+        f"located by its edges: {edges.samples} samples, {100 * edges.inlier_share:.0f} % on their edges, RMS "
+        f"{edges.rms_px:.2f} px; "
         f"{len(features)} features found" + (f", {len(missed)} not" if missed else "")
     )
     return Located(

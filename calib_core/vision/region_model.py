@@ -22,7 +22,8 @@ import numpy as np
 _LEVELS = 32
 """Histogram bins a colour channel (32 x 32 x 32 RGB bins)."""
 _INNER_PX = 5
-"""The object's colours are taken this far inside its silhouette at the start pose (the pose may be a few pixels off)."""
+"""The object's colours are taken this far inside its silhouette at the start pose (the pose may be a few pixels
+off)."""
 _BAND_PX = (6, 30)
 """Its surroundings' colours: a band this far outside the silhouette (px, inner and outer edge)."""
 STEP_LENGTH_PX = 8

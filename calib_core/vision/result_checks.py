@@ -23,13 +23,15 @@ def intrinsics_problems(result, nominal=None) -> list[str]:
     problems = []
     if result.rms_px > MAX_INTRINSICS_RMS_PX:
         problems.append(
-            f"the fit's RMS of {result.rms_px:.2f} px is over {MAX_INTRINSICS_RMS_PX:g} px (board corners refine to a few tenths): remove blurred or mis-detected views"
+            f"the fit's RMS of {result.rms_px:.2f} px is over {MAX_INTRINSICS_RMS_PX:g} px (board corners refine to a "
+            "few tenths): remove blurred or mis-detected views"
         )
     if nominal is not None:
         change = max(abs(result.intrinsics.fu / nominal.fu - 1.0), abs(result.intrinsics.fv / nominal.fv - 1.0))
         if change > MAX_FOCAL_CHANGE:
             problems.append(
-                f"the focal lengths differ from the cell's camera file by {100 * change:.0f} % (another lens, or a bad fit)"
+                f"the focal lengths differ from the cell's camera file by {100 * change:.0f} % (another lens, or a bad "
+                "fit)"
             )
     return problems
 
@@ -52,13 +54,15 @@ def hand_eye_problems(
     disagree = any("do not agree" in w for w in result.warnings)
     if not disagree and result.rms_px > 3.0 * noise:
         problems.append(
-            f"the views do not agree on one mounting: RMS {result.rms_px:.2f} px, over 3 x the corner noise of {noise:.2f} px"
+            f"the views do not agree on one mounting: RMS {result.rms_px:.2f} px, over 3 x the corner noise of "
+            f"{noise:.2f} px"
             f"{' measured by the intrinsics fit' if measured else ' (each view fitted alone)'}"
         )
     d_mm, d_deg = model_difference
     if d_mm > limits.model_error_mm or d_deg > limits.model_error_deg:
         problems.append(
-            f"it differs from the modelled mounting by {d_mm:.1f} mm and {d_deg:.2f} deg, beyond the cell's stated model error ({limits.model_error_mm:g} mm, {limits.model_error_deg:g} deg)"
+            f"it differs from the modelled mounting by {d_mm:.1f} mm and {d_deg:.2f} deg, beyond the cell's stated "
+            f"model error ({limits.model_error_mm:g} mm, {limits.model_error_deg:g} deg)"
         )
     return problems
 

@@ -1,7 +1,8 @@
 """The detectors of one camera frame and one target: the image's gradient computed once, the model's
 view of the target rendered in its box (at half resolution: it only says which edges show) and, for
 each feature, a 2 x 2 supersampled view of its neighbourhood that its detector measures the image
-against (:mod:`calib_core.vision.corner_against_model`, :func:`~calib_core.vision.feature_detectors.detect_circle_against_model`)."""
+against (:mod:`calib_core.vision.corner_against_model`,
+:func:`~calib_core.vision.feature_detectors.detect_circle_against_model`)."""
 
 from __future__ import annotations
 
@@ -139,7 +140,8 @@ class TargetDetectors:
     def _visible_arm(self, corner: np.ndarray, far: np.ndarray, magnitude: np.ndarray) -> np.ndarray | None:
         """The pixel (2,) the arm from ``corner`` to ``far`` (px) may be searched to, by the model's view
         (``magnitude``: its gradient, supersampled round the corner: at half resolution a faint edge's
-        gradient falls under the threshold and the arm was lost): ``far`` when it shows an edge along most of the arm's first 40 px; the end of the
+        gradient falls under the threshold and the arm was lost): ``far`` when it shows an edge along most of the arm's
+        first 40 px; the end of the
         stretch it shows from the corner when something stands in front of the rest (a gripper's finger
         across a plate's edge: the first 12 px or more are enough for a line); ``None`` when no edge shows."""
         d = far - corner

@@ -35,7 +35,8 @@ def check_name(name: str, what: str) -> str:
 
 
 def load_component_mesh(path: str | Path, units: str = "mm") -> trimesh.Trimesh:
-    """A component's mesh (mm) from a file; :class:`FileFormatError` names the file (:func:`calib_core.mesh_files.load_mesh`)."""
+    """A component's mesh (mm) from a file; :class:`FileFormatError` names the file
+    (:func:`calib_core.mesh_files.load_mesh`)."""
     if units not in MESH_SCALE:
         raise OperatorError(f"mesh units must be one of {', '.join(MESH_SCALE)}, got {units!r}")
     return load_mesh(path, units)

@@ -143,7 +143,9 @@ def tool_alignment(robot: RobotModel, flange: str) -> tuple[np.ndarray, str | No
 
     align = make_transform(Rotation.from_rotvec(axis * angle).as_matrix(), np.zeros(3))
     words = (
-        f"the z axis of {flange!r} points {np.degrees(angle):.0f} deg from the way out of the wrist: the tool and camera are placed "
-        "along the way out instead (from the last joint to the flange); give --flange a frame whose z points out of the tool to change it"
+        f"the z axis of {flange!r} points {np.degrees(angle):.0f} deg from the way out of the wrist: the tool and "
+        "camera are placed "
+        "along the way out instead (from the last joint to the flange); give --flange a frame whose z points out of "
+        "the tool to change it"
     )
     return align, words

@@ -118,7 +118,8 @@ class _Reader:
         except (ValueError, OSError) as exc:  # a NUL byte, a name longer than the file system takes
             raise self.fail(
                 field,
-                f"not a usable file name ({exc.strerror if isinstance(exc, OSError) and exc.strerror else exc}): {text[:80]!r}",
+                f"not a usable file name ({exc.strerror if isinstance(exc, OSError) and exc.strerror else exc}): "
+                f"{text[:80]!r}",
             ) from None
         if not found:
             raise self.fail(field, f"file not found: {path}")
@@ -154,7 +155,8 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
     if not 0.0 <= form <= FORM_TOLERANCE_LIMIT_MM:
         raise reader.fail(
             f"{f}.form_tolerance_mm",
-            f"must lie in [0, {FORM_TOLERANCE_LIMIT_MM:g}] mm (1-sigma of the part's features about their CAD positions), got {form:g}",
+            f"must lie in [0, {FORM_TOLERANCE_LIMIT_MM:g}] mm (1-sigma of the part's features about their CAD "
+            f"positions), got {form:g}",
         )
     return SceneItem(
         name=name,
@@ -267,7 +269,8 @@ def load_workcell(path: str | Path = DEFAULT_WORKCELL) -> Workcell:
     ):
         raise reader.fail(
             "schema_version",
-            f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version {data['schema_version']!r}",
+            f"this videocal reads versions {', '.join(map(str, _READABLE_VERSIONS))}, the file is version "
+            f"{data['schema_version']!r}",
         )
     units = reader.mapping(data["units"], "units", {"length", "angle"}, {"length", "angle"})
     if units["length"] != "mm" or units["angle"] != "deg":

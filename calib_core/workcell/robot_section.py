@@ -98,7 +98,8 @@ def check_against_robot(reader, spec: RobotSpec, robot) -> np.ndarray:
         if len(spec.home_joints) != n:
             raise reader.fail(
                 "robot.home_joints_deg",
-                f"the robot drives {n} joints ({', '.join(robot.joint_names)}), the list has {len(spec.home_joints)} values",
+                f"the robot drives {n} joints ({', '.join(robot.joint_names)}), the list has {len(spec.home_joints)} "
+                "values",
             )
         home = spec.home_joints
         outside = np.flatnonzero(~robot.within_limits(home))
@@ -106,7 +107,8 @@ def check_against_robot(reader, spec: RobotSpec, robot) -> np.ndarray:
             j = int(outside[0])
             raise reader.fail(
                 f"robot.home_joints_deg[{j}]",
-                f"{home[j]:g} {robot.joint_units[j]} is outside joint '{robot.joint_names[j]}' limits [{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]",
+                f"{home[j]:g} {robot.joint_units[j]} is outside joint '{robot.joint_names[j]}' limits "
+                f"[{robot.lower_limits_deg[j]:g}, {robot.upper_limits_deg[j]:g}]",
             )
     if spec.controller is not None:
         unknown = [j for j in spec.controller.joints if j not in robot.joint_names]

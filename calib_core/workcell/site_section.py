@@ -7,7 +7,8 @@
       controller_options: {trajectory_controller: joint_trajectory_controller}
       camera: aravis://Basler-12345           # a camera spec; a relative path is the workcell's folder
       camera_options: {exposure_us: 8000}
-      camera_frame: camera_color_optical_frame   # the camera driver's optical frame (default videocal_camera_optical_frame)
+      camera_frame: camera_color_optical_frame   # the camera driver's optical frame (default
+      videocal_camera_optical_frame)
       camera_parent_frame: tool0              # the link the camera hangs from (default: the robot's flange link)
 
 The command line's ``--port`` and ``--camera`` take precedence; ``--site sim`` ignores the section.

@@ -81,7 +81,8 @@ class StarterCell:
     flange_why: str = ""
     """Why this frame was taken as the flange (said by ``new-cell``)."""
     tool_axis_warning: str | None = None
-    """Words for a flange whose z did not point away from the wrist (the tool was placed along the way out), else ``None``."""
+    """Words for a flange whose z did not point away from the wrist (the tool was placed along the way out), else
+    ``None``."""
 
 
 def _target_mesh() -> trimesh.Trimesh:
@@ -170,7 +171,8 @@ def _find_task(
                 continue
             return tcp, q_approach
     raise StarterCellError(
-        "found no grasp pose in front of the robot that it reaches with the tool pointing forward; give --flange (the frame whose z points out of the tool)"
+        "found no grasp pose in front of the robot that it reaches with the tool pointing forward; give --flange (the "
+        "frame whose z points out of the tool)"
     )
 
 
@@ -353,7 +355,8 @@ def _write_files(
         f"# A starting cell for {json.dumps(urdf.name)}, written by videocal new-cell. Schema: docs/workcell.md.",
         "# Replace the example target by your components (placements as surveyed, in the robot's base frame).",
         "schema_version: 2",
-        f"name: {json.dumps(name or urdf.stem + ' cell')}",  # JSON's strings are YAML's: a newline or '#' stays in the value
+        # JSON's strings are YAML's: a newline or '#' stays in the value
+        f"name: {json.dumps(name or urdf.stem + ' cell')}",
         "units: {length: mm, angle: deg}",
         "",
         "robot:",

@@ -44,9 +44,11 @@ class NotASixAxisArmError(VideocalError):
 
 @dataclass(frozen=True)
 class ArmConfiguration:
-    """``axes_deg`` (n,): the controller's axis values (deg) in its axis order; ``wrist_x_mm``: the wrist centre's x in the
+    """``axes_deg`` (n,): the controller's axis values (deg) in its axis order; ``wrist_x_mm``: the wrist centre's x in
+    the
     axis-1 frame (> 0 in front of axis 1); ``elbow_mm``: the wrist centre's signed distance from the lower arm's line
-    (> 0 on the side of the vendor's reference pose); ``near``: boundaries within :data:`NEAR_DEG` or :data:`NEAR_MM`."""
+    (> 0 on the side of the vendor's reference pose); ``near``: boundaries within :data:`NEAR_DEG` or
+    :data:`NEAR_MM`."""
 
     axes_deg: np.ndarray
     wrist_x_mm: float
@@ -100,7 +102,8 @@ def _axes(robot, q_model_deg) -> tuple[list[_Axis], np.ndarray]:
         omega = J[3:, model.idx_vs[j]] if model.nvs[j] == 1 else np.zeros(3)
         if np.linalg.norm(omega) < 0.5:  # a prismatic joint moves, it does not turn
             raise NotASixAxisArmError(
-                f"joint {model.names[j]!r} is not a revolute axis: a controller's arm configuration is for six revolute axes"
+                f"joint {model.names[j]!r} is not a revolute axis: a controller's arm configuration is for six "
+                "revolute axes"
             )
         axes.append(_Axis(data.oMi[j].translation * 1000.0, omega / np.linalg.norm(omega)))
     return axes, data.oMi[1].rotation.copy()

@@ -158,7 +158,8 @@ def listing_name(fmt: str, stem: str | None) -> str:
         return name
     if not _IDENTIFIER.fullmatch(name) or len(name) > limit:
         raise InvalidNameError(
-            f"{name!r}: a {fmt} file's name is its {'DEFDAT' if fmt == 'krl' else 'MODULE' if fmt == 'rapid' else 'program'} name: "
+            f"{name!r}: a {fmt} file's name is its "
+            f"{'DEFDAT' if fmt == 'krl' else 'MODULE' if fmt == 'rapid' else 'program'} name: "
             f"a letter, then letters, digits or _, at most {limit} characters; rename the output file"
         )
     return name.upper() if fmt == "fanuc" else name
@@ -167,7 +168,8 @@ def listing_name(fmt: str, stem: str | None) -> str:
 def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [
         f"# videocal corrected task locations, {when}",
-        "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real tool reaches the planned location",
+        "# p[x, y, z, rx, ry, rz]: m and a rotation vector (rad) in the base frame: the target to command so the real "
+        "tool reaches the planned location",
     ]
     if tool is not None:
         lines += [
@@ -179,8 +181,8 @@ def _urscript(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: n
         if isinstance(e.arm, ArmConfiguration):
             q = ", ".join(f"{v:.6f}" for v in np.radians(e.arm.axes_deg[:6]))
             lines += [
-                f"# the joints (rad) near which the arm stands there: movej(get_inverse_kin({e.ident}, qnear={e.ident}_qnear))"
-                + (f"; near: {'; '.join(e.arm.near)}" if e.arm.near else ""),
+                f"# the joints (rad) near which the arm stands there: movej(get_inverse_kin({e.ident}, "
+                f"qnear={e.ident}_qnear))" + (f"; near: {'; '.join(e.arm.near)}" if e.arm.near else ""),
                 f"global {e.ident}_qnear = [{q}]",
             ]
     return lines
@@ -190,11 +192,13 @@ def _rapid(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.n
     lines = [
         f"MODULE {name}",
         f"  ! videocal corrected task locations, {when}",
-        "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0), confdata [cf1, cf4, cf6, cfx]",
+        "  ! robtarget: mm and a quaternion [q1 (w), q2, q3, q4] in the base frame (wobj0), confdata [cf1, cf4, cf6, "
+        "cfx]",
     ]
     if tool is not None:
         lines += [
-            "  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and centre of gravity",
+            "  ! the tool (TCP) the targets are for; its load data is tool0's (0.001 kg): enter the real mass and "
+            "centre of gravity",
             f"  PERS tooldata videocal_tool := {rapid_tooldata(tool)};",
         ]
     for e in entries:
@@ -210,7 +214,8 @@ def _krl(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.nda
     lines = [
         f"DEFDAT {name} PUBLIC",
         f"; videocal corrected task locations, {when}",
-        "; {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; a POS carries S and T",
+        "; {X, Y, Z, A, B, C}: mm and deg (A about Z, B about Y, C about X) in the robot's base frame; a POS carries S "
+        "and T",
     ]
     if tool is not None:
         lines += [
@@ -266,7 +271,8 @@ def _fanuc(
     notes = [
         f"videocal corrected task locations, {when}",
         "positions in the robot's world frame: X Y Z mm, W P R deg (R = Rz(R) Ry(P) Rx(W))",
-        f"CONFIG is not known: each P[n] says '{FANUC_UNTAUGHT}', which the controller refuses: teach it (TOUCHUP) before use",
+        f"CONFIG is not known: each P[n] says '{FANUC_UNTAUGHT}', which the controller refuses: teach it (TOUCHUP) "
+        "before use",
     ]
     if tool is not None:
         x, y, z, w, p, r = fanuc_position(tool)
@@ -298,7 +304,8 @@ def _fanuc(
 def _pdl2(entries: list[Entry], when: str, name: str = DEFAULT_NAME, tool: np.ndarray | None = None) -> list[str]:
     lines = [
         f"-- videocal corrected task locations, {when}",
-        "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the planned location",
+        "-- POS(x, y, z, e1, e2, e3, cnfg): mm, Euler ZYZ deg; the target to command so the real tool reaches the "
+        "planned location",
         "VAR",
     ]
     lines += [f"  {e.ident} : POSITION  -- {e.note}" for e in entries]
@@ -375,6 +382,9 @@ def controller_listing(
     entries = []
     for name, T in targets.items():
         c = table.latest(name)
-        note = f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, {np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"
+        note = (
+            f"{_remark(name)}: displacement {np.linalg.norm(c.displacement_mm):.2f} mm, "
+            f"{np.linalg.norm(c.rotation_deg):.3f} deg; rms {c.rms_px:.2f} px, {c.pairs} pairs"
+        )
         entries.append(Entry(idents[name], T, note, _arm_at(fmt, robot, joint_map, T, c.joints_deg)))
     return "\n".join(writer(entries, time.strftime("%Y-%m-%d %H:%M:%S"), listing, tool) + [""])

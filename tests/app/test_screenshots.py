@@ -106,7 +106,8 @@ def _compare(name: str, rgb: np.ndarray) -> None:
     mean_limit, share_limit = TOLERANCES[name]
     mean, share = float(diff.mean()), float((diff > 48).mean())
     assert mean <= mean_limit and share <= share_limit, (
-        f"{name}: mean difference {mean:.2f} (limit {mean_limit}), {100 * share:.2f} % of pixels off by > 48 (limit {100 * share_limit:.1f} %); see tests/output/{name}_diff.png"
+        f"{name}: mean difference {mean:.2f} (limit {mean_limit}), {100 * share:.2f} % of pixels off by > 48 (limit "
+        f"{100 * share_limit:.1f} %); see tests/output/{name}_diff.png"
     )
 
 

@@ -42,7 +42,8 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
         qtbot.waitUntil(lambda: win.workbench.motion.motion.value == "arrived", timeout=30_000)
     except Exception:
         raise AssertionError(
-            f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; {win.overview.preview_text.text()}"
+            f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; "
+            f"{win.overview.preview_text.text()}"
         ) from None
     _fresh_still_frame(qtbot, win)
     assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3

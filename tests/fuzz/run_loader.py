@@ -200,7 +200,11 @@ def loaders(folder: Path) -> dict:
         "intrinsics": {"fx": 1352.0, "fy": 1356.1, "cx": 789.7, "cy": 627.3},
         "static_camera": True,
     }
-    csv_text = "image,x_mm,y_mm,z_mm,qx,qy,qz,qw\nimages/0.png,110.0,590.0,650.0,-0.5186,0.8156,0.0932,0.2390\nimages/1.png,120,600,640,0,0,0,1\n"
+    csv_text = (
+        "image,x_mm,y_mm,z_mm,qx,qy,qz,qw\n"
+        "images/0.png,110.0,590.0,650.0,-0.5186,0.8156,0.0932,0.2390\n"
+        "images/1.png,120,600,640,0,0,0,1\n"
+    )
 
     from app.cli.cmd_locate import read_features, read_prior
     from calib_core.mesh_files import load_mesh
@@ -233,13 +237,17 @@ def loaders(folder: Path) -> dict:
 
     bag_folder, bag_mcap = _small_bag(out)
     launch_xml = (
-        '<launch>\n  <node pkg="tf2_ros" exec="static_transform_publisher" name="mounting" args="--x 0.081 --y -0.001 --z 0.088 '
-        '--roll -1.745 --pitch 0.0 --yaw -1.571 --frame-id tool0 --child-frame-id camera_color_optical_frame"/>\n</launch>\n'
+        '<launch>\n  <node pkg="tf2_ros" exec="static_transform_publisher" name="mounting" args="--x 0.081 --y -0.001 '
+        "--z 0.088 "
+        "--roll -1.745 --pitch 0.0 --yaw -1.571 --frame-id tool0 --child-frame-id "
+        'camera_color_optical_frame"/>\n</launch>\n'
     )
     xacro_text = (
         '<robot name="fuzz" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <xacro:property name="l" value="0.3"/>\n'
-        '  <xacro:macro name="link" params="n"><link name="${n}"/></xacro:macro>\n  <xacro:link n="base"/>\n  <xacro:link n="tip"/>\n'
-        '  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 ${l}"/><axis xyz="0 0 1"/>'
+        '  <xacro:macro name="link" params="n"><link name="${n}"/></xacro:macro>\n  <xacro:link n="base"/>\n  '
+        '<xacro:link n="tip"/>\n'
+        '  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 ${l}"/><axis '
+        'xyz="0 0 1"/>'
         '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n</robot>\n'
     )
     url_texts = st.one_of(

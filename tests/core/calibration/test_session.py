@@ -29,7 +29,8 @@ FEATURES = [
 @pytest.fixture(scope="module")
 def bed():
     errors = RobotErrors.typical(0)
-    # No hand-eye error here: with the modelled mounting the camera tells the TCP exactly (the hand-eye calibration measures it).
+    # No hand-eye error here: with the modelled mounting the camera tells the TCP exactly (the hand-eye calibration
+    # measures it).
     errors = RobotErrors(errors.joint_offsets_deg, errors.link_errors_mm, errors.base_xyz_mm, errors.base_rpy_deg)
     return TestBed.create(errors=errors)
 
@@ -46,7 +47,8 @@ def _pick_all(session, bed, q, names=FEATURES, noise_px=0.2, seed=0):
 
 
 def _look_at_the_approach(bed, noise_px=0.2):
-    """The paper's task location, a session whose picks at its approach (``noise_px`` of noise) are solved, and the look."""
+    """The paper's task location, a session whose picks at its approach (``noise_px`` of noise) are solved, and the
+    look."""
     task = bed.workcell.task("oru_1_grasp")
     q_app = solve_ik(bed.model_robot, task.approach2base, bed.workcell.home_joints_deg).q_deg
     s = CalibrationSession()

@@ -31,7 +31,8 @@ def test_ros1_upper_case_fields_and_a_wrong_one(tmp_path):
     ros1 = tmp_path / "info.yaml"
     ros1.write_text(
         "height: 480\nwidth: 640\ndistortion_model: plumb_bob\nD: [0.1, -0.2, 0.0, 0.0, 0.0]\n"
-        "K: [500.0, 0.0, 320.0, 0.0, 501.0, 240.0, 0.0, 0.0, 1.0]\nR: [1, 0, 0, 0, 1, 0, 0, 0, 1]\nP: [500, 0, 320, 0, 0, 501, 240, 0, 0, 0, 1, 0]\n"
+        "K: [500.0, 0.0, 320.0, 0.0, 501.0, 240.0, 0.0, 0.0, 1.0]\nR: [1, 0, 0, 0, 1, 0, 0, 0, 1]\nP: [500, 0, 320, 0, "
+        "0, 501, 240, 0, 0, 0, 1, 0]\n"
     )
     assert load_intrinsics(ros1).fv == 501.0
     bad = tmp_path / "bad.yaml"

@@ -61,19 +61,23 @@ BAD_FILES = {
         "field 'camera_matrix.data': expected 9 numbers",
     ),
     "ros_text.yaml": (
-        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [a, 0, 0, 0, 1, 0, 0, 0, 1]\n",
+        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [a, 0, 0, 0, 1, 0, 0, 0, "
+        "1]\n",
         "field 'camera_matrix.data': data must be a list of numbers",
     ),
     "ros_width.yaml": (
-        "image_width: 64.5\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
+        "image_width: 64.5\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, 320, 0, 500, "
+        "240, 0, 0, 1]\n",
         "field 'image_width'",
     ),
     "ros_unknown.yaml": (
-        "image_width: 640\nimage_height: 480\nlens: fisheye\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
+        "image_width: 640\nimage_height: 480\nlens: fisheye\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [500, 0, "
+        "320, 0, 500, 240, 0, 0, 1]\n",
         "unknown key.*lens",
     ),
     "ros_negative_focal.yaml": (
-        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [-500, 0, 320, 0, 500, 240, 0, 0, 1]\n",
+        "image_width: 640\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [-500, 0, 320, 0, 500, "
+        "240, 0, 0, 1]\n",
         "focal lengths must be positive",
     ),
     "cv_no_height.yaml": (
@@ -82,7 +86,8 @@ BAD_FILES = {
         "field 'image_height': missing",
     ),
     "cv_2x2.yaml": (
-        "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 2\n   dt: d\n"
+        "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 2\n "
+        "  dt: d\n"
         "   data: [ 500., 0., 0., 510. ]\n",
         "field 'camera_matrix': expected a 3x3 matrix",
     ),

@@ -7,7 +7,8 @@ FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bot
 
 
 def pick_all(core, bed, q, features=FEATURES) -> None:
-    """Pick each of ``features`` of the task's component on the model and on its true image at commanded joints ``q``."""
+    """Pick each of ``features`` of the task's component on the model and on its true image at commanded joints
+    ``q``."""
     fixture = core.workcell.component(core.task.component)
     true_cam = bed.true_cam2world(q)
     for name in features:

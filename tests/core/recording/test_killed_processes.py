@@ -1,7 +1,8 @@
 """Real crashes: a recording process and a saving process killed with SIGKILL at an arbitrary moment.
 
 A killed recorder leaves a file that holds every message it had reported written (it counts
-what is in chunks handed to the OS) and all but the last second, and ``recover`` makes it whole. A process killed while saving a workspace leaves the old file or the new one,
+what is in chunks handed to the OS) and all but the last second, and ``recover`` makes it whole. A process killed while
+saving a workspace leaves the old file or the new one,
 always loadable, never half of either.
 """
 
@@ -55,7 +56,8 @@ SAVER = textwrap.dedent(
     while True:
         n = 200 + (k % 2) * 300  # two different sizes, so old and new files differ
         pairs = [Correspondence(i + 1, "oru_1_fixture", None, (float(i), 2.0, 3.0), (10.0 + i, 20.0)) for i in range(n)]
-        save_workspace(sys.argv[1], Workspace(str(cell.path), intr, dict(cell.task_locations), "oru_1_fixture", pairs, CorrectionTable()))
+        ws = Workspace(str(cell.path), intr, dict(cell.task_locations), "oru_1_fixture", pairs, CorrectionTable())
+        save_workspace(sys.argv[1], ws)
         k += 1
         print(k, n, flush=True)
     """

@@ -1,7 +1,8 @@
 """Renderers on two threads at once (the simulated camera's worker and the window's overview): they take turns at the
 process's GL, so neither crashes the process (a segmentation fault inside both ``Render`` calls ended a test run)
 and each still renders its own scene: every image equals the one its renderer made alone. (A synthetic pair of threads
-did not crash without the turns in this machine's runs: this checks that turns keep each render its own, not the race.)"""
+did not crash without the turns in this machine's runs: this checks that turns keep each render its own, not the
+race.)"""
 
 import threading
 

@@ -1,4 +1,5 @@
-"""The bundled workcell rendered from the modelled camera at the paper's task location (where the calibration looks from); picking
+"""The bundled workcell rendered from the modelled camera at the paper's task location (where the calibration looks
+from); picking
 round trips; the renders are saved to tests/output/ to be looked at."""
 
 from pathlib import Path

@@ -126,7 +126,8 @@ def test_a_continuous_joint_counts_once_in_degrees(tmp_path):
     urdf.write_text("""<robot name="spinner">
   <link name="base"/><link name="arm"/><link name="slider"/><link name="tip"/>
   <joint name="spin" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
-  <joint name="slide" type="prismatic"><parent link="arm"/><child link="slider"/><origin xyz="0.5 0 0"/><axis xyz="1 0 0"/>
+  <joint name="slide" type="prismatic"><parent link="arm"/><child link="slider"/>
+    <origin xyz="0.5 0 0"/><axis xyz="1 0 0"/>
     <limit lower="0" upper="0.2" velocity="0.1" effort="1"/></joint>
   <joint name="fix" type="fixed"><parent link="slider"/><child link="tip"/><origin xyz="0.1 0 0"/></joint>
 </robot>""")
@@ -156,14 +157,17 @@ def test_a_xacro_file_is_expanded_and_a_broken_one_named(tmp_path):
 <robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
   <xacro:property name="upper" value="0.4"/>
   <xacro:macro name="link_with_box" params="name length">
-    <link name="${name}"><visual><origin xyz="0 0 ${length/2}"/><geometry><box size="0.05 0.05 ${length}"/></geometry></visual></link>
+    <link name="${name}"><visual><origin xyz="0 0 ${length/2}"/>
+      <geometry><box size="0.05 0.05 ${length}"/></geometry></visual></link>
   </xacro:macro>
   <xacro:link_with_box name="base_link" length="0.1"/>
   <xacro:link_with_box name="upper_arm" length="${upper}"/>
   <link name="flange"/>
-  <joint name="shoulder" type="revolute"><parent link="base_link"/><child link="upper_arm"/><origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
+  <joint name="shoulder" type="revolute"><parent link="base_link"/><child link="upper_arm"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
     <limit lower="-3" upper="3" velocity="2" effort="10"/></joint>
-  <joint name="to_flange" type="fixed"><parent link="upper_arm"/><child link="flange"/><origin xyz="0 0 ${upper}"/></joint>
+  <joint name="to_flange" type="fixed"><parent link="upper_arm"/><child link="flange"/>
+    <origin xyz="0 0 ${upper}"/></joint>
 </robot>""")
     robot = load_robot(RobotSpec(good, (), {"tcp": "flange"}))
     assert robot.n_joints == 1

@@ -110,13 +110,15 @@ def test_xacro_arguments(tmp_path):
 def test_runaway_expressions_are_bounded(tmp_path):
     slow = tmp_path / "slow.xacro"
     slow.write_text(
-        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>'
+        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" '
+        'value="${9**9**9}"/><link name="${x}"/></robot>'
     )
     with pytest.raises(FileFormatError, match="slow.xacro.*took longer than 2 s"):
         expand_xacro(slow, [], timeout_s=2)
     big = tmp_path / "big.xacro"
     big.write_text(
-        """<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${'a'*10**10}"/><link name="${x}"/></robot>"""
+        """<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro">
+<xacro:property name="x" value="${'a'*10**10}"/><link name="${x}"/></robot>"""
     )
     with pytest.raises(FileFormatError, match="big.xacro.*needed more than 512 MB"):
         expand_xacro(big, [], memory_mb=512)
@@ -154,7 +156,8 @@ def test_the_xacro_child_ends_with_its_parent(tmp_path):
 
     slow = tmp_path / "slow.xacro"
     slow.write_text(
-        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" value="${9**9**9}"/><link name="${x}"/></robot>'
+        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="x" '
+        'value="${9**9**9}"/><link name="${x}"/></robot>'
     )
     parent = subprocess.Popen(
         [

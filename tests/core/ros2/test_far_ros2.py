@@ -41,7 +41,8 @@ def test_a_far_network_delays_and_drops_udp_between_its_two_sides():
         port = receiver.getsockname()[1]
         sender = (
             f"import socket, time\ns = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)\n"
-            f"for i in range(200):\n    s.sendto(f'{{i}} {{time.monotonic()}}'.encode(), ('{net.near_ip}', {port}))\n    time.sleep(0.002)\n"
+            f"for i in range(200):\n    s.sendto(f'{{i}} {{time.monotonic()}}'.encode(), ('{net.near_ip}', {port}))\n  "
+            "  time.sleep(0.002)\n"
         )
         subprocess.run(net.far_command([sys.executable, "-c", sender]), check=True, timeout=30)
         got = []

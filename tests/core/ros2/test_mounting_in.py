@@ -77,11 +77,13 @@ def test_roll_pitch_yaw_are_tf2_s_fixed_axes(tmp_path):
 def test_an_xml_launch_with_positional_arguments(tmp_path):
     euler = tmp_path / "a.launch"
     euler.write_text(
-        '<launch>\n  <node pkg="tf2_ros" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 1.1 -0.2 0.3 flange cam_optical_frame" />\n</launch>\n'
+        '<launch>\n  <node pkg="tf2_ros" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 1.1 -0.2 '
+        '0.3 flange cam_optical_frame" />\n</launch>\n'
     )
     quat = tmp_path / "b.launch.xml"
     quat.write_text(
-        '<launch><node pkg="tf" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 0 0 0.7071068 0.7071068 flange cam_optical_frame 100"/></launch>'
+        '<launch><node pkg="tf" type="static_transform_publisher" name="cam" args="0.1 0.02 -0.03 0 0 0.7071068 '
+        '0.7071068 flange cam_optical_frame 100"/></launch>'
     )
     a, b = read_static_transform(euler), read_static_transform(quat)
     np.testing.assert_allclose(a.child2parent_mm[:3, 3], [100.0, 20.0, -30.0])

@@ -1,5 +1,6 @@
 """The camera mounting written for ROS 2: the URDF read alone by Pinocchio's URDF parser (the reader robot software
-uses), the xacro macro included and called in a robot's description and expanded by xacro, the launch file's static_transform_publisher arguments read back as tf2 reads them (metres, a
+uses), the xacro macro included and called in a robot's description and expanded by xacro, the launch file's
+static_transform_publisher arguments read back as tf2 reads them (metres, a
 quaternion x y z w); both against the transform written, for random mountings."""
 
 from __future__ import annotations

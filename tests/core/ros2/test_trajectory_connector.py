@@ -212,9 +212,14 @@ from calib_core.connectors.registry import open_controller
 from calib_core.connectors.joint_map import JointMap
 from calib_core.connectors.link_types import LinkState
 names = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "slide")
-link = open_controller("ros2:///joint_states", ControllerContext(names, ("deg",) * 5 + ("mm",), JointMap.identity(6), 100.0,
-                       {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5, "interface": sys.argv[1]})).start()
-while not (link.state is LinkState.UP and (link._goals.client.server_ready() if sys.argv[1] == "action" else link._writer.get_publication_matched_status().current_count > 0)):
+options = {"controller": "arm_controller", "speed_deg_s": 20, "horizon_s": 0.5, "interface": sys.argv[1]}
+context = ControllerContext(names, ("deg",) * 5 + ("mm",), JointMap.identity(6), 100.0, options)
+link = open_controller("ros2:///joint_states", context).start()
+def matched():
+    if sys.argv[1] == "action":
+        return link._goals.client.server_ready()
+    return link._writer.get_publication_matched_status().current_count > 0
+while not (link.state is LinkState.UP and matched()):
     time.sleep(0.01)
 handle = link.move_joints([80.0, -30.0, 60.0, 0.0, 45.0, 100.0], timeout_s=30)
 print("moving", flush=True)

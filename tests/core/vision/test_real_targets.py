@@ -133,7 +133,8 @@ def test_a_bad_board_text_says_what_the_forms_are(bad, says):
 def test_detector_settings_come_from_a_file_and_name_a_wrong_field(tmp_path):
     path = tmp_path / "detector.yaml"
     path.write_text(
-        "refine_markers: false\naruco:\n  adaptiveThreshWinSizeMax: 35\n  adaptiveThreshConstant: 9\ncircle_blobs:\n  minArea: 25.0\n"
+        "refine_markers: false\naruco:\n  adaptiveThreshWinSizeMax: 35\n  adaptiveThreshConstant: 9\ncircle_blobs:\n  "
+        "minArea: 25.0\n"
     )
     settings = load_detector_settings(path)
     assert settings.refine_markers is False and settings.aruco.adaptiveThreshWinSizeMax == 35

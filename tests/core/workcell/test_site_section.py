@@ -20,7 +20,8 @@ def _cell_with(tmp_path, site_text: str):
 def test_a_site_section_is_read_with_its_camera_path_made_absolute(tmp_path):
     path = _cell_with(
         tmp_path,
-        "site:\n  controller: ros2:///joint_states\n  camera: shots\n  controller_options: {trajectory_controller: arm_controller}",
+        "site:\n  controller: ros2:///joint_states\n  camera: shots\n  controller_options: {trajectory_controller: "
+        "arm_controller}",
     )
     section = load_site_section(path)
     assert section.controller == "ros2:///joint_states"

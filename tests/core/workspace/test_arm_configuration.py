@@ -44,7 +44,8 @@ def kr6():
 
 @pytest.fixture(scope="module")
 def irb1200():
-    """The IRB 1200 xacro expanded as shipped; its meshes (7 MB, not kept here) left out: the kinematics are the joints'."""
+    """The IRB 1200 xacro expanded as shipped; its meshes (7 MB, not kept here) left out: the kinematics are the
+    joints'."""
     abb = ROS_I / "abb"
     root = ET.fromstring(
         expand_xacro(abb / "abb_irb1200_support" / "urdf" / "irb1200_5_90.xacro", package_search_roots([abb]))

@@ -233,7 +233,8 @@ def test_each_listing_carries_the_tool_its_targets_are_for(table):
     )
     rapid = controller_listing("rapid", t, tasks, tool=tool)
     data = re.search(
-        r"PERS tooldata videocal_tool := \[TRUE,\[\[([^\]]*)\],\[([^\]]*)\]\],\[0.001,\[0,0,0.001\],\[1,0,0,0\],0,0,0\]\];",
+        r"PERS tooldata videocal_tool := "
+        r"\[TRUE,\[\[([^\]]*)\],\[([^\]]*)\]\],\[0.001,\[0,0,0.001\],\[1,0,0,0\],0,0,0\]\];",
         rapid,
     )
     assert data, rapid
