@@ -186,7 +186,8 @@ def _close_pairs(points: np.ndarray, tol: float) -> list[tuple[int, int]]:
     points (O(n log n)), a compiled comparison of all pairs below (cheaper than building the tree)."""
     if len(points) > 64:
         return sorted(cKDTree(points).query_pairs(tol))
-    return [(int(i), int(j)) for i, j in close_pairs(points, tol)]
+    found = close_pairs(points, tol)
+    return [(int(i), int(j)) for i, j in found] if len(found) else []
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:
