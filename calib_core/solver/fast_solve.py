@@ -1,7 +1,8 @@
-"""The common cases in one compiled call: four or more non-coplanar pairs, known focal lengths,
-pinhole model, no robust loss (six and more seeded by a DLT, four and five by P3P over every
-triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit
-worse than the limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well)."""
+"""The common cases in one compiled call: four or more pairs (up to eight on a plane), known focal lengths, pinhole
+model, no robust loss (six and more off a plane seeded by a DLT, four and five, and a plane's up to eight, by P3P over
+every triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit worse than the
+limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well: a plane's mirror
+pose, which the full search ranks by the prior)."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ _SAME_POSE_COS = float(np.cos(np.radians(SAME_POSE_DEG)))
 def applies(problem: PoseProblem, robust: bool) -> bool:
     return (
         problem.n_points >= 4
-        and not problem.coplanar
+        and (not problem.coplanar or problem.n_points <= P3P_SEEDED_UP_TO)
         and not problem.estimate_focal
         and problem.model == "pinhole"
         and not robust
@@ -50,7 +51,7 @@ def fast_solve(
     misfit_test = (noise, fisher, float(OWN_SCALE_MIN_DOF), FALSE_FLAG_PER_SOLVE)
     common = (intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX)
     out = None
-    if n >= SEEDED_BY_DLT:
+    if n >= SEEDED_BY_DLT and not problem.coplanar:  # (a plane's points leave the DLT's 12 unknowns undetermined)
         out = dlt_newton_summary(problem.points_3d, problem.points_2d, *common, misfit_test)
     if out is None and n <= P3P_SEEDED_UP_TO:
         # (six to eight pairs whose DLT found no seed, a noisy near-minimal DLT, take the triplets' roots as four do)
