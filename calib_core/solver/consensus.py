@@ -131,6 +131,7 @@ def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
         100,
         -1.0,
         DEFAULT_SIGMA_PX,
+        (1.0, np.inf, 1e9, 1e-3),  # (its mis-pick test is not asked here)
         1e9,
         -1.0,
         1.0,
@@ -138,7 +139,8 @@ def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
     )
     if out is None:
         return None
-    return refine_seed(sub, out[0], out[1], chosen.fu, chosen.fv, None)
+    obj2cam = out[0]
+    return refine_seed(sub, obj2cam[:3, :3].copy(), obj2cam[:3, 3].copy(), chosen.fu, chosen.fv, None)
 
 
 def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) -> list[RefinedPose]:

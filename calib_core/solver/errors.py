@@ -36,6 +36,10 @@ def named_points_as_given(rows: Sequence[int]) -> Iterator[None]:
         yield
 
 
+LISTED = 12
+"""The most points a message names one by one."""
+
+
 def _number(index: int) -> tuple[str, str]:
     names = _NAMES.get()
     if names is not None and 0 <= index < len(names[1]):
@@ -50,12 +54,15 @@ def point_label(index: int) -> str:
 
 
 def points_label(indices: Iterable[int]) -> str:
-    """``'points 1, 4'`` for indices (0, 3) (or ``'pairs 9, 12'`` inside :func:`named_points`)."""
+    """``'points 1, 4'`` for indices (0, 3) (or ``'pairs 9, 12'`` inside :func:`named_points`); beyond
+    :data:`LISTED` of them the first ones and how many more (``'points 1, 2, ..., 10 and 1490 more'``): a message
+    that names every one of a detector's thousand rejected pairs is read by no one."""
     idx = [int(i) for i in indices]
     if len(idx) == 1:
         return point_label(idx[0])
-    labels = [_number(i) for i in idx]
-    return f"{labels[0][0]}s " + ", ".join(n for _, n in labels)
+    labels = [_number(i) for i in idx[:LISTED]]
+    more = f" and {len(idx) - LISTED} more" if len(idx) > LISTED else ""
+    return f"{labels[0][0]}s " + ", ".join(n for _, n in labels) + more
 
 
 class SolverInputError(VideocalError, ValueError):

@@ -1,7 +1,8 @@
-"""The common cases in one compiled call: four or more non-coplanar pairs, known focal lengths,
-pinhole model, no robust loss (six and more seeded by a DLT, four and five by P3P over every
-triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit
-worse than the limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well)."""
+"""The common cases in one compiled call: four or more pairs (up to eight on a plane), known focal lengths, pinhole
+model, no robust loss (six and more off a plane seeded by a DLT, four and five, and a plane's up to eight, by P3P over
+every triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit worse than the
+limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well: a plane's mirror
+pose, which the full search ranks by the prior)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,6 @@ from calib_core.solver.finish import noise_px, operator_warnings
 from calib_core.solver.candidates import SAME_POSE_DEG, SAME_POSE_REL
 from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
-from calib_core.solver.kernels.diagnostics import flags_a_misfit
 from calib_core.solver.misfit import FALSE_FLAG_PER_SOLVE, OWN_SCALE_MIN_DOF, fisher_quantile
 from calib_core.solver.problem import PoseProblem
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
@@ -20,13 +20,14 @@ from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 _MAX_ITERATIONS = 100
 SEEDED_BY_DLT = 6
 P3P_SEEDED_UP_TO = 8
+_SAME_POSE_COS = float(np.cos(np.radians(SAME_POSE_DEG)))
 """Up to this many pairs, P3P over every triplet seeds the fast path when the DLT gives no seed (56 triplets at 8)."""
 
 
 def applies(problem: PoseProblem, robust: bool) -> bool:
     return (
         problem.n_points >= 4
-        and not problem.coplanar
+        and (not problem.coplanar or problem.n_points <= P3P_SEEDED_UP_TO)
         and not problem.estimate_focal
         and problem.model == "pinhole"
         and not robust
@@ -40,63 +41,38 @@ def fast_solve(
     six pairs, a second minimum costing within ``ambiguity_chi2`` noise variances of the best is an
     ambiguity the full search reports (the same rule)."""
     intr = problem.intrinsics
+    n = problem.n_points
     sigma = -1.0 if sigma_px is None else float(sigma_px)
+    noise = noise_px(sigma_px)
+    # The full path's own mis-pick test on the fit (from its hat matrix, no further solve): a pair it would flag sends
+    # the problem there. (A bound by the leave-one-out misses alone sent two clean four-pair solves in three there:
+    # with little redundancy they exceed the statistic many times.)
+    fisher = 2.0 * fisher_quantile(n, 2 * n - 8) if 2 * n - 8 >= OWN_SCALE_MIN_DOF else np.inf
+    misfit_test = (noise, fisher, float(OWN_SCALE_MIN_DOF), FALSE_FLAG_PER_SOLVE)
+    common = (intr.fu, intr.fv, intr.cx, intr.cy, problem.distortion, _MAX_ITERATIONS, sigma, DEFAULT_SIGMA_PX)
     out = None
-    if problem.n_points >= SEEDED_BY_DLT:
-        out = dlt_newton_summary(
-            problem.points_3d,
-            problem.points_2d,
-            intr.fu,
-            intr.fv,
-            intr.cx,
-            intr.cy,
-            problem.distortion,
-            _MAX_ITERATIONS,
-            sigma,
-            DEFAULT_SIGMA_PX,
-        )
-    if out is None and problem.n_points <= P3P_SEEDED_UP_TO:
+    if n >= SEEDED_BY_DLT and not problem.coplanar:  # (a plane's points leave the DLT's 12 unknowns undetermined)
+        out = dlt_newton_summary(problem.points_3d, problem.points_2d, *common, misfit_test)
+    if out is None and n <= P3P_SEEDED_UP_TO:
         # (six to eight pairs whose DLT found no seed, a noisy near-minimal DLT, take the triplets' roots as four do)
         # A P3P root that puts all the pairs more than ten times the limit off is refuted by them;
         # every minimum that fits them has a root of each triplet near it.
         out = p3p_newton_summary(
             problem.points_3d,
             problem.points_2d,
-            intr.fu,
-            intr.fv,
-            intr.cx,
-            intr.cy,
-            problem.distortion,
-            _MAX_ITERATIONS,
-            sigma,
-            DEFAULT_SIGMA_PX,
+            *common,
+            misfit_test,
             10.0 * limit_px,
-            ambiguity_chi2 * noise_px(sigma_px) ** 2,
-            np.cos(np.radians(SAME_POSE_DEG)),
+            ambiguity_chi2 * noise**2,
+            _SAME_POSE_COS,
             SAME_POSE_REL * 1e3,
         )
     if out is None:
         return None
-    R, t, r, J, cov, cov_c, loo, scalars = out
-    iterations, outcome, rms, sigma, source, condition = scalars
-    if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
+    obj2cam, r, cov, cov_c, loo, scalars = out
+    iterations, outcome, rms, sigma, source, condition, misfit = scalars
+    if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px or misfit != 0.0:
         return None
-    # The full path's own mis-pick test on this fit (from its hat matrix, no further solve): a pair it would flag
-    # sends the problem there. (A bound by the leave-one-out misses alone sent two clean four-pair solves in three
-    # there: with little redundancy they exceed the statistic many times.)
-    n = len(r)
-    fisher = 2.0 * fisher_quantile(n, 2 * n - 8) if 2 * n - 8 >= OWN_SCALE_MIN_DOF else np.inf
-    # (a scale of zero is an exact fit: every residual is zero and no pair can be flagged)
-    if (
-        sigma > 0.0
-        and flags_a_misfit(J, r, cov / sigma**2, noise_px(sigma_px), fisher, OWN_SCALE_MIN_DOF, FALSE_FLAG_PER_SOLVE)
-        != 0
-    ):
-        return None
-    obj2cam = np.zeros((4, 4))
-    obj2cam[:3, :3] = R
-    obj2cam[:3, 3] = t
-    obj2cam[3, 3] = 1.0
     return PoseSolution(
         status=SolveStatus.OK,
         obj2cam=obj2cam,
@@ -107,7 +83,7 @@ def fast_solve(
         residuals_px=r,
         uncertainty=uncertainty_from(cov, cov_c, sigma, int(source), condition),
         leave_one_out_px=loo,
-        outliers=np.zeros(len(r), dtype=bool),
+        outliers=np.zeros(n, dtype=bool),
         candidates=(PoseCandidate(obj2cam, intr.fu, intr.fv, float(rms)),),
-        warnings=tuple(operator_warnings(problem, condition, noise_px(sigma_px))),
+        warnings=tuple(operator_warnings(problem, condition, noise)),
     )

@@ -13,9 +13,15 @@ from numpy.typing import ArrayLike
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import as_pinhole
-from scipy.spatial import cKDTree
 
-from calib_core.solver.kernels.geometry_checks import COLLINEAR, NON_FINITE_2D, NON_FINITE_3D, check_pairs, close_pairs
+from calib_core.solver.kernels.geometry_checks import (
+    COLLINEAR,
+    NON_FINITE_2D,
+    NON_FINITE_3D,
+    check_pairs,
+    close_pairs,
+    close_pairs_swept,
+)
 from calib_core.solver.errors import (
     DegenerateGeometryError,
     DuplicatePointsError,
@@ -183,11 +189,10 @@ def first_of_each_pair(points_3d: np.ndarray, points_2d: np.ndarray) -> np.ndarr
 
 
 def _close_pairs(points: np.ndarray, tol: float) -> list[tuple[int, int]]:
-    """Index pairs (i < j) of points within ``tol`` of each other, sorted: a k-d tree beyond 64
-    points (O(n log n)), a compiled comparison of all pairs below (cheaper than building the tree)."""
-    if len(points) > 64:
-        return sorted(cKDTree(points).query_pairs(tol))
-    return [(int(i), int(j)) for i, j in close_pairs(points, tol)]
+    """Index pairs (i < j) of points within ``tol`` of each other, sorted: a compiled sweep along one direction beyond
+    64 points (O(n log n)), a compiled comparison of all pairs below."""
+    found = close_pairs(points, tol) if len(points) <= 64 else close_pairs_swept(points, tol)
+    return sorted((int(i), int(j)) for i, j in found) if len(found) else []
 
 
 def check_in_front(points_3d: np.ndarray, obj2cam: np.ndarray, what: str) -> None:

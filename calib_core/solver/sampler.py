@@ -26,6 +26,8 @@ CONFIDENCE = 0.9999
 MAX_HYPOTHESES = 10_000
 MIN_HYPOTHESES = 20  # PoseLib's default of 1000 costs 2 ms even on a clean set
 MIN_POINTS = 4
+SAMPLED_FROM = 1000
+"""Beyond this many pairs the hypotheses are drawn and scored among this many of them."""
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,15 @@ def robust_seed(
         uv = np.column_stack([xy[:, 0] * fu + intr.cx, xy[:, 1] * fv + intr.cy])
     if order is not None:
         P, uv = P[order], uv[order]
+    all_P, all_uv = P, uv
+    if n > SAMPLED_FROM:
+        # The hypotheses are drawn and scored among a subset (the most confident, else a seeded random draw): a
+        # hypothesis scored on thousands of pairs costs as many times more and picks the same pose; the pose's
+        # inliers are then counted over every pair.
+        keep = (
+            np.arange(SAMPLED_FROM) if order is not None else np.random.default_rng(seed).permutation(n)[:SAMPLED_FROM]
+        )
+        P, uv = P[keep], uv[keep]
     camera = {"model": "PINHOLE", "width": intr.width, "height": intr.height, "params": [fu, fv, intr.cx, intr.cy]}
     options = {
         "max_reproj_error": inlier_threshold_px(noise_px),
@@ -76,13 +87,27 @@ def robust_seed(
         )
     except (RuntimeError, ValueError):
         return None
-    inliers = np.flatnonzero(np.asarray(info.get("inliers", []), dtype=bool))
-    if len(inliers) < 4:
-        return None
-    mask = np.zeros(n, dtype=bool)
-    mask[order[inliers] if order is not None else inliers] = True
     R = np.asarray(pose.R, dtype=float)
     t = np.asarray(pose.t, dtype=float).reshape(3)
     if not (np.all(np.isfinite(R)) and np.all(np.isfinite(t))):
         return None
+    if n > SAMPLED_FROM:
+        inliers = np.flatnonzero(_within(all_P, all_uv, R, t, fu, fv, intr.cx, intr.cy, inlier_threshold_px(noise_px)))
+    else:
+        inliers = np.flatnonzero(np.asarray(info.get("inliers", []), dtype=bool))
+    if len(inliers) < 4:
+        return None
+    mask = np.zeros(n, dtype=bool)
+    mask[order[inliers] if order is not None else inliers] = True
     return RobustSeed(R, t, mask)
+
+
+def _within(P, uv, R, t, fu, fv, cx, cy, threshold_px) -> np.ndarray:
+    """Which pairs (n,) bool the pose ``(R, t)`` puts in front of the camera and within ``threshold_px`` of their
+    pixels (pinhole; ``uv`` already without the lens's distortion)."""
+    X = P @ R.T + t
+    z = X[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        du = fu * X[:, 0] / z + cx - uv[:, 0]
+        dv = fv * X[:, 1] / z + cy - uv[:, 1]
+        return (z > 0.0) & (du * du + dv * dv <= threshold_px * threshold_px)

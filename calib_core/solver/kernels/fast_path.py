@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 from calib_core.solver.kernels.camera_models import PINHOLE
-from calib_core.solver.kernels.diagnostics import fit_summary
+from calib_core.solver.kernels.diagnostics import fit_summary, flags_a_misfit
 from calib_core.solver.kernels.dlt import dlt_pose
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, newton
 from calib_core.solver.kernels.p3p import p3p
@@ -42,11 +42,9 @@ def seed_coordinates(uv, fu, fv, cx, cy, dist):
 
 
 @njit(cache=True)
-def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma):
-    """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else
-    ``(R, t, residuals, Jacobian (n, 2, 6), covariance (6, 6), centre covariance (3, 3), leave-one-out (n,),
-    scalars)`` with ``scalars`` = ``iterations, outcome, rms px, sigma px, sigma source,
-    condition`` (all arrays allocated here: one call, few interpreter round trips)."""
+def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, misfit_test):
+    """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else :func:`_summary`'s tuple (all arrays
+    allocated here: one call, few interpreter round trips)."""
     n = P.shape[0]
     R = np.empty((3, 3))
     t = np.empty(3)
@@ -56,6 +54,16 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     J = np.empty((n, 2, 6))
     f = np.array([fu, fv])
     iterations, outcome = newton(PINHOLE, P, uv, R, t, f, cx, cy, dist, False, False, 0.0, max_iterations, True, r, J)
+    return _summary(R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test)
+
+
+@njit(cache=True)
+def _summary(R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test):
+    """What the fast path returns for a fit: ``(obj2cam (4, 4), residuals (n, 2), covariance (6, 6), centre
+    covariance (3, 3), leave-one-out (n,), scalars)`` with ``scalars`` = ``iterations, outcome, rms px, sigma px,
+    sigma source, condition, misfit`` (misfit: :func:`flags_a_misfit`'s answer, ``misfit_test`` = ``(noise px, fisher
+    limit, own-scale minimum dof, false flags per solve)``; 0 for an exact fit, where no pair can be flagged)."""
+    n = r.shape[0]
     cov = np.empty((6, 6))
     cov_centre = np.empty((3, 3))
     loo = np.empty(n)
@@ -63,21 +71,50 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     rms, sigma, source, condition = fit_summary(
         J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths
     )
-    scalars = np.array([iterations, outcome, rms, sigma, source, condition], dtype=np.float64)
-    return R, t, r, J, cov, cov_centre, loo, scalars
+    misfit = 0
+    if sigma > 0.0:
+        cov_unit = cov / (sigma * sigma)
+        noise, fisher_limit, own_scale_min_dof, false_flags = misfit_test
+        misfit = flags_a_misfit(J, r, cov_unit, noise, fisher_limit, own_scale_min_dof, false_flags)
+    obj2cam = np.zeros((4, 4))
+    obj2cam[:3, :3] = R
+    obj2cam[:3, 3] = t
+    obj2cam[3, 3] = 1.0
+    scalars = np.array([iterations, outcome, rms, sigma, source, condition, misfit], dtype=np.float64)
+    return obj2cam, r, cov, cov_centre, loo, scalars
 
 
 @njit(cache=True)
 def _same_pose(Ra, ta, Rb, tb, cos_limit, rel_translation):
-    scale = max(np.sqrt(np.sum(ta * ta)), 1.0)
-    if np.sqrt(np.sum((ta - tb) ** 2)) > rel_translation * scale:
+    # (element by element: it runs for every pair of seeds, where an array made per call costs more than the test)
+    scale = max(np.sqrt(ta[0] ** 2 + ta[1] ** 2 + ta[2] ** 2), 1.0)
+    gap = np.sqrt((ta[0] - tb[0]) ** 2 + (ta[1] - tb[1]) ** 2 + (ta[2] - tb[2]) ** 2)
+    if gap > rel_translation * scale:
         return False
-    return (np.sum(Ra * Rb) - 1.0) / 2.0 >= cos_limit
+    trace = 0.0
+    for i in range(3):
+        for j in range(3):
+            trace += Ra[i, j] * Rb[i, j]
+    return (trace - 1.0) / 2.0 >= cos_limit
 
 
 @njit(cache=True)
 def p3p_newton_summary(
-    P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, gate_px, margin_cost, same_cos, same_rel
+    P,
+    uv,
+    fu,
+    fv,
+    cx,
+    cy,
+    dist,
+    max_iterations,
+    sigma_given,
+    default_sigma,
+    misfit_test,
+    gate_px,
+    margin_cost,
+    same_cos,
+    same_rel,
 ):
     """The whole solve for a few points (4 or 5, off a plane): P3P over every triplet, the roots
     that put all the points within ``gate_px`` (RMS) refined, summarised as
@@ -112,12 +149,15 @@ def p3p_newton_summary(
                     # all the points within the gate, in front of the camera
                     e2 = 0.0
                     front = True
+                    R_, t_ = Rk[k], tk[k]
                     for i in range(n):
-                        X = Rk[k] @ P[i] + tk[k]
-                        if X[2] <= 0.0:
+                        x = R_[0, 0] * P[i, 0] + R_[0, 1] * P[i, 1] + R_[0, 2] * P[i, 2] + t_[0]
+                        y = R_[1, 0] * P[i, 0] + R_[1, 1] * P[i, 1] + R_[1, 2] * P[i, 2] + t_[1]
+                        z = R_[2, 0] * P[i, 0] + R_[2, 1] * P[i, 1] + R_[2, 2] * P[i, 2] + t_[2]
+                        if z <= 0.0:
                             front = False
                             break
-                        e2 += ((X[0] / X[2] - xy[i, 0]) * fu) ** 2 + ((X[1] / X[2] - xy[i, 1]) * fv) ** 2
+                        e2 += ((x / z - xy[i, 0]) * fu) ** 2 + ((y / z - xy[i, 1]) * fv) ** 2
                     if not front or not np.sqrt(e2 / n) <= gate_px:
                         continue
                     copy = False
@@ -168,16 +208,14 @@ def p3p_newton_summary(
             and not _same_pose(Rs[best], ts[best], Rs[j], ts[j], same_cos, same_rel)
         ):
             return None
-    R = Rs[best].copy()
-    t = ts[best].copy()
-    r = rs[best].copy()
-    cov = np.empty((6, 6))
-    cov_centre = np.empty((3, 3))
-    loo = np.empty(n)
-    lengths = np.empty(n)
-    J = Js[best].copy()
-    rms, sigma, source, condition = fit_summary(
-        J, r, np.ones(n), R, t, sigma_given, default_sigma, cov, cov_centre, loo, lengths
+    return _summary(
+        Rs[best],
+        ts[best],
+        rs[best].copy(),
+        Js[best],
+        its[best],
+        outcomes[best],
+        sigma_given,
+        default_sigma,
+        misfit_test,
     )
-    scalars = np.array([its[best], outcomes[best], rms, sigma, source, condition], dtype=np.float64)
-    return R, t, r, J, cov, cov_centre, loo, scalars

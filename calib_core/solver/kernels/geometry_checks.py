@@ -50,19 +50,69 @@ def close_pairs(points, tol):
     """Index pairs (k, 2), i < j in row-major order, of points (n, d) within ``tol`` of each other:
     all pairs compared (for the few points of a hand-picked solve; the caller uses a k-d tree for many)."""
     n, d = points.shape
-    out = np.empty((0, 2), dtype=np.int64)
-    found = []
+    tol2 = tol * tol
+    count = 0
     for i in range(n):
         for j in range(i + 1, n):
-            s = 0.0
-            for k in range(d):
-                s += (points[i, k] - points[j, k]) ** 2
-            if s <= tol * tol:
-                found.append((i, j))
-    if len(found) == 0:
-        return out
-    out = np.empty((len(found), 2), dtype=np.int64)
-    for k in range(len(found)):
-        out[k, 0] = found[k][0]
-        out[k, 1] = found[k][1]
+            if _squared_gap(points, i, j, d) <= tol2:
+                count += 1
+    out = np.empty((count, 2), dtype=np.int64)
+    k = 0
+    if count:  # (a second pass only when some are close: rare, a list would cost every call)
+        for i in range(n):
+            for j in range(i + 1, n):
+                if _squared_gap(points, i, j, d) <= tol2:
+                    out[k, 0] = i
+                    out[k, 1] = j
+                    k += 1
+    return out
+
+
+@njit(cache=True)
+def _squared_gap(points, i, j, d):
+    s = 0.0
+    for k in range(d):
+        s += (points[i, k] - points[j, k]) ** 2
+    return s
+
+
+# A direction no grid of CAD features lines up across: points within ``tol`` of each other have projections on it within
+# ``tol``, and distinct points rarely share one.
+_SWEEP_DIRECTION = np.array([0.5717, 0.7063, 0.4174, 0.0])
+
+
+@njit(cache=True)
+def close_pairs_swept(points, tol):
+    """:func:`close_pairs` for many points: sorted along a fixed oblique direction, each point compared only with those
+    whose projection is within ``tol`` of its own (O(n log n) unless many points crowd within ``tol`` along it)."""
+    n, d = points.shape
+    norm = 0.0
+    for k in range(d):
+        norm += _SWEEP_DIRECTION[k] ** 2
+    key = np.zeros(n)
+    for i in range(n):
+        for k in range(d):
+            key[i] += points[i, k] * _SWEEP_DIRECTION[k]
+        key[i] /= np.sqrt(norm)
+    order = np.argsort(key)
+    tol2 = tol * tol
+    count = 0
+    for a in range(n):
+        for b in range(a + 1, n):
+            if key[order[b]] - key[order[a]] > tol:
+                break
+            if _squared_gap(points, order[a], order[b], d) <= tol2:
+                count += 1
+    out = np.empty((count, 2), dtype=np.int64)
+    k = 0
+    for a in range(n):
+        if k == count:
+            break
+        for b in range(a + 1, n):
+            if key[order[b]] - key[order[a]] > tol:
+                break
+            i, j = order[a], order[b]
+            if _squared_gap(points, i, j, d) <= tol2:
+                out[k, 0], out[k, 1] = min(i, j), max(i, j)
+                k += 1
     return out

@@ -3,7 +3,7 @@ quartic as reviewed by Haralick et al. (IJCV 1994), its real roots bracketed bet
 critical points and found by safeguarded Newton steps, each pose from the frames of the object's
 triangle and of the camera's. OpenCV has P3P too, but calling it from compiled code is not possible, and its
 Python call costs more than this whole kernel (the small-problem fast path runs it over every
-triplet).
+triplet). Scalar arithmetic throughout: a small array made, or a BLAS call, per root costs more than the root.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from numba import njit
 
 
 @njit(cache=True)
-def _cubic_real_roots(a, b, c, d, roots):
-    """Real roots of ``a x^3 + b x^2 + c x + d`` (``a`` != 0) into ``roots`` (3,), ascending; how many."""
+def _cubic_real_roots(a, b, c, d):
+    """Real roots of ``a x^3 + b x^2 + c x + d`` (``a`` != 0), ascending: ``(count, x0, x1, x2)``."""
     p = b / a
     q = c / a
     r = d / a
@@ -25,23 +25,49 @@ def _cubic_real_roots(a, b, c, d, roots):
     disc = Q * Q / 4.0 + P * P * P / 27.0
     if disc > 0.0:
         s = np.sqrt(disc)
-        roots[0] = np.cbrt(-Q / 2.0 + s) + np.cbrt(-Q / 2.0 - s) + shift
-        return 1
+        return 1, np.cbrt(-Q / 2.0 + s) + np.cbrt(-Q / 2.0 - s) + shift, 0.0, 0.0
     if P == 0.0:
-        roots[0] = shift
-        return 1
+        return 1, shift, 0.0, 0.0
     m = 2.0 * np.sqrt(-P / 3.0)
     theta = np.arccos(min(1.0, max(-1.0, 3.0 * Q / (P * m)))) / 3.0
-    roots[0] = m * np.cos(theta) + shift
-    roots[1] = m * np.cos(theta - 2.0 * np.pi / 3.0) + shift
-    roots[2] = m * np.cos(theta - 4.0 * np.pi / 3.0) + shift
-    roots[:3].sort()
-    return 3
+    x0 = m * np.cos(theta) + shift
+    x1 = m * np.cos(theta - 2.0 * np.pi / 3.0) + shift
+    x2 = m * np.cos(theta - 4.0 * np.pi / 3.0) + shift
+    # sort three
+    if x0 > x1:
+        x0, x1 = x1, x0
+    if x1 > x2:
+        x1, x2 = x2, x1
+    if x0 > x1:
+        x0, x1 = x1, x0
+    return 3, x0, x1, x2
 
 
 @njit(cache=True)
-def _quartic(c, x):
-    return (((c[0] * x + c[1]) * x + c[2]) * x + c[3]) * x + c[4]
+def _quartic(c1, c2, c3, c4, x):
+    """The monic quartic ``x^4 + c1 x^3 + c2 x^2 + c3 x + c4``."""
+    return (((x + c1) * x + c2) * x + c3) * x + c4
+
+
+@njit(cache=True)
+def _bracketed_root(c1, c2, c3, c4, lo, hi, flo):
+    """The one root of the monic quartic in ``[lo, hi]``, where it is monotonic and changes sign
+    (``flo``: its value at ``lo``): safeguarded Newton steps."""
+    x = 0.5 * (lo + hi)
+    for _ in range(60):
+        fx = _quartic(c1, c2, c3, c4, x)
+        if fx == 0.0:
+            break
+        if (fx < 0.0) == (flo < 0.0):
+            lo = x
+        else:
+            hi = x
+        d = ((4.0 * x + 3.0 * c1) * x + 2.0 * c2) * x + c3
+        step = x - fx / d if d != 0.0 else 0.5 * (lo + hi)
+        x = step if lo < step < hi else 0.5 * (lo + hi)
+        if hi - lo <= 1e-15 * (1.0 + abs(x)):
+            break
+    return x
 
 
 @njit(cache=True)
@@ -51,19 +77,26 @@ def _real_quartic_roots(A4, A3, A2, A1, A0, roots):
     sign change there brackets exactly one root, found by safeguarded Newton steps."""
     if abs(A4) < 1e-300:
         return 0
-    c = np.array([1.0, A3 / A4, A2 / A4, A1 / A4, A0 / A4])
-    bound = 1.0 + max(abs(c[1]), max(abs(c[2]), max(abs(c[3]), abs(c[4]))))  # Cauchy's bound
-    crit = np.empty(3)
-    nc = _cubic_real_roots(4.0, 3.0 * c[1], 2.0 * c[2], c[3], crit)
-    edges = np.empty(5)
-    edges[0] = -bound
-    for k in range(nc):
-        edges[k + 1] = min(max(crit[k], -bound), bound)
-    edges[nc + 1] = bound
+    c1, c2, c3, c4 = A3 / A4, A2 / A4, A1 / A4, A0 / A4
+    bound = 1.0 + max(abs(c1), max(abs(c2), max(abs(c3), abs(c4))))  # Cauchy's bound
+    nc, k0, k1, k2 = _cubic_real_roots(4.0, 3.0 * c1, 2.0 * c2, c3)
+    # the intervals' edges: -bound, the critical points (clipped), bound
+    e0 = -bound
+    e1 = min(max(k0, -bound), bound)
+    e2 = min(max(k1, -bound), bound) if nc == 3 else bound
+    e3 = min(max(k2, -bound), bound) if nc == 3 else bound
+    e4 = bound
     count = 0
     for k in range(nc + 1):
-        lo, hi = edges[k], edges[k + 1]
-        flo, fhi = _quartic(c, lo), _quartic(c, hi)
+        if k == 0:
+            lo, hi = e0, e1
+        elif k == 1:
+            lo, hi = e1, e2
+        elif k == 2:
+            lo, hi = e2, e3
+        else:
+            lo, hi = e3, e4
+        flo, fhi = _quartic(c1, c2, c3, c4, lo), _quartic(c1, c2, c3, c4, hi)
         if flo == 0.0:
             if count == 0 or roots[count - 1] != lo:
                 roots[count] = lo
@@ -71,47 +104,44 @@ def _real_quartic_roots(A4, A3, A2, A1, A0, roots):
             continue
         if flo * fhi > 0.0 or hi <= lo:
             continue
-        x = 0.5 * (lo + hi)
-        for _ in range(60):
-            fx = _quartic(c, x)
-            if fx == 0.0:
-                break
-            if (fx < 0.0) == (flo < 0.0):
-                lo = x
-            else:
-                hi = x
-            d = ((4.0 * c[0] * x + 3.0 * c[1]) * x + 2.0 * c[2]) * x + c[3]
-            step = x - fx / d if d != 0.0 else 0.5 * (lo + hi)
-            x = step if lo < step < hi else 0.5 * (lo + hi)
-            if hi - lo <= 1e-15 * (1.0 + abs(x)):
-                break
-        roots[count] = x
+        roots[count] = _bracketed_root(c1, c2, c3, c4, lo, hi, flo)
         count += 1
     return count
 
 
 @njit(cache=True)
-def _triangle_frame(A, B, C, F):
-    """``F`` (3, 3): columns an orthonormal frame of the triangle ``A B C`` (x along AB, z its normal)."""
-    e1 = B - A
-    e1 = e1 / np.sqrt(np.sum(e1 * e1))
-    n = np.cross(e1, C - A)
-    e3 = n / np.sqrt(np.sum(n * n))
-    e2 = np.cross(e3, e1)
-    for i in range(3):
-        F[i, 0], F[i, 1], F[i, 2] = e1[i], e2[i], e3[i]
+def _unit(x, y, z):
+    n = np.sqrt(x * x + y * y + z * z)
+    return x / n, y / n, z / n
 
 
 @njit(cache=True)
-def _kabsch(Pw, X, R, t):
+def _triangle_frame(A, B, C, F):
+    """``F`` (3, 3): columns an orthonormal frame of the triangle ``A B C`` (rows of 3; x along AB, z its normal)."""
+    e1x, e1y, e1z = _unit(B[0] - A[0], B[1] - A[1], B[2] - A[2])
+    cx, cy, cz = C[0] - A[0], C[1] - A[1], C[2] - A[2]
+    e3x, e3y, e3z = _unit(e1y * cz - e1z * cy, e1z * cx - e1x * cz, e1x * cy - e1y * cx)
+    F[0, 0], F[1, 0], F[2, 0] = e1x, e1y, e1z
+    F[0, 1], F[1, 1], F[2, 1] = e3y * e1z - e3z * e1y, e3z * e1x - e3x * e1z, e3x * e1y - e3y * e1x
+    F[0, 2], F[1, 2], F[2, 2] = e3x, e3y, e3z
+
+
+@njit(cache=True)
+def _kabsch(Pw, X, Fw, Fc, R, t):
     """``R``, ``t`` with ``X_i = R Pw_i + t`` for three pairs (3, 3) of congruent triangles: the
-    rotation between their frames (P3P makes the camera triangle the object's, to round-off)."""
-    Fw = np.empty((3, 3))
-    Fc = np.empty((3, 3))
-    _triangle_frame(Pw[0], Pw[1], Pw[2], Fw)
+    rotation between their frames (P3P makes the camera triangle the object's, to round-off); ``Fw``
+    holds the object triangle's frame, ``Fc`` (3, 3) is scratch."""
     _triangle_frame(X[0], X[1], X[2], Fc)
-    R[:, :] = Fc @ Fw.T
-    t[:] = X[0] - R @ Pw[0]
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = Fc[i, 0] * Fw[j, 0] + Fc[i, 1] * Fw[j, 1] + Fc[i, 2] * Fw[j, 2]
+    for i in range(3):
+        t[i] = X[0, i] - (R[i, 0] * Pw[0, 0] + R[i, 1] * Pw[0, 1] + R[i, 2] * Pw[0, 2])
+
+
+@njit(cache=True)
+def _squared_distance(a, b):
+    return (a[0] - b[0]) ** 2 + (a[1] - b[1]) ** 2 + (a[2] - b[2]) ** 2
 
 
 @njit(cache=True)
@@ -120,14 +150,14 @@ def p3p(Pw, bearings, Rs, ts):
     ``bearings`` (3, 3); up to four, into ``Rs`` (4, 3, 3) and ``ts`` (4, 3). Returns how many
     (0 for a degenerate triangle)."""
     j1, j2, j3 = bearings[0], bearings[1], bearings[2]
-    a2 = np.sum((Pw[1] - Pw[2]) ** 2)
-    b2 = np.sum((Pw[0] - Pw[2]) ** 2)
-    c2 = np.sum((Pw[0] - Pw[1]) ** 2)
+    a2 = _squared_distance(Pw[1], Pw[2])
+    b2 = _squared_distance(Pw[0], Pw[2])
+    c2 = _squared_distance(Pw[0], Pw[1])
     if a2 < 1e-12 or b2 < 1e-12 or c2 < 1e-12:
         return 0
-    ca = np.dot(j2, j3)
-    cb = np.dot(j1, j3)
-    cg = np.dot(j1, j2)
+    ca = j2[0] * j3[0] + j2[1] * j3[1] + j2[2] * j3[2]
+    cb = j1[0] * j3[0] + j1[1] * j3[1] + j1[2] * j3[2]
+    cg = j1[0] * j2[0] + j1[1] * j2[1] + j1[2] * j2[2]
     amc = (a2 - c2) / b2
     apc = (a2 + c2) / b2
     A4 = (amc - 1.0) ** 2 - 4.0 * c2 / b2 * ca * ca
@@ -144,7 +174,11 @@ def p3p(Pw, bearings, Rs, ts):
     A0 = (1.0 + amc) ** 2 - 4.0 * a2 / b2 * cg * cg
     vs = np.empty(4)
     nv = _real_quartic_roots(A4, A3, A2, A1, A0, vs)
-    X = np.empty((3, 3))
+    if nv == 0:
+        return 0
+    scratch = np.empty((3, 3, 3))
+    X, Fw, Fc = scratch[0], scratch[1], scratch[2]
+    _triangle_frame(Pw[0], Pw[1], Pw[2], Fw)
     count = 0
     for k in range(nv):
         v = vs[k]
@@ -156,9 +190,10 @@ def p3p(Pw, bearings, Rs, ts):
         if q <= 0.0 or u <= 0.0 or v <= 0.0:
             continue
         s1 = np.sqrt(b2 / q)
-        X[0] = s1 * j1
-        X[1] = u * s1 * j2
-        X[2] = v * s1 * j3
-        _kabsch(Pw, X, Rs[count], ts[count])
+        for i in range(3):
+            X[0, i] = s1 * j1[i]
+            X[1, i] = u * s1 * j2[i]
+            X[2, i] = v * s1 * j3[i]
+        _kabsch(Pw, X, Fw, Fc, Rs[count], ts[count])
         count += 1
     return count

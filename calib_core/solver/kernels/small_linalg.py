@@ -82,10 +82,12 @@ def symmetric_eigenvalues(A):
     M = A.copy()
     for _ in range(50):
         off = 0.0
+        diagonal = 0.0
         for i in range(p):
+            diagonal += M[i, i] * M[i, i]
             for j in range(i + 1, p):
                 off += M[i, j] * M[i, j]
-        if off < 1e-30 * (np.sum(M * M) + 1e-300):
+        if off < 1e-30 * (diagonal + 2.0 * off + 1e-300):
             break
         for i in range(p):
             for j in range(i + 1, p):

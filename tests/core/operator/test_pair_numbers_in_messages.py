@@ -16,6 +16,7 @@ FEATURES = ("plate_top_left", "plate_top_right", "plate_bottom_left", "plate_bot
 
 def test_labels_follow_the_names_given_and_fall_back_to_positions():
     assert point_label(2) == "point 3" and points_label([0, 3]) == "points 1, 4"
+    assert points_label(range(1500)) == "points 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12 and 1488 more"
     with named_points("pair", [9, 10, 14]):
         assert point_label(2) == "pair 14" and points_label([0, 2]) == "pairs 9, 14"
         assert point_label(5) == "point 6"  # beyond the names given: its position
