@@ -61,6 +61,9 @@ def _opencv(method, P, uv, start=None):
         elif method == "sqpnp+lm":
             ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_SQPNP)
             rvec, tvec = cv2.solvePnPRefineLM(P, uv, K, None, rvec, tvec)
+        elif method == "ippe+lm":
+            ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_IPPE)
+            rvec, tvec = cv2.solvePnPRefineLM(P, uv, K, None, rvec, tvec)
         elif method == "epnp":
             ok, rvec, tvec = cv2.solvePnP(P, uv, K, None, flags=cv2.SOLVEPNP_EPNP)
         elif method == "iterative":

@@ -53,10 +53,12 @@ def speed_section(rng) -> list[str]:
     ]
     import calib_core.solver.solve as solve_module
 
-    for n in (4, 5, 6, 8, 20):
+    for n, planar in ((4, False), (5, False), (6, False), (8, False), (20, False), (4, True)):
         problems = [
-            (P, uv + rng.normal(0, NOISE_PX, uv.shape)) for _, P, uv in (_scene(rng, n) for _ in range(SPEED_SCENES))
+            (P, uv + rng.normal(0, NOISE_PX, uv.shape))
+            for _, P, uv in (_scene(rng, n, planar) for _ in range(SPEED_SCENES))
         ]
+        peer = "ippe+lm" if planar else "sqpnp+lm"
         slow = []
         fast = solve_module.fast_solve
         solve_module.fast_solve = lambda *a, **k: slow.append(1) if (out := fast(*a, **k)) is None else out
@@ -66,13 +68,14 @@ def speed_section(rng) -> list[str]:
         finally:
             solve_module.fast_solve = fast
         for P, uv in problems[:10]:  # warm-up
-            _opencv("sqpnp+lm", P, uv)
+            _opencv(peer, P, uv)
             _poselib_plain(P, uv)
         ours = _mean_per_solve(lambda P, uv: solve_pose(P, uv, CAM), problems)
-        cv = _mean_per_solve(lambda P, uv: _opencv("sqpnp+lm", P, uv), problems)
+        cv = _mean_per_solve(lambda P, uv: _opencv(peer, P, uv), problems)
         pl = _mean_per_solve(_poselib_plain, problems)
         lines.append(
-            f"| N = {n} | {ours * 1e6:.0f} us | {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us "
+            f"| N = {n}{' on a plane (OpenCV: IPPE + RefineLM)' if planar else ''} | {ours * 1e6:.0f} us "
+            f"| {len(slow)} of {SPEED_SCENES} | {cv * 1e6:.0f} us | {pl * 1e6:.0f} us "
             f"| {ours / cv:.2f} | {ours / pl:.2f} |"
         )
     scenes = [_scene(rng, 6) for _ in range(1000)]
