@@ -79,7 +79,7 @@ class StatusLine:
             prev, self._samples_then = self._samples_then, (clock, s["samples"])
             same_clock = prev is not None and prev[0][0] == clock[0] and clock[1] > prev[0][1]
             rate = f"{(s['samples'] - prev[1]) / (clock[1] - prev[0][1]):.0f} Hz, " if same_clock else ""
-            delay = getattr(link, "delay_s", None)
+            delay = link.delay_s
             delay_text = "" if delay is None else f", delay {delay:.2f} s" if delay >= 0.01 else ", delay < 0.01 s"
             text = (
                 f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} "
@@ -87,7 +87,7 @@ class StatusLine:
             )
             last = self.workbench.arm.last_sample_s
             # a far link delivers its samples in bursts: late only past its own spread of delays
-            late_after = STALE_LINK_S + (link.stale_after_now_s() if hasattr(link, "stale_after_now_s") else 0.0)
+            late_after = STALE_LINK_S + link.stale_after_now_s()
             if link.state.value == "up" and last is not None and now - last > late_after:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)

@@ -71,6 +71,13 @@ class ControllerConnector(Protocol):
     def stats_snapshot(self) -> dict[str, int]:
         """Counters (samples delivered, gaps, errors...) since the start."""
 
+    @property
+    def delay_s(self) -> float | None:
+        """The link's one-way delay (s) where the connector measures it, else ``None``."""
+
+    def stale_after_now_s(self) -> float:
+        """No joint sample for this long marks the link stale by the connector's own rule now (s); 0 for none."""
+
     publishes_transforms: bool
     """Declared by the connector (False in :class:`~calib_core.connectors.events.ConnectorEvents`): it takes the
     results through ``publish_static_transforms(transforms)``."""

@@ -39,6 +39,11 @@ class ConnectorEvents:
         """The link's one-way delay (s) where the connector measures it, else ``None``."""
         return None
 
+    def stale_after_now_s(self) -> float:
+        """No joint sample for this long marks the link stale by the connector's own rule now (s; a far link's
+        includes its spread of delays); 0 where the connector has no such rule."""
+        return 0.0
+
     def _set_state(self, state: LinkState, reason: str) -> None:
         if state is self._state:
             return
