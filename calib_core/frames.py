@@ -17,7 +17,6 @@ import warnings
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial.transform import Rotation
 
 __all__ = [
     "check_transform",
@@ -34,6 +33,14 @@ __all__ = [
     "pose_difference",
     "skew",
 ]
+
+
+def _rotation():
+    """SciPy's ``Rotation``, imported when first needed: ``scipy.spatial`` costs a fifth of a second to import, and
+    most commands never turn Euler angles or rotation vectors into matrices."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
 
 
 def check_transform(a2b: ArrayLike, *, name: str = "transform", tol: float = 1e-6) -> np.ndarray:
@@ -103,7 +110,7 @@ def apply(a2b: ArrayLike, points_a: ArrayLike) -> np.ndarray:
 
 def transform_from_xyz_rpy(xyz_mm: ArrayLike, rpy_deg: ArrayLike) -> np.ndarray:
     """Placement from a survey: position (mm) and fixed-axis roll, pitch, yaw (deg)."""
-    R = Rotation.from_euler("xyz", np.asarray(rpy_deg, dtype=float), degrees=True).as_matrix()
+    R = _rotation().from_euler("xyz", np.asarray(rpy_deg, dtype=float), degrees=True).as_matrix()
     return make_transform(R, xyz_mm)
 
 
@@ -113,19 +120,19 @@ def xyz_rpy_from_transform(a2b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     with warnings.catch_warnings():
         # At +-90 deg pitch roll and yaw are not unique; scipy's choice still gives the same rotation.
         warnings.simplefilter("ignore", UserWarning)
-        rpy = Rotation.from_matrix(m[:3, :3]).as_euler("xyz", degrees=True)
+        rpy = _rotation().from_matrix(m[:3, :3]).as_euler("xyz", degrees=True)
     return m[:3, 3].copy(), rpy
 
 
 def transform_from_rotvec_deg(rotvec_deg: ArrayLike, t_mm: ArrayLike = (0.0, 0.0, 0.0)) -> np.ndarray:
     """Transform from an axis-angle vector (deg; direction = axis, norm = angle) and mm."""
-    R = Rotation.from_rotvec(np.asarray(rotvec_deg, dtype=float), degrees=True).as_matrix()
+    R = _rotation().from_rotvec(np.asarray(rotvec_deg, dtype=float), degrees=True).as_matrix()
     return make_transform(R, t_mm)
 
 
 def rotation_angle_deg(R: ArrayLike) -> float:
     """Angle of a rotation matrix, deg, in [0, 180]; robust near 0 and 180."""
-    return float(np.degrees(np.linalg.norm(Rotation.from_matrix(np.asarray(R, dtype=float)).as_rotvec())))
+    return float(np.degrees(np.linalg.norm(_rotation().from_matrix(np.asarray(R, dtype=float)).as_rotvec())))
 
 
 def pose_difference(actual2base: ArrayLike, model2base: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -139,7 +146,7 @@ def pose_difference(actual2base: ArrayLike, model2base: ArrayLike) -> tuple[np.n
     a = np.asarray(actual2base, dtype=float)
     m = np.asarray(model2base, dtype=float)
     d_mm = a[:3, 3] - m[:3, 3]
-    rotvec_deg = Rotation.from_matrix(a[:3, :3] @ m[:3, :3].T).as_rotvec(degrees=True)
+    rotvec_deg = _rotation().from_matrix(a[:3, :3] @ m[:3, :3].T).as_rotvec(degrees=True)
     return d_mm, rotvec_deg
 
 
