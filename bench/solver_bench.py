@@ -385,6 +385,9 @@ def main() -> str:
         + robust_section(rng)
     )
     body += robust_reliability_section(rng) + mis_pick_section(rng)
+    from bench.solver_focal import focal_section
+
+    body += focal_section(np.random.default_rng(20261206))
     header = [
         "# Pose solver benchmarks",
         "",
