@@ -37,3 +37,14 @@ def pytest_unconfigure(config):
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(_exit_status["code"])
+
+
+@pytest.fixture
+def domain(monkeypatch):
+    """A ROS 2 domain of this test's own, held by no other process on the machine (another test suite running at once
+    included), so nothing else on the machine's DDS is heard; ``ROS_DOMAIN_ID`` is set to it."""
+    from tests.ros_domains import reserved_domain
+
+    with reserved_domain() as value:
+        monkeypatch.setenv("ROS_DOMAIN_ID", str(value))
+        yield value

@@ -113,13 +113,13 @@ def test_demo_with_a_gige_camera_reaches_the_same_accuracy(tmp_path):
     assert report["estimate_within_3_sigma"]
 
 
-def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
+def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path, domain):
     """``demo --site ros2``: the robot a simulated ros2_control arm in another process, the camera a ROS 2 image
     topic; the window reaches both only through its ROS 2 connectors, on Cyclone DDS."""
     import os
 
     out = tmp_path / "demo"
-    env = {**os.environ, "ROS_DOMAIN_ID": str(56 + os.getpid() % 8)}
+    env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
     run = subprocess.run(
         [
             sys.executable,
@@ -152,14 +152,14 @@ def test_demo_over_ros2_reaches_the_same_accuracy(tmp_path):
 
 
 @pytest.mark.skipif(why_not_available() is not None, reason=f"no far network here: {why_not_available()}")
-def test_demo_over_ros2_1_5_s_away_reaches_the_same_accuracy(tmp_path):
+def test_demo_over_ros2_1_5_s_away_reaches_the_same_accuracy(tmp_path, domain):
     """``demo --site ros2 --link-delay-ms 1500``: the ros2_control arm in a network namespace of its own, every DDS
     packet to and from it 1.5 s late (+-30 %), 1 % dropped; the camera's frames follow the joint states as they
     arrive. The link's delay is measured from the stamps and the result is as good as near."""
     import os
 
     out = tmp_path / "demo"
-    env = {**os.environ, "ROS_DOMAIN_ID": str(56 + os.getpid() % 8)}
+    env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
     run = subprocess.run(
         [
             sys.executable,

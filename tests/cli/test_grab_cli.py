@@ -21,7 +21,7 @@ def _grab(*args, env=None, timeout=90):
     )
 
 
-def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
+def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path, domain):
     from cyclonedds.domain import DomainParticipant
     from cyclonedds.pub import DataWriter
     from cyclonedds.topic import Topic
@@ -29,7 +29,6 @@ def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
     from calib_core.ros2 import messages as msg
     from calib_core.ros2.wire import sensor_qos
 
-    domain = 41 + os.getpid() % 10  # within ROS 2's safe 0-101: ports below the ephemeral range
     out = tmp_path / "frames"
     grab = _grab(
         "ros2:///cam/image_raw", "--count", "6", "--out", str(out), "--wait", "20", env={"ROS_DOMAIN_ID": str(domain)}
@@ -63,7 +62,7 @@ def test_grab_survives_a_ros2_camera_vanishing_for_a_while(tmp_path):
     assert [int(cv2.imread(str(out / r["file"]), cv2.IMREAD_GRAYSCALE)[0, 0]) for r in rows] == [10, 11, 12, 50, 51, 52]
 
 
-def test_grab_keeps_what_it_got_when_the_camera_stays_away(tmp_path):
+def test_grab_keeps_what_it_got_when_the_camera_stays_away(tmp_path, domain):
     out = tmp_path / "frames"
     grab = _grab(
         "ros2:///nobody/image_raw",
@@ -73,7 +72,7 @@ def test_grab_keeps_what_it_got_when_the_camera_stays_away(tmp_path):
         str(out),
         "--wait",
         "1",
-        env={"ROS_DOMAIN_ID": str(51 + os.getpid() % 5)},
+        env={"ROS_DOMAIN_ID": str(domain)},
     )
     _, err = grab.communicate(timeout=60)
     assert (

@@ -102,14 +102,14 @@ def test_monitor_does_not_show_a_sample_of_another_joint_count(tmp_path):
     assert "has 3 joint values, the robot has 6: not shown" in run.stderr
 
 
-def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch):
+def test_monitor_reads_a_ros2_arm_in_another_process(tmp_path, monkeypatch, domain):
     """``sim-ros2`` (a ros2_control arm on Cyclone DDS) and ``monitor ros2://`` as two processes: the
     samples come in the workcell's joint order, stamped by the arm's clock (ms since the epoch)."""
     import os
 
     from calib_core.workcell import DEFAULT_WORKCELL
 
-    env = {**os.environ, "ROS_DOMAIN_ID": str(64 + os.getpid() % 6)}
+    env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
     arm = subprocess.Popen(
         [sys.executable, "-m", "app.cli.main", "sim-ros2", "--rate", "200", "--joints", "10,-20,30,-40,50,-60"],
         stdout=subprocess.PIPE,

@@ -151,5 +151,6 @@ def test_a_pending_move_times_out_while_the_link_is_down(sim):  # noqa: F811
         deadline = time.monotonic() + 15
         while not handle.finished and time.monotonic() < deadline:
             time.sleep(0.02)
-        assert link.state is LinkState.DOWN
+        # (reconnecting: down between its attempts, connecting during one; never up)
+        assert link.state in (LinkState.DOWN, LinkState.CONNECTING)
         assert handle.finished and isinstance(handle.error, MoveTimeout) and handle.id in str(handle.error)
