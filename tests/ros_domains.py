@@ -10,7 +10,6 @@ where any other socket (a GigE stream, a UDP client) may hold one. Tests take 1-
 from __future__ import annotations
 
 import fcntl
-import itertools
 import os
 import tempfile
 from contextlib import contextmanager
@@ -18,24 +17,28 @@ from pathlib import Path
 
 TEST_DOMAINS = range(1, 71)
 LOCKS = Path(tempfile.gettempdir()) / "videocal-test-ros-domains"
-_turns = itertools.count()
+_next = [os.getpid() % len(TEST_DOMAINS)]  # where this process looks first: past the last domain it took
 
 
 @contextmanager
 def reserved_domain():
     """A ROS 2 domain id no other process on this machine holds while the block runs (:data:`TEST_DOMAINS`)."""
     LOCKS.mkdir(exist_ok=True)
-    # Where to start looking: by process, so suites rarely contend, and on by one each time, so a test does not take
-    # the domain the previous one's child processes may still be leaving.
-    start = (os.getpid() + next(_turns)) % len(TEST_DOMAINS)
+    # Where to start looking: by process at first, so suites rarely contend, then past the last domain this process
+    # took, so it comes back to one only after all the others: what an earlier test left on a domain (a participant
+    # not yet collected, a child process still leaving) is not heard by a later one (a leftover action server once
+    # made a test's client find a server where its arm had none).
+    start = _next[0]
     for k in range(len(TEST_DOMAINS)):
-        domain = TEST_DOMAINS[(start + k) % len(TEST_DOMAINS)]
+        index = (start + k) % len(TEST_DOMAINS)
+        domain = TEST_DOMAINS[index]
         handle = open(LOCKS / f"{domain}.lock", "w")
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             handle.close()
             continue
+        _next[0] = index + 1
         try:
             yield domain
         finally:
