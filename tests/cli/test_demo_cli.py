@@ -7,6 +7,7 @@ import sys
 import cv2
 import pytest
 
+from tests.child_process import run_videocal
 from videocal_sim.far_network import why_not_available
 
 
@@ -59,24 +60,7 @@ def test_demo_on_the_workshop_camera_still_corrects_the_task_location(tmp_path):
     camera. Find points still finds the target and the correction removes most of the 8 mm; what is left is the
     parts' own deviation from their CAD, which no look can see (docs/benchmarks/find_points.md)."""
     out = tmp_path / "demo"
-    run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "app.cli.main",
-            "demo",
-            "--offscreen",
-            "--look",
-            "workshop",
-            "--out",
-            str(out),
-            "--scale",
-            "0.5",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=400,
-    )
+    run = run_videocal(["demo", "--offscreen", "--look", "workshop", "--out", str(out), "--scale", "0.5"])
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert report["camera_look"] == "workshop" and report["status"] == "ok" and report["pairs"] >= 5
