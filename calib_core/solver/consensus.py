@@ -114,6 +114,7 @@ _CONSISTENT_QUANTILE = 0.999
 
 def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
     """The least-squares pose of the pairs of ``sub`` alone, seeded by P3P over its triplets (compiled), or None."""
+    from calib_core.solver.initialisation import MAX_SUBSETS
     from calib_core.solver.kernels.fast_path import p3p_newton_summary
     from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
 
@@ -136,6 +137,7 @@ def _own_minimum(sub: PoseProblem, chosen: RefinedPose) -> RefinedPose | None:
         -1.0,
         1.0,
         0.0,
+        MAX_SUBSETS,
     )
     if out is None:
         return None

@@ -1,13 +1,17 @@
 """The common cases in one compiled call: four or more pairs (up to eight on a plane), known focal lengths, pinhole
-model, no robust loss (six and more off a plane seeded by a DLT, four and five, and a plane's up to eight, by P3P over
-every triplet). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit worse than the
-limit, a pair that may be a mis-pick, or, for a few pairs, a second pose that fits about as well: a plane's mirror
-pose, which the full search ranks by the prior)."""
+model, no robust loss (six and more off a plane seeded by a DLT, four and five, and a plane's up to eight, by P3P
+over the largest triangles). Returns ``None`` whenever the full search is needed (no seed, no convergence, a fit
+worse than the limit, a pair that may be a mis-pick), and a :class:`Tie` when for a few pairs a second pose fits
+about as well (a plane's mirror pose): the full search ranks the poses found by the prior and reports them, without
+seeking them again."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from calib_core.solver.initialisation import MAX_SUBSETS, P3P_SEEDED_UP_TO
 from calib_core.solver.finish import noise_px, operator_warnings
 from calib_core.solver.candidates import SAME_POSE_DEG, SAME_POSE_REL
 from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
@@ -19,9 +23,16 @@ from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 
 _MAX_ITERATIONS = 100
 SEEDED_BY_DLT = 6
-P3P_SEEDED_UP_TO = 8
 _SAME_POSE_COS = float(np.cos(np.radians(SAME_POSE_DEG)))
-"""Up to this many pairs, P3P over every triplet seeds the fast path when the DLT gives no seed (56 triplets at 8)."""
+
+
+@dataclass(frozen=True)
+class Tie:
+    """Two or more distinct poses that fit the pairs about as well (within the ambiguity margin), each ``obj2cam``
+    (4, 4) mm at its own least-squares minimum, the best first. Every such minimum has a P3P root of each triplet
+    near it, and the fast path refined the roots of the full search's triplets: it would find these same poses."""
+
+    minima: tuple[np.ndarray, ...]
 
 
 def applies(problem: PoseProblem, robust: bool) -> bool:
@@ -36,10 +47,10 @@ def applies(problem: PoseProblem, robust: bool) -> bool:
 
 def fast_solve(
     problem: PoseProblem, sigma_px: float | None, limit_px: float, ambiguity_chi2: float = 9.0
-) -> PoseSolution | None:
-    """Solve ``problem`` through the compiled fast path, or ``None`` to fall back. With fewer than
-    six pairs, a second minimum costing within ``ambiguity_chi2`` noise variances of the best is an
-    ambiguity the full search reports (the same rule)."""
+) -> PoseSolution | Tie | None:
+    """Solve ``problem`` through the compiled fast path, or ``None`` to fall back. For a few pairs (P3P's seeds),
+    a second minimum costing within ``ambiguity_chi2`` noise variances of the best is an ambiguity the full search
+    reports (the same rule): the minima are returned as a :class:`Tie` when the best fits within the limit."""
     intr = problem.intrinsics
     n = problem.n_points
     sigma = -1.0 if sigma_px is None else float(sigma_px)
@@ -66,12 +77,17 @@ def fast_solve(
             ambiguity_chi2 * noise**2,
             _SAME_POSE_COS,
             SAME_POSE_REL * 1e3,
+            MAX_SUBSETS,
         )
     if out is None:
         return None
-    obj2cam, r, cov, cov_c, loo, scalars = out
+    obj2cam, r, cov, cov_c, loo, scalars, rivals = out
     iterations, outcome, rms, sigma, source, condition, misfit = scalars
-    if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px or misfit != 0.0:
+    if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
+        return None
+    if len(rivals):
+        return Tie((obj2cam, *rivals))
+    if misfit != 0.0:
         return None
     return PoseSolution(
         status=SolveStatus.OK,

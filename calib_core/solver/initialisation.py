@@ -22,6 +22,9 @@ from calib_core.solver.problem import PoseProblem
 # P3P over subsets is run for small problems (where other local minima are likely and must be
 # reported) and as a fallback when the all-points seeds fit badly (a mis-click spoils SQPnP).
 SMALL_PROBLEM_POINTS = 5
+P3P_SEEDED_UP_TO = 8
+"""Up to this many pairs on a plane, P3P over the largest triangles seeds the search too: SQPnP and IPPE's
+two poses can miss a minimum that fits a plane's six to eight pairs about as well as the best."""
 MAX_SUBSETS = 6
 
 
@@ -154,16 +157,16 @@ def initial_seeds(
     problem: PoseProblem, fu: float, fv: float, gate_px: float | None = None
 ) -> list[tuple[np.ndarray, np.ndarray]]:
     """Seeds for a problem without a guess: P3P roots for 3 pairs; DLT (6 or more pairs off a
-    plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs. With ``gate_px``
-    (known focal lengths only) the triplets' roots that put all the pairs more than that off (RMS)
-    are left out, unless none is within it."""
+    plane), SQPnP, IPPE when planar, P3P over triplets when there are few pairs (up to eight on a
+    plane). With ``gate_px`` (known focal lengths only) the triplets' roots that put all the pairs
+    more than that off (RMS) are left out, unless none is within it."""
     P, uv, intr = problem.points_3d, problem.points_2d, problem.intrinsics
     if problem.n_points == 3:
         return p3p_seeds(P, uv, intr, fu, fv)
     seeds = dlt_seed(problem, fu, fv) + sqpnp_seed(P, uv, intr, fu, fv)
     if problem.coplanar:
         seeds += ippe_seeds(P, uv, intr, fu, fv)
-    if problem.n_points <= SMALL_PROBLEM_POINTS:
+    if problem.n_points <= SMALL_PROBLEM_POINTS or (problem.coplanar and problem.n_points <= P3P_SEEDED_UP_TO):
         roots = subset_p3p_seeds(problem, fu, fv)
         if gate_px is not None and roots:
             # Each triplet's roots: the true pose and up to three others that the remaining pairs

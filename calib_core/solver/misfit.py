@@ -17,6 +17,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from calib_core.solver.kernels.diagnostics import quadratic_forms
+
 FALSE_FLAG_PER_SOLVE = 0.001
 OWN_SCALE_MIN_DOF = 4
 """The picks' own scale replaces the noise model only when measured with this many degrees of freedom: from
@@ -28,25 +30,17 @@ def _quadratic_forms(
     jacobian: np.ndarray, residuals: np.ndarray, used: np.ndarray, rows: np.ndarray, sign: float
 ) -> np.ndarray:
     """``r_i^T (I + sign H_ii)^-1 r_i`` (len(rows),) for the ``rows``, ``H_ii = J_i (J^T J)^-1 J_i^T`` over the ``used``
-    pairs: all 2 x 2 blocks at once (a loop over 5000 pairs cost 40 times the solve). NaN where the block is singular
-    or there is no redundancy."""
-    out = np.full(len(rows), np.nan)
-    J = jacobian[used]
-    if len(J) * 2 <= jacobian.shape[2] or len(rows) == 0:
-        return out
-    flat = J.reshape(-1, J.shape[2])
-    try:
-        C = np.linalg.inv(flat.T @ flat)
-    except np.linalg.LinAlgError:
-        return out
-    Jr = jacobian[rows]
-    H = (Jr @ C) @ Jr.transpose(0, 2, 1)  # (rows, 2, 2): batched products (einsum's generic loop cost 5x here)
-    m00, m01, m10, m11 = 1.0 + sign * H[:, 0, 0], sign * H[:, 0, 1], sign * H[:, 1, 0], 1.0 + sign * H[:, 1, 1]
-    det = m00 * m11 - m01 * m10
-    r0, r1 = residuals[rows, 0], residuals[rows, 1]
-    ok = det > 1e-9
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out[ok] = ((m11 * r0 * r0 - (m01 + m10) * r0 * r1 + m00 * r1 * r1) / det)[ok]
+    pairs (compiled: one pass over the pairs, no (n, 2, 2) arrays). NaN where the block is singular or there is no
+    redundancy."""
+    out = np.empty(len(rows))
+    quadratic_forms(
+        np.ascontiguousarray(jacobian, dtype=float),
+        np.ascontiguousarray(residuals, dtype=float),
+        np.ascontiguousarray(used, dtype=np.bool_),
+        np.ascontiguousarray(rows, dtype=np.int64),
+        float(sign),
+        out,
+    )
     return out
 
 

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import distinct_poses, refine_seed, same_pose
-from calib_core.solver.fast_solve import applies as fast_path_applies, fast_solve
+from calib_core.solver.fast_solve import Tie, applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
 from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px, rival_consensus
 from calib_core.solver.sampler import robust_seed
@@ -120,12 +120,14 @@ def solve_pose(
     limit = 5.0 * noise if max_rms_px is None else float(max_rms_px)
     huber = 2.0 * noise if robust else None
 
+    tie = None
     if fast_path_applies(problem, robust):
         # A DLT seed (many points) or P3P's roots (a few) refined to one good fit is the answer; the
         # other seeds cost more than the whole solve.
-        solution = fast_solve(problem, sigma_px, limit, _AMBIGUITY_CHI2)
-        if solution is not None:
-            return solution
+        answer = fast_solve(problem, sigma_px, limit, _AMBIGUITY_CHI2)
+        if isinstance(answer, PoseSolution):
+            return answer
+        tie = answer if isinstance(answer, Tie) else None
     sampled = robust_seed(problem, fu0, fv0, noise, order=order) if robust else None
     # With a sampled seed the all-points seeds add nothing: outliers spoil them, and on a clean set the
     # sampler's seed is theirs.
@@ -134,17 +136,20 @@ def solve_pose(
     gate = 10.0 * limit if not problem.estimate_focal and problem.model == "pinhole" and not robust else None
     # (a few pairs: every triplet's roots as well, so that a second pose fitting another subset as well is
     # found and the answer called ambiguous rather than ok)
-    seeds = (
-        []
-        if sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS
-        else initial_seeds(problem, fu0, fv0, gate)
-    )
+    if tie is not None:
+        # the poses that tie are already found, each at its minimum: they are the seeds (refined again, a step or two)
+        seeds = [(pose[:3, :3], pose[:3, 3]) for pose in tie.minima]
+    elif sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS:
+        seeds = []
+    else:
+        seeds = initial_seeds(problem, fu0, fv0, gate)
     if sampled is not None and problem.model != "pinhole":
         seeds.append((sampled.R, sampled.t))
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
     refine = _refiner(problem, fu0, fv0, huber, noise, floor)
-    refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
+    # (a tie's minima are distinct already; the prior, if a copy of one, is refined to it and dropped as one)
+    refined = [r for r in (refine(R, t) for R, t in (seeds if tie else distinct_seeds(seeds))) if r is not None]
     if sampled is not None and problem.model == "pinhole":
         # the sampler's own inliers are where its seed's consensus starts (one least-squares fit, usually)
         fit = consensus_refine(

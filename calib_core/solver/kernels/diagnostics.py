@@ -161,3 +161,41 @@ def flags_a_misfit(J, r, cov_unit, noise, fisher_limit, own_scale_min_dof, false
         if T[i] / (sigma * sigma) > limit:
             return 1
     return 0
+
+
+@njit(cache=True)
+def quadratic_forms(J, r, used, rows, sign, out):
+    """Fill ``out`` (len(rows),) with ``r_i^T (I + sign H_ii)^-1 r_i`` px^2 for the pairs ``rows`` (k,) int, ``H_ii``
+    the 2 x 2 hat block of the least-squares fit over the ``used`` (n,) bool pairs (``J`` (n, 2, p), ``r`` (n, 2)
+    px); NaN where the block is singular, or every row when the fit has no redundancy or a singular information
+    matrix."""
+    n, _, p = J.shape
+    out[:] = np.nan
+    count = 0
+    A = np.zeros((p, p))
+    for i in range(n):
+        if not used[i]:
+            continue
+        count += 1
+        for row in range(2):
+            for a in range(p):
+                ja = J[i, row, a]
+                for b in range(a + 1):
+                    A[a, b] += ja * J[i, row, b]
+    if 2 * count <= p:
+        return
+    for a in range(p):
+        for b in range(a + 1, p):
+            A[a, b] = A[b, a]
+    cov_unit = np.empty((p, p))
+    if not spd_inverse(A, cov_unit):
+        return
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        h00, h01, h11 = hat_block(J, i, cov_unit)
+        m00 = 1.0 + sign * h00
+        m01 = sign * h01
+        m11 = 1.0 + sign * h11
+        det = m00 * m11 - m01 * m01
+        if det > 1e-9:
+            out[k] = (m11 * r[i, 0] * r[i, 0] - 2.0 * m01 * r[i, 0] * r[i, 1] + m00 * r[i, 1] * r[i, 1]) / det

@@ -1,5 +1,5 @@
-"""The whole solve in one compiled call: for many points a DLT seed, for a few P3P over every
-triplet; Newton; the fit summary.
+"""The whole solve in one compiled call: for many points a DLT seed, for a few P3P over the
+largest triangles; Newton; the fit summary.
 
 Most operator solves have six or more well-spread points; for them one call replaces a
 dozen interpreter round trips (the solve then costs less than OpenCV's own refinement).
@@ -14,7 +14,7 @@ from numba import njit
 from calib_core.solver.kernels.camera_models import PINHOLE
 from calib_core.solver.kernels.diagnostics import fit_summary, flags_a_misfit
 from calib_core.solver.kernels.dlt import dlt_pose
-from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, newton
+from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, MAX_ITERATIONS, newton
 from calib_core.solver.kernels.p3p import p3p
 
 # Fixed-point undistortion sweeps for the seed: the Newton iterations absorb what is left.
@@ -43,8 +43,9 @@ def seed_coordinates(uv, fu, fv, cx, cy, dist):
 
 @njit(cache=True)
 def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, misfit_test):
-    """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else :func:`_summary`'s tuple (all arrays
-    allocated here: one call, few interpreter round trips)."""
+    """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else :func:`_summary`'s tuple and no rival
+    (an empty (0, 4, 4) array, as :func:`p3p_newton_summary` returns; all arrays allocated here: one call, few
+    interpreter round trips)."""
     n = P.shape[0]
     R = np.empty((3, 3))
     t = np.empty(3)
@@ -54,7 +55,10 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     J = np.empty((n, 2, 6))
     f = np.array([fu, fv])
     iterations, outcome = newton(PINHOLE, P, uv, R, t, f, cx, cy, dist, False, False, 0.0, max_iterations, True, r, J)
-    return _summary(R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test)
+    obj2cam, r, cov, cov_centre, loo, scalars = _summary(
+        R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test
+    )
+    return obj2cam, r, cov, cov_centre, loo, scalars, np.empty((0, 4, 4))
 
 
 @njit(cache=True)
@@ -98,6 +102,44 @@ def _same_pose(Ra, ta, Rb, tb, cos_limit, rel_translation):
     return (trace - 1.0) / 2.0 >= cos_limit
 
 
+_FIRST_STEPS = 3
+"""A seed after the first is refined this many steps, then checked against the minima found, before the rest."""
+
+
+@njit(cache=True)
+def _near_a_minimum(Rs, ts, costs, R, t, basin_cos):
+    """Whether ``(R, t)`` is within the basin (``basin_cos``, 5 % of the distance) of a minimum found (finite cost)."""
+    for i in range(costs.shape[0]):
+        if costs[i] < np.inf and _same_pose(Rs[i], ts[i], R, t, basin_cos, 0.05):
+            return True
+    return False
+
+
+@njit(cache=True)
+def largest_triangles(P, limit):
+    """Up to ``limit`` triplets of the points ``P`` (n, 3), (k, 3) indices, the largest triangles first (the best
+    conditioned P3P; ties in the order of enumeration); all of them, in that order, when there are no more."""
+    n = P.shape[0]
+    count = n * (n - 1) * (n - 2) // 6
+    every = np.empty((count, 3), dtype=np.int64)
+    k = 0
+    for a in range(n):
+        for b in range(a + 1, n):
+            for c in range(b + 1, n):
+                every[k, 0], every[k, 1], every[k, 2] = a, b, c
+                k += 1
+    if count <= limit:
+        return every
+    area = np.empty(count)
+    for k in range(count):
+        a, b, c = every[k, 0], every[k, 1], every[k, 2]
+        u0, u1, u2 = P[b, 0] - P[a, 0], P[b, 1] - P[a, 1], P[b, 2] - P[a, 2]
+        v0, v1, v2 = P[c, 0] - P[a, 0], P[c, 1] - P[a, 1], P[c, 2] - P[a, 2]
+        w0, w1, w2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+        area[k] = -np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    return every[np.argsort(area, kind="mergesort")[:limit]]
+
+
 @njit(cache=True)
 def p3p_newton_summary(
     P,
@@ -115,13 +157,14 @@ def p3p_newton_summary(
     margin_cost,
     same_cos,
     same_rel,
+    max_triplets,
 ):
-    """The whole solve for a few points (4 or 5, off a plane): P3P over every triplet, the roots
-    that put all the points within ``gate_px`` (RMS) refined, summarised as
-    :func:`dlt_newton_summary`. ``None`` when no root is near or no refinement converges, or when a
-    second distinct minimum (``same_cos``/``same_rel``: the cosine and relative distance under which
-    two poses are one) costs within ``margin_cost`` px^2 of the best: an ambiguity, for the full
-    search to report with its candidates."""
+    """The whole solve for a few points (four to eight): P3P over the ``max_triplets`` largest triangles (the full
+    search's triplets, :func:`calib_core.solver.initialisation.spread_triplets`), the roots that put all the points
+    within ``gate_px`` (RMS) refined, summarised as :func:`dlt_newton_summary`, with the **rivals** (k, 4, 4): every
+    other distinct minimum (``same_cos``/``same_rel``: the cosine and relative distance under which two poses are one)
+    costing within ``margin_cost`` px^2 of the best (a plane's mirror pose), best first; empty when the best stands
+    alone. ``None`` when no root is near or no refinement converges."""
     n = P.shape[0]
     xy = seed_coordinates(uv, fu, fv, cx, cy, dist)
     bearings = np.empty((n, 3))
@@ -130,7 +173,8 @@ def p3p_newton_summary(
         bearings[i, 0] = xy[i, 0] / norm
         bearings[i, 1] = xy[i, 1] / norm
         bearings[i, 2] = 1.0 / norm
-    m_max = 4 * (n * (n - 1) * (n - 2) // 6)
+    triplets = largest_triangles(P, max_triplets)
+    m_max = 4 * triplets.shape[0]
     Rs = np.empty((m_max, 3, 3))
     ts = np.empty((m_max, 3))
     seed_rms = np.empty(m_max)
@@ -140,36 +184,35 @@ def p3p_newton_summary(
     tri_P = np.empty((3, 3))
     tri_b = np.empty((3, 3))
     seed_cos = np.cos(np.radians(2.0))
-    for a in range(n):
-        for b in range(a + 1, n):
-            for c in range(b + 1, n):
-                tri_P[0], tri_P[1], tri_P[2] = P[a], P[b], P[c]
-                tri_b[0], tri_b[1], tri_b[2] = bearings[a], bearings[b], bearings[c]
-                for k in range(p3p(tri_P, tri_b, Rk, tk)):
-                    # all the points within the gate, in front of the camera
-                    e2 = 0.0
-                    front = True
-                    R_, t_ = Rk[k], tk[k]
-                    for i in range(n):
-                        x = R_[0, 0] * P[i, 0] + R_[0, 1] * P[i, 1] + R_[0, 2] * P[i, 2] + t_[0]
-                        y = R_[1, 0] * P[i, 0] + R_[1, 1] * P[i, 1] + R_[1, 2] * P[i, 2] + t_[1]
-                        z = R_[2, 0] * P[i, 0] + R_[2, 1] * P[i, 1] + R_[2, 2] * P[i, 2] + t_[2]
-                        if z <= 0.0:
-                            front = False
-                            break
-                        e2 += ((x / z - xy[i, 0]) * fu) ** 2 + ((y / z - xy[i, 1]) * fv) ** 2
-                    if not front or not np.sqrt(e2 / n) <= gate_px:
-                        continue
-                    copy = False
-                    for j in range(m):
-                        if _same_pose(Rs[j], ts[j], Rk[k], tk[k], seed_cos, 0.02):
-                            copy = True
-                            break
-                    if not copy:
-                        Rs[m] = Rk[k]
-                        ts[m] = tk[k]
-                        seed_rms[m] = np.sqrt(e2 / n)
-                        m += 1
+    for tri in range(triplets.shape[0]):
+        for v in range(3):
+            tri_P[v] = P[triplets[tri, v]]
+            tri_b[v] = bearings[triplets[tri, v]]
+        for k in range(p3p(tri_P, tri_b, Rk, tk)):
+            # all the points within the gate, in front of the camera
+            e2 = 0.0
+            front = True
+            R_, t_ = Rk[k], tk[k]
+            for i in range(n):
+                x = R_[0, 0] * P[i, 0] + R_[0, 1] * P[i, 1] + R_[0, 2] * P[i, 2] + t_[0]
+                y = R_[1, 0] * P[i, 0] + R_[1, 1] * P[i, 1] + R_[1, 2] * P[i, 2] + t_[1]
+                z = R_[2, 0] * P[i, 0] + R_[2, 1] * P[i, 1] + R_[2, 2] * P[i, 2] + t_[2]
+                if z <= 0.0:
+                    front = False
+                    break
+                e2 += ((x / z - xy[i, 0]) * fu) ** 2 + ((y / z - xy[i, 1]) * fv) ** 2
+            if not front or not np.sqrt(e2 / n) <= gate_px:
+                continue
+            copy = False
+            for j in range(m):
+                if _same_pose(Rs[j], ts[j], Rk[k], tk[k], seed_cos, 0.02):
+                    copy = True
+                    break
+            if not copy:
+                Rs[m] = Rk[k]
+                ts[m] = tk[k]
+                seed_rms[m] = np.sqrt(e2 / n)
+                m += 1
     if m == 0:
         return None
     order = np.argsort(seed_rms[:m])
@@ -184,31 +227,56 @@ def p3p_newton_summary(
     for j in order:
         # best seeds first; one within a few degrees of a pose already found would only find it again
         # (the true pose's roots from each triplet, apart by the noise)
-        again = False
-        for i in range(m):
-            if costs[i] < np.inf and _same_pose(Rs[i], ts[i], Rs[j], ts[j], basin_cos, 0.05):
-                again = True
-                break
-        if again:
+        if _near_a_minimum(Rs, ts, costs, Rs[j], ts[j], basin_cos):
             continue
         f[0], f[1] = fu, fv
+        first = max_iterations if best < 0 else min(_FIRST_STEPS, max_iterations)
         its[j], outcomes[j] = newton(
-            PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, max_iterations, True, rs[j], Js[j]
+            PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, first, True, rs[j], Js[j]
         )
+        if outcomes[j] == MAX_ITERATIONS and first < max_iterations:
+            # on a plane the triplets' roots of one pose lie far apart (its turn is poorly fixed by three points): a few
+            # steps bring each next to the minimum it falls into, and one already found is not sought again
+            if _near_a_minimum(Rs, ts, costs, Rs[j], ts[j], basin_cos):
+                continue
+            more, outcomes[j] = newton(
+                PINHOLE,
+                P,
+                uv,
+                Rs[j],
+                ts[j],
+                f,
+                cx,
+                cy,
+                dist,
+                False,
+                False,
+                0.0,
+                max_iterations - first,
+                True,
+                rs[j],
+                Js[j],
+            )
+            its[j] += more
         if outcomes[j] == CONVERGED or outcomes[j] == EXACT_FIT:
             costs[j] = np.sum(rs[j] ** 2)
             if best < 0 or costs[j] < costs[best]:
                 best = j
     if best < 0:
         return None
-    for j in range(m):
+    rivals = np.zeros((m, 4, 4))
+    k = 0
+    for j in np.argsort(costs):
         if (
             j != best
             and costs[j] <= costs[best] + margin_cost
             and not _same_pose(Rs[best], ts[best], Rs[j], ts[j], same_cos, same_rel)
         ):
-            return None
-    return _summary(
+            rivals[k, :3, :3] = Rs[j]
+            rivals[k, :3, 3] = ts[j]
+            rivals[k, 3, 3] = 1.0
+            k += 1
+    obj2cam, r, cov, cov_centre, loo, scalars = _summary(
         Rs[best],
         ts[best],
         rs[best].copy(),
@@ -219,3 +287,4 @@ def p3p_newton_summary(
         default_sigma,
         misfit_test,
     )
+    return obj2cam, r, cov, cov_centre, loo, scalars, rivals[:k].copy()
