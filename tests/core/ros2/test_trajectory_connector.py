@@ -151,7 +151,9 @@ def test_a_move_through_the_trajectory_controller_ends_at_its_target(arm, interf
         assert handle.sent and handle.acked
         handle.wait(20)
         assert np.allclose(link.latest.joints_deg, target, atol=0.05)
-        assert np.allclose(arm.position(time.monotonic()), target, atol=1e-6)
+        # (the move ends when the joints are within the link's tolerance; the arm settles its last thousandth of a
+        # degree after, later still on a loaded machine)
+        assert wait_until(lambda: np.allclose(arm.position(time.monotonic()), target, atol=1e-6))
         if interface == "action":
             assert arm.action.accepted >= 1 and arm.trajectories == 0  # goals, none on the topic
         else:
