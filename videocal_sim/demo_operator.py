@@ -183,18 +183,23 @@ def run_demo(
     warm_solver_in_background()  # as videocal gui does
     shots = []
 
+    shooting_s = [0.0]  # time spent on screenshots, left out of the looks' times
+
     def shot(name: str, widget=None) -> None:
         """The window (or ``widget``: a dialog of its own) as the operator sees it now, saved as a PNG."""
+        t0 = time.monotonic()
         _pause(app, 0.3)
         path = out_dir / f"{len(shots) + 1:02d}_{name}.png"
         (widget or win).grab().save(str(path))
         shots.append(path.name)
+        shooting_s[0] += time.monotonic() - t0
 
     skipped: list[str] = []
     refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
     confirmed: list[str] = []  # moves the operator confirmed in the overview (large joint changes)
     moves_seen: list[str] = []
     looks_s: list[float] = []  # Go pressed -> a frame the core accepts for picks
+    look_work_s: list[float] = []  # a settled frame -> the correction stored (the picks or Find points, the solve)
     last_go = [time.monotonic()]
     wb.arm.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
@@ -299,10 +304,16 @@ def run_demo(
             store()
 
         def pick_and_calibrate(round_name: str) -> None:
-            """One calibration where the robot stands: every feature picked in both panes, solved, stored."""
+            """One calibration where the robot stands (timed, screenshots left out)."""
+            t0, shooting0 = time.monotonic(), shooting_s[0]
             if method != "picks":
                 find_and_calibrate(round_name)
-                return
+            else:
+                pick_each_and_calibrate(round_name)
+            look_work_s.append(time.monotonic() - t0 - (shooting_s[0] - shooting0))
+
+        def pick_each_and_calibrate(round_name: str) -> None:
+            """Every feature picked in both panes (scripted clicks), solved, stored."""
             win.camera.freeze.setChecked(True)
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
@@ -396,6 +407,7 @@ def run_demo(
             "method": method,
             "site": site.description,
             "camera_look": look,
+            "settled_frame_to_stored_s": [round(v, 2) for v in look_work_s],
             "link": {
                 "one_way_ms": link_delay_ms,
                 "measured_one_way_s": getattr(wb.link, "delay_s", None),

@@ -70,6 +70,13 @@ class FollowJointTrajectoryServer:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=1.0)
+        if self._thread is not None and not self._thread.is_alive():
+            # a closed server is gone from the domain at once: a client must not find it and send it goals
+            from calib_core.ros2.participant import delete
+
+            for taker in self._takers.values():
+                taker.close()
+            delete(*self._replies.values(), self._feedback, self._status)
 
     # --- the services --------------------------------------------------------------------------
     def _serve(self) -> None:

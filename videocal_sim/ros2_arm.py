@@ -92,6 +92,11 @@ class SimulatedRos2Arm:
         self._stop.set()
         for thread in self._threads:
             thread.join(timeout=1.0)
+        if self._threads and not any(thread.is_alive() for thread in self._threads):
+            from calib_core.ros2.participant import delete
+
+            self._taker.close()
+            delete(self._writer)
 
     # --- the controller ------------------------------------------------------------------------
     def position(self, now: float) -> np.ndarray:

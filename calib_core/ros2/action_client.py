@@ -55,6 +55,14 @@ class FollowJointTrajectoryClient:
         self._seq = itertools.count(1)
         self._pending: dict[tuple[str, int], bytes] = {}  # (service, seq) -> goal id
 
+    def close(self) -> None:
+        """Delete the client's readers and writers: a server no longer sees it."""
+        from calib_core.ros2.participant import delete
+
+        for taker in self._takers.values():
+            taker.close()
+        delete(*self._writers.values())
+
     def server_ready(self) -> bool:
         """Every service of the action has a server that reads our requests and writes to our reply readers."""
         return all(

@@ -125,6 +125,9 @@ class Ros2ImageSource(FrameSource):
             self._ready.notify_all()
         if getattr(self, "_thread", None) is not None:
             self._thread.join(timeout=1.0)
+            if not self._thread.is_alive():
+                self._taker.close()
+                self._info.close()
 
 
 def open_ros2_camera(spec: str, options: dict) -> Ros2ImageSource:

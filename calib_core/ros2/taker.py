@@ -27,3 +27,9 @@ class Taker:
             self._waitset.wait(duration(microseconds=int(timeout_s * 1e6)))
             samples = self.reader.take(N=n, condition=self._condition)
         return [s for s in samples if not isinstance(s, self._invalid)]
+
+    def close(self) -> None:
+        """Delete the wait set and the reader (with its condition), once no thread takes from them."""
+        from calib_core.ros2.participant import delete
+
+        delete(self._waitset, self.reader)

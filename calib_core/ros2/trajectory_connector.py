@@ -182,6 +182,14 @@ class Ros2TrajectoryController(ConnectorEvents):
             self._thread.join(timeout=1.0)
         self._set_state(LinkState.CLOSED, "closed by the caller")
         self._moves.finish(MoveError("the link was closed"))
+        if self._thread is not None and not self._thread.is_alive():
+            # (gone from the domain now: a client left to the collector was found by the next link on it)
+            from calib_core.ros2.participant import delete
+
+            self._taker.close()
+            delete(self._writer, self._types.reader)
+            if self._goals is not None:
+                self._goals.client.close()
 
     @property
     def latest(self) -> TimedSample | None:

@@ -16,7 +16,11 @@ import numpy as np
 from calib_core.solver.candidates import RefinedPose, refine_seed
 from calib_core.solver.misfit import admissible
 from calib_core.solver.problem import PoseProblem
+from calib_core.solver.kernels.subset_fit import FITTED, fit_subset_rounds
 from calib_core.solver.refine import NewtonResult, residuals_and_jacobian
+from calib_core.solver.solution import pose_matrix
+
+_MAX_ITERATIONS = 100
 
 INLIER_SIGMAS = 4.0
 """A pair is an inlier within this many times the pick noise (the outlier flag's threshold)."""
@@ -59,51 +63,71 @@ def consensus_refine(
     the pairs near the seed. ``noise_floor_px`` the noise model a left-out pair is judged against for
     admission (default: the threshold's)."""
     minimal = 4 if problem.estimate_focal else 3
+    n, p = problem.n_points, problem.n_params
+    R = np.array(R, dtype=float)
+    t = np.array(t_mm, dtype=float).reshape(3)
+    f = np.array([fu, fv], dtype=float)
     if inliers is None:
-        r, _, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
+        r, _, _ = residuals_and_jacobian(problem, R, t, fu, fv)
         inliers = np.linalg.norm(r, axis=1) < 3.0 * threshold_px  # a seed from three pairs is only near the pose
-    fit = None
-    for _ in range(rounds):
-        if inliers.sum() < minimal:
-            return None
-        idx = np.flatnonzero(inliers)
-        sub = replace(
-            problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=()
-        )
-        fit = refine_seed(sub, R, t_mm, fu, fv, None)
-        if fit is None or not np.all(np.isfinite(fit.obj2cam)):
-            return None
-        R, t_mm, fu, fv = fit.newton.R, fit.newton.t, fit.fu, fit.fv
-        r, J, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
-        again = np.linalg.norm(r, axis=1) < threshold_px
-        if np.array_equal(again, inliers):
-            break
-        inliers = again
+    inliers = np.array(inliers, dtype=np.bool_)  # (the rounds update it)
+    r, J = np.empty((n, 2)), np.empty((n, 2, p))
+    fit = _fit_rounds(problem, R, t, f, inliers, threshold_px, rounds, minimal, r, J)
     if fit is None or not np.all(np.isfinite(r)):
         return None
+    iterations, outcome = fit
     # A good pick just beyond the threshold (a 2-D Gaussian's tail) is judged as the misfit test judges picks:
     # by how far the inliers' pose misses it against that prediction's spread. Admitted pairs join the fit.
     floor = threshold_px / INLIER_SIGMAS if noise_floor_px is None else noise_floor_px
     for _ in range(rounds):
-        admit = admissible(J, r, inliers, problem.n_params, floor)
+        admit = admissible(J, r, inliers, p, floor)
         if not admit.any():
             break
         inliers = inliers | admit
-        idx = np.flatnonzero(inliers)
-        sub = replace(
-            problem, points_3d=problem.points_3d[idx], points_2d=problem.points_2d[idx], off_image=(), repeated_3d=()
-        )
-        again = refine_seed(sub, R, t_mm, fu, fv, None)
-        if again is None or not np.all(np.isfinite(again.obj2cam)):
+        R2, t2, f2, r2, J2 = R.copy(), t.copy(), f.copy(), np.empty_like(r), np.empty_like(J)
+        again = _fit_rounds(problem, R2, t2, f2, inliers.copy(), threshold_px, 1, minimal, r2, J2)
+        if again is None:
             break
-        fit = again
-        R, t_mm, fu, fv = fit.newton.R, fit.newton.t, fit.fu, fit.fv
-        r, J, _ = residuals_and_jacobian(problem, R, t_mm, fu, fv)
-    newton = NewtonResult(R, t_mm, fu, fv, r, J, fit.newton.iterations, fit.newton.outcome)
+        (iterations, outcome), R, t, f, r, J = again, R2, t2, f2, r2, J2
+    newton = NewtonResult(R, t, float(f[0]), float(f[1]), r, J, int(iterations), int(outcome))
     cost = float(np.sum(r**2))
     return RefinedPose(
-        fit.obj2cam, fu, fv, cost, float(np.sqrt(cost / problem.n_points)), fit.converged, newton, inliers.copy()
+        pose_matrix(R, t),
+        newton.fu,
+        newton.fv,
+        cost,
+        float(np.sqrt(cost / n)),
+        newton.converged,
+        newton,
+        inliers.copy(),
     )
+
+
+def _fit_rounds(problem: PoseProblem, R, t, f, inliers, threshold_px, rounds, minimal, r, J) -> tuple[int, int] | None:
+    """:func:`~calib_core.solver.kernels.subset_fit.fit_subset_rounds` on the problem (the state, ``inliers``, ``r``
+    and ``J`` updated in place): the last fit's ``(iterations, outcome)``, or ``None`` when no pose came of it."""
+    intr = problem.intrinsics
+    code, iterations, outcome = fit_subset_rounds(
+        problem.points_3d,
+        problem.points_2d,
+        R,
+        t,
+        f,
+        intr.cx,
+        intr.cy,
+        problem.distortion,
+        problem.estimate_focal,
+        inliers,
+        float(threshold_px),
+        rounds,
+        _MAX_ITERATIONS,
+        minimal,
+        r,
+        J,
+    )
+    if code != FITTED or not (np.all(np.isfinite(R)) and np.all(np.isfinite(t))):
+        return None
+    return int(iterations), int(outcome)
 
 
 RIVAL_CHECK_POINTS = 10

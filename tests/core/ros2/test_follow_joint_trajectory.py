@@ -177,3 +177,33 @@ def test_insisting_on_the_action_without_a_server_is_not_sent(domain):
     finally:
         link.close()
         arm.close()
+
+
+def test_a_closed_arm_s_action_server_is_gone_from_the_domain_at_once(arm, domain):
+    # DDS entities left to Python's collector stay discoverable: a later client on the domain found the action server
+    # of an arm closed long before and sent it its goals
+    client = FollowJointTrajectoryClient(domain, ACTION)
+    try:
+        assert wait_until(client.server_ready)
+        arm.close()
+        assert wait_until(lambda: not client.server_ready())
+    finally:
+        client.close()
+
+
+def test_a_closed_link_s_action_client_and_reader_are_gone_from_the_domain_at_once(arm):
+    link = open_controller(
+        "ros2:///joint_states",
+        ControllerContext(
+            NAMES, ("deg",) * 3, JointMap.identity(3), 100.0, {"controller": "arm_controller", "interface": "action"}
+        ),
+    ).start()
+    requests = arm.action._takers["send_goal"].reader
+    try:
+        assert wait_until(lambda: link.state is LinkState.UP)
+        assert wait_until(lambda: requests.get_subscription_matched_status().current_count == 1)
+        assert arm._writer.get_publication_matched_status().current_count == 1  # the link's joint_states reader
+    finally:
+        link.close()
+    assert wait_until(lambda: requests.get_subscription_matched_status().current_count == 0)
+    assert wait_until(lambda: arm._writer.get_publication_matched_status().current_count == 0)
