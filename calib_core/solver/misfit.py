@@ -17,7 +17,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from calib_core.solver.kernels.diagnostics import quadratic_forms
+from calib_core.solver.kernels.diagnostics import misfit_flags, quadratic_forms
 
 FALSE_FLAG_PER_SOLVE = 0.001
 OWN_SCALE_MIN_DOF = 4
@@ -108,13 +108,20 @@ def flag_misfits(
     dof = 2 * int(used.sum()) - n_params - 2  # without pair i: two observations fewer
     if finite.sum() < 3 or dof <= 0:
         return np.zeros(n, dtype=bool), sigma, limit
-    rss = float(np.sum(residuals[used] ** 2))
-    others = np.where(finite, np.maximum(rss - np.nan_to_num(statistics), 0.0) / dof, 0.0)
-    if dof < OWN_SCALE_MIN_DOF:
-        others = np.zeros(n)  # too few to measure a scale: the noise model alone
-    sigma = np.maximum(noise_px, np.sqrt(others))
-    # Where the scale is the picks' own estimate, the statistic over it is 2 F(2, dof), not chi-square: the
-    # heavier tail of an estimated scale (12 degrees of freedom for 10 pairs) must not flag coarse good picks.
-    limits = np.where(np.sqrt(others) > noise_px, 2.0 * fisher_quantile(int(finite.sum()), dof), limit)
-    with np.errstate(invalid="ignore"):
-        return np.nan_to_num(statistics / sigma**2, nan=0.0) > limits, sigma, limit
+    # With fewer than OWN_SCALE_MIN_DOF degrees of freedom, too few to measure a scale: the noise model alone. Where
+    # the scale is the picks' own estimate, the statistic over it is 2 F(2, dof), not chi-square: the heavier tail of
+    # an estimated scale (12 degrees of freedom for 10 pairs) must not flag coarse good picks.
+    flags = np.empty(n, dtype=np.bool_)
+    misfit_flags(
+        np.ascontiguousarray(statistics, dtype=float),
+        np.ascontiguousarray(residuals, dtype=float),
+        np.ascontiguousarray(used, dtype=np.bool_),
+        dof,
+        float(noise_px),
+        limit,
+        2.0 * fisher_quantile(int(finite.sum()), dof),
+        OWN_SCALE_MIN_DOF,
+        flags,
+        sigma,
+    )
+    return flags, sigma, limit

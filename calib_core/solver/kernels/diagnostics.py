@@ -199,3 +199,25 @@ def quadratic_forms(J, r, used, rows, sign, out):
         det = m00 * m11 - m01 * m01
         if det > 1e-9:
             out[k] = (m11 * r[i, 0] * r[i, 0] - 2.0 * m01 * r[i, 0] * r[i, 1] + m00 * r[i, 1] * r[i, 1]) / det
+
+
+@njit(cache=True)
+def misfit_flags(statistics, residuals, used, dof, noise, chi2_limit, fisher_limit, own_scale_min_dof, flags, sigma):
+    """:func:`calib_core.solver.misfit.flag_misfits`'s arithmetic: fill ``flags`` (n,) bool and ``sigma`` (n,) px.
+    ``statistics`` (n,) px^2 (NaN where a pair is not judged), ``residuals`` (n, 2) px, ``used`` (n,) bool, ``dof``
+    the fit's degrees of freedom without one pair; a pair's sigma is the larger of ``noise`` and the other pairs' own
+    scale (measured with ``dof >= own_scale_min_dof``), its limit ``fisher_limit`` where that scale rules, else
+    ``chi2_limit``."""
+    n = statistics.shape[0]
+    rss = 0.0
+    for i in range(n):
+        if used[i]:
+            rss += residuals[i, 0] * residuals[i, 0] + residuals[i, 1] * residuals[i, 1]
+    for i in range(n):
+        s = statistics[i]
+        finite = np.isfinite(s)
+        others = max(rss - s, 0.0) / dof if finite and dof >= own_scale_min_dof else 0.0
+        scale = np.sqrt(others)
+        sigma[i] = max(noise, scale)
+        limit = fisher_limit if scale > noise else chi2_limit
+        flags[i] = not np.isnan(s) and s / (sigma[i] * sigma[i]) > limit
