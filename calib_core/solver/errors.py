@@ -9,6 +9,8 @@ import contextlib
 import contextvars
 from collections.abc import Iterable, Iterator, Sequence
 
+import numpy as np
+
 from calib_core.errors import VideocalError
 
 _NAMES: contextvars.ContextVar[tuple[str, tuple[int, ...]] | None] = contextvars.ContextVar("point_names", default=None)
@@ -18,7 +20,7 @@ _NAMES: contextvars.ContextVar[tuple[str, tuple[int, ...]] | None] = contextvars
 def named_points(word: str, numbers: Sequence[int]) -> Iterator[None]:
     """Within this block, messages name point ``i`` as ``f"{word} {numbers[i]}"``: the window's solves
     say ``pair 12`` for the pair the table shows as 12, whatever its place in the solve."""
-    token = _NAMES.set((word, tuple(int(n) for n in numbers)))
+    token = _NAMES.set((word, tuple(np.asarray(numbers, dtype=np.int64).reshape(-1).tolist())))
     try:
         yield
     finally:
@@ -31,7 +33,12 @@ def named_points_as_given(rows: Sequence[int]) -> Iterator[None]:
     from (in the caller's names, when there are any)."""
     outer = _NAMES.get()
     word = outer[0] if outer is not None else "point"
-    numbers = [int(outer[1][r]) if outer is not None and r < len(outer[1]) else int(r) + 1 for r in rows]
+    rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+    numbers = rows + 1
+    if outer is not None and len(outer[1]):
+        known = np.asarray(outer[1], dtype=np.int64)
+        inside = rows < len(known)
+        numbers[inside] = known[rows[inside]]
     with named_points(word, numbers):
         yield
 
@@ -90,7 +97,12 @@ class DuplicatePointsError(SolverInputError):
 
 
 class RepeatedPairError(DuplicatePointsError):
-    """One pair given twice (the same 3D point at the same pixel); ``solve_pose`` counts it once."""
+    """One pair given twice (the same 3D point at the same pixel); ``solve_pose`` counts it once. ``same_pixel``: the
+    index pairs (i < j) found at one pixel, so that the pairs given again are told without a second search."""
+
+    def __init__(self, message: str, points: Iterable[int] = (), same_pixel: Sequence[tuple[int, int]] = ()):
+        super().__init__(message, points)
+        self.same_pixel = tuple(same_pixel)
 
 
 class DegenerateGeometryError(SolverInputError):

@@ -6,6 +6,7 @@ Validation happens once here, so the numerical code can trust its input.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -164,25 +165,30 @@ def _repeated_points(p3: np.ndarray, p2: np.ndarray, tol3_mm: float) -> tuple[tu
     if same_px:
         i, j = same_px[0]
         same = [(a, b) for a, b in same_px if np.linalg.norm(p3[a] - p3[b]) <= tol3_mm]
-        other = [(a, b) for a, b in same_px if (a, b) not in set(same)]
+        kept = set(same)
+        other = [(a, b) for a, b in same_px if (a, b) not in kept]
         if other:
             a, b = other[0]
             raise DuplicatePointsError(f"{point_label(a)} and {point_label(b)} have the same pixel", (a, b))
         raise RepeatedPairError(
             f"{point_label(i)} and {point_label(j)} are the same pair (the same 3D point at the same pixel)",
             sorted({k for pair in same for k in pair}),
+            same_px,
         )
     return tuple(_close_pairs(p3, tol3_mm))
 
 
-def first_of_each_pair(points_3d: np.ndarray, points_2d: np.ndarray) -> np.ndarray:
+def first_of_each_pair(
+    points_3d: np.ndarray, points_2d: np.ndarray, same_pixel: Sequence[tuple[int, int]] | None = None
+) -> np.ndarray:
     """For each pair (n,) the index of the first pair that is the same (the same 3D point at the same
-    pixel, to the tolerances the checks use): itself when it is the first."""
+    pixel, to the tolerances the checks use): itself when it is the first. ``same_pixel``: the index pairs (i < j)
+    at one pixel, sorted, when a check found them already (:class:`RepeatedPairError`)."""
     p3 = np.asarray(points_3d, dtype=float)
     p2 = np.asarray(points_2d, dtype=float)
     spread = float(np.ptp(p3, axis=0).max()) if len(p3) else 0.0
     first = np.arange(len(p3))
-    for i, j in _close_pairs(p2, _DUPLICATE_PX):
+    for i, j in _close_pairs(p2, _DUPLICATE_PX) if same_pixel is None else same_pixel:
         if np.linalg.norm(p3[i] - p3[j]) <= _DUPLICATE_REL_3D * max(spread, 1.0):
             first[j] = min(first[j], first[i])
     return first

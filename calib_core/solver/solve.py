@@ -92,9 +92,9 @@ def solve_pose(
     """
     try:
         problem, prior2 = _prepare(points_3d, points_2d, intrinsics, prior, estimate_focal, model, sigma_px)
-    except RepeatedPairError:
+    except RepeatedPairError as repeated:
         # (found by the checks every solve makes: the common case pays nothing for this)
-        first = first_of_each_pair(points_3d, points_2d)
+        first = first_of_each_pair(points_3d, points_2d, repeated.same_pixel)
         if np.all(first == np.arange(len(first))):
             raise
         return _solve_distinct(
