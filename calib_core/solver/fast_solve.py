@@ -13,7 +13,7 @@ import numpy as np
 
 from calib_core.solver.initialisation import MAX_SUBSETS, P3P_SEEDED_UP_TO
 from calib_core.solver.finish import noise_px, operator_warnings
-from calib_core.solver.candidates import SAME_POSE_DEG, SAME_POSE_REL
+from calib_core.solver.candidates import SAME_POSE_COS, SAME_POSE_REL
 from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
 from calib_core.solver.misfit import FALSE_FLAG_PER_SOLVE, OWN_SCALE_MIN_DOF, fisher_quantile
@@ -23,7 +23,6 @@ from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 
 _MAX_ITERATIONS = 100
 SEEDED_BY_DLT = 6
-_SAME_POSE_COS = float(np.cos(np.radians(SAME_POSE_DEG)))
 
 
 @dataclass(frozen=True)
@@ -75,8 +74,8 @@ def fast_solve(
             misfit_test,
             10.0 * limit_px,
             ambiguity_chi2 * noise**2,
-            _SAME_POSE_COS,
-            SAME_POSE_REL * 1e3,
+            SAME_POSE_COS,
+            SAME_POSE_REL,
             MAX_SUBSETS,
         )
     if out is None:

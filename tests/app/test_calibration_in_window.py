@@ -211,6 +211,8 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     assert 40.0 <= hz <= 60.0, win.link_label.text()
     # The link: the controller process dies; the state shows it and no pair is lost.
     wb.site.process.process.kill()
+    # (and its pty with it: the path left behind may soon lead to another program's pty on a busy machine)
+    wb.site.process.link_path.unlink(missing_ok=True)
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
     qtbot.waitUntil(lambda: "up" not in win.link_label.text().split(",")[0], timeout=5_000)
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)

@@ -3,6 +3,7 @@ silent (the link closed mid-move), ERR replies go to the move they name, a DON w
 believed, move ids differ between sessions, and samples going backwards are not the robot now."""
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -148,6 +149,9 @@ def test_a_pending_move_times_out_while_the_link_is_down(sim):  # noqa: F811
         handle = link.move_joints((150.0, 0, 0, 0, 0, 0), timeout_s=1.5)
         s.proc.kill()  # the controller is gone for good: the link stays down, reconnecting
         s.proc.wait(5)
+        # ... and its device with it: a killed pty's number is soon another program's pty on a busy machine (another
+        # suite's simulator), which the link would open again through the path left behind and find samples on
+        Path(s.url).unlink(missing_ok=True)
         deadline = time.monotonic() + 15
         while not handle.finished and time.monotonic() < deadline:
             time.sleep(0.02)
