@@ -13,11 +13,12 @@ import numpy as np
 
 from calib_core.solver.initialisation import MAX_SUBSETS, P3P_SEEDED_UP_TO
 from calib_core.solver.finish import noise_px, operator_warnings
-from calib_core.solver.candidates import SAME_POSE_COS, SAME_POSE_REL
+from calib_core.solver.candidates import SAME_POSE_COS, SAME_POSE_REL, RefinedPose
 from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_summary
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
 from calib_core.solver.misfit import FALSE_FLAG_PER_SOLVE, OWN_SCALE_MIN_DOF, fisher_quantile
 from calib_core.solver.problem import PoseProblem
+from calib_core.solver.refine import NewtonResult, residuals_and_jacobian
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 
@@ -27,11 +28,22 @@ SEEDED_BY_DLT = 6
 
 @dataclass(frozen=True)
 class Tie:
-    """Two or more distinct poses that fit the pairs about as well (within the ambiguity margin), each ``obj2cam``
-    (4, 4) mm at its own least-squares minimum, the best first. Every such minimum has a P3P root of each triplet
-    near it, and the fast path refined the roots of the full search's triplets: it would find these same poses."""
+    """Two or more distinct poses that fit the pairs about as well (within the ambiguity margin), each refined to its
+    own least-squares minimum, the best first. Every such minimum has a P3P root of each triplet near it, and the
+    fast path refined the roots of the full search's triplets: it would find these same poses."""
 
-    minima: tuple[np.ndarray, ...]
+    minima: tuple[RefinedPose, ...]
+
+
+def _at_minimum(problem: PoseProblem, obj2cam: np.ndarray, iterations: int, outcome: int) -> RefinedPose:
+    """A minimum the fast path refined (converged), as the full search's refinement gives it: every pair's residual
+    and Jacobian there."""
+    intr = problem.intrinsics
+    R, t = obj2cam[:3, :3].copy(), obj2cam[:3, 3].copy()
+    r, J, _ = residuals_and_jacobian(problem, R, t, intr.fu, intr.fv)
+    cost = float(np.sum(r**2))
+    newton = NewtonResult(R, t, intr.fu, intr.fv, r, J, iterations, outcome)
+    return RefinedPose(obj2cam, intr.fu, intr.fv, cost, float(np.sqrt(cost / problem.n_points)), True, newton)
 
 
 def applies(problem: PoseProblem, robust: bool) -> bool:
@@ -80,12 +92,13 @@ def fast_solve(
         )
     if out is None:
         return None
-    obj2cam, r, cov, cov_c, loo, scalars, rivals = out
+    obj2cam, r, cov, cov_c, loo, scalars, rivals, rival_fits = out
     iterations, outcome, rms, sigma, source, condition, misfit = scalars
     if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
         return None
     if len(rivals):
-        return Tie((obj2cam, *rivals))
+        fits = ((obj2cam, iterations, outcome), *((pose, *fit) for pose, fit in zip(rivals, rival_fits)))
+        return Tie(tuple(_at_minimum(problem, pose, int(its), int(code)) for pose, its, code in fits))
     if misfit != 0.0:
         return None
     return PoseSolution(

@@ -137,8 +137,7 @@ def solve_pose(
     # (a few pairs: every triplet's roots as well, so that a second pose fitting another subset as well is
     # found and the answer called ambiguous rather than ok)
     if tie is not None:
-        # the poses that tie are already found, each at its minimum: they are the seeds (refined again, a step or two)
-        seeds = [(pose[:3, :3], pose[:3, 3]) for pose in tie.minima]
+        seeds = []  # the poses that tie are found already, each at its minimum
     elif sampled is not None and problem.n_points > SMALL_PROBLEM_POINTS:
         seeds = []
     else:
@@ -148,8 +147,10 @@ def solve_pose(
     if prior2 is not None:
         seeds.append((prior2[:3, :3], prior2[:3, 3]))
     refine = _refiner(problem, fu0, fv0, huber, noise, floor)
-    # (a tie's minima are distinct already; the prior, if a copy of one, is refined to it and dropped as one)
-    refined = [r for r in (refine(R, t) for R, t in (seeds if tie else distinct_seeds(seeds))) if r is not None]
+    refined = [r for r in (refine(R, t) for R, t in distinct_seeds(seeds)) if r is not None]
+    if tie is not None:
+        # (the prior, if a copy of one of them, is refined to it and dropped as one by distinct_poses)
+        refined = [*tie.minima, *refined]
     if sampled is not None and problem.model == "pinhole":
         # the sampler's own inliers are where its seed's consensus starts (one least-squares fit, usually)
         fit = consensus_refine(

@@ -44,8 +44,8 @@ def seed_coordinates(uv, fu, fv, cx, cy, dist):
 @njit(cache=True)
 def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, misfit_test):
     """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else :func:`_summary`'s tuple and no rival
-    (an empty (0, 4, 4) array, as :func:`p3p_newton_summary` returns; all arrays allocated here: one call, few
-    interpreter round trips)."""
+    (empty (0, 4, 4) and (0, 2) arrays, as :func:`p3p_newton_summary` returns; all arrays allocated here: one call,
+    few interpreter round trips)."""
     n = P.shape[0]
     R = np.empty((3, 3))
     t = np.empty(3)
@@ -58,7 +58,7 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     obj2cam, r, cov, cov_centre, loo, scalars = _summary(
         R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test
     )
-    return obj2cam, r, cov, cov_centre, loo, scalars, np.empty((0, 4, 4))
+    return obj2cam, r, cov, cov_centre, loo, scalars, np.empty((0, 4, 4)), np.empty((0, 2), dtype=np.int64)
 
 
 @njit(cache=True)
@@ -163,8 +163,9 @@ def p3p_newton_summary(
     search's triplets, :func:`calib_core.solver.initialisation.spread_triplets`), the roots that put all the points
     within ``gate_px`` (RMS) refined, summarised as :func:`dlt_newton_summary`, with the **rivals** (k, 4, 4): every
     other distinct minimum (``same_cos``/``same_rel``: the cosine and relative distance under which two poses are one)
-    costing within ``margin_cost`` px^2 of the best (a plane's mirror pose), best first; empty when the best stands
-    alone. ``None`` when no root is near or no refinement converges."""
+    costing within ``margin_cost`` px^2 of the best (a plane's mirror pose), best first, and their fits (k, 2): each
+    one's Newton iterations and outcome; empty when the best stands alone. ``None`` when no root is near or no
+    refinement converges."""
     n = P.shape[0]
     xy = seed_coordinates(uv, fu, fv, cx, cy, dist)
     bearings = np.empty((n, 3))
@@ -265,6 +266,7 @@ def p3p_newton_summary(
     if best < 0:
         return None
     rivals = np.zeros((m, 4, 4))
+    rival_fits = np.zeros((m, 2), dtype=np.int64)
     k = 0
     for j in np.argsort(costs):
         if (
@@ -275,6 +277,7 @@ def p3p_newton_summary(
             rivals[k, :3, :3] = Rs[j]
             rivals[k, :3, 3] = ts[j]
             rivals[k, 3, 3] = 1.0
+            rival_fits[k, 0], rival_fits[k, 1] = its[j], outcomes[j]
             k += 1
     obj2cam, r, cov, cov_centre, loo, scalars = _summary(
         Rs[best],
@@ -287,4 +290,4 @@ def p3p_newton_summary(
         default_sigma,
         misfit_test,
     )
-    return obj2cam, r, cov, cov_centre, loo, scalars, rivals[:k].copy()
+    return obj2cam, r, cov, cov_centre, loo, scalars, rivals[:k].copy(), rival_fits[:k].copy()
