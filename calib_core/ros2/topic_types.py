@@ -20,11 +20,17 @@ class TopicTypes:
     def __init__(self, participant):
         from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
 
-        self.reader = BuiltinDataReader(participant, BuiltinTopicDcpsPublication)
+        self._reader = BuiltinDataReader(participant, BuiltinTopicDcpsPublication)
+
+    def close(self) -> None:
+        """Delete the discovery reader (once no thread reads it)."""
+        from calib_core.ros2.participant import delete
+
+        delete(self._reader)
 
     def on(self, dds_topic: str) -> set[str]:
         """The DDS type names of the writers now on ``dds_topic`` (``rt/joint_states``)."""
-        return {s.type_name for s in self.reader.read(N=4096) if s.topic_name == dds_topic}
+        return {s.type_name for s in self._reader.read(N=4096) if s.topic_name == dds_topic}
 
     def foreign(self, dds_topic: str, wanted_dds_type: str) -> list[str]:
         """The ROS names of the other types than ``wanted_dds_type`` sent on ``dds_topic``, sorted."""

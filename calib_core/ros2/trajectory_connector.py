@@ -187,7 +187,8 @@ class Ros2TrajectoryController(ConnectorEvents):
             from calib_core.ros2.participant import delete
 
             self._taker.close()
-            delete(self._writer, self._types.reader)
+            self._types.close()
+            delete(self._writer)
             if self._goals is not None:
                 self._goals.client.close()
 

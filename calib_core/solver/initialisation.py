@@ -8,8 +8,6 @@ each is refined afterwards by the Newton solver. Seeds are object-to-camera pose
 
 from __future__ import annotations
 
-from functools import lru_cache
-from itertools import combinations
 
 import cv2
 import numpy as np
@@ -17,6 +15,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import undistort_normalized
 from calib_core.solver.kernels.dlt import dlt_pose
+from calib_core.solver.kernels.fast_path import largest_triangles
 from calib_core.solver.problem import PoseProblem
 
 # P3P over subsets is run for small problems (where other local minima are likely and must be
@@ -105,11 +104,6 @@ _ENUMERATE_UP_TO = 12  # C(12, 3) = 220 triplets: below this, every one is looke
 _SAMPLED_TRIPLETS = 200
 
 
-@lru_cache(maxsize=_ENUMERATE_UP_TO + 1)
-def _all_triplets(n: int) -> np.ndarray:
-    return np.array(list(combinations(range(n), 3)))
-
-
 def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tuple[int, int, int]]:
     """Up to ``limit`` triplets of point indices, the largest triangles first (best conditioned P3P).
 
@@ -121,22 +115,20 @@ def spread_triplets(points_3d: np.ndarray, limit: int = MAX_SUBSETS) -> list[tup
     if n < 3:
         return []
     if n <= _ENUMERATE_UP_TO:
-        triplets = _all_triplets(n)
-        if len(triplets) <= limit:  # all of them: no ranking needed
-            return [tuple(int(v) for v in tri) for tri in triplets]
-    else:
-        rng = np.random.default_rng(n)
-        drawn = np.sort(np.stack([rng.choice(n, 3, replace=False) for _ in range(_SAMPLED_TRIPLETS)]), axis=1)
-        i = int(np.argmax(np.linalg.norm(P - P.mean(axis=0), axis=1)))
-        j = int(np.argmax(np.linalg.norm(P - P[i], axis=1)))
-        d = P[j] - P[i]
-        off_line = np.linalg.norm(np.cross(P - P[i], d), axis=1)
-        k = int(np.argmax(off_line))
-        triplets = (
-            np.unique(np.vstack([drawn, np.sort([i, j, k])[None]]), axis=0)
-            if len({i, j, k}) == 3
-            else np.unique(drawn, axis=0)
-        )
+        # (the fast path's own ranking, so that both paths seed from the same triangles)
+        return [tuple(int(v) for v in tri) for tri in largest_triangles(np.ascontiguousarray(P), limit)]
+    rng = np.random.default_rng(n)
+    drawn = np.sort(np.stack([rng.choice(n, 3, replace=False) for _ in range(_SAMPLED_TRIPLETS)]), axis=1)
+    i = int(np.argmax(np.linalg.norm(P - P.mean(axis=0), axis=1)))
+    j = int(np.argmax(np.linalg.norm(P - P[i], axis=1)))
+    d = P[j] - P[i]
+    off_line = np.linalg.norm(np.cross(P - P[i], d), axis=1)
+    k = int(np.argmax(off_line))
+    triplets = (
+        np.unique(np.vstack([drawn, np.sort([i, j, k])[None]]), axis=0)
+        if len({i, j, k}) == 3
+        else np.unique(drawn, axis=0)
+    )
     area = np.linalg.norm(
         np.cross(P[triplets[:, 1]] - P[triplets[:, 0]], P[triplets[:, 2]] - P[triplets[:, 0]]), axis=1
     )

@@ -1,0 +1,118 @@
+"""The operator's files through the real window: recent workspaces, a recording and a workspace saved while
+calibrating, an unsaved session offered from its autosave."""
+
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtWidgets import QApplication, QFileDialog
+
+from app.gui.main_window import MainWindow
+from app.gui.workbench import Workbench
+from videocal_sim.sim_site import simulated_cell
+from tests.app.windows import wait_for_settled_frame
+
+
+def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
+    win, wb = window, window.workbench
+    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    win.files.save_workspace(tmp_path / "w.json")
+    wb.session.clear()
+    win.files.recent.fill()
+    actions = [a for a in win.files.recent.menu.actions() if a.text() == str(tmp_path / "w.json")]
+    assert actions
+    actions[0].trigger()
+    assert len(wb.session.pairs) == 1
+
+
+def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
+    from calib_core.recording.reader import read_recording
+    from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, VIDEO_TOPIC
+
+    win = window
+    wb = win.workbench
+    win.files.start_recording(tmp_path / "session.mcap")
+    assert win.files.record_action.isChecked()
+    wait_for_settled_frame(qtbot, win)  # a pick holds the newest frame: one taken with the robot settled
+    wb.picking.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    wb.picking.pick_image_point((100.0, 120.0))
+    qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
+    qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
+
+    def recording_shown() -> bool:  # the status line the window's timer refreshes
+        win._update_status()
+        return "REC" in win.record_label.text()
+
+    qtbot.waitUntil(recording_shown, timeout=10_000)
+    win.files.save_workspace(tmp_path / "w.json")
+    win.files.stop_recording()
+    contents = read_recording(tmp_path / "session.mcap")
+    assert contents.complete and contents.topic(VIDEO_TOPIC) and contents.topic(JOINTS_TOPIC)
+    # (link_state events may come and go with the controller; the operator's edits are these)
+    assert [m.payload["kind"] for m in contents.topic(EVENT_TOPIC) if m.payload["kind"].startswith("pair_")] == [
+        "pair_added",
+        "pair_changed",
+        "pair_accepted",
+    ]
+    # Clear, then open the saved workspace: the pair comes back.
+    wb.session.clear()
+    assert len(wb.session.pairs) == 0
+    win.files.open_workspace(tmp_path / "w.json")
+    assert [p.feature for p in wb.session.pairs] == ["pin_tip"] and win.table.rowCount() == 1
+    # A bad file is a message; nothing is lost.
+    (tmp_path / "bad.json").write_text("{broken")
+    win.files.open_workspace(tmp_path / "bad.json")
+    assert "not valid JSON" in win.results.status.text()
+    assert len(wb.session.pairs) == 1
+
+
+def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
+    from calib_core.calibration.correspondences import Correspondence
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+    settings.setValue("files/autosave_dir", str(tmp_path))
+    settings.setValue("window/ask_unsaved", False)
+    cell, site = simulated_cell()
+    (tmp_path / "recovery").mkdir()
+    save_workspace(
+        tmp_path / "recovery" / "autosave.json",
+        Workspace(
+            "cell",
+            cell.intrinsics,
+            {},
+            "oru_1_fixture",
+            [Correspondence(1, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), (10.0, 20.0))],
+            cell=cell.identity.to_dict(),
+        ),
+    )
+    wb = Workbench(cell, site)
+    win = MainWindow(wb, settings=settings)
+    qtbot.addWidget(win)
+    try:
+        assert "Restore" in win.files.restore_action.text()
+        win.files.restore_action.trigger()
+        assert [p.feature for p in wb.session.pairs] == ["pin_tip"]
+        # Save after a restore wrote into the recovery folder without a dialog, and the next
+        # start offered that file again. A restored session has no file yet: Save asks where.
+        assert win.files.workspace_path is None
+        chosen = tmp_path / "mine.json"
+        asked = []
+
+        def answer():
+            dialog = QApplication.activeModalWidget()
+            if isinstance(dialog, QFileDialog):
+                asked.append(dialog.windowTitle())
+                dialog.selectFile(str(chosen))
+                dialog.accept()
+            else:
+                QTimer.singleShot(20, answer)
+
+        QTimer.singleShot(0, answer)
+        assert win.files.save_workspace_dialog()
+        assert asked == ["Save workspace"] and chosen.is_file()
+        assert sorted(p.name for p in (tmp_path / "recovery").iterdir()) == ["recovered-autosave.json"]
+        assert win.files.autosave.orphans() == []
+        assert not win.files.save_workspace(
+            tmp_path / "recovery" / "w.json"
+        )  # the recovery folder holds autosaves only
+        assert "recovery folder" in win.results.status.text() and not (tmp_path / "recovery" / "w.json").exists()
+    finally:
+        win.close()
