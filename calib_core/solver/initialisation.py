@@ -158,7 +158,10 @@ def initial_seeds(
     seeds = dlt_seed(problem, fu, fv) + sqpnp_seed(P, uv, intr, fu, fv)
     if problem.coplanar:
         seeds += ippe_seeds(P, uv, intr, fu, fv)
-    if problem.n_points <= SMALL_PROBLEM_POINTS or (problem.coplanar and problem.n_points <= P3P_SEEDED_UP_TO):
+    # A plane's 6-8 pairs: the triplets too where the fast path seeds from them (a gate: known focal lengths, pinhole,
+    # not robust), so that both paths find the same minima; a robust solve's consensus is judged as before.
+    plane_triplets = problem.coplanar and problem.n_points <= P3P_SEEDED_UP_TO and gate_px is not None
+    if problem.n_points <= SMALL_PROBLEM_POINTS or plane_triplets:
         roots = subset_p3p_seeds(problem, fu, fv)
         if gate_px is not None and roots:
             # Each triplet's roots: the true pose and up to three others that the remaining pairs
