@@ -64,10 +64,10 @@ def points_label(indices: Iterable[int]) -> str:
     """``'points 1, 4'`` for indices (0, 3) (or ``'pairs 9, 12'`` inside :func:`named_points`); beyond
     :data:`LISTED` of them the first ones and how many more (``'points 1, 2, ..., 10 and 1490 more'``): a message
     that names every one of a detector's thousand rejected pairs is read by no one."""
-    idx = [int(i) for i in indices]
+    idx = indices if isinstance(indices, (np.ndarray, list, tuple)) else list(indices)
     if len(idx) == 1:
-        return point_label(idx[0])
-    labels = [_number(i) for i in idx[:LISTED]]
+        return point_label(int(idx[0]))
+    labels = [_number(int(i)) for i in idx[:LISTED]]  # (only those named are converted: a robust solve drops thousands)
     more = f" and {len(idx) - LISTED} more" if len(idx) > LISTED else ""
     return f"{labels[0][0]}s " + ", ".join(n for _, n in labels) + more
 

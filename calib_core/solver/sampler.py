@@ -26,7 +26,7 @@ CONFIDENCE = 0.9999
 MAX_HYPOTHESES = 10_000
 MIN_HYPOTHESES = 20  # PoseLib's default of 1000 costs 2 ms even on a clean set
 MIN_POINTS = 4
-SAMPLED_FROM = 500
+SAMPLED_FROM = 300
 """Beyond this many pairs the hypotheses are drawn and scored among this many of them."""
 
 

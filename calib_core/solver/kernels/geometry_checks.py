@@ -78,28 +78,30 @@ def _squared_gap(points, i, j, d):
 
 # A direction no grid of CAD features lines up across: points within ``tol`` of each other have projections on it within
 # ``tol``, and distinct points rarely share one.
-_SWEEP_DIRECTION = np.array([0.5717, 0.7063, 0.4174, 0.0])
+_SWEEP_DIRECTION = np.array([0.5717, 0.7063, 0.4174])
+
+
+def close_pairs_swept(points: np.ndarray, tol: float) -> np.ndarray:
+    """:func:`close_pairs` for many points (n, 2 or 3): sorted along a fixed oblique direction, each point compared only
+    with those whose projection is within ``tol`` of its own (O(n log n) unless many points crowd within ``tol`` along
+    it). The sort is NumPy's (vectorised: 0.16 ms for 5000 keys where a compiled quicksort took 0.36 ms, its
+    comparisons' branches unpredictable), the sweep compiled."""
+    direction = _SWEEP_DIRECTION[: points.shape[1]]
+    key = points @ (direction / np.linalg.norm(direction))
+    order = np.argsort(key)
+    return _sweep_sorted(points, key[order], order, float(tol))
 
 
 @njit(cache=True)
-def close_pairs_swept(points, tol):
-    """:func:`close_pairs` for many points: sorted along a fixed oblique direction, each point compared only with those
-    whose projection is within ``tol`` of its own (O(n log n) unless many points crowd within ``tol`` along it)."""
+def _sweep_sorted(points, sorted_key, order, tol):
+    """The index pairs (i < j) within ``tol`` of each other, from the points' keys in ascending order
+    (``sorted_key``) and the order that sorts them."""
     n, d = points.shape
-    norm = 0.0
-    for k in range(d):
-        norm += _SWEEP_DIRECTION[k] ** 2
-    key = np.zeros(n)
-    for i in range(n):
-        for k in range(d):
-            key[i] += points[i, k] * _SWEEP_DIRECTION[k]
-        key[i] /= np.sqrt(norm)
-    order = np.argsort(key)
     tol2 = tol * tol
     count = 0
     for a in range(n):
         for b in range(a + 1, n):
-            if key[order[b]] - key[order[a]] > tol:
+            if sorted_key[b] - sorted_key[a] > tol:
                 break
             if _squared_gap(points, order[a], order[b], d) <= tol2:
                 count += 1
@@ -109,7 +111,7 @@ def close_pairs_swept(points, tol):
         if k == count:
             break
         for b in range(a + 1, n):
-            if key[order[b]] - key[order[a]] > tol:
+            if sorted_key[b] - sorted_key[a] > tol:
                 break
             i, j = order[a], order[b]
             if _squared_gap(points, i, j, d) <= tol2:
