@@ -84,7 +84,16 @@ def _pause(app: QApplication, seconds: float) -> None:
         time.sleep(0.01)
 
 
+_operator_actions = [0]
+"""The operator's actions so far (a click, a key, a zoom, a box ticked): what a look asks of a person, counted."""
+
+
+def _act(n: int = 1) -> None:
+    _operator_actions[0] += n
+
+
 def _click(widget, x: float, y: float, button=Qt.MouseButton.LeftButton) -> None:
+    _act()
     pos = QPointF(round(x), round(y))
     for kind in (QMouseEvent.Type.MouseButtonPress, QMouseEvent.Type.MouseButtonRelease):
         event = QMouseEvent(
@@ -100,6 +109,7 @@ def _click(widget, x: float, y: float, button=Qt.MouseButton.LeftButton) -> None
 
 def _click_image(view, u: float, v: float, zoom: float | None = None) -> None:
     if zoom is not None:
+        _act()  # the wheel, zooming in on the feature
         view.set_zoom(zoom, QPointF(u, v))
     _click(view, *view.image_to_widget(u, v))
 
@@ -200,6 +210,7 @@ def run_demo(
     moves_seen: list[str] = []
     looks_s: list[float] = []  # Go pressed -> a frame the core accepts for picks
     look_work_s: list[float] = []  # a settled frame -> the correction stored (the picks or Find points, the solve)
+    look_actions: list[int] = []  # the operator's actions in each look (clicks, keys, zooms)
     last_go = [time.monotonic()]
     wb.arm.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
@@ -267,10 +278,12 @@ def run_demo(
                 raise RuntimeError(
                     f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})"
                 )
+            _act()
             win.camera.freeze.setChecked(False)
 
         def find_and_calibrate(round_name: str) -> None:
             """One calibration with Find points (F6): Accept all and Calibrate, or Calibrate on edges."""
+            _act()
             win.camera.freeze.setChecked(True)
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
@@ -305,15 +318,17 @@ def run_demo(
 
         def pick_and_calibrate(round_name: str) -> None:
             """One calibration where the robot stands (timed, screenshots left out)."""
-            t0, shooting0 = time.monotonic(), shooting_s[0]
+            t0, shooting0, acted0 = time.monotonic(), shooting_s[0], _operator_actions[0]
             if method != "picks":
                 find_and_calibrate(round_name)
             else:
                 pick_each_and_calibrate(round_name)
             look_work_s.append(time.monotonic() - t0 - (shooting_s[0] - shooting0))
+            look_actions.append(_operator_actions[0] - acted0)
 
         def pick_each_and_calibrate(round_name: str) -> None:
             """Every feature picked in both panes (scripted clicks), solved, stored."""
+            _act()
             win.camera.freeze.setChecked(True)
             if len(wb.session.pairs):
                 _click(win.commands.clear, 10, 10)
@@ -339,6 +354,8 @@ def run_demo(
                     continue
                 picked.append(name)
                 uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
+                if win.camera.subpixel.isChecked() != _is_corner(name):
+                    _act()
                 win.camera.subpixel.setChecked(_is_corner(name))
                 _click_image(win.camera.view, *uv_true, zoom=8.0)
                 refined = wb.session.pairs.get(pending.number).pixel
@@ -357,9 +374,11 @@ def run_demo(
                 if np.hypot(*(np.asarray(refined) - uv_true)) > _REFINE_TRUST_PX:
                     # The operator sees the refined cross-hair leave the corner (a junction of faces the
                     # refinement takes for another corner): clicks it again, refinement off.
+                    _act()
                     win.camera.subpixel.setChecked(False)
                     _click_image(win.camera.view, *(uv_true + hand.uniform(-_HAND_PX, _HAND_PX, 2)))
                     refined_away.append(f"{round_name}: {name}")
+                _act(2)  # the view reset and the pair accepted (two keys)
                 win.camera.view.reset_view()
                 win.actions.accept()
                 app.processEvents()
@@ -408,6 +427,7 @@ def run_demo(
             "site": site.description,
             "camera_look": look,
             "settled_frame_to_stored_s": [round(v, 2) for v in look_work_s],
+            "operator_actions_per_look": look_actions,
             "link": {
                 "one_way_ms": link_delay_ms,
                 "measured_one_way_s": getattr(wb.link, "delay_s", None),

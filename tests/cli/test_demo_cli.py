@@ -47,6 +47,10 @@ def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     # Half-size images: a coarser look than the full-size demo, which reaches 0.1 mm (docs/benchmarks/gui.md).
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
     assert report["estimate_within_3_sigma"] and report["first_look"]["rms_px"] < 1.0
+    # what each of the two looks asked of the operator: Find points a handful of actions, picks two clicks a pair or more
+    actions = report["operator_actions_per_look"]
+    assert len(actions) == 2
+    assert min(actions) >= 2 * report["pairs"] if method == "picks" else max(actions) <= 8
     # the window at each step; with Find points also its list of proposals (a dialog of its own) at each look
     lists = [name for name in report["screenshots"] if name.endswith("_points_found_list.png")]
     assert len(report["screenshots"]) == 7 + len(lists) and len(lists) == (0 if method == "picks" else 2)
