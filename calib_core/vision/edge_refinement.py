@@ -89,6 +89,9 @@ CREASES_JOIN_PX = 2.0
 """With the outline found by colour, the creases join the fit once its search window is this narrow, px."""
 CREASES_AGREE_PX = 0.75
 """... and only when their median offset from where the outline puts them is at most this, px."""
+COLOUR_SNAP_PX = 1.5
+"""How far from where the colours end the outline's strongest gradient is sought, px, to measure the colour step's
+offset from the edge (the print a gradient search is misled by lies further inside: 10-15 px on a printed box)."""
 MIN_REGION_SEPARATION = 0.2
 """The least :attr:`~calib_core.vision.region_model.RegionModel.separation` at which the outline is found by
 colour: below it the object's colours are too much its surroundings' to tell the two apart."""
@@ -198,9 +201,18 @@ def refine_to_edges(
         counted = np.ones(len(uv), dtype=bool)  # the samples the fit's share on its edges is of
         if regions is not None and outward.any():
             on_outline = outward != 0
-            step, contrast, step_inside = regions.step_edges(
-                uv[on_outline], normals[on_outline] * outward[on_outline, None], window
-            )
+            out_normals = normals[on_outline] * outward[on_outline, None]
+            step, contrast, step_inside = regions.step_edges(uv[on_outline], out_normals, window)
+            # Where the colours end lies inward of the edge: the blurred pixels astride it are mixed colours, likelier
+            # the surroundings' than the object's (a dark fixture on a lit floor: 0.25 px plain, 0.6 px with a softer
+            # lens and a ring light, which put a flat plate's fit 2 mm off in depth and kept its creases from
+            # agreeing). One shift for the whole outline: the median distance to the strongest gradient near each
+            # step (a print or grain nearer than the edge moves a few samples, not the median).
+            snapped, snap_strength, snap_inside = search_normals(magnitude, step, out_normals, COLOUR_SNAP_PX)
+            snap = snap_inside & step_inside & (snap_strength >= _MIN_STRENGTH)
+            if snap.sum() >= 12:
+                shift = float(np.median(np.einsum("ij,ij->i", snapped[snap] - step[snap], out_normals[snap])))
+                step = step + shift * out_normals
             found[on_outline] = step
             # The outline alone brings the pose near, as the region-based trackers fit: a crease between two of the
             # object's faces has its colours on both sides, and on a printed part the strongest gradient within a
@@ -228,6 +240,7 @@ def refine_to_edges(
         c = _TUKEY * sigma
         wts = np.where(ok & (np.abs(r) < c), (1 - (r / c) ** 2) ** 2, 0.0)
         J = normal_jacobian(pts, pose, normals, intrinsics)
+        J_chain = chain  # (the samples may be taken again before the loop ends: the covariance is of these)
         H = J.T @ (wts[:, None] * J)
         g = J.T @ (wts * r)
         try:
@@ -257,7 +270,7 @@ def refine_to_edges(
         H_inv = np.linalg.inv(H)
         independent = sigma**2 * H_inv
         covariance = (
-            independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, chain, sigma**2 * H) @ H_inv
+            independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, J_chain, sigma**2 * H) @ H_inv
         )
     except np.linalg.LinAlgError:
         independent = covariance = np.full((6, 6), np.nan)
