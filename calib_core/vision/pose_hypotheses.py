@@ -92,7 +92,8 @@ def rank_starts(
     rolls = np.linspace(-ROLL_DEG, ROLL_DEG, _ROLL_STEPS)
     grid = np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
     poses = moved_cameras(obj2cam, grid[:, :3], grid[:, 3])
-    pts = np.einsum("hij,nj->hni", poses[:, :3, :3], samples_mm) + poses[:, None, :3, 3]
+    # (a batched matmul: einsum's generic loop took 30 ms for a thousand poses of 400 samples)
+    pts = np.matmul(samples_mm, poses[:, :3, :3].transpose(0, 2, 1)) + poses[:, None, :3, 3]
     uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)

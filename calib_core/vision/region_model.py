@@ -55,11 +55,14 @@ class RegionModel:
         if rows <= 0 or cols <= 0:
             return None
         full[v0 : v0 + rows, u0 : u0 + cols] = mask[:rows, :cols]
-        kernel = lambda r: cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))  # noqa: E731
-        inner = cv2.erode(full, kernel(_INNER_PX)) > 0
-        near = cv2.dilate(full, kernel(_BAND_PX[0])) > 0
-        far = cv2.dilate(full, kernel(_BAND_PX[1])) > 0
-        band = far & ~near
+        # Euclidean distances to the silhouette's edge, from inside and from outside: a disc's erosion and dilations
+        # by thresholds (a dilation by a 61 px disc took 6 ms a call, the distance transform a fraction of it)
+        from_outside = cv2.distanceTransform(
+            np.where(full > 0, 0, 255).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE
+        )
+        from_inside = cv2.distanceTransform(full, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        inner = from_inside > _INNER_PX
+        band = (from_outside > _BAND_PX[0]) & (from_outside <= _BAND_PX[1])
         if inner.sum() < 50 or band.sum() < 50:
             return None
         bins = _bins(image_rgb)
