@@ -47,7 +47,7 @@ def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     # Half-size images: a coarser look than the full-size demo, which reaches 0.1 mm (docs/benchmarks/gui.md).
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
     assert report["estimate_within_3_sigma"] and report["first_look"]["rms_px"] < 1.0
-    # what each of the two looks asked of the operator: Find points a handful of actions, picks two clicks a pair or more
+    # what each of the two looks asked of the operator: Find points a handful of actions, picks 2 clicks a pair or more
     actions = report["operator_actions_per_look"]
     assert len(actions) == 2
     assert min(actions) >= 2 * report["pairs"] if method == "picks" else max(actions) <= 8

@@ -33,6 +33,9 @@ _COST_RTOL = 1e-15
 # A step predicted to lower the cost by this share of it or less is round-off: the pose it would move is 1e-6 of its
 # own standard deviation for 5000 pairs (the step's Mahalanobis length squared is about this times the pairs' count)
 _PREDICTED_RTOL = 1e-14
+# ... judged only on a step this lightly damped (a heavily damped one is small because it is damped, not because the
+# cost is at its minimum)
+_UNDAMPED = 1e-6
 # A step this small relative to the state ends the iterations: 1e-10 of the distance is
 # 5e-8 mm at 500 mm, so one more Newton step would only polish round-off.
 TRANSLATION_RTOL = 1e-10
@@ -250,7 +253,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
                 Aa[a, a] += lam * max(A[a, a], 1e-300)
             cost_new = np.inf
             if cholesky_solve(Aa, g, delta):
-                if _round_off_step(delta, g, p, cost):
+                if lam <= _UNDAMPED and _round_off_step(delta, g, p, cost):
                     return iteration - 1, CONVERGED
                 _step(R, t, f, delta, p, R_new, t_new, f_new)
                 zmin = evaluate(
