@@ -2,10 +2,10 @@
 does not wait for them.
 
 Each kernel compiles on its first call with a new type signature and is cached for every later process, in a
-folder named by the kernels' sources (``~/.cache/videocal/numba/<hash>``, :mod:`calib_core.solver.kernels`). On a fresh install that first call is the operator's first
-Calibrate: the window froze for 2-9 s on a 2-core machine (four pairs take one compiled path, six
-another, a robust solve a third). ``make venv`` runs this after installing; ``python -m
-calib_core.solver.compile_kernels`` does it by hand and prints how long it took.
+folder named by the kernels' sources (``~/.cache/videocal/numba/<hash>``, :mod:`calib_core.solver.kernels`). On a
+fresh install that first call is the operator's first Calibrate: the window froze for 2-9 s on a 2-core machine
+(four pairs take one compiled path, six another, a robust solve a third). ``make venv`` runs this after
+installing; ``python -m calib_core.solver.compile_kernels`` does it by hand and prints how long it took.
 """
 
 from __future__ import annotations
