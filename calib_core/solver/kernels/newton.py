@@ -30,9 +30,10 @@ OUTCOMES = (
 _LAMBDA_START = 1e-8
 _LAMBDA_GIVE_UP = 1e10
 _COST_RTOL = 1e-15
-# A step predicted to lower the cost by this share of it or less is round-off: the pose it would move is 1e-6 of its
-# own standard deviation for 5000 pairs (the step's Mahalanobis length squared is about this times the pairs' count)
-_PREDICTED_RTOL = 1e-14
+# A step predicted to lower the cost by this share of it or less is round-off: the pose it would move is a few
+# millionths of its own standard deviation for 5000 pairs (the step's Mahalanobis length squared is about this times
+# the pairs' count); at the minimum of 5000 pairs the round-off steps predict 1e-16 to 1e-15
+_PREDICTED_RTOL = 1e-15
 # ... judged only on a step this lightly damped (a heavily damped one is small because it is damped, not because the
 # cost is at its minimum)
 _UNDAMPED = 1e-6
