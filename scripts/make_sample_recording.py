@@ -1,7 +1,7 @@
 """Make ``resources/recordings/sample_session.mcap``: a short calibration on the simulated test bed,
 recorded through the operator core and its recording tap, exactly as the window records one.
 
-The robot drives from home to the approach of the task location ``oru_1_grasp`` (joints at 50 Hz,
+The robot drives from home to the task location ``oru_1_grasp``, where a look counts for it (joints at 50 Hz,
 1280 x 960 H.264 frames at 15 fps), settles, then the operator picks six pairs on the held frame,
 solves twice (plain and robust) and stores the correction, with the camera running throughout.
 The session runs in simulated time, so the file has the rates it states on any machine (rendering
@@ -44,12 +44,13 @@ def main() -> None:
     core = OperatorCore(cell, site)
     core.set_task("oru_1_grasp")
     q_home = np.array(cell.home_joints, dtype=float)
-    q_task = solve_ik(core.robot, core.task.approach2base, q_home).q_deg
+    q_task = solve_ik(core.robot, core.task.tcp2base, q_home).q_deg  # (a look counts where it is made)
     camera = bed.camera(seed=1)
     rng = np.random.default_rng(5)
     clock = SimulatedClock(1000.0)
     OUT.parent.mkdir(parents=True, exist_ok=True)
-    core.start_recording(OUT, clock=clock, drop_when_busy=False)
+    part = OUT.with_name(OUT.stem + ".part.mcap")  # (the sample is replaced only by a whole recording)
+    core.start_recording(part, clock=clock, drop_when_busy=False)
     start = clock.t_s
     steps = [("pick", name) for name in FEATURES] + [("solve", False), ("solve", True), ("store", None), ("idle", None)]
     next_step = start + DRIVE_S + SETTLE_S
@@ -67,29 +68,30 @@ def main() -> None:
             n_joint += 1
         elif clock.t_s == t_frame:
             image, _ = camera.render(bed.joints_deg)
-            core.observe_frame(Frame(image, n_frame, clock.t_s))
+            core.picking.observe_frame(Frame(image, n_frame, clock.t_s))
             n_frame += 1
         else:
             kind, arg = steps.pop(0)
             if kind == "pick":
                 fixture = core.workcell.component(core.task.component)
                 p = apply(fixture.item2world, fixture.features[arg])
-                core.pick_model_point(fixture.name, arg, p)
+                core.picking.pick_model_point(fixture.name, arg, p)
                 true_pixel = project(apply(invert(bed.true_cam2world(bed.joints_deg)), p[None]), core.intrinsics)[0]
-                core.pick_image_point(true_pixel + rng.normal(0, 0.3, 2))  # an operator's click, 0.3 px off
-                core.accept_pair()
+                core.picking.pick_image_point(true_pixel + rng.normal(0, 0.3, 2))  # an operator's click, 0.3 px off
+                core.picking.accept_pair()
             elif kind == "solve":
                 core.session.options.robust = arg
-                core.calibrate()
+                core.picking.calibrate()
             elif kind == "store":
                 try:
-                    core.store_correction()
+                    core.desk.store_correction()
                 except ConfirmationNeeded as why:
-                    core.store_correction(confirmation=f"sample recording: {why}")
+                    core.desk.store_correction(confirmation=f"sample recording: {why}")
             next_step += STEP_S
     rec = core.recorder
     core.stop_recording()
     camera.close()
+    part.replace(OUT)
     duration = clock.t_s - start
     print(
         f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, "
