@@ -66,12 +66,14 @@ def test_the_freshness_bound_follows_the_handshake_s_round_trip(round_trip_ms, b
 def _handshake(logic: ControllerLogic, key: bytes = KEY) -> bytes | None:
     """A session opened by the holder of ``key`` (None when the controller refuses its hello: another key)."""
     wn = auth.new_nonce()
+    before_ms = logic.clock_ms()
     (reply,) = logic.handle(f"HEL,{wn},{auth.hello_request(key, wn)}")
+    after_ms = logic.clock_ms()
     if key != KEY:
         assert reply.code == "AUTH" and reply.text.startswith(f"hello {wn}: wrong request")
         return None
     assert isinstance(reply, HelloReply) and reply.proof == auth.controller_proof(KEY, wn, reply.nonce, reply.clock_ms)
-    assert abs(reply.clock_ms - logic.clock_ms()) <= 1
+    assert before_ms <= reply.clock_ms <= after_ms  # the controller's clock when it answered (a loaded machine is slow)
     (ack,) = logic.handle(f"AUT,{auth.workstation_proof(key, wn, reply.nonce)}")
     assert ack == Ack("AUT", "-")
     return auth.session_key(key, wn, reply.nonce)
