@@ -84,3 +84,8 @@ def _time_per_call(fn, reps):
             fn()
         best = min(best, (time.perf_counter() - t0) / reps)
     return best
+
+
+def _errors(T: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
+    dt = float(np.linalg.norm(T[:3, 3] - truth[:3, 3]))
+    return dt, float(np.degrees(Rotation.from_matrix(T[:3, :3] @ truth[:3, :3].T).magnitude()))
