@@ -37,7 +37,7 @@ def _timed(argv: list[str]) -> tuple[float, float]:
     run = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=300)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if run.returncode not in (0,):
+    if run.returncode != 0:
         raise RuntimeError(f"{' '.join(argv)} exited {run.returncode}: {run.stderr[-500:]}")
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), wall
 
