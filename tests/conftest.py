@@ -7,6 +7,15 @@ os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkOSOpenGLRenderWindow")
 
 import tempfile  # noqa: E402
 
+from calib_core.solver.kernel_cache import kernel_cache_folder  # noqa: E402
+
+# The solver's compiled kernels are the one per-user file the tests share with the user: they are machine code named
+# by the kernels' sources, which `make` compiles at install. In a throw-away cache every test process (each worker and
+# every command a test starts) compiled them again, about a minute of CPU each.
+_kernels = kernel_cache_folder()
+if _kernels is not None:
+    os.environ.setdefault("NUMBA_CACHE_DIR", _kernels)
+
 # Autosaves, window settings and other per-user files (platformdirs and QSettings follow the XDG folders) go to
 # throw-away folders, never into the home of whoever runs the tests.
 os.environ["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="videocal-test-data-")

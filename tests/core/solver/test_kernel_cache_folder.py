@@ -12,6 +12,12 @@ ROOT = Path(__file__).resolve().parents[3]
 PROBE = "import calib_core.solver.kernels.newton\nfrom numba.core import config\nprint(config.CACHE_DIR)\n"
 
 
+def _without_a_chosen_folder() -> dict[str, str]:
+    # The suite names the user's folder for every process it starts (tests/conftest.py); these tests see the choice
+    # the program makes when nobody has chosen.
+    return {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}
+
+
 def _cache_folder(source_root: Path, cache_home: Path, **env) -> Path:
     run = subprocess.run(
         [sys.executable, "-c", PROBE],
@@ -19,7 +25,7 @@ def _cache_folder(source_root: Path, cache_home: Path, **env) -> Path:
         text=True,
         timeout=120,
         cwd=source_root,
-        env={**os.environ, "PYTHONPATH": str(source_root), "XDG_CACHE_HOME": str(cache_home), **env},
+        env={**_without_a_chosen_folder(), "PYTHONPATH": str(source_root), "XDG_CACHE_HOME": str(cache_home), **env},
     )
     assert run.returncode == 0, run.stderr[-2000:]
     return Path(run.stdout.strip())
