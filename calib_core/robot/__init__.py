@@ -1,9 +1,26 @@
 """The robot model: URDF loaded with Pinocchio; forward kinematics, Jacobians and inverse
 kinematics of any frame, in mm and degrees at the boundary (Pinocchio's metres inside)."""
 
-from calib_core.robot.errors import RobotModelError, UnknownFrameError, UnreachableTargetError
-from calib_core.robot.ik import IKSolution, solve_ik
-from calib_core.robot.model import RobotModel, load_robot
+import importlib
+
+# Submodule of each public name. They load on first use (PEP 562): the model pulls in Pinocchio, trimesh and SciPy
+# (0.6 s), which a submodule needing none of them (the bounded xacro child, started once a document) need not pay.
+_WHERE = {
+    "RobotModelError": "errors",
+    "UnknownFrameError": "errors",
+    "UnreachableTargetError": "errors",
+    "IKSolution": "ik",
+    "solve_ik": "ik",
+    "RobotModel": "model",
+    "load_robot": "model",
+}
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(importlib.import_module(f"calib_core.robot.{_WHERE[name]}"), name)
+    raise AttributeError(f"module 'calib_core.robot' has no attribute {name!r}")
+
 
 __all__ = [
     "RobotModel",

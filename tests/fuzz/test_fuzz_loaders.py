@@ -35,9 +35,6 @@ LOADERS = [
     "connector_url",
 ]
 EXAMPLES = int(os.environ.get("VIDEOCAL_FUZZ_EXAMPLES", "150"))
-PER_LOADER = {"xacro": 50}
-"""Loaders whose every document costs a child process (a xacro is expanded in a bounded one: 0.9 s each) run fewer in
-the suite (150 took 133 s, a tenth of it); the reliability bench runs 10,000 of each."""
 
 
 def run_fuzz(loader: str, examples: int, seed: int = 0, timeout: float = 1200) -> dict:
@@ -54,9 +51,8 @@ def run_fuzz(loader: str, examples: int, seed: int = 0, timeout: float = 1200) -
 
 @pytest.mark.parametrize("loader", LOADERS)
 def test_every_generated_document_is_accepted_or_refused_clearly(loader):
-    examples = min(EXAMPLES, PER_LOADER.get(loader, EXAMPLES))
-    stats = run_fuzz(loader, examples)
-    assert stats["examples"] >= min(examples, 50)
+    stats = run_fuzz(loader, EXAMPLES)
+    assert stats["examples"] >= min(EXAMPLES, 50)
     assert stats["unexpected"] == [], json.dumps(stats["unexpected"][:3], indent=1)
     assert stats["refused"] > 0  # the mutations do reach the checks
 
