@@ -7,8 +7,14 @@ the photo. The prior is JSON: ``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as
 ``obj2cam`` (4 x 4, mm). ``--features`` is YAML: ``name: [x, y, z]`` in the mesh's units, corners of the object
 (default: the vertices of a mesh of at most 64, a box's eight).
 
-Exit codes: 0 located (``ok``), 2 bad input (one ``error:`` line), 3 not located or ``uncertain`` (another start
-settled elsewhere on the image; the JSON says why and still gives the pose).
+Several photos (frames of a recording, one look's photos) are located in one process, from the same prior: the
+libraries are loaded once (about 2 s), then each photo takes its own time. The output is then JSON Lines, one object
+per photo in the order given, each with its ``photo``, written as soon as it is located; a photo that cannot be read
+or does not fit the camera file is a line with its ``error`` (and an ``error:`` line on stderr) and the others go on.
+``--overlay`` then names a folder, one ``<photo name>.png`` each.
+
+Exit codes: 0 located (``ok``; every photo), 2 bad input (one ``error:`` line; any photo), 3 not located or
+``uncertain`` (another start settled elsewhere on the image; the JSON says why and still gives the pose).
 """
 
 from __future__ import annotations
@@ -31,7 +37,12 @@ MAX_FEATURES = 1000
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from calib_core.vision.search_reach import REACH_DEG, REACH_MM
 
-    parser.add_argument("photo", type=Path, help="the photo (PNG, JPEG, ...) of the object")
+    parser.add_argument(
+        "photo",
+        type=Path,
+        nargs="+",
+        help="the photo (PNG, JPEG, ...) of the object; several: one JSON line each, from the same prior",
+    )
     parser.add_argument("--mesh", type=Path, required=True, help="the object's mesh (STL, OBJ, PLY, DAE, glTF)")
     parser.add_argument(
         "--intrinsics", type=Path, required=True, help="the camera's intrinsics (OpenCV YAML or ROS camera_info YAML)"
@@ -68,7 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--overlay",
         type=Path,
-        help="write the photo with the located outline (green) and the prior's (red) to this PNG",
+        help="write the photo with the located outline (green) and the prior's (red) to this PNG (several photos: a "
+        "folder of them)",
     )
     parser.add_argument("--indent", type=int, default=2, help="JSON indentation (0 for one line)")
 
@@ -129,11 +141,6 @@ def read_features(path: Path, scale: float) -> dict[str, np.ndarray]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from calib_core.camera.intrinsics_io import load_intrinsics
-    from calib_core.image_files import read_image
-    from calib_core.render.model_view import ModelView
-    from calib_core.vision.locate import locate
-
     for name in ("reach_mm", "reach_deg"):
         value = getattr(args, name)
         if not (np.isfinite(value) and 0.0 < value <= (500.0 if name == "reach_mm" else 30.0)):
@@ -141,51 +148,122 @@ def run(args: argparse.Namespace) -> int:
                 f"--{name.replace('_', '-')} must be above 0 and at most {500 if name == 'reach_mm' else 30}, got "
                 f"{value:g}"
             )
-    image = read_image(args.photo)
-    intrinsics = load_intrinsics(args.intrinsics, image_size=(image.shape[1], image.shape[0]))
-    if (intrinsics.width, intrinsics.height) != (image.shape[1], image.shape[0]):
-        raise FileFormatError(
-            args.photo,
-            f"the photo is {image.shape[1]} x {image.shape[0]} px but {args.intrinsics} is for {intrinsics.width} x "
-            f"{intrinsics.height} px",
-        )
-    from calib_core.mesh_files import load_mesh  # trimesh: loaded for a run, not for --help
-
-    mesh = load_mesh(args.mesh, args.units)
-    features = read_features(args.features, MESH_SCALE[args.units]) if args.features else None
-    prior = read_prior(args.prior)
-    centre = prior[:3, :3] @ np.asarray(mesh.bounding_box.centroid, dtype=float) + prior[:3, 3]
-    if not centre[2] > 0.0:
-        raise FileFormatError(
-            args.prior,
-            f"the prior puts the object's centre {centre[2]:.1f} mm in front of the camera: behind it, or in its "
-            "plane; the camera looks along +z (OpenCV's axes)",
-        )
-    view = ModelView(intrinsics)
+    several = len(args.photo) > 1
+    if several and args.overlay is not None:
+        _check_overlay_folder(args.overlay, args.photo)
+    locator = _Locator(args)
     try:
-        from calib_core.scene import SceneItem
+        if not several:
+            image, result = locator.locate(args.photo[0])
+            if args.overlay:
+                _write_overlay(args.overlay, image, locator.intrinsics, locator.mesh, locator.prior, result)
+            json.dump(result.to_dict(), sys.stdout, indent=args.indent or None)
+            sys.stdout.write("\n")
+            return 0 if result.status == "ok" else EXIT_NOT_LOCATED
+        worst = 0
+        for photo in args.photo:
+            try:
+                image, result = locator.locate(photo)
+            except (FileFormatError, FileNotFoundError, IsADirectoryError, PermissionError) as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                _write_line({"photo": str(photo), "status": "error", "error": str(exc)})
+                worst = 2
+                continue
+            if args.overlay:
+                overlay = args.overlay / f"{photo.stem}.png"
+                _write_overlay(overlay, image, locator.intrinsics, locator.mesh, locator.prior, result)
+            _write_line({"photo": str(photo), **result.to_dict()})
+            if result.status != "ok" and worst == 0:
+                worst = EXIT_NOT_LOCATED
+        return worst
+    finally:
+        locator.close()
 
-        # the model's view only says which edges show: the object alone, light on the renderer's black, its faces
-        # shaded apart by the light
-        expected = view.of([SceneItem(args.mesh.stem, mesh, np.eye(4), color=(0.75, 0.75, 0.75))], np.eye(4))
+
+class _Locator:
+    """The mesh, features and prior read once (a bad one ends the command), then :meth:`locate` photo by photo; the
+    camera file is read with the first photo (a file without a size takes that photo's)."""
+
+    def __init__(self, args: argparse.Namespace) -> None:
+        from calib_core.mesh_files import load_mesh  # trimesh: loaded for a run, not for --help
+
+        self.args = args
+        self.intrinsics = None
+        self._view = None
+        self._expected = None
+        self.mesh = load_mesh(args.mesh, args.units)
+        self.features = read_features(args.features, MESH_SCALE[args.units]) if args.features else None
+        self.prior = read_prior(args.prior)
+        centre = self.prior[:3, :3] @ np.asarray(self.mesh.bounding_box.centroid, dtype=float) + self.prior[:3, 3]
+        if not centre[2] > 0.0:
+            raise FileFormatError(
+                args.prior,
+                f"the prior puts the object's centre {centre[2]:.1f} mm in front of the camera: behind it, or in its "
+                "plane; the camera looks along +z (OpenCV's axes)",
+            )
+
+    def locate(self, photo: Path):
+        """(image (h, w[, 3]) uint8, :class:`~calib_core.vision.locate.LocateResult`) of one photo; a photo that cannot
+        be read or is not the camera file's size raises :class:`FileFormatError` naming it."""
+        from calib_core.image_files import read_image
+        from calib_core.vision.locate import locate
+
+        image = read_image(photo)
+        if self.intrinsics is None:
+            self._open_camera(image)
+        if (self.intrinsics.width, self.intrinsics.height) != (image.shape[1], image.shape[0]):
+            raise FileFormatError(
+                photo,
+                f"the photo is {image.shape[1]} x {image.shape[0]} px but {self.args.intrinsics} is for "
+                f"{self.intrinsics.width} x {self.intrinsics.height} px",
+            )
         result = locate(
             image,
-            intrinsics,
-            mesh,
-            prior,
-            features=features,
-            expected=expected,
-            reach_mm=args.reach_mm,
-            reach_deg=args.reach_deg,
-            name=args.mesh.stem,
+            self.intrinsics,
+            self.mesh,
+            self.prior,
+            features=self.features,
+            expected=self._expected,
+            reach_mm=self.args.reach_mm,
+            reach_deg=self.args.reach_deg,
+            name=self.args.mesh.stem,
         )
-    finally:
-        view.close()
-    if args.overlay:
-        _write_overlay(args.overlay, image, intrinsics, mesh, prior, result)
-    json.dump(result.to_dict(), sys.stdout, indent=args.indent or None)
-    sys.stdout.write("\n")
-    return 0 if result.status == "ok" else EXIT_NOT_LOCATED
+        return image, result
+
+    def _open_camera(self, image: np.ndarray) -> None:
+        from calib_core.camera.intrinsics_io import load_intrinsics
+        from calib_core.render.model_view import ModelView
+        from calib_core.scene import SceneItem
+
+        self.intrinsics = load_intrinsics(self.args.intrinsics, image_size=(image.shape[1], image.shape[0]))
+        self._view = ModelView(self.intrinsics)
+        # the model's view only says which edges show: the object alone, light on the renderer's black, its faces
+        # shaded apart by the light
+        item = SceneItem(self.args.mesh.stem, self.mesh, np.eye(4), color=(0.75, 0.75, 0.75))
+        self._expected = self._view.of([item], np.eye(4))
+
+    def close(self) -> None:
+        if self._view is not None:
+            self._view.close()
+
+
+def _check_overlay_folder(folder: Path, photos: list[Path]) -> None:
+    """Several photos' overlays go to a folder, one ``<photo name>.png`` each: refused before any work when the name
+    is a file's or two photos share a name."""
+    if folder.suffix.lower() in (".png", ".jpg", ".jpeg") or folder.is_file():
+        raise FileFormatError(folder, "with several photos --overlay names a folder, one <photo name>.png each")
+    stems: dict[str, Path] = {}
+    for photo in photos:
+        if photo.stem in stems and stems[photo.stem] != photo:
+            raise FileFormatError(
+                photo, f"its overlay would overwrite that of {stems[photo.stem]} (both {photo.stem}.png)"
+            )
+        stems[photo.stem] = photo
+
+
+def _write_line(document: dict) -> None:
+    sys.stdout.write(json.dumps(document) + "\n")
+    sys.stdout.flush()  # a line as each photo is done: progress for whoever reads the stream
 
 
 def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.ndarray, result) -> None:

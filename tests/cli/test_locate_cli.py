@@ -260,3 +260,62 @@ def test_the_simulated_camera_s_frame_is_located_where_the_truth_is(tmp_path):
     angle = np.degrees(Rotation.from_matrix(np.array(out["R_obj2cam"]) @ truth[:3, :3].T).magnitude())
     assert angle < 0.1
     assert np.linalg.norm(t - truth[:3, 3]) < 4.0 * np.linalg.norm(out["std"]["translation_mm"]) + 0.1
+
+
+def test_several_photos_are_one_json_line_each_and_a_bad_one_does_not_stop_the_others(photo_files):
+    """The tutorial's photo under two names with a broken photo between them: a line per photo in the order given,
+    the same answer for the same photo, the broken one a line with its error (and one on stderr), exit 2; the
+    overlays go to a folder, one per photo located."""
+    import shutil
+
+    again = photo_files / "again.jpg"
+    shutil.copy(PHOTO, again)
+    broken = photo_files / "broken.png"
+    broken.write_bytes(b"not a PNG at all")
+    overlays = photo_files / "overlays"
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        str(broken),
+        str(again),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "camera.yaml"),
+        "--prior",
+        str(_prior(photo_files, "hand.json", HAND_PRIOR)),
+        "--overlay",
+        str(overlays),
+    )
+    assert run.returncode == 2, run.stderr
+    lines = [json.loads(line) for line in run.stdout.splitlines()]
+    assert [line["photo"] for line in lines] == [str(PHOTO), str(broken), str(again)]
+    first, bad, second = lines
+    assert first["status"] == "ok" and second["status"] == "ok", (first["message"], second["message"])
+    np.testing.assert_allclose(first["t_obj2cam_mm"], second["t_obj2cam_mm"], atol=1e-6)
+    assert bad["status"] == "error" and str(broken) in bad["error"] and "R_obj2cam" not in bad
+    errors = [line for line in run.stderr.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1 and str(broken) in errors[0] and "Traceback" not in run.stderr
+    assert sorted(p.name for p in overlays.iterdir()) == ["again.png", "resized_IMG_3875.png"]
+
+
+def test_several_photos_with_an_overlay_file_name_are_refused_before_any_work(photo_files):
+    run = _videocal(
+        "locate",
+        str(PHOTO),
+        str(PHOTO),
+        "--mesh",
+        str(BOX),
+        "--units",
+        "cm",
+        "--intrinsics",
+        str(photo_files / "camera.yaml"),
+        "--prior",
+        str(_prior(photo_files, "hand.json", HAND_PRIOR)),
+        "--overlay",
+        str(photo_files / "one.png"),
+    )
+    assert run.returncode == 2 and run.stdout == "" and "Traceback" not in run.stderr
+    assert "names a folder" in run.stderr and "one.png" in run.stderr
