@@ -28,9 +28,8 @@ from calib_core.errors import OperatorError, VideocalError
 from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
-from calib_core.robot import solve_ik
-from videocal_sim.sim_site import simulated_cell
-from videocal_sim.true_robot import RobotErrors
+from videocal_sim.demo_report import OperatorLog, demo_report
+from videocal_sim.demo_site import demo_site
 from calib_core.workcell import DEFAULT_WORKCELL
 
 _MIN_FEATURES = 4
@@ -131,48 +130,10 @@ def run_demo(
     from app.gui.main_window import MainWindow
     from app.gui.solver_warmup import warm_solver_in_background
     from app.gui.workbench import Workbench
-    from calib_core.workcell import load_workcell
 
     out_dir.mkdir(parents=True, exist_ok=True)
     app = QApplication.instance() or QApplication([])
-    # One view cannot see an error in the camera's mounting (a hand-eye calibration takes the robot's kinematics
-    # as exact): the demo's true robot has typical joint, link and base errors and the modelled camera mounting.
-    n_joints = load_workcell(workcell).load_robot().n_joints
-    typical = RobotErrors.typical(0, n_joints=n_joints)
-    cell, site = simulated_cell(
-        workcell,
-        errors=RobotErrors(
-            typical.joint_offsets_deg, typical.link_errors_mm, typical.base_xyz_mm, typical.base_rpy_deg
-        ),
-        image_scale=scale,
-        less_kind=look == "workshop",
-    )
-    weather = None
-    if link_delay_ms:  # the same cell far away, with a far link's weather
-        from videocal_sim.delay_line import LinkWeather
-
-        weather = LinkWeather(link_delay_ms / 1000.0, 0.3, 0.01)
-        if site_kind not in ("sim", "ros2"):
-            raise ValueError(
-                "--link-delay-ms crosses videocal's own link (--site sim) or ROS 2's (--site ros2), not --site "
-                f"{site_kind}"
-            )
-    if site_kind == "ros2":  # the same simulated cell, its robot and camera reached through ROS 2
-        from videocal_sim.ros2_site import Ros2SimulatedSite
-
-        site = Ros2SimulatedSite(site, weather=weather)
-    elif site_kind == "gige":  # the same cell, its camera served over GigE Vision and read through Aravis
-        from videocal_sim.gige_site import GigESimulatedSite
-
-        site = GigESimulatedSite(site)
-    elif site_kind == "ur":  # the same cell, its robot a simulated UR controller reached through ur_rtde and URScript
-        from videocal_sim.ur_site import URSimulatedSite
-
-        site = URSimulatedSite(site)
-    if weather is not None and site_kind == "sim":  # videocal's own link through a delay line
-        from videocal_sim.far_site import FarSimulatedSite
-
-        site = FarSimulatedSite(site, weather)
+    cell, site = demo_site(workcell, scale=scale, site_kind=site_kind, link_delay_ms=link_delay_ms, look=look)
     bed = site.bed  # the truth: read by the simulated operator's eyes and by the score only
     wb = Workbench(cell, site)
     if location is not None:
@@ -191,26 +152,19 @@ def run_demo(
     win.start_camera(site.camera_factory())
     win.show()
     warm_solver_in_background()  # as videocal gui does
-    shots = []
-
+    log = OperatorLog()
     shooting_s = [0.0]  # time spent on screenshots, left out of the looks' times
 
     def shot(name: str, widget=None) -> None:
         """The window (or ``widget``: a dialog of its own) as the operator sees it now, saved as a PNG."""
         t0 = time.monotonic()
         _pause(app, 0.3)
-        path = out_dir / f"{len(shots) + 1:02d}_{name}.png"
+        path = out_dir / f"{len(log.shots) + 1:02d}_{name}.png"
         (widget or win).grab().save(str(path))
-        shots.append(path.name)
+        log.shots.append(path.name)
         shooting_s[0] += time.monotonic() - t0
 
-    skipped: list[str] = []
-    refined_away: list[str] = []  # corners where the sub-pixel refinement moved off the corner
-    confirmed: list[str] = []  # moves the operator confirmed in the overview (large joint changes)
     moves_seen: list[str] = []
-    looks_s: list[float] = []  # Go pressed -> a frame the core accepts for picks
-    look_work_s: list[float] = []  # a settled frame -> the correction stored (the picks or Find points, the solve)
-    look_actions: list[int] = []  # the operator's actions in each look (clicks, keys, zooms)
     last_go = [time.monotonic()]
     wb.arm.motion_changed.connect(lambda state: moves_seen.append(f"{time.monotonic():.2f} {state.text}"))
     hand = np.random.default_rng(0)
@@ -252,7 +206,7 @@ def run_demo(
                 return frame is not None and frame.t_host_s >= since and wb.observations.stillness(frame).settled
 
             _wait(app, usable, 60, f"a camera frame with the robot settled {what}")
-            looks_s.append(time.monotonic() - last_go[0])
+            log.go_to_settled_s.append(time.monotonic() - last_go[0])
             _wait(app, win.virtual.is_current, 10, "the virtual camera")
 
         def go(button) -> None:
@@ -260,7 +214,7 @@ def run_demo(
             last_go[0] = time.monotonic()
             _click(button, 10, 10)
             if win.overview.preview_bar.isVisible() and win.overview.move_button.isVisible():
-                confirmed.append(win.overview.preview.what)
+                log.confirmed.append(win.overview.preview.what)
                 _click(win.overview.move_button, 10, 10)
             if wb.motion.motion.value not in ("moving", "arrived"):
                 raise RuntimeError(f"demo: the move was not sent: {win.results.status.text()}")
@@ -323,8 +277,8 @@ def run_demo(
                 find_and_calibrate(round_name)
             else:
                 pick_each_and_calibrate(round_name)
-            look_work_s.append(time.monotonic() - t0 - (shooting_s[0] - shooting0))
-            look_actions.append(_operator_actions[0] - acted0)
+            log.look_s.append(time.monotonic() - t0 - (shooting_s[0] - shooting0))
+            log.look_actions.append(_operator_actions[0] - acted0)
 
         def pick_each_and_calibrate(round_name: str) -> None:
             """Every feature picked in both panes (scripted clicks), solved, stored."""
@@ -348,7 +302,7 @@ def run_demo(
                 if pending is None or pending.feature != name:
                     if pending is not None:
                         wb.session.delete(pending.number)
-                    skipped.append(
+                    log.skipped.append(
                         f"{round_name}: {name} ({win.virtual.info.text() or 'hidden in the virtual camera'})"
                     )
                     continue
@@ -377,7 +331,7 @@ def run_demo(
                     _act()
                     win.camera.subpixel.setChecked(False)
                     _click_image(win.camera.view, *(uv_true + hand.uniform(-_HAND_PX, _HAND_PX, 2)))
-                    refined_away.append(f"{round_name}: {name}")
+                    log.refined_away.append(f"{round_name}: {name}")
                 _act(2)  # the view reset and the pair accepted (two keys)
                 win.camera.view.reset_view()
                 win.actions.accept()
@@ -413,65 +367,19 @@ def run_demo(
         corrected = wb.session.corrections.corrected_target(task.name, task.tcp2base)
         _wait(app, lambda: at(corrected), 60, "the robot at the twice-corrected task location", where(corrected))
         shot("at_corrected_task")
-        r = wb.session.result.estimate
-        d_true, r_true = pose_difference(bed.true_robot.fk(q_measured), bed.model_robot.fk(q_measured))
-        d_first, r_first = pose_difference(bed.true_robot.fk(q_first), bed.model_robot.fk(q_first))
-        miss_d, miss_r = pose_difference(bed.true_robot.fk(wb.joints_deg), task.tcp2base)
-        q_plain = solve_ik(wb.robot, task.tcp2base, wb.joints_deg).q_deg
-        plain_d, plain_r = pose_difference(bed.true_robot.fk(q_plain), task.tcp2base)
-        report = {
-            "workcell": str(Path(workcell).resolve()),
-            "robot_joints": n_joints,
-            "task_location": task.name,
-            "method": method,
-            "site": site.description,
-            "camera_look": look,
-            "settled_frame_to_stored_s": [round(v, 2) for v in look_work_s],
-            "operator_actions_per_look": look_actions,
-            "link": {
-                "one_way_ms": link_delay_ms,
-                "measured_one_way_s": getattr(wb.link, "delay_s", None),
-                "go_to_settled_frame_s": [round(v, 2) for v in looks_s],
-            },
-            "connectors": {
-                "controller": wb.link.url,
-                "camera": {"ros2": "ros2:///camera/image_raw", "gige": "aravis://127.0.0.1"}.get(
-                    site_kind, "the simulated camera (in process)"
-                ),
-            },
-            "target": wb.session.target,
-            "features_skipped": skipped,
-            "subpixel_refinement_refused": refined_away,
-            "moves_confirmed": confirmed,
-            "status": r.solution.status.value,
-            "pairs": len(wb.session.pairs.usable()) if r.solution.method == "points" else 0,
-            "edge_samples": len(r.solution.residuals_px) if r.solution.method == "edges" else 0,
-            "rms_px": r.solution.rms_px,
-            "estimated_displacement": {"d_mm": r.displacement_mm.tolist(), "rotation_deg": r.rotation_deg.tolist()},
-            "std": {"d_mm": r.std_displacement_mm.tolist(), "rotation_deg": r.std_rotation_deg.tolist()},
-            "true_displacement": {"d_mm": d_true.tolist(), "rotation_deg": r_true.tolist()},
-            "first_look": {
-                "estimated_displacement": {
-                    "d_mm": first.displacement_mm.tolist(),
-                    "rotation_deg": first.rotation_deg.tolist(),
-                },
-                "true_displacement": {"d_mm": d_first.tolist(), "rotation_deg": r_first.tolist()},
-                "rms_px": first.solution.rms_px,
-            },
-            "uncorrected_tcp_error_mm": float(np.linalg.norm(plain_d)),
-            "uncorrected_tcp_error_deg": float(np.linalg.norm(plain_r)),
-            "corrected_tcp_error_mm": float(np.linalg.norm(miss_d)),
-            "corrected_tcp_error_deg": float(np.linalg.norm(miss_r)),
-            "hand_eye": "exact",
-            "estimate_within_3_sigma": bool(np.all(np.abs(r.displacement_mm - d_true) <= 3 * r.std_displacement_mm)),
-            "screenshots": shots,
-            "note": "the true robot has typical joint, link and base errors and the modelled camera mounting (hand_eye "
-            "exact: a hand-eye "
-            "calibration takes the robot's kinematics as exact, so with these errors it cannot be better than they "
-            "are); the "
-            "correction is measured at the task location, then again from the corrected location, and the second one "
-            "is stored last",
-        }
+        report = demo_report(
+            workcell=workcell,
+            method=method,
+            look=look,
+            site_kind=site_kind,
+            link_delay_ms=link_delay_ms,
+            wb=wb,
+            bed=bed,
+            log=log,
+            first=first,
+            q_first=q_first,
+            q_measured=q_measured,
+        )
         wb.files.save_workspace(out_dir / "workspace.json")  # the corrections, for videocal export
         report["workspace"] = "workspace.json"
         atomic_write_text(out_dir / "report.json", json.dumps(report, indent=2))
