@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.busy_core import busy_core
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "benchmarks" / "cli.md"
 PHOTOS = ROOT / "tests" / "data" / "third_party" / "opencv_samples"
@@ -120,12 +122,8 @@ def main() -> str:
     with tempfile.TemporaryDirectory() as tmp:
         locate_args = _locate_files(Path(tmp))
         idle = _rows(locate_args)
-        hog = subprocess.Popen([sys.executable, "-c", "while True: pass"])
-        try:
+        with busy_core():
             loaded = _rows(locate_args)
-        finally:
-            hog.kill()
-            hog.wait()
     lines = [
         "# The command line: start-up and whole commands",
         "",

@@ -17,6 +17,8 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 import cv2
 import numpy as np
 
+from bench.busy_core import busy_core
+
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "gui.md"
 OPERATOR_ACTION_S = 1.0
 """A person's time an action (a click, a key, a zoom) in the look time at an operator's pace: a lower bound (see the
@@ -156,6 +158,13 @@ def _demo(workcell: Path | None, tmp: Path, tag: str, method: str) -> dict | Non
     return json.loads((tmp / tag / "report.json").read_text()) if run.returncode == 0 else {"failed": run.stderr[-300:]}
 
 
+def _look_times(report: dict | None) -> str:
+    """A demo's looks, a settled frame to the correction stored, or why there are none."""
+    if not report or "failed" in report:
+        return f"failed: {(report or {}).get('failed', 'no report')}"
+    return " / ".join(f"{v:.1f} s" for v in report["settled_frame_to_stored_s"])
+
+
 def main() -> str:
     from PySide6.QtWidgets import QApplication
 
@@ -178,6 +187,9 @@ def main() -> str:
     ur5 = write_starter_cell(tmp / "ur5", UR5, [SHARE]).workcell_path
     panda = write_starter_cell(tmp / "panda", PANDA, [SHARE]).workcell_path
     launch_ur5, ready_ur5 = _launch(tmp, "ur5", "--workcell", str(ur5))
+    with busy_core():  # another program keeping a core busy: the window's start, and a look by Find points
+        launch_loaded, ready_loaded = _launch(tmp, "bundled_loaded")
+        demo_loaded = _demo(None, tmp, "demo_loaded", "find-points")
 
     app = QApplication.instance() or QApplication([])
     wb = Workbench(*simulated_cell())
@@ -291,9 +303,13 @@ def main() -> str:
         "",
         "| measure | result | target |",
         "|---|---|---|",
-        f"| launch to window on screen (`videocal gui`, fresh process: the loading window) | {launch_s:.2f} s | <= 3 s "
+        f"| launch to window on screen (`videocal gui`, fresh process: the loading window) | {launch_s:.2f} s | <= 2 s "
         "|",
-        f"| launch to the full window with every pane, the simulator and the link running | {ready_s:.2f} s | |",
+        f"| launch to the full window with every pane, the simulator and the link running | {ready_s:.2f} s | <= 5 s |",
+        f"| ... with a second process keeping a core busy: to window on screen / to the full window | "
+        f"{launch_loaded:.2f} s / {ready_loaded:.2f} s | <= 2 s / <= 5 s |",
+        f"| ... and a look by Find points, a settled frame to the correction stored (first / second look) | "
+        f"{_look_times(demo_loaded)} | <= 2 s |",
         f"| UR5 cell (vendor DAE meshes): launch to window on screen | {launch_ur5:.2f} s | <= 3 s |",
         f"| UR5 cell: launch to the full window | {ready_ur5:.2f} s | <= 3 s |",
         f"| UR5 cell: overview redraws while following the 50 Hz joint stream (during the move) | {overview_ur5:.1f} "
