@@ -24,6 +24,7 @@ class OperatorLog:
     go_to_settled_s: list[float] = field(default_factory=list)  # Go pressed -> a frame the core accepts for picks
     look_s: list[float] = field(default_factory=list)  # a settled frame -> the correction stored, screenshots left out
     look_actions: list[int] = field(default_factory=list)  # the operator's clicks, keys and zooms in each look
+    proposals_s: list[float] = field(default_factory=list)  # Find points pressed -> its proposals shown, each look
 
 
 def demo_report(
@@ -59,6 +60,7 @@ def demo_report(
         "camera_look": look,
         "settled_frame_to_stored_s": [round(v, 2) for v in log.look_s],
         "operator_actions_per_look": log.look_actions,
+        "find_points_proposals_s": [round(v, 2) for v in log.proposals_s],
         "link": {
             "one_way_ms": link_delay_ms,
             "measured_one_way_s": getattr(wb.link, "delay_s", None),

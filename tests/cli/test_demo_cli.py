@@ -51,6 +51,8 @@ def test_demo_writes_screenshots_and_a_report(tmp_path, method):
     actions = report["operator_actions_per_look"]
     assert len(actions) == 2
     assert min(actions) >= 2 * report["pairs"] if method == "picks" else max(actions) <= 8
+    # a Find points look times its proposals (one each look); picks by hand make none
+    assert len(report["find_points_proposals_s"]) == (0 if method == "picks" else 2)
     # the window at each step; with Find points also its list of proposals (a dialog of its own) at each look
     lists = [name for name in report["screenshots"] if name.endswith("_points_found_list.png")]
     assert len(report["screenshots"]) == 7 + len(lists) and len(lists) == (0 if method == "picks" else 2)
