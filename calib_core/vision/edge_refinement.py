@@ -46,7 +46,8 @@ class EdgeFit:
     offsets; ``sigma_px`` their robust scale; ``samples`` used in the last step; ``covariance`` (6, 6)
     of (rotation vector rad, translation mm) from the last step's normal equations, the samples of each
     edge chain taken as one measurement (their offsets share the edge's error) and never less than
-    ``sigma_px`` over independent samples gives (``covariance_independent``);
+    ``sigma_px`` over independent samples gives (``covariance_independent``), and with the outline found by colour
+    the pose's own doubt about where the edge is (:attr:`outline_bias`);
     ``converged``; ``edges_px`` (m, 2) the image edge points found, ``offsets_px`` (m,) their offsets
     along the normals and ``residuals_px`` (m, 2) as vectors (image edge minus the model's edge, at the
     pose before the last step), for drawing and for the solution's residuals."""
@@ -68,6 +69,12 @@ class EdgeFit:
     ``covariance`` takes each edge chain's samples as one measurement as well, and is never less."""
     rms_bound_px: float = SETTLED_RMS_PX
     """The largest RMS at which this fit may count as settled (what the caller asked of its images)."""
+    outline_bias: np.ndarray | None = None
+    """(6,) rotation vector rad, translation mm: how far the pose would move if the outline found by colour were where
+    the strongest gradient lies near each sample instead (after the whole outline's shift), ``None`` when the outline
+    was not found by colour. Both are estimates of the same edge that err apart (the colours end inward of a lit
+    bevel, a print line lies near an edge), and their disagreement is no noise that averages away over the samples:
+    ``covariance`` holds its outer product."""
     min_share: float = 0.5
     """The least share of the samples on their edges at which a fit within 0.5 px counts as settled. Find points,
     which proposes pairs from the fit, asks 60 %: a wrong minimum can settle within 0.3 px holding about half of them
@@ -177,6 +184,7 @@ def refine_to_edges(
     share = 0.0
     previous_xi, damping = None, 1.0
     creases_join = None
+    gap = J_gap = None  # along each sample's normal: the gradient near the colour step, less the step (px)
     for it in range(iterations):
         if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
             # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
@@ -199,6 +207,7 @@ def refine_to_edges(
         found, strength, inside = search_normals(magnitude, uv, normals, window)
         ok = inside & (strength >= _MIN_STRENGTH)
         counted = np.ones(len(uv), dtype=bool)  # the samples the fit's share on its edges is of
+        gap = None
         if regions is not None and outward.any():
             on_outline = outward != 0
             out_normals = normals[on_outline] * outward[on_outline, None]
@@ -213,6 +222,10 @@ def refine_to_edges(
             if snap.sum() >= 12:
                 shift = float(np.median(np.einsum("ij,ij->i", snapped[snap] - step[snap], out_normals[snap])))
                 step = step + shift * out_normals
+            gap = np.zeros(len(uv))
+            gap_on_outline = np.zeros(len(step))
+            gap_on_outline[snap] = np.einsum("ij,ij->i", snapped[snap] - step[snap], normals[on_outline][snap])
+            gap[on_outline] = gap_on_outline
             found[on_outline] = step
             # The outline alone brings the pose near, as the region-based trackers fit: a crease between two of the
             # object's faces has its colours on both sides, and on a printed part the strongest gradient within a
@@ -240,7 +253,7 @@ def refine_to_edges(
         c = _TUKEY * sigma
         wts = np.where(ok & (np.abs(r) < c), (1 - (r / c) ** 2) ** 2, 0.0)
         J = normal_jacobian(pts, pose, normals, intrinsics)
-        J_chain = chain  # (the samples may be taken again before the loop ends: the covariance is of these)
+        J_chain, J_gap = chain, gap  # (the samples may be taken again before the loop ends: the covariance is of these)
         H = J.T @ (wts[:, None] * J)
         g = J.T @ (wts * r)
         try:
@@ -266,14 +279,30 @@ def refine_to_edges(
         if it > 0 and (moved_px < 0.01 or (at_finest and moved_px < 0.1 * sigma)):
             converged = True
             break
+    bias = None
     try:
         H_inv = np.linalg.inv(H)
         independent = sigma**2 * H_inv
         covariance = (
             independent if len(offsets) == 0 else H_inv @ clustered_scatter(J, wts * r, J_chain, sigma**2 * H) @ H_inv
         )
+        if J_gap is not None and len(offsets):
+            bias = H_inv @ (J.T @ (wts * J_gap))
+            covariance = covariance + np.outer(bias, bias)
     except np.linalg.LinAlgError:
         independent = covariance = np.full((6, 6), np.nan)
     return EdgeFit(
-        pose, rms, sigma, len(offsets), covariance, converged, edges, offsets, vectors, share, independent, rms_bound_px
+        pose,
+        rms,
+        sigma,
+        len(offsets),
+        covariance,
+        converged,
+        edges,
+        offsets,
+        vectors,
+        share,
+        independent,
+        rms_bound_px,
+        outline_bias=bias,
     )
