@@ -171,7 +171,7 @@ def main() -> str:
 
     from videocal_sim.demo_operator import METHODS
     from app.gui.main_window import MainWindow
-    from app.gui.solver_warmup import warm_solver_in_background
+    from app.gui.warm_up import warm_up_in_background
     from app.gui.workbench import Workbench
     from calib_core.camera.projection import project
     from calib_core.frames import apply, invert
@@ -203,7 +203,7 @@ def main() -> str:
     )  # frames until the picks at the end (a pick needs a frame newer than the settled robot)
     win.start_camera(lambda: OpenCVSource(str(video)))
     win.show()
-    warm_solver_in_background()  # as videocal gui does: the solves below do not wait for the kernels' loading
+    warm_up_in_background(wb.intrinsics)  # as videocal gui does: the solves below do not wait for the kernels' loading
     _spin(app, 2.0)
     # 2. Camera pane fps on a 30 fps 1280 x 960 file while the overview follows a 50 Hz joint stream and the robot
     # moves.

@@ -128,7 +128,7 @@ def run_demo(
     look: str = "plain",
 ) -> dict:
     from app.gui.main_window import MainWindow
-    from app.gui.solver_warmup import warm_solver_in_background
+    from app.gui.warm_up import warm_up_in_background
     from app.gui.workbench import Workbench
 
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -151,7 +151,7 @@ def run_demo(
     win.resize(1600, 1000)
     win.start_camera(site.camera_factory())
     win.show()
-    warm_solver_in_background()  # as videocal gui does
+    warm_up_in_background(wb.intrinsics)  # as videocal gui does
     log = OperatorLog()
     shooting_s = [0.0]  # time spent on screenshots, left out of the looks' times
 

@@ -140,9 +140,9 @@ def _run_window(args: argparse.Namespace, site_kind, simulator) -> int:
     window = CellLauncher(open_site, args.hand_eye).open(args.workcell, simulator)
     window.setGeometry(shell.geometry())
     window.show()
-    from app.gui.solver_warmup import warm_solver_in_background
+    from app.gui.warm_up import warm_up_in_background
 
-    warm_solver_in_background()
+    warm_up_in_background(window.workbench.intrinsics)
     if args.recording is not None:
         window.files.open_recording(args.recording)
     shell.close()
