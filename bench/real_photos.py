@@ -174,7 +174,8 @@ def box_photo_rows() -> list[str]:
 
     from calib_core.camera.intrinsics import Intrinsics
     from calib_core.mesh_files import load_mesh
-    from calib_core.vision.locate import image_distance_px, locate
+    from calib_core.vision.locate import locate
+    from calib_core.vision.locate_verdict import image_distance_px
 
     data = Path(__file__).resolve().parent.parent / "tests" / "data" / "third_party" / "opencv_samples"
     image = np.ascontiguousarray(cv2.imread(str(data / "resized_IMG_3875.JPG"))[:, :, ::-1])

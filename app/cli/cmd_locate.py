@@ -203,7 +203,7 @@ class _Locator:
             )
 
     def locate(self, photo: Path):
-        """(image (h, w[, 3]) uint8, :class:`~calib_core.vision.locate.LocateResult`) of one photo; a photo that cannot
+        """(image (h, w[, 3]) uint8, :class:`~calib_core.vision.located.Located`) of one photo; a photo that cannot
         be read or is not the camera file's size raises :class:`FileFormatError` naming it."""
         from calib_core.image_files import read_image
         from calib_core.vision.locate import locate

@@ -12,7 +12,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from calib_core.mesh_files import load_mesh
-from calib_core.vision.locate import image_distance_px, locate
+from calib_core.vision.locate import locate
+from calib_core.vision.locate_verdict import image_distance_px
 from tests.cli.test_locate_cli import BOX, HAND_PRIOR, PHOTO, TUTORIAL_CAMERA
 
 
