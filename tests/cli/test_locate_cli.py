@@ -41,6 +41,13 @@ def _videocal(*args, cwd=None):
     )
 
 
+def _locate_box(photos: list[str], intrinsics: str, prior: str, *more: str):
+    """``videocal locate`` of the tutorial's box (its mesh in cm) in ``photos``."""
+    return _videocal(
+        "locate", *photos, "--mesh", str(BOX), "--units", "cm", "--intrinsics", intrinsics, "--prior", prior, *more
+    )
+
+
 @pytest.fixture(scope="module")
 def photo_files(tmp_path_factory):
     folder = tmp_path_factory.mktemp("locate")
@@ -67,16 +74,9 @@ def _moved(pose: dict, mm: float, deg: float, rng) -> dict:
 
 def test_the_tutorial_box_is_located_by_its_edges_and_its_corners_agree(photo_files):
     overlay = photo_files / "located.png"
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
+    run = _locate_box(
+        [str(PHOTO)],
         str(photo_files / "camera.yaml"),
-        "--prior",
         str(_prior(photo_files, "prior.json", HAND_PRIOR)),
         "--overlay",
         str(overlay),
@@ -117,21 +117,8 @@ def test_starts_around_the_prior_end_at_one_pose(photo_files):
     poses, stds = [], []
     for k in range(4):
         prior = _prior(photo_files, f"prior{k}.json", _moved(HAND_PRIOR, 8.0, 0.7, rng))
-        run = _videocal(
-            "locate",
-            str(PHOTO),
-            "--mesh",
-            str(BOX),
-            "--units",
-            "cm",
-            "--intrinsics",
-            str(photo_files / "camera.yaml"),
-            "--prior",
-            str(prior),
-            "--indent",
-            "0",
-            "--reach-deg",
-            "3",
+        run = _locate_box(
+            [str(PHOTO)], str(photo_files / "camera.yaml"), str(prior), "--indent", "0", "--reach-deg", "3"
         )
         assert run.returncode == 0, run.stderr + run.stdout
         out = json.loads(run.stdout)
@@ -148,18 +135,7 @@ def test_a_prior_too_far_says_not_located_with_exit_3(photo_files):
         "R_obj2cam": HAND_PRIOR["R_obj2cam"],
         "t_obj2cam_mm": [150.0, 110.7, 943.5],
     }  # 150 mm to the side: off the box
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
-        str(photo_files / "camera.yaml"),
-        "--prior",
-        str(_prior(photo_files, "far.json", far)),
-    )
+    run = _locate_box([str(PHOTO)], str(photo_files / "camera.yaml"), str(_prior(photo_files, "far.json", far)))
     assert run.returncode == 3, run.stderr
     out = json.loads(run.stdout)
     assert out["status"] == "not found" and out["R_obj2cam"] is None and "prior" in out["message"]
@@ -175,18 +151,7 @@ def test_a_prior_too_far_says_not_located_with_exit_3(photo_files):
 )
 def test_a_bad_prior_is_one_error_line_naming_the_file(photo_files, bad, says):
     path = _prior(photo_files, "bad.json", bad)
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
-        str(photo_files / "camera.yaml"),
-        "--prior",
-        str(path),
-    )
+    run = _locate_box([str(PHOTO)], str(photo_files / "camera.yaml"), str(path))
     assert run.returncode == 2 and run.stdout == ""
     assert (
         run.stderr.startswith("error: ")
@@ -198,18 +163,7 @@ def test_a_bad_prior_is_one_error_line_naming_the_file(photo_files, bad, says):
 
 def test_a_photo_of_another_size_than_the_camera_file_is_refused(photo_files):
     save_intrinsics(photo_files / "other.yaml", Intrinsics(1000, 1000, 320, 240, 640, 480))
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
-        str(photo_files / "other.yaml"),
-        "--prior",
-        str(_prior(photo_files, "p.json", HAND_PRIOR)),
-    )
+    run = _locate_box([str(PHOTO)], str(photo_files / "other.yaml"), str(_prior(photo_files, "p.json", HAND_PRIOR)))
     assert run.returncode == 2 and "Traceback" not in run.stderr
     assert "718" in run.stderr and "640" in run.stderr
 
@@ -273,18 +227,9 @@ def test_several_photos_are_one_json_line_each_and_a_bad_one_does_not_stop_the_o
     broken = photo_files / "broken.png"
     broken.write_bytes(b"not a PNG at all")
     overlays = photo_files / "overlays"
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        str(broken),
-        str(again),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
+    run = _locate_box(
+        [str(PHOTO), str(broken), str(again)],
         str(photo_files / "camera.yaml"),
-        "--prior",
         str(_prior(photo_files, "hand.json", HAND_PRIOR)),
         "--overlay",
         str(overlays),
@@ -302,17 +247,9 @@ def test_several_photos_are_one_json_line_each_and_a_bad_one_does_not_stop_the_o
 
 
 def test_several_photos_with_an_overlay_file_name_are_refused_before_any_work(photo_files):
-    run = _videocal(
-        "locate",
-        str(PHOTO),
-        str(PHOTO),
-        "--mesh",
-        str(BOX),
-        "--units",
-        "cm",
-        "--intrinsics",
+    run = _locate_box(
+        [str(PHOTO), str(PHOTO)],
         str(photo_files / "camera.yaml"),
-        "--prior",
         str(_prior(photo_files, "hand.json", HAND_PRIOR)),
         "--overlay",
         str(photo_files / "one.png"),

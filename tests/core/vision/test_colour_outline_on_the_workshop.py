@@ -14,12 +14,17 @@ from videocal_sim.real_look import make_less_kind
 from videocal_sim.test_bed import TestBed
 
 
-def test_the_fixture_by_its_colours_on_the_workshop_camera_is_where_it_is():
+def _fixture_by_colour(place: str):
+    """Find points by colour on the workshop camera (no form error: the truth's features stay where the CAD has them)
+    with the robot's typical errors, at the paper's task location (``tcp``) or its approach: (bed, the fixture, the
+    result, the true cam2world)."""
     bed = TestBed.create()
-    make_less_kind(bed, form_error_mm=0.0)  # no form error: the truth's features stay where the CAD has them
+    make_less_kind(bed, form_error_mm=0.0)
     cell = bed.workcell
     item = cell.component("oru_1_fixture")
-    q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").tcp2base, np.array(cell.home_joints_deg, float)).q_deg
+    task = cell.task("oru_1_grasp")
+    target = task.tcp2base if place == "tcp" else task.approach2base
+    q = solve_ik(bed.model_robot, target, np.array(cell.home_joints_deg, float)).q_deg
     bed.joints_deg = q
     camera = bed.camera()
     view = ModelView(bed.intrinsics)
@@ -31,7 +36,11 @@ def test_the_fixture_by_its_colours_on_the_workshop_camera_is_where_it_is():
     finally:
         view.close()
         camera.close()
-    truth_cam2world = camera.last_truth.cam2world
+    return bed, item, result, camera.last_truth.cam2world
+
+
+def test_the_fixture_by_its_colours_on_the_workshop_camera_is_where_it_is():
+    bed, item, result, truth_cam2world = _fixture_by_colour("tcp")
     truth = np.linalg.inv(truth_cam2world) @ item.item2world
     assert result.found and result.edges is not None and result.edges.settled, result.message
     fitted_cam2world = item.item2world @ np.linalg.inv(result.edges.obj2cam)
@@ -43,34 +52,16 @@ def test_the_fixture_by_its_colours_on_the_workshop_camera_is_where_it_is():
 
 
 def test_the_fixture_by_its_colours_from_the_approach_states_a_1_sigma_its_error_falls_within():
-    """From the approach (about 350 mm) with the robot's typical errors, the outline by colour puts the camera about
-    1.5 mm off: the colours end inward of the lit top bevel by more than the median shift takes out.
-    The fit says so itself: where the strongest gradient lies near its colour steps moves the pose that far, and that
-    disagreement is in its covariance (without it the error was 3-5 times the stated 1-sigma)."""
+    """From the approach (about 350 mm), the outline by colour puts the camera about 1.5 mm off: the colours end
+    inward of the lit top bevel by more than the median shift takes out. The fit says so itself: where the strongest
+    gradient lies near its colour steps moves the pose that far, and that disagreement is in its covariance (without
+    it the error was 3 times the stated 1-sigma)."""
     from calib_core.vision.edge_solution import edge_solution
-    from tests.core.vision.test_find_points import _errors_times
 
-    bed = TestBed.create(errors=_errors_times(1.0))
-    make_less_kind(bed, form_error_mm=0.0)
-    cell = bed.workcell
-    item = cell.component("oru_1_fixture")
-    q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").approach2base, np.array(cell.home_joints_deg, float)).q_deg
-    bed.joints_deg = q
-    camera = bed.camera()
-    view = ModelView(bed.intrinsics)
-    try:
-        frame = camera.read()
-        model = np.linalg.inv(bed.model_cam2world(q)) @ item.item2world
-        expected = view.of_cell(cell.components, bed.visuals_for_model(), q, item.item2world)
-        result = find_points(frame.image, bed.intrinsics, item, model, expected=expected, by_colour=True)
-    finally:
-        view.close()
-        camera.close()
+    bed, item, result, truth_cam2world = _fixture_by_colour("approach")
     fit = result.edges
     assert fit is not None and fit.settled and fit.outline_bias is not None, result.message
-    error_mm = np.linalg.norm(
-        (item.item2world @ np.linalg.inv(fit.obj2cam))[:3, 3] - camera.last_truth.cam2world[:3, 3]
-    )
+    error_mm = np.linalg.norm((item.item2world @ np.linalg.inv(fit.obj2cam))[:3, 3] - truth_cam2world[:3, 3])
     stated_mm = np.linalg.norm(edge_solution(fit, bed.intrinsics).uncertainty.std_camera_position_mm)
     # the gradients' pose is the stated bias away; the error lies within three of the stated 1-sigma
     assert np.linalg.norm(fit.outline_bias[3:]) > 0.2 * error_mm, (fit.outline_bias, error_mm)
