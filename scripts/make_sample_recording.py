@@ -6,11 +6,12 @@ The robot drives from home to the task location ``oru_1_grasp``, where a look co
 solves twice (plain and robust) and stores the correction, with the camera running throughout.
 The session runs in simulated time, so the file has the rates it states on any machine (rendering
 a frame takes longer than 1/15 s here); every stamp in it comes from that one clock. Run from the
-project root: ``.venv/bin/python scripts/make_sample_recording.py``.
+project root: ``.venv/bin/python scripts/make_sample_recording.py [--out FILE.mcap]``.
 """
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +39,8 @@ class SimulatedClock:
         return self.t_s
 
 
-def main() -> None:
+def main(out: Path = OUT) -> None:
+    """Record the session into ``out`` (written whole or not at all)."""
     cell, site = simulated_cell()
     bed = site.bed
     core = OperatorCore(cell, site)
@@ -48,8 +50,8 @@ def main() -> None:
     camera = bed.camera(seed=1)
     rng = np.random.default_rng(5)
     clock = SimulatedClock(1000.0)
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    part = OUT.with_name(OUT.stem + ".part.mcap")  # (the sample is replaced only by a whole recording)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    part = out.with_name(out.stem + ".part.mcap")  # (the sample is replaced only by a whole recording)
     core.start_recording(part, clock=clock, drop_when_busy=False)
     start = clock.t_s
     steps = [("pick", name) for name in FEATURES] + [("solve", False), ("solve", True), ("store", None), ("idle", None)]
@@ -91,13 +93,15 @@ def main() -> None:
     rec = core.recorder
     core.stop_recording()
     camera.close()
-    part.replace(OUT)
+    part.replace(out)
     duration = clock.t_s - start
     print(
-        f"wrote {OUT} ({OUT.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, "
+        f"wrote {out} ({out.stat().st_size // 1024} KiB, {duration:.1f} s: {rec.frames_written} frames at {FPS:g} fps, "
         f"{n_joint} joint samples at {JOINT_HZ:g} Hz)"
     )
 
 
 if __name__ == "__main__":
-    main()
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=OUT, help=f"the recording to write (default {OUT})")
+    main(parser.parse_args().out)
