@@ -9,17 +9,30 @@ and the fake camera keeps calling it. The fake camera stamps the buffer just bef
 takes its image *then* (a simulated camera renders the robot where it stands at that moment): the stamp is the
 exposure, as a real camera's is. The image is resized to the region the client chose and written in the pixel
 format it chose (RGB8, Mono8) into the buffer Aravis hands it.
+
+One simulated camera serves on an interface at a time on this machine: a GigE Vision device owns its address's
+control port (GVCP, UDP 3956), and two fake cameras bound to the loopback's both answered discovery, a client's
+register writes reaching the one another client controlled (a write timed out while two test suites ran). A camera
+made while another serves waits for it to close (:data:`WAIT_FOR_INTERFACE_S`), holding a lock file of the
+interface's that the system releases when its process ends, however it ends.
 """
 
 from __future__ import annotations
 
 import ctypes
+import fcntl
+import os
+import tempfile
+import time
 
 import cv2
 import numpy as np
 
 from calib_core.gige.aravis_lib import aravis
 from calib_core.gige.pixel_formats import MONO8, RGB8
+
+WAIT_FOR_INTERFACE_S = 300.0
+"""How long a simulated camera waits for another to leave its interface, s (a whole demo serves for a minute)."""
 
 _FILL = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint32)
 
@@ -56,8 +69,10 @@ class SimulatedGigECamera:
         self.images = images
         self.frames_sent = 0
         self._lib = _library()
+        self._hold = _hold_interface(interface)
         self._gv = Aravis.GvFakeCamera.new(interface, serial)
         if not self._gv.is_running():
+            self._release()
             raise RuntimeError(f"the fake GigE Vision camera could not serve on {interface} (another one there?)")
         self._fill_c = _FILL(self._fill)  # kept: the fake camera calls it for as long as it runs
         self._lib.arv_fake_camera_set_fill_pattern(_gpointer(self._gv.get_fake_camera()), self._fill_c, None)
@@ -90,3 +105,29 @@ class SimulatedGigECamera:
         import gc
 
         gc.collect()
+        self._release()
+
+    def _release(self) -> None:
+        if self._hold is not None:
+            os.close(self._hold)  # (closing the file releases its lock)
+            self._hold = None
+
+
+def _hold_interface(interface: str) -> int:
+    """An open lock file (its descriptor) of ``interface``'s GigE Vision port, held by this process; waits up to
+    :data:`WAIT_FOR_INTERFACE_S` for another simulated camera to close, then raises :class:`RuntimeError`."""
+    path = os.path.join(tempfile.gettempdir(), f"videocal-gige-{interface}.lock")
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+    deadline = time.monotonic() + WAIT_FOR_INTERFACE_S
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return fd
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                os.close(fd)
+                raise RuntimeError(
+                    f"another simulated GigE Vision camera has served on {interface} for over "
+                    f"{WAIT_FOR_INTERFACE_S:g} s ({path} is held)"
+                ) from None
+            time.sleep(0.05)  # another process's camera: nothing here to wait on but its lock

@@ -124,3 +124,36 @@ def test_pixel_formats():
         to_rgb(bytes(10), 8, 6, RGB8, "cam")
     with pytest.raises(VideoSourceError, match="0x02100032 is not supported"):
         to_rgb(bytes(100), 8, 6, 0x02100032, "cam")
+
+
+def test_one_simulated_camera_serves_on_an_interface_at_a_time():
+    """Two fake GigE Vision cameras on the loopback both answered discovery and a client's register writes reached the
+    one another client controlled: a second waits until the first has closed, across processes (a lock file of the
+    interface), and only it is then on the network."""
+    import fcntl
+    import os
+    import tempfile
+    import threading
+
+    scene = _scene()
+    first = SimulatedGigECamera(lambda: scene, serial="FIRST1")
+    second = {}
+    lock = os.open(os.path.join(tempfile.gettempdir(), "videocal-gige-lo.lock"), os.O_RDWR)
+    maker = threading.Thread(
+        target=lambda: second.setdefault("camera", SimulatedGigECamera(lambda: scene, serial="NEXT1"))
+    )
+    try:
+        with pytest.raises(BlockingIOError):  # held while the first serves: another process's camera would wait
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        maker.start()
+        first.close()
+        maker.join(timeout=60)
+        assert "camera" in second  # made once the first had gone
+        listing = subprocess.run(["arv-tool-0.8"], capture_output=True, text=True, timeout=60).stdout
+        assert "Aravis-Fake-NEXT1" in listing and "FIRST1" not in listing, listing
+    finally:
+        os.close(lock)
+        first.close()
+        maker.join(timeout=60)
+        if "camera" in second:
+            second["camera"].close()
