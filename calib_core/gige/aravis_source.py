@@ -132,6 +132,12 @@ class AravisSource(FrameSource):
             try:
                 apply()
             except Exception as exc:
+                if _timed_out(exc, self._Aravis):  # no answer is no refusal: the camera or the network is busy
+                    why = getattr(exc, "message", exc)
+                    raise VideoSourceError(
+                        f"{self.description}: no answer while setting {name}={o[name]!r} ({why}): is another "
+                        "application controlling the camera, or is the network dropping packets?"
+                    ) from None
                 raise VideoSourceError(
                     f"{self.description}: it refuses {name}={o[name]!r}: {getattr(exc, 'message', exc)}"
                 ) from None
@@ -267,3 +273,12 @@ class AravisSource(FrameSource):
 def open_aravis(spec: str, options: dict) -> AravisSource:
     """Entry point of ``videocal.cameras`` for ``aravis://``."""
     return AravisSource(spec, options)
+
+
+def _timed_out(exc: Exception, Aravis) -> bool:
+    """Whether ``exc`` is Aravis's timeout (a GLib error of its device domain): the camera did not answer."""
+    matches = getattr(exc, "matches", None)
+    try:
+        return bool(matches and matches(Aravis.device_error_quark(), int(Aravis.DeviceError.TIMEOUT)))
+    except TypeError:
+        return False

@@ -157,3 +157,20 @@ def test_one_simulated_camera_serves_on_an_interface_at_a_time():
         maker.join(timeout=60)
         if "camera" in second:
             second["camera"].close()
+
+
+def test_a_camera_that_does_not_answer_is_told_apart_from_one_that_refuses():
+    """Aravis's timeout (a GLib error of its device domain) is the camera or the network not answering, which the
+    message says as such; any other error is the camera's refusal."""
+    from gi.repository import GLib
+
+    from calib_core.gige.aravis_lib import aravis
+    from calib_core.gige.aravis_source import _timed_out
+
+    Aravis = aravis()
+    timeout = GLib.Error.new_literal(Aravis.device_error_quark(), "GigEVision write_register timeout", 5)
+    refused = GLib.Error.new_literal(
+        Aravis.device_error_quark(), "out of range", int(Aravis.DeviceError.PROTOCOL_ERROR)
+    )
+    assert _timed_out(timeout, Aravis) and not _timed_out(refused, Aravis)
+    assert not _timed_out(ValueError("not a GLib error"), Aravis)
