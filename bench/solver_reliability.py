@@ -9,19 +9,16 @@ status, so every pose they return counts as their answer.
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
-import poselib
 
-from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.frames import make_transform
 from calib_core.solver import solve_pose
-from calib_core.solver.sampler import INLIER_SIGMAS
 from scipy.spatial.transform import Rotation
 
-CAM = Intrinsics(1120.0, 1116.0, 645.2, 476.8, 1280, 960)
-NOISE_PX = 0.5
+from bench.solver_robust import _opencv_ransac, _poselib
+from bench.solver_scenes import CAM, NOISE_PX
+
 SCENES = 200
 
 
@@ -41,25 +38,12 @@ def _right(pose, T, allowed_mm: float) -> bool:
 
 
 def _peers(P, uv):
-    K = CAM.K
-    ok, rvec, tvec, _ = cv2.solvePnPRansac(
-        P,
-        uv,
-        K,
-        None,
-        reprojectionError=INLIER_SIGMAS * NOISE_PX,
-        confidence=0.9999,
-        iterationsCount=10000,
-        flags=cv2.SOLVEPNP_AP3P,
-    )
-    opencv = make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()) if ok else None
-    camera = {"model": "PINHOLE", "width": CAM.width, "height": CAM.height, "params": [CAM.fu, CAM.fv, CAM.cx, CAM.cy]}
+    """OpenCV's RANSAC and PoseLib's LO-RANSAC, as the robust timing rows call them; a peer that raises gives None."""
     try:
-        pose, _ = poselib.estimate_absolute_pose(uv, P, camera, {"max_reproj_error": INLIER_SIGMAS * NOISE_PX}, {})
-        theirs = make_transform(np.asarray(pose.R), np.asarray(pose.t))
+        theirs = _poselib(P, uv)
     except (RuntimeError, ValueError):
         theirs = None
-    return opencv, theirs
+    return _opencv_ransac(P, uv), theirs
 
 
 def robust_reliability_section(rng: np.random.Generator) -> list[str]:

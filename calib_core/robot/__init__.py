@@ -1,7 +1,7 @@
 """The robot model: URDF loaded with Pinocchio; forward kinematics, Jacobians and inverse
 kinematics of any frame, in mm and degrees at the boundary (Pinocchio's metres inside)."""
 
-import importlib
+from calib_core.lazy_exports import lazy_exports
 
 # Submodule of each public name. They load on first use (PEP 562): the model pulls in Pinocchio, trimesh and SciPy
 # (0.6 s), which a submodule needing none of them (the bounded xacro child, started once a document) need not pay.
@@ -16,11 +16,7 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f"calib_core.robot.{_WHERE[name]}"), name)
-    raise AttributeError(f"module 'calib_core.robot' has no attribute {name!r}")
-
+__getattr__ = lazy_exports(__name__, _WHERE)
 
 __all__ = [
     "RobotModel",

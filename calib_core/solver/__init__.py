@@ -4,7 +4,7 @@
 did; ``solve_pose_batch`` solves many independent problems at once.
 """
 
-import importlib
+from calib_core.lazy_exports import lazy_exports
 
 # Submodule of each public name. They load on first use (PEP 562): the numba kernels behind
 # ``solve_pose`` cost a few tenths of a second to import, which the window's start need not pay.
@@ -27,11 +27,7 @@ _WHERE = {
 }
 
 
-def __getattr__(name: str):
-    if name in _WHERE:
-        return getattr(importlib.import_module(f"calib_core.solver.{_WHERE[name]}"), name)
-    raise AttributeError(f"module 'calib_core.solver' has no attribute {name!r}")
-
+__getattr__ = lazy_exports(__name__, _WHERE)
 
 __all__ = [
     "solve_pose",
