@@ -21,6 +21,7 @@ from pathlib import Path
 
 from app.cli.options import bounded_int
 from calib_core.errors import VideocalError
+from calib_core.vision.target_spec import turn_ambiguity
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -208,10 +209,7 @@ def _from_files(args):
             )
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     if not spec.unambiguous:
-        raise VideocalError(
-            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
-            "board"
-        )
+        raise VideocalError(turn_ambiguity(spec, "a robot calibration"))
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
     board_views, views, rejected, size, of_components = [], [], [], None, []
@@ -264,10 +262,7 @@ def _from_bag(args, source: Path):
     robot = cell.load_robot()
     spec = parse_board(args.board or DEFAULT_SPEC)
     if not spec.unambiguous:
-        raise VideocalError(
-            f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
-            "board"
-        )
+        raise VideocalError(turn_ambiguity(spec, "a robot calibration"))
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     found = bag_board_views(
         source, spec, detect, joints_settled(source, robot, args.joint_topic), topic=args.topic, every=args.every

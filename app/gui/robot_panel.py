@@ -35,6 +35,7 @@ from calib_core.operator.tool_measuring import ToolMeasuring
 from calib_core.errors import OperatorError
 from calib_core.operator.calibration_run import VIA
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
+from calib_core.vision.target_spec import turn_ambiguity
 
 
 class RobotPanel(QWidget):
@@ -162,10 +163,7 @@ class RobotPanel(QWidget):
     def _spec(self):
         spec = parse_board(self.spec.text().strip())
         if not spec.unambiguous:
-            raise OperatorError(
-                f"a {spec.kind} target looks the same turned half a turn: a robot calibration needs a ChArUco or ArUco "
-                "board"
-            )
+            raise OperatorError(turn_ambiguity(spec, "a robot calibration"))
         return spec
 
     def _refresh(self) -> None:

@@ -3,9 +3,12 @@
 
 Detected with ``findChessboardCornersSB`` (the sector-based detector: sub-pixel corners, robust to
 blur and to lighting), falling back to the classic ``findChessboardCorners`` + ``cornerSubPix``.
-The whole board must be seen. A chessboard looks the same turned half a turn (a square one, a
-quarter turn too), so its detections fix the corners but not which is the first: fine for the
-intrinsics, while a hand-eye or robot calibration needs a ChArUco or ArUco board.
+The whole board must be seen. A board of odd by even squares (inner corners odd by even: OpenCV's
+``left01.jpg`` board of 9 x 6) looks different turned half a turn, since its colours swap: the square
+diagonally out from the first corner is black, and a detection that starts at the other end is turned
+round, so the first corner is known and the board serves a hand-eye or robot calibration. A board of
+odd by odd or even by even squares (a square one, too) looks the same turned: its detections fix the
+corners but not which is the first, fine for the intrinsics only.
 """
 
 from __future__ import annotations
@@ -30,7 +33,11 @@ class ChessboardSpec:
     square_mm: float
 
     kind = "chessboard"
-    unambiguous = False
+
+    @property
+    def unambiguous(self) -> bool:
+        """Whether a detection fixes which corner is the first: odd by even squares (a half turn swaps the colours)."""
+        return (self.cols + self.rows) % 2 == 1
 
     @classmethod
     def parse(cls, text: str) -> ChessboardSpec:
@@ -74,8 +81,25 @@ class ChessboardSpec:
                     corners = cv2.cornerSubPix(grey, corners, (5, 5), (-1, -1), _SUBPIX)
             if not found:
                 return TargetDetection(np.zeros((0, 2)), np.zeros(0, dtype=int), 0)
-            return TargetDetection(
-                corners.reshape(-1, 2).astype(np.float64), np.arange(self.cols * self.rows), self.cols * self.rows
-            )
+            corners = corners.reshape(-1, 2).astype(np.float64)
+            if self.unambiguous and _turned_round(grey, corners, self.cols):
+                corners = corners[::-1].copy()
+            return TargetDetection(corners, np.arange(self.cols * self.rows), self.cols * self.rows)
 
         return detect
+
+
+def _turned_round(grey: np.ndarray, corners_px: np.ndarray, cols: int) -> bool:
+    """Whether a detection (n, 2) px of a board of odd by even squares starts at the far end: the squares diagonal to
+    the first corner (outward and inward) are the sheet's black ones, the two beside them white; turned round, the
+    colours there are the other way."""
+    first, along, down = corners_px[0], corners_px[1] - corners_px[0], corners_px[cols] - corners_px[0]
+    blurred = cv2.GaussianBlur(grey, (0, 0), 1.0).astype(np.float32)
+
+    def shade(a: float, b: float) -> float:
+        p = (first + a * along + b * down).astype(np.float32).reshape(1, 1, 2)
+        return float(cv2.remap(blurred, p[..., 0], p[..., 1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)[0, 0])
+
+    dark = shade(-0.5, -0.5) + shade(0.5, 0.5)
+    light = shade(0.5, -0.5) + shade(-0.5, 0.5)
+    return dark > light

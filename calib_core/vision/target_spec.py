@@ -62,3 +62,17 @@ def dictionary(text: str, name: str, markers: int) -> None:
     available = cv2.aruco.getPredefinedDictionary(getattr(cv2.aruco, name)).bytesList.shape[0]
     if markers > available:
         raise spec_error(text, f"the board has {markers} markers, {name} only {available}")
+
+
+def turn_ambiguity(spec, purpose: str) -> str:
+    """Why ``spec`` (a target that looks the same turned) cannot serve ``purpose``, and which boards can."""
+    what = f"a {spec.kind} target"
+    if spec.kind == "chessboard":
+        what = (
+            f"a chessboard of {spec.cols + 1} x {spec.rows + 1} squares ({spec.cols} x {spec.rows} inner corners, both "
+            f"{'odd' if spec.cols % 2 else 'even'})"
+        )
+    return (
+        f"{what} looks the same turned half a turn, so a view does not say which corner is the first: {purpose} needs "
+        "a chessboard of odd by even squares (inner corners odd by even, as 9 x 6), or a ChArUco or ArUco board"
+    )

@@ -63,9 +63,15 @@ def test_ros_industrial_static_camera_set_gives_the_camera_in_the_base(tmp_path)
     np.testing.assert_allclose(placed.rotation, cam2base[:3, :3], atol=1e-6)
     assert "cam2base" in doc and "board2flange" in doc and "cam2flange" not in doc
     assert np.linalg.norm(np.array(doc["cam2base"]["xyz"]) - [-19.646, 1278.43, 283.965]) < 15.0
-    assert max(doc["std"]["xyz_mm"]) < 0.5 and doc["poses"] == 16
-    # 2.6 px on a 1600 x 1200 image from a real robot's poses is a good result: no disagreement said.
+    assert doc["poses"] == 16
+    # 2.6 px on a 1600 x 1200 image from a real robot's poses, where the corners are good to 0.7 px: within what poses
+    # good to a millimetre explain (no "do not agree"), but beyond the corners' noise, so the poses' agreement is said
+    # and the 1-sigma takes each view's pose error as one measurement (it claimed 0.1-0.4 mm with every corner taken
+    # as independent; the answer lies 9.5 mm from ROS-Industrial's starting guess)
     assert 1.0 < doc["rms_px"] < 4.0 and not any("do not agree" in w for w in doc["warnings"])
+    said = [w for w in doc["warnings"] if "beyond the corners' noise" in w]
+    assert len(said) == 1 and "the robot's poses agree to" in said[0] and "disagree most" in said[0]
+    assert 0.3 < max(doc["std"]["xyz_mm"]) < 3.0
     written = yaml.safe_load(out.read_text())
     assert written["cam2base"] == doc["cam2base"]
     # The same data read as a camera on the robot fits nothing, and says so without a traceback.

@@ -153,3 +153,27 @@ def test_locate_finds_the_creaseless_object_from_a_prior_10_mm_and_3_deg_off(dat
     error = mspd(located.obj2cam, view.obj2cam, points, np.eye(4)[None], view.intrinsics)
     assert prior_error > 8.0 and error < 5.0, (prior_error, error, located.message)
     assert located.status == "ok", located.message  # an unprinted object on its background: one answer
+
+
+def test_a_rounded_rotation_is_read_as_the_nearest_one_and_a_matrix_that_is_none_is_named(dataset, tmp_path):
+    """LM-O's annotated rotations are off orthonormal by up to 0.0096: read, they are the nearest rotation; a matrix
+    that is no rotation at all names its file and field."""
+    root, _, _ = dataset
+    import shutil
+
+    copy = tmp_path / "blob"
+    shutil.copytree(root, copy)
+    gt = copy / "test" / "000007" / "scene_gt.json"
+    data = json.loads(gt.read_text())
+    R = np.array(data["1"][0]["cam_R_m2c"]).reshape(3, 3)
+    data["1"][0]["cam_R_m2c"] = (R * 1.004).reshape(-1).tolist()  # as rounded annotations are
+    gt.write_text(json.dumps(data))
+    view = next(v for v in BopDataset(copy).views() if v.im_id == 1)
+    read = view.obj2cam[:3, :3]
+    np.testing.assert_allclose(read @ read.T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(read, R, atol=1e-9)
+    data["1"][0]["cam_R_m2c"] = (R * 1.2).reshape(-1).tolist()
+    gt.write_text(json.dumps(data))
+    with pytest.raises(FileFormatError) as e:
+        list(BopDataset(copy).views())
+    assert "1[0].cam_R_m2c" in str(e.value) and "not a rotation" in str(e.value)

@@ -162,3 +162,43 @@ def test_an_intrinsics_file_without_the_image_size_takes_the_images_size(tmp_pat
     assert (camera.width, camera.height) == (640, 480) and camera.fu == pytest.approx(535.9157, abs=1e-3)
     with pytest.raises(FileFormatError, match="another camera mode"):
         load_intrinsics(OPENCV / "left_intrinsics.yml", image_size=(1280, 960))
+
+
+def test_an_odd_by_even_chessboard_knows_its_first_corner_on_real_photos_turned_half_a_turn():
+    """OpenCV's left*.jpg board has 10 x 7 squares: a half turn swaps its colours, so the first corner is the same
+    physical corner in a photo and in the photo turned upside down (the detector alone starts where the image puts
+    it). What lets a chessboard serve a hand-eye calibration."""
+    spec = parse_board("chessboard:9x6:25")
+    assert spec.unambiguous
+    detect = spec.detector()
+    for path in sorted(OPENCV.glob("left[0-9]*.jpg"))[:6]:
+        grey = _grey(path)
+        h, w = grey.shape
+        upright, turned = detect(grey), detect(np.ascontiguousarray(grey[::-1, ::-1]))
+        assert len(upright.ids) == len(turned.ids) == 54, path.name
+        # a pixel (u, v) of the photo is at (w - 1 - u, h - 1 - v) in the turned one
+        back = np.array([w - 1.0, h - 1.0]) - turned.corners_px
+        # (the sub-pixel corners of a blurred photo differ by a pixel at most; turned the wrong way, by hundreds)
+        assert np.max(np.linalg.norm(back - upright.corners_px, axis=1)) < 1.5, path.name
+
+
+@pytest.mark.parametrize("text, unambiguous", [("chessboard:9x6:25", True), ("chessboard:8x6:25", False)])
+def test_a_printed_chessboard_turned_half_a_turn_is_found_the_right_way_round_or_said_ambiguous(text, unambiguous):
+    from calib_core.vision.hand_eye import calibrate_hand_eye
+    from calib_core.vision.intrinsics_calibration import CalibrationInputError
+
+    spec = parse_board(text)
+    assert spec.unambiguous is unambiguous
+    sheet = cv2.copyMakeBorder(spec.image(4.0), 60, 60, 60, 60, cv2.BORDER_CONSTANT, value=255)
+    turned = np.ascontiguousarray(sheet[::-1, ::-1])
+    found = spec.detector()(turned)
+    h, w = turned.shape
+    expected = np.array([w - 1.0, h - 1.0]) - (4.0 * spec.corners_mm()[found.ids, :2] + 60.0 - 0.5)
+    apart = np.max(np.linalg.norm(found.corners_px - expected, axis=1))
+    if unambiguous:
+        assert apart < 0.6
+        return
+    with pytest.raises(CalibrationInputError) as refused:
+        calibrate_hand_eye([None] * 4, [np.eye(4)] * 4, spec, None)
+    said = str(refused.value)
+    assert "9 x 7 squares" in said and "odd by even" in said and "ChArUco" in said
