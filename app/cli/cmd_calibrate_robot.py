@@ -21,7 +21,6 @@ from pathlib import Path
 
 from app.cli.options import bounded_int
 from calib_core.errors import VideocalError
-from calib_core.vision.target_spec import turn_ambiguity
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -209,6 +208,8 @@ def _from_files(args):
             )
     spec = parse_board(args.board or data.board_text or DEFAULT_SPEC)
     if not spec.unambiguous:
+        from calib_core.vision.target_spec import turn_ambiguity
+
         raise VideocalError(turn_ambiguity(spec, "a robot calibration"))
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
@@ -262,6 +263,8 @@ def _from_bag(args, source: Path):
     robot = cell.load_robot()
     spec = parse_board(args.board or DEFAULT_SPEC)
     if not spec.unambiguous:
+        from calib_core.vision.target_spec import turn_ambiguity
+
         raise VideocalError(turn_ambiguity(spec, "a robot calibration"))
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     found = bag_board_views(

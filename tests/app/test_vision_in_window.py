@@ -129,8 +129,20 @@ def test_bad_vision_input_gives_messages(qtbot, window):
     confirm_move_if_asked(qtbot, win)
     start = wb.joints_deg.copy()
     qtbot.waitUntil(lambda: np.max(np.abs(wb.joints_deg - start)) > 0.5, timeout=10_000)
-    # a frame the core's rule calls unsettled (what the capture applies)
-    qtbot.waitUntil(lambda: not wb.observations.stillness(win.camera.last_frame).settled, timeout=5_000)
+
+    # the frame the capture takes (the newest usable one), taken after the move was sent and unsettled by the core's
+    # rule: what the capture applies (under load the newest may still predate the move, a refusal of its own)
+    def moving_frame() -> bool:
+        frame = wb.observations.newest_usable()
+        sent_s = wb.arm.last_move_sent_s
+        return (
+            frame is not None
+            and sent_s is not None
+            and frame.t_host_s > sent_s
+            and not wb.observations.stillness(frame).settled
+        )
+
+    qtbot.waitUntil(moving_frame, timeout=5_000)
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert "the robot was moving" in win.results.status.text() and "deg/s" in win.results.status.text()
     assert not vision.capture.views and not vision.capture.rejected
