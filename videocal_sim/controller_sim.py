@@ -8,6 +8,8 @@ transports in :mod:`videocal_sim.controller_transport` carry the bytes.
 
 from __future__ import annotations
 
+import re
+
 import time
 from collections.abc import Callable
 
@@ -146,7 +148,8 @@ class ControllerLogic:
             msg = parse_body(inner)
         except ProtocolError as exc:
             code = "UNKNOWN" if exc.kind == "unknown" else "SYNTAX"
-            return out + [ErrorReply(code, str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80])]
+            why = str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80]
+            return out + [ErrorReply(code, f"move {move_id}: {why}" if (move_id := _move_id_of(inner)) else why)]
         if isinstance(msg, RequestJoints):
             out.append(self._sample())
         elif isinstance(msg, Stream):
@@ -291,3 +294,12 @@ class ControllerLogic:
             if self.deadman_s > 0:
                 deadlines.append(self._last_heartbeat_t + self.deadman_s + 1e-3)
         return min(deadlines)
+
+
+def _move_id_of(body: str) -> str | None:
+    """The id of a move sentence the controller could not read (``MVJ,<id>,...``), when its id is one: a refusal
+    names the move it refuses (a workstation ends only the move an error names)."""
+    fields = body.split(",")
+    if len(fields) >= 2 and fields[0] == "MVJ" and re.fullmatch(r"[A-Za-z0-9_.-]{1,32}", fields[1]):
+        return fields[1]
+    return None
