@@ -289,7 +289,8 @@ def test_a_flood_of_unsealed_heartbeats_is_counted_not_answered_beyond_ten_a_sec
     for _ in range(1000):  # 1 s of forged heartbeats every millisecond
         clock.t += 0.001
         replies += c.handle("HBT,60000")
-    assert 1 <= len(replies) <= 11 and len(c.auth_refusals) == 1000
+    assert 1 <= len(replies) <= 11 and c.refusals == 1000
+    assert len(c.auth_refusals) <= 200  # the latest kept: a flood does not grow the controller's memory
     assert ws.sealed("MVJ,a.1,10,0,0,0,0,0") == [Ack("MVJ", "a.1")]  # the workstation's move is obeyed at once
 
 
@@ -398,3 +399,31 @@ def test_a_second_writer_s_refused_sentences_do_not_end_the_workstation_s_moves(
             assert workstation.wait_for_samples(workstation.stats.samples + 2, 5.0)
             assert abs(workstation.latest.sample.joints_deg[0] - goal) < 0.5, k
         assert workstation.stats.errors >= errors + 4  # the foreign refusals did reach the workstation
+
+
+def test_a_flood_of_old_style_hellos_does_not_stop_the_workstation_opening_its_session(sim):  # noqa: F811
+    """A keyless writer on the line sending old-style two-field hellos every 20 ms (each draws
+    ``ERR,SYNTAX,HEL with 1 fields``): the workstation took any error mentioning HEL during its handshake as a
+    controller without authentication and gave up (3 of 6 connects). Every connect now opens its session and moves."""
+    import threading
+
+    s = sim("--pty")
+    stop = threading.Event()
+
+    def flood():
+        with serial.Serial(str(s.url), timeout=0) as other:
+            while not stop.is_set():
+                other.write(encode("HEL,0123456789abcdef"))
+                stop.wait(0.02)
+
+    flooder = threading.Thread(target=flood, daemon=True)
+    flooder.start()
+    try:
+        for k in range(4):
+            with ControllerLink(s.url, rate_hz=50) as workstation:
+                assert workstation.wait_for_samples(3, 5.0)
+                assert workstation._auth.wait_settled(10.0) is AuthState.READY, (k, workstation.auth_failure)
+                workstation.move_joints((2.0 * (k + 1), 0, 0, 0, 0, 0), timeout_s=20).wait(20)
+    finally:
+        stop.set()
+        flooder.join(5)
