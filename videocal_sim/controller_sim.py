@@ -8,6 +8,9 @@ transports in :mod:`videocal_sim.controller_transport` carry the bytes.
 
 from __future__ import annotations
 
+import re
+from collections import deque
+
 import time
 from collections.abc import Callable
 
@@ -41,6 +44,9 @@ from calib_core.link.protocol import (
 MAX_STREAM_HZ = 250.0
 REFUSALS_PER_S = 10
 """Refusals answered a second at most; the rest are counted (``refusals_unanswered``) and not answered."""
+KEPT_REFUSALS = 200
+"""The latest refusals kept (``auth_refusals``); all are counted (``refusals``): a flood of forged sentences grew the
+list without limit (42 to 206 MB in 15 s)."""
 SEEN_HELLOS = 16
 """How many of the workstation's latest hello nonces are remembered: a hello seen again is a replay, not answered."""
 
@@ -55,8 +61,9 @@ class ControllerLogic:
     ``key`` (32 bytes): the link's pre-shared key. With one, the controller speaks protocol 6 and
     obeys a motion sentence and a heartbeat only when sealed in the current session and sealed recently
     (:mod:`calib_core.link.auth`); it answers only hellos from the key's holder, and the dead-man counts by the
-    heartbeats' sealed times. Every refusal is kept in ``auth_refusals`` (and passed to ``on_refusal``) and answered
-    ``ERR,AUTH``, at most :data:`REFUSALS_PER_S` a second (a flood of forged sentences must not fill the line the
+    heartbeats' sealed times. Every refusal is counted (``refusals``), the latest :data:`KEPT_REFUSALS` kept in
+    ``auth_refusals``; those answered ``ERR,AUTH``, at most :data:`REFUSALS_PER_S` a second, are passed to
+    ``on_refusal`` (a flood's log is bounded as its replies are) (a flood of forged sentences must not fill the line the
     workstation's replies travel on). Without a key it is a protocol-3 controller: any client's ``MVJ`` moves it.
     """
 
@@ -85,7 +92,8 @@ class ControllerLogic:
         self.seq = seq_start % SEQ_MODULUS
         self.key = key
         self.on_refusal = on_refusal
-        self.auth_refusals: list[str] = []
+        self.auth_refusals: deque[str] = deque(maxlen=KEPT_REFUSALS)
+        self.refusals = 0
         self.refusals_unanswered = 0
         self._refusal_window = (0.0, 0)  # (start s, refusals answered in it)
         self._seen_hellos: list[str] = []
@@ -146,7 +154,8 @@ class ControllerLogic:
             msg = parse_body(inner)
         except ProtocolError as exc:
             code = "UNKNOWN" if exc.kind == "unknown" else "SYNTAX"
-            return out + [ErrorReply(code, str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80])]
+            why = str(exc).replace(",", ";").replace("*", "x").replace("$", "S")[:80]
+            return out + [ErrorReply(code, f"move {move_id}: {why}" if (move_id := _move_id_of(inner)) else why)]
         if isinstance(msg, RequestJoints):
             out.append(self._sample())
         elif isinstance(msg, Stream):
@@ -212,8 +221,7 @@ class ControllerLogic:
     def _refuse(self, text: str, now: float) -> list[ErrorReply]:
         """The refusal's reply, or none past :data:`REFUSALS_PER_S` this second (it is still counted)."""
         self.auth_refusals.append(text)
-        if self.on_refusal is not None:
-            self.on_refusal(text)
+        self.refusals += 1
         start, answered = self._refusal_window
         if now - start >= 1.0:
             start, answered = now, 0
@@ -222,6 +230,8 @@ class ControllerLogic:
             self._refusal_window = (start, answered)
             return []
         self._refusal_window = (start, answered + 1)
+        if self.on_refusal is not None:
+            self.on_refusal(text)
         return [ErrorReply("AUTH", text)]
 
     def _handshake(self, msg, now: float) -> list:
@@ -291,3 +301,12 @@ class ControllerLogic:
             if self.deadman_s > 0:
                 deadlines.append(self._last_heartbeat_t + self.deadman_s + 1e-3)
         return min(deadlines)
+
+
+def _move_id_of(body: str) -> str | None:
+    """The id of a move sentence the controller could not read (``MVJ,<id>,...``), when its id is one: a refusal
+    names the move it refuses (a workstation ends only the move an error names)."""
+    fields = body.split(",")
+    if len(fields) >= 2 and fields[0] == "MVJ" and re.fullmatch(r"[A-Za-z0-9_.-]{1,32}", fields[1]):
+        return fields[1]
+    return None

@@ -24,6 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "source",
         help="'sim', a cal_data.yaml (or its folder), a CSV of image,x_mm,y_mm,z_mm,qx,qy,qz,qw or image,<joints>, "
+        "a JSON list of {image, flange2base} (4 x 4, metres), "
         "or a ROS 2 bag (a bag folder, .mcap or .db3: images, /joint_states, CameraInfo)",
     )
     parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")

@@ -50,7 +50,14 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.workspace.exports import export_corrections
     from calib_core.workspace.workspace import load_workspace
 
+    from calib_core.workspace.controller_formats import left_out
+
     ws = load_workspace(args.workspace)
+    if args.format not in ("json", "csv") and not ws.corrections.corrected_tasks():
+        raise VideocalError(
+            f"{args.workspace}: no task location holds a correction, nothing to command"
+            + "".join(f"; {line}" for line in left_out(ws.corrections))
+        )
     robot, joint_map = _robot(args.workcell or ws.workcell_path)
     text = export_corrections(
         args.format,
@@ -60,6 +67,9 @@ def run(args: argparse.Namespace) -> int:
         robot,
         joint_map,
     )
+    if args.format not in ("json", "csv"):
+        for line in left_out(ws.corrections):
+            print(line, file=sys.stderr)
     if args.out:
         atomic_write_text(args.out, text)
         print(f"wrote {args.out}")

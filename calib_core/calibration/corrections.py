@@ -95,7 +95,17 @@ class CorrectionTable:
         return corrections[-1] if corrections else None
 
     def tasks(self) -> list[str]:
+        """Every task location with something stored: a correction or a measurement."""
         return list(self._table)
+
+    def corrected_tasks(self) -> list[str]:
+        """The task locations that hold a correction (what is commanded; a measurement never is)."""
+        return [task for task in self._table if self.latest(task) is not None]
+
+    def measured_only(self) -> list[str]:
+        """The task locations that hold measurements and no correction: nothing of theirs is commanded or exported
+        as a target."""
+        return [task for task in self._table if self.latest(task) is None]
 
     def corrected_target(self, task: str, target2base: np.ndarray) -> np.ndarray:
         """The pose (4, 4) mm to command through the model so the real TCP reaches ``target2base``:

@@ -63,8 +63,8 @@ def place_of_look(
 ) -> LookPlace:
     """Where a look was made for ``task`` (a :class:`~calib_core.workcell.model.TaskLocation`):
     ``tcp2base_at_look`` (4, 4) mm, the modelled TCP at the look's joints; ``corrected2base`` (4, 4) mm
-    the task's corrected target (``None`` without a stored correction); ``view_sources``: where the
-    look's frames came from (``live`` or a recording's name)."""
+    the task's corrected target (``None`` without a stored correction); ``view_sources``: the recordings the
+    look's frames came from, by name (empty: every frame live)."""
     tolerance_mm = float(task.tolerance_mm)
     tolerance_deg = float(np.degrees(tolerance_mm / LEVER_MM))
     places = {"task": task.tcp2base}
@@ -76,9 +76,8 @@ def place_of_look(
         offsets[name] = (float(np.linalg.norm(d)), float(np.linalg.norm(r)))
     nearest = min(offsets, key=lambda k: offsets[k][0] / tolerance_mm + offsets[k][1] / tolerance_deg)
     mm, deg = offsets[nearest]
-    recorded = [s for s in view_sources if s != "live"]
-    if recorded:
-        return LookPlace(task.name, "recording", mm, deg, tolerance_mm, tolerance_deg, ", ".join(recorded))
+    if view_sources:
+        return LookPlace(task.name, "recording", mm, deg, tolerance_mm, tolerance_deg, ", ".join(view_sources))
     if mm > tolerance_mm or deg > tolerance_deg:
         return LookPlace(task.name, "elsewhere", mm, deg, tolerance_mm, tolerance_deg)
     return LookPlace(task.name, nearest, mm, deg, tolerance_mm, tolerance_deg)

@@ -41,9 +41,9 @@ class SolveContext:
     points_obj_mm: np.ndarray | None = None
     """The solve's 3D points (m, 3) in the target's frame, for the image points' shared error."""
     intrinsics: Intrinsics | None = None
-    view_sources: tuple[str, ...] = ("live",)
-    """Where the frames of the look came from: ``live``, or a recording's name (see
-    :class:`~calib_core.calibration.view_stamp.ViewStamp`)."""
+    view_sources: tuple[str, ...] = ()
+    """The recordings the frames of the look came from, by name; empty when every frame was live (a frame's
+    :attr:`~calib_core.calibration.view_stamp.ViewStamp.recorded`, never its source's name, says which)."""
     form_tolerance_mm: float = 0.0
     """The target's features about their CAD positions (1-sigma per axis, mm): :attr:`SceneItem.form_tolerance_mm`."""
 

@@ -162,12 +162,12 @@ class CalibrationSession:
         carries the image points' shared error
         (:func:`~calib_core.calibration.end_effector.shared_shift_covariance`) and the target's
         ``form_tolerance_mm`` (:func:`~calib_core.calibration.form_error.form_error_covariance`). ``view_sources``:
-        where the look's frames came from (default: the used pairs' stamps). ``inputs``: the solve's inputs as a
-        recording keeps them."""
+        the recordings the look's frames came from, by name (default: the used pairs' stamps; empty: all live).
+        ``inputs``: the solve's inputs as a recording keeps them."""
         used = [p for p in self.pairs if p.number in set(numbers)]
         points = None if points_obj_mm is None else np.asarray(points_obj_mm, dtype=float).reshape(-1, 3)
         if view_sources is None:
-            view_sources = tuple(sorted({p.view.source for p in used if p.view is not None})) or ("live",)
+            view_sources = tuple(sorted({p.view.source for p in used if p.view is not None and p.view.recorded}))
         context = SolveContext(
             obj2world,
             cam2world_model,

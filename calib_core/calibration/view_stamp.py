@@ -31,6 +31,9 @@ class ViewStamp:
     stamp_gap_s: float
     captured_at: str = ""
     source: str = "live"
+    recorded: bool = False
+    """Whether the frame came from a recording (``source`` then names it, for people): a type, never the name's
+    spelling, since a user names a recording's file as they like (one named ``live`` is still a recording)."""
 
     def same_state(self, other: ViewStamp, tolerance_deg: float = SAME_STATE_DEG) -> bool:
         return self.joint_difference(other) <= tolerance_deg
@@ -52,6 +55,7 @@ class ViewStamp:
             "stamp_gap_s": self.stamp_gap_s,
             "captured_at": self.captured_at,
             "source": self.source,
+            "recorded": self.recorded,
         }
 
     @classmethod
@@ -68,4 +72,6 @@ class ViewStamp:
             float(d.get("stamp_gap_s", 0.0)),
             str(d.get("captured_at", "")),
             str(d.get("source", "live")),
+            # (files written before the flag: only a recording's name other than "live" says so)
+            bool(d["recorded"]) if "recorded" in d else str(d.get("source", "live")) != "live",
         )

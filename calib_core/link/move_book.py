@@ -61,17 +61,21 @@ class MoveBook:
         handle._finish()
         return None
 
-    def refused(self, msg: ErrorReply) -> None:
-        """An ``ERR``: it ends the move it names (``move <id>: ...``), else the oldest one waiting for its ``ACK``."""
+    def refused(self, msg: ErrorReply) -> bool:
+        """An ``ERR``: it ends the move it names (``move <id>: ...``) and nothing else. An error naming no move may
+        answer another writer on the line (a second client's malformed sentence, an old-style hello): taken as the
+        oldest move's refusal it once told the operator a move was refused that the robot went on to make. A move
+        refused without its name ends at its timeout, as one the controller never answered. True: it ended one."""
         named = _MOVE_IN_ERROR.match(msg.text)
+        if not named:
+            return False
         with self._lock:
-            handle = self._moves.get(named.group(1)) if named else None
-            if handle is None and not named and self._awaiting_ack:
-                handle = self._awaiting_ack[0]
+            handle = self._moves.get(named.group(1))
             if handle is None:
-                return
+                return False
             self._drop(handle)
         handle._finish(MoveError(f"move {handle.id} refused by the controller: {msg.code}: {msg.text}"))
+        return True
 
     def expire(self, now_s: float) -> None:
         """Finish every move whose deadline (host monotonic s) has passed with :class:`MoveTimeout`."""

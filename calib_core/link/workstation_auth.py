@@ -143,11 +143,7 @@ class WorkstationAuth:
             # (in a session, an "auth:" refusal answers another writer's handshake on the line, not ours)
             self._set(AuthState.FAILED, f"the controller refused {self._key_name} ({msg.text}); the robot is not moved")
             return True
-        if (
-            self.state is AuthState.PENDING
-            and not msg.text.startswith("move ")
-            and ("HEL" in msg.text or "AUT" in msg.text)
-        ):
+        if self.state is AuthState.PENDING and _does_not_know_the_handshake(msg):
             self._set(
                 AuthState.FAILED,
                 f"the controller does not authenticate as protocol 6 does (it answered {msg.code}: {msg.text}): "
@@ -220,3 +216,14 @@ class WorkstationAuth:
         if self.state is AuthState.PENDING:
             return "the link's handshake is still under way"
         return self.failure or "the link is not authenticated"
+
+
+def _does_not_know_the_handshake(msg: ErrorReply) -> bool:
+    """Whether ``msg`` is an older controller's answer to our hello: ``UNKNOWN`` about ``HEL`` or ``AUT`` (a
+    protocol-5 controller knows no three-field hello, a protocol-3 one no key). Any other error that mentions them
+    answers another writer on the line (a flood of old-style two-field hellos draws ``ERR,SYNTAX,HEL with 1 fields``,
+    which ours never is) and once made the workstation give up its handshake."""
+    if msg.code != "UNKNOWN":
+        return False
+    text = msg.text
+    return text.startswith(("HEL", "AUT")) or "'HEL'" in text or "'AUT'" in text

@@ -133,7 +133,11 @@ class CameraCalibrating:
         with the joints then; a :class:`RejectedView` says why not. Both are said in the log."""
         frame, stamp = self.picking.frame_to_capture()
         joints = None if stamp is None else np.array(stamp.joints_deg)
-        view = self.capture.add(frame.image, joints, frame_key=(self.observations.source, frame.index, frame.t_host_s))
+        view = self.capture.add(
+            frame.image,
+            joints,
+            frame_key=(self.observations.live, self.observations.source, frame.index, frame.t_host_s),
+        )
         if isinstance(view, RejectedView):
             self.log.say(f"{view.name} rejected: {view.reason}")
         else:

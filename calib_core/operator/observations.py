@@ -64,6 +64,9 @@ class Observations:
         self.history = live_history
         self._clock: ControllerClock | None = self.live_clock
         self.source = "live"
+        """What the frames are called for people: ``live`` or the recording's name (which the user chose)."""
+        self.live = True
+        """Whether the frames come from the camera: the type of the source, never its name."""
         self.latest: Frame | None = None
         self._recent: deque[Frame] = deque()
         self._recent_bytes = 0
@@ -71,7 +74,7 @@ class Observations:
 
     @property
     def replaying(self) -> bool:
-        return self.source != "live"
+        return not self.live
 
     def observe(self, frame: Frame) -> None:
         """A frame of the current source arrived: ``frame_observed``."""
@@ -95,12 +98,12 @@ class Observations:
     def replay(self, history: JointHistory, name: str) -> None:
         """A recording ``name`` stands in for the live source: its frames, stamped by its ``history``
         (on the recording's time axis, which has no link spread)."""
-        self._switch(history, name, None)
+        self._switch(history, name, None, live=False)
 
     def go_live(self) -> None:
         """Back to the camera and the link's joints. Frames seen before the replay are not kept: their
         joints are minutes old by now."""
-        self._switch(self.live_history, "live", self.live_clock)
+        self._switch(self.live_history, "live", self.live_clock, live=True)
 
     @property
     def margin_s(self) -> float:
@@ -108,9 +111,9 @@ class Observations:
         (none for a recording's frames, stamped on the recording's own time axis)."""
         return 0.0 if self._clock is None else self._clock.spread_s
 
-    def _switch(self, history: JointHistory, source: str, clock: ControllerClock | None) -> None:
+    def _switch(self, history: JointHistory, source: str, clock: ControllerClock | None, *, live: bool) -> None:
         self.release()
-        self.history, self.source, self._clock = history, source, clock
+        self.history, self.source, self._clock, self.live = history, source, clock, live
         self.latest = None
         self._recent.clear()
         self._recent_bytes = 0
@@ -131,7 +134,7 @@ class Observations:
         at = self.history.joints_at(frame.t_host_s)
         if at is None:
             raise NotSettledError(f"frame {frame.index} cannot be used: no joint sample near its capture time")
-        if self.source == "live":
+        if self.live:
             age_s = max(0.0, time.monotonic() - frame.t_host_s)
             captured_at = (datetime.now(timezone.utc) - timedelta(seconds=age_s)).isoformat(timespec="milliseconds")
         else:
@@ -143,6 +146,7 @@ class Observations:
             float(at.stamp_gap_s),
             captured_at,
             self.source,
+            recorded=not self.live,
         )
 
     def newest_usable(self) -> Frame | None:

@@ -138,7 +138,7 @@ class PointFinding:
             [],
             points_obj_mm=features,
             intrinsics=self.cell.intrinsics,
-            view_sources=(found.view.source,),
+            view_sources=(found.view.source,) if found.view.recorded else (),
             label="Calibrate on edges",
             form_tolerance_mm=item.form_tolerance_mm,
             inputs=inputs,

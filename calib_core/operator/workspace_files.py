@@ -87,9 +87,12 @@ class WorkspaceFiles:
         from calib_core.atomic_file import atomic_write_text
         from calib_core.workspace.exports import export_corrections
 
-        if not self.session.corrections.tasks():
+        from calib_core.workspace.controller_formats import left_out
+
+        if not self.session.corrections.corrected_tasks():
             raise CalibrationError(
                 "no corrections stored yet: calibrate at a task location and store its correction first"
+                + ("; " + "; ".join(left_out(self.session.corrections)) if self.session.corrections.tasks() else "")
             )
         atomic_write_text(
             path,
@@ -102,4 +105,7 @@ class WorkspaceFiles:
                 self.cell.joint_map,
             ),
         )
-        self.log.say(f"corrections exported to {path} ({fmt})")
+        self.log.say(
+            f"corrections exported to {path} ({fmt})"
+            + "".join(f"; {line}" for line in left_out(self.session.corrections))
+        )

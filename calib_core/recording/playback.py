@@ -99,9 +99,10 @@ class RecordingPlayback:
         return [self._recorded(p) for p in pairs.values()]
 
     def _recorded(self, pair: Correspondence) -> Correspondence:
-        if pair.view is None or pair.view.source == self.name:
+        if pair.view is None or (pair.view.recorded and pair.view.source == self.name):
             return pair
-        return replace(pair, view=replace(pair.view, source=self.name))
+        # a pair picked live is, replayed, a pair of this recording, whatever the recording's file is called
+        return replace(pair, view=replace(pair.view, source=self.name, recorded=True))
 
     def _view_at(self, t_s: float) -> ViewStamp | None:
         """For a pair recorded without its frame stamp (older recordings): the frame shown and the

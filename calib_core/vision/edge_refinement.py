@@ -23,6 +23,7 @@ from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_samples import MIN_STRENGTH as _MIN_STRENGTH
 from calib_core.vision.edge_samples import edge_model
 from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
+from calib_core.vision.pose_prior import PosePrior
 from calib_core.vision.region_model import MIN_CONTRAST, RegionModel
 
 _TUKEY = 4.685
@@ -151,6 +152,7 @@ def refine_to_edges(
     magnitude: np.ndarray | None = None,
     rms_bound_px: float = SETTLED_RMS_PX,
     colour: np.ndarray | None = None,
+    prior: PosePrior | None = None,
 ) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
@@ -158,7 +160,9 @@ def refine_to_edges(
     ``magnitude``: ``grey``'s :func:`gradient_magnitude`, when the caller has it. ``colour``: the image in RGB
     (h, w, 3) uint8; given, the outline's samples are found where the object's colours end
     (:mod:`calib_core.vision.region_model`) when its colours tell it from its surroundings, not at the strongest
-    gradient (print, texture and clutter have gradients too)."""
+    gradient (print, texture and clutter have gradients too). ``prior``: where the object is believed to be, as one
+    more measurement (:class:`~calib_core.vision.pose_prior.PosePrior`), which keeps the fit from walking along what
+    the edges hardly fix."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
     by_colour = colour is not None and colour.ndim == 3
     model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude, whole_outline=by_colour)
@@ -256,6 +260,10 @@ def refine_to_edges(
         J_chain, J_gap = chain, gap  # (the samples may be taken again before the loop ends: the covariance is of these)
         H = J.T @ (wts[:, None] * J)
         g = J.T @ (wts * r)
+        if prior is not None:
+            # the edges' residuals are px with unit weights: the prior's, in units of their scale
+            H_prior, g_prior = prior.normal_equations(pose)
+            H, g = H + sigma**2 * H_prior, g + sigma**2 * g_prior
         try:
             xi = np.linalg.solve(H + 1e-9 * np.eye(6) * np.trace(H), g)
         except np.linalg.LinAlgError:

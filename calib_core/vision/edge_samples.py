@@ -28,11 +28,25 @@ OUTLINE_ONLY_WHEN_UNCOVERED = 0.5
 any (a scanned mesh's outline: none of its facet edges holds a sample)."""
 
 
-def _segment_keys(seg: np.ndarray) -> list[bytes]:
-    """One key per segment (E, 2, 3), the same for both directions (to 1 um)."""
+def _segment_keys(seg: np.ndarray) -> np.ndarray:
+    """One key per segment (E, 2, 3), the same for both directions (to 1 um): (E, 6) int64, its ends in
+    lexicographic order."""
     ends = np.round(seg * 1000.0).astype(np.int64)
-    flip = [tuple(a) > tuple(b) for a, b in zip(ends[:, 0], ends[:, 1])]
-    return [(e[::-1] if f else e).tobytes() for e, f in zip(ends, flip)]
+    a, b = ends[:, 0], ends[:, 1]
+    differs = a != b
+    first = np.argmax(differs, axis=1)  # the first coordinate where the ends differ decides their order
+    rows = np.arange(len(ends))
+    flip = differs.any(axis=1) & (a[rows, first] > b[rows, first])
+    ordered = np.where(flip[:, None, None], ends[:, ::-1], ends)
+    return ordered.reshape(len(ends), 6)
+
+
+def _rows_in(rows: np.ndarray, known: np.ndarray) -> np.ndarray:
+    """Which of ``rows`` (n, k) int64 appear among ``known`` (m, k)."""
+    if not len(known) or not len(rows):
+        return np.zeros(len(rows), dtype=bool)
+    view = np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))
+    return np.isin(np.ascontiguousarray(rows).view(view).ravel(), np.ascontiguousarray(known).view(view).ravel())
 
 
 def visible_segments(mesh, obj2cam: np.ndarray, silhouette: np.ndarray | None = None) -> np.ndarray:
@@ -45,8 +59,8 @@ def visible_segments(mesh, obj2cam: np.ndarray, silhouette: np.ndarray | None = 
     seg = seg[facing.any(axis=1)]
     silhouette = silhouette_segments(mesh, centre) if silhouette is None else silhouette
     if len(silhouette):
-        known = set(_segment_keys(seg)) if len(seg) else set()
-        new = np.array([k not in known for k in _segment_keys(silhouette)], dtype=bool)
+        known = _segment_keys(seg) if len(seg) else np.zeros((0, 6), np.int64)
+        new = ~_rows_in(_segment_keys(silhouette), known)
         seg = np.concatenate([seg, silhouette[new]]) if len(seg) else silhouette
     return seg
 
@@ -59,30 +73,25 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
     and turn by less than 35 deg (a rim's facets make one chain; a plate's edges meet at corners and
     stay apart). A chain's samples share what the image does to that edge (its lighting, its bevel), so
     their offsets are not independent."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     n = len(seg)
-    parent = np.arange(n)
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    ends = np.round(seg * 1000.0).astype(np.int64)  # to 1 um
-    at: dict[bytes, list[tuple[int, int]]] = {}
-    for e in range(n):
-        for k in range(2):
-            at.setdefault(ends[e, k].tobytes(), []).append((e, k))
-    for meeting in at.values():
-        if len(meeting) != 2:
-            continue
-        (a, ka), (b, kb) = meeting
-        da = seg[a, 1 - ka] - seg[a, ka]  # both pointing away from the shared end
-        db = seg[b, 1 - kb] - seg[b, kb]
-        cos = -float(da @ db) / max(float(np.linalg.norm(da) * np.linalg.norm(db)), 1e-12)
-        if cos > np.cos(np.radians(_CHAIN_TURN_DEG)):
-            parent[root(a)] = root(b)
-    return np.array([root(i) for i in range(n)])
+    if n == 0:
+        return np.zeros(0, dtype=int)
+    ends = np.round(seg * 1000.0).astype(np.int64).reshape(-1, 3)  # to 1 um; slot i is segment i // 2, end i % 2
+    _, point, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+    point = point.ravel()
+    shared = np.flatnonzero(counts[point] == 2)  # the ends where exactly two segments meet
+    shared = shared[np.argsort(point[shared], kind="stable")]
+    first, second = shared[0::2], shared[1::2]
+    a, ka, b, kb = first // 2, first % 2, second // 2, second % 2
+    da = seg[a, 1 - ka] - seg[a, ka]  # both pointing away from the shared end
+    db = seg[b, 1 - kb] - seg[b, kb]
+    cos = -np.einsum("ij,ij->i", da, db) / np.maximum(np.linalg.norm(da, axis=1) * np.linalg.norm(db, axis=1), 1e-12)
+    join = cos > np.cos(np.radians(_CHAIN_TURN_DEG))
+    graph = coo_matrix((np.ones(int(join.sum())), (a[join], b[join])), shape=(n, n))
+    return connected_components(graph, directed=False)[1]
 
 
 def edge_points(

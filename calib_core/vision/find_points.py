@@ -36,6 +36,7 @@ from calib_core.vision.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to
 from calib_core.vision.edge_samples import edge_points
 from calib_core.vision.feature_detectors import Detection, NotDetected
 from calib_core.vision.target_detectors import TargetDetectors, as_grey
+from calib_core.vision.pose_prior import PosePrior
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
 from calib_core.workcell.feature_kinds import CORNER, FeatureKind
 
@@ -156,6 +157,7 @@ def find_points(
     expected=None,
     edge_rms_px: float = SETTLED_RMS_PX,
     by_colour: bool = False,
+    prior: PosePrior | None = None,
 ) -> FoundPoints:
     """Locate ``item``'s features in ``image`` (h, w[, 3]) uint8, seen by a camera that the model puts at
     ``obj2cam_model`` (4, 4: the item's frame to the camera's, mm). ``kinds`` by feature name (default:
@@ -166,7 +168,8 @@ def find_points(
     from the modelled one (the robot's error), which bounds the search. ``edge_rms_px``: the edge fit's settle bound
     (:data:`~calib_core.vision.edge_refinement.SETTLED_RMS_PX` for the cell's camera; coarser for a photo).
     ``by_colour``: the outline found where the target's colours end (:mod:`~calib_core.vision.region_model`),
-    not at the strongest gradient, on a colour image where the target's colours tell it from its surroundings."""
+    not at the strongest gradient, on a colour image where the target's colours tell it from its surroundings.
+    ``prior``: where the target is believed to be, a measurement of every edge fit (a look on a photograph)."""
     t0 = time.perf_counter()
     kinds = item.feature_kinds if kinds is None else kinds
     names = list(item.features)
@@ -225,6 +228,7 @@ def find_points(
             magnitude=detectors.magnitude,
             rms_bound_px=edge_rms_px,
             colour=colour,
+            prior=prior,
         )
         return replace(fit, min_share=_FIT_SHARE)  # settled only on more than half its edges: proposals follow from it
 
@@ -310,6 +314,7 @@ def find_points(
                 search_px=_RECHECK_SEARCH_PX,
                 rms_bound_px=edge_rms_px,
                 colour=colour,
+                prior=prior,
             ),
             min_share=_FIT_SHARE,
         )

@@ -11,6 +11,9 @@ Two layouts are read:
   joint), each row one view. With joints, an optional ``component`` column after ``image`` names the
   workcell's surveyed component a view shows instead of the board (empty: a board view), for the
   robot calibration's tie to the cell.
+- **A JSON pose file**: a list of ``{image, flange2base}``, the tool's pose in the base as a row-major 4 x 4 with its
+  translation in metres (as controllers and ROS report it; the form of the workplace's shared hand-eye sets), or
+  ``{"length_unit": "mm" | "m", "poses": [...]}`` to say the unit.
 
 Every problem is a :class:`~calib_core.errors.FileFormatError` naming the file, the row or entry
 and the field; nothing is read from an image until it is used.
@@ -99,7 +102,64 @@ def load_posed_images(path: str | Path) -> PosedImages:
         path = found[0]
     if path.suffix.lower() == ".csv":
         return _load_csv(path)
+    if path.suffix.lower() == ".json":
+        return _load_json(path)
     return _load_cal_data(path)
+
+
+ROTATION_TOLERANCE = 1e-3
+"""How far from orthonormal (the largest element of R R^T - I) a pose file's rotation may be: controllers print
+nine or so digits; a rotation further off is none, and is named."""
+
+
+def _load_json(path: Path) -> PosedImages:
+    import json
+
+    text = read_text(path, "pose file (JSON)", 16 * 1024 * 1024)
+    try:
+        doc = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise FileFormatError(path, f"not JSON ({exc})") from None
+    scale = 1000.0
+    if isinstance(doc, dict):
+        unit = doc.get("length_unit", "m")
+        if unit not in ("m", "mm"):
+            raise FileFormatError(path, f"must be 'm' or 'mm', got {unit!r}", "length_unit")
+        scale = 1000.0 if unit == "m" else 1.0
+        doc = doc.get("poses")
+    if not isinstance(doc, list) or not 1 <= len(doc) <= MAX_VIEWS:
+        raise FileFormatError(path, f"expected a list of 1 to {MAX_VIEWS} {{image, flange2base}} entries")
+    views = []
+    for k, entry in enumerate(doc):
+        where = f"[{k}]"
+        if not isinstance(entry, dict) or not isinstance(entry.get("image"), str) or not entry["image"].strip():
+            raise FileFormatError(path, "expected an object with an image (a path) and flange2base", where)
+        try:
+            T = np.array(entry.get("flange2base"), dtype=float)
+        except (TypeError, ValueError):
+            raise FileFormatError(path, "expected a 4 x 4 matrix of numbers", f"{where}.flange2base") from None
+        if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+            raise FileFormatError(path, "expected a 4 x 4 matrix of finite numbers", f"{where}.flange2base")
+        R = T[:3, :3]
+        if (
+            np.abs(R @ R.T - np.eye(3)).max() > ROTATION_TOLERANCE
+            or np.linalg.det(R) <= 0
+            or not np.allclose(T[3], [0, 0, 0, 1])
+        ):
+            raise FileFormatError(
+                path,
+                "not a rigid transform (its rotation is none, or its last row is not 0 0 0 1)",
+                f"{where}.flange2base",
+            )
+        u, _, vt = np.linalg.svd(R)
+        t_mm = T[:3, 3] * scale
+        if np.abs(t_mm).max() > 1e5:
+            raise FileFormatError(
+                path, f"a translation of {np.abs(t_mm).max():.3g} mm: is the unit right?", f"{where}.flange2base"
+            )
+        image = entry["image"].strip()
+        views.append(PosedImage(Path(image).stem, path.parent / image, flange2base=make_transform(u @ vt, t_mm)))
+    return PosedImages(path, views)
 
 
 def _quaternion_pose(values: dict, path: Path, where: str, scale_mm: float, keys: tuple[str, ...]) -> np.ndarray:

@@ -20,6 +20,7 @@ from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.vision.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
 from calib_core.vision.located import Located, LocatedFeature
+from calib_core.vision.pose_prior import PosePrior
 from calib_core.vision.locate_verdict import points_sigma_px, verdict
 
 PHOTO_EDGE_RMS_PX = 1.5
@@ -66,6 +67,8 @@ def locate(
         features=default_features(mesh) if features is None else dict(features),
     )
 
+    believed = PosePrior(prior, reach_mm, reach_deg)
+
     def look(start: np.ndarray) -> FoundPoints:
         if item.features:
             return find_points(
@@ -78,8 +81,9 @@ def locate(
                 reach_deg=reach_deg,
                 edge_rms_px=PHOTO_EDGE_RMS_PX,
                 by_colour=True,
+                prior=believed,
             )
-        return _edges_only(image, intrinsics, item, start, expected, reach_mm, reach_deg)
+        return _edges_only(image, intrinsics, item, start, expected, reach_mm, reach_deg, believed)
 
     located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg, mesh)
     if located.status != "ok":
@@ -137,7 +141,7 @@ def _starts_round(prior: np.ndarray, mm: float, deg: float) -> list[np.ndarray]:
     return out
 
 
-def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -> FoundPoints:
+def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg, believed) -> FoundPoints:
     """Find points' pose search and edge fit for an object without features: one dummy feature at its centre,
     reported as missed, so the same code runs."""
     centre = np.asarray(item.mesh.bounding_box.centroid, dtype=float)
@@ -161,6 +165,7 @@ def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg) -
         reach_deg=reach_deg,
         edge_rms_px=PHOTO_EDGE_RMS_PX,
         by_colour=True,
+        prior=believed,
     )
 
 
@@ -240,5 +245,6 @@ def _report(
         round(moved, 3),
         round(float(turned), 4),
         found.seconds,
-        {"points_sigma_px": round(points_sigma, 2)},
+        covariance=edges.covariance,
+        points_sigma_px=points_sigma,
     )

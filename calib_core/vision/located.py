@@ -46,6 +46,12 @@ class Located:
     prior_turned_deg: float | None = None
     seconds: float = 0.0
     extra: dict = field(default_factory=dict)
+    covariance: np.ndarray | None = field(default=None, repr=False)
+    """(6, 6) of the pose: the rotation vector (rad) and the translation (mm), camera frame, as the edge fit's step
+    moves it; widened by the spread of the starts that agree."""
+    points_sigma_px: float | None = None
+    """How far the object's points may lie from where ``obj2cam`` puts them in the image, 1-sigma px (the largest over
+    its vertices): what a pose error scored as BOP scores it (MSPD) would be."""
 
     def to_dict(self) -> dict:
         """The JSON form (mm, degrees): ``R_obj2cam``, ``t_obj2cam_mm``, ``std`` and the rest."""
@@ -89,6 +95,7 @@ class Located:
             else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
             "starts_apart_mm": self.extra.get("starts_apart_mm"),
             "starts_apart_px": self.extra.get("starts_apart_px"),
+            "points_sigma_px": _finite(self.points_sigma_px),
             "seconds": round(self.seconds, 3),
         }
 

@@ -327,8 +327,20 @@ FORMATS = tuple(LISTINGS)
 
 
 def corrected_targets(table: CorrectionTable, tasks: dict[str, TaskLocation]) -> dict[str, np.ndarray]:
-    """The target to command (4, 4) mm in base for every corrected task location the workspace knows."""
-    return {name: table.corrected_target(name, tasks[name].tcp2base) for name in table.tasks() if name in tasks}
+    """The target to command (4, 4) mm in base for every corrected task location the workspace knows (one that holds
+    only a measurement has none: it is left out, :func:`left_out`)."""
+    return {
+        name: table.corrected_target(name, tasks[name].tcp2base) for name in table.corrected_tasks() if name in tasks
+    }
+
+
+def left_out(table: CorrectionTable) -> list[str]:
+    """One line for each task location an export leaves out because it holds only a measurement."""
+    return [
+        f"{task}: left out, it holds only a measurement (a look made away from its pose or on a recording), never a "
+        "target to command"
+        for task in table.measured_only()
+    ]
 
 
 REFERENCE_POSES = {"rapid": (0.0, 0.0, 0.0, 0.0, 0.0, 0.0), "krl": (0.0, -90.0, 90.0, 0.0, 0.0, 0.0)}

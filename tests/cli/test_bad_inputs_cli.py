@@ -443,3 +443,51 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
 def test_joints_whose_first_is_negative_given_as_two_tokens_say_how_to_write_them():
     run = _videocal("render", "--joints", "-5,0,0,0,0,0", "--out", "never.png")
     _refused(run, "argument --joints: expected one argument", "--joints=VALUE", "--joints=-20,10,30")
+
+
+def test_an_export_of_a_task_holding_only_a_measurement_leaves_it_out_and_says_so(tmp_path):
+    """A look made elsewhere kept as a measurement: every controller listing failed on it with a traceback. Alone it
+    is a clear refusal (nothing to command); beside a correction, the listing holds the correction's target only and
+    a line says which task was left out and why."""
+    import numpy as np
+
+    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.camera.intrinsics_io import load_intrinsics
+    from calib_core.workcell import load_workcell
+    from calib_core.workspace.workspace import Workspace, save_workspace
+
+    cell = load_workcell()
+    tasks = dict(cell.task_locations)
+    names = list(tasks)
+
+    def stored(task, kind):
+        measured = tasks[task].tcp2base.copy()
+        measured[0, 3] += 1.0
+        return Correction(
+            task,
+            tasks[task].tcp2base,
+            measured,
+            np.array([1.0, 0, 0]),
+            np.zeros(3),
+            np.full(3, 0.1),
+            np.full(3, 0.01),
+            np.zeros(6),
+            0.3,
+            6,
+            kind=kind,
+        )
+
+    table = CorrectionTable()
+    table.add(stored(names[0], "measurement"))
+    path = tmp_path / "w.json"
+    intrinsics = load_intrinsics(cell.intrinsics_path)
+    save_workspace(path, Workspace(str(cell.path), intrinsics, tasks, "oru_1_fixture", [], table))
+    for fmt in ("urscript", "rapid", "krl", "fanuc", "pdl2"):
+        said = _refused(_videocal("export", path, "--format", fmt), "no task location holds a correction", names[0])
+        assert "only a measurement" in said
+    table.add(stored(names[1], "correction"))
+    save_workspace(path, Workspace(str(cell.path), intrinsics, tasks, "oru_1_fixture", [], table))
+    run = _videocal("export", path, "--format", "urscript")
+    assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr[-2000:]
+    assert f"global {names[1]}" in run.stdout and names[0] not in run.stdout
+    assert f"{names[0]}: left out, it holds only a measurement" in run.stderr

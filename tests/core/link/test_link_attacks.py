@@ -289,7 +289,8 @@ def test_a_flood_of_unsealed_heartbeats_is_counted_not_answered_beyond_ten_a_sec
     for _ in range(1000):  # 1 s of forged heartbeats every millisecond
         clock.t += 0.001
         replies += c.handle("HBT,60000")
-    assert 1 <= len(replies) <= 11 and len(c.auth_refusals) == 1000
+    assert 1 <= len(replies) <= 11 and c.refusals == 1000
+    assert len(c.auth_refusals) <= 200  # the latest kept: a flood does not grow the controller's memory
     assert ws.sealed("MVJ,a.1,10,0,0,0,0,0") == [Ack("MVJ", "a.1")]  # the workstation's move is obeyed at once
 
 
@@ -352,3 +353,77 @@ def test_a_relay_releasing_a_withheld_move_after_the_workstation_died_moves_noth
     assert not any(isinstance(r, Ack) and r.cmd == "MVJ" for r in replies)
     samples = [r for r in replies if isinstance(r, JointSample)]
     assert len(samples) >= 10 and all(abs(s.joints_deg[0]) < 1e-6 for s in samples)  # joint 1 never left 0 deg
+
+
+def test_an_error_naming_no_move_ends_no_move_and_one_naming_it_ends_that_one():
+    """A second writer's refusal (``$STR,999``: a rate too high; an old-style hello) names no move: it once ended the
+    oldest move waiting for its ACK, and the window said "refused" while the robot went on to the goal."""
+    from calib_core.connectors.link_types import MoveError, MoveHandle
+    from calib_core.link.move_book import MoveBook
+
+    book = MoveBook()
+    first, second = (
+        MoveHandle("m1.1", (10.0,), time.monotonic() + 30),
+        MoveHandle("m1.2", (20.0,), time.monotonic() + 30),
+    )
+    book.add(first)
+    book.add(second)
+    for foreign in (
+        ErrorReply("RANGE", "stream rate 999 Hz above 250 Hz"),
+        ErrorReply("AUTH", "hello 0123456789abcdef: wrong request: expected a nonce and a request"),
+        ErrorReply("SYNTAX", "bad checksum"),
+    ):
+        assert book.refused(foreign) is False
+    assert not first.finished and not second.finished
+    assert book.refused(ErrorReply("LIMIT", "move m1.2: joint 1 beyond its limit")) is True
+    assert second.finished and not first.finished
+    with pytest.raises(MoveError, match="m1.2 refused"):
+        second.wait(0)
+    assert book.refused(ErrorReply("LIMIT", "move m9.9: not ours")) is False and not first.finished
+
+
+def test_a_second_writer_s_refused_sentences_do_not_end_the_workstation_s_moves(sim):  # noqa: F811
+    """The real driver against the simulated controller on a pty, a second writer on the same line sending a sentence
+    that draws an error naming no move just before each of the workstation's moves (so the error arrives while the
+    move waits for its ACK): every move is confirmed done where it went, none said refused."""
+    s = sim("--pty")
+    with ControllerLink(s.url, rate_hz=50) as workstation, serial.Serial(str(s.url), timeout=0) as other:
+        assert workstation.wait_for_samples(3, 5.0) and workstation.auth_state is AuthState.READY
+        errors = workstation.stats.errors
+        for k, (goal, foreign) in enumerate(
+            ((8.0, "STR,999"), (-8.0, "HEL,0123456789abcdef"), (6.0, "STR,999"), (-6.0, "HEL,0123456789abcdef"))
+        ):
+            other.write(encode(foreign))
+            move = workstation.move_joints((goal, 0, 0, 0, 0, 0), timeout_s=30)
+            move.wait(30)  # raises MoveError had the foreign refusal ended it
+            assert workstation.wait_for_samples(workstation.stats.samples + 2, 5.0)
+            assert abs(workstation.latest.sample.joints_deg[0] - goal) < 0.5, k
+        assert workstation.stats.errors >= errors + 4  # the foreign refusals did reach the workstation
+
+
+def test_a_flood_of_old_style_hellos_does_not_stop_the_workstation_opening_its_session(sim):  # noqa: F811
+    """A keyless writer on the line sending old-style two-field hellos every 20 ms (each draws
+    ``ERR,SYNTAX,HEL with 1 fields``): the workstation took any error mentioning HEL during its handshake as a
+    controller without authentication and gave up (3 of 6 connects). Every connect now opens its session and moves."""
+    import threading
+
+    s = sim("--pty")
+    stop = threading.Event()
+
+    def flood():
+        with serial.Serial(str(s.url), timeout=0) as other:
+            while not stop.is_set():
+                other.write(encode("HEL,0123456789abcdef"))
+                stop.wait(0.02)
+
+    flooder = threading.Thread(target=flood, daemon=True)
+    flooder.start()
+    try:
+        for k in range(4):
+            with ControllerLink(s.url, rate_hz=50) as workstation:
+                assert workstation.wait_for_samples(3, 5.0)
+                assert workstation._auth.wait_settled(10.0) is AuthState.READY, (k, workstation.auth_failure)
+                workstation.move_joints((2.0 * (k + 1), 0, 0, 0, 0, 0), timeout_s=20).wait(20)
+    finally:
+        stop.set()
+        flooder.join(5)

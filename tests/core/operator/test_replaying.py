@@ -72,3 +72,24 @@ def test_a_file_that_is_no_recording_is_refused_by_name_and_nothing_changes(core
     with pytest.raises(FileFormatError, match="notes.mcap"):
         core.replay.open(bad)
     assert core.replay.playback is None and not core.picking.replaying
+
+
+def test_a_recording_named_live_branched_and_solved_is_no_correction_of_the_live_task(core, tmp_path):
+    """The sample recording saved as a file named ``live``: its pairs (picked live when it was made), branched, solved
+    again and stored, make a look on a recording, never the live task's correction."""
+    from calib_core.calibration.look_place import LookNotAtTask
+
+    path = tmp_path / "live"
+    shutil.copy(SAMPLE, path)
+    core.replay.open(path)
+    truth = RecordingPlayback(read_recording(path))
+    core.replay.seek(truth.duration_s)
+    assert all(p.view is None or p.view.recorded for p in core.session.pairs)
+    core.session.delete(core.session.pairs.pairs()[0].number)  # branch
+    core.picking.calibrate()
+    assert core.session.result.context.view_sources  # the recording, by name
+    place = core.desk.look_place()
+    assert place.at == "recording", place.text
+    with pytest.raises(LookNotAtTask):
+        core.desk.store_correction()
+    assert core.session.corrections.latest(core.task.name) is None
