@@ -92,6 +92,10 @@ class NonFiniteInputError(SolverInputError):
     """A coordinate is NaN or infinite."""
 
 
+class OutOfRangeInputError(SolverInputError):
+    """A coordinate far beyond any cell or sensor (a unit mistake, or a number no one meant)."""
+
+
 class DuplicatePointsError(SolverInputError):
     """Two pairs share the same 3D point or the same pixel."""
 

@@ -30,6 +30,7 @@ from calib_core.solver.errors import (
     InvalidIntrinsicsError,
     MismatchedPointsError,
     NonFiniteInputError,
+    OutOfRangeInputError,
     PointsBehindCameraError,
     TooFewPointsError,
     point_label,
@@ -45,6 +46,12 @@ COPLANAR_RATIO = 1e-6
 # Two 3D points closer than this fraction of the point spread, or two pixels closer than this, are duplicates.
 _DUPLICATE_REL_3D = 1e-9
 _DUPLICATE_PX = 1e-6
+
+
+MAX_COORDINATE_MM = 1e7
+"""The largest 3D coordinate a solve takes, mm (10 km: a cell is metres; 1e308 overflowed the kernels)."""
+MAX_PIXEL = 1e6
+"""The largest pixel coordinate a solve takes (a million pixels off any sensor)."""
 
 
 @dataclass(frozen=True)
@@ -116,6 +123,17 @@ def make_problem(
     if len(p3) < needed:
         why = " (the focal lengths are estimated too)" if estimate_focal else ""
         raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
+    with np.errstate(invalid="ignore"):  # (NaN and infinity are named below)
+        absurd = np.flatnonzero(
+            (np.isfinite(p3) & (np.abs(p3) > MAX_COORDINATE_MM)).any(axis=1)
+            | (np.isfinite(p2) & (np.abs(p2) > MAX_PIXEL)).any(axis=1)
+        )
+    if len(absurd):
+        raise OutOfRangeInputError(
+            f"{points_label(absurd)}: a coordinate beyond {MAX_COORDINATE_MM:g} mm or {MAX_PIXEL:g} px (is the unit "
+            "right?)",
+            absurd,
+        )
     code, i, j, coplanar, n_off_image, spread = check_pairs(
         p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height
     )

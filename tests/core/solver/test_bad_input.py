@@ -131,3 +131,19 @@ def test_nonsense_pixels_fail_as_a_status_not_an_exception():
     sol = solve_pose(P, uv, GRIPPER_CAMERA)
     assert sol.status is SolveStatus.FAILED
     assert sol.reason
+
+
+@pytest.mark.parametrize("value", [-1e308, 1e23, 5e7])
+def test_a_coordinate_no_cell_holds_names_its_point(value):
+    """A point at -1e308 mm once reached the kernels (ZeroDivisionError); one at 1e23 or 50 km is no cell's."""
+    from calib_core.solver import OutOfRangeInputError
+
+    p3 = P.copy()
+    p3[2, 0] = value
+    with pytest.raises(OutOfRangeInputError, match="point 3") as info:
+        solve_pose(p3, UV, GRIPPER_CAMERA)
+    assert info.value.points == (2,) and "is the unit right" in str(info.value)
+    uv = UV.copy()
+    uv[4, 1] = value
+    with pytest.raises(OutOfRangeInputError, match="point 5"):
+        solve_pose(P, uv, GRIPPER_CAMERA)
