@@ -1,4 +1,5 @@
-"""Run every ``bench/*_bench.py`` and ``bench/real_photos.py`` (or the ones named on the command line).
+"""Run every ``bench/*_bench.py``, ``bench/real_photos.py`` and ``bench/hand_eye_real.py`` (or the ones named on the
+command line, each followed by its own options).
 
 Each bench module has ``main() -> str``: it measures, writes its Markdown report to
 ``docs/benchmarks/<name>.md`` and returns the report's path. Timings never go in tests.
@@ -14,7 +15,9 @@ HERE = Path(__file__).resolve().parent
 
 
 def main(argv: list[str]) -> int:
-    names = argv or sorted(p.stem for p in HERE.glob("*_bench.py")) + ["real_photos"]
+    # names are the benches; what follows an option (``--views 60``) is the benches' own, read from sys.argv
+    names = [a for k, a in enumerate(argv) if not a.startswith("-") and (k == 0 or not argv[k - 1].startswith("-"))]
+    names = names or sorted(p.stem for p in HERE.glob("*_bench.py")) + ["real_photos", "hand_eye_real"]
     failed = []
     for name in names:
         mod = importlib.import_module(f"bench.{name.removesuffix('.py')}")

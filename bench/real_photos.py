@@ -350,7 +350,8 @@ def main(argv: list[str] | None = None) -> str:
         "",
         "## Where the data comes from",
         "",
-        f"BOP-format data sets (the BOP toolkit's layout) from `{root}`; the shared folder's README names each set's "
+        "BOP-format data sets (the BOP toolkit's layout) from "
+        f"`{os.path.relpath(root, PROJECT)}`; the shared folder's README names each set's "
         "source and licence: lmo_dev is LM-O's BOP 2019 test subset of scene 2 (134 Kinect images), handal_dev ten "
         "HANDAL photos (1920 x 1440, non-commercial: measured here, never shipped). A set named `lmo` (LM-O entire) "
         "and LM's scene 2 are held back for a final check and skipped.",
