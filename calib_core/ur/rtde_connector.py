@@ -58,6 +58,13 @@ class URRtdeController(ConnectorEvents):
         parts = urlsplit(url)
         if not parts.hostname:
             raise LinkError(f"{url!r}: a UR controller is ur-rtde://HOST (its IP address or name)")
+        host = parts.netloc.rsplit("@", 1)[-1]
+        if "]:" in host if host.startswith("[") else ":" in host:
+            # a port (or a malformed one, -1 or 99999) was given: it was silently replaced by UR's own
+            raise LinkError(
+                f"{url!r}: a UR controller serves on its fixed ports (RTDE {RTDE_PORT}, the secondary interface 30002, "
+                "the dashboard 29999): give ur-rtde://HOST without a port"
+            )
         if context.n_joints == 0:  # no cell (``monitor`` without --workcell): the UR's own six joints, in its order
             context = ControllerContext(
                 tuple(f"joint_{k + 1}" for k in range(6)),

@@ -152,6 +152,9 @@ def test_an_unreachable_controller_and_wrong_urls():
         open_controller("ur-rtde:///x", _context())
     with pytest.raises(LinkError, match="unknown option"):
         open_controller("ur-rtde://10.0.0.2?speed=3", _context())
+    for port in ("-1", "99999", "30004", "abc"):  # -1 once went to 30004 silently
+        with pytest.raises(LinkError, match="without a port"):
+            open_controller(f"ur-rtde://10.0.0.2:{port}", _context())
     with pytest.raises(LinkError, match="6 revolute joints"):
         open_controller("ur-rtde://10.0.0.2", ControllerContext(NAMES[:5], ("deg",) * 5, JointMap.identity(5)))
 
