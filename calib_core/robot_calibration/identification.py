@@ -25,6 +25,7 @@ from calib_core.camera.projection import as_pinhole, project
 from calib_core.errors import VideocalError
 from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.robot.model import RobotModel
+from calib_core.robot_calibration.left_out_views import OVERFIT_RATIO, left_out_ratio
 from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
@@ -46,11 +47,6 @@ SURVEY_SIGMA_MM = 0.05
 FD_STEP = 1e-4
 """Forward-difference step, in parameter units (mm, mrad, px, thousandths)."""
 MIN_VIEWS = 6
-OVERFIT_RATIO = 1.5
-"""How much further off (RMS) a view left out of the fit is predicted than the fit leaves it, beyond which the result
-says it bends the geometry to the views' errors. Measured: the simulated cold cell's 12 board and 9 component views,
-38 parameters, 1.14 (the parameters within their 3-sigma); 12 real views of a Franka, 24 parameters, 1.79 (0.33 px
-left against the corners' 0.29 px, where its recorded poses disagree by 3-6 mm)."""
 
 
 class RobotCalibrationError(VideocalError, ValueError):
@@ -358,7 +354,7 @@ def identify(
     warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
-    loo_ratio = _left_out_ratio(J, fit.fun, view_of, kept)
+    loo_ratio = left_out_ratio(J, fit.fun, view_of, kept)
     if loo_ratio > OVERFIT_RATIO:
         warnings.append(
             f"{len(views)} views for {k} identified parameters: each view, left out of the fit, is predicted "
@@ -388,28 +384,6 @@ def identify(
         {groups[g]: v for g, v in group_sigma.items()},
         left_out,
     )
-
-
-def _left_out_ratio(J: np.ndarray, residuals: np.ndarray, view_of: np.ndarray, kept: np.ndarray) -> float:
-    """The RMS of every view's residuals predicted with that view left out of the fit, over the RMS the fit leaves
-    (the deleted-residuals of a linearised least squares, a view at a time: ``(I - H_gg)^-1 r_g`` with ``H`` the hat
-    matrix ``J (J^T J)^-1 J^T``); near 1 when the views are many for the parameters, large when each view's own error
-    is fitted."""
-    rows = np.flatnonzero(kept & (residuals != 0))
-    if not len(rows):
-        return 1.0
-    H_inv = np.linalg.pinv(J.T @ J)
-    deleted = []
-    for g in np.unique(view_of[rows]):
-        idx = rows[view_of[rows] == g]
-        Jg = J[idx]
-        hat = Jg @ H_inv @ Jg.T
-        try:
-            deleted.append(np.linalg.solve(np.eye(len(idx)) - hat, residuals[idx]))
-        except np.linalg.LinAlgError:  # a view that alone fixes a parameter: its left-out prediction is unbounded
-            return float("inf")
-    fitted = float(np.sqrt(np.mean(residuals[rows] ** 2)))
-    return float(np.sqrt(np.mean(np.concatenate(deleted) ** 2))) / max(fitted, 1e-12)
 
 
 def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray, kept: np.ndarray) -> dict[str, str]:

@@ -114,7 +114,9 @@ def _moved_beyond(a: np.ndarray, b: np.ndarray, bound: tuple[float, float]) -> b
     return bool(turn > bound[0] or np.linalg.norm(a[:3, 3] - b[:3, 3]) > bound[1])
 
 
-def _perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
+def perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """``obj2cam`` (4, 4, mm) moved by ``xi`` (6,): the rotation vector (rad) turning it about the camera's origin,
+    then the translation (mm), camera frame: the step every edge fit, its Jacobians and the pose prior share."""
     out = obj2cam.copy()
     out[:3, :3] = Rotation.from_rotvec(xi[:3]).as_matrix() @ obj2cam[:3, :3]
     out[:3, 3] = Rotation.from_rotvec(xi[:3]).as_matrix() @ obj2cam[:3, 3] + xi[3:]
@@ -126,7 +128,7 @@ def normal_jacobian(
 ) -> np.ndarray:
     """The derivative (m, 6) of each point's (m, 3, object frame, mm) pixel along its unit normal
     (m, 2) in the pose's six small motions (the rotation vector in rad, then the translation in mm,
-    both in the camera frame, applied as :func:`_perturbed` does). The pixel's derivative in the
+    both in the camera frame, applied as :func:`perturbed` does). The pixel's derivative in the
     camera-frame point (central differences through the lens, three directions) times the point's in
     the motion (``-[X]x`` for a turn, the identity for a move)."""
     X = points_mm @ obj2cam[:3, :3].T + obj2cam[:3, 3]
@@ -275,7 +277,7 @@ def refine_to_edges(
             damping *= 0.5
         previous_xi = xi
         xi = damping * xi
-        pose = _perturbed(pose, xi)
+        pose = perturbed(pose, xi)
         rms = float(np.sqrt(np.sum(wts * r**2) / max(np.sum(wts), 1e-9)))
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
         share = float(np.mean(wts[counted] > 0)) if counted.any() else 0.0

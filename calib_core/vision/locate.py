@@ -21,7 +21,7 @@ from calib_core.solver import solve_pose
 from calib_core.vision.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
 from calib_core.vision.located import Located, LocatedFeature
 from calib_core.vision.pose_prior import PosePrior
-from calib_core.vision.locate_verdict import points_sigma_px, verdict
+from calib_core.vision.locate_verdict import verdict
 
 PHOTO_EDGE_RMS_PX = 1.5
 """The edge fit's settle bound on a photograph, px (with three quarters of the samples on their edges): a
@@ -85,7 +85,7 @@ def locate(
             )
         return _edges_only(image, intrinsics, item, start, expected, reach_mm, reach_deg, believed)
 
-    located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg, mesh)
+    located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg)
     if located.status != "ok":
         return located
     # Starts round the prior (half the reach, along and across the line of sight): on a photo whose view is nearly
@@ -100,7 +100,7 @@ def locate(
     for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(
         located.obj2cam, RIVAL_DEPTH_SHARE
     ):
-        other = _report(look(start), intrinsics, start, reach_mm, reach_deg, mesh)
+        other = _report(look(start), intrinsics, start, reach_mm, reach_deg)
         if other.status == "ok" and _within_reach(other.obj2cam, prior, reach_mm, reach_deg):
             fits.append(other)
     return verdict(fits, mesh, intrinsics, prior)
@@ -170,7 +170,7 @@ def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg, b
 
 
 def _report(
-    found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float, mesh
+    found: FoundPoints, intrinsics: Intrinsics, prior: np.ndarray, reach_mm: float, reach_deg: float
 ) -> Located:
     edges = found.edges
     features = tuple(LocatedFeature(p.feature, p.uv_px, p.point_mm, p.confidence, p.why) for p in found.proposals)
@@ -212,7 +212,6 @@ def _report(
             seconds=found.seconds,
         )
     std = np.sqrt(np.clip(np.diag(edges.covariance), 0.0, None))
-    points_sigma = points_sigma_px(mesh, edges.obj2cam, edges.covariance, intrinsics)
     features_pose, apart = None, None
     if len(features) >= 4:
         solution = solve_pose(
@@ -246,5 +245,4 @@ def _report(
         round(float(turned), 4),
         found.seconds,
         covariance=edges.covariance,
-        points_sigma_px=points_sigma,
     )

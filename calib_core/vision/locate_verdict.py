@@ -49,7 +49,7 @@ def points_sigma_px(mesh, obj2cam: np.ndarray, covariance: np.ndarray, intrinsic
     An outline that fixes the object's place but not its turn (a round silhouette) leaves the hidden and inner points
     free: what the pose error BOP scores (MSPD) measures, and the fit's own samples do not."""
     from calib_core.camera.projection import project_points
-    from calib_core.vision.edge_refinement import _perturbed
+    from calib_core.vision.edge_refinement import perturbed
 
     if covariance is None or not np.all(np.isfinite(covariance)):
         return float("inf")
@@ -61,7 +61,7 @@ def points_sigma_px(mesh, obj2cam: np.ndarray, covariance: np.ndarray, intrinsic
         step = np.zeros(6)
         h = 1e-5 if k < 3 else 1e-3
         step[k] = h
-        J[:, :, k] = (project_points(vertices, _perturbed(obj2cam, step), intrinsics) - base) / h
+        J[:, :, k] = (project_points(vertices, perturbed(obj2cam, step), intrinsics) - base) / h
     per_point = np.einsum("mik,kl,mil->m", J, covariance, J)
     return float(np.sqrt(np.max(np.clip(per_point, 0.0, None))))
 

@@ -132,10 +132,31 @@ def test_ros_rows_given_as_text_and_an_absurd_image_size(cell):
     _refused(_render(_camera_file(cell, huge), cell.folder), "bad.yaml", "image_width")
 
 
+def _stored(task: str, model, measured, kind: str = "correction"):
+    """A look's result stored for ``task``: the TCP 1 mm off its model along x, 6 pairs at 0.3 px."""
+    import numpy as np
+
+    from calib_core.calibration.corrections import Correction
+
+    return Correction(
+        task,
+        model,
+        measured,
+        np.array([1.0, 0, 0]),
+        np.zeros(3),
+        np.full(3, 0.1),
+        np.full(3, 0.01),
+        np.zeros(6),
+        0.3,
+        6,
+        kind=kind,
+    )
+
+
 def test_export_with_std_or_time_as_objects(tmp_path):
     import numpy as np
 
-    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.calibration.corrections import CorrectionTable
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.workcell import load_workcell
     from calib_core.workspace.workspace import Workspace, save_workspace
@@ -144,20 +165,7 @@ def test_export_with_std_or_time_as_objects(tmp_path):
     table = CorrectionTable()
     measured = np.eye(4)
     measured[0, 3] = 1.0
-    table.add(
-        Correction(
-            "oru_1_grasp",
-            np.eye(4),
-            measured,
-            np.array([1.0, 0, 0]),
-            np.zeros(3),
-            np.full(3, 0.1),
-            np.full(3, 0.01),
-            np.zeros(6),
-            0.3,
-            6,
-        )
-    )
+    table.add(_stored("oru_1_grasp", np.eye(4), measured))
     path = tmp_path / "w.json"
     save_workspace(
         path,
@@ -342,7 +350,7 @@ def test_a_camera_mounting_10_km_from_the_flange_is_refused(tmp_path):
 def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_path):
     import numpy as np
 
-    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.calibration.corrections import CorrectionTable
     from calib_core.calibration.correspondences import Correspondence
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.workcell import load_workcell
@@ -352,20 +360,7 @@ def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_
     table = CorrectionTable()
     measured = np.eye(4)
     measured[0, 3] = 1.0
-    table.add(
-        Correction(
-            "oru_1_grasp",
-            np.eye(4),
-            measured,
-            np.array([1.0, 0, 0]),
-            np.zeros(3),
-            np.full(3, 0.1),
-            np.full(3, 0.01),
-            np.zeros(6),
-            0.3,
-            6,
-        )
-    )
+    table.add(_stored("oru_1_grasp", np.eye(4), measured))
     pair = Correspondence(1, "oru_1_fixture", None, (100.0, 0.0, 0.0), None)
     path = tmp_path / "w.json"
     save_workspace(
@@ -449,9 +444,8 @@ def test_an_export_of_a_task_holding_only_a_measurement_leaves_it_out_and_says_s
     """A look made elsewhere kept as a measurement: every controller listing failed on it with a traceback. Alone it
     is a clear refusal (nothing to command); beside a correction, the listing holds the correction's target only and
     a line says which task was left out and why."""
-    import numpy as np
 
-    from calib_core.calibration.corrections import Correction, CorrectionTable
+    from calib_core.calibration.corrections import CorrectionTable
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.workcell import load_workcell
     from calib_core.workspace.workspace import Workspace, save_workspace
@@ -463,19 +457,7 @@ def test_an_export_of_a_task_holding_only_a_measurement_leaves_it_out_and_says_s
     def stored(task, kind):
         measured = tasks[task].tcp2base.copy()
         measured[0, 3] += 1.0
-        return Correction(
-            task,
-            tasks[task].tcp2base,
-            measured,
-            np.array([1.0, 0, 0]),
-            np.zeros(3),
-            np.full(3, 0.1),
-            np.full(3, 0.01),
-            np.zeros(6),
-            0.3,
-            6,
-            kind=kind,
-        )
+        return _stored(task, tasks[task].tcp2base, measured, kind)
 
     table = CorrectionTable()
     table.add(stored(names[0], "measurement"))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.robot_calibration.identification import _left_out_ratio
+from calib_core.robot_calibration.left_out_views import left_out_ratio
 
 
 def _fit(views: int, parameters: int, rows_per_view: int, seed: int) -> float:
@@ -17,7 +17,7 @@ def _fit(views: int, parameters: int, rows_per_view: int, seed: int) -> float:
     shared = np.vstack([rng.normal(size=(rows_per_view, 6)) @ rng.normal(size=6) for _ in range(views)]).ravel()
     y = shared + 0.1 * rng.normal(size=len(view_of))
     x, *_ = np.linalg.lstsq(J, y, rcond=None)
-    return _left_out_ratio(J, y - J @ x, view_of, np.ones(len(y), dtype=bool))
+    return left_out_ratio(J, y - J @ x, view_of, np.ones(len(y), dtype=bool))
 
 
 def test_many_views_for_few_parameters_predict_a_left_out_view_about_as_well_as_the_fit():
@@ -44,4 +44,4 @@ def test_a_view_left_out_is_predicted_exactly_as_refitting_without_it_does():
         xg, *_ = np.linalg.lstsq(J[keep], y[keep], rcond=None)
         refit.append(y[~keep] - J[~keep] @ xg)
     expected = np.sqrt(np.mean(np.concatenate(refit) ** 2)) / np.sqrt(np.mean(r**2))
-    assert abs(_left_out_ratio(J, r, view_of, np.ones(40, dtype=bool)) - expected) < 1e-9
+    assert abs(left_out_ratio(J, r, view_of, np.ones(40, dtype=bool)) - expected) < 1e-9

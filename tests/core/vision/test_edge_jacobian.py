@@ -5,7 +5,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.frames import make_transform
-from calib_core.vision.edge_refinement import _perturbed, normal_jacobian
+from calib_core.vision.edge_refinement import perturbed, normal_jacobian
 from scipy.spatial.transform import Rotation
 
 
@@ -21,15 +21,15 @@ def test_the_normal_jacobian_matches_central_differences_of_the_pose_through_a_d
     for k in range(6):
         step = np.zeros(6)
         step[k] = 1e-6 if k < 3 else 1e-4
-        plus = project_points(points, _perturbed(obj2cam, step), intrinsics)
-        minus = project_points(points, _perturbed(obj2cam, -step), intrinsics)
+        plus = project_points(points, perturbed(obj2cam, step), intrinsics)
+        minus = project_points(points, perturbed(obj2cam, -step), intrinsics)
         numeric[:, k] = np.einsum("ij,ij->i", (plus - minus) / (2 * step[k]), normals)
     assert np.allclose(J, numeric, rtol=1e-5, atol=1e-4 * np.abs(numeric).max())
     # and a small motion predicts the offsets it makes (first order)
     xi = np.array([2e-4, -1e-4, 3e-4, 0.05, -0.03, 0.1])
     moved = np.einsum(
         "ij,ij->i",
-        project_points(points, _perturbed(obj2cam, xi), intrinsics) - project_points(points, obj2cam, intrinsics),
+        project_points(points, perturbed(obj2cam, xi), intrinsics) - project_points(points, obj2cam, intrinsics),
         normals,
     )
     assert np.allclose(J @ xi, moved, atol=2e-3)

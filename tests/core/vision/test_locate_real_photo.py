@@ -10,23 +10,13 @@ import cv2
 import numpy as np
 import pytest
 
+from bench.real_photos import moved_prior  # the bench's priors, drawn the same way
 from calib_core.datasets.bop import BopDataset
 from calib_core.datasets.pose_errors import mspd
 from calib_core.mesh_files import load_mesh
 from calib_core.vision.locate import locate
-from scipy.spatial.transform import Rotation
 
 LMO = Path(__file__).resolve().parents[2] / "data" / "third_party" / "lmo"
-
-
-def _moved(truth: np.ndarray, mm: float, deg: float, seed: str) -> np.ndarray:
-    """The truth moved ``mm`` in a random direction and turned ``deg`` about a random axis (as the bench does)."""
-    rng = np.random.default_rng(zlib.crc32(seed.encode()))
-    d, axis = rng.normal(size=3), rng.normal(size=3)
-    prior = truth.copy()
-    prior[:3, :3] = Rotation.from_rotvec(np.radians(deg) * axis / np.linalg.norm(axis)).as_matrix() @ truth[:3, :3]
-    prior[:3, 3] = truth[:3, 3] + mm * d / np.linalg.norm(d)
-    return prior
 
 
 @pytest.mark.parametrize("obj_id", [1, 6])
@@ -39,7 +29,7 @@ def test_a_real_photo_gives_the_object_within_5_px_from_a_robots_error(obj_id):
     info = dataset.models()[obj_id]
     mesh = load_mesh(info.path)
     image = np.ascontiguousarray(cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1])
-    prior = _moved(view.obj2cam, 10.0, 3.0, f"{view.key}/10")
+    prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
     located = locate(image, view.intrinsics, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={})
     points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
     error_px = mspd(located.obj2cam, view.obj2cam, points, info.symmetries, view.intrinsics)

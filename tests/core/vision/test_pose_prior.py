@@ -8,7 +8,7 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
-from calib_core.vision.edge_refinement import _perturbed
+from calib_core.vision.edge_refinement import perturbed
 from calib_core.vision.locate_verdict import points_sigma_px
 from calib_core.vision.pose_prior import PosePrior
 
@@ -36,7 +36,7 @@ def test_the_priors_normal_equations_are_its_residuals_linearised():
     for k in range(6):
         h = np.zeros(6)
         h[k] = 1e-6
-        J[:, k] = (residual(_perturbed(pose, h)) - residual(_perturbed(pose, -h))) / 2e-6
+        J[:, k] = (residual(perturbed(pose, h)) - residual(perturbed(pose, -h))) / 2e-6
     H, g = prior.normal_equations(pose)
     expected = J.T @ W @ J
     assert np.max(np.abs(H - expected)) < 0.02 * np.max(np.abs(expected))
@@ -44,7 +44,7 @@ def test_the_priors_normal_equations_are_its_residuals_linearised():
     # steps on the prior alone land on it
     for _ in range(3):
         H, g = prior.normal_equations(pose)
-        pose = _perturbed(pose, np.linalg.solve(H, g))
+        pose = perturbed(pose, np.linalg.solve(H, g))
     np.testing.assert_allclose(residual(pose), 0.0, atol=1e-9)
 
 
