@@ -27,6 +27,7 @@ from calib_core.operator.cell import Cell
 from calib_core.operator.observations import HeldFrame, NotSettledError, Observations
 from calib_core.operator.operator_log import OperatorLog
 from calib_core.vision.corner_pick import refine_corner_pick
+from calib_core.vision.image_evidence import ImageEvidence
 
 
 class Picking:
@@ -39,6 +40,7 @@ class Picking:
         self.cell, self.session, self.observations, self.arm, self.log = cell, session, observations, arm, log
         self.current_pair: int | None = None
         """The pair being made: picked, not yet accepted (a click on the image moves its point)."""
+        self._evidence: ImageEvidence | None = None
         session.pairs.changed.connect(self.release_unused_still)
 
     def let_go(self) -> None:
@@ -125,7 +127,7 @@ class Picking:
             )
         shown = held.frame if held is not None else self.observations.latest
         if refine and shown is not None:
-            pixel = refine_corner_pick(shown.image, pixel)
+            pixel = refine_corner_pick(self.evidence(shown.image), pixel)
         self.session.move_2d(number, pixel, view)
         self.log.record("pair_moved", number=number, pixel=[float(pixel[0]), float(pixel[1])])
 
@@ -167,13 +169,20 @@ class Picking:
         )[0]
         return (uv, basis) if np.all(np.isfinite(uv)) else None
 
+    def evidence(self, image: np.ndarray) -> ImageEvidence:
+        """What the picks and Find points read from ``image`` (a frame's), kept for the last frame asked: the clicks
+        and Find points on one held frame share one grey, one gradient and one edge map."""
+        if self._evidence is None or self._evidence.source is not image:
+            self._evidence = ImageEvidence(image)
+        return self._evidence
+
     def refine_pick(self, image, pixel) -> tuple[float, float]:
         """``pixel`` (u, v) px on ``image`` refined: to the rim's centre for a round feature
         (:meth:`refine_circle_pick`), else to the nearest corner (``cv2.cornerSubPix``)."""
         centre = self.refine_circle_pick(image, pixel)
         if centre is not None:
             return float(centre[0]), float(centre[1])
-        return refine_corner_pick(image, pixel)
+        return refine_corner_pick(self.evidence(image), pixel)
 
     def refine_circle_pick(self, image, pixel):
         """A click on a round feature (the waiting pair's feature is a circle in the workcell) moved to the
@@ -181,7 +190,7 @@ class Picking:
         4 px, corrected for perspective. ``None`` when the feature is no circle or no rim was found."""
         from calib_core.camera.projection import project_points
         from calib_core.vision.feature_detectors import Detection, detect_circle
-        from calib_core.vision.target_detectors import as_grey, circle_rim
+        from calib_core.vision.target_detectors import circle_rim
 
         pending = self.session.pairs.pending()
         target = self.session.target
@@ -195,13 +204,16 @@ class Picking:
         point = np.asarray(item.features[pending.feature], dtype=float)
         rim, offset = circle_rim(point, kind, obj2cam, self.cell.intrinsics)
         centre = project_points(point[None], obj2cam, self.cell.intrinsics)[0]
-        grey = as_grey(image)
-        found = detect_circle(grey, rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0)
+        evidence = self.evidence(image)
+        grey, magnitude = evidence.grey, evidence.grey_magnitude
+        found = detect_circle(
+            grey, rim + (np.asarray(pixel, float) - centre), offset, search_px=4.0, magnitude=magnitude
+        )
         if not isinstance(found, Detection):
             return None
         # again from there in a tight window: the rim nearest, not the strongest edge within reach (a faint
         # boss's base beside its rim)
-        again = detect_circle(grey, rim + (found.uv_px - centre), offset, search_px=1.5)
+        again = detect_circle(grey, rim + (found.uv_px - centre), offset, search_px=1.5, magnitude=magnitude)
         return again.uv_px if isinstance(again, Detection) else found.uv_px
 
     def _view_for_pick(self, number: int) -> ViewStamp:

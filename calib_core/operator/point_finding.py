@@ -64,7 +64,11 @@ class PointFinding:
         from calib_core.vision.find_points import find_points
 
         result = find_points(
-            held.frame.image, self.cell.intrinsics, item, obj2cam_model, expected=self.modelled_view(q, item)
+            self.picking.evidence(held.frame.image),
+            self.cell.intrinsics,
+            item,
+            obj2cam_model,
+            expected=self.modelled_view(q, item),
         )
         self.found = FoundOnFrame(result, held.stamp)
         self.log.record(

@@ -5,15 +5,17 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from calib_core.vision.image_evidence import ImageEvidence
+
 
 def refine_corner_pick(
-    image_rgb: np.ndarray, pixel, half_window: int = 5, max_shift_px: float = 2.0
+    image_rgb: np.ndarray | ImageEvidence, pixel, half_window: int = 5, max_shift_px: float = 2.0
 ) -> tuple[float, float]:
-    """The corner nearest ``pixel`` (u, v) px to sub-pixel accuracy on ``image_rgb`` (h, w, 3); the
+    """The corner nearest ``pixel`` (u, v) px to sub-pixel accuracy on ``image_rgb`` (h, w, 3) (or its evidence); the
     click itself when the refinement wanders further than ``max_shift_px`` (no corner there: a circle
     centre, a flat patch), since the operator's click is then the better estimate."""
     u, v = float(pixel[0]), float(pixel[1])
-    grey = cv2.cvtColor(np.ascontiguousarray(image_rgb), cv2.COLOR_RGB2GRAY).astype(np.float32)
+    grey = ImageEvidence.of(image_rgb).grey.astype(np.float32)
     corner = np.array([[[u, v]]], dtype=np.float32)
     criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 40, 0.01)
     try:

@@ -11,13 +11,11 @@ from __future__ import annotations
 
 import weakref
 
-import cv2
 import numpy as np
 import trimesh
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
-from calib_core.vision import colour_contrast
 
 SHARP_DEG = 30.0
 TRUNCATE_PX = 8.0
@@ -79,9 +77,9 @@ def edge_samples_px(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intr
 def edge_distance_map(image: np.ndarray, truncate_px: float = TRUNCATE_PX) -> np.ndarray:
     """Distance (px, float32, truncated at ``truncate_px``) from every pixel to the nearest image edge (Canny;
     ``image`` grey, or RGB for edges of colour as well: :mod:`calib_core.vision.colour_contrast`)."""
-    edges = colour_contrast.edges(image)
-    dist = cv2.distanceTransform((edges == 0).astype(np.uint8), cv2.DIST_L2, 3)
-    return np.minimum(dist, truncate_px).astype(np.float32)
+    from calib_core.vision.image_evidence import ImageEvidence
+
+    return ImageEvidence.of(image).edge_distance(truncate_px)
 
 
 def matched_share(samples_px: np.ndarray, distance: np.ndarray, within_px: float = 2.0) -> float:

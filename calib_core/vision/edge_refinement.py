@@ -22,7 +22,8 @@ from calib_core.camera.projection import project, project_points
 from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.edge_samples import MIN_STRENGTH as _MIN_STRENGTH
 from calib_core.vision.edge_samples import edge_model
-from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
+from calib_core.vision.colour_contrast import gradient_magnitude
+from calib_core.vision.feature_detectors import search_normals
 from calib_core.vision.pose_prior import PosePrior
 from calib_core.vision.region_model import MIN_CONTRAST, RegionModel
 
@@ -155,6 +156,7 @@ def refine_to_edges(
     rms_bound_px: float = SETTLED_RMS_PX,
     colour: np.ndarray | None = None,
     prior: PosePrior | None = None,
+    colour_bins: np.ndarray | None = None,
 ) -> EdgeFit:
     """Refine ``obj2cam`` (the mesh's frame to the camera's, mm) so that the mesh's edges lie on the
     image's; ``expected_magnitude`` (h, w) the :func:`gradient_magnitude` of the cell rendered at
@@ -164,7 +166,8 @@ def refine_to_edges(
     (:mod:`calib_core.vision.region_model`) when its colours tell it from its surroundings, not at the strongest
     gradient (print, texture and clutter have gradients too). ``prior``: where the object is believed to be, as one
     more measurement (:class:`~calib_core.vision.pose_prior.PosePrior`), which keeps the fit from walking along what
-    the edges hardly fix."""
+    the edges hardly fix. ``colour_bins``: ``colour``'s
+    :attr:`~calib_core.vision.image_evidence.ImageEvidence.colour_bins`, when the caller has them."""
     magnitude = gradient_magnitude(grey) if magnitude is None else magnitude
     by_colour = colour is not None and colour.ndim == 3
     model = edge_model(mesh, obj2cam, intrinsics, expected_magnitude, whole_outline=by_colour)
@@ -178,7 +181,7 @@ def refine_to_edges(
     )
     regions = None
     if colour is not None and colour.ndim == 3:
-        regions = RegionModel.from_image(colour, *model.silhouette)
+        regions = RegionModel.from_image(colour, *model.silhouette, bins=colour_bins)
         if regions is not None and regions.separation < MIN_REGION_SEPARATION:
             regions = None  # the object's colours are its surroundings' too: the gradients are all there is
     pose = obj2cam.copy()

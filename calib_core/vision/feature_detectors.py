@@ -25,7 +25,7 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project, undistort_pixels, unproject
 from calib_core.vision.profile_matching import match_profiles
-from calib_core.vision import colour_contrast
+from calib_core.vision.colour_contrast import gradient_magnitude
 
 _ALIKE = 0.5  # the least correlation of a rim point's gradient profile with the model's to measure it by
 
@@ -101,12 +101,6 @@ def detect_corner(grey: np.ndarray, uv_pred: np.ndarray, radius_px: float) -> De
             crowded,
         )
     return detection(refined, confidence, crowded)
-
-
-def gradient_magnitude(image: np.ndarray) -> np.ndarray:
-    """The image's gradient magnitude (float32), lightly smoothed: what edge searches climb. ``image`` grey, or
-    RGB for edges of colour as well as lightness (:func:`calib_core.vision.colour_contrast.gradient_magnitude`)."""
-    return colour_contrast.gradient_magnitude(image)
 
 
 def search_normals(

@@ -19,6 +19,7 @@ from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
 from calib_core.vision.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
+from calib_core.vision.image_evidence import ImageEvidence
 from calib_core.vision.located import Located, LocatedFeature
 from calib_core.vision.pose_prior import PosePrior
 from calib_core.vision.locate_verdict import verdict
@@ -53,7 +54,8 @@ def locate(
     name: str = "object",
     color=(0.7, 0.7, 0.7),
 ) -> Located:
-    """The pose of the object ``mesh`` (mm, its own frame) in ``image`` (h, w[, 3]) uint8 taken by a camera of
+    """The pose of the object ``mesh`` (mm, its own frame) in ``image`` (h, w[, 3]) uint8 (or its
+    :class:`~calib_core.vision.image_evidence.ImageEvidence`) taken by a camera of
     ``intrinsics``, starting from ``prior_obj2cam`` (4, 4, mm: the object's frame to the camera's) and searching
     ``reach_mm`` and ``reach_deg`` round it. ``features`` name -> (3,) mm (default :func:`default_features`);
     ``expected``: the object rendered as the camera would see it (as :func:`find_points` takes it), to leave out
@@ -68,11 +70,12 @@ def locate(
     )
 
     believed = PosePrior(prior, reach_mm, reach_deg)
+    evidence = ImageEvidence.of(image)  # one grey, gradient and edge map for every start
 
     def look(start: np.ndarray) -> FoundPoints:
         if item.features:
             return find_points(
-                image,
+                evidence,
                 intrinsics,
                 item,
                 start,
@@ -83,7 +86,7 @@ def locate(
                 by_colour=True,
                 prior=believed,
             )
-        return _edges_only(image, intrinsics, item, start, expected, reach_mm, reach_deg, believed)
+        return _edges_only(evidence, intrinsics, item, start, expected, reach_mm, reach_deg, believed)
 
     located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg)
     if located.status != "ok":

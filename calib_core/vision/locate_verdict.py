@@ -13,11 +13,11 @@ RIVAL_SHARE = 0.02
 """A settled fit elsewhere on the image whose share of samples on their edges is within this of the answer's is a
 rival (on OpenCV's box photo the fits of the box's outline hold 97.5-99 %, a fit 11 px off it 94-96 %; fits that
 took the print for the outline, before the outline was found by colour, held 100 %)."""
-AGREE_PX = 2.0
+AGREE_PX = 3.0
 """Settled fits whose outlines lie within this many pixels of each other (or within three times the edges' RMS) are
-one answer: apart further, the photo holds two explanations and the answer is ``uncertain``. (On OpenCV's box photo,
-whose lens nobody calibrated, fits of the box's own outline from different starts lie up to 3 px apart at 1.3 px
-RMS; fits that took its print for its outline lay 12-35 px away.)"""
+one answer, their spread part of its 1-sigma: apart further, the photo holds two explanations and the answer is
+``uncertain``. (On OpenCV's box photo, whose lens nobody calibrated, fits of the box's own outline from different
+starts lie up to 3 px apart at 1.3 px RMS; fits that took its print for its outline lay 12-35 px away.)"""
 
 
 POINTS_SIGMA_PX = 5.0
@@ -104,15 +104,15 @@ def verdict(fits: list[Located], mesh, intrinsics: Intrinsics, prior: np.ndarray
             "rival_apart_px": round(max(d for d, _ in rivals), 2) if rivals else None,
         },
     )
-    bound = POINTS_SIGMA_PX * intrinsics.width / 640.0
+    sigma_bound = POINTS_SIGMA_PX * intrinsics.width / 640.0
     if not rivals:
-        if located.points_sigma_px is not None and located.points_sigma_px > bound:
+        if located.points_sigma_px is not None and located.points_sigma_px > sigma_bound:
             return with_fields(
                 located,
                 status="uncertain",
                 message="uncertain: the outline fixes where the object is seen, but not where its points are: they "
                 f"may lie {located.points_sigma_px:.1f} px from where this answer puts them (1-sigma, more than "
-                f"{bound:.1f} px); " + located.message,
+                f"{sigma_bound:.1f} px); " + located.message,
             )
         return located
     d, rival = max(rivals, key=lambda r: r[0])

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-_LEVELS = 32
-"""Histogram bins a colour channel (32 x 32 x 32 RGB bins)."""
+from calib_core.vision.image_evidence import COLOUR_LEVELS as _LEVELS
+
 _INNER_PX = 5
 """The object's colours are taken this far inside its silhouette at the start pose (the pose may be a few pixels
 off)."""
@@ -42,10 +42,13 @@ class RegionModel:
     separation: float
 
     @staticmethod
-    def from_image(image_rgb: np.ndarray, mask: np.ndarray, origin: tuple[int, int]) -> "RegionModel | None":
+    def from_image(
+        image_rgb: np.ndarray, mask: np.ndarray, origin: tuple[int, int], bins: np.ndarray | None = None
+    ) -> "RegionModel | None":
         """The model from ``image_rgb`` (h, w, 3) uint8 and the object's silhouette ``mask`` (uint8, 255 inside)
-        whose top-left pixel is ``origin`` (u0, v0) in the image; None where there is too little of either
-        region (under 50 pixels) to count."""
+        whose top-left pixel is ``origin`` (u0, v0) in the image; None where there is too little of either region
+        (under 50 pixels) to count. ``bins``: the image's colour bins
+        (:attr:`~calib_core.vision.image_evidence.ImageEvidence.colour_bins`), when the caller has them."""
         h, w = image_rgb.shape[:2]
         if mask.size == 0 or image_rgb.ndim != 3:
             return None
@@ -65,7 +68,7 @@ class RegionModel:
         band = (from_outside > _BAND_PX[0]) & (from_outside <= _BAND_PX[1])
         if inner.sum() < 50 or band.sum() < 50:
             return None
-        bins = _bins(image_rgb)
+        bins = _bins(image_rgb) if bins is None else bins
         n = _LEVELS**3
         h_object = np.bincount(bins[inner], minlength=n).astype(np.float64) / inner.sum()
         h_around = np.bincount(bins[band], minlength=n).astype(np.float64) / band.sum()
@@ -123,5 +126,6 @@ class RegionModel:
 
 
 def _bins(image_rgb: np.ndarray) -> np.ndarray:
-    q = (image_rgb.astype(np.int32) * _LEVELS) >> 8
-    return (q[..., 0] * _LEVELS + q[..., 1]) * _LEVELS + q[..., 2]
+    from calib_core.vision.image_evidence import ImageEvidence
+
+    return ImageEvidence(image_rgb).colour_bins

@@ -16,6 +16,8 @@ from calib_core.scene import SceneItem
 from calib_core.vision.corner_against_model import detect_corner_against_model
 from calib_core.vision.edge_alignment import crease_segments
 from calib_core.vision.edge_samples import model_shows_edge
+from calib_core.vision.colour_contrast import gradient_magnitude
+from calib_core.vision.image_evidence import ImageEvidence
 from calib_core.vision.feature_detectors import (
     Detection,
     NotDetected,
@@ -24,7 +26,6 @@ from calib_core.vision.feature_detectors import (
     detect_circle_against_model,
     detect_corner,
     detect_corner_from_edges,
-    gradient_magnitude,
 )
 from calib_core.workcell.feature_kinds import FeatureKind
 
@@ -32,10 +33,6 @@ _BOX_MARGIN_PX = 24.0  # the widest search from an edge (8 px) and the corner's 
 _COARSE = 0.5  # the view that says which edges show, at half resolution
 _DETAIL_SAMPLES = 2  # the test bed's camera integrates 2 x 2 (a real one its whole pixel area)
 _DETAIL_MARGIN_PX = 12.0  # a detector's search (3 px), its profile's half (3 px) and the gradient's reach
-
-
-def as_grey(image: np.ndarray) -> np.ndarray:
-    return image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
 
 
 def rim_points_mm(point: np.ndarray, kind: FeatureKind, count: int = 48) -> np.ndarray:
@@ -63,18 +60,16 @@ class TargetDetectors:
     """The detectors of one image and one target: the gradient computed once, the edges that end at
     each corner found once."""
 
-    def __init__(
-        self, grey: np.ndarray, item: SceneItem, intrinsics: Intrinsics, expected=None, colour: np.ndarray | None = None
-    ):
-        self.grey = grey
+    def __init__(self, evidence: ImageEvidence, item: SceneItem, intrinsics: Intrinsics, expected=None):
+        self.grey = evidence.grey
         self.expected = expected
         self._rendered: tuple[np.ndarray, np.ndarray, np.ndarray] | None = (
             None  # (obj2cam, the view as rendered, its grey)
         )
         self._expected_magnitude: np.ndarray | None = None
         self._box = (0, 0, 0, 0)
-        # edges from colour as well as lightness (``colour``: the frame as taken, RGB): an orange top on a tan table
-        self.magnitude = gradient_magnitude(grey if colour is None else colour)
+        # edges from colour as well as lightness: an orange top on a tan table
+        self.magnitude = evidence.magnitude
         self.intrinsics = intrinsics
         self.segments, self.normals = crease_segments(item.mesh)
         self.box_corners = trimesh.bounds.corners(item.mesh.bounds)
@@ -102,7 +97,7 @@ class TargetDetectors:
             h, w = self.grey.shape
             self._box = (max(int(lo[0]), 0), max(int(lo[1]), 0), min(int(hi[0]) + 1, w), min(int(hi[1]) + 1, h))
             view = self.expected(obj2cam, box_px=self._box, supersample=_COARSE)
-            self._rendered = (obj2cam.copy(), view, as_grey(view))
+            self._rendered = (obj2cam.copy(), view, ImageEvidence(view).grey)
             self._expected_magnitude = None
         return self._rendered[2]
 

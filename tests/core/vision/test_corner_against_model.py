@@ -4,7 +4,8 @@ import cv2
 import numpy as np
 
 from calib_core.vision.corner_against_model import detect_corner_against_model
-from calib_core.vision.feature_detectors import Detection, NotDetected, gradient_magnitude
+from calib_core.vision.colour_contrast import gradient_magnitude
+from calib_core.vision.feature_detectors import Detection, NotDetected
 
 
 def _plate(shift_px, size=120, samples=8) -> np.ndarray:

@@ -15,7 +15,7 @@ from videocal_sim.true_robot import RobotErrors
 from calib_core.vision.edge_alignment import edge_distance_map
 from calib_core.vision.edge_refinement import refine_to_edges
 from calib_core.vision.edge_samples import edge_points
-from calib_core.vision.feature_detectors import gradient_magnitude
+from calib_core.vision.colour_contrast import gradient_magnitude
 from calib_core.vision.find_points import find_points
 from calib_core.vision.pose_hypotheses import TRUNCATE_PX, rank_starts
 

@@ -37,3 +37,31 @@ def test_a_real_photo_gives_the_object_within_5_px_from_a_robots_error(obj_id):
     assert error_px < 5.0
     assert 0.3 < located.points_sigma_px < 5.0
     assert located.to_dict()["points_sigma_px"] == pytest.approx(located.points_sigma_px, abs=1e-3)
+
+
+def test_a_look_reads_the_photo_once(monkeypatch):
+    """Every start of a look (the prior, starts round it and nearer and further, at full and at half size) shares one
+    image evidence: one Canny pass and one gradient a pyramid level, where each start made its own (ten Canny and
+    five gradient passes a photo)."""
+    from calib_core.vision import colour_contrast
+
+    calls = {"edges": 0, "gradient": 0}
+    edges, gradient = colour_contrast.edges, colour_contrast.gradient_magnitude
+
+    def counted(name, fn):
+        def wrapper(*args, **kwargs):
+            calls[name] += 1
+            return fn(*args, **kwargs)
+
+        return wrapper
+
+    monkeypatch.setattr(colour_contrast, "edges", counted("edges", edges))
+    monkeypatch.setattr(colour_contrast, "gradient_magnitude", counted("gradient", gradient))
+    dataset = BopDataset(LMO, "test")
+    (view,) = [v for v in dataset.views() if v.obj_id == 6]
+    mesh = load_mesh(dataset.models()[6].path)
+    image = np.ascontiguousarray(cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1])
+    prior = moved_prior(view.obj2cam, 30.0, 10.0, np.random.default_rng(7))
+    located = locate(image, view.intrinsics, mesh, prior, reach_mm=30.0, reach_deg=10.0, features={})
+    assert located.edge_samples > 0, located.message  # the fits ran
+    assert calls["edges"] == 1 and calls["gradient"] <= 2, calls

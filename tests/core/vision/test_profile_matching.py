@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from calib_core.vision.feature_detectors import gradient_magnitude, search_normals
+from calib_core.vision.colour_contrast import gradient_magnitude
+from calib_core.vision.feature_detectors import search_normals
 from calib_core.vision.profile_matching import match_profiles
 
 
