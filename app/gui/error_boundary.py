@@ -1,6 +1,7 @@
 """One error boundary at the edge of the UI: an action that fails becomes a message, never a crash.
 
-A user's mistake raises a :class:`~calib_core.errors.VideocalError`: its message is shown as it is.
+A user's mistake raises a :class:`~calib_core.errors.VideocalError`: its message is shown as it is; so is the
+machine's refusal (an :class:`OSError`: a read-only folder, a full disk), with the file it names.
 Anything else is a bug: its traceback goes to a log file under the user's state folder, and the
 operator is told an internal error happened and where its details are.
 """
@@ -36,12 +37,22 @@ def record_internal_error(exc: BaseException) -> Path:
     return path
 
 
+def refused_by_the_system(exc: OSError) -> str:
+    """One line for an :class:`OSError` that no part of videocal turned into its own message: the file it names
+    and the system's reason (``Read-only file system``, ``No space left on device``)."""
+    where = f"{exc.filename}: " if exc.filename else ""
+    return f"{where}{exc.strerror or exc} (the system refused it)"
+
+
 def attempt(report: Callable[[str], None], fn, *args, **kwargs) -> bool:
     """Run ``fn``; True if it succeeded. A failure is reported (see the module) and gives False."""
     try:
         fn(*args, **kwargs)
     except VideocalError as exc:
         report(str(exc))
+        return False
+    except OSError as exc:  # the machine refused (a read-only folder, a full disk): the operator's to mend, no bug
+        report(refused_by_the_system(exc))
         return False
     except Exception as exc:  # the boundary: nothing escapes into Qt's event loop
         log = record_internal_error(exc)

@@ -96,7 +96,9 @@ class ResultsPanel(QWidget):
         session.result.changed.connect(self.refresh)
         session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
         self._elsewhere = False
+        self._shown = None  # the estimate shown: a new one clears the message line
         arm.joints_changed.connect(self._joints_changed)
+        session.corrections.changed.connect(lambda *_: self.clear_message())
 
     def _solved_elsewhere(self) -> bool:
         """The last result was solved from another robot pose than the robot's now."""
@@ -136,9 +138,18 @@ class ResultsPanel(QWidget):
         self.status.setText(f"<span style='color:#ff6b6b'>{html.escape(text, quote=False)}</span>")
         self._fit_text()
 
+    def clear_message(self) -> None:
+        """The message line emptied: what it said was about a step the session has moved past (a new result, a
+        stored correction), and under a new verdict an old "the last solve failed" reads as this one's."""
+        self.status.setText("")
+        self._fit_text()
+
     def refresh(self) -> None:
         session = self.session
         r = session.result.estimate
+        if r is not self._shown:
+            self._shown = r
+            self.clear_message()
         while self.candidates.count():
             w = self.candidates.takeAt(0).widget()
             if w is not None:

@@ -31,6 +31,7 @@ import numpy as np
 from mcap.writer import CompressionType, Writer
 
 from calib_core import __version__
+from calib_core.errors import FileWriteError
 from calib_core.recording.frame_message import FrameEncoder
 from calib_core.recording.schemas import (
     CORRECTION_TOPIC,
@@ -107,7 +108,10 @@ class SessionRecorder:
         self.clock = clock
         self._unix_minus_host_ns = time.time_ns() - int(round(clock() * 1e9))
         self.chunk_every_ns, self.hold_ns = int(chunk_every_s * 1e9), int(hold_s * 1e9)
-        self._file = open(self.path, "wb")
+        try:
+            self._file = open(self.path, "wb")
+        except OSError as exc:  # a read-only or missing folder, a full disk: the operator's to mend, not a bug
+            raise FileWriteError(self.path, f"cannot record here ({exc.strerror or exc})") from None
         self._writer = Writer(
             self._file,
             compression=CompressionType.LZ4,

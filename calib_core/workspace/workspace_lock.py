@@ -11,7 +11,7 @@ import os
 import time
 from pathlib import Path
 
-from calib_core.errors import OperatorError
+from calib_core.errors import FileWriteError, OperatorError
 
 
 class WorkspaceInUse(OperatorError):
@@ -29,7 +29,12 @@ class WorkspaceLock:
         self._fd: int | None = None
         self.workspace = Path(workspace).resolve()
         self.path = lock_path(self.workspace)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o600)
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o600)
+        except OSError as exc:  # a read-only or missing folder, a full disk: said before anything is written
+            raise FileWriteError(
+                self.workspace, f"cannot save here: the lock beside it cannot be made ({exc.strerror or exc})"
+            ) from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -42,9 +47,12 @@ class WorkspaceLock:
         except OSError:
             os.close(fd)
             raise
-        os.ftruncate(fd, 0)
-        os.write(fd, f"videocal (pid {os.getpid()}, since {time.strftime('%H:%M:%S')})".encode())
         self._fd = fd
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, f"videocal (pid {os.getpid()}, since {time.strftime('%H:%M:%S')})".encode())
+        except OSError:
+            pass  # a full disk: the lock holds without its note of who holds it
 
     def release(self) -> None:
         if self._fd is not None:

@@ -11,7 +11,7 @@ from PySide6.QtWidgets import QApplication
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
-from tests.app.windows import confirm_move_if_asked, pick_pair, wait_for_settled_frame
+from tests.app.windows import confirm_move_if_asked, pick_features, pick_pair, wait_for_settled_frame
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = [
@@ -324,3 +324,17 @@ def test_a_refused_move_is_shown_and_ctrl_q_stops_the_simulator(qtbot, window):
     quit_action.trigger()
     qtbot.waitUntil(lambda: not process.running, timeout=10_000)
     assert not win.isVisible()
+
+
+def test_a_message_about_an_earlier_step_goes_when_a_result_comes(qtbot, window):
+    """F5 with no pairs says calibrating needs 3; after four picks and Calibrate the verdict is OK and that message is
+    gone (it once stayed under the OK verdict, as "the last solve failed" did)."""
+    win, wb = window, window.workbench
+    _go_to_task(qtbot, win)
+    qtbot.keyClick(win, Qt.Key.Key_F5)
+    assert "calibrating needs 3" in win.results.status.text()
+    pick_features(qtbot, win, ["plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left"])
+    qtbot.mouseClick(win.commands.calibrate, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: wb.session.result.estimate is not None, timeout=30_000)
+    assert "OK" in win.results.verdict.text(), win.results.verdict.text()
+    assert "calibrating needs" not in win.results.status.text()
