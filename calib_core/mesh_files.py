@@ -85,6 +85,15 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
             f"a mesh of {len(mesh.faces)} triangles is over the limit of {MAX_TRIANGLES}: decimate it for viewing",
             field,
         )
+    faces = np.asarray(mesh.faces)
+    if faces.min() < 0 or faces.max() >= len(mesh.vertices):
+        bad = int(np.flatnonzero((faces < 0).any(axis=1) | (faces >= len(mesh.vertices)).any(axis=1))[0])
+        raise FileFormatError(
+            path,
+            f"face {bad} names vertices {faces[bad].tolist()}, but the mesh has {len(mesh.vertices)} (numbered from "
+            "0): the file is broken",
+            field,
+        )
     vertices = np.asarray(mesh.vertices) * MESH_SCALE[units]
     if not np.all(np.isfinite(vertices)):
         bad = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])

@@ -53,3 +53,27 @@ def check_typed_name(name, what: str) -> str:
     if any(c in name for c in EDITOR_FORBIDDEN):
         raise InvalidNameError(f"{what} name {name!r}: use letters, digits, '_', '-', '.' or spaces")
     return name
+
+
+MAX_NOTE_CHARS = 4000
+"""The longest note (a correction's source, who confirmed it and why) a file may hold."""
+
+
+def one_line(text: str) -> str:
+    """``text`` as one line: every control or line-break character a space (a note written into an export's remark
+    must not start a statement on the next line)."""
+    return "".join(
+        " " if unicodedata.category(c)[0] == "C" or unicodedata.category(c) in ("Zl", "Zp") else c for c in text
+    )
+
+
+def note_problem(text) -> str | None:
+    """Why ``text`` is not a usable note (``None``: it is): not text, too long, or a control character."""
+    if not isinstance(text, str):
+        return f"must be text, got {type(text).__name__}"
+    if len(text) > MAX_NOTE_CHARS:
+        return f"is {len(text)} characters long; at most {MAX_NOTE_CHARS}"
+    if one_line(text) != text:
+        c = next(c for c, d in zip(text, one_line(text)) if c != d)
+        return f"holds the control character U+{ord(c):04X}"
+    return None

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from calib_core.names import one_line
 from calib_core.frames import concat, invert
 from calib_core.undo import Command
 
@@ -41,6 +42,11 @@ class Correction:
     verdict: str = "ok"
     confirmation: str = ""
     kind: str = "correction"
+
+    def __post_init__(self) -> None:
+        # the notes go into exports as remarks: one line each, whatever the operator typed
+        object.__setattr__(self, "source", one_line(self.source))
+        object.__setattr__(self, "confirmation", one_line(self.confirmation))
 
     @property
     def delta_base(self) -> np.ndarray:

@@ -23,6 +23,9 @@ MAX_IMAGE_SIDE_PX = 20000
 MAX_DISTORTION = 1e4
 """The largest distortion coefficient taken (in size): a real lens's are under 10 (a rational model's a few hundred);
 -1e308 is a damaged file, which would send every projection to infinity."""
+MAX_INTRINSIC_PX = 1e6
+"""The largest focal length or principal point (px) a camera has: a long lens on a large sensor is 1e4-1e5 px;
+1e23 is a unit error, and the projections and renders made from it are nothing."""
 
 
 @dataclass(frozen=True)
@@ -50,6 +53,10 @@ class Intrinsics:
             v = float(getattr(self, name))
             if not np.isfinite(v):
                 raise ValueError(f"intrinsics: {name} must be finite, got {v}")
+            if abs(v) > MAX_INTRINSIC_PX:
+                raise ValueError(
+                    f"intrinsics: {name} = {v:g} px is no camera's (at most {MAX_INTRINSIC_PX:g} px: a unit error?)"
+                )
             object.__setattr__(self, name, v)
         if self.fu <= 0 or self.fv <= 0:
             raise ValueError(f"intrinsics: focal lengths must be positive, got fu={self.fu}, fv={self.fv}")

@@ -131,6 +131,9 @@ MAX_URDF_JOINTS = 500
 """The most joints a description may have (a humanoid has about 50; a 2999-joint URDF exhausted memory)."""
 MAX_ORIGIN_M = 1000.0
 """The farthest an origin may place a link from its parent (m): beyond, a unit error (mm read as m)."""
+MAX_ANGLE_RAD = 100.0
+"""The largest angle (rad, 16 turns) an origin's rpy or a revolute joint's limit may hold: a multi-turn joint has a
+few turns; beyond, degrees written as radians, or a number that is no angle (1e23 rad: no digit of its turn left)."""
 
 
 def _check_numbers(root: ET.Element, path: Path) -> None:
@@ -152,6 +155,12 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
                 if values is None or not all(math.isfinite(v) for v in values):
                     raise FileFormatError(
                         path, f"{owner}: origin {attr}={origin.get(attr)!r} must be three finite numbers"
+                    )
+                if attr == "rpy" and max(abs(v) for v in values) > MAX_ANGLE_RAD:
+                    raise FileFormatError(
+                        path,
+                        f"{owner}: origin rpy={origin.get(attr)!r} turns more than {MAX_ANGLE_RAD:g} rad: a URDF's "
+                        "angles are radians within a turn or so (degrees written as radians?)",
                     )
                 if attr == "xyz" and max(abs(v) for v in values) > MAX_ORIGIN_M:
                     raise FileFormatError(
@@ -179,6 +188,21 @@ def _check_numbers(root: ET.Element, path: Path) -> None:
                 f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} must be "
                 "finite numbers",
             )
+        reach = MAX_ORIGIN_M if joint.get("type") == "prismatic" else MAX_ANGLE_RAD
+        if max(abs(lo[0]), abs(hi[0])) > reach:
+            raise FileFormatError(
+                path,
+                f"joint '{joint.get('name')}': limit lower={limit.get('lower')!r} upper={limit.get('upper')!r} is "
+                f"beyond {reach:g} {'m' if reach == MAX_ORIGIN_M else 'rad'}: no joint moves that far (a joint without "
+                "limits is type continuous)",
+            )
+        for key in ("velocity", "effort"):
+            value = _numbers(limit.get(key), 1) if limit.get(key) is not None else [0.0]
+            if value is None or not math.isfinite(value[0]) or value[0] < 0:
+                raise FileFormatError(
+                    path,
+                    f"joint '{joint.get('name')}': limit {key}={limit.get(key)!r} must be a finite number, 0 or more",
+                )
         if lo[0] > hi[0]:
             raise FileFormatError(
                 path, f"joint '{joint.get('name')}': limit lower ({lo[0]:g}) is above upper ({hi[0]:g})"

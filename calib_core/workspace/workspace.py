@@ -28,7 +28,7 @@ from calib_core.documents import read_json
 from calib_core.errors import FileFormatError
 from calib_core.frames import transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.workcell.model import TaskLocation
-from calib_core.names import name_problem
+from calib_core.names import name_problem, note_problem
 from calib_core.workcell.safety import DEFAULT_TOLERANCE_MM
 
 SCHEMA_VERSION = 2
@@ -165,6 +165,26 @@ class _Fields:
             raise self.fail(f"{where}.{key}" if where else key, f"the name {value[:60]!r} {why}")
         return value
 
+    def note(self, data: dict, key: str, where: str) -> str:
+        """A line of text (a correction's source, who confirmed it), empty when absent: written into exports as a
+        remark, so one line without control characters (a newline there would start a controller's statement)."""
+        value = data.get(key, "")
+        why = note_problem(value)
+        if why is not None:
+            shown = value[:60] if isinstance(value, str) else value
+            raise self.fail(f"{where}.{key}", f"the text {shown!r} {why}")
+        return value
+
+    def verdict(self, data: dict, where: str) -> str:
+        """A correction's verdict: one of the verdicts' words (default ``ok``)."""
+        from calib_core.calibration.verdict import Verdict
+
+        value = data.get("verdict", "ok")
+        words = [v.value for v in Verdict]
+        if value not in words:
+            raise self.fail(f"{where}.verdict", f"must be one of {', '.join(words)}, got {value!r}")
+        return value
+
     def vector(self, value, n: int, where: str, bound: float = MAX_MAGNITUDE) -> np.ndarray:
         """``n`` finite numbers, each at most ``bound`` in size (mm, px: a cell is metres across, an image thousands
         of pixels; -1e308 is a damaged file, and an export would carry it to a controller)."""
@@ -295,9 +315,9 @@ def load_workspace(path: str | Path) -> Workspace:
                 rms_px=f.number(f.get(c, "rms_px", where), f"{where}.rms_px", 0.0, 1e6, allow_nan=True),
                 pairs=int(f.get(c, "pairs", where, int)),
                 time_s=f.number(c.get("time_s", 0.0), f"{where}.time_s"),
-                source=str(c.get("source", "")),
-                verdict=str(c.get("verdict", "ok")),
-                confirmation=str(c.get("confirmation", "")),
+                source=f.note(c, "source", where),
+                verdict=f.verdict(c, where),
+                confirmation=f.note(c, "confirmation", where),
                 kind=_correction_kind(c.get("kind", "correction"), f"{where}.kind", f),
             )
         )

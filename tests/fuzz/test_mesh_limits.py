@@ -40,7 +40,12 @@ def test_absurd_or_empty_meshes_are_refused_and_a_good_one_is_read_in_mm(tmp_pat
     flat = trimesh.Trimesh(vertices=[[0, 0, 0], [1, 0, 0], [2, 0, 0]], faces=[[0, 1, 2]], process=False)
     flat.export(tmp_path / "flat.stl")
     (tmp_path / "text.stl").write_text("solid nothing\nendsolid nothing\n")
+    (tmp_path / "broken.ply").write_text(  # a face naming a vertex the file does not hold (IndexError from trimesh)
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n10 0 0\n0 10 0\n3 0 1 7\n"
+    )
     for name, why in (
+        ("broken.ply", r"face 0 names vertices \[0, 1, 7\], but the mesh has 3"),
         ("far.stl", "beyond 1e\\+07 mm: are its units right"),
         ("flat.stl", "no area|no triangles"),
         ("text.stl", "no triangles|cannot read"),
@@ -70,11 +75,14 @@ def test_the_workcell_names_its_field_and_the_mesh(tmp_path):
         load_workcell(cell / DEFAULT_WORKCELL.name)
 
 
-def _chain(n: int, axis: str = "0 0 1", xyz: str = "0 0 0.1") -> str:
+def _chain(
+    n: int, axis: str = "0 0 1", xyz: str = "0 0 0.1", rpy: str = "0 0 0", lower: str = "-1", velocity: str = "1"
+) -> str:
     links = "".join(f'<link name="l{k}"/>' for k in range(n + 1))
     joints = "".join(
-        f'<joint name="j{k}" type="revolute"><parent link="l{k}"/><child link="l{k + 1}"/><origin xyz="{xyz}"/>'
-        f'<axis xyz="{axis}"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        f'<joint name="j{k}" type="revolute"><parent link="l{k}"/><child link="l{k + 1}"/>'
+        f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>'
+        f'<limit lower="{lower}" upper="1" effort="1" velocity="{velocity}"/></joint>'
         for k in range(n)
     )
     return f'<robot name="chain">{links}{joints}</robot>'
@@ -87,10 +95,14 @@ def _chain(n: int, axis: str = "0 0 1", xyz: str = "0 0 0.1") -> str:
         (_chain(3, axis="0 0 0"), "axis xyz='0 0 0' must be three finite numbers, not all zero"),
         (_chain(3, xyz="0 0 1e308"), "over 1000 m away"),
         (_chain(3, axis="nan 0 1"), "axis"),
+        (_chain(3, rpy="1e23 0 0"), "rpy='1e23 0 0' turns more than 100 rad"),
+        (_chain(3, lower="-1e23"), "lower='-1e23' upper='1' is beyond 100 rad"),
+        (_chain(3, velocity="nan"), "limit velocity='nan' must be a finite number"),
     ],
 )
 def test_urdfs_beyond_a_robots_limits_are_refused_by_name(tmp_path, text, why):
-    """A 2999-joint URDF ended in a MemoryError traceback; a zero axis and 1e308 m origins loaded."""
+    """A 2999-joint URDF ended in a MemoryError traceback; a zero axis, 1e308 m origins, a turn of 1e23 rad, a limit of
+    1e23 rad and a NaN velocity loaded (and ``new-cell`` wrote a cell from them)."""
     from calib_core.robot.description import read_description
 
     path = tmp_path / "robot.urdf"

@@ -79,6 +79,8 @@ def test_scaled_keeps_rays():
         ({"fu": 0.0}, "focal lengths must be positive"),
         ({"fv": -5.0}, "focal lengths must be positive"),
         ({"cx": float("nan")}, "cx must be finite"),
+        ({"fu": 1e23, "fv": 1e23}, "fu = 1e\\+23 px is no camera's"),
+        ({"cy": -3e7}, "cy = -3e\\+07 px is no camera's"),
         ({"width": 0}, "width must be a positive whole number"),
         ({"distortion": (0.1, 0.2)}, "distortion needs 5 values"),
     ],

@@ -91,6 +91,26 @@ def test_a_failed_save_leaves_the_old_file_whole(tmp_path, workspace, monkeypatc
         ),
         (lambda t: _edit(t, lambda d: d.update(cell="my cell")), "cell", "name, content_hash"),
         (
+            lambda t: _edit(t, lambda d: d["corrections"][0].update(verdict=1e16)),
+            "corrections[0].verdict",
+            "must be one of ok, ambiguous, implausible, uncertain, failed, got 1e+16",
+        ),
+        (
+            lambda t: _edit(t, lambda d: d["corrections"][0].update(confirmation=float("nan"))),
+            "corrections[0].confirmation",
+            "must be text, got float",
+        ),
+        (
+            lambda t: _edit(t, lambda d: d["corrections"][0].update(source="pairs 1\nmovej([0,0,0,0,0,0])")),
+            "corrections[0].source",
+            "holds the control character U+000A",
+        ),
+        (
+            lambda t: _edit(t, lambda d: d["corrections"][0].update(joints_deg=[0.0] * 500)),
+            "corrections[0].joints_deg",
+            "1 to 16 joint values",
+        ),
+        (
             lambda t: _edit(t, lambda d: d["pairs"][0].update(point_world_mm=[1, 2])),
             "pairs[0].point_world_mm",
             "3 finite numbers",
@@ -184,3 +204,19 @@ def test_exports(tmp_path, workspace):
         and "Traceback" not in dashed.stderr
     )
     assert not (tmp_path / "cell-targets.dat").exists()
+
+
+def test_a_note_typed_over_lines_is_stored_as_one_line_and_read_back(tmp_path, workspace):
+    """A conversion's note the operator typed with a line break is kept as one line: an export's remark cannot start
+    a statement, and the file it is saved in reads back."""
+    from dataclasses import replace
+
+    task = workspace.corrections.tasks()[0]
+    c = workspace.corrections.latest(task)
+    typed = replace(c, source="converted: from a recording;\nmovej([0, 0, 0, 0, 0, 0])", confirmation="ok\r\nby me")
+    assert typed.source == "converted: from a recording; movej([0, 0, 0, 0, 0, 0])"
+    assert typed.confirmation == "ok  by me"
+    workspace.corrections.add(typed)
+    save_workspace(tmp_path / "w.json", workspace)
+    back = load_workspace(tmp_path / "w.json").corrections.latest(task)
+    assert (back.source, back.confirmation) == (typed.source, typed.confirmation)
