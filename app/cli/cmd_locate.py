@@ -269,7 +269,7 @@ def _write_line(document: dict) -> None:
 def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.ndarray, result) -> None:
     import cv2
 
-    from calib_core.atomic_file import atomic_path
+    from calib_core.atomic_file import atomic_write_bytes
     from calib_core.camera.projection import project_points
 
     out = cv2.cvtColor(image, cv2.COLOR_RGB2BGR) if image.ndim == 3 else cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
@@ -293,6 +293,8 @@ def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.nd
     if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):
         raise FileFormatError(path, "the overlay is written as PNG or JPEG: name it .png or .jpg")
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:  # (the temporary name keeps the suffix, which tells OpenCV the format)
-        if not cv2.imwrite(str(tmp), out):
-            raise FileFormatError(path, "could not write the overlay image")
+    # encoded in memory and written by Python: libpng writing to a full disk printed its own line before the error
+    encoded, data = cv2.imencode(path.suffix.lower(), out)
+    if not encoded:
+        raise FileFormatError(path, "could not encode the overlay image")
+    atomic_write_bytes(path, data.tobytes())

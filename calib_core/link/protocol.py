@@ -21,7 +21,8 @@ SEQ_MODULUS = 2**32
 
 
 class ProtocolError(ValueError):
-    """A sentence body that is not a valid message. ``kind``: ``malformed``, ``non_finite`` or ``unknown``."""
+    """A sentence body that is not a valid message. ``kind``: ``malformed``, ``non_finite`` (or
+    beyond any robot's: a joint at 1e308 deg) or ``unknown``."""
 
     def __init__(self, kind: str, message: str):
         self.kind = kind
@@ -253,6 +254,18 @@ def _number(text: str, what: str) -> float:
     return value
 
 
+MAX_JOINT_VALUE = 1e6
+"""The largest joint value (deg or mm) a sample may carry: a joint at 1e308 deg is no robot's, and was printed and
+plotted as one. (A move's target beyond it parses, and the controller refuses it as beyond its limits: LIMIT.)"""
+
+
+def _joint(text: str, what: str) -> float:
+    value = _number(text, what)
+    if abs(value) > MAX_JOINT_VALUE:
+        raise ProtocolError("non_finite", f"{what}: {text} is no joint's value (beyond {MAX_JOINT_VALUE:g} deg or mm)")
+    return value
+
+
 def _integer(text: str, what: str) -> int:
     if not text.isdigit():
         raise ProtocolError("malformed", f"{what}: not a non-negative integer: {text!r}")
@@ -297,7 +310,7 @@ def parse_body(body: str) -> Message:
         if seq >= SEQ_MODULUS:
             raise ProtocolError("malformed", f"JNT seq {seq} exceeds 2^32 - 1")
         return JointSample(
-            seq, _integer(fields[2], "JNT t_ms"), tuple(_number(f, f"JNT q{i + 1}") for i, f in enumerate(fields[3:]))
+            seq, _integer(fields[2], "JNT t_ms"), tuple(_joint(f, f"JNT q{i + 1}") for i, f in enumerate(fields[3:]))
         )
     if kind == "ACK" and n == 3:
         return Ack(_token(fields[1], "ACK cmd"), _token(fields[2], "ACK id"))

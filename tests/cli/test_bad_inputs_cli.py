@@ -322,6 +322,47 @@ def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_cam
     )
 
 
+def test_locate_overlay_on_a_full_disk_is_one_line_and_leaves_no_file(tmp_path):
+    """libpng, writing the overlay to a full disk, printed its own "libpng error" line before videocal's error."""
+    import cv2
+    import numpy as np
+    import trimesh
+
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.camera.intrinsics_io import save_intrinsics
+
+    def small_files() -> None:
+        import signal
+
+        _limits()
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG, as on a full disk
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))  # the noisy photo's overlay is larger
+
+    trimesh.creation.box([100.0, 80.0, 60.0]).export(tmp_path / "box.stl")
+    noise = np.random.default_rng(1).integers(0, 255, (480, 640, 3), dtype=np.uint8)
+    cv2.imwrite(str(tmp_path / "photo.png"), noise)
+    save_intrinsics(tmp_path / "camera.yaml", Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480))
+    (tmp_path / "ahead.json").write_text(
+        json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 500], [0, 0, 0, 1]]})
+    )
+    run = _videocal(
+        "locate",
+        tmp_path / "photo.png",
+        "--mesh",
+        tmp_path / "box.stl",
+        "--intrinsics",
+        tmp_path / "camera.yaml",
+        "--prior",
+        tmp_path / "ahead.json",
+        "--overlay",
+        tmp_path / "out" / "overlay.png",
+        preexec=small_files,
+    )
+    assert "libpng" not in run.stderr, run.stderr
+    _refused(run, "overlay.png", "not written")
+    assert list((tmp_path / "out").iterdir()) == []
+
+
 # --- numbers that parse but mean nothing --------------------------------------------------------------
 def test_a_feature_at_1e23_mm_and_a_distortion_of_minus_1e308_are_refused_by_field(cell):
     def far_feature(d):

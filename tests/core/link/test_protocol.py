@@ -59,6 +59,7 @@ def test_round_trip(message):
         ("JNT,1,2,0,0,0,0,0,abc", "malformed", "q6: not a number"),
         ("JNT,1,2,0,0,nan,0,0,0", "non_finite", "q3: not finite"),
         ("JNT,1,2,0,0,0,inf,0,0", "non_finite", "q4"),
+        ("JNT,1,2,0,0,0,1e308,0,0", "non_finite", "q4: 1e308 is no joint's value"),
         ("JNT,-1,2,0,0,0,0,0,0", "malformed", "seq"),
         ("JNT,4294967296,2,0,0,0,0,0,0", "malformed", "exceeds"),
         ("XYZ,1", "unknown", "unknown sentence type"),
