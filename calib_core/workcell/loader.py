@@ -105,10 +105,23 @@ class _Reader:
         return value
 
     def placement(self, value, field: str) -> np.ndarray:
+        """A placement ``{xyz: mm, rpy: deg}``: within 10 km and a few turns (1e308 mm, 1e23 deg: a damaged file,
+        whose renders and moves would be nothing)."""
+        from calib_core.mesh_files import MAX_COORDINATE_MM
+
         value = self.mapping(value, field, {"xyz", "rpy"}, {"xyz", "rpy"})
-        return transform_from_xyz_rpy(
-            self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy")
-        )
+        xyz, rpy = self.vector(value["xyz"], 3, f"{field}.xyz"), self.vector(value["rpy"], 3, f"{field}.rpy")
+        if np.abs(xyz).max() > MAX_COORDINATE_MM:
+            raise self.fail(
+                f"{field}.xyz",
+                f"lies {np.abs(xyz).max():.3g} mm away, beyond {MAX_COORDINATE_MM:g} mm: placements are in mm",
+            )
+        if np.abs(rpy).max() > MAX_PLACEMENT_DEG:
+            raise self.fail(
+                f"{field}.rpy",
+                f"turns {np.abs(rpy).max():.3g} deg, beyond {MAX_PLACEMENT_DEG:g} deg: angles are in deg",
+            )
+        return transform_from_xyz_rpy(xyz, rpy)
 
     def file(self, value, field: str) -> Path:
         text = self.text(value, field)
@@ -169,6 +182,9 @@ def _component(reader: _Reader, raw, i: int) -> SceneItem:
         form_tolerance_mm=form,
     )
 
+
+MAX_PLACEMENT_DEG = 3600.0
+"""The largest roll, pitch or yaw (deg, ten turns) a placement may hold; a bigger one is a damaged number."""
 
 _FEATURE_KEYS = {"at", "kind", "radius_mm", "normal"}
 

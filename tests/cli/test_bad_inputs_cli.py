@@ -371,6 +371,15 @@ def test_a_feature_at_1e23_mm_and_a_distortion_of_minus_1e308_are_refused_by_fie
         component["features"][name] = [1e23, 0.0, 0.0]
 
     _refused(_render(cell(far_feature), cell.folder), "edited.yaml", "features", "beyond")
+
+    def far_board(d):
+        d["hand_eye_board"] = {"xyz": [1e308, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}
+
+    def turned_part(d):
+        d["components"][0]["placement"]["rpy"] = [1e23, 0.0, 0.0]
+
+    _refused(_render(cell(far_board), cell.folder), "edited.yaml", "hand_eye_board.xyz", "beyond 1e+07 mm")
+    _refused(_render(cell(turned_part), cell.folder), "edited.yaml", "components[0].placement.rpy", "beyond 3600 deg")
     ros = yaml.safe_load((cell.folder / "camera" / "gripper_camera_ros.yaml").read_text())
     ros["distortion_coefficients"]["data"][1] = -1e308
     _refused(_render(_camera_file(cell, yaml.safe_dump(ros)), cell.folder), "bad.yaml", "k2", "no lens")
