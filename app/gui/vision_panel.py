@@ -13,14 +13,17 @@ from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QCheckBox,
+    QApplication,
     QFileDialog,
     QGroupBox,
     QHBoxLayout,
     QLabel,
     QLineEdit,
     QListWidget,
+    QProgressDialog,
     QVBoxLayout,
     QWidget,
 )
@@ -96,7 +99,17 @@ class VisionPanel(QWidget):
         vl.addWidget(self.views)
         self.remove_button = button("Remove view", "vision_remove", "Drop the selected view (blurred or mis-detected)")
         self.remove_button.clicked.connect(guard(self._remove_selected))
-        vl.addWidget(self.remove_button)
+        self.read_set_button = button(
+            "Read set...",
+            "vision_read_set",
+            "Read a recorded hand-eye set in place of the views: a pose file (JSON of image and flange2base, a CSV of "
+            "image and joints, cal_data.yaml) beside its images",
+        )
+        self.read_set_button.clicked.connect(guard(self._read_set_dialog))
+        row = QHBoxLayout()
+        row.addWidget(self.remove_button)
+        row.addWidget(self.read_set_button)
+        vl.addLayout(row)
         self.coverage = QLabel("No views yet.")
         self.coverage.setWordWrap(True)
         vl.addWidget(self.coverage)
@@ -212,14 +225,54 @@ class VisionPanel(QWidget):
         self.vision.remove_view(item.data(Qt.ItemDataRole.UserRole))
         self._refresh()
 
+    def read_set(self, path) -> None:
+        """Read a recorded hand-eye set (:meth:`CameraCalibrating.read_set`) in place of the views."""
+        dialog = QProgressDialog("Reading the set's views...", "Cancel", 0, 1, self)
+        dialog.setWindowTitle("Read set")
+        dialog.setWindowModality(Qt.WindowModality.WindowModal)
+        dialog.setMinimumDuration(500)  # a small set reads before it would show
+
+        def progress(done: int, total: int) -> bool:
+            dialog.setMaximum(total)
+            dialog.setValue(done)
+            dialog.setLabelText(f"Reading the set's views: {done} of {total} (finding the board in each)")
+            QApplication.processEvents()
+            return not dialog.wasCanceled()
+
+        try:
+            self.vision.read_set(path, progress)
+        finally:
+            dialog.close()
+        self._intrinsics_text = self._hand_eye_text = ""
+        self._show_results()
+        self._refresh()
+
+    def _read_set_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(
+            self, "Read a hand-eye set", "", "hand-eye sets (*.json *.csv *.yaml *.yml);;all files (*)"
+        )
+        if path:
+            self.read_set(path)
+
     def _refresh(self) -> None:
         c = self.vision.capture
+        if self.spec.text().strip() != str(c.spec):
+            self.spec.setText(str(c.spec))  # a set read from files names its own board
         self.views.clear()
         lost = views_with_lost_corners([len(v.ids) for v in c.views])
-        for k, (v, q) in enumerate(zip(c.views, c.joints_deg)):
+        mounting = self.vision.mounting
+        for k, v in enumerate(c.views):
             flag = f", lost corners ({len(v.ids)} where its neighbours have {lost[k]:.0f})" if k in lost else ""
-            self.views.addItem(f"{v.name}: {len(v.ids)} corners" + ("" if q is not None else ", no robot pose") + flag)
-            self.views.item(self.views.count() - 1).setData(Qt.ItemDataRole.UserRole, v.name)
+            check = None if mounting is None else mounting.check_of(v.name)
+            if check is not None:
+                flag += f", {check.rms_px:.2f} px, {check.apart_mm:.1f} mm from the others"
+            text = f"{v.name}: {len(v.ids)} corners" + ("" if c.has_robot_pose(k) else ", no robot pose") + flag
+            self.views.addItem(("! " if check is not None and not check.agrees else "") + text)
+            item = self.views.item(self.views.count() - 1)
+            item.setData(Qt.ItemDataRole.UserRole, v.name)
+            if check is not None and not check.agrees:
+                item.setForeground(QColor(255, 170, 60))  # stands out: the operator looks at it, and may remove it
+                item.setToolTip(check.why)
         for r in c.rejected:
             self.views.addItem(f"x {r.name}: {r.reason}")
         n = len(c.views)
@@ -233,7 +286,7 @@ class VisionPanel(QWidget):
             )
         )
         self.calibrate_intrinsics_button.setEnabled(n >= 3)
-        self.calibrate_hand_eye_button.setEnabled(n >= 3 and all(q is not None for q in c.joints_deg))
+        self.calibrate_hand_eye_button.setEnabled(n >= 3 and all(c.has_robot_pose(k) for k in range(n)))
         has_intrinsics, has_mounting = self.vision.intrinsics_result is not None, self.vision.mounting is not None
         self.apply_intrinsics_button.setEnabled(has_intrinsics)
         self.save_intrinsics_button.setEnabled(has_intrinsics)

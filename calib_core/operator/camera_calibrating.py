@@ -27,6 +27,7 @@ from calib_core.operator.picking import Picking
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.intrinsics_calibration import RejectedView
+from calib_core.vision.view_checks import view_checks
 from calib_core.vision.result_checks import hand_eye_problems, intrinsics_problems, views_with_lost_corners
 
 
@@ -38,6 +39,13 @@ class MountingResult:
     off_model_mm: float
     off_model_deg: float
     problems: list[str]
+    views: tuple = ()
+    """Each view's :class:`~calib_core.vision.view_checks.ViewCheck` (its residual, its agreement with the others)."""
+
+    def check_of(self, name: str):
+        """The :class:`~calib_core.vision.view_checks.ViewCheck` of the view ``name``, ``None`` when it was not in
+        this calibration (captured after it)."""
+        return next((v for v in self.views if v.name == name), None)
 
 
 class CameraCalibrating:
@@ -127,6 +135,32 @@ class CameraCalibrating:
         self.plan_index += 1
         return q, f"board pose {(self.plan_index - 1) % len(self.plan) + 1} of {len(self.plan)}"
 
+    # --- a set read from files -------------------------------------------------------------------
+    def read_set(self, path, progress=None) -> tuple[int, int]:
+        """The views of a hand-eye set (a pose file: JSON of {image, flange2base}, a CSV of image and joints,
+        ROS-Industrial's cal_data.yaml; or a folder holding one; :mod:`calib_core.vision.hand_eye_data`) in place of
+        the views captured: each image detected with its recorded flange pose or joints, named by its file. The board
+        is the file's when it names one, else the one set. ``(accepted, rejected)``; the file's problems raise
+        before anything is replaced. ``progress(done, total) -> bool``, called before each image (a large real
+        image's board takes a second to find), ends the reading when it returns False: the views stay as they were."""
+        from calib_core.vision.hand_eye_data import load_posed_images
+
+        posed = load_posed_images(path)  # raises, naming the file and field, before anything changes
+        spec = parse_board(posed.board_text) if posed.board_text else self.capture.spec
+        capture = BoardCapture(spec)
+        for k, view in enumerate(posed.views):
+            if progress is not None and progress(k, len(posed.views)) is False:
+                raise OperatorError(f"reading {posed.source.name} was cancelled: the views are as they were")
+            image = posed.read_image(view)
+            capture.add(image, view.joints_deg, flange2base=view.flange2base, name=view.image_path.stem)
+        self.capture, self.intrinsics_result, self.mounting = capture, None, None
+        self.log.say(
+            f"{len(capture.views)} of {len(posed.views)} views of {posed.source.name} read"
+            + (f"; {len(capture.rejected)} rejected (see the list)" if capture.rejected else "")
+        )
+        self.changed.emit()
+        return len(capture.views), len(capture.rejected)
+
     # --- capturing ------------------------------------------------------------------------------
     def capture_view(self):
         """Detect the board in the newest frame (taken after the last move, once the robot had settled) and keep it
@@ -183,7 +217,17 @@ class CameraCalibrating:
         off = (float(np.linalg.norm(d)), float(np.linalg.norm(rot)))
         noise = self.intrinsics_result.rms_px if self.intrinsics_result is not None else None
         problems = hand_eye_problems(calibration, off, noise, self.cell.workcell.safety)
-        self.mounting = MountingResult(calibration, off[0], off[1], problems)
+        names = [v.name for v in self.capture.views]
+        apart = calibration.poses.per_view_mm if calibration.poses is not None else [0.0] * len(names)
+        checks = view_checks(names, calibration.per_view_rms_px, apart)
+        self.mounting = MountingResult(calibration, off[0], off[1], problems, checks)
+        odd = [c for c in checks if not c.agrees]
+        if odd:
+            self.log.say(
+                f"{len(odd)} of {len(checks)} views stand out: "
+                + "; ".join(f"{c.name}: {c.why}" for c in odd[:3])
+                + " - look at them, and remove those that are wrong"
+            )
         self.changed.emit()
         return self.mounting
 

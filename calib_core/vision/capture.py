@@ -1,8 +1,9 @@
 """Collecting board views for the vision-system calibration: each captured image with the robot's
-joints when it was taken, detected at once so the operator sees what each view adds.
+joints when it was taken (or the flange's pose a controller recorded, for a set read from files), detected at once so
+the operator sees what each view adds.
 
 The window's Vision mode is a view of this; the same object calibrates the intrinsics and, from the
-joints, the camera's mounting on the flange.
+joints or flange poses, the camera's mounting on the flange.
 """
 
 from __future__ import annotations
@@ -31,15 +32,20 @@ class BoardCapture:
         self.spec = spec
         self.views: list[BoardView] = []
         self.joints_deg: list[np.ndarray | None] = []
+        self.flange2base: list[np.ndarray | None] = []
+        """(4, 4) mm: the flange's pose a controller recorded with the view (a set read from files), else ``None``"""
         self.rejected: list[RejectedView] = []
         self._detector = spec.detector()
         self._count = 0
         self._captured: dict = {}  # frame key -> the view's name
 
-    def add(self, image_rgb: np.ndarray, joints_deg=None, frame_key=None) -> BoardView | RejectedView:
+    def add(
+        self, image_rgb: np.ndarray, joints_deg=None, frame_key=None, *, flange2base=None, name: str | None = None
+    ) -> BoardView | RejectedView:
         """Detect the board in an image and keep the view when enough corners are seen. ``frame_key``
         (hashable: the frame's source and number) refuses a frame captured already: four captures of one
-        frame are one view, not four."""
+        frame are one view, not four. ``flange2base`` (4, 4) mm: the flange's recorded pose, in place of joints;
+        ``name``: the view's (default ``view_NN``)."""
         if frame_key is not None and frame_key in self._captured:
             raise CalibrationInputError(
                 f"this frame was captured already ({self._captured[frame_key]}): wait for a new frame from the next "
@@ -52,7 +58,7 @@ class BoardCapture:
                 "calibration is for one camera mode"
             )
         self._count += 1
-        result = detect_view(f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
+        result = detect_view(name or f"view_{self._count:02d}", image_rgb, self.spec, self._detector)
         if frame_key is not None:
             self._captured[frame_key] = result.name
         if isinstance(result, RejectedView):
@@ -60,13 +66,14 @@ class BoardCapture:
         else:
             self.views.append(result)
             self.joints_deg.append(None if joints_deg is None else np.array(joints_deg, dtype=float))
+            self.flange2base.append(None if flange2base is None else np.array(flange2base, dtype=float))
         return result
 
     def remove(self, name: str) -> None:
         """Drop an accepted view (a blurred or mis-detected one)."""
         for k, v in enumerate(self.views):
             if v.name == name:
-                del self.views[k], self.joints_deg[k]
+                del self.views[k], self.joints_deg[k], self.flange2base[k]
                 return
         raise KeyError(f"no view named {name}; views: {', '.join(v.name for v in self.views) or 'none'}")
 
@@ -77,14 +84,17 @@ class BoardCapture:
     def calibrate_intrinsics(self) -> IntrinsicsCalibration:
         return calibrate_intrinsics(self.views, self.spec, rejected=self.rejected)
 
+    def has_robot_pose(self, k: int) -> bool:
+        return self.flange2base[k] is not None or self.joints_deg[k] is not None
+
     def calibrate_hand_eye(self, robot: RobotModel, intrinsics: Intrinsics) -> HandEyeCalibration:
-        """``cam2flange`` from the views taken with a robot pose, the flange placed by ``robot``'s FK."""
-        posed = [(v, q) for v, q in zip(self.views, self.joints_deg) if q is not None]
-        if len(posed) < len(self.views):
+        """``cam2flange`` from the views taken with a robot pose: the flange's recorded pose, else placed by
+        ``robot``'s FK at the view's joints."""
+        missing = [v.name for k, v in enumerate(self.views) if not self.has_robot_pose(k)]
+        if missing:
             raise CalibrationInputError(
-                f"{len(self.views) - len(posed)} of {len(self.views)} views have no robot pose (captured without a "
-                "controller link)"
+                f"{len(missing)} of {len(self.views)} views have no robot pose (captured without a controller link): "
+                + ", ".join(missing[:5])
             )
-        return calibrate_hand_eye(
-            [v for v, _ in posed], [robot.fk(q, "flange") for _, q in posed], self.spec, intrinsics
-        )
+        flanges = [F if F is not None else robot.fk(q, "flange") for F, q in zip(self.flange2base, self.joints_deg)]
+        return calibrate_hand_eye(list(self.views), flanges, self.spec, intrinsics)

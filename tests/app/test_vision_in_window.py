@@ -249,3 +249,60 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
     )
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert len(vision.capture.views) == 2
+
+
+def _recorded_set(folder: Path, moved_view: int, moved_mm: float) -> Path:
+    """A hand-eye set as a robot cell records one: the simulated camera's PNG images of a ChArUco board and a JSON of
+    each image's flange pose from the controller (mm), one view's pose recorded ``moved_mm`` off (a pose read before
+    the robot settled)."""
+    import json
+
+    import cv2
+
+    from calib_core.vision.board import BoardSpec
+    from videocal_sim.hand_eye_views import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
+    from videocal_sim.test_bed import TestBed
+
+    spec = BoardSpec()
+    bed = TestBed.create()
+    board2base = board_facing_robot(spec)
+    joints = hand_eye_poses(bed, spec, board2base, 10)
+    (folder / "images").mkdir(parents=True)
+    poses = []
+    for k, (name, image, q) in enumerate(simulated_hand_eye_images(bed, spec, joints, board2base)):
+        cv2.imwrite(str(folder / "images" / f"{name}.png"), image[:, :, ::-1])
+        flange = bed.model_robot.fk(q, "flange")
+        if k == moved_view:
+            flange[:3, 3] += [moved_mm, 0.0, 0.0]
+        poses.append({"image": f"images/{name}.png", "flange2base": flange.tolist()})
+    path = folder / "poses.json"
+    path.write_text(json.dumps({"length_unit": "mm", "poses": poses}))
+    return path
+
+
+def test_a_recorded_set_is_read_and_its_odd_view_shown_and_dropped(qtbot, window, tmp_path):
+    """Read set... takes a recorded set (images and their flange poses) in place of the views; after Calibrate
+    hand-eye each view shows its residual and its distance from the others, the view whose pose was recorded 15 mm
+    off stands out (marked, with why), and once it is removed the calibration again has no view that stands out."""
+    from tests.app.test_session_files_in_window import _answer_file_dialog
+
+    win = window
+    path = _recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
+    asked = _answer_file_dialog(path)
+    qtbot.mouseClick(win.vision.read_set_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: len(win.vision.capture.views) == 10, timeout=30_000)
+    assert asked == ["Read a hand-eye set"]
+    assert all(win.vision.capture.has_robot_pose(k) for k in range(10))
+    qtbot.mouseClick(win.vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(win.vision.calibrate_hand_eye_button, Qt.MouseButton.LeftButton)
+    rows = [win.vision.views.item(k) for k in range(win.vision.views.count())]
+    odd = [r for r in rows if r.text().startswith("! ")]
+    moved = win.vision.capture.views[3].name
+    assert [r.data(Qt.ItemDataRole.UserRole) for r in odd] == [moved], [r.text() for r in rows]
+    assert "mm from the others' mean" in odd[0].toolTip() and " px, " in odd[0].text()
+    win.vision.views.setCurrentItem(odd[0])
+    qtbot.mouseClick(win.vision.remove_button, Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(win.vision.calibrate_hand_eye_button, Qt.MouseButton.LeftButton)
+    rows = [win.vision.views.item(k).text() for k in range(win.vision.views.count())]
+    assert len(rows) == 9 and not any(r.startswith("! ") for r in rows), rows
+    assert win.vision.hand_eye_result.views == 9

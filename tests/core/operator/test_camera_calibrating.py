@@ -68,3 +68,31 @@ def test_a_mounting_that_failed_its_checks_is_used_only_with_those_checks_confir
     core.vision.apply_calibrated_mounting(["poses disagree"])
     assert np.allclose(concat(core.robot.frame_placement("camera"), invert(flange)), moved)
     assert "vision_result_confirmed" in events
+
+
+def test_a_recorded_set_replaces_the_views_only_when_read_whole(core, tmp_path):
+    """A set is read view by view with progress; cancelled, or with an image missing, the views captured before stay
+    as they were; read whole, its views carry the recorded flange poses and are named by their files."""
+    import json
+
+    from calib_core.errors import FileFormatError
+    from tests.app.test_vision_in_window import _recorded_set
+
+    vision = core.vision
+    before = vision.capture
+    path = _recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
+    seen = []
+    with pytest.raises(OperatorError, match="reading poses.json was cancelled: the views are as they were"):
+        vision.read_set(path, lambda done, total: seen.append((done, total)) or done < 2)
+    assert vision.capture is before and seen == [(0, 10), (1, 10), (2, 10)]
+    broken = json.loads(path.read_text())
+    broken["poses"][5]["image"] = "images/gone.png"
+    (tmp_path / "set" / "broken.json").write_text(json.dumps(broken))
+    with pytest.raises(FileFormatError, match="gone.png"):
+        vision.read_set(tmp_path / "set" / "broken.json")
+    assert vision.capture is before
+    assert vision.read_set(path) == (10, 0)
+    capture, poses = vision.capture, json.loads(path.read_text())["poses"]
+    assert [v.name for v in capture.views] == [p["image"].split("/")[-1][: -len(".png")] for p in poses]
+    assert all(q is None for q in capture.joints_deg)
+    assert all(np.allclose(F, p["flange2base"]) for F, p in zip(capture.flange2base, poses))  # mm, as recorded
