@@ -24,9 +24,9 @@ from calib_core.robot.errors import UnreachableTargetError
 from videocal_sim.real_look import make_less_kind
 from videocal_sim.test_bed import TestBed
 from videocal_sim.true_robot import RobotErrors
-from calib_core.vision.edge_solution import edge_solution
-from calib_core.vision.find_points import find_points
-from calib_core.vision.target_detectors import rim_points_mm
+from calib_core.look.edge_solution import edge_solution
+from calib_core.look.find_points import find_points
+from calib_core.look.target_detectors import rim_points_mm
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "benchmarks" / "find_points.md"
 TARGET = "oru_1_fixture"

@@ -95,7 +95,7 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
 
     from calib_core.datasets.pose_errors import mspd, mssd, rotation_error_deg, translation_error_mm
     from calib_core.mesh_files import load_mesh
-    from calib_core.vision.locate import locate
+    from calib_core.look.locate import locate
 
     rows, sets = [], []
     for dataset in found_datasets(root):
@@ -171,8 +171,8 @@ def box_photo_rows() -> list[str]:
 
     from calib_core.camera.intrinsics import Intrinsics
     from calib_core.mesh_files import load_mesh
-    from calib_core.vision.locate import locate
-    from calib_core.vision.locate_verdict import image_distance_px
+    from calib_core.look.locate import locate
+    from calib_core.look.locate_verdict import image_distance_px
 
     data = Path(__file__).resolve().parent.parent / "tests" / "data" / "third_party" / "opencv_samples"
     image = np.ascontiguousarray(cv2.imread(str(data / "resized_IMG_3875.JPG"))[:, :, ::-1])
@@ -219,8 +219,8 @@ def truth_overlays(root: Path) -> list[str]:
     from calib_core.camera.projection import project_points
     from calib_core.datasets.bop import BopDataset
     from calib_core.mesh_files import load_mesh
-    from calib_core.vision.locate import locate
-    from calib_core.vision.outline import outline_samples
+    from calib_core.look.locate import locate
+    from calib_core.look.outline import outline_samples
 
     folder = root / "lmo_dev"
     if not (folder / "test").is_dir():

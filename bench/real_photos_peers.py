@@ -24,7 +24,7 @@ def peer_rows(n_priors: int = 5) -> list[str]:
 
     from bench.peer_env import peer_python
     from calib_core.datasets.pose_errors import mspd
-    from calib_core.vision.locate import locate
+    from calib_core.look.locate import locate
     from videocal_sim.printed_box_scene import CAMERA, TRUTH, printed_box, render
     from videocal_sim.printed_box_scene import silhouette_centre_px
 

@@ -22,8 +22,8 @@ from calib_core.render.model_view import ModelView
 from calib_core.robot import solve_ik
 from calib_core.robot.visuals import RobotVisuals
 from videocal_sim.sim_camera import SimulatedCamera
-from calib_core.vision.edge_solution import edge_solution
-from calib_core.vision.find_points import find_points
+from calib_core.look.edge_solution import edge_solution
+from calib_core.look.find_points import find_points
 
 
 def look_at_task(

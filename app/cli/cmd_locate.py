@@ -1,6 +1,6 @@
 """``videocal locate PHOTO --mesh MESH --intrinsics FILE --prior POSE.json``: a known object's pose in a photo.
 
-Runs Find points and the edge fit (:mod:`calib_core.vision.locate`) on one photo of one object and prints the
+Runs Find points and the edge fit (:mod:`calib_core.look.locate`) on one photo of one object and prints the
 object's pose in the camera's frame with its 1-sigma as JSON (``R_obj2cam``, ``t_obj2cam_mm``, ``std``,
 ``status``, the features found). ``--overlay OUT.png`` draws the located outline (green) and the prior's (red) on
 the photo. The prior is JSON: ``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as this command prints them, or
@@ -35,7 +35,7 @@ MAX_FEATURES = 1000
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from calib_core.vision.search_reach import REACH_DEG, REACH_MM
+    from calib_core.look.search_reach import REACH_DEG, REACH_MM
 
     parser.add_argument(
         "photo",
@@ -203,10 +203,10 @@ class _Locator:
             )
 
     def locate(self, photo: Path):
-        """(image (h, w[, 3]) uint8, :class:`~calib_core.vision.located.Located`) of one photo; a photo that cannot
+        """(image (h, w[, 3]) uint8, :class:`~calib_core.look.located.Located`) of one photo; a photo that cannot
         be read or is not the camera file's size raises :class:`FileFormatError` naming it."""
         from calib_core.image_files import read_image
-        from calib_core.vision.locate import locate
+        from calib_core.look.locate import locate
 
         image = read_image(photo)
         if self.intrinsics is None:

@@ -26,8 +26,8 @@ from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.observations import HeldFrame, NotSettledError, Observations
 from calib_core.operator.operator_log import OperatorLog
-from calib_core.vision.corner_pick import refine_corner_pick
-from calib_core.vision.image_evidence import ImageEvidence
+from calib_core.look.corner_pick import refine_corner_pick
+from calib_core.look.image_evidence import ImageEvidence
 
 
 class Picking:
@@ -189,8 +189,8 @@ class Picking:
         rim's centre: the rim the model predicts, placed at the click, fitted to the image's edges within
         4 px, corrected for perspective. ``None`` when the feature is no circle or no rim was found."""
         from calib_core.camera.projection import project_points
-        from calib_core.vision.feature_detectors import Detection, detect_circle
-        from calib_core.vision.target_detectors import circle_rim
+        from calib_core.look.feature_detectors import Detection, detect_circle
+        from calib_core.look.target_detectors import circle_rim
 
         pending = self.session.pairs.pending()
         target = self.session.target

@@ -26,7 +26,7 @@ from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.picking import Picking
 
 if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
-    from calib_core.vision.find_points import FoundPoints
+    from calib_core.look.find_points import FoundPoints
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ class PointFinding:
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.cell.workcell.component(target)
         obj2cam_model = concat(item.item2world, invert(self.cell.robot.fk(q, "camera")))
-        from calib_core.vision.find_points import find_points
+        from calib_core.look.find_points import find_points
 
         result = find_points(
             self.picking.evidence(held.frame.image),
@@ -118,7 +118,7 @@ class PointFinding:
                 "points by hand"
             )
         from calib_core.solver.solve_inputs import solve_inputs
-        from calib_core.vision.edge_solution import edge_solution
+        from calib_core.look.edge_solution import edge_solution
 
         solution = edge_solution(found.result.edges, self.cell.intrinsics)
         item = self.cell.workcell.component(found.result.component)

@@ -2,7 +2,7 @@
 
 A board at an unknown pose cannot say where the robot's base is; the cell's components can, since
 their placements are surveyed in the base frame. At a few poses around each task location's approach
-the camera looks at its component, and :func:`~calib_core.vision.find_points.find_points` locates the
+the camera looks at its component, and :func:`~calib_core.look.find_points.find_points` locates the
 component in the frame (through the given intrinsics, never the truth). The observation is the
 component's pose from its edges (the model-based refinement over hundreds of samples) with that
 fit's covariance, not single features: the edges carry less bias than any one detector (0.2-0.8 px on
@@ -141,7 +141,7 @@ def cell_view(
     covariance, as an :class:`ObjectPoseView` (the component surveyed in the base frame); or the
     reason there is none. ``robot`` places the modelled camera
     (the nominal robot, or one calibrated on a board already, which starts the search closer)."""
-    from calib_core.vision.find_points import find_points
+    from calib_core.look.find_points import find_points
 
     item = workcell.component(component)
     obj2cam_model = concat(item.item2world, invert(robot.fk(joints_deg, "camera")))

@@ -25,8 +25,8 @@ from calib_core.frames import concat, invert
 from calib_core.render.model_view import ModelView
 from calib_core.robot.model import RobotModel
 from calib_core.robot.visuals import RobotVisuals
-from calib_core.vision.edge_solution import edge_solution
-from calib_core.vision.find_points import find_points
+from calib_core.look.edge_solution import edge_solution
+from calib_core.look.find_points import find_points
 
 CENTRING_SIGMA_MM = 0.01
 """How well the closed fingers centre the TCP on the pin, 1-sigma per axis (taken from the model: a

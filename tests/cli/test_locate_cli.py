@@ -173,7 +173,7 @@ def test_the_simulated_camera_s_frame_is_located_where_the_truth_is(tmp_path):
     mm): edges only (the fixture's mesh has too many vertices for default corners). The truth only scores."""
     from calib_core.frames import concat, invert
     from calib_core.robot import solve_ik
-    from tests.core.vision.test_find_points import TARGET, _errors_times
+    from tests.core.look.test_find_points import TARGET, _errors_times
     from videocal_sim.test_bed import TestBed
 
     bed = TestBed.create(errors=_errors_times(1.0))

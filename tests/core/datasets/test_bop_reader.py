@@ -17,8 +17,8 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.datasets.bop import BopDataset
 from calib_core.datasets.pose_errors import mspd
 from calib_core.errors import FileFormatError
-from calib_core.vision.edge_samples import edge_points
-from calib_core.vision.locate import locate
+from calib_core.look.edge_samples import edge_points
+from calib_core.look.locate import locate
 
 K = Intrinsics(572.4, 573.6, 325.3, 242.0, 640, 480)
 
@@ -124,7 +124,7 @@ def test_a_creaseless_mesh_gives_edge_samples_along_its_outline():
     # the blob's outline is about 380 px round at 650 mm: a sample every 4 px or so
     assert len(samples) > 60
     from calib_core.camera.projection import project_points
-    from calib_core.vision.outline import silhouette_mask
+    from calib_core.look.outline import silhouette_mask
 
     mask, (u0, v0) = silhouette_mask(mesh, pose, K)
     uv = project_points(samples, pose, K)

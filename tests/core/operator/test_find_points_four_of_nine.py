@@ -41,7 +41,7 @@ def test_find_points_on_the_demo_s_frame_12_finds_the_target_where_it_is():
 def test_a_fit_on_half_its_edges_proposes_nothing_and_offers_no_edge_calibration(monkeypatch):
     """The second guard: were the right start out of reach (three starts tried, as before), the fit on about half of
     its edges (1.6 mm off) no longer counts as settled: no proposals, no Calibrate on edges, the operator picks."""
-    import calib_core.vision.find_points as find_points_module
+    import calib_core.look.find_points as find_points_module
     from calib_core.errors import OperatorError
 
     monkeypatch.setattr(find_points_module, "_STARTS", 3)

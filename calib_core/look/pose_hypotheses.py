@@ -1,0 +1,134 @@
+"""Where to start the edge refinement: camera poses within the robot's error of the modelled one,
+ranked by how well the target's edges lie on the image's (truncated chamfer distance).
+
+A robot's error moves the camera's centre (up to ``reach_mm``) and turns it (up to ``reach_deg``).
+Far from the target both look alike, a shift of the image; close to it the move also shifts near and
+far edges by different amounts (parallax): at the paper's task location, 177 mm from the fixture, a
+shift that lays the plate's outline on the image leaves the pin 15 px off, and the edge refinement
+settled from there with half its samples on the plate, 2.4 mm from the true pose. A 2D shift found
+first also locks onto the wrong edges once the error reaches 100 px (twice the typical robot error,
+that close), and a search around it inherits that. So the search is over the camera itself: its centre
+on a grid over the reach (across and along the line of sight), a roll about the line of sight, and the
+turn of its line of sight, which is nearly a shift of the image, scored as one (a grid of pixel
+offsets over ``reach_deg``, added to each centre's projection). Every candidate is scored by the mean
+distance of the target's edge samples from the image's edges (Canny, truncated at
+:data:`TRUNCATE_PX`); the best few that differ in the image by more than a few pixels are where the
+refinement starts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project
+from calib_core.frames import concat
+
+TRUNCATE_PX = 40.0
+"""The distance map's cap (px): wide enough that a pose 30 px from the target still sees its way down
+(at 20 px the landscape was flat between the grid's points, 5 mm apart at 155 mm), and one far edge
+costs no more than this."""
+ROLL_DEG = 2.0
+"""The largest roll about the line of sight searched: about three times a typical robot's orientation error."""
+_LATERAL_STEPS = 9
+_DEPTH_STEPS = 5
+_ROLL_STEPS = 5
+_TURN_STEPS = 7
+_MAX_SAMPLES = 150
+_DISTINCT_PX = 6.0
+_RESCORED = 600
+
+
+def turned_camera(obj2cam: np.ndarray, shift_px: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """``obj2cam`` (4, 4) with the camera turned about its centre so the image moves by ``shift_px`` (2,)
+    (to first order: exact at the image's centre)."""
+    turn = Rotation.from_rotvec([-shift_px[1] / intrinsics.fv, shift_px[0] / intrinsics.fu, 0.0]).as_matrix()
+    out = obj2cam.copy()
+    out[:3, :3] = turn @ obj2cam[:3, :3]
+    out[:3, 3] = turn @ obj2cam[:3, 3]
+    return out
+
+
+def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndarray) -> np.ndarray:
+    """``obj2cam`` (4, 4) with the camera's centre moved by each of ``shifts_mm`` (H, 3) (camera axes)
+    and the camera rolled by ``rolls_deg`` (H,) about its optical axis: (H, 4, 4)."""
+    moved = np.tile(np.eye(4), (len(shifts_mm), 1, 1))
+    moved[:, :3, :3] = Rotation.from_rotvec(np.radians(rolls_deg)[:, None] * np.array([0.0, 0.0, 1.0])).as_matrix()
+    moved[:, :3, 3] = -np.einsum("hij,hj->hi", moved[:, :3, :3], shifts_mm)
+    return concat(obj2cam, moved)
+
+
+def _scores(padded_flat: np.ndarray, base: np.ndarray, offsets_flat: np.ndarray) -> np.ndarray:
+    """Mean truncated distance (H, S) of the samples at the flat indices ``base`` (H, m) of the padded
+    distance map, each moved by every flat offset ``offsets_flat`` (S,) (a move of (du, dv) whole
+    pixels is du + dv times the padded width: the padding holds every move inside the map)."""
+    return padded_flat[base[:, None, :] + offsets_flat[None, :, None]].mean(axis=2)
+
+
+def rank_starts(
+    distance: np.ndarray,
+    intrinsics: Intrinsics,
+    samples_mm: np.ndarray,
+    obj2cam: np.ndarray,
+    reach_mm: float,
+    reach_deg: float,
+    keep: int = 3,
+) -> list[np.ndarray]:
+    """The ``keep`` best poses (4, 4) to start an edge refinement from, best first, near ``obj2cam``.
+
+    ``distance`` (h, w): each pixel's distance to the nearest image edge, truncated at
+    :data:`TRUNCATE_PX` (:func:`calib_core.look.edge_alignment.edge_distance_map`);
+    ``samples_mm`` (m, 3): points on the target's edges that the camera sees (object frame);
+    ``reach_mm``, ``reach_deg``: how far the camera's centre and its line of sight may be from
+    ``obj2cam``'s. Candidates whose edges lie within a few pixels of a better one's are left out.
+    """
+    if len(samples_mm) < 10:
+        return [obj2cam]
+    if len(samples_mm) > _MAX_SAMPLES:
+        samples_mm = samples_mm[np.random.default_rng(0).choice(len(samples_mm), _MAX_SAMPLES, replace=False)]
+    lateral = np.linspace(-reach_mm, reach_mm, _LATERAL_STEPS)
+    depth = np.linspace(-reach_mm, reach_mm, _DEPTH_STEPS)
+    rolls = np.linspace(-ROLL_DEG, ROLL_DEG, _ROLL_STEPS)
+    grid = np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
+    poses = moved_cameras(obj2cam, grid[:, :3], grid[:, 3])
+    # (a batched matmul: einsum's generic loop took 30 ms for a thousand poses of 400 samples)
+    pts = np.matmul(samples_mm, poses[:, :3, :3].transpose(0, 2, 1)) + poses[:, None, :3, 3]
+    uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
+    turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
+    t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
+    offsets = np.rint(
+        np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2)
+    )  # whole pixels: a chamfer ranking needs no finer
+    # whole pixels; anything outside the image (or behind the camera: NaN) clipped to just outside it,
+    # where the padding (wider than any offset) holds the cap
+    h, w = distance.shape
+    pad = int(np.abs(offsets).max()) + 2
+    padded = np.pad(np.asarray(distance, dtype=np.float32), pad, constant_values=TRUNCATE_PX)
+    uv_px = np.rint(np.nan_to_num(uv, nan=-1e6).clip(-1e6, 1e6)).astype(np.int64)
+    u = np.clip(uv_px[..., 0], -1, w) + pad
+    v = np.clip(uv_px[..., 1], -1, h) + pad
+    base = v * padded.shape[1] + u  # (H, m)
+    offsets_flat = (offsets[:, 1] * padded.shape[1] + offsets[:, 0]).astype(np.int64)
+    flat = padded.ravel()
+    # every candidate on a third of the samples, the best few hundred again on all of them (the coarse
+    # score only has to keep the right one among those)
+    coarse = base[:, : max(10, base.shape[1] // 3)]
+    rough = np.concatenate(
+        [_scores(flat, chunk, offsets_flat) for chunk in np.array_split(coarse, max(1, len(coarse) // 128))]
+    )  # (H, S)
+    best = np.argpartition(rough, min(_RESCORED, rough.size) - 1, axis=None)[:_RESCORED]
+    rows, cols = np.unravel_index(best, rough.shape)
+    cost = np.full(rough.shape, np.inf, dtype=np.float32)
+    cost[rows, cols] = flat[base[rows] + offsets_flat[cols][:, None]].mean(axis=1)
+    # the unmoved pose wins a tie
+    cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
+    chosen: list[tuple[int, int]] = []
+    order = np.argsort(cost, axis=None, kind="stable")
+    for i, s in zip(*np.unravel_index(order[: 50 * keep], cost.shape)):
+        seen = uv[i] + offsets[s]
+        if all(np.nanmean(np.linalg.norm(seen - (uv[j] + offsets[k]), axis=1)) > _DISTINCT_PX for j, k in chosen):
+            chosen.append((int(i), int(s)))
+        if len(chosen) == keep:
+            break
+    return [turned_camera(poses[i], offsets[s], intrinsics) for i, s in chosen]

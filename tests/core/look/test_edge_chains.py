@@ -1,0 +1,37 @@
+"""The edge fit's noise model: samples of one edge chain share its error (a cluster-robust covariance)."""
+
+import numpy as np
+import trimesh
+
+from calib_core.look.edge_alignment import crease_segments
+from calib_core.solver.clustered_covariance import clustered_scatter
+from calib_core.look.edge_samples import edge_chains
+
+
+def test_a_box_has_twelve_chains_and_a_cylinder_s_rims_one_each():
+    box_segments, _ = crease_segments(trimesh.creation.box((40.0, 30.0, 10.0)))
+    assert len(np.unique(edge_chains(box_segments))) == 12  # its edges meet at right angles: none join
+    cylinder = trimesh.creation.cylinder(radius=5.0, height=8.0, sections=32)
+    segments, _ = crease_segments(cylinder)
+    chains = edge_chains(segments)
+    rims = [np.flatnonzero(np.isclose(segments[:, :, 2], z).all(axis=1)) for z in (-4.0, 4.0)]
+    for rim in rims:
+        assert len(rim) == 32 and len(np.unique(chains[rim])) == 1  # 11 deg a facet: one chain round
+    assert chains[rims[0][0]] != chains[rims[1][0]]
+
+
+def test_the_chained_scatter_grows_with_a_shared_error_and_never_falls_below_the_independent():
+    rng = np.random.default_rng(0)
+    m, sigma = 2000, 0.1
+    chain = np.repeat(np.arange(20), m // 20)
+    J = rng.normal(size=(20, 6))[chain] + 0.3 * rng.normal(size=(m, 6))  # the samples of one edge move alike
+    H = J.T @ J
+    independent = sigma**2 * H
+    # independent offsets, each sample its own chain: the scatter is sigma^2 H (the sandwich is consistent)
+    alone = clustered_scatter(J, rng.normal(0, sigma, m), np.arange(m), independent)
+    assert np.allclose(alone, independent, rtol=0.25, atol=0.25 * sigma**2 * np.abs(H).max())
+    # the same noise plus an offset shared by each chain's samples: the scatter grows, in every direction no less
+    shared = rng.normal(0, sigma, m) + np.repeat(rng.normal(0, sigma, 20), m // 20)
+    grown = clustered_scatter(J, shared, chain, independent)
+    assert np.trace(grown) > 5 * np.trace(independent)
+    assert np.linalg.eigvalsh(grown - independent).min() > -1e-9 * np.trace(grown)

@@ -1,0 +1,61 @@
+"""The prior as a measurement of a pose fit, and the points' 1-sigma a pose's covariance gives: each against finite
+differences or a known answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from scipy.spatial.transform import Rotation
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.look.edge_refinement import perturbed
+from calib_core.look.locate_verdict import points_sigma_px
+from calib_core.look.pose_prior import PosePrior
+
+
+def _pose(rotvec, t) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_rotvec(rotvec).as_matrix()
+    T[:3, 3] = t
+    return T
+
+
+def test_the_priors_normal_equations_are_its_residuals_linearised():
+    """J^T W J and J^T W r from the prior match the residuals (the turn and the move from the prior, weighted by
+    their 1-sigma) differentiated numerically through the fit's own step: to first order in the turn from the prior
+    (2 deg here: within 1 %), and exactly where it matters, at the prior, where the steps end."""
+    prior = PosePrior(_pose([0.1, -0.2, 0.3], [20.0, -10.0, 900.0]), sigma_mm=10.0, sigma_deg=3.0)
+    pose = _pose([0.12, -0.18, 0.31], [26.0, -4.0, 915.0])
+    W = np.diag([1.0 / np.radians(3.0) ** 2] * 3 + [1.0 / 10.0**2] * 3)
+
+    def residual(T):
+        turn = Rotation.from_matrix(T[:3, :3] @ prior.obj2cam[:3, :3].T).as_rotvec()
+        return np.concatenate([turn, T[:3, 3] - prior.obj2cam[:3, 3]])
+
+    J = np.empty((6, 6))
+    for k in range(6):
+        h = np.zeros(6)
+        h[k] = 1e-6
+        J[:, k] = (residual(perturbed(pose, h)) - residual(perturbed(pose, -h))) / 2e-6
+    H, g = prior.normal_equations(pose)
+    expected = J.T @ W @ J
+    assert np.max(np.abs(H - expected)) < 0.02 * np.max(np.abs(expected))
+    np.testing.assert_allclose(g, -J.T @ W @ residual(pose), rtol=0.02, atol=1e-6 * np.max(np.abs(g)))
+    # steps on the prior alone land on it
+    for _ in range(3):
+        H, g = prior.normal_equations(pose)
+        pose = perturbed(pose, np.linalg.solve(H, g))
+    np.testing.assert_allclose(residual(pose), 0.0, atol=1e-9)
+
+
+def test_the_points_sigma_of_a_move_across_the_sight_line_is_f_sigma_over_depth():
+    """A point 1000 mm ahead, a 1-sigma of 2 mm in x and y: f 2 / 1000 px per axis, sqrt(2) of it as a distance."""
+    camera = Intrinsics(800.0, 800.0, 320.0, 240.0, 640, 480)
+    point = trimesh.Trimesh(vertices=np.zeros((1, 3)), faces=np.zeros((0, 3), dtype=int), process=False)
+    pose = _pose([0.0, 0.0, 0.0], [0.0, 0.0, 1000.0])
+    covariance = np.diag([0.0, 0.0, 0.0, 4.0, 4.0, 0.0])
+    assert abs(points_sigma_px(point, pose, covariance, camera) - np.sqrt(2.0) * 800.0 * 2.0 / 1000.0) < 1e-3
+    # a turn about the sight line moves a point 100 mm off it by 100 sigma: f 100 sigma / 1000
+    off = trimesh.Trimesh(vertices=np.array([[100.0, 0.0, 0.0]]), faces=np.zeros((0, 3), dtype=int), process=False)
+    turn = np.diag([0.0, 0.0, 1e-4, 0.0, 0.0, 0.0])
+    assert abs(points_sigma_px(off, pose, turn, camera) - 800.0 * 100.0 * 1e-2 / 1000.0) < 1e-3
