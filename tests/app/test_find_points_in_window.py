@@ -81,3 +81,18 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
         timeout=120,
     )
     assert run.returncode == 0 and "skipped (solved on the image's edges" in run.stdout, run.stdout + run.stderr
+
+
+def test_find_points_where_the_target_cannot_be_seen_says_so_and_names_the_way(qtbot, window):
+    """At the window's first screen the robot stands at home and the target is in no camera: F6 says the target is
+    not in the camera's view and to go to the task, not "pick the points by hand" (no pick could)."""
+    from tests.app.windows import wait_for_settled_frame
+
+    win = window
+    wait_for_settled_frame(qtbot, win)
+    qtbot.keyClick(win, Qt.Key.Key_F6)
+    qtbot.waitUntil(lambda: "not in the camera's view" in win.statusBar().currentMessage(), timeout=20_000)
+    shown = win.statusBar().currentMessage()
+    assert "Go to task" in shown and "pick the points by hand" not in shown, shown
+    if win.finder.dialog is not None:  # the list, when shown, gives each feature the same reason
+        assert not win.finder.dialog.found.result.found and win.finder.dialog.found.result.proposals == ()
