@@ -88,6 +88,13 @@ class CommandPanel(QTabWidget):
         # Calibration
         cal = QWidget()
         cl = QVBoxLayout(cal)
+        # the first step of a calibration, where the operator is: the camera sees the target only at its task
+        self.go_task_here = button(
+            "Go to task",
+            "calibrate_go_task",
+            "Move the robot to the selected task location: the camera then sees the target",
+        )
+        cl.addWidget(self.go_task_here)
         form = QFormLayout()
         self.target = QComboBox()
         self.target.setObjectName("target")

@@ -77,6 +77,7 @@ class WorkflowActions(QObject):
         c.store.clicked.connect(self.store)
         c.go_approach.clicked.connect(lambda: self.go(approach=True))
         c.go_task.clicked.connect(lambda: self.go(approach=False))
+        c.go_task_here.clicked.connect(lambda: self.go(approach=False))
         c.go_corrected.clicked.connect(lambda: self.go(approach=False, corrected=True))
         c.go_uncorrected.clicked.connect(lambda: self.go(approach=False, corrected=False))
         c.verify.clicked.connect(self.report(self._verify))

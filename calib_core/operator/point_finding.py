@@ -57,6 +57,7 @@ class PointFinding:
         target = self.session.target
         if target is None:
             raise CalibrationError("choose the target object first")
+        was_held = self.picking.observations.still is not None
         held = self.picking.observations.still or self.picking.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.cell.workcell.component(target)
@@ -70,6 +71,10 @@ class PointFinding:
             obj2cam_model,
             expected=self.modelled_view(q, item),
         )
+        if not was_held and not result.found and result.edges is None:
+            # held for this look, and nothing on it to pick or fit (the target not in view): the next look, after the
+            # robot has moved, takes a new frame instead of this one
+            self.picking.release_unused_still()
         self.found = FoundOnFrame(result, held.stamp)
         self.log.record(
             "points_found",

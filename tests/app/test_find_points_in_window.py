@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import Qt
 
+from calib_core.frames import pose_difference
 from tests.app.test_calibration_in_window import _go_to_task
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
@@ -96,3 +97,19 @@ def test_find_points_where_the_target_cannot_be_seen_says_so_and_names_the_way(q
     assert "Go to task" in shown and "pick the points by hand" not in shown, shown
     if win.finder.dialog is not None:  # the list, when shown, gives each feature the same reason
         assert not win.finder.dialog.found.result.found and win.finder.dialog.found.result.proposals == ()
+        win.finder.dialog.close()
+    # the way is on the Calibrate tab itself: Go to task there, and Find points then proposes points
+    from tests.app.windows import confirm_move_if_asked
+
+    assert win.commands.tabText(win.commands.currentIndex()) == "Calibrate"
+    qtbot.mouseClick(win.commands.go_task_here, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    wb = win.workbench
+    qtbot.waitUntil(
+        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), wb.task.tcp2base)[0]) < 0.01, timeout=30_000
+    )
+    wait_for_settled_frame(qtbot, win)
+    qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
+    qtbot.mouseClick(win.commands.find_points, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
+    assert win.finder.dialog.found.result.found, win.finder.dialog.found.result.message
