@@ -170,13 +170,20 @@ def run_demo(
     hand = np.random.default_rng(0)
     try:
         # (60 s: a loaded machine starts the simulator, the camera's process and the link slowly)
+        def handshake_done() -> bool:
+            # samples flow while the handshake is under way; a move waits for it, and on a loaded machine the
+            # demo's first move once waited past its budget: the demo starts once the link takes moves
+            state = getattr(wb.arm.link, "auth_state", None)
+            return state is None or getattr(state, "value", state) in ("ready", "off")
+
         _wait(
             app,
-            lambda: wb.link_up and win.camera.last_frame is not None,
+            lambda: wb.link_up and handshake_done() and win.camera.last_frame is not None,
             60,
             "the controller link and the camera",
             lambda: (
-                f"link {'up' if wb.link_up else 'not up'}; camera "
+                f"link {'up' if wb.link_up else 'not up'}"
+                f"{'' if handshake_done() else ', its handshake under way'}; camera "
                 f"{'sending' if win.camera.last_frame is not None else 'no frame yet'}; "
                 f"status: {win.results.status.text()!r}"
             ),
