@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
+
+from bench.photo_priors import moved_prior
 
 PROJECT = Path(__file__).resolve().parent.parent
 OUT = PROJECT / "docs" / "benchmarks" / "real_photos.md"
@@ -79,15 +80,6 @@ def found_datasets(root: Path):
                 out.append(BopDataset(folder, split))
                 break
     return out
-
-
-def moved_prior(truth: np.ndarray, mm: float, deg: float, rng: np.random.Generator) -> np.ndarray:
-    """``truth`` (4, 4) moved ``mm`` in a random direction and turned ``deg`` about a random axis (camera frame)."""
-    d, axis = rng.normal(size=3), rng.normal(size=3)
-    prior = truth.copy()
-    prior[:3, :3] = Rotation.from_rotvec(np.radians(deg) * axis / np.linalg.norm(axis)).as_matrix() @ truth[:3, :3]
-    prior[:3, 3] = truth[:3, 3] + mm * d / np.linalg.norm(d)
-    return prior
 
 
 def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:

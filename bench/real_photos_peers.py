@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.real_photos import moved_prior
+from bench.photo_priors import moved_prior
 
 
 def peer_rows(n_priors: int = 5) -> list[str]:

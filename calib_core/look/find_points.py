@@ -35,7 +35,9 @@ from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge
 from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
+from calib_core.look.coarse_to_fine import coarse_fit, fit_starts
 from calib_core.look.image_evidence import ImageEvidence
+from calib_core.look.in_view import MIN_SHOWN_SAMPLES, share_in_view
 from calib_core.look.target_detectors import TargetDetectors
 from calib_core.look.pose_prior import PosePrior
 from calib_core.look.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -129,12 +131,6 @@ def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> 
     return out
 
 
-MIN_SHOWN_SAMPLES = 40
-"""Fewer of the target's edge samples (3 px apart) in the model's view of the cell than this, and the target is not in
-the camera's view to speak of (behind other parts, or outside the image): at the window's first screen, with the
-robot at home, the model showed 23 of the fixture's; at its task location 548."""
-
-
 def _not_in_view(item: SceneItem, names: list[str], t0: float, why: str) -> FoundPoints:
     return FoundPoints(
         item.name,
@@ -144,19 +140,6 @@ def _not_in_view(item: SceneItem, names: list[str], t0: float, why: str) -> Foun
         missed=tuple(Missed(n, "not in the camera's view at the modelled pose") for n in names),
         seconds=time.perf_counter() - t0,
     )
-
-
-def share_in_view(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intrinsics, margin_px: float) -> float:
-    """The share (0-1) of the mesh's vertices (at most 2000, evenly) in front of a camera at ``obj2cam`` (4, 4, mm) and
-    inside its image widened by ``margin_px`` on every side (the search's reach)."""
-    vertices = np.asarray(mesh.vertices, dtype=float)
-    vertices = vertices[:: max(1, len(vertices) // 2000)]
-    z = vertices @ obj2cam[2, :3] + obj2cam[2, 3]
-    ahead = z > 1.0
-    if not ahead.any():
-        return 0.0
-    inside = intrinsics.contains(project_points(vertices[ahead], obj2cam, intrinsics), margin_px=-margin_px)
-    return float(np.count_nonzero(inside)) / len(vertices)
 
 
 def search_radius_px(
@@ -274,8 +257,8 @@ def find_points(
         return replace(fit, min_share=_FIT_SHARE)  # settled only on more than half its edges: proposals follow from it
 
     best = None
-    for start_pose, coarse in _starts(obj2cam_model, ranked, prior is not None):
-        fit = refined(_coarse_fit(evidence, intrinsics, item.mesh, start_pose, colour, prior) if coarse else start_pose)
+    for start_pose, coarse in fit_starts(obj2cam_model, ranked, prior is not None):
+        fit = refined(coarse_fit(evidence, intrinsics, item.mesh, start_pose, colour, prior) if coarse else start_pose)
         if best is None or _fit_rank(fit) > _fit_rank(best):
             best = fit
         if best.settled and best.inlier_share >= _CLEAR_SHARE:
@@ -413,35 +396,6 @@ def find_points(
         edge_fit,
         edge_seconds,
     )
-
-
-def _starts(model: np.ndarray, ranked: list[np.ndarray], believed: bool) -> list[tuple[np.ndarray, bool]]:
-    """The starts of the edge fit in turn, each with whether it goes coarse to fine: the ranked ones; with a prior
-    believed (a look on a photograph), first the modelled pose itself, at full size and then coarse to fine. On real
-    photographs the chamfer ranking puts clutter first (LM-O from 10 mm / 3 deg off: 11 of 24 views within 5 px
-    from the ranked starts, 18 from the prior alone), and from 30 mm / 10 deg off the fine fit's 8 px window misses
-    edges 20-35 px away that the half-size fit reaches."""
-    first = [(model, False), (model, True)] if believed else []
-    return first + [(r, False) for r in ranked]
-
-
-def _coarse_fit(
-    evidence: ImageEvidence, intrinsics: Intrinsics, mesh, start: np.ndarray, colour, prior: PosePrior | None
-) -> np.ndarray:
-    """``start`` (4, 4) moved by an edge fit on the image at half size (twice the reach in the image, the clutter's
-    fine edges blurred away): where the full-size fit starts from."""
-    half = evidence.half()
-    fit = refine_to_edges(
-        half.grey,
-        intrinsics.scaled(0.5),
-        mesh,
-        start,
-        magnitude=half.magnitude,
-        colour=half.colour if colour is not None else None,
-        colour_bins=half.colour_bins if colour is not None else None,
-        prior=prior,
-    )
-    return fit.obj2cam
 
 
 def _moved_px(points_mm: np.ndarray, a: np.ndarray, b: np.ndarray, intrinsics: Intrinsics) -> float:

@@ -10,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 
-from bench.real_photos import moved_prior  # the bench's priors, drawn the same way
+from bench.photo_priors import moved_prior  # the bench's priors, drawn the same way
 from calib_core.datasets.bop import BopDataset
 from calib_core.datasets.pose_errors import mspd
 from calib_core.mesh_files import load_mesh

@@ -1,0 +1,30 @@
+"""Whether the target can be in the camera's view at all where the model puts it: in front of the camera and inside
+its image (widened by the search's reach), and not hidden behind other parts of the cell in the model's view. Find
+points asked where it cannot be says so and names the way (Go to task), not "pick the points by hand"."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from calib_core.camera.intrinsics import Intrinsics
+from calib_core.camera.projection import project_points
+
+
+MIN_SHOWN_SAMPLES = 40
+"""Fewer of the target's edge samples (3 px apart) in the model's view of the cell than this, and the target is not in
+the camera's view to speak of (behind other parts, or outside the image): at the window's first screen, with the
+robot at home, the model showed 23 of the fixture's; at its task location 548."""
+
+
+def share_in_view(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intrinsics, margin_px: float) -> float:
+    """The share (0-1) of the mesh's vertices (at most 2000, evenly) in front of a camera at ``obj2cam`` (4, 4, mm) and
+    inside its image widened by ``margin_px`` on every side (the search's reach)."""
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    vertices = vertices[:: max(1, len(vertices) // 2000)]
+    z = vertices @ obj2cam[2, :3] + obj2cam[2, 3]
+    ahead = z > 1.0
+    if not ahead.any():
+        return 0.0
+    inside = intrinsics.contains(project_points(vertices[ahead], obj2cam, intrinsics), margin_px=-margin_px)
+    return float(np.count_nonzero(inside)) / len(vertices)
