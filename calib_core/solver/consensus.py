@@ -215,3 +215,44 @@ def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) 
                 )
             )
     return rivals
+
+
+def other_minima(problem: PoseProblem, chosen: RefinedPose, noise_px: float) -> list[RefinedPose]:
+    """Other poses that fit ``chosen``'s own consensus about as well: its pairs alone, solved as a plain problem, which
+    seeds every triplet's P3P roots and calls two minima within the noise ambiguous. With four or five agreeing pairs a
+    second minimum can fit them as well (4 pairs: two poses 32 mm apart, both at 0.35 px) while the sampler found only
+    one. Each returned with its residuals over every pair and ``chosen``'s inliers; empty when the consensus has
+    fewer than four or more than :data:`RIVAL_CHECK_POINTS` pairs, or one pose. Pinhole model, focal lengths known."""
+    from calib_core.solver.solution import SolveStatus
+    from calib_core.solver.solve import solve_pose
+
+    if chosen.inliers is None or problem.estimate_focal or problem.model != "pinhole":
+        return []
+    idx = np.flatnonzero(chosen.inliers)
+    if not 4 <= len(idx) <= RIVAL_CHECK_POINTS:
+        return []
+    intr = problem.intrinsics
+    own = solve_pose(
+        problem.points_3d[idx], problem.points_2d[idx], intr.with_focal(chosen.fu, chosen.fv), sigma_px=noise_px
+    )
+    if own.status is not SolveStatus.AMBIGUOUS:
+        return []
+    out = []
+    for c in own.candidates:
+        R, t = c.obj2cam[:3, :3].copy(), c.obj2cam[:3, 3].copy()
+        r, J, _ = residuals_and_jacobian(problem, R, t, chosen.fu, chosen.fv)
+        cost = float(np.sum(r**2))
+        newton = NewtonResult(R, t, chosen.fu, chosen.fv, r, J, 0, 0)
+        out.append(
+            RefinedPose(
+                c.obj2cam,
+                chosen.fu,
+                chosen.fv,
+                cost,
+                float(np.sqrt(cost / problem.n_points)),
+                True,
+                newton,
+                chosen.inliers.copy(),
+            )
+        )
+    return out

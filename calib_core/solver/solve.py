@@ -17,7 +17,13 @@ from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.solver.candidates import distinct_poses, refine_seed, same_pose
 from calib_core.solver.fast_solve import Tie, applies as fast_path_applies, fast_solve
 from calib_core.solver.initialisation import SMALL_PROBLEM_POINTS, distinct_seeds, initial_seeds, subset_p3p_seeds
-from calib_core.solver.consensus import by_consensus, consensus_refine, inlier_threshold_px, rival_consensus
+from calib_core.solver.consensus import (
+    by_consensus,
+    consensus_refine,
+    inlier_threshold_px,
+    other_minima,
+    rival_consensus,
+)
 from calib_core.solver.sampler import robust_seed
 from calib_core.solver.pick_scale import pick_scale_px
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
@@ -188,7 +194,7 @@ def solve_pose(
         rivals = distinct_poses(
             [
                 r
-                for r in rival_consensus(problem, close[0], noise)
+                for r in rival_consensus(problem, close[0], noise) + other_minima(problem, close[0], noise)
                 if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)
             ]
         )
@@ -200,9 +206,9 @@ def solve_pose(
     ranked = [close[i] for i in rank]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, rank))
     solution = finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
-    if rivals and solution.status is SolveStatus.AMBIGUOUS:
-        # name the pairs: the operator re-picks those, not every point
-        suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
+    # name the pairs: the operator re-picks those, not every point (a second minimum of the same pairs names none)
+    suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
+    if rivals and solution.status is SolveStatus.AMBIGUOUS and suspects:
         solution = replace(
             solution,
             reason=f"{points_label(suspects)}: any one of them could be the pick that is off (leaving out each, the "
