@@ -246,7 +246,7 @@ def _from_files(args):
     from calib_core.vision.board import DEFAULT_SPEC, parse_board
     from calib_core.vision.hand_eye import calibrate_hand_eye
     from calib_core.vision.hand_eye_data import load_posed_images
-    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+    from app.cli.progress import counted, progress
 
     source = Path(args.source)
     if not source.exists():
@@ -282,30 +282,16 @@ def _from_files(args):
         order = data.joint_order(robot.joint_names)
     detect = _detector(args, spec)
     views, flanges, size = [], [], None
-    for posed in data.views:
-        if posed.component is not None:
-            print(
-                f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; "
-                "calibrate-robot uses both)",
-                file=sys.stderr,
+    with progress(len(data.views), "finding the board", args.json) as bar:
+        for posed in counted(data.views, bar):
+            found = _board_view(posed, data, spec, detect, size, bar)
+            if found is None:
+                continue
+            v, size = found
+            views.append(v)
+            flanges.append(
+                posed.flange2base if posed.flange2base is not None else robot.fk(posed.joints_deg[order], "flange")
             )
-            continue
-        image = data.read_image(posed)
-        if size is None:
-            size = (image.shape[1], image.shape[0])
-        elif (image.shape[1], image.shape[0]) != size:
-            raise VideocalError(
-                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
-                "px: one calibration is for one camera mode"
-            )
-        v = detect_view(posed.name, image, spec, detect)
-        if not isinstance(v, BoardView):
-            print(f"rejected {posed.name}: {v.reason}", file=sys.stderr)
-            continue
-        views.append(v)
-        flanges.append(
-            posed.flange2base if posed.flange2base is not None else robot.fk(posed.joints_deg[order], "flange")
-        )
     if args.intrinsics is not None:
         intrinsics = load_intrinsics(args.intrinsics, image_size=size)
     elif data.pinhole is not None:
@@ -331,3 +317,32 @@ def _simulated(args):
         detector_params=args.detector_params,
         pose_sigma_mm=args.pose_sigma_mm,
     )
+
+
+def _board_view(posed, data, spec, detect, size, bar):
+    """``(view, image size)`` of one posed image whose board was found; ``None`` (said) when it shows a component
+    instead, or no board. A size other than the first image's (``size``) is refused: one calibration is for one
+    camera mode."""
+    from app.cli.progress import say
+    from calib_core.vision.intrinsics_calibration import BoardView, detect_view
+
+    if posed.component is not None:
+        say(
+            bar,
+            f"skipped {posed.name}: a view of {posed.component}, not of the board (hand-eye uses board views; "
+            "calibrate-robot uses both)",
+        )
+        return None
+    image = data.read_image(posed)
+    if size is None:
+        size = (image.shape[1], image.shape[0])
+    elif (image.shape[1], image.shape[0]) != size:
+        raise VideocalError(
+            f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
+            "px: one calibration is for one camera mode"
+        )
+    v = detect_view(posed.name, image, spec, detect)
+    if not isinstance(v, BoardView):
+        say(bar, f"rejected {posed.name}: {v.reason}")
+        return None
+    return v, size

@@ -57,6 +57,8 @@ def run(args: argparse.Namespace) -> int:
     from calib_core.vision.board import parse_board
     from calib_core.vision.target_detection import load_detector_settings
     from calib_core.vision.image_sources import folder_images, video_frames
+    from app.cli.progress import counted, progress, say
+    from calib_core.bags.bag_source import looks_like_bag
     from calib_core.vision.intrinsics_calibration import calibrate_intrinsics, detect_views
 
     args.every_given = args.every is not None
@@ -86,9 +88,15 @@ def run(args: argparse.Namespace) -> int:
             images = video_frames(source, args.every)
         else:
             raise VideocalError(f"{source}: no such folder or video file (or use 'sim')")
-    views, rejected = detect_views(images, spec, settings)
-    for r in rejected:
-        print(f"rejected {r.name}: {r.reason}", file=sys.stderr)
+    total = None
+    if args.source != "sim" and Path(args.source).is_dir() and not looks_like_bag(Path(args.source)):
+        from calib_core.vision.image_sources import IMAGE_SUFFIXES
+
+        total = sum(1 for p in Path(args.source).iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+    with progress(total, "finding the board", args.json) as bar:
+        views, rejected = detect_views(counted(images, bar), spec, settings)
+        for r in rejected:
+            say(bar, f"rejected {r.name}: {r.reason}")
     result = calibrate_intrinsics(
         views, spec, distortion=not args.no_distortion, radial_terms=args.k_coefficients, rejected=rejected
     )
