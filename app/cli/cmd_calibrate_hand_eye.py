@@ -333,14 +333,7 @@ def _board_view(posed, data, spec, detect, size, bar):
             "calibrate-robot uses both)",
         )
         return None
-    image = data.read_image(posed)
-    if size is None:
-        size = (image.shape[1], image.shape[0])
-    elif (image.shape[1], image.shape[0]) != size:
-        raise VideocalError(
-            f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
-            "px: one calibration is for one camera mode"
-        )
+    image, size = data.read_image_sized(posed, size)
     v = detect_view(posed.name, image, spec, detect)
     if not isinstance(v, BoardView):
         say(bar, f"rejected {posed.name}: {v.reason}")

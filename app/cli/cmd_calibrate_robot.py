@@ -215,14 +215,7 @@ def _from_files(args):
     corners = spec.corners_mm()
     board_views, views, rejected, size, of_components = [], [], [], None, []
     for k, posed in enumerate(data.views):
-        image = data.read_image(posed)
-        if size is None:
-            size = (image.shape[1], image.shape[0])
-        elif (image.shape[1], image.shape[0]) != size:
-            raise VideocalError(
-                f"{posed.image_path}: {image.shape[1]} x {image.shape[0]} px, the first image is {size[0]} x {size[1]} "
-                "px: one calibration is for one camera mode"
-            )
+        image, size = data.read_image_sized(posed, size)
         if posed.component is not None:
             of_components.append(posed)  # located once the intrinsics are known
             continue

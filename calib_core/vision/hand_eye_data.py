@@ -86,6 +86,19 @@ class PosedImages:
         """The view's image, grey; :class:`FileFormatError` names the file when it is not an image."""
         return read_grey_image(view.image_path, self.source, view.name)
 
+    def read_image_sized(self, view: PosedImage, size: tuple[int, int] | None) -> tuple[np.ndarray, tuple[int, int]]:
+        """The view's image, grey, and its size (w, h) px, which must be ``size`` (the first image's) when given:
+        one calibration is for one camera mode; :class:`FileFormatError` names the file that differs."""
+        image = self.read_image(view)
+        own = (image.shape[1], image.shape[0])
+        if size is not None and own != size:
+            raise FileFormatError(
+                view.image_path,
+                f"{own[0]} x {own[1]} px, the first image is {size[0]} x {size[1]} px: one calibration is for one "
+                "camera mode",
+            )
+        return image, own
+
 
 def load_posed_images(path: str | Path) -> PosedImages:
     """A ``cal_data.yaml`` or a ``.csv``, or a folder holding one (``cal_data.yaml``, else

@@ -49,3 +49,19 @@ def test_a_bad_entry_names_its_file_and_field(tmp_path, doc, field, says):
     with pytest.raises(FileFormatError) as refused:
         load_posed_images(path)
     assert "poses.json" in str(refused.value) and field in str(refused.value) and says in str(refused.value)
+
+
+def test_an_image_of_another_size_is_named(tmp_path):
+    """One calibration is for one camera mode: the image whose size differs from the first's is named."""
+    import cv2
+
+    T = np.eye(4)
+    cv2.imwrite(str(tmp_path / "a.png"), np.zeros((480, 640), np.uint8))
+    cv2.imwrite(str(tmp_path / "b.png"), np.zeros((600, 800), np.uint8))
+    path = tmp_path / "poses.json"
+    path.write_text(json.dumps([{"image": n, "flange2base": T.tolist()} for n in ("a.png", "b.png")]))
+    data = load_posed_images(path)
+    image, size = data.read_image_sized(data.views[0], None)
+    assert size == (640, 480) and image.shape == (480, 640)
+    with pytest.raises(FileFormatError, match=r"b.png: 800 x 600 px, the first image is 640 x 480 px"):
+        data.read_image_sized(data.views[1], size)
