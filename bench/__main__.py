@@ -17,7 +17,12 @@ HERE = Path(__file__).resolve().parent
 def main(argv: list[str]) -> int:
     # names are the benches; what follows an option (``--views 60``) is the benches' own, read from sys.argv
     names = [a for k, a in enumerate(argv) if not a.startswith("-") and (k == 0 or not argv[k - 1].startswith("-"))]
-    names = names or sorted(p.stem for p in HERE.glob("*_bench.py")) + ["real_photos", "hand_eye_real"]
+    pages = sorted(p.stem for p in HERE.glob("*_bench.py")) + ["real_photos", "hand_eye_real"]
+    names = names or pages
+    unknown = [n for n in names if not (HERE / f"{n.removesuffix('.py')}.py").is_file()]
+    if unknown:
+        print(f"error: no bench named {', '.join(unknown)}; the benches: {', '.join(pages)}", file=sys.stderr)
+        return 2
     failed = []
     for name in names:
         mod = importlib.import_module(f"bench.{name.removesuffix('.py')}")
