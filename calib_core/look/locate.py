@@ -72,21 +72,21 @@ def locate(
     believed = PosePrior(prior, reach_mm, reach_deg)
     evidence = ImageEvidence.of(image)  # one grey, gradient and edge map for every start
 
+    target = item if item.features else _with_centre(item)  # (the same search for an object without features)
+
     def look(start: np.ndarray) -> FoundPoints:
-        if item.features:
-            return find_points(
-                evidence,
-                intrinsics,
-                item,
-                start,
-                expected=expected,
-                reach_mm=reach_mm,
-                reach_deg=reach_deg,
-                edge_rms_px=PHOTO_EDGE_RMS_PX,
-                by_colour=True,
-                prior=believed,
-            )
-        return _edges_only(evidence, intrinsics, item, start, expected, reach_mm, reach_deg, believed)
+        return find_points(
+            evidence,
+            intrinsics,
+            target,
+            start,
+            expected=expected,
+            reach_mm=reach_mm,
+            reach_deg=reach_deg,
+            edge_rms_px=PHOTO_EDGE_RMS_PX,
+            by_colour=True,
+            prior=believed,
+        )
 
     located = _report(look(prior), intrinsics, prior, reach_mm, reach_deg)
     if located.status != "ok":
@@ -144,31 +144,19 @@ def _starts_round(prior: np.ndarray, mm: float, deg: float) -> list[np.ndarray]:
     return out
 
 
-def _edges_only(image, intrinsics, item, prior, expected, reach_mm, reach_deg, believed) -> FoundPoints:
-    """Find points' pose search and edge fit for an object without features: one dummy feature at its centre,
-    reported as missed, so the same code runs."""
-    centre = np.asarray(item.mesh.bounding_box.centroid, dtype=float)
+def _with_centre(item: SceneItem) -> SceneItem:
+    """``item`` with one feature at its mesh's centre (reported as missed): Find points' pose search and edge fit then
+    run for an object without features."""
     from calib_core.workcell.feature_kinds import FeatureKind
 
-    item = SceneItem(
+    centre = np.asarray(item.mesh.bounding_box.centroid, dtype=float)
+    return SceneItem(
         item.name,
         item.mesh,
         item.item2world,
         color=item.color,
         features={"centre": centre},
         feature_kinds={"centre": FeatureKind("point")},
-    )
-    return find_points(
-        image,
-        intrinsics,
-        item,
-        prior,
-        expected=expected,
-        reach_mm=reach_mm,
-        reach_deg=reach_deg,
-        edge_rms_px=PHOTO_EDGE_RMS_PX,
-        by_colour=True,
-        prior=believed,
     )
 
 
