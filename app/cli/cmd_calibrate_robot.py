@@ -77,11 +77,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
-def _progress(k, n):
-    print(f"\rview {k} of {n}", end="" if k < n else "\n", file=sys.stderr)
-
-
 def run(args: argparse.Namespace) -> int:
+    from app.cli.progress import progress
+
+    with progress(None, "views", args.json) as bar:
+        return _run(args, bar)
+
+
+def _run(args: argparse.Namespace, bar) -> int:
+    from app.cli.progress import reported, say
     from calib_core.robot_calibration.report import save_robot_calibration
 
     if args.source == "sim":
@@ -91,8 +95,8 @@ def run(args: argparse.Namespace) -> int:
             args.views,
             args.seed,
             with_intrinsics=not args.fixed_intrinsics,
-            progress=_progress,
-            say=lambda text: print(text, file=sys.stderr),
+            progress=reported(bar),
+            say=lambda text: say(bar, text),
         )
         result, robot, nominal, tool, rejected, score = (
             run_.result,
@@ -116,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
 
             cell = load_workcell(args.workcell or DEFAULT_WORKCELL)
             grasps = load_grasps(args.grasps, cell.load_robot().joint_names, cell)
-        result, nominal, rejected, intrinsics_rms, counts = _from_files(args)
+        result, nominal, rejected, intrinsics_rms, counts = _from_files(args, bar)
         robot, tool, score = result.robot, None, None
         if grasps is not None:
             from calib_core.robot_calibration.camera_to_tool import camera_to_tool, with_tool
@@ -168,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _from_files(args):
+def _from_files(args, bar):
     from calib_core.camera.intrinsics_io import load_intrinsics
     from calib_core.robot_calibration.identify_robot import CellFrame, identify_robot
     from calib_core.robot_calibration.observations import PoseView
@@ -214,7 +218,8 @@ def _from_files(args):
     detect = spec.detector(load_detector_settings(args.detector_params) if args.detector_params else None)
     corners = spec.corners_mm()
     board_views, views, rejected, size, of_components = [], [], [], None, []
-    for k, posed in enumerate(data.views):
+    bar.reset(total=len(data.views))
+    for posed in data.views:
         image, size = data.read_image_sized(posed, size)
         if posed.component is not None:
             of_components.append(posed)  # located once the intrinsics are known
@@ -225,7 +230,7 @@ def _from_files(args):
             views.append(PoseView(posed.name, posed.joints_deg[order], corners[v.ids], v.corners_px))
         else:
             rejected.append(f"{posed.name}: {v.reason}")
-        _progress(k + 1, len(data.views))
+        bar.update()
     if args.intrinsics is not None:
         intrinsics, rms = load_intrinsics(args.intrinsics, image_size=size), None
     else:

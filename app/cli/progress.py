@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import os
 import sys
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
 from tqdm import tqdm
@@ -54,6 +54,17 @@ def say(bar: tqdm, line: str) -> None:
         print(line, file=sys.stderr)
     else:
         bar.write(line, file=sys.stderr)
+
+
+def reported(bar: tqdm) -> Callable[[int, int], None]:
+    """A ``progress(done, total)`` callback (as the simulated site's long runs take one) that moves ``bar``."""
+
+    def report(done: int, total: int) -> None:
+        if bar.total != total:
+            bar.total = total
+        bar.update(done - bar.n)
+
+    return report
 
 
 def counted(items: Iterable, bar: tqdm) -> Iterator:

@@ -64,7 +64,7 @@ def consensus_refine(
     admission (default: the threshold's)."""
     minimal = 4 if problem.estimate_focal else 3
     n, p = problem.n_points, problem.n_params
-    R = np.array(R, dtype=float)
+    R = np.array(R, dtype=float, order="C")  # (a transposed rotation is F-ordered: another compiled signature)
     t = np.array(t_mm, dtype=float).reshape(3)
     f = np.array([fu, fv], dtype=float)
     if inliers is None:

@@ -22,6 +22,7 @@ from videocal_sim.compliant_grasp import grasp_frame, grasp_joints
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.board_placement import board_in_cell
 from videocal_sim.hand_eye_views import simulated_hand_eye_images
+from tests.terminal_run import run_on_terminal
 from tests.tool_on_pins import assert_tool_on_the_pins
 
 
@@ -80,8 +81,18 @@ def files(tmp_path_factory):
 
 def test_the_grasps_give_the_tool_and_the_urdf_carries_it(files, tmp_path):
     folder, bed, grasps, _ = files
-    run = _videocal("calibrate-robot", folder / "views.csv", "--grasps", folder / "grasps.csv", "--out", tmp_path)
-    assert run.returncode == 0, run.stderr[-2000:]
+    args = [
+        "calibrate-robot",
+        str(folder / "views.csv"),
+        "--grasps",
+        str(folder / "grasps.csv"),
+        "--out",
+        str(tmp_path),
+    ]
+    code, _, terminal = run_on_terminal(args, timeout=600)
+    assert code == 0, terminal[-2000:]
+    # on a terminal, the board's search through the views shows its progress: counts and the time left
+    assert re.search(r"views: +\d+%.*\d+/16 \[\d\d:\d\d<\d\d:\d\d", terminal), terminal[-2000:]
     assert_tool_on_the_pins(tmp_path / "videocal_arm_calibrated.urdf", bed, grasps)
     assert "tcp2cam" in (tmp_path / "robot_calibration.yaml").read_text()
 

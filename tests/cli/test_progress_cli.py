@@ -3,36 +3,11 @@ read by a program: with --json, or with standard error not a terminal."""
 
 from __future__ import annotations
 
-import os
-import pty
 import re
 import subprocess
 import sys
 
-
-def _run_on_terminal(args: list[str], timeout: float = 300.0) -> tuple[int, str, str]:
-    """The CLI with standard error on a pseudo-terminal (as a user's shell gives it), standard output on a pipe:
-    ``(exit code, stdout, what the terminal received)``."""
-    master, slave = pty.openpty()
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", *args],
-        stdout=subprocess.PIPE,
-        stderr=slave,
-        env={**os.environ, "QT_QPA_PLATFORM": "offscreen"},
-    )
-    os.close(slave)
-    chunks = []
-    while True:
-        try:
-            data = os.read(master, 65536)
-        except OSError:  # the child closed the terminal (EIO)
-            break
-        if not data:
-            break
-        chunks.append(data)
-    out, _ = proc.communicate(timeout=timeout)
-    os.close(master)
-    return proc.returncode, out.decode(), b"".join(chunks).decode(errors="replace")
+from tests.terminal_run import run_on_terminal
 
 
 def test_calibrate_hand_eye_shows_its_progress_on_a_terminal_and_not_with_json(tmp_path):
@@ -44,12 +19,12 @@ def test_calibrate_hand_eye_shows_its_progress_on_a_terminal_and_not_with_json(t
     save_intrinsics(tmp_path / "camera.yaml", TestBed.create().intrinsics)
     args = ["calibrate-hand-eye", str(poses), "--intrinsics", str(tmp_path / "camera.yaml")]
     args += ["--out", str(tmp_path / "mount.yaml")]
-    code, out, terminal = _run_on_terminal(args)
+    code, out, terminal = run_on_terminal(args)
     assert code == 0, terminal
     # the bar, with its counts and the time left ("3/10 [00:00<00:01, ...")
     assert "finding the board" in terminal and re.search(r"\d+/10 \[\d\d:\d\d<\d\d:\d\d", terminal), terminal
     assert "finding the board" not in out
-    code, out, terminal = _run_on_terminal([*args, "--json"])
+    code, out, terminal = run_on_terminal([*args, "--json"])
     assert code == 0 and "finding the board" not in terminal and "finding the board" not in out
     import json
 
