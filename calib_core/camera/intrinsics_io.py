@@ -1,6 +1,7 @@
-"""Intrinsics files: OpenCV FileStorage YAML and ROS ``camera_info`` YAML.
+"""Intrinsics files: OpenCV FileStorage YAML, ROS ``camera_info`` YAML, a ``sensor_msgs/CameraInfo`` message, and the
+plain matrices a script dumps as JSON or YAML (``K`` as rows, ``dist``, ``image_size``).
 
-``load_intrinsics(path)`` tells the two apart by their keys; ``save_intrinsics(path,
+``load_intrinsics(path)`` tells them apart by their keys; ``save_intrinsics(path,
 intrinsics, fmt=...)`` writes either, atomically. Every problem is a
 :class:`~calib_core.errors.FileFormatError` naming the file and the field.
 """
@@ -42,11 +43,14 @@ def load_intrinsics(path: str | Path, image_size: tuple[int, int] | None = None)
         return _load_ros(path, data, image_size)
     if isinstance(data, dict) and ("k" in data or "K" in data) and ("width" in data or "height" in data):
         return _load_camera_info_message(path, data, image_size)
+    if isinstance(data, dict) and any(k in data for k in PLAIN_MATRIX_KEYS):
+        return _load_plain(path, data, image_size)
     raise FileFormatError(
         path,
         "not an intrinsics file: expected OpenCV FileStorage YAML (camera_matrix as "
-        "!!opencv-matrix), ROS camera_info YAML (camera_matrix: {rows, cols, data}) or a "
-        "sensor_msgs/CameraInfo message as `ros2 topic echo` prints it (k, d, width, height)",
+        "!!opencv-matrix), ROS camera_info YAML (camera_matrix: {rows, cols, data}), a "
+        "sensor_msgs/CameraInfo message as `ros2 topic echo` prints it (k, d, width, height), or plain matrices as "
+        "JSON or YAML (K: [[fu, 0, cx], [0, fv, cy], [0, 0, 1]], dist: [k1, k2, p1, p2, k3], image_size: [w, h])",
     )
 
 
@@ -219,6 +223,47 @@ def _load_camera_info_message(path: Path, data: dict, image_size: tuple[int, int
             raise FileFormatError(path, f"must be a list of {size or 'the distortion'} numbers, got {v!r}", name)
         values[name] = np.asarray(v, dtype=float)
     return _build(path, values["k"].reshape(3, 3), values["d"], width, height, "k", "d", model)
+
+
+PLAIN_MATRIX_KEYS = ("K", "camera_matrix", "cameraMatrix", "mtx")
+"""The names scripts give the camera matrix when they dump it as plain rows (``json.dump(K.tolist())``)."""
+PLAIN_DISTORTION_KEYS = ("dist", "D", "dist_coeffs", "distCoeffs", "distortion", "distortion_coefficients")
+
+
+def _load_plain(path: Path, data: dict, image_size: tuple[int, int] | None = None) -> Intrinsics:
+    """Plain matrices as a calibration script dumps them (JSON or YAML): the camera matrix as three rows or nine
+    numbers under one of :data:`PLAIN_MATRIX_KEYS`, the distortion (a flat or nested list, absent: none) under one of
+    :data:`PLAIN_DISTORTION_KEYS`, the size as ``image_size: [width, height]`` or ``width``/``height`` (absent: the
+    images' own). Other keys (a script's RMS, a note) are left alone."""
+
+    def numbers(key: str, value) -> np.ndarray:
+        flat = np.asarray(value, dtype=object).ravel() if isinstance(value, list) else None
+        if flat is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in flat):
+            raise FileFormatError(path, f"must be a list of numbers (or of rows of numbers), got {value!r}", key)
+        return flat.astype(float)
+
+    k_key = next(k for k in PLAIN_MATRIX_KEYS if k in data)
+    K = numbers(k_key, data[k_key])
+    if K.size != 9:
+        raise FileFormatError(path, f"a camera matrix has 9 numbers (3 rows of 3), got {K.size}", k_key)
+    d_key = next((k for k in PLAIN_DISTORTION_KEYS if k in data), None)
+    dist = numbers(d_key, data[d_key]) if d_key is not None else np.zeros(0)
+    size = data.get("image_size")
+    if size is not None:
+        if not isinstance(size, list) or len(size) != 2:
+            raise FileFormatError(path, f"must be [width, height], got {size!r}", "image_size")
+        w_value, h_value, w_key, h_key = size[0], size[1], "image_size[0]", "image_size[1]"
+    elif any(k in data for k in ("width", "height", "image_width", "image_height")):
+        w_key = "width" if "width" in data else "image_width"
+        h_key = "height" if "height" in data else "image_height"
+        w_value, h_value = data.get(w_key), data.get(h_key)
+    else:
+        w_value = h_value = None
+        w_key = h_key = "image_size"
+    width = _image_side(path, w_key, w_value, image_size[0] if image_size else None)
+    height = _image_side(path, h_key, h_value, image_size[1] if image_size else None)
+    model = _model_field(path, data["distortion_model"]) if "distortion_model" in data else None
+    return _build(path, K.reshape(3, 3), dist, width, height, k_key, d_key or "dist", model)
 
 
 def _ros_matrix(path: Path, data: dict, key: str, size: int | None) -> np.ndarray:

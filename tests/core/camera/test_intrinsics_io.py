@@ -91,6 +91,21 @@ BAD_FILES = {
         "   data: [ 500., 0., 0., 510. ]\n",
         "field 'camera_matrix': expected a 3x3 matrix",
     ),
+    "plain_ragged.json": (
+        '{"K": [[500, 0, 320], [0, 500]], "dist": [0, 0, 0, 0], "image_size": [640, 480]}',
+        "field 'K': must be a list of numbers",
+    ),
+    "plain_eight.json": ('{"K": [500, 0, 320, 0, 500, 240, 0, 0], "image_size": [640, 480]}', "field 'K': .*got 8"),
+    "plain_text.json": (
+        '{"K": [[500, 0, 320], [0, 500, 240], [0, 0, 1]], "dist": ["a", 0, 0, 0], "image_size": [640, 480]}',
+        "field 'dist': must be a list of numbers",
+    ),
+    "plain_size.json": ('{"K": [[500, 0, 320], [0, 500, 240], [0, 0, 1]], "image_size": 640}', "field 'image_size'"),
+    "plain_no_size.json": ('{"mtx": [[500, 0, 320], [0, 500, 240], [0, 0, 1]]}', "field 'image_size': missing"),
+    "plain_nan.yaml": (
+        "K: [[.nan, 0, 320], [0, 500, 240], [0, 0, 1]]\nimage_size: [640, 480]\n",
+        "field 'K': contains NaN",
+    ),
     "cv_broken.yaml": (
         "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: [\n",
         "cannot parse|cannot open|camera_matrix",
@@ -113,3 +128,30 @@ def test_bad_files_name_file_and_field(tmp_path, name):
 def test_directory_is_not_a_file(tmp_path):
     with pytest.raises(FileFormatError, match="not a regular file"):
         load_intrinsics(Path(tmp_path))
+
+
+def test_reads_the_plain_matrices_a_script_dumps_as_json(tmp_path):
+    """A real set's intrinsics.json (a RealSense's, as its recording script wrote it: K as rows, five coefficients
+    nested, the size as a pair): the same camera as the OpenCV file of the same numbers."""
+    path = tmp_path / "intrinsics.json"
+    path.write_text(
+        '{"K": [[634.578, 0.0, 641.951], [0.0, 634.056, 358.995], [0.0, 0.0, 1.0]],\n'
+        ' "dist": [[-0.0606, 0.0713, -0.0002, 0.0007, -0.0231]], "image_size": [1280, 720], "rms": 0.21}\n'
+    )
+    intr = load_intrinsics(path)
+    assert (intr.fu, intr.fv, intr.cx, intr.cy, intr.width, intr.height) == (
+        634.578,
+        634.056,
+        641.951,
+        358.995,
+        1280,
+        720,
+    )
+    assert intr.distortion == (-0.0606, 0.0713, -0.0002, 0.0007, -0.0231) and intr.model == "plumb_bob"
+    save_intrinsics(tmp_path / "same.yaml", intr, fmt="opencv")
+    assert load_intrinsics(tmp_path / "same.yaml") == intr
+    # as YAML, flat, the size from the images and no distortion
+    flat = tmp_path / "camera.yaml"
+    flat.write_text("camera_matrix: [500, 0, 320, 0, 510, 240, 0, 0, 1]\n")
+    intr = load_intrinsics(flat, image_size=(640, 480))
+    assert (intr.fu, intr.fv, intr.width, intr.height) == (500, 510, 640, 480) and not any(intr.distortion)
