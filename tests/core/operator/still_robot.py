@@ -37,3 +37,20 @@ def frame_now(core, index: int = 0, image=None, t_s: float | None = None) -> Fra
     frame = Frame(np.zeros((480, 640, 3), np.uint8) if image is None else image, index, t_s)
     core.picking.observe_frame(frame)
     return frame
+
+
+def core_looking_at_task(**cell_options):
+    """An operator core on the simulated cell with the robot standing at the task's approach and a frame of its
+    camera held as frame 3: ``(core, site, joints_deg, camera)``; the caller closes the camera."""
+    from calib_core.operator.core import OperatorCore
+    from calib_core.robot import solve_ik
+    from videocal_sim.sim_site import simulated_cell
+
+    cell, site = simulated_cell(**cell_options)
+    core = OperatorCore(cell, site)
+    q = solve_ik(core.robot, core.task.approach2base, core.cell.home_joints).q_deg
+    site.bed.joints_deg = q
+    camera = site.camera_factory()()
+    still_for(core, joints_deg=q)
+    frame_now(core, index=3, image=camera.read().image)
+    return core, site, q, camera

@@ -11,21 +11,12 @@ ROOT = Path(__file__).resolve().parents[3]
 
 FIRST_LOOK = """
 import json
-from calib_core.operator.core import OperatorCore
-from calib_core.robot import solve_ik
 from calib_core.solver.compile_kernels import called_signatures, compile_kernels
-from videocal_sim.sim_site import simulated_cell
-from tests.core.operator.still_robot import frame_now, still_for
+from tests.core.operator.still_robot import core_looking_at_task
 
 compile_kernels()
 set_up = called_signatures()
-cell, site = simulated_cell()
-core = OperatorCore(cell, site)
-q = solve_ik(core.robot, core.task.approach2base, core.cell.home_joints).q_deg
-site.bed.joints_deg = q
-camera = site.camera_factory()()
-still_for(core, joints_deg=q)
-frame_now(core, index=3, image=camera.read().image)
+core, site, q, camera = core_looking_at_task()
 found = core.finder.find_points()
 core.finder.accept_found_points()
 core.picking.calibrate()

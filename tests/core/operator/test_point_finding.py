@@ -6,21 +6,12 @@ import pytest
 
 from calib_core.calibration.verdict import Verdict
 from calib_core.errors import OperatorError
-from calib_core.operator.core import OperatorCore
-from calib_core.robot import solve_ik
-from videocal_sim.sim_site import simulated_cell
-from tests.core.operator.still_robot import frame_now, still_for
+from tests.core.operator.still_robot import core_looking_at_task
 
 
 @pytest.fixture(scope="module")
 def found_core():
-    cell, site = simulated_cell()
-    core = OperatorCore(cell, site)
-    q = solve_ik(core.robot, core.task.approach2base, core.cell.home_joints).q_deg
-    site.bed.joints_deg = q
-    camera = site.camera_factory()()
-    still_for(core, joints_deg=q)
-    frame_now(core, index=3, image=camera.read().image)
+    core, site, q, camera = core_looking_at_task()
     events = []
     core.points_found.connect(events.append)
     found = core.finder.find_points()
