@@ -19,13 +19,13 @@ import platform
 import resource
 import sys
 import time
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from bench.photo_priors import moved_prior
+from bench.real_views import chosen_views, datasets_root, found_datasets, view_prior
 
 PROJECT = Path(__file__).resolve().parent.parent
 OUT = PROJECT / "docs" / "benchmarks" / "real_photos.md"
@@ -33,9 +33,6 @@ PRIORS = ((5.0, 1.0), (10.0, 3.0), (30.0, 10.0))
 VISIBLE_BINS = ((0.5, 0.7), (0.7, 0.9), (0.9, 1.01))
 WRONG_OK_PX = 10.0
 """An answer called ``ok`` further than this from the truth (MSPD at 640 px width) is a wrong ``ok``."""
-HELD_BACK = {"lmo"}
-HELD_BACK_SCENES = {("lm", 2)}
-SPLITS = ("test", "test_primesense", "val", "test_primesense_bop19")
 
 
 @dataclass
@@ -54,34 +51,6 @@ class Row:
     width: int
 
 
-def datasets_root(given: str | None = None) -> Path:
-    """Where the data sets are: ``given``, ``$VIDEOCAL_DATASETS``, the shared folder beside the project, the cache."""
-    if given:
-        return Path(given).expanduser().resolve()
-    if os.environ.get("VIDEOCAL_DATASETS"):
-        return Path(os.environ["VIDEOCAL_DATASETS"]).expanduser()
-    shared = PROJECT.parent / "shared" / "datasets"
-    if shared.is_dir():
-        return shared
-    return Path.home() / ".cache" / "videocal" / "datasets"
-
-
-def found_datasets(root: Path):
-    from calib_core.datasets.bop import BopDataset
-
-    if not root.is_dir():
-        return []
-    out = []
-    for folder in sorted(p for p in root.iterdir() if p.is_dir()):
-        if folder.name.lower() in HELD_BACK:
-            continue
-        for split in SPLITS:
-            if (folder / split).is_dir() and (folder / "models" / "models_info.json").exists():
-                out.append(BopDataset(folder, split))
-                break
-    return out
-
-
 def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
     import cv2
 
@@ -93,10 +62,7 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
     for dataset in found_datasets(root):
         models = dataset.models()
         meshes = {}
-        chosen = [v for v in dataset.views(min_visible=0.5) if (dataset.name, v.scene_id) not in HELD_BACK_SCENES]
-        rng = np.random.default_rng(48)
-        if len(chosen) > views_per_set:
-            chosen = [chosen[i] for i in sorted(rng.choice(len(chosen), views_per_set, replace=False))]
+        chosen = chosen_views(dataset, views_per_set)
         sets.append(f"{dataset.name}/{dataset.split}: {len(chosen)} views")
         for view in chosen:
             if view.obj_id not in meshes:
@@ -105,9 +71,7 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
             image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1]
             points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
             for mm, deg in PRIORS:
-                prior = moved_prior(
-                    view.obj2cam, mm, deg, np.random.default_rng(zlib.crc32(f"{view.key}/{mm:g}".encode()))
-                )
+                prior = view_prior(view, mm, deg)
                 t0 = time.perf_counter()
                 located = locate(
                     np.ascontiguousarray(image), view.intrinsics, mesh, prior, reach_mm=mm, reach_deg=deg, features={}
@@ -235,7 +199,7 @@ def truth_overlays(root: Path) -> list[str]:
             continue
         mesh = load_mesh(dataset.models()[view.obj_id].path)
         image = cv2.imread(str(view.image_path))
-        prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
+        prior = view_prior(view, 10.0, 3.0)
         located = locate(
             np.ascontiguousarray(image[:, :, ::-1]), view.intrinsics, mesh, prior, reach_mm=10, reach_deg=3, features={}
         )
@@ -334,8 +298,10 @@ def main(argv: list[str] | None = None) -> str:
         "box where the others do.",
         "",
     ] + box_photo_rows()
-    from bench.real_photos_peers import peer_rows  # (it draws its priors as this page does)
+    from bench.real_photos_peers import peer_rows, real_peer_rows
 
+    if rows:
+        lines += ["", "## Beside a peer (the same real photographs)", ""] + real_peer_rows(rows, root, views)
     lines += ["", "## Beside a peer (renders)", ""] + peer_rows()
     lines += ["", "## What the truth is worth", ""] + truth_overlays(root)
     lines += [

@@ -1,6 +1,7 @@
 """``locate`` beside OpenCV contrib's model-based trackers (RAPID, OLS, GOS) from the same priors on the same views,
-for the real-photo page (``bench/real_photos.py``): the printed box rendered on a grained table with its truth.
-Renders, not photographs: the peers are run in their own environment (``bench/peer_env.py``)."""
+for the real-photo page (``bench/real_photos.py``): on the real photographs the page measures (the same views, the
+same seeded priors), and on the printed box rendered on a grained table with its truth. The peers are run in their
+own environment (``bench/peer_env.py``)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,103 @@ from pathlib import Path
 import numpy as np
 
 from bench.photo_priors import moved_prior
+
+
+def _run_trackers(python: Path, image_path: Path, K: np.ndarray, mesh, priors: list[np.ndarray]) -> dict | str:
+    """OpenCV's trackers on one image from each of ``priors`` (4, 4 obj2cam, mm): per tracker, per prior, ``(pose or
+    None, seconds)``; or why they could not run."""
+    import json
+    import subprocess
+
+    import cv2
+
+    request = {
+        "image": str(image_path),
+        "K": np.asarray(K).tolist(),
+        "vertices": np.asarray(mesh.vertices).tolist(),
+        "faces": np.asarray(mesh.faces).tolist(),
+        "views": [{"rvec": cv2.Rodrigues(p[:3, :3])[0].ravel().tolist(), "tvec": p[:3, 3].tolist()} for p in priors],
+        "iterations": 10,
+    }
+    done = subprocess.run(
+        [str(python), str(Path(__file__).resolve().parent / "peers" / "opencv_trackers.py")],
+        input=json.dumps(request),
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    if done.returncode != 0:
+        return done.stderr.strip()[-200:]
+    out = {}
+    for name, runs in json.loads(done.stdout).items():
+        out[f"OpenCV {name.upper()}"] = []
+        for o in runs:
+            pose = None
+            if o["ok"]:
+                pose = np.eye(4)
+                pose[:3, :3] = cv2.Rodrigues(np.array(o["rvec"]))[0]
+                pose[:3, 3] = o["tvec"]
+            out[f"OpenCV {name.upper()}"].append((pose, o["seconds"]))
+    return out
+
+
+def real_peer_rows(ours: list, root: Path, views_per_set: int, priors=((10.0, 3.0), (30.0, 10.0))) -> list[str]:
+    """OpenCV's trackers on the real photographs of the page (the same views, the same seeded priors as ``ours``,
+    videocal's rows), scored as videocal is: within MSPD 5 px (at 640 px width), the median MSPD, the median time;
+    beside videocal's figures on the same runs. The trackers give no verdict: every answer counts."""
+    from calib_core.datasets.pose_errors import mspd
+    from calib_core.mesh_files import load_mesh
+
+    from bench.peer_env import peer_python
+    from bench.real_views import chosen_views, found_datasets, view_prior
+
+    python, what = peer_python()
+    if python is None:
+        return [f"Peer on the real photographs not run: {what}."]
+    lines = [
+        f"Peer: {what}, each tracker called as its documentation shows (200 control points, 15 px search, 10 "
+        "iterations) from the same seeded priors on the same views as videocal's rows above. They give no verdict: "
+        "every answer counts.",
+        "",
+        "| data set | prior | method | views | within MSPD 5 px | within 10 px | median MSPD | median s |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for dataset in found_datasets(root):
+        models, meshes = dataset.models(), {}
+        results: dict[tuple, list[tuple[float, float]]] = {}
+        for view in chosen_views(dataset, views_per_set):
+            if view.obj_id not in meshes:
+                meshes[view.obj_id] = load_mesh(models[view.obj_id].path)
+            mesh, info = meshes[view.obj_id], models[view.obj_id]
+            points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
+            poses = [view_prior(view, mm, deg) for mm, deg in priors]
+            ran = _run_trackers(python, view.image_path, view.intrinsics.K, mesh, poses)
+            if isinstance(ran, str):
+                lines.append(f"(the peer failed on {view.key}: {ran})")
+                continue
+            scale = 640.0 / view.intrinsics.width
+            for method, runs in ran.items():
+                for prior, (pose, seconds) in zip(priors, runs):
+                    error = (
+                        np.inf
+                        if pose is None
+                        else scale * mspd(pose, view.obj2cam, points, info.symmetries, view.intrinsics)
+                    )
+                    results.setdefault((prior, method), []).append((error, seconds))
+        for prior in priors:
+            mine = [r for r in ours if r.dataset == dataset.name and r.prior == prior]
+            measured = [("videocal locate", [(r.mspd_px * 640.0 / r.width, r.seconds) for r in mine])]
+            measured += [(m, rs) for (p, m), rs in results.items() if p == prior]
+            for method, rs in measured:
+                if not rs:
+                    continue
+                errors = np.array([e for e, _ in rs])
+                lines.append(
+                    f"| {dataset.name} | {prior[0]:g} mm / {prior[1]:g} deg | {method} | {len(rs)} | "
+                    f"{int(np.sum(errors < 5.0))} ({100 * np.mean(errors < 5.0):.0f} %) | "
+                    f"{int(np.sum(errors < 10.0))} | {np.median(errors):.1f} px | {np.median([t for _, t in rs]):.2f} |"
+                )
+    return lines
 
 
 def peer_rows(n_priors: int = 5) -> list[str]:
