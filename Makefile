@@ -43,6 +43,7 @@ test: $(STAMP) $(NODE_STAMP)
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist worksteal
 
 bench: $(STAMP)
+	@bash scripts/install-system-deps.sh --bench  # ViSP, a peer of the real-photo bench
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench
 
 clean:

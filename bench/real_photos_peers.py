@@ -51,6 +51,67 @@ def _run_trackers(python: Path, image_path: Path, K: np.ndarray, mesh, priors: l
     return out
 
 
+VISP_FACES = 800
+"""ViSP's edge tracker follows every edge of its model's polygons: a scanned mesh's 10,000-45,000 triangles are edges
+nobody sees (and took minutes a view); it is given the mesh clustered to at most this many triangles (454-742 on
+LM-O and HANDAL), as a CAD model for ViSP would be drawn."""
+
+
+def coarse_mesh(vertices: np.ndarray, faces: np.ndarray, most: int = VISP_FACES) -> tuple[np.ndarray, np.ndarray]:
+    """``vertices`` (n, 3) and ``faces`` (m, 3) clustered on a grid (each cell's vertices merged at their mean), the
+    finest grid of a few that leaves at most ``most`` triangles; collapsed and repeated triangles dropped."""
+    size = float(np.ptp(vertices, axis=0).max())
+    for cells in (40, 32, 24, 18, 14, 10, 8, 6):
+        key = np.floor((vertices - vertices.min(axis=0)) / (size / cells)).astype(np.int64)
+        _, cluster = np.unique(key, axis=0, return_inverse=True)
+        cluster = cluster.ravel()
+        merged = np.zeros((cluster.max() + 1, 3))
+        np.add.at(merged, cluster, vertices)
+        merged /= np.bincount(cluster)[:, None]
+        tri = cluster[faces]
+        tri = tri[(tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])]
+        tri = tri[np.sort(np.unique(np.sort(tri, axis=1), axis=0, return_index=True)[1])]
+        if len(tri) <= most:
+            break
+    return merged, tri
+
+
+def _run_visp(program: Path, image_path: Path, K: np.ndarray, mesh, priors: list[np.ndarray]) -> dict | str:
+    """ViSP's edge tracker, and with KLT points, on one image from each of ``priors`` (4, 4 obj2cam, mm), the mesh
+    coarsened (:func:`coarse_mesh`): as :func:`_run_trackers`."""
+    import json
+    import subprocess
+
+    import cv2
+
+    vertices, faces = coarse_mesh(np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces))
+    out = {}
+    for label, klt in (("ViSP edges", False), ("ViSP edges + KLT", True)):
+        request = {
+            "image": str(image_path),
+            "K": np.asarray(K).tolist(),
+            "vertices": vertices.tolist(),
+            "faces": faces.tolist(),
+            "views": [
+                {"rvec": cv2.Rodrigues(p[:3, :3])[0].ravel().tolist(), "tvec": p[:3, 3].tolist()} for p in priors
+            ],
+            "iterations": 10,
+            "klt": klt,
+        }
+        done = subprocess.run([str(program)], input=json.dumps(request), capture_output=True, text=True, timeout=600)
+        if done.returncode != 0:
+            return done.stderr.strip()[-200:]
+        out[label] = []
+        for o in json.loads(done.stdout.strip().splitlines()[-1]):  # (ViSP prints the model's counts first)
+            pose = None
+            if o["ok"]:
+                pose = np.eye(4)
+                pose[:3, :3] = cv2.Rodrigues(np.array(o["rvec"]))[0]
+                pose[:3, 3] = o["tvec"]
+            out[label].append((pose, o["seconds"]))
+    return out
+
+
 def real_peer_rows(ours: list, root: Path, views_per_set: int, priors=((10.0, 3.0), (30.0, 10.0))) -> list[str]:
     """OpenCV's trackers on the real photographs of the page (the same views, the same seeded priors as ``ours``,
     videocal's rows), scored as videocal is: within MSPD 5 px (at 640 px width), the median MSPD, the median time;
@@ -61,13 +122,18 @@ def real_peer_rows(ours: list, root: Path, views_per_set: int, priors=((10.0, 3.
     from bench.peer_env import peer_python
     from bench.real_views import chosen_views, found_datasets, view_prior
 
+    from bench.peer_env import visp_tracker
+
     python, what = peer_python()
-    if python is None:
-        return [f"Peer on the real photographs not run: {what}."]
+    visp, visp_what = visp_tracker()
     lines = [
-        f"Peer: {what}, each tracker called as its documentation shows (200 control points, 15 px search, 10 "
-        "iterations) from the same seeded priors on the same views as videocal's rows above. They give no verdict: "
-        "every answer counts.",
+        f"Peers: {what if python else 'OpenCV contrib not run: ' + what}; "
+        f"{visp_what if visp else 'ViSP not run: ' + visp_what}. OpenCV's trackers called as their documentation "
+        "shows (200 control points, 15 px search, 10 iterations); ViSP's as its tutorials set it (moving edges: "
+        "mask 5, range 8 px, threshold 10000, sample step 4; KLT: 300 points), 10 tracking iterations on the photo, "
+        f"given the mesh clustered to at most {VISP_FACES} triangles (its edge tracker follows every polygon's "
+        "edges). Each from the same seeded priors on the same views as videocal's rows above, none tuned. They give "
+        "no verdict: every answer counts.",
         "",
         "| data set | prior | method | views | within MSPD 5 px | within 10 px | median MSPD | median s |",
         "|---|---|---|---|---|---|---|---|",
@@ -81,10 +147,15 @@ def real_peer_rows(ours: list, root: Path, views_per_set: int, priors=((10.0, 3.
             mesh, info = meshes[view.obj_id], models[view.obj_id]
             points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
             poses = [view_prior(view, mm, deg) for mm, deg in priors]
-            ran = _run_trackers(python, view.image_path, view.intrinsics.K, mesh, poses)
-            if isinstance(ran, str):
-                lines.append(f"(the peer failed on {view.key}: {ran})")
-                continue
+            ran = {}
+            for peer, run_peer in ((python, _run_trackers), (visp, _run_visp)):
+                if peer is None:
+                    continue
+                got = run_peer(peer, view.image_path, view.intrinsics.K, mesh, poses)
+                if isinstance(got, str):
+                    lines.append(f"(a peer failed on {view.key}: {got})")
+                else:
+                    ran.update(got)
             scale = 640.0 / view.intrinsics.width
             for method, runs in ran.items():
                 for prior, (pose, seconds) in zip(priors, runs):

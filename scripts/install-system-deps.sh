@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the system libraries videocal needs: OSMesa/EGL/GL for offscreen VTK rendering,
 # what Qt's xcb platform plugin needs to open a window on a desktop, Aravis for GenICam cameras, and iproute2.
-# As root it runs apt-get; otherwise it prints the exact command and stops.
+# As root it runs apt-get; otherwise it prints the exact command and stops. `--bench` adds the benches' peers.
 set -euo pipefail
 
 PACKAGES=(
@@ -16,6 +16,11 @@ PACKAGES=(
   # a far ROS 2 link (videocal_sim/far_network.py): network namespaces and TUN devices are set up with ip
   iproute2
 )
+# `--bench`: the peers the benches measure videocal against that come from Debian (ViSP's model-based tracker, built
+# by bench/peer_env.py with g++); the tests never need them
+if [ "${1:-}" = "--bench" ]; then
+  PACKAGES+=(libvisp-mbt-dev nlohmann-json3-dev g++)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
