@@ -11,7 +11,8 @@ from PySide6.QtWidgets import QApplication, QWidget
 
 @contextmanager
 def busy(widget: QWidget, text: str = ""):
-    """Show the wait cursor (and ``text`` in the window's status bar) while the block runs."""
+    """Show the wait cursor (and ``text`` in the window's status bar) while the block runs; the line is cleared after
+    it unless the work put a message of its own there."""
     window = widget.window()
     bar = window.statusBar() if hasattr(window, "statusBar") else None
     if bar is not None and text:
@@ -22,3 +23,5 @@ def busy(widget: QWidget, text: str = ""):
         yield
     finally:
         QApplication.restoreOverrideCursor()
+        if bar is not None and text and bar.currentMessage() == text:
+            bar.clearMessage()  # the work is over: the line no longer says it is under way

@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.gui.busy import busy
 from app.gui.buttons import button
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
@@ -295,7 +296,8 @@ class VisionPanel(QWidget):
 
     # --- calibrating ---------------------------------------------------------------------------
     def calibrate_intrinsics(self) -> None:
-        r = self.vision.calibrate_intrinsics()
+        with busy(self, "calibrating the intrinsics ..."):  # OpenCV's fit of every view: seconds on a real set
+            r = self.vision.calibrate_intrinsics()
         i, s = r.intrinsics, r.std
         lines = [
             f"<b>Intrinsics</b> from {len(r.used)} views, RMS {r.rms_px:.3f} px",
@@ -313,7 +315,8 @@ class VisionPanel(QWidget):
         self.result.setText("<br><br>".join(t for t in (self._intrinsics_text, self._hand_eye_text) if t))
 
     def calibrate_hand_eye(self) -> None:
-        m = self.vision.calibrate_mounting()
+        with busy(self, "calibrating the camera's mounting ..."):
+            m = self.vision.calibrate_mounting()
         r = m.calibration
         lines = [
             f"<b>Camera mounting</b> from {r.views} poses, RMS {r.rms_px:.3f} px",

@@ -49,7 +49,7 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
     assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3
 
 
-def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
+def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path, monkeypatch):
     win, wb = window, window.workbench
     vision = win.vision
     win.commands.setCurrentIndex(next(i for i in range(win.commands.count()) if win.commands.tabText(i) == "Vision"))
@@ -74,8 +74,21 @@ def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path):
     assert vision.calibrate_intrinsics_button.isEnabled() and vision.calibrate_hand_eye_button.isEnabled()
     assert vision.views.count() == 13 and vision.views.item(12).text().startswith("x view_01")
 
-    # Intrinsics against the test bed's lens.
+    # Intrinsics against the test bed's lens; while OpenCV fits them the window says so and shows the wait cursor
+    from PySide6.QtWidgets import QApplication
+
+    during = []
+    fit = vision.vision.calibrate_intrinsics
+
+    def watched():
+        cursor = QApplication.overrideCursor()
+        during.append((win.statusBar().currentMessage(), cursor.shape() if cursor is not None else None))
+        return fit()
+
+    monkeypatch.setattr(vision.vision, "calibrate_intrinsics", watched)
     qtbot.mouseClick(vision.calibrate_intrinsics_button, Qt.MouseButton.LeftButton)
+    assert during == [("calibrating the intrinsics ...", Qt.CursorShape.WaitCursor)]
+    assert QApplication.overrideCursor() is None and "calibrating" not in win.statusBar().currentMessage()
     got, truth = vision.intrinsics_result.intrinsics, wb.site.bed.intrinsics
     assert abs(got.fu / truth.fu - 1) < 0.005 and abs(got.fv / truth.fv - 1) < 0.005
     assert abs(got.cx - truth.cx) < 2.0 and abs(got.cy - truth.cy) < 2.0
