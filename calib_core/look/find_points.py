@@ -37,7 +37,7 @@ from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
 from calib_core.look.coarse_to_fine import coarse_fit, fit_starts
 from calib_core.look.image_evidence import ImageEvidence
-from calib_core.look.in_view import MIN_SHOWN_SAMPLES, share_in_view
+from calib_core.look.in_view import MIN_SHOWN_SAMPLES, hidden_in_view, share_in_view
 from calib_core.look.target_detectors import TargetDetectors
 from calib_core.look.pose_prior import PosePrior
 from calib_core.look.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -225,9 +225,11 @@ def find_points(
         intrinsics,
         detectors.expected_magnitude(obj2cam_model) if expected is not None else None,
     )
-    if expected is not None and len(samples) < MIN_SHOWN_SAMPLES:
-        # (the model's view of the cell says what other parts hide; without one, as on a photograph, a small object
-        # far off shows few samples and is still there: LM-O's ape, 96 % in sight, has 39)
+    if (
+        expected is not None
+        and len(samples) < MIN_SHOWN_SAMPLES
+        and hidden_in_view(samples, item.mesh, obj2cam_model, intrinsics)
+    ):
         return _not_in_view(item, names, t0, f"only {len(samples)} samples of its edges would show")
     ranked = rank_starts(
         evidence.edge_distance(HYPOTHESIS_TRUNCATE_PX),

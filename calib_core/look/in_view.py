@@ -14,9 +14,18 @@ from calib_core.camera.projection import project_points
 MIN_SHOWN_SAMPLES = 40
 """Fewer of the target's edge samples (3 px apart) in the model's view of the cell than this, and the target is not in
 the camera's view to speak of (behind other parts, or outside the image): at the window's first screen, with the
-robot at home, the model showed 23 of the fixture's; at its task location 548. Only where the model's view of the
-cell is known (what other parts hide): on a photograph a small object far off shows as few and is in sight (LM-O's
-ape, 96 % in sight, 39)."""
+robot at home, the model showed 23 of the fixture's; at its task location 548. Only where the model's view hides most
+of them (:func:`hidden_in_view`): a small object far off shows as few and is in sight (LM-O's ape, 96 % in sight,
+39)."""
+
+
+def hidden_in_view(shown: np.ndarray, mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> bool:
+    """Whether the model's view hides most of the target: ``shown`` (k, ...) the edge samples its view shows, fewer than
+    half of those the target's own outline and creases give at ``obj2cam`` (4, 4, mm) inside the image with nothing in
+    front (other parts of the cell, or the image's border, hide the rest)."""
+    from calib_core.look.edge_samples import edge_points
+
+    return len(shown) < 0.5 * len(edge_points(mesh, obj2cam, intrinsics, None)[0])
 
 
 def share_in_view(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intrinsics, margin_px: float) -> float:

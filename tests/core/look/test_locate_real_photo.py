@@ -61,6 +61,52 @@ def test_a_small_object_on_a_photo_is_looked_for_however_few_edges_show():
     assert mspd(located.obj2cam, view.obj2cam, points, info.symmetries, half) < 5.0
 
 
+def test_videocal_locate_looks_for_a_small_object_too(tmp_path):
+    """The same half-size photo through ``videocal locate``, which renders the object alone to see which of its edges
+    show: nothing hides it there, so however few samples show it is looked for (it said "not in the camera's view")."""
+    import json
+    import subprocess
+    import sys
+
+    from calib_core.camera.intrinsics_io import save_intrinsics
+
+    dataset = BopDataset(LMO, "test")
+    (view,) = [v for v in dataset.views() if v.obj_id == 1]
+    half = view.intrinsics.scaled(0.5)
+    image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)
+    cv2.imwrite(str(tmp_path / "half.png"), cv2.resize(image, (half.width, half.height), interpolation=cv2.INTER_AREA))
+    save_intrinsics(tmp_path / "half.yaml", half)
+    prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
+    (tmp_path / "prior.json").write_text(
+        json.dumps({"R_obj2cam": prior[:3, :3].tolist(), "t_obj2cam_mm": prior[:3, 3].tolist()})
+    )
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "locate",
+            str(tmp_path / "half.png"),
+            "--mesh",
+            str(dataset.models()[1].path),
+            "--intrinsics",
+            str(tmp_path / "half.yaml"),
+            "--prior",
+            str(tmp_path / "prior.json"),
+            "--reach-mm",
+            "10",
+            "--reach-deg",
+            "3",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    answer = json.loads(run.stdout)
+    assert answer["status"] == "ok", answer["message"]
+
+
 def test_a_look_reads_the_photo_once(monkeypatch):
     """Every start of a look (the prior, starts round it and nearer and further, at full and at half size) shares one
     image evidence: one Canny pass and one gradient a pyramid level, where each start made its own (ten Canny and
