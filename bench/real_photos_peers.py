@@ -185,8 +185,6 @@ def peer_rows(n_priors: int = 5) -> list[str]:
     """videocal's ``locate`` beside OpenCV contrib's trackers (RAPID, OLS, GOS) from the same priors on the same views:
     the printed box rendered on a grained table with its truth (plain, and with an occluder over a third of its
     outline). Renders, not photographs: what the peers do on real data waits for the data."""
-    import json
-    import subprocess
     import tempfile
 
     import cv2
@@ -236,37 +234,15 @@ def peer_rows(n_priors: int = 5) -> list[str]:
             with tempfile.TemporaryDirectory() as tmp:
                 png = Path(tmp) / "view.png"
                 cv2.imwrite(str(png), image[:, :, ::-1])
-                views = [
-                    {"rvec": cv2.Rodrigues(pr[:3, :3])[0].ravel().tolist(), "tvec": pr[:3, 3].tolist()} for pr in priors
-                ]
-                request = {
-                    "image": str(png),
-                    "K": CAMERA.K.tolist(),
-                    "vertices": np.asarray(mesh.vertices).tolist(),
-                    "faces": np.asarray(mesh.faces).tolist(),
-                    "views": views,
-                    "iterations": 10,
-                }
-                done = subprocess.run(
-                    [str(python), str(Path(__file__).resolve().parent / "peers" / "opencv_trackers.py")],
-                    input=json.dumps(request),
-                    capture_output=True,
-                    text=True,
-                    timeout=600,
-                )
-            if done.returncode == 0:
-                for name, outs in json.loads(done.stdout).items():
-                    key = f"OpenCV {name.upper()}"
-                    results[key] = []
-                    for o in outs:
-                        pose = np.eye(4)
-                        if o["ok"]:
-                            pose[:3, :3] = cv2.Rodrigues(np.array(o["rvec"]))[0]
-                            pose[:3, 3] = o["tvec"]
-                        error = mspd(pose, TRUTH, np.asarray(mesh.vertices), identity, CAMERA) if o["ok"] else np.inf
-                        results[key].append((error, o["seconds"]))
+                ran = _run_trackers(python, png, CAMERA.K, mesh, priors)
+            if isinstance(ran, str):
+                rows.append(f"(the peer failed on {label}: {ran})")
             else:
-                rows.append(f"(the peer failed on {label}: {done.stderr.strip()[-200:]})")
+                for method, runs in ran.items():
+                    results[method] = [
+                        (np.inf if pose is None else mspd(pose, TRUTH, np.asarray(mesh.vertices), identity, CAMERA), t)
+                        for pose, t in runs
+                    ]
         for method, rs in results.items():
             errors = np.array([e for e, _ in rs])
             rows.append(
