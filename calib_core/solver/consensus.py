@@ -9,6 +9,7 @@ judged by how many pairs it explains and how well: the pose that fits the four g
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -18,7 +19,7 @@ from calib_core.solver.misfit import admissible
 from calib_core.solver.problem import PoseProblem
 from calib_core.solver.kernels.subset_fit import FITTED, fit_subset_rounds
 from calib_core.solver.refine import NewtonResult, residuals_and_jacobian
-from calib_core.solver.solution import pose_matrix
+from calib_core.solver.solution import PoseSolution, pose_matrix
 
 _MAX_ITERATIONS = 100
 
@@ -217,14 +218,17 @@ def rival_consensus(problem: PoseProblem, chosen: RefinedPose, noise_px: float) 
     return rivals
 
 
-def other_minima(problem: PoseProblem, chosen: RefinedPose, noise_px: float) -> list[RefinedPose]:
+def other_minima(
+    problem: PoseProblem, chosen: RefinedPose, noise_px: float, solve_plain: Callable[..., PoseSolution]
+) -> list[RefinedPose]:
     """Other poses that fit ``chosen``'s own consensus about as well: its pairs alone, solved as a plain problem, which
     seeds every triplet's P3P roots and calls two minima within the noise ambiguous. With four or five agreeing pairs a
     second minimum can fit them as well (4 pairs: two poses 32 mm apart, both at 0.35 px) while the sampler found only
     one. Each returned with its residuals over every pair and ``chosen``'s inliers; empty when the consensus has
-    fewer than four or more than :data:`RIVAL_CHECK_POINTS` pairs, or one pose. Pinhole model, focal lengths known."""
+    fewer than four or more than :data:`RIVAL_CHECK_POINTS` pairs, or one pose. Pinhole model, focal lengths known.
+    ``solve_plain(points_3d, points_2d, intrinsics, sigma_px=...)``: the plain solve (the caller's: the solver that
+    calls this check is the one it runs again)."""
     from calib_core.solver.solution import SolveStatus
-    from calib_core.solver.solve import solve_pose
 
     if chosen.inliers is None or problem.estimate_focal or problem.model != "pinhole":
         return []
@@ -232,7 +236,7 @@ def other_minima(problem: PoseProblem, chosen: RefinedPose, noise_px: float) -> 
     if not 4 <= len(idx) <= RIVAL_CHECK_POINTS:
         return []
     intr = problem.intrinsics
-    own = solve_pose(
+    own = solve_plain(
         problem.points_3d[idx], problem.points_2d[idx], intr.with_focal(chosen.fu, chosen.fv), sigma_px=noise_px
     )
     if own.status is not SolveStatus.AMBIGUOUS:

@@ -194,7 +194,7 @@ def solve_pose(
         rivals = distinct_poses(
             [
                 r
-                for r in rival_consensus(problem, close[0], noise) + other_minima(problem, close[0], noise)
+                for r in rival_consensus(problem, close[0], noise) + other_minima(problem, close[0], noise, solve_pose)
                 if not any(same_pose(r.obj2cam, c.obj2cam) for c in close)
             ]
         )
