@@ -27,6 +27,22 @@ def _locate_inputs(folder: Path, photo) -> None:
     )
 
 
+def _locate(folder: Path, mesh: str = "box.stl", prior: str = "ahead.json", *more, **run_options):
+    """``videocal locate`` on ``folder``'s inputs (:func:`_locate_inputs`), with ``mesh`` and ``prior`` by name."""
+    return _videocal(
+        "locate",
+        folder / "photo.png",
+        "--mesh",
+        folder / mesh,
+        "--intrinsics",
+        folder / "camera.yaml",
+        "--prior",
+        folder / prior,
+        *more,
+        **run_options,
+    )
+
+
 def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_camera(tmp_path):
     """A NaN vertex was dropped by trimesh's processing without a word (and locate then said "give a prior nearer the
     object"); a prior behind the camera ended in "cannot convert float NaN to integer"."""
@@ -42,30 +58,12 @@ def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_cam
         json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -500], [0, 0, 0, 1]]})
     )
     _refused(
-        _videocal(
-            "locate",
-            tmp_path / "photo.png",
-            "--mesh",
-            tmp_path / "nan.stl",
-            "--intrinsics",
-            tmp_path / "camera.yaml",
-            "--prior",
-            tmp_path / "ahead.json",
-        ),
+        _locate(tmp_path, mesh="nan.stl"),
         "nan.stl",
         "not finite",
     )
     _refused(
-        _videocal(
-            "locate",
-            tmp_path / "photo.png",
-            "--mesh",
-            tmp_path / "box.stl",
-            "--intrinsics",
-            tmp_path / "camera.yaml",
-            "--prior",
-            tmp_path / "behind.json",
-        ),
+        _locate(tmp_path, prior="behind.json"),
         "behind.json",
         "behind it",
     )
@@ -83,19 +81,7 @@ def test_locate_overlay_on_a_full_disk_is_one_line_and_leaves_no_file(tmp_path):
         resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))  # the noisy photo's overlay is larger
 
     _locate_inputs(tmp_path, np.random.default_rng(1).integers(0, 255, (480, 640, 3), dtype=np.uint8))
-    run = _videocal(
-        "locate",
-        tmp_path / "photo.png",
-        "--mesh",
-        tmp_path / "box.stl",
-        "--intrinsics",
-        tmp_path / "camera.yaml",
-        "--prior",
-        tmp_path / "ahead.json",
-        "--overlay",
-        tmp_path / "out" / "overlay.png",
-        preexec=small_files,
-    )
+    run = _locate(tmp_path, "box.stl", "ahead.json", "--overlay", tmp_path / "out" / "overlay.png", preexec=small_files)
     assert "libpng" not in run.stderr, run.stderr
     _refused(run, "overlay.png", "not written")
     assert list((tmp_path / "out").iterdir()) == []

@@ -3,14 +3,14 @@ scanned objects. Fails when the look gets worse on it; the whole data set is mea
 
 from __future__ import annotations
 
-import zlib
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from bench.photo_priors import moved_prior  # the bench's priors, drawn the same way
+from bench.photo_priors import moved_prior
+from bench.real_views import view_prior  # the bench's priors, drawn the same way
 from calib_core.datasets.bop import BopDataset
 from calib_core.datasets.pose_errors import mspd
 from calib_core.mesh_files import load_mesh
@@ -29,7 +29,7 @@ def test_a_real_photo_gives_the_object_within_5_px_from_a_robots_error(obj_id):
     info = dataset.models()[obj_id]
     mesh = load_mesh(info.path)
     image = np.ascontiguousarray(cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1])
-    prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
+    prior = view_prior(view, 10.0, 3.0)
     located = locate(image, view.intrinsics, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={})
     points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
     error_px = mspd(located.obj2cam, view.obj2cam, points, info.symmetries, view.intrinsics)
@@ -39,6 +39,17 @@ def test_a_real_photo_gives_the_object_within_5_px_from_a_robots_error(obj_id):
     assert located.to_dict()["points_sigma_px"] == pytest.approx(located.points_sigma_px, abs=1e-3)
 
 
+def _ape_at_half_size():
+    """LM-O's ape in the slice's photo at half size: ``(view, model info, mesh, half-size intrinsics, RGB image)``."""
+    dataset = BopDataset(LMO, "test")
+    (view,) = [v for v in dataset.views() if v.obj_id == 1]
+    info = dataset.models()[1]
+    half = view.intrinsics.scaled(0.5)
+    image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1]
+    image = np.ascontiguousarray(cv2.resize(image, (half.width, half.height), interpolation=cv2.INTER_AREA))
+    return view, info, load_mesh(info.path), half, image
+
+
 def test_a_small_object_on_a_photo_is_looked_for_however_few_edges_show():
     """The photo at half size: the ape's outline is 23 samples (3 px apart), fewer than the window takes to say a target
     is not in view in the model's view of the cell (hidden by other parts). A photograph has no such view: the ape is
@@ -46,16 +57,9 @@ def test_a_small_object_on_a_photo_is_looked_for_however_few_edges_show():
     from calib_core.look.edge_samples import edge_points
     from calib_core.look.in_view import MIN_SHOWN_SAMPLES
 
-    dataset = BopDataset(LMO, "test")
-    (view,) = [v for v in dataset.views() if v.obj_id == 1]
-    info = dataset.models()[1]
-    mesh = load_mesh(info.path)
-    half = view.intrinsics.scaled(0.5)
-    image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)[:, :, ::-1]
-    image = np.ascontiguousarray(cv2.resize(image, (half.width, half.height), interpolation=cv2.INTER_AREA))
+    view, info, mesh, half, image = _ape_at_half_size()
     assert len(edge_points(mesh, view.obj2cam, half)[0]) < MIN_SHOWN_SAMPLES
-    prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
-    located = locate(image, half, mesh, prior, reach_mm=10.0, reach_deg=3.0, features={})
+    located = locate(image, half, mesh, view_prior(view, 10.0, 3.0), reach_mm=10.0, reach_deg=3.0, features={})
     assert located.status == "ok", located.message
     points = np.asarray(mesh.vertices)[:: max(1, len(mesh.vertices) // 2000)]
     assert mspd(located.obj2cam, view.obj2cam, points, info.symmetries, half) < 5.0
@@ -70,37 +74,17 @@ def test_videocal_locate_looks_for_a_small_object_too(tmp_path):
 
     from calib_core.camera.intrinsics_io import save_intrinsics
 
-    dataset = BopDataset(LMO, "test")
-    (view,) = [v for v in dataset.views() if v.obj_id == 1]
-    half = view.intrinsics.scaled(0.5)
-    image = cv2.imread(str(view.image_path), cv2.IMREAD_COLOR)
-    cv2.imwrite(str(tmp_path / "half.png"), cv2.resize(image, (half.width, half.height), interpolation=cv2.INTER_AREA))
+    view, info, _, half, image = _ape_at_half_size()
+    cv2.imwrite(str(tmp_path / "half.png"), image[:, :, ::-1])
     save_intrinsics(tmp_path / "half.yaml", half)
-    prior = moved_prior(view.obj2cam, 10.0, 3.0, np.random.default_rng(zlib.crc32(f"{view.key}/10".encode())))
+    prior = view_prior(view, 10.0, 3.0)
     (tmp_path / "prior.json").write_text(
         json.dumps({"R_obj2cam": prior[:3, :3].tolist(), "t_obj2cam_mm": prior[:3, 3].tolist()})
     )
+    args = ["locate", tmp_path / "half.png", "--mesh", info.path, "--intrinsics", tmp_path / "half.yaml"]
+    args += ["--prior", tmp_path / "prior.json", "--reach-mm", "10", "--reach-deg", "3"]
     run = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "app.cli.main",
-            "locate",
-            str(tmp_path / "half.png"),
-            "--mesh",
-            str(dataset.models()[1].path),
-            "--intrinsics",
-            str(tmp_path / "half.yaml"),
-            "--prior",
-            str(tmp_path / "prior.json"),
-            "--reach-mm",
-            "10",
-            "--reach-deg",
-            "3",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
+        [sys.executable, "-m", "app.cli.main", *map(str, args)], capture_output=True, text=True, timeout=300
     )
     assert run.returncode == 0, run.stderr[-2000:]
     answer = json.loads(run.stdout)
