@@ -106,7 +106,8 @@ def test_the_ros2_connector_moves_an_arm_seconds_away_once_along_its_line(domain
             handle.wait(60.0)
             # Along its line, never back, never past the target: each message replaced the last, none ran twice.
             along = np.array([q @ target / (target @ target) for q in samples[start:]])
-            assert along[-1] == pytest.approx(1.0, abs=1e-3)
+            # Done as the connector calls it done: every joint within its done tolerance of the target.
+            assert np.max(np.abs(samples[-1] - target)) <= link.done_tolerance_deg
             assert np.all(np.diff(along) >= -1e-6) and np.all(along <= 1.0 + 1e-6)
             assert LinkState.STALE not in states  # no late burst taken for a lost robot
         finally:
