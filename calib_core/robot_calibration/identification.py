@@ -26,6 +26,7 @@ from calib_core.errors import VideocalError
 from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.left_out_views import OVERFIT_RATIO, left_out_ratio
+from calib_core.robot_calibration.mounting_start import mounting_start
 from calib_core.robot_calibration.observability import Observability, analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
@@ -248,12 +249,27 @@ def identify(
     started = time.perf_counter()
     if len(views) < MIN_VIEWS:
         raise RobotCalibrationError(f"{len(views)} views, at least {MIN_VIEWS} needed (30-40 recommended)")
-    problem = IdentificationProblem(robot, intrinsics, views, camera_frame, with_intrinsics, survey_sigma_mm)
-    if problem.has_board:
-        problem.board0 = initial_board2base(robot, intrinsics, views, camera_frame)
+    pixel_rows = np.concatenate([np.full(residual_count(v), v.target != OBJECT) for v in views])
+
+    def problem_of(model: RobotModel) -> IdentificationProblem:
+        problem = IdentificationProblem(model, intrinsics, views, camera_frame, with_intrinsics, survey_sigma_mm)
+        if problem.has_board:
+            problem.board0 = initial_board2base(model, intrinsics, views, camera_frame)
+        return problem
+
+    def start_rms_px(model: RobotModel) -> float:
+        r = problem_of(model).residuals(np.zeros(problem.size), np.zeros(6))[pixel_rows]
+        return float(np.sqrt(2.0 * np.mean(r**2))) if np.all(np.isfinite(r)) else float("inf")
+
+    problem = problem_of(robot)
     p0, b0 = np.zeros(problem.size), np.zeros(6)
     start_r = problem.residuals(p0, b0)
-    pixel_rows = np.concatenate([np.full(residual_count(v), v.target != OBJECT) for v in views])
+    nominal_rms_px = float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))) if np.all(np.isfinite(start_r)) else np.inf
+    start = mounting_start(robot, intrinsics, views, camera_frame, start_rms_px) if problem.has_board else None
+    if start is not None and start.note is not None:
+        robot = start.robot
+        problem = problem_of(robot)
+        start_r = problem.residuals(p0, b0)
     if not np.all(np.isfinite(start_r)):
         raise RobotCalibrationError(
             "some points project behind the camera with the nominal model: a view's joints or points are wrong"
@@ -352,6 +368,8 @@ def identify(
         for v, a, b in zip(views, bounds[:-1], bounds[1:])
     }
     warnings = [f"{name} left out: {why}" for name, why in left_out.items()]
+    if start is not None and start.note is not None:
+        warnings.insert(0, start.note)
     if not fit.success:
         warnings.append(f"the fit stopped before converging ({fit.message})")
     loo_ratio = left_out_ratio(J, fit.fun, view_of, kept)
@@ -375,7 +393,7 @@ def identify(
         problem.corrected.calibrated_model(),
         problem.corrected.intrinsics(intrinsics),
         time.perf_counter() - started,
-        float(np.sqrt(2.0 * np.mean(start_r[pixel_rows] ** 2))),
+        nominal_rms_px,
         warnings,
         cov[:k, :k],
         robot.copy(),
