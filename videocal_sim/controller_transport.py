@@ -9,10 +9,8 @@ then back with a fresh joint-sample sequence).
 
 from __future__ import annotations
 
-import contextlib
 import os
 import select
-import socket
 import time
 import tty
 from collections.abc import Callable
@@ -21,8 +19,9 @@ from pathlib import Path
 
 from calib_core.link.assembler import SentenceAssembler
 from videocal_sim.controller_sim import ControllerLogic
+from videocal_sim.tcp_port import TcpPort
 from videocal_sim.wire_faults import FaultInjector
-from calib_core.link.protocol import ErrorReply, encode
+from calib_core.link.protocol import encode
 
 
 @dataclass
@@ -58,16 +57,25 @@ class _PtyEndpoint:
             tmp.symlink_to(self.path)
             os.replace(tmp, link_path)
 
+        self.assembler = SentenceAssembler()  # one line, shared by whoever writes on it
+
     def fds(self) -> list[int]:
         return [self.master]
 
-    def read(self, fd: int) -> bytes:
+    def read(self, fd: int) -> tuple[None, list[str]]:
         try:
-            return os.read(self.master, 4096)
+            data = os.read(self.master, 4096)
         except OSError:
-            return b""
+            data = b""
+        return None, self.assembler.feed(data)
 
-    def write(self, data: bytes) -> None:
+    def accepts(self, client, body: str) -> bool:
+        return True  # one line: whoever writes on it is heard, as on a serial cable
+
+    def heard(self, client, replies: list) -> None:
+        pass
+
+    def write(self, data: bytes, to=None) -> None:
         try:
             os.write(self.master, data)
         except (BlockingIOError, OSError):
@@ -79,80 +87,6 @@ class _PtyEndpoint:
                 os.close(fd)
             except OSError:
                 pass
-
-
-class _TcpEndpoint:
-    """One workstation at a time on a TCP port. ``holds_session()``: the connected client has an
-    authenticated session (``None``: a controller without a key, where the first client keeps the
-    port). A client without a session does not lock the port: the next connection takes its place."""
-
-    def __init__(self, port: int, holds_session: Callable[[], bool] | None = None):
-        self.holds_session = holds_session
-        self.server = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        self.server.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        self.server.bind(("127.0.0.1", port))
-        self.server.listen(1)
-        self.client: socket.socket | None = None
-        self.refused = 0
-        self.generation = 0  # counts client changes: a new or lost client ends the authenticated session
-        self.path = f"socket://127.0.0.1:{self.server.getsockname()[1]}"
-
-    @staticmethod
-    def _alive(client: socket.socket) -> bool:
-        """The connected client is still there (a peer that closed reads as end of stream)."""
-        try:
-            return client.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) != b""
-        except BlockingIOError:
-            return True
-        except OSError:
-            return False
-
-    def fds(self) -> list:
-        return [self.server] + ([self.client] if self.client else [])
-
-    def read(self, fd) -> bytes:
-        if fd is self.server:
-            conn, _ = self.server.accept()
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            keeps_port = self.holds_session is None or self.holds_session()
-            if self.client is not None and self._alive(self.client) and keeps_port:
-                # One workstation at a time: a second client does not take the robot over.
-                with contextlib.suppress(OSError):
-                    conn.sendall(
-                        encode(ErrorReply("BUSY", "another workstation is connected; this connection is closed").body())
-                    )
-                conn.close()
-                self.refused += 1
-                return b""
-            if self.client is not None:
-                self.client.close()
-            self.client = conn
-            self.generation += 1
-            return b""
-        try:
-            data = self.client.recv(4096)
-        except OSError:
-            data = b""
-        if not data:
-            self.client.close()
-            self.client = None
-            self.generation += 1
-        return data
-
-    def write(self, data: bytes) -> None:
-        if self.client is None:
-            return
-        try:
-            self.client.sendall(data)
-        except OSError:
-            self.client.close()
-            self.client = None
-            self.generation += 1
-
-    def close(self) -> None:
-        if self.client is not None:
-            self.client.close()
-        self.server.close()
 
 
 def serve(
@@ -169,21 +103,16 @@ def serve(
     faults = faults or FaultInjector()
 
     def open_endpoint():
-        return (
-            _PtyEndpoint(options.link_path)
-            if options.pty
-            else _TcpEndpoint(options.tcp_port, None if logic.key is None else lambda: logic.session_open)
-        )
+        return _PtyEndpoint(options.link_path) if options.pty else TcpPort(options.tcp_port, logic.key is not None)
 
     endpoint = open_endpoint()
     announce(endpoint.path)
-    assembler = SentenceAssembler()
     started = time.monotonic()
     rebooted = False
 
-    def send(messages) -> None:
+    def send(messages, to=None) -> None:
         for msg in messages:
-            endpoint.write(faults.apply(encode(msg.body())))
+            endpoint.write(faults.apply(encode(msg.body())), to)
 
     try:
         while not should_stop():
@@ -195,7 +124,6 @@ def serve(
                 time.sleep(options.reboot_downtime_s)
                 # a rebooted controller forgets streams, moves and its session
                 logic.__init__(logic.model, logic.joints_deg, logic.clock, key=logic.key, on_refusal=logic.on_refusal)
-                assembler.reset()
                 endpoint = open_endpoint()
                 announce(endpoint.path)
                 rebooted = True
@@ -204,12 +132,15 @@ def serve(
             ready, _, _ = select.select(endpoint.fds(), [], [], timeout)
             for fd in ready:
                 generation = getattr(endpoint, "generation", 0)
-                data = endpoint.read(fd)
+                client, bodies = endpoint.read(fd)
                 if getattr(endpoint, "generation", 0) != generation:
-                    logic.end_session()
-                    assembler.reset()
-                for body in assembler.feed(data):
-                    send(logic.handle(body))
+                    logic.end_session()  # its holder went away
+                for body in bodies:
+                    if not endpoint.accepts(client, body):
+                        continue  # another's AUT: it would spend the one try of the hello in force
+                    replies = logic.handle(body)
+                    endpoint.heard(client, replies)
+                    send(replies, client)
             send(logic.tick())
     finally:
         endpoint.close()

@@ -191,7 +191,8 @@ def test_a_keyless_tcp_client_does_not_lock_the_workstation_out(sim):  # noqa: F
                 assert b"ERR,BUSY,another workstation is connected" in intruder.recv(4096)
             assert workstation.state is LinkState.UP
         squatter.settimeout(1.0)
-        assert squatter.recv(4096) == b""  # it was let go when the workstation came
+        while squatter.recv(4096):  # the samples it heard while nobody held a session, then the end:
+            pass  # it was let go when the workstation came (a recv that times out fails the test)
 
 
 def test_a_sealed_move_held_back_by_a_relay_and_released_after_the_workstation_died_is_refused():
