@@ -17,6 +17,7 @@ from pathlib import Path
 
 
 from calib_core.errors import VideocalError
+from app.cli.bag_options import add_bag_arguments
 from app.cli.options import bounded_float, bounded_int
 
 
@@ -27,13 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "a JSON list of {image, flange2base} (4 x 4, metres), "
         "or a ROS 2 bag (a bag folder, .mcap or .db3: images, /joint_states, CameraInfo)",
     )
-    parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
-    parser.add_argument(
-        "--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)"
-    )
-    parser.add_argument(
-        "--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)"
-    )
+    add_bag_arguments(parser)
     parser.add_argument(
         "--flange-from",
         choices=("auto", "joints", "tf"),

@@ -19,6 +19,7 @@ import json
 import sys
 from pathlib import Path
 
+from app.cli.bag_options import add_bag_arguments
 from app.cli.options import bounded_int
 from calib_core.errors import VideocalError
 
@@ -30,13 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "holding views.csv (and grasps.csv), "
         "or a ROS 2 bag (a bag folder, .mcap or .db3: board images, /joint_states, CameraInfo)",
     )
-    parser.add_argument("--topic", help="with a bag: the image topic (needed when it has several)")
-    parser.add_argument(
-        "--joint-topic", help="with a bag: the JointState topic (default: the only one, else /joint_states)"
-    )
-    parser.add_argument(
-        "--every", type=bounded_int(1, 100_000), default=1, help="with a bag: use every n-th image (default 1)"
-    )
+    add_bag_arguments(parser)
     parser.add_argument(
         "--views", type=bounded_int(8, 200), default=40, help="with 'sim': poses to view the board from (8 to 200)"
     )
