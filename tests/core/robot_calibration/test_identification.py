@@ -5,6 +5,8 @@ calibrated URDF read back by the loader every other part uses."""
 import numpy as np
 import pytest
 
+from tests.core.robot_calibration.board_scenes import SPEC, board_views, cold_cell_with_board
+
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.robot.model import load_robot
@@ -13,32 +15,12 @@ from calib_core.robot_calibration.observations import CELL, PoseView
 from calib_core.robot_calibration.parameters import CorrectedRobot
 from calib_core.robot_calibration.pose_planner import plan_poses
 from calib_core.robot_calibration.report import calibrated_urdf, save_robot_calibration
-from videocal_sim.test_bed import TestBed
-from videocal_sim.true_robot import RobotErrors
-from calib_core.vision.board import DEFAULT_SPEC, parse_board
-from calib_core.vision.board_placement import board_in_cell, board_view_joints
 from calib_core.workcell import load_workcell
-
-SPEC = parse_board(DEFAULT_SPEC)
 
 
 @pytest.fixture(scope="module")
 def setup():
-    cell = load_workcell()
-    bed = TestBed.create(cell, errors=RobotErrors.typical(0))
-    board2base = board_in_cell(SPEC, cell, bed.model_robot)
-    joints = board_view_joints(bed.model_robot, cell.home_joints_deg, SPEC, board2base, 50, seed=3)
-    return bed, board2base, joints
-
-
-def _views(cam2base_at, joints, board2base, intrinsics, noise_px=0.0, seed=0):
-    rng = np.random.default_rng(seed)
-    pts = SPEC.corners_mm()
-    out = []
-    for k, q in enumerate(joints):
-        px = project(apply(invert(cam2base_at(q)) @ board2base, pts), intrinsics)
-        out.append(PoseView(f"v{k}", np.asarray(q), pts, px + rng.normal(0.0, noise_px, px.shape)))
-    return out
+    return cold_cell_with_board(50)
 
 
 def test_exact_views_of_the_true_robot_give_its_camera_poses_exactly(setup):
@@ -46,7 +28,7 @@ def test_exact_views_of_the_true_robot_give_its_camera_poses_exactly(setup):
     pixels the held-out camera poses (relative to the board, what board views determine) come back to
     round-off, from 7 px of nominal-model error."""
     bed, board2base, joints = setup
-    views = _views(bed.true_cam2world, joints[:35], board2base, bed.intrinsics)
+    views = board_views(bed.true_cam2world, joints[:35], board2base, bed.intrinsics)
     result = identify(bed.model_robot, bed.intrinsics, views)
     assert result.start_rms_px > 3.0 and result.rms_px < 1e-6
     for q in joints[35:]:
@@ -61,7 +43,7 @@ def test_the_board_absorbs_the_first_joint_and_the_report_says_so(setup):
     first joint's placement is a move of the whole robot, which the board's placement takes up."""
     bed, board2base, joints = setup
     result = identify(
-        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+        bed.model_robot, bed.intrinsics, board_views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
     )
     names = result.names
     unidentified = {names[k] for k in result.observability.unidentified}
@@ -76,7 +58,7 @@ def test_parameters_come_back_from_views_made_with_them_and_their_sigmas_are_hon
     identified subset, seen with 0.1 px noise, gives them back within their 1-sigma's reach."""
     bed, board2base, joints = setup
     probe = identify(
-        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+        bed.model_robot, bed.intrinsics, board_views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
     )
     rng = np.random.default_rng(5)
     truth = np.zeros(len(probe.names))
@@ -88,7 +70,7 @@ def test_parameters_come_back_from_views_made_with_them_and_their_sigmas_are_hon
         result = identify(
             bed.model_robot,
             bed.intrinsics,
-            _views(made.cam2base, joints[:30], board2base, bed.intrinsics, 0.1, seed),
+            board_views(made.cam2base, joints[:30], board2base, bed.intrinsics, 0.1, seed),
             parameters=probe.identified_names,
         )
         assert result.observability.identified == probe.observability.identified
@@ -103,7 +85,7 @@ def test_surveyed_cell_features_tie_the_robot_to_the_cell(setup):
     """With views of points surveyed in the base frame, the first joint's placement (the base) is
     determined too, and the camera comes back in the base frame itself."""
     bed, board2base, joints = setup
-    views = _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+    views = board_views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
     # The board's corners as if surveyed: known in the base frame.
     pts = apply(board2base, SPEC.corners_mm())
     for k, q in enumerate(joints[30:40]):
@@ -119,7 +101,7 @@ def test_surveyed_cell_features_tie_the_robot_to_the_cell(setup):
 def test_the_calibrated_urdf_loads_and_moves_like_the_calibrated_model(setup, tmp_path):
     bed, board2base, joints = setup
     result = identify(
-        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+        bed.model_robot, bed.intrinsics, board_views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
     )
     yaml_path, urdf_path = save_robot_calibration(tmp_path, result, bed.model_robot)
     assert yaml_path.is_file() and urdf_path.name == "videocal_arm_calibrated.urdf"
@@ -137,7 +119,9 @@ def test_the_calibrated_urdf_loads_and_moves_like_the_calibrated_model(setup, tm
 def test_too_few_views_are_refused(setup):
     bed, board2base, joints = setup
     with pytest.raises(RobotCalibrationError, match="at least 6"):
-        identify(bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, joints[:3], board2base, bed.intrinsics))
+        identify(
+            bed.model_robot, bed.intrinsics, board_views(bed.true_cam2world, joints[:3], board2base, bed.intrinsics)
+        )
 
 
 def test_the_planned_poses_see_the_board_and_inform_more_than_arbitrary_ones(setup):
@@ -152,10 +136,12 @@ def test_the_planned_poses_see_the_board_and_inform_more_than_arbitrary_ones(set
     first12 = identify(
         bed.model_robot,
         bed.intrinsics,
-        _views(bed.true_cam2world, arbitrary.joints_deg[:12], board2base, bed.intrinsics, 0.1),
+        board_views(bed.true_cam2world, arbitrary.joints_deg[:12], board2base, bed.intrinsics, 0.1),
     )
     chosen = identify(
-        bed.model_robot, bed.intrinsics, _views(bed.true_cam2world, plan.joints_deg, board2base, bed.intrinsics, 0.1)
+        bed.model_robot,
+        bed.intrinsics,
+        board_views(bed.true_cam2world, plan.joints_deg, board2base, bed.intrinsics, 0.1),
     )
     # The D-optimal set determines the parameters better: smaller sigmas on what both identify.
     common = sorted(set(first12.observability.identified) & set(chosen.observability.identified))

@@ -15,7 +15,12 @@ from calib_core.robot_calibration.observations import PoseView
 from calib_core.vision.board_placement import board_view_joints
 from calib_core.workcell import load_workcell
 from scipy.spatial.transform import Rotation
-from tests.core.robot_calibration.test_identification import SPEC, _views, setup  # noqa: F401 (the fixture)
+from tests.core.robot_calibration.board_scenes import SPEC, board_views, cold_cell_with_board
+
+
+@pytest.fixture(scope="module")
+def setup():
+    return cold_cell_with_board(50)
 
 
 def _guessed(robot, turn_deg: float, move_mm: float):
@@ -29,18 +34,18 @@ def _guessed(robot, turn_deg: float, move_mm: float):
     return guessed
 
 
-def test_the_views_give_the_mounting_they_were_made_with(setup):  # noqa: F811
+def test_the_views_give_the_mounting_they_were_made_with(setup):
     """Known answer: views made through the model robot itself give back its camera's placement on its joint, from
     a cell that guessed it 140 deg and 120 mm off (the guess does not enter the answer)."""
     bed, board2base, joints = setup
     robot = bed.model_robot
-    views = _views(lambda q: robot.fk(q, "camera"), joints[:30], board2base, bed.intrinsics)
+    views = board_views(lambda q: robot.fk(q, "camera"), joints[:30], board2base, bed.intrinsics)
     found = mounting_from_views(_guessed(robot, 140.0, 120.0), bed.intrinsics, views)
     d_mm, r_deg = pose_difference(found, robot.frame_placement("camera"))
     assert np.linalg.norm(d_mm) < 1e-3 and np.linalg.norm(r_deg) < 1e-4
 
 
-def test_a_mounting_guessed_far_off_is_started_from_the_views_and_said(setup):  # noqa: F811
+def test_a_mounting_guessed_far_off_is_started_from_the_views_and_said(setup):
     """Twelve views with the joints read to 0.3 deg and the corners to 0.3 px (as few and as rough as a real Franka
     set's), from a cell whose camera is guessed 136 deg and 115 mm off: the fit ends where it ends from the right
     mounting, and says the cell's was far off. From the guess alone it ends in another minimum, twice as far off."""
@@ -71,11 +76,11 @@ def test_a_mounting_guessed_far_off_is_started_from_the_views_and_said(setup):  
     assert abs(mm - np.linalg.norm(d_mm)) < 10.0 and abs(deg - np.linalg.norm(r_deg)) < 3.0
 
 
-def test_a_mounting_near_the_views_is_kept(setup):  # noqa: F811
+def test_a_mounting_near_the_views_is_kept(setup):
     """The model robot's own mounting (a few mm from the views' through the robot's errors) is the start: nothing is
     said, and the views' mounting lies within the bound that keeps it."""
     bed, board2base, joints = setup
-    views = _views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
+    views = board_views(bed.true_cam2world, joints[:30], board2base, bed.intrinsics)
     d_mm, r_deg = pose_difference(
         mounting_from_views(bed.model_robot, bed.intrinsics, views), bed.model_robot.frame_placement("camera")
     )
