@@ -4,7 +4,7 @@ Joints come from RTDE through ``ur_rtde``'s ``RTDEReceiveInterface`` at the cont
 e-Series), each sample stamped with the controller's own ``timestamp`` (s since it started). Moves are URScript
 ``movej`` programs sent to the controller's secondary interface (port 30002) and Stop is ``stopj``: no program
 has to be installed on the robot (``RTDEControlInterface`` uploads a control script of its own that takes the
-robot over, docs/decisions.md). A move is done when the joints stand within ``done_tolerance_deg`` of the target.
+robot over, docs/decisions/). A move is done when the joints stand within ``done_tolerance_deg`` of the target.
 
 Shown to the operator (``status_changed``): protective stop, the speed slider (``speed_scaling``) and whether the
 robot is in remote control (the dashboard server, port 29999); in a protective stop or local control a move is

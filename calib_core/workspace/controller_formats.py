@@ -14,7 +14,7 @@ A pose alone does not fix the arm's configuration. Given the cell's robot, each 
 there (:mod:`calib_core.workspace.arm_configuration`: IK from the joints the look was made at): ABB ``confdata``,
 KUKA ``S``/``T`` (a ``POS`` in place of a ``FRAME``), and for a UR the joints to pass as ``qnear`` to the controller's
 own ``get_inverse_kin``; a target near a configuration boundary says so. FANUC's ``CONFIG`` is left to be taught
-(docs/decisions.md says why), as is every configuration without the robot.
+(docs/decisions/ says why), as is every configuration without the robot.
 Variable names are made unique within a listing after the vendor's length limit. The listing's own name (RAPID's
 ``MODULE``, KRL's ``DEFDAT``, FANUC's ``/PROG``) is the file's, as the controllers require (a KRL data list whose
 ``DEFDAT`` differs from its file name is refused when loaded; a FANUC ``.ls`` is loaded under its ``/PROG`` name).
@@ -262,7 +262,7 @@ def _fanuc_attr(line_count: int, when: str) -> list[str]:
 
 FANUC_UNTAUGHT = "TEACH ME"
 """What a FANUC position's CONFIG says until taught: not a configuration (those are 'F|N U|D T|B, t1, t4, t6'), so the
-controller refuses the listing rather than loading a guessed one (docs/decisions.md says why none is derived)."""
+controller refuses the listing rather than loading a guessed one (docs/decisions/ says why none is derived)."""
 
 
 def _fanuc(
