@@ -82,9 +82,6 @@ class MainWindow(QMainWindow):
             self.show_error,
             self,
         )
-        # the actions by their old names (tests, the bench and the demo's scripted operator use them)
-        for name in ("undo_action", "redo_action", "delete_action", "accept_action", "calibrate_action", "stop_action"):
-            setattr(self, name, getattr(self.actions, name))
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0
         self.worker: FrameWorker | None = None
@@ -173,9 +170,6 @@ class MainWindow(QMainWindow):
 
     def _build_status(self) -> None:
         self.status_line = StatusLine(self.statusBar(), self.workbench, self._camera_state, self)
-        # the fields, by their old names (tests and the bench read them)
-        self.link_label, self.fps_label = self.status_line.link_label, self.status_line.fps_label
-        self.pairs_label, self.record_label = self.status_line.pairs_label, self.status_line.record_label
 
     def _connect(self) -> None:
         wb = self.workbench

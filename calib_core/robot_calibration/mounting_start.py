@@ -17,7 +17,7 @@ import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import as_pinhole
-from calib_core.frames import invert, make_transform, pose_difference
+from calib_core.frames import concat, invert, make_transform, pose_difference
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.observations import BOARD
 
@@ -56,7 +56,7 @@ def mounting_from_views(
         if not ok:
             continue
         # the camera's parent joint in the base: wherever the camera is modelled on it, the same pose
-        links.append(robot.fk(v.joints_deg, camera_frame) @ invert(placement))
+        links.append(concat(invert(placement), robot.fk(v.joints_deg, camera_frame)))  # joint2cam, cam2base
         boards.append(make_transform(cv2.Rodrigues(rvec)[0], tvec.ravel()))
     if len(links) < MIN_HAND_EYE_VIEWS:
         return None

@@ -100,7 +100,7 @@ def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window)
     win.grab().save(str(OUTPUT / "window_after_calibration.png"))
 
     # The solve is an edit like the picks: Undo takes it (and its edges) back, Redo shows the same answer.
-    assert win.undo_action.text() == f"&Undo Calibrate ({len(FEATURES)} pairs)"
+    assert win.actions.undo_action.text() == f"&Undo Calibrate ({len(FEATURES)} pairs)"
     qtbot.mouseClick(win.commands.undo, Qt.MouseButton.LeftButton)
     assert wb.session.result.estimate is None and win.camera.view.overlay.image is None
     assert "OK" not in win.results.verdict.text()
@@ -197,21 +197,22 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     qtbot.waitUntil(lambda: "end of stream" in win.results.status.text(), timeout=10_000)
     assert win.camera.last_frame is not None
     win._update_status()
-    qtbot.waitUntil(lambda: (win._update_status(), "no frame for" in win.fps_label.text())[1], timeout=10_000)
+    fps = win.status_line.fps_label
+    qtbot.waitUntil(lambda: (win._update_status(), "no frame for" in fps.text())[1], timeout=10_000)
     # The link shows its measured delay (the handshake timed the round trip; a near controller: milliseconds).
-    qtbot.waitUntil(lambda: (win._update_status(), "delay" in win.link_label.text())[1], timeout=10_000)
+    qtbot.waitUntil(lambda: (win._update_status(), "delay" in win.status_line.link_label.text())[1], timeout=10_000)
     assert wb.link.delay_s is not None and wb.link.delay_s < 1.0
     # the sample rate by the controller's stamps: the 50 Hz the link asks for (arrivals per second of ours showed
     # 182 Hz on a far link's bursts)
-    qtbot.waitUntil(lambda: (win._update_status(), " Hz, " in win.link_label.text())[1], timeout=10_000)
-    hz = float(win.link_label.text().split(" Hz, ")[0].split(", ")[-1])
-    assert 40.0 <= hz <= 60.0, win.link_label.text()
+    qtbot.waitUntil(lambda: (win._update_status(), " Hz, " in win.status_line.link_label.text())[1], timeout=10_000)
+    hz = float(win.status_line.link_label.text().split(" Hz, ")[0].split(", ")[-1])
+    assert 40.0 <= hz <= 60.0, win.status_line.link_label.text()
     # The link: the controller process dies; the state shows it and no pair is lost.
     wb.site.process.process.kill()
     # (and its pty with it: the path left behind may soon lead to another program's pty on a busy machine)
     wb.site.process.link_path.unlink(missing_ok=True)
     qtbot.waitUntil(lambda: wb.link.state.value != "up", timeout=10_000)
-    qtbot.waitUntil(lambda: "up" not in win.link_label.text().split(",")[0], timeout=5_000)
+    qtbot.waitUntil(lambda: "up" not in win.status_line.link_label.text().split(",")[0], timeout=5_000)
     qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
     assert "nothing was sent" in win.results.status.text()  # the link's reason, not "moving to ..."

@@ -38,7 +38,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
 
     def recording_shown() -> bool:  # the status line the window's timer refreshes
         win._update_status()
-        return "REC" in win.record_label.text()
+        return "REC" in win.status_line.record_label.text()
 
     qtbot.waitUntil(recording_shown, timeout=10_000)
     win.files.save_workspace(tmp_path / "w.json")
