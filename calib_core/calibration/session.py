@@ -205,19 +205,26 @@ class CalibrationSession:
         """Why the result no longer belongs to the pairs on screen (``None``: it does, or there is none)."""
         return self.result.stale_reason(self.pairs.usable())
 
+    def storable_estimate(self):
+        """The last solve's estimate, when it may be stored as a correction; else :class:`CalibrationError` saying
+        why: there is none, it failed, or the pairs changed since (the stale result is said before anything else is
+        asked of the look)."""
+        r = self.result.estimate
+        if r is None:
+            raise CalibrationError("calibrate first")
+        stale = self.stale_reason
+        if stale:
+            raise CalibrationError(f"the result is from an earlier state ({stale}); nothing stored")
+        if r.solution.status is SolveStatus.FAILED:
+            raise CalibrationError(f"the last solve failed ({r.solution.reason}); nothing to store")
+        return r
+
     def store_correction(self, task: str, source: str = "", **how) -> Correction:
         """``Store correction`` for a task location from the last solve, undoable; ``how``: the confirmation, the look
         fused with a calibrated robot, a measured tool's covariance and the kind
         (:func:`~calib_core.calibration.correction_from_look.correction_from_look`). Raises
         :class:`CalibrationError` when there is no result to store, it failed or the pairs changed since."""
-        r = self.result.estimate
-        if r is None:
-            raise CalibrationError("calibrate first")
-        if r.solution.status is SolveStatus.FAILED:
-            raise CalibrationError(f"the last solve failed ({r.solution.reason}); nothing to store")
-        stale = self.stale_reason
-        if stale:
-            raise CalibrationError(f"the result is from an earlier state ({stale}); nothing stored")
+        r = self.storable_estimate()
         verdict = self.result.verdict or self.result.judge(r)
         correction = correction_from_look(r, self.result.context, verdict, task, source, **how)
         self.undo.push(StoreCorrection(self.corrections, correction))

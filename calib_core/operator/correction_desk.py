@@ -78,10 +78,7 @@ class CorrectionDesk:
         stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        if self.session.result.estimate is None:
-            raise CalibrationError("calibrate first")
-        if self.session.stale_reason:  # said first: a look that changed since is no look at all
-            raise CalibrationError(f"the result is from an earlier state ({self.session.stale_reason}); nothing stored")
+        self.session.storable_estimate()  # said first: a look that changed since is no look at all
         place = self.look_place()
         if place is None:
             raise CalibrationError(
