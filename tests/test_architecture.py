@@ -258,3 +258,32 @@ def test_the_panes_are_given_the_parts_they_show():
         "command_panel.py",
     }
     assert given_parts <= {p.name for p in (ROOT / "app" / "gui").glob("*.py")} and given_parts.isdisjoint(taking)
+
+
+def _touches_the_core(source: str) -> list[int]:
+    """Lines where code touches a ``workbench`` attribute: the whole core, however the object holding it is named
+    (``self.window.workbench``, ``wb = w.workbench``)."""
+    return sorted(
+        {n.lineno for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Attribute) and n.attr == "workbench"}
+    )
+
+
+# Widgets that still reach the core through the window or hold it whole; none may join them.
+STILL_TOUCHING_THE_CORE = PANES_STILL_TAKING_THE_CORE | {
+    "file_menu.py",  # the File menu: the workspace, recordings and exports, reached through the window
+}  # fmt: skip
+
+
+def test_no_widget_reaches_the_core_through_the_window():
+    # By what a widget's code touches, not by a parameter's name: Find points once took the window and reached
+    # ``self.window.workbench.finder`` eight times; it is now given the finder and two callbacks.
+    assert _touches_the_core("class F:\n    def run(self):\n        return self.window.workbench.finder\n") == [3]
+    touching = {
+        p.name
+        for p in (ROOT / "app" / "gui").glob("*.py")
+        if p.name != "main_window.py" and _touches_the_core(p.read_text())
+    }
+    assert touching <= STILL_TOUCHING_THE_CORE, (
+        f"reach the core through the window: {sorted(touching - STILL_TOUCHING_THE_CORE)}"
+    )
+    assert "found_points.py" not in touching

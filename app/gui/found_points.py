@@ -91,48 +91,41 @@ class FoundPointsDialog(QDialog):
 
 
 class FindPoints:
-    """The F6 action and the Find points button of a main window."""
+    """The F6 action of a main window: Find points by ``finder`` (the core's, see
+    :class:`~calib_core.operator.point_finding.PointFinding`), its proposals in a dialog over ``parent``; errors to
+    ``show_error(text)``, news to ``show_message(text, ms)``. The window puts :attr:`action` in its menu and wires its
+    Find points button to :meth:`run`."""
 
-    def __init__(self, window):
-        self.window = window
+    def __init__(self, finder, parent, show_error, show_message):
+        self.finder, self.parent = finder, parent
+        self.show_error, self.show_message = show_error, show_message
         self.dialog: FoundPointsDialog | None = None
-        self.action = QAction("&Find points", window, shortcut=QKeySequence("F6"), triggered=self.run)
+        self.action = QAction("&Find points", parent, shortcut=QKeySequence("F6"), triggered=self.run)
         self.action.setToolTip("Find the target's features on the camera image and propose them as pairs (F6)")
-        window.calibration_menu.addAction(self.action)
-        window.commands.find_points.clicked.connect(self.run)
 
     def run(self) -> None:
-        window, wb = self.window, self.window.workbench
         found = {}
-        with busy(window, "finding points ..."):  # rendering and fitting take a second
-            if not attempt(window.show_error, lambda: found.setdefault("found", wb.finder.find_points())):
+        with busy(self.parent, "finding points ..."):  # rendering and fitting take a second
+            if not attempt(self.show_error, lambda: found.setdefault("found", self.finder.find_points())):
                 return
         self.show(found["found"])
 
     def show(self, found) -> None:
-        window = self.window
         if self.dialog is not None:
             self.dialog.close()
-        self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, window)
-        self.dialog.finished.connect(
-            lambda _: window.workbench.finder.dismiss_found_points()
-        )  # the camera pane hides them
+        self.dialog = FoundPointsDialog(found, self._accept, self._calibrate_on_edges, self.parent)
+        self.dialog.finished.connect(lambda _: self.finder.dismiss_found_points())  # the camera pane hides them
         self.dialog.show()
 
     def _calibrate_on_edges(self) -> bool:
-        return attempt(self.window.show_error, self.window.workbench.finder.calibrate_on_edges)
+        return attempt(self.show_error, self.finder.calibrate_on_edges)
 
     def _accept(self, features: list[str]) -> bool:
         if not features:
-            self.window.show_error("check at least one point to accept, or Cancel")
+            self.show_error("check at least one point to accept, or Cancel")
             return False
         numbers = {}
-        ok = attempt(
-            self.window.show_error,
-            lambda: numbers.setdefault("n", self.window.workbench.finder.accept_found_points(features)),
-        )
+        ok = attempt(self.show_error, lambda: numbers.setdefault("n", self.finder.accept_found_points(features)))
         if ok:
-            self.window.statusBar().showMessage(
-                f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000
-            )
+            self.show_message(f"pairs {', '.join(map(str, numbers['n']))} added from the points found", 8000)
         return ok

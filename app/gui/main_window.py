@@ -186,7 +186,9 @@ class MainWindow(QMainWindow):
         wb.arm.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
         wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
-        self.finder = FindPoints(self)
+        self.finder = FindPoints(wb.finder, self, self.show_error, self.statusBar().showMessage)
+        self.calibration_menu.addAction(self.finder.action)
+        self.commands.find_points.clicked.connect(self.finder.run)
 
     def _live_toggled(self, on: bool) -> None:
         if self.worker is not None:
