@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from urllib.parse import SplitResult, urlsplit
 
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.\-]*)://")
 
@@ -34,3 +35,14 @@ def camera_scheme(spec: str) -> str:
     if spec.strip().isdigit():
         return "opencv"
     return "folder" if Path(spec).is_dir() else "file"
+
+
+def split_url(url: str, error: type[Exception]) -> SplitResult:
+    """``url`` split as :func:`urllib.parse.urlsplit` splits it; ``error`` (the connector's own, naming the URL) where
+    it cannot be (an unmatched ``[`` or ``]``: ``ros2://]x`` once escaped as Python's "Invalid IPv6 URL")."""
+    try:
+        return urlsplit(url)
+    except ValueError as exc:
+        raise error(
+            f"{url!r}: not a URL the connector can read ({exc}; a bracket belongs round an IPv6 address)"
+        ) from None

@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import ipaddress
 import time
-from urllib.parse import parse_qs, unquote, urlsplit
+from urllib.parse import parse_qs, unquote
 
 from calib_core.gige.aravis_lib import aravis
 from calib_core.gige.pixel_formats import to_rgb
+from calib_core.connectors.urls import split_url
 from calib_core.connectors.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 _OPTIONS = {"exposure_us", "gain_db", "pixel_format", "width", "height", "timeout_s", "reopen_after_s", "fake"}
@@ -32,7 +33,7 @@ def _is_address(device: str) -> bool:
 
 
 def _device_id(spec: str) -> str:
-    parts = urlsplit(spec)
+    parts = split_url(spec, VideoSourceError)
     device = unquote(parts.netloc + parts.path).strip("/")
     if not device:
         raise VideoSourceError(
@@ -44,7 +45,7 @@ def _device_id(spec: str) -> str:
 class AravisSource(FrameSource):
     def __init__(self, spec: str, options: dict | None = None):
         merged = dict(options or {})
-        merged.update({k: v[-1] for k, v in parse_qs(urlsplit(spec).query).items()})
+        merged.update({k: v[-1] for k, v in parse_qs(split_url(spec, VideoSourceError).query).items()})
         unknown = set(merged) - _OPTIONS
         if unknown:
             raise VideoSourceError(

@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import threading
 import time
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import parse_qs
 
+from calib_core.connectors.urls import split_url
 from calib_core.connectors.frame import Frame, FrameSource, FrameTimeout, VideoSourceError
 
 _OPTIONS = {"domain", "timeout_s"}
@@ -26,7 +27,7 @@ class Ros2ImageSource(FrameSource):
     def __init__(self, spec: str, options: dict | None = None):
         from calib_core.ros2.wire import Ros2NameError, dds_topic, domain_id
 
-        parts = urlsplit(spec)
+        parts = split_url(spec, VideoSourceError)
         if parts.netloc:
             raise VideoSourceError(
                 f"{spec!r}: a ros2 URL has no host (ros2:///camera/image_raw); the domain is ROS_DOMAIN_ID or ?domain=N"

@@ -37,10 +37,11 @@ from __future__ import annotations
 import itertools
 import threading
 import time
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import parse_qs
 
 import numpy as np
 
+from calib_core.connectors.urls import split_url
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
@@ -67,7 +68,7 @@ INTERFACES = ("auto", "action", "topic")
 
 
 def _options(url: str, context: ControllerContext) -> tuple[str, dict]:
-    parts = urlsplit(url)
+    parts = split_url(url, LinkError)
     if parts.netloc:
         raise LinkError(
             f"{url!r}: a ros2 URL has no host (ros2:///joint_states); the domain is ROS_DOMAIN_ID or ?domain=N"

@@ -21,11 +21,12 @@ import math
 import socket
 import threading
 import time
-from urllib.parse import parse_qs, urlsplit
+from urllib.parse import parse_qs
 
 import numpy as np
 from psygnal import Signal
 
+from calib_core.connectors.urls import split_url
 from calib_core.connectors.controller import ControllerContext
 from calib_core.connectors.options import number_option
 from calib_core.connectors.events import ConnectorEvents, SingleMove
@@ -55,7 +56,7 @@ class URRtdeController(ConnectorEvents):
     status_changed = Signal(str)
 
     def __init__(self, url: str, context: ControllerContext):
-        parts = urlsplit(url)
+        parts = split_url(url, LinkError)
         if not parts.hostname:
             raise LinkError(f"{url!r}: a UR controller is ur-rtde://HOST (its IP address or name)")
         host = parts.netloc.rsplit("@", 1)[-1]
