@@ -234,15 +234,16 @@ PANES_STILL_TAKING_THE_CORE = {
 }  # fmt: skip
 
 
+def _widget_modules_where(found) -> set[str]:
+    """The window's modules but its assembly (main_window.py) in which ``found(source)`` finds something."""
+    return {p.name for p in (ROOT / "app" / "gui").glob("*.py") if p.name != "main_window.py" and found(p.read_text())}
+
+
 def test_the_panes_are_given_the_parts_they_show():
     assert _widgets_taking_the_core("class P:\n    def __init__(self, workbench, parent=None):\n        pass\n") == [
         "P"
     ]
-    taking = {
-        p.name
-        for p in (ROOT / "app" / "gui").glob("*.py")
-        if p.name != "main_window.py" and _widgets_taking_the_core(p.read_text())
-    }
+    taking = _widget_modules_where(_widgets_taking_the_core)
     assert taking <= PANES_STILL_TAKING_THE_CORE, (
         f"given the whole core: {sorted(taking - PANES_STILL_TAKING_THE_CORE)}"
     )
@@ -278,11 +279,7 @@ def test_no_widget_reaches_the_core_through_the_window():
     # By what a widget's code touches, not by a parameter's name: Find points once took the window and reached
     # ``self.window.workbench.finder`` eight times; it is now given the finder and two callbacks.
     assert _touches_the_core("class F:\n    def run(self):\n        return self.window.workbench.finder\n") == [3]
-    touching = {
-        p.name
-        for p in (ROOT / "app" / "gui").glob("*.py")
-        if p.name != "main_window.py" and _touches_the_core(p.read_text())
-    }
+    touching = _widget_modules_where(_touches_the_core)
     assert touching <= STILL_TOUCHING_THE_CORE, (
         f"reach the core through the window: {sorted(touching - STILL_TOUCHING_THE_CORE)}"
     )

@@ -258,7 +258,8 @@ def identify(
         return problem
 
     def start_rms_px(model: RobotModel) -> float:
-        r = problem_of(model).residuals(np.zeros(problem.size), np.zeros(6))[pixel_rows]
+        uncorrected = problem_of(model)
+        r = uncorrected.residuals(np.zeros(uncorrected.size), np.zeros(6))[pixel_rows]
         return float(np.sqrt(2.0 * np.mean(r**2))) if np.all(np.isfinite(r)) else float("inf")
 
     problem = problem_of(robot)
