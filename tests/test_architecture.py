@@ -229,7 +229,6 @@ def _widgets_taking_the_core(source: str) -> list[str]:
 # The window's panes not yet given only the parts they show; none may join them. The window (main_window.py)
 # alone assembles the panes from the core.
 PANES_STILL_TAKING_THE_CORE = {
-    "status_line.py",  # what the status bar reports of the whole: the link, the recorder, the settle state
     "workflow_actions.py",  # the window's menu and shortcut actions: every workflow's buttons
 }  # fmt: skip
 

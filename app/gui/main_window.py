@@ -168,7 +168,17 @@ class MainWindow(QMainWindow):
             robot.addAction(a)
 
     def _build_status(self) -> None:
-        self.status_line = StatusLine(self.statusBar(), self.workbench, self._camera_state, self)
+        wb = self.workbench
+        self.status_line = StatusLine(
+            self.statusBar(),
+            arm=wb.arm,
+            session=wb.session,
+            picking=wb.picking,
+            link=lambda: wb.link,
+            recorder=lambda: wb.recorder,
+            camera_state=self._camera_state,
+            parent=self,
+        )
 
     def _connect(self) -> None:
         wb = self.workbench

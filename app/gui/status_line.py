@@ -21,10 +21,25 @@ WARN = "<span style='color:#ff9a30'>{}</span>"
 
 
 class StatusLine:
-    """``camera_state()`` gives ``(last frame received or None, worker or None, replaying)``."""
+    """The status bar's fields, given the parts they show: the ``arm`` (its motion, link state and last sample), the
+    ``session`` (its pairs, result and target), ``picking`` (the settle rule and whether a recording is replayed), and
+    callables for what comes and goes: ``link()`` (the controller's link or None), ``recorder()`` (the session
+    recorder or None) and ``camera_state()`` ``(last frame received or None, worker or None, replaying)``."""
 
-    def __init__(self, bar: QStatusBar, workbench, camera_state: Callable[[], tuple], parent) -> None:
-        self.workbench = workbench
+    def __init__(
+        self,
+        bar: QStatusBar,
+        *,
+        arm,
+        session,
+        picking,
+        link: Callable[[], object],
+        recorder: Callable[[], object],
+        camera_state: Callable[[], tuple],
+        parent,
+    ) -> None:
+        self._arm, self._session, self._picking = arm, session, picking
+        self._link, self._recorder = link, recorder
         self._camera_state = camera_state
         self.record_label = QLabel("")
         self.link_label = QLabel("link: not connected")
@@ -43,13 +58,10 @@ class StatusLine:
             self.pairs_label,
         ):
             bar.addPermanentWidget(w)
-        workbench.arm.motion_changed.connect(self.show_motion)
-        workbench.arm.link_state.connect(self.show_link_state)
-        for signal in (
-            workbench.session.pairs.changed,
-            workbench.session.result.changed,
-            workbench.session.target_changed,
-        ):  # pairs change outside the undo stack too
+        arm.motion_changed.connect(self.show_motion)
+        arm.link_state.connect(self.show_link_state)
+        # (pairs change outside the undo stack too)
+        for signal in (session.pairs.changed, session.result.changed, session.target_changed):
             signal.connect(self.show_pairs)
         self.show_pairs()
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
@@ -69,7 +81,7 @@ class StatusLine:
                 self.fps_label.setText(WARN.format(f"camera: no frame for {age:.0f} s"))
             else:
                 self.fps_label.setText(f"camera: {worker.fps_measured:.1f} fps")
-        link = self.workbench.link
+        link = self._link()
         if link is not None:
             s = link.stats_snapshot()
             # the rate by the controller's own clock (the samples' stamps): a far link delivers in bursts, and
@@ -85,14 +97,14 @@ class StatusLine:
                 f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} "
                 f"rejected{delay_text}"
             )
-            last = self.workbench.arm.last_sample_s
+            last = self._arm.last_sample_s
             # a far link delivers its samples in bursts: late only past its own spread of delays
             late_after = STALE_LINK_S + link.stale_after_now_s()
             if link.state.value == "up" and last is not None and now - last > late_after:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)
         self._show_settled()
-        rec = self.workbench.recorder
+        rec = self._recorder()
         self.record_label.setText(
             "" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB"
         )
@@ -116,11 +128,10 @@ class StatusLine:
 
     def _show_settled(self) -> None:
         """Whether the newest frame can be picked on: the settle rule, from the joint samples."""
-        wb = self.workbench
-        if wb.link is None and not wb.picking.replaying:
+        if self._link() is None and not self._picking.replaying:
             self.settled_label.setText("")
             return
-        still = wb.picking.robot_settled()
+        still = self._picking.robot_settled()
         self.settled_label.setText(
             "<span style='color:#5fd35f'>settled</span>"
             if still.settled
@@ -129,7 +140,7 @@ class StatusLine:
         self.settled_label.setToolTip(still.reason or f"still for {still.still_for_s:.1f} s: frames can be picked on")
 
     def show_pairs(self, *_) -> None:
-        session = self.workbench.session
+        session = self._session
         self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.options.required_pairs} needed")
 
     def show_link_state(self, text: str) -> None:
