@@ -11,7 +11,14 @@ from PySide6.QtWidgets import QApplication
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert, pose_difference
 from calib_core.solver import SolveStatus
-from tests.app.windows import confirm_move_if_asked, pick_features, pick_pair, wait_for_settled_frame
+from tests.app.windows import (
+    click_image,
+    confirm_move_if_asked,
+    go_to_task,
+    pick_features,
+    pick_pair,
+    wait_for_settled_frame,
+)
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 FEATURES = [
@@ -24,47 +31,25 @@ FEATURES = [
 ]
 
 
-def _click_image(qtbot, view, u, v, zoom=None):
-    if zoom is not None:
-        # The operator zooms in (mouse wheel) around the point before clicking it.
-        view.set_zoom(zoom, QPointF(u, v))
-    x, y = view.image_to_widget(u, v)
-    qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
-
-
-def _go_to_task(qtbot, win):
-    """The robot to the task location itself (uncorrected): the camera sees the fixture from there."""
-    wb = win.workbench
-    task = wb.task
-    qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
-    confirm_move_if_asked(qtbot, win)
-    qtbot.waitUntil(
-        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000
-    )
-    # A frame taken with the robot settled there, and the virtual camera redrawn there.
-    wait_for_settled_frame(qtbot, win)
-    qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
-
-
 def test_operator_calibrates_the_task_location_by_point_and_click(qtbot, window):
     win = window
     wb = win.workbench
     bed = wb.site.bed  # the truth, for the operator's eyes and the score
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     fixture = wb.workcell.component("oru_1_fixture")
     model_cam = wb.model_cam2world()
     true_cam = bed.true_cam2world(wb.joints_deg)
     for k, name in enumerate(FEATURES, start=1):
         p_world = apply(fixture.item2world, fixture.features[name])
         uv_model = project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0]
-        _click_image(qtbot, win.virtual.view, *uv_model)
+        click_image(qtbot, win.virtual.view, *uv_model)
         pair = wb.session.pairs.pending()
         assert pair is not None and pair.feature == name, f"pick {k}: {win.virtual.info.text()}"
         # The operator looks at the camera image and clicks the same corner: here the truth tells where it is.
         uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
         # Sub-pixel refinement finds corners; the operator turns it off for the centre of a round boss.
         win.camera.subpixel.setChecked(name.startswith("plate"))
-        _click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
+        click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
         picked = wb.session.pairs.get(pair.number).pixel
         assert picked is not None
         assert np.linalg.norm(np.array(picked) - uv_true) < 1.0
@@ -141,7 +126,7 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     win.camera.freeze.setChecked(True)  # the operator froze this (black) frame to pick on
     assert wb.observations.still is not None
     win.camera.show_frame(Frame(np.zeros((480, 640, 3), np.uint8), 0, time.monotonic()))
-    _click_image(qtbot, win.camera.view, 100, 100)
+    click_image(qtbot, win.camera.view, 100, 100)
     assert "pick the point on the model" in win.results.status.text()
     # Calibrate with no pairs: the button is disabled, the shortcut explains.
     assert not win.commands.calibrate.isEnabled()
@@ -244,7 +229,7 @@ def test_the_approach_is_edited_undone_and_the_overview_pans(qtbot, window):
 def test_ambiguous_solve_shows_ghosts_and_the_operator_chooses(qtbot, window):
     win = window
     wb = win.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
     for name in ("plate_top_left", "plate_top_right", "pin_tip"):  # three pairs: P3P has several exact poses
@@ -331,7 +316,7 @@ def test_a_message_about_an_earlier_step_goes_when_a_result_comes(qtbot, window)
     """F5 with no pairs says calibrating needs 3; after four picks and Calibrate the verdict is OK and that message is
     gone (it once stayed under the OK verdict, as "the last solve failed" did)."""
     win, wb = window, window.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     qtbot.keyClick(win, Qt.Key.Key_F5)
     assert "calibrating needs 3" in win.results.status.text()
     pick_features(qtbot, win, ["plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left"])

@@ -7,7 +7,7 @@ import numpy as np
 from PySide6.QtCore import Qt
 
 from calib_core.frames import pose_difference
-from tests.app.test_calibration_in_window import _go_to_task
+from tests.app.windows import go_to_task
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
@@ -15,7 +15,7 @@ OUTPUT = Path(__file__).resolve().parents[1] / "output"
 def test_f6_proposes_points_and_accept_checked_adds_them_in_one_undo_step(qtbot, window):
     win = window
     wb = win.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     qtbot.keyClick(win, Qt.Key.Key_F6)
     qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
     dialog = win.finder.dialog
@@ -56,7 +56,7 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
 
     win = window
     wb = win.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     wb.start_recording(tmp_path / "edges.mcap")
     qtbot.keyClick(win, Qt.Key.Key_F6)
     qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)

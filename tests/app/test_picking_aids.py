@@ -5,14 +5,14 @@ import numpy as np
 
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
-from tests.app.test_calibration_in_window import _click_image, _go_to_task
+from tests.app.windows import click_image, go_to_task
 
 FEATURES = ["plate_bottom_left", "plate_bottom_right", "pin_tip", "boss_top_left"]
 
 
 def _pick_on_model(qtbot, win, model_cam, p_world) -> None:
     """The operator clicks the feature at ``p_world`` (3,) mm in the virtual camera."""
-    _click_image(
+    click_image(
         qtbot,
         win.virtual.view,
         *project(apply(invert(model_cam), p_world[None]), win.virtual.intrinsics, distort=False)[0],
@@ -26,7 +26,7 @@ def _expected_mark(win):
 
 def test_the_expected_position_is_drawn_and_sharpens_after_three_pairs(qtbot, window):
     win, wb = window, window.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     bed = wb.site.bed  # the truth, for the operator's eyes and the score
     fixture = wb.workcell.component("oru_1_fixture")
     model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
@@ -41,7 +41,7 @@ def test_the_expected_position_is_drawn_and_sharpens_after_three_pairs(qtbot, wi
         assert mark is not None, win.camera.view.overlay.text
         misses.append(float(np.linalg.norm(mark - uv_true)))
         texts.append(win.camera.view.overlay.text)
-        _click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
+        click_image(qtbot, win.camera.view, *uv_true, zoom=4.0)
         wb.picking.accept_pair()
         assert _expected_mark(win) is None  # nothing waits: nothing expected
     # the first marks come from the model (the robot's error: many pixels off); the fourth from the pose
@@ -66,7 +66,7 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
     from PySide6.QtCore import QPoint, Qt
 
     win, wb = window, window.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     bed = wb.site.bed
     fixture = wb.workcell.component("oru_1_fixture")
     model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
@@ -74,7 +74,7 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
     for name in FEATURES[:3]:
         p_world = apply(fixture.item2world, fixture.features[name])
         _pick_on_model(qtbot, win, model_cam, p_world)
-        _click_image(qtbot, win.camera.view, *project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0])
+        click_image(qtbot, win.camera.view, *project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0])
         wb.picking.accept_pair()
     view = win.camera.view
     before = np.array(wb.session.pairs.get(2).pixel)
@@ -113,7 +113,7 @@ def test_a_point_is_dragged_after_accept_undone_and_a_click_on_it_selects_its_pa
 
 def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
     win, wb = window, window.workbench
-    _go_to_task(qtbot, win)
+    go_to_task(qtbot, win)
     bed = wb.site.bed
     fixture = wb.workcell.component("oru_1_fixture")
     model_cam, true_cam = wb.model_cam2world(), bed.true_cam2world(wb.joints_deg)
@@ -123,7 +123,7 @@ def test_a_click_off_a_round_boss_lands_on_its_centre(qtbot, window):
         p_world = apply(fixture.item2world, fixture.features[name])
         _pick_on_model(qtbot, win, model_cam, p_world)
         uv_true = project(apply(invert(true_cam), p_world[None]), wb.intrinsics)[0]
-        _click_image(qtbot, win.camera.view, *(uv_true + (2.5, -2.0)), zoom=4.0)  # a hand 3 px off
+        click_image(qtbot, win.camera.view, *(uv_true + (2.5, -2.0)), zoom=4.0)  # a hand 3 px off
         errors.append(float(np.linalg.norm(np.array(wb.session.pairs.get(wb.picking.current_pair).pixel) - uv_true)))
         wb.picking.accept_pair()
     # The hand was 3.2 px off. The boss's rim puts it within 0.1-1.1 px (by the frame's noise). The knob's

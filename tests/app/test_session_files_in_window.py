@@ -6,8 +6,8 @@ from PySide6.QtWidgets import QApplication, QFileDialog
 
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
+from tests.app.windows import answer_file_dialog, wait_for_settled_frame
 from videocal_sim.sim_site import simulated_cell
-from tests.app.windows import wait_for_settled_frame
 
 
 def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
@@ -118,23 +118,6 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         win.close()
 
 
-def _answer_file_dialog(path) -> list[str]:
-    """Choose ``path`` in the next file dialog the window opens; the dialogs' titles are gathered."""
-    asked = []
-
-    def answer():
-        dialog = QApplication.activeModalWidget()
-        if isinstance(dialog, QFileDialog):
-            asked.append(dialog.windowTitle())
-            dialog.selectFile(str(path))
-            dialog.accept()
-        else:
-            QTimer.singleShot(20, answer)
-
-    QTimer.singleShot(0, answer)
-    return asked
-
-
 def test_a_folder_that_cannot_be_written_is_one_line_naming_it(qtbot, window, tmp_path):
     """Save workspace and Record session, each into a folder the system refuses (here a file where the folder should
     be: as root a read-only folder refuses nothing), say so naming the file, not "internal error", and leave no file
@@ -142,14 +125,14 @@ def test_a_folder_that_cannot_be_written_is_one_line_naming_it(qtbot, window, tm
     win, wb = window, window.workbench
     blocked = tmp_path / "not-a-folder"
     blocked.write_text("a file")
-    asked = _answer_file_dialog(blocked / "w.json")
+    asked = answer_file_dialog(blocked / "w.json")
     assert not win.files.save_workspace_dialog(ask_path=True)
     shown = win.results.status.text()
     assert asked == ["Save workspace"] and str(blocked / "w.json") in shown, shown
     assert "internal error" not in shown and "Not a directory" in shown
     assert win.files.workspace_path is None
 
-    asked = _answer_file_dialog(blocked / "session.mcap")
+    asked = answer_file_dialog(blocked / "session.mcap")
     win.files.record_action.trigger()
     qtbot.waitUntil(lambda: asked == ["Record session"] and not win.files.record_action.isChecked())
     shown = win.results.status.text()

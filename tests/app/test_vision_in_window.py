@@ -11,8 +11,9 @@ from PySide6.QtCore import Qt
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import pose_difference
-from videocal_sim.true_robot import RobotErrors
+from tests.app.recorded_sets import recorded_set
 from tests.app.windows import confirm_move_if_asked
+from videocal_sim.true_robot import RobotErrors
 
 OUTPUT = Path(__file__).resolve().parents[1] / "output"
 
@@ -207,7 +208,7 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
 def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, live_window):
     """A robot with its typical kinematic errors: the views disagree (hand-eye takes the kinematics as
     exact), so Apply mounting asks first; the intrinsics result stays on screen under the hand-eye."""
-    from tests.app.test_safe_calibration_in_window import _answer
+    from tests.app.windows import answer_next_question as _answer
 
     win = live_window(RobotErrors.typical(0))
     wb, vision = win.workbench, win.vision
@@ -264,44 +265,15 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
     assert len(vision.capture.views) == 2
 
 
-def _recorded_set(folder: Path, moved_view: int, moved_mm: float) -> Path:
-    """A hand-eye set as a robot cell records one: the simulated camera's PNG images of a ChArUco board and a JSON of
-    each image's flange pose from the controller (mm), one view's pose recorded ``moved_mm`` off (a pose read before
-    the robot settled)."""
-    import json
-
-    import cv2
-
-    from calib_core.vision.board import BoardSpec
-    from videocal_sim.hand_eye_views import board_facing_robot, hand_eye_poses, simulated_hand_eye_images
-    from videocal_sim.test_bed import TestBed
-
-    spec = BoardSpec()
-    bed = TestBed.create()
-    board2base = board_facing_robot(spec)
-    joints = hand_eye_poses(bed, spec, board2base, 10)
-    (folder / "images").mkdir(parents=True)
-    poses = []
-    for k, (name, image, q) in enumerate(simulated_hand_eye_images(bed, spec, joints, board2base)):
-        cv2.imwrite(str(folder / "images" / f"{name}.png"), image[:, :, ::-1])
-        flange = bed.model_robot.fk(q, "flange")
-        if k == moved_view:
-            flange[:3, 3] += [moved_mm, 0.0, 0.0]
-        poses.append({"image": f"images/{name}.png", "flange2base": flange.tolist()})
-    path = folder / "poses.json"
-    path.write_text(json.dumps({"length_unit": "mm", "poses": poses}))
-    return path
-
-
 def test_a_recorded_set_is_read_and_its_odd_view_shown_and_dropped(qtbot, window, tmp_path):
     """Read set... takes a recorded set (images and their flange poses) in place of the views; after Calibrate
     hand-eye each view shows its residual and its distance from the others, the view whose pose was recorded 15 mm
     off stands out (marked, with why), and once it is removed the calibration again has no view that stands out."""
-    from tests.app.test_session_files_in_window import _answer_file_dialog
+    from tests.app.windows import answer_file_dialog
 
     win = window
-    path = _recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
-    asked = _answer_file_dialog(path)
+    path = recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
+    asked = answer_file_dialog(path)
     qtbot.mouseClick(win.vision.read_set_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: len(win.vision.capture.views) == 10, timeout=30_000)
     assert asked == ["Read a hand-eye set"]

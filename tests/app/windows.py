@@ -2,8 +2,12 @@
 
 import time
 
-from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtWidgets import QApplication, QMessageBox
+import numpy as np
+from PySide6.QtCore import QPoint, QPointF, QSettings, Qt, QTimer
+from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+
+from calib_core.camera.projection import project
+from calib_core.frames import apply, invert, pose_difference
 
 
 def window_settings(folder, name: str = "settings") -> QSettings:
@@ -99,12 +103,6 @@ def pick_features(
     """Pick each feature through the panes: on the virtual camera, then on the camera image where the
     truth puts it (the operator's eyes; ``off_px``: a feature's pick moved by (du, dv) px, a mis-pick), then
     Ctrl+Return."""
-    import numpy as np
-    from PySide6.QtCore import QPoint
-
-    from calib_core.camera.projection import project
-    from calib_core.frames import apply, invert
-
     wb = win.workbench
     fixture = wb.workcell.component(component)
     true_cam = wb.site.bed.true_cam2world(wb.joints_deg)
@@ -121,3 +119,42 @@ def pick_features(
         qtbot.mouseClick(win.camera.view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
         qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)
     assert len(wb.session.pairs.usable()) == len(features), win.results.status.text()
+
+
+def click_image(qtbot, view, u, v, zoom=None):
+    if zoom is not None:
+        # The operator zooms in (mouse wheel) around the point before clicking it.
+        view.set_zoom(zoom, QPointF(u, v))
+    x, y = view.image_to_widget(u, v)
+    qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(x)), int(round(y))))
+
+
+def go_to_task(qtbot, win):
+    """The robot to the task location itself (uncorrected): the camera sees the fixture from there."""
+    wb = win.workbench
+    task = wb.task
+    qtbot.mouseClick(win.commands.go_task, Qt.MouseButton.LeftButton)
+    confirm_move_if_asked(qtbot, win)
+    qtbot.waitUntil(
+        lambda: np.linalg.norm(pose_difference(wb.robot.fk(wb.joints_deg), task.tcp2base)[0]) < 0.01, timeout=20_000
+    )
+    # A frame taken with the robot settled there, and the virtual camera redrawn there.
+    wait_for_settled_frame(qtbot, win)
+    qtbot.waitUntil(win.virtual.is_current, timeout=5_000)
+
+
+def answer_file_dialog(path) -> list[str]:
+    """Choose ``path`` in the next file dialog the window opens; the dialogs' titles are gathered."""
+    asked = []
+
+    def answer():
+        dialog = QApplication.activeModalWidget()
+        if isinstance(dialog, QFileDialog):
+            asked.append(dialog.windowTitle())
+            dialog.selectFile(str(path))
+            dialog.accept()
+        else:
+            QTimer.singleShot(20, answer)
+
+    QTimer.singleShot(0, answer)
+    return asked

@@ -8,42 +8,13 @@ import os
 import resource
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
 
 from calib_core.workcell import DEFAULT_WORKCELL
-
-ADDRESS_SPACE = 6 * 1024**3  # far above any good run of these commands, far below a runaway allocation
-
-
-def _limits() -> None:
-    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
-
-
-def _videocal(*args, cwd=None, preexec=_limits, timeout=120) -> subprocess.CompletedProcess:
-    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
-    return subprocess.run(
-        [sys.executable, "-m", "app.cli.main", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        cwd=cwd,
-        env=env,
-        preexec_fn=preexec,
-    )
-
-
-def _refused(run: subprocess.CompletedProcess, *expected: str) -> str:
-    assert "Traceback" not in run.stderr, run.stderr[-3000:]
-    assert run.returncode == 2, (run.returncode, run.stderr[-2000:])
-    errors = [line for line in run.stderr.splitlines() if line.startswith("error: ")]
-    assert len(errors) == 1, run.stderr
-    for text in expected:
-        assert text in errors[0], errors[0]
-    return errors[0]
+from tests.cli.refused_runs import limits, refused, videocal
 
 
 @pytest.fixture
@@ -70,26 +41,26 @@ def cell(tmp_path):
 
 
 def _render(workcell: Path, tmp: Path) -> subprocess.CompletedProcess:
-    return _videocal("render", "--workcell", workcell, "--out", tmp / "out.png", "--scale", "0.25")
+    return videocal("render", "--workcell", workcell, "--out", tmp / "out.png", "--scale", "0.25")
 
 
 # --- documents that are too deep, too big, too aliased --------------------------------------------
 def test_a_workcell_nested_10000_deep(cell):
     deep = "name: " + "[" * 10000 + "]" * 10000 + "\n"
-    _refused(_render(cell(text=deep), cell.folder), "edited.yaml", "nests deeper than")
+    refused(_render(cell(text=deep), cell.folder), "edited.yaml", "nests deeper than")
 
 
 def test_a_json_nested_10000_deep(tmp_path):
     path = tmp_path / "deep.json"
     path.write_text("[" * 10000 + "]" * 10000)
-    _refused(_videocal("solve", path), "deep.json", "nests deeper than")
-    _refused(_videocal("export", path), "deep.json", "nests deeper than")
+    refused(videocal("solve", path), "deep.json", "nests deeper than")
+    refused(videocal("export", path), "deep.json", "nests deeper than")
 
 
 def test_an_alias_bomb_in_a_workcell_name(cell):
     bomb = "".join(f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]\n" for i in range(1, 9))
     text = cell().read_text().replace("name: space station robotic test bed", "a0: &a0 [x]\n" + bomb + "name: *a8")
-    _refused(_render(cell(text=text), cell.folder), "edited.yaml", "aliases")
+    refused(_render(cell(text=text), cell.folder), "edited.yaml", "aliases")
 
 
 def test_a_huge_all_comment_workcell(cell):
@@ -98,20 +69,20 @@ def test_a_huge_all_comment_workcell(cell):
         line = "# " + "x" * 98 + "\n"
         for _ in range(170_000):  # 17 MB
             f.write(line)
-    _refused(_render(path, cell.folder), "comments.yaml", "at most")
+    refused(_render(path, cell.folder), "comments.yaml", "at most")
 
 
 # --- fields of the wrong type or out of range -----------------------------------------------------
 def test_a_workcell_without_a_camera(cell):
     for edit in (lambda d: d.pop("camera"), lambda d: d.update(camera=None)):
-        _refused(_render(cell(edit), cell.folder), "camera")
+        refused(_render(cell(edit), cell.folder), "camera")
 
 
 def test_a_task_component_given_as_a_list(cell):
     def edit(d):
         d["task_locations"][0]["component"] = ["oru_1", "oru_2"]
 
-    _refused(_render(cell(edit), cell.folder), "component")
+    refused(_render(cell(edit), cell.folder), "component")
 
 
 def _camera_file(cell, text: str) -> Path:
@@ -121,15 +92,15 @@ def _camera_file(cell, text: str) -> Path:
 
 def test_an_opencv_intrinsics_file_whose_rows_and_cols_disagree_with_its_data(cell):
     text = (cell.folder / "camera" / "gripper_camera.yaml").read_text().replace("rows: 3", "rows: 4", 1)
-    _refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix")
+    refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix")
 
 
 def test_ros_rows_given_as_text_and_an_absurd_image_size(cell):
     ros = yaml.safe_load((cell.folder / "camera" / "gripper_camera_ros.yaml").read_text())
     text = yaml.safe_dump({**ros, "camera_matrix": {**ros["camera_matrix"], "rows": "3"}})
-    _refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix.rows")
+    refused(_render(_camera_file(cell, text), cell.folder), "bad.yaml", "camera_matrix.rows")
     huge = yaml.safe_dump({**ros, "image_width": 10**12})
-    _refused(_render(_camera_file(cell, huge), cell.folder), "bad.yaml", "image_width")
+    refused(_render(_camera_file(cell, huge), cell.folder), "bad.yaml", "image_width")
 
 
 def _stored(task: str, model, measured, kind: str = "correction"):
@@ -173,7 +144,7 @@ def test_export_with_std_or_time_as_objects(tmp_path):
             str(cell.path), load_intrinsics(cell.intrinsics_path), dict(cell.task_locations), "oru_1_fixture", [], table
         ),
     )
-    assert _videocal("export", path).returncode == 0
+    assert videocal("export", path).returncode == 0
     original = json.loads(path.read_text())
     for field, value in (
         ("std_displacement_mm", {"x": 1}),
@@ -183,7 +154,7 @@ def test_export_with_std_or_time_as_objects(tmp_path):
         data = json.loads(json.dumps(original))
         data["corrections"][0][field] = value
         path.write_text(json.dumps(data))
-        _refused(_videocal("export", path), "w.json", field)
+        refused(videocal("export", path), "w.json", field)
 
 
 def test_a_recorded_solve_without_its_result(tmp_path):
@@ -193,7 +164,7 @@ def test_a_recorded_solve_without_its_result(tmp_path):
     path = tmp_path / "s.mcap"
     with SessionRecorder(path) as rec:
         rec._write(SOLVE_TOPIC, {"id": 1, "inputs": {}})
-    _refused(_videocal("replay", path), "s.mcap", "solve 1")
+    refused(videocal("replay", path), "s.mcap", "solve 1")
 
 
 # --- options out of range -------------------------------------------------------------------------
@@ -222,20 +193,20 @@ def test_a_recorded_solve_without_its_result(tmp_path):
 )
 def test_options_out_of_range(tmp_path, args, expected):
     (tmp_path / "a_file").write_text("I am a file, not a folder")
-    _refused(_videocal(*[a.format(tmp=tmp_path) for a in args]), expected)
+    refused(videocal(*[a.format(tmp=tmp_path) for a in args]), expected)
 
 
 def test_a_full_disk_is_an_error_not_a_traceback(tmp_path):
     def small_files() -> None:
         import signal
 
-        _limits()
+        limits()
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (2000, 2000))
 
     out = tmp_path / "r.png"
-    run = _videocal("render", "--out", out, "--scale", "0.5", preexec=small_files)
-    _refused(run, "r.png")
+    run = videocal("render", "--out", out, "--scale", "0.5", preexec=small_files)
+    refused(run, "r.png")
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
 
 
@@ -249,8 +220,8 @@ def test_board_views_too_small_or_of_no_camera_s_shape_are_rejected_by_name(tmp_
     folder.mkdir()
     cv2.imwrite(str(folder / "one.png"), np.zeros((1, 1), np.uint8))
     cv2.imwrite(str(folder / "tall.jpg"), np.random.default_rng(0).integers(0, 255, (14304, 640), dtype=np.uint8))
-    line = _refused(
-        _videocal("calibrate-intrinsics", folder, "--board", "chessboard:9x6:25", "--out", tmp_path / "camera.yaml"),
+    line = refused(
+        videocal("calibrate-intrinsics", folder, "--board", "chessboard:9x6:25", "--out", tmp_path / "camera.yaml"),
         "one.png: the image is 1 x 1 px: too small",
         "tall.jpg: the image is 640 x 14304 px: not a camera's picture",
     )
@@ -259,11 +230,11 @@ def test_board_views_too_small_or_of_no_camera_s_shape_are_rejected_by_name(tmp_
 
 def test_grab_into_a_folder_under_a_file_or_from_no_camera_leaves_nothing(tmp_path):
     (tmp_path / "afile").write_text("x")
-    _refused(
-        _videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file"
+    refused(
+        videocal("grab", "file:nothing.png", "--count", "1", "--out", tmp_path / "afile" / "sub"), "afile is a file"
     )
-    _refused(
-        _videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"),
+    refused(
+        videocal("grab", str(tmp_path / "missing.mp4"), "--count", "1", "--out", tmp_path / "new" / "frames"),
         "missing.mp4",
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]  # no folder made for a camera that did not open
@@ -276,7 +247,7 @@ def test_a_feature_at_1e23_mm_and_a_distortion_of_minus_1e308_are_refused_by_fie
         name = next(iter(component["features"]))
         component["features"][name] = [1e23, 0.0, 0.0]
 
-    _refused(_render(cell(far_feature), cell.folder), "edited.yaml", "features", "beyond")
+    refused(_render(cell(far_feature), cell.folder), "edited.yaml", "features", "beyond")
 
     def far_board(d):
         d["hand_eye_board"] = {"xyz": [1e308, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]}
@@ -284,11 +255,11 @@ def test_a_feature_at_1e23_mm_and_a_distortion_of_minus_1e308_are_refused_by_fie
     def turned_part(d):
         d["components"][0]["placement"]["rpy"] = [1e23, 0.0, 0.0]
 
-    _refused(_render(cell(far_board), cell.folder), "edited.yaml", "hand_eye_board.xyz", "beyond 1e+07 mm")
-    _refused(_render(cell(turned_part), cell.folder), "edited.yaml", "components[0].placement.rpy", "beyond 3600 deg")
+    refused(_render(cell(far_board), cell.folder), "edited.yaml", "hand_eye_board.xyz", "beyond 1e+07 mm")
+    refused(_render(cell(turned_part), cell.folder), "edited.yaml", "components[0].placement.rpy", "beyond 3600 deg")
     ros = yaml.safe_load((cell.folder / "camera" / "gripper_camera_ros.yaml").read_text())
     ros["distortion_coefficients"]["data"][1] = -1e308
-    _refused(_render(_camera_file(cell, yaml.safe_dump(ros)), cell.folder), "bad.yaml", "k2", "no lens")
+    refused(_render(_camera_file(cell, yaml.safe_dump(ros)), cell.folder), "bad.yaml", "k2", "no lens")
 
 
 def test_a_camera_mounting_10_km_from_the_flange_is_refused(tmp_path):
@@ -330,21 +301,21 @@ def test_a_workspace_pair_at_minus_1e308_or_a_sigma_of_9e18_is_not_exported(tmp_
             table,
         ),
     )
-    assert _videocal("export", path).returncode == 0
+    assert videocal("export", path).returncode == 0
     original = json.loads(path.read_text())
     data = json.loads(json.dumps(original))
     data["pairs"][0]["point_world_mm"] = [-1e308, 0.0, 0.0]
     path.write_text(json.dumps(data))
-    _refused(_videocal("export", path), "w.json", "point_world_mm", "within")
+    refused(videocal("export", path), "w.json", "point_world_mm", "within")
     data = json.loads(json.dumps(original))
     data["corrections"][0]["std_displacement_mm"] = [9e18, 0.1, 0.1]
     path.write_text(json.dumps(data))
-    _refused(_videocal("export", path), "w.json", "std_displacement_mm", "up to")
+    refused(videocal("export", path), "w.json", "std_displacement_mm", "up to")
 
 
 def test_a_site_url_with_a_newline_or_a_nul_is_refused_by_field(cell):
     for url in ("socket://robot:30002\nmore", "ros2:///joint_states\x00"):
-        _refused(
+        refused(
             _render(cell(lambda d: d.update(site={"controller": url})), cell.folder),
             "edited.yaml",
             "site.controller",
@@ -361,12 +332,12 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
     def small_files() -> None:
         import signal
 
-        _limits()
+        limits()
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (1500, 1500))  # the workcell file and the target's STL are larger
 
     urdf = require(UR5)
-    run = _videocal(
+    run = videocal(
         "new-cell",
         tmp_path / "deep" / "cell",
         "--urdf",
@@ -376,24 +347,22 @@ def test_new_cell_on_a_full_disk_or_a_read_only_folder_says_so_and_leaves_nothin
         preexec=small_files,
         timeout=300,
     )
-    _refused(run, "cell", "nothing was left behind")
+    refused(run, "cell", "nothing was left behind")
     assert list(tmp_path.iterdir()) == []
     locked = tmp_path / "locked"
     locked.mkdir()
     locked.chmod(stat.S_IRUSR | stat.S_IXUSR)
     try:
         if os.geteuid() != 0:  # root writes anywhere: the read-only case is a user's
-            _refused(
-                _videocal("new-cell", locked / "cell", "--urdf", urdf, "--package-path", SHARE, timeout=300), "cell"
-            )
+            refused(videocal("new-cell", locked / "cell", "--urdf", urdf, "--package-path", SHARE, timeout=300), "cell")
             assert list(locked.iterdir()) == []
     finally:
         locked.chmod(stat.S_IRWXU)
 
 
 def test_joints_whose_first_is_negative_given_as_two_tokens_say_how_to_write_them():
-    run = _videocal("render", "--joints", "-5,0,0,0,0,0", "--out", "never.png")
-    _refused(run, "argument --joints: expected one argument", "--joints=VALUE", "--joints=-20,10,30")
+    run = videocal("render", "--joints", "-5,0,0,0,0,0", "--out", "never.png")
+    refused(run, "argument --joints: expected one argument", "--joints=VALUE", "--joints=-20,10,30")
 
 
 def test_an_export_of_a_task_holding_only_a_measurement_leaves_it_out_and_says_so(tmp_path):
@@ -421,11 +390,11 @@ def test_an_export_of_a_task_holding_only_a_measurement_leaves_it_out_and_says_s
     intrinsics = load_intrinsics(cell.intrinsics_path)
     save_workspace(path, Workspace(str(cell.path), intrinsics, tasks, "oru_1_fixture", [], table))
     for fmt in ("urscript", "rapid", "krl", "fanuc", "pdl2"):
-        said = _refused(_videocal("export", path, "--format", fmt), "no task location holds a correction", names[0])
+        said = refused(videocal("export", path, "--format", fmt), "no task location holds a correction", names[0])
         assert "only a measurement" in said
     table.add(stored(names[1], "correction"))
     save_workspace(path, Workspace(str(cell.path), intrinsics, tasks, "oru_1_fixture", [], table))
-    run = _videocal("export", path, "--format", "urscript")
+    run = videocal("export", path, "--format", "urscript")
     assert run.returncode == 0 and "Traceback" not in run.stderr, run.stderr[-2000:]
     assert f"global {names[1]}" in run.stdout and names[0] not in run.stdout
     assert f"{names[0]}: left out, it holds only a measurement" in run.stderr

@@ -7,7 +7,7 @@ import json
 import resource
 from pathlib import Path
 
-from tests.cli.test_bad_inputs_cli import _limits, _refused, _videocal
+from tests.cli.refused_runs import limits, refused, videocal
 
 
 def _locate_inputs(folder: Path, photo) -> None:
@@ -29,7 +29,7 @@ def _locate_inputs(folder: Path, photo) -> None:
 
 def _locate(folder: Path, mesh: str = "box.stl", prior: str = "ahead.json", *more, **run_options):
     """``videocal locate`` on ``folder``'s inputs (:func:`_locate_inputs`), with ``mesh`` and ``prior`` by name."""
-    return _videocal(
+    return videocal(
         "locate",
         folder / "photo.png",
         "--mesh",
@@ -57,12 +57,12 @@ def test_locate_names_a_mesh_with_a_non_finite_vertex_and_a_prior_behind_the_cam
     (tmp_path / "behind.json").write_text(
         json.dumps({"obj2cam": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -500], [0, 0, 0, 1]]})
     )
-    _refused(
+    refused(
         _locate(tmp_path, mesh="nan.stl"),
         "nan.stl",
         "not finite",
     )
-    _refused(
+    refused(
         _locate(tmp_path, prior="behind.json"),
         "behind.json",
         "behind it",
@@ -76,12 +76,12 @@ def test_locate_overlay_on_a_full_disk_is_one_line_and_leaves_no_file(tmp_path):
     def small_files() -> None:
         import signal
 
-        _limits()
+        limits()
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG, as on a full disk
         resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))  # the noisy photo's overlay is larger
 
     _locate_inputs(tmp_path, np.random.default_rng(1).integers(0, 255, (480, 640, 3), dtype=np.uint8))
     run = _locate(tmp_path, "box.stl", "ahead.json", "--overlay", tmp_path / "out" / "overlay.png", preexec=small_files)
     assert "libpng" not in run.stderr, run.stderr
-    _refused(run, "overlay.png", "not written")
+    refused(run, "overlay.png", "not written")
     assert list((tmp_path / "out").iterdir()) == []

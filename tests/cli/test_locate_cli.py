@@ -18,15 +18,7 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.intrinsics_io import save_intrinsics
-
-DATA = Path(__file__).resolve().parents[1] / "data" / "third_party" / "opencv_samples"
-PHOTO, BOX = DATA / "resized_IMG_3875.JPG", DATA / "box.ply"
-TUTORIAL_CAMERA = Intrinsics(718 * 45 / 22.3, 480 * 45 / 14.9, 359.0, 240.0, 718, 480)
-# The box's pose from six of its corners picked by hand in the photo (about 4 px RMS: a rough prior)
-HAND_PRIOR = {
-    "R_obj2cam": [[0.7512, -0.6587, -0.0433], [-0.3824, -0.3808, -0.8419], [0.538, 0.649, -0.5379]],
-    "t_obj2cam_mm": [-5.9, 110.7, 943.5],
-}
+from tests.core.look.box_photo import BOX, HAND_PRIOR, PHOTO, TUTORIAL_CAMERA
 
 
 def _videocal(*args, cwd=None):
@@ -173,10 +165,10 @@ def test_the_simulated_camera_s_frame_is_located_where_the_truth_is(tmp_path):
     mm): edges only (the fixture's mesh has too many vertices for default corners). The truth only scores."""
     from calib_core.frames import concat, invert
     from calib_core.robot import solve_ik
-    from tests.core.look.test_find_points import TARGET, _errors_times
+    from tests.core.look.find_points_scenes import TARGET, errors_times
     from videocal_sim.test_bed import TestBed
 
-    bed = TestBed.create(errors=_errors_times(1.0))
+    bed = TestBed.create(errors=errors_times(1.0))
     cell = bed.workcell
     q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").approach2base, np.array(cell.home_joints_deg, float)).q_deg
     bed.joints_deg = q

@@ -12,10 +12,10 @@ from tests.terminal_run import run_on_terminal
 
 def test_calibrate_hand_eye_shows_its_progress_on_a_terminal_and_not_with_json(tmp_path):
     from calib_core.camera.intrinsics_io import save_intrinsics
-    from tests.app.test_vision_in_window import _recorded_set
+    from tests.app.recorded_sets import recorded_set
     from videocal_sim.test_bed import TestBed
 
-    poses = _recorded_set(tmp_path / "set", moved_view=3, moved_mm=0.0)
+    poses = recorded_set(tmp_path / "set", moved_view=3, moved_mm=0.0)
     save_intrinsics(tmp_path / "camera.yaml", TestBed.create().intrinsics)
     args = ["calibrate-hand-eye", str(poses), "--intrinsics", str(tmp_path / "camera.yaml")]
     args += ["--out", str(tmp_path / "mount.yaml")]

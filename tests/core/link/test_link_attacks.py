@@ -16,14 +16,13 @@ import numpy as np
 import pytest
 import serial
 
+from calib_core.connectors.link_types import LinkState
 from calib_core.link import auth
 from calib_core.link.assembler import SentenceAssembler
-from videocal_sim.controller_sim import ControllerLogic
 from calib_core.link.driver import ControllerLink
-from calib_core.connectors.link_types import LinkState
 from calib_core.link.protocol import MAX_SENTENCE_BYTES, Ack, ErrorReply, JointSample, encode, parse_body
 from calib_core.link.workstation_auth import AuthState
-from tests.core.link.test_link_with_simulator import sim  # noqa: F401 (the fixture)
+from videocal_sim.controller_sim import ControllerLogic
 
 KEY = bytes(range(32))
 
@@ -251,8 +250,8 @@ def test_a_flood_of_keyless_hellos_leaves_the_workstation_s_handshake_alone_and_
     """A writer without the key sends a hello every 20 ms while the workstation connects (version 5 answered each,
     and the workstation's answer to its own hello no longer matched: 3 of 6 connects failed). Now only the key's
     holder is answered, the refusals at most 10 a second."""
-    from videocal_sim.controller_sim import REFUSALS_PER_S
     from calib_core.link.workstation_auth import WorkstationAuth
+    from videocal_sim.controller_sim import REFUSALS_PER_S
 
     clock = _Clock()
     c = ControllerLogic(clock=clock, key=KEY)

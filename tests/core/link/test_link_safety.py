@@ -8,13 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from videocal_sim.controller_sim import ControllerLogic
-from calib_core.link.driver import ControllerLink
 from calib_core.connectors.link_types import LinkState, MoveError
+from calib_core.link.driver import ControllerLink
 from calib_core.link.protocol import Ack, Done, ErrorReply, JointSample, encode
-
-
-from tests.core.link.test_link_with_simulator import sim  # noqa: F401 (the fixture)
+from videocal_sim.controller_sim import ControllerLogic
 
 
 class _Clock:

@@ -8,24 +8,8 @@ import time
 import numpy as np
 import pytest
 
-from calib_core.link.driver import ControllerLink
 from calib_core.connectors.link_types import LinkError, LinkState, MoveError, MoveTimeout
-
-from tests.core.link.sim_process import SimProcess
-
-
-@pytest.fixture
-def sim(tmp_path):
-    procs = []
-
-    def start(*args, link=True):
-        p = SimProcess(*args, link=tmp_path / "controller" if link else None)
-        procs.append(p)
-        return p
-
-    yield start
-    for p in procs:
-        p.stop()
+from calib_core.link.driver import ControllerLink
 
 
 def _link_threads():

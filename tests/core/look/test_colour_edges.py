@@ -12,13 +12,13 @@ import cv2
 import numpy as np
 import pytest
 
-from calib_core.render.model_view import ModelView
-from calib_core.robot import solve_ik
 from calib_core.look import colour_contrast
 from calib_core.look.edge_alignment import edge_distance_map, edge_samples_px, matched_share
 from calib_core.look.find_points import find_points
+from calib_core.render.model_view import ModelView
+from calib_core.robot import solve_ik
 from calib_core.workcell import load_workcell
-from tests.core.look.test_find_points import TARGET, _errors_times, _pixel_errors
+from tests.core.look.find_points_scenes import TARGET, errors_times, pixel_errors
 from videocal_sim.test_bed import TestBed
 
 ORANGE, TAN = (1.0, 0.55, 0.12), (0.74, 0.62, 0.44)  # 0.299 R + 0.587 G + 0.114 B: 0.6355 and 0.6354
@@ -34,7 +34,7 @@ def _painted_look(target_rgb, behind_rgb):
     cell = dataclasses.replace(
         cell, components=[dataclasses.replace(c, color=paint.get(c.name, c.color)) for c in cell.components]
     )
-    bed = TestBed.create(workcell=cell, errors=_errors_times(1.0))
+    bed = TestBed.create(workcell=cell, errors=errors_times(1.0))
     q = solve_ik(bed.model_robot, cell.task("oru_1_grasp").tcp2base, np.array(cell.home_joints_deg, float)).q_deg
     bed.joints_deg = q
     camera = bed.camera()
@@ -81,7 +81,7 @@ def test_find_points_finds_a_target_whose_edges_are_colour_only(equal_grey):
     found = find_points(image, intrinsics, item, model, expected=expected)
     assert found.found, found.message
     assert len(found.proposals) == len(item.features)
-    assert _pixel_errors(item, found.obj2cam, truth, intrinsics).max() < 0.5
+    assert pixel_errors(item, found.obj2cam, truth, intrinsics).max() < 0.5
     # the same frame in grey: the outline is gone and the fit does not settle (the report's "0 % of its edges")
     grey = find_points(cv2.cvtColor(image, cv2.COLOR_RGB2GRAY), intrinsics, item, model, expected=expected)
     assert not grey.found
@@ -91,7 +91,7 @@ def test_dark_on_dark_is_found_as_well():
     for image, intrinsics, item, model, truth, expected in _painted_look((0.16, 0.15, 0.17), (0.24, 0.23, 0.25)):
         found = find_points(image, intrinsics, item, model, expected=expected)
         assert found.found, found.message
-        assert _pixel_errors(item, found.obj2cam, truth, intrinsics).max() < 0.5
+        assert pixel_errors(item, found.obj2cam, truth, intrinsics).max() < 0.5
 
 
 def test_an_unsure_detection_names_what_made_it_unsure():

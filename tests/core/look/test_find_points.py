@@ -7,38 +7,25 @@ import numpy as np
 import pytest
 
 from calib_core.camera.projection import project_points
-from calib_core.render.model_view import ModelView
-from calib_core.robot import solve_ik
-from videocal_sim.sim_camera import CameraLook
-from videocal_sim.test_bed import TestBed
-from videocal_sim.true_robot import RobotErrors
+from calib_core.look.colour_contrast import gradient_magnitude
 from calib_core.look.edge_alignment import edge_distance_map
 from calib_core.look.edge_refinement import refine_to_edges
 from calib_core.look.edge_samples import edge_points
-from calib_core.look.colour_contrast import gradient_magnitude
 from calib_core.look.find_points import find_points
 from calib_core.look.pose_hypotheses import TRUNCATE_PX, rank_starts
-
-TARGET = "oru_1_fixture"
-
-
-def _errors_times(factor: float) -> RobotErrors:
-    e = RobotErrors.typical(0, n_joints=6)
-    return RobotErrors(
-        e.joint_offsets_deg * factor,
-        e.link_errors_mm * factor,
-        e.base_xyz_mm * factor,
-        e.base_rpy_deg * factor,
-        e.hand_eye_xyz_mm * factor,
-        e.hand_eye_rpy_deg * factor,
-    )
+from calib_core.render.model_view import ModelView
+from calib_core.robot import solve_ik
+from tests.core.look.find_points_scenes import TARGET, errors_times, pixel_errors
+from videocal_sim.sim_camera import CameraLook
+from videocal_sim.test_bed import TestBed
+from videocal_sim.true_robot import RobotErrors
 
 
 def _look(factor: float, place: str = "approach"):
     """The paper's task location's approach (or the ``task`` location itself, 177 mm from the fixture)
     seen through a robot with ``factor`` times the typical errors: (image, intrinsics, item, modelled
     obj2cam, true obj2cam, expected)."""
-    bed = TestBed.create(errors=_errors_times(factor))
+    bed = TestBed.create(errors=errors_times(factor))
     cell = bed.workcell
     task = cell.task("oru_1_grasp")
     q = solve_ik(
@@ -64,14 +51,9 @@ def look(request):
     yield from _look(request.param)
 
 
-def _pixel_errors(item, pose, truth, intrinsics):
-    points = np.array(list(item.features.values()))
-    return np.linalg.norm(project_points(points, pose, intrinsics) - project_points(points, truth, intrinsics), axis=1)
-
-
 def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
     image, intrinsics, item, model, truth, expected = look
-    assert _pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
+    assert pixel_errors(item, model, truth, intrinsics).max() > 4.0  # the robot's error, before
     grey = image.mean(axis=2).astype(np.uint8)
     samples, _, _, _ = edge_points(
         item.mesh, model, intrinsics, gradient_magnitude(expected(model).mean(axis=2).astype(np.uint8))
@@ -87,7 +69,7 @@ def test_the_edges_put_every_feature_within_a_fifth_of_a_pixel(look):
         expected_magnitude=gradient_magnitude(expected(start).mean(axis=2).astype(np.uint8)),
     )
     assert fit.converged and fit.samples > 300
-    errors = _pixel_errors(item, fit.obj2cam, truth, intrinsics)
+    errors = pixel_errors(item, fit.obj2cam, truth, intrinsics)
     assert errors.max() < 0.2, errors
     # the reported uncertainty is of the size of the error, not a thousand times smaller or larger
     position_sigma_mm = np.sqrt(np.trace(fit.covariance[3:, 3:]))
@@ -114,7 +96,7 @@ def test_close_up_the_camera_s_move_is_found_not_only_its_turn(factor):
     shift of the image settled 2.4 mm from the true pose with half its samples on the plate (the demo's
     first look: 2.3 mm after correction, 'ok'); the camera poses searched from the model's must find it."""
     for image, intrinsics, item, model, truth, expected in _look(factor, "task"):
-        assert _pixel_errors(item, model, truth, intrinsics).max() > 40.0  # the robot's error, before
+        assert pixel_errors(item, model, truth, intrinsics).max() > 40.0  # the robot's error, before
         result = find_points(image, intrinsics, item, model, expected=expected)
         assert result.found, result.message
         assert result.edges.settled and result.edges.inlier_share > 0.75
@@ -155,4 +137,4 @@ def test_the_edge_fit_settles_on_an_aliased_frame():
     finally:
         view.close()
     assert result.edges is not None and result.edges.converged and result.edges.settled, result.message
-    assert _pixel_errors(item, result.edges.obj2cam, truth, bed.intrinsics).max() < 0.5
+    assert pixel_errors(item, result.edges.obj2cam, truth, bed.intrinsics).max() < 0.5

@@ -11,10 +11,10 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from calib_core.mesh_files import load_mesh
 from calib_core.look.locate import locate
 from calib_core.look.locate_verdict import image_distance_px
-from tests.cli.test_locate_cli import BOX, HAND_PRIOR, PHOTO, TUTORIAL_CAMERA
+from calib_core.mesh_files import load_mesh
+from tests.core.look.box_photo import BOX, HAND_PRIOR, PHOTO, TUTORIAL_CAMERA
 
 
 def _hand_prior() -> np.ndarray:

@@ -4,16 +4,15 @@ session, picks while the robot moves, pairs from two poses, a link that drops, a
 import numpy as np
 import pytest
 
-from calib_core.calibration.look_place import LookNotAtTask
 from calib_core.calibration.errors import CalibrationError, ConfirmationNeeded
+from calib_core.calibration.look_place import LookNotAtTask
 from calib_core.calibration.verdict import Verdict
 from calib_core.frames import apply
 from calib_core.operator.core import OperatorCore
 from calib_core.operator.observations import NotSettledError
-from calib_core.robot import solve_ik
-from videocal_sim.sim_site import simulated_cell
-from tests.core.operator.perfect_operator import FEATURES, pick_all as _pick_all
+from tests.core.operator.perfect_operator import FEATURES, pick_all, task_joints
 from tests.core.operator.still_robot import frame_now, sample, still_for
+from videocal_sim.sim_site import simulated_cell
 
 
 @pytest.fixture
@@ -21,27 +20,23 @@ def cell_and_site():
     return simulated_cell(image_scale=0.5)
 
 
-def _task_joints(core) -> np.ndarray:
-    return solve_ik(core.robot, core.task.approach2base, core.cell.home_joints).q_deg
-
-
 def _picked_at_task(cell, site) -> tuple[OperatorCore, np.ndarray]:
     """A core whose pairs were picked (perfectly) on a still at the task location's approach."""
     core = OperatorCore(cell, site)
-    q_task = _task_joints(core)
+    q_task = task_joints(core)
     still_for(core, joints_deg=q_task)
     frame_now(core)
-    _pick_all(core, site.bed, q_task)
+    pick_all(core, site.bed, q_task)
     return core, q_task
 
 
 def test_a_restored_session_solves_with_the_joints_its_picks_were_made_at(cell_and_site, tmp_path):
     cell, site = cell_and_site
     core = OperatorCore(cell, site)
-    q_task = _task_joints(core)
+    q_task = task_joints(core)
     still_for(core, joints_deg=q_task)
     frame_now(core, index=7)
-    _pick_all(core, site.bed, q_task)
+    pick_all(core, site.bed, q_task)
     stamps = {p.view for p in core.session.pairs}
     assert len(stamps) == 1 and next(iter(stamps)).frame_index == 7  # one still for the whole set
     np.testing.assert_allclose(next(iter(stamps)).joints_deg, q_task, atol=1e-9)
@@ -166,7 +161,7 @@ def test_a_pick_on_a_frame_newer_than_the_joint_stream_holds_the_frame_before_it
     of a moving robot is refused all the same."""
     cell, site = cell_and_site
     core = OperatorCore(cell, site)
-    q = _task_joints(core)
+    q = task_joints(core)
     t_last = still_for(core, joints_deg=q)
     before = frame_now(core, index=1, t_s=t_last - 0.005)
     frame_now(core, index=2, t_s=t_last + 0.010)  # its joint samples are still on the way

@@ -76,11 +76,11 @@ def test_a_recorded_set_replaces_the_views_only_when_read_whole(core, tmp_path):
     import json
 
     from calib_core.errors import FileFormatError
-    from tests.app.test_vision_in_window import _recorded_set
+    from tests.app.recorded_sets import recorded_set
 
     vision = core.vision
     before = vision.capture
-    path = _recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
+    path = recorded_set(tmp_path / "set", moved_view=3, moved_mm=15.0)
     seen = []
     with pytest.raises(OperatorError, match="reading poses.json was cancelled: the views are as they were"):
         vision.read_set(path, lambda done, total: seen.append((done, total)) or done < 2)

@@ -28,9 +28,9 @@ from calib_core.recording.schemas import (
     TRANSFORMS_TOPIC,
     VIDEO_TOPIC,
 )
-from videocal_sim.sim_site import simulated_cell
+from tests.core.operator.perfect_operator import pick_all, task_joints
 from tests.core.operator.still_robot import frame_now, still_for
-from tests.core.operator.test_bound_observations import _pick_all, _task_joints
+from videocal_sim.sim_site import simulated_cell
 
 
 @pytest.fixture(scope="module")
@@ -41,14 +41,14 @@ def recorded(tmp_path_factory):
     core = OperatorCore(cell, site)
     path = tmp_path_factory.mktemp("tap") / "session.mcap"
     core.start_recording(path)
-    q = _task_joints(core)
+    q = task_joints(core)
     # still elsewhere, then a move, then still at q; stamped after the recording's start, as a live session is
     t = still_for(core, 0.4, joints_deg=q - 2.0, start_s=time.monotonic() + 1.0)
     for k in range(1, 11):
         still_for(core, 0.0, joints_deg=q - 2.0 + 0.2 * k, start_s=t + 0.02 * k)
     still_for(core, 2.5, joints_deg=q, start_s=t + 0.24)
     frame_now(core, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 90, np.uint8))
-    _pick_all(core, site.bed, q)
+    pick_all(core, site.bed, q)
     core.picking.calibrate()
     solution = core.session.result.estimate.solution
     points_obj, _, numbers = core.session.pairs.arrays()

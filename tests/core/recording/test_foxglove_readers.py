@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from calib_core.recording.reader import read_recording, recover
-from tests.core.recording.test_killed_processes import RECORDER, _read_until, _start
+from tests.core.recording.recorder_process import RECORDER, read_until, start
 
 NODE_DIR = Path(__file__).resolve().parents[2] / "node"
 SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "recordings" / "sample_session.mcap"
@@ -56,19 +56,19 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     import numpy as np
 
     from calib_core.operator.core import OperatorCore
-    from videocal_sim.sim_site import simulated_cell
+    from tests.core.operator.perfect_operator import pick_all, task_joints
     from tests.core.operator.still_robot import frame_now, still_for
-    from tests.core.operator.test_bound_observations import _pick_all, _task_joints
+    from videocal_sim.sim_site import simulated_cell
 
     cell, site = simulated_cell(image_scale=0.5)
     core = OperatorCore(cell, site)
     path = tmp_path / "fresh.mcap"
     core.start_recording(path)
-    q = _task_joints(core)
+    q = task_joints(core)
     still_for(core, 1.0, joints_deg=q)
     for k in range(3):
         frame_now(core, k, image=np.full((cell.intrinsics.height, cell.intrinsics.width, 3), 60 + 40 * k, np.uint8))
-    _pick_all(core, site.bed, q)
+    pick_all(core, site.bed, q)
     assert not core.finder.find_points().result.found  # a flat grey frame: recorded all the same
     core.picking.calibrate()
     core.desk.store_correction(convert="a test: the approach's look stands for the task", confirmation="test")
@@ -94,8 +94,8 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
 def test_a_recording_recovered_after_a_kill_opens_indexed_and_decodes(tmp_path):
     killed = tmp_path / "killed.mcap"
-    proc = _start(RECORDER, killed)
-    _read_until(proc, lambda line: int(line.split()[1]) >= 20)
+    proc = start(RECORDER, killed)
+    read_until(proc, lambda line: int(line.split()[1]) >= 20)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(10)
     proc.stdout.close()

@@ -8,7 +8,6 @@ always loadable, never half of either.
 
 import os
 import signal
-import subprocess
 import sys
 import textwrap
 import time
@@ -19,28 +18,10 @@ from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.reader import read_recording, recover
 from calib_core.recording.schemas import JOINTS_TOPIC, VIDEO_TOPIC
 from calib_core.workspace.workspace import load_workspace
+from tests.core.recording.recorder_process import RECORDER, read_until, start
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="SIGKILL")
 
-RECORDER = textwrap.dedent(
-    """
-    import sys, time, numpy as np
-    from calib_core.recording.recorder import SessionRecorder
-    rec = SessionRecorder(sys.argv[1], drop_when_busy=False)
-    rec.record_setup(note="killed on purpose")
-    k = 0
-    while True:
-        image = np.zeros((240, 320, 3), np.uint8) + np.linspace(0, 200, 320).astype(np.uint8)[None, :, None]
-        image[100:140, (k * 3) % 280 : (k * 3) % 280 + 40] = (240, 40, 40)
-        now = time.monotonic()
-        rec.record_frame(image, now)
-        for j in range(3):
-            rec.record_joints(3 * k + j, 20 * (3 * k + j), now, [0.1 * k] * 6)
-        k += 1
-        print(rec.messages, rec.frames_written, flush=True)
-        time.sleep(1 / 30)
-    """
-)
 
 SAVER = textwrap.dedent(
     """
@@ -64,27 +45,10 @@ SAVER = textwrap.dedent(
 )
 
 
-def _start(script: str, *args) -> subprocess.Popen:
-    return subprocess.Popen(
-        [sys.executable, "-c", script, *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-    )
-
-
-def _read_until(proc: subprocess.Popen, enough) -> str:
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline:
-        line = proc.stdout.readline()
-        if not line:
-            raise AssertionError(f"the child stopped: {proc.stderr.read()[-2000:]}")
-        if enough(line):
-            return line
-    raise AssertionError("the child did not get far enough")
-
-
 def test_a_recorder_killed_mid_recording_keeps_every_reported_message(tmp_path):
     path = tmp_path / "killed.mcap"
-    proc = _start(RECORDER, path)
-    last = _read_until(proc, lambda line: int(line.split()[1]) >= 45)  # past a keyframe interval
+    proc = start(RECORDER, path)
+    last = read_until(proc, lambda line: int(line.split()[1]) >= 45)  # past a keyframe interval
     killed_at_ns = time.time_ns()
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait(10)
@@ -114,8 +78,8 @@ def test_a_recorder_killed_mid_recording_keeps_every_reported_message(tmp_path):
 def test_a_process_killed_while_saving_leaves_a_whole_workspace(tmp_path):
     path = tmp_path / "w.json"
     for attempt in range(4):
-        proc = _start(SAVER, path)
-        _read_until(proc, lambda line: int(line.split()[0]) >= 2 + attempt)
+        proc = start(SAVER, path)
+        read_until(proc, lambda line: int(line.split()[0]) >= 2 + attempt)
         time.sleep(0.003 * attempt)  # land the kill at different points of a save
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(10)

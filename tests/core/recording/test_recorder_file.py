@@ -12,8 +12,7 @@ from mcap.reader import make_reader
 from calib_core.recording.reader import read_recording, recover
 from calib_core.recording.recorder import SessionRecorder
 from calib_core.recording.schemas import EVENT_TOPIC, JOINTS_TOPIC, VIDEO_TOPIC
-
-from tests.core.recording.test_recording import SimulatedClock, _image, _record
+from tests.core.recording.recordings import SimulatedClock, noisy_image, record
 
 
 def _indexed(path):
@@ -28,7 +27,7 @@ def _indexed(path):
 
 
 def test_an_indexed_reader_gets_every_message_back_in_order(tmp_path):
-    path = _record(tmp_path / "s.mcap", n_frames=12, n_solves=2, frames="h264")
+    path = record(tmp_path / "s.mcap", n_frames=12, n_solves=2, frames="h264")
     summary, indexed = _indexed(path)
     streamed = read_recording(path).messages
     assert len(summary.chunk_indexes) >= 4 and summary.statistics.message_count == len(streamed) == len(indexed)
@@ -48,7 +47,7 @@ def test_an_indexed_reader_gets_every_message_back_in_order(tmp_path):
 def test_a_frame_is_logged_at_its_capture_and_samples_that_came_while_it_was_encoded_follow_it(tmp_path):
     clock = SimulatedClock(2.0)
     rec = SessionRecorder(tmp_path / "o.mcap", clock=clock, hold_s=0.0, drop_when_busy=False)
-    rec.record_frame(_image(0, None, noise=0.0), 1.0)  # captured at 1.0 s, reached the recorder at 2.0 s
+    rec.record_frame(noisy_image(0, None, noise=0.0), 1.0)  # captured at 1.0 s, reached the recorder at 2.0 s
     rec.record_joints(0, 0, 1.5, [0.0] * 6)  # arrived at 1.5 s: written only once the frame is
     rec.close(timeout_s=None)
     messages = read_recording(tmp_path / "o.mcap").messages
@@ -63,7 +62,7 @@ def test_a_frame_is_logged_at_its_capture_and_samples_that_came_while_it_was_enc
 def test_a_monochrome_camera_is_recorded_as_grey_video(tmp_path):
     from calib_core.recording.frame_track import FrameTrack
 
-    grey = _image(0, None, noise=0.0)[..., 1]
+    grey = noisy_image(0, None, noise=0.0)[..., 1]
     with SessionRecorder(tmp_path / "mono.mcap", drop_when_busy=False) as rec:
         rec.record_frame(grey, time.monotonic())
     image = FrameTrack(read_recording(tmp_path / "mono.mcap")).image(0)
@@ -75,7 +74,7 @@ def test_a_frame_later_than_what_was_written_keeps_its_capture_time_and_the_file
     rec = SessionRecorder(tmp_path / "late.mcap", clock=clock, hold_s=0.0, drop_when_busy=False)
     rec.record_joints(0, 0, 4.0, [0.0] * 6)
     assert rec.flush()
-    rec.record_frame(_image(0, None, noise=0.0), 3.0)  # captured before the sample already written
+    rec.record_frame(noisy_image(0, None, noise=0.0), 3.0)  # captured before the sample already written
     rec.close(timeout_s=None)
     messages = read_recording(tmp_path / "late.mcap").messages
     frame = next(m for m in messages if m.topic == VIDEO_TOPIC)
@@ -94,7 +93,7 @@ def test_a_failing_encoder_stops_the_recorder_without_raising_into_the_caller(tm
         rec.flush(timeout_s=0.2)
     assert rec.failure is not None and "ValueError" in rec.failure
     rec.record_event("after")  # neither raises nor reaches the file
-    rec.record_frame(_image(0, None, noise=0.0), time.monotonic())
+    rec.record_frame(noisy_image(0, None, noise=0.0), time.monotonic())
     assert rec.messages_lost == 2
     started = time.monotonic()
     rec.close()
@@ -156,7 +155,7 @@ def test_close_drops_what_the_encoder_cannot_finish_in_time_and_still_finishes_t
 
 
 def test_a_damaged_chunk_is_skipped_and_the_rest_recovered(tmp_path):
-    path = _record(tmp_path / "s.mcap", n_frames=12, n_solves=1, frames="jpeg")
+    path = record(tmp_path / "s.mcap", n_frames=12, n_solves=1, frames="jpeg")
     summary, _ = _indexed(path)
     full = read_recording(path).messages
     second = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)[1]

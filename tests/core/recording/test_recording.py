@@ -10,60 +10,18 @@ import numpy as np
 import pytest
 
 from calib_core.errors import FileFormatError
+from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.reader import decode_frame, read_recording, recover
 from calib_core.recording.recorder import SessionRecorder
 from calib_core.recording.replay import replay
-from calib_core.solver.solve_inputs import solve_inputs
-from calib_core.recording.frame_track import FrameTrack
 from calib_core.recording.schemas import EVENT_TOPIC, FRAME_TOPIC, JOINTS_TOPIC, SOLVE_TOPIC, VIDEO_TOPIC
-from calib_core.solver import solve_pose
-
-from tests.core.solver.scenes import GRIPPER_CAMERA, pixels, random_points, random_pose
+from tests.core.recording.recordings import noisy_image, record
 
 SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "recordings" / "sample_session.mcap"
 
 
-def _image(i, rng, noise=3.0):
-    """A gradient with a moving square and some noise: video-like, so inter-frame coding matters."""
-    image = np.zeros((48, 64, 3), np.uint8) + np.linspace(20, 220, 64).astype(np.uint8)[None, :, None]
-    image[10:20, 5 + i : 15 + i] = (250, 30, 30)
-    return image if noise == 0 else np.clip(image + rng.normal(0, noise, image.shape), 0, 255).astype(np.uint8)
-
-
-class SimulatedClock:
-    """Host seconds that a test sets: a recording made faster than real time, stamped consistently."""
-
-    def __init__(self, t_s: float = 0.0):
-        self.t_s = t_s
-
-    def __call__(self) -> float:
-        return self.t_s
-
-
-def _record(path, n_frames=3, n_solves=2, frames="jpeg"):
-    rng = np.random.default_rng(0)
-    clock = SimulatedClock()
-    with SessionRecorder(path, frames=frames, drop_when_busy=False, clock=clock) as rec:
-        rec.record_setup(intrinsics=GRIPPER_CAMERA.to_dict())
-        for i in range(n_frames):
-            image = _image(i, rng)
-            clock.t_s = i + 0.02  # each frame reaches the recorder 20 ms after its capture
-            rec.record_frame(image, float(i))
-            rec.record_joints(i, 10 * i, i + 0.01, [1.0, 2.0, 3.0, 4.0, 5.0, float(i)])
-            rec.record_event("pick", number=i)
-            if i % 3 == 2:
-                rec.flush()  # several chunks, as a recording of some seconds has
-        for _ in range(n_solves):
-            truth = random_pose(rng)
-            P = random_points(rng, 6)
-            uv = pixels(P, truth, noise_px=0.4, rng=rng)
-            inputs = solve_inputs(P, uv, GRIPPER_CAMERA, prior=truth)
-            rec.record_solve(inputs, solve_pose(P, uv, GRIPPER_CAMERA, prior=truth).to_dict())
-    return path
-
-
 def test_round_trip(tmp_path):
-    path = _record(tmp_path / "s.mcap")
+    path = record(tmp_path / "s.mcap")
     contents = read_recording(path)
     assert contents.complete and contents.problem is None
     assert (
@@ -77,12 +35,12 @@ def test_round_trip(tmp_path):
 
 
 def test_video_frames_decode_in_order_and_by_seeking(tmp_path):
-    path = _record(tmp_path / "v.mcap", n_frames=70, n_solves=0, frames="h264")
+    path = record(tmp_path / "v.mcap", n_frames=70, n_solves=0, frames="h264")
     contents = read_recording(path)
     assert not contents.topic(FRAME_TOPIC)
     track = FrameTrack(contents)
     assert track.is_video and len(track) == 70 and track.keyframes == [0, 30, 60]
-    truth = [_image(i, None, noise=0.0) for i in range(70)]
+    truth = [noisy_image(i, None, noise=0.0) for i in range(70)]
     sequential = [track.image(k) for k in range(70)]
     for k in (69, 31, 5, 45, 44, 0):  # jumps forwards, back across keyframes, to the start
         assert np.array_equal(track.image(k), sequential[k])
@@ -100,7 +58,7 @@ def test_video_frames_use_foxglove_compressed_video(tmp_path):
 
     from calib_core.recording.video_codec import nal_unit_types
 
-    path = _record(tmp_path / "v.mcap", n_frames=3, n_solves=0, frames="h264")
+    path = record(tmp_path / "v.mcap", n_frames=3, n_solves=0, frames="h264")
     with open(path, "rb") as f:
         summary = make_reader(f).get_summary()
     channel = next(c for c in summary.channels.values() if c.topic == VIDEO_TOPIC)
@@ -119,7 +77,7 @@ def test_video_frames_use_foxglove_compressed_video(tmp_path):
     types = nal_unit_types(message.data)
     assert message.data.startswith(b"\x00\x00\x00\x01") and types.index(7) < types.index(5) and 8 in types
     assert not any(c.topic == FRAME_TOPIC for c in summary.channels.values())  # only the frame topic in use
-    jpeg = _record(tmp_path / "j.mcap", n_frames=2, n_solves=0, frames="jpeg")
+    jpeg = record(tmp_path / "j.mcap", n_frames=2, n_solves=0, frames="jpeg")
     with open(jpeg, "rb") as f:
         summary = make_reader(f).get_summary()
     image = next(c for c in summary.channels.values() if c.topic == FRAME_TOPIC)
@@ -138,7 +96,7 @@ def test_a_busy_encoder_drops_frames_and_counts_them(tmp_path):
 
 @pytest.mark.parametrize("frames", ["jpeg", "h264"])
 def test_every_message_before_a_cut_survives_and_recovers(tmp_path, frames):
-    path = _record(tmp_path / "s.mcap", n_frames=8, n_solves=1, frames=frames)
+    path = record(tmp_path / "s.mcap", n_frames=8, n_solves=1, frames=frames)
     full = read_recording(path).messages
     data = path.read_bytes()
     for cut in (len(data) // 3, len(data) // 2, len(data) - 200):
@@ -158,7 +116,7 @@ def test_every_message_before_a_cut_survives_and_recovers(tmp_path, frames):
 
 
 def test_replay_agrees_exactly_and_finds_a_tampered_result(tmp_path):
-    path = _record(tmp_path / "s.mcap")
+    path = record(tmp_path / "s.mcap")
     assert all(r.agree for r in replay(path))
     # Tamper: the same messages with one recorded translation nudged by 1 um.
     contents = read_recording(path)
