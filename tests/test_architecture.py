@@ -283,3 +283,30 @@ def test_no_widget_reaches_the_core_through_the_window():
         f"reach the core through the window: {sorted(touching - STILL_TOUCHING_THE_CORE)}"
     )
     assert "found_points.py" not in touching
+
+
+def _test_modules_imported(source: str) -> list[str]:
+    """The test modules (``tests....test_*``) that ``source`` imports, at any depth."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        modules = (
+            [node.module]
+            if isinstance(node, ast.ImportFrom) and node.module
+            else [a.name for a in node.names]
+            if isinstance(node, ast.Import)
+            else []
+        )
+        found += [m for m in modules if m.startswith("tests.") and m.rsplit(".", 1)[-1].startswith("test_")]
+    return found
+
+
+def test_no_test_module_imports_another():
+    # a test module's helpers shared by importing it run its module-level set-up twice and tie the two files together:
+    # shared helpers live in plain modules (tests/app/windows.py, tests/core/solver/scenes.py, conftest fixtures)
+    assert _test_modules_imported("def f():\n    from tests.app.test_x import _go\n") == ["tests.app.test_x"]
+    importing = {
+        str(p.relative_to(ROOT)): found
+        for p in (ROOT / "tests").rglob("*.py")
+        if (found := _test_modules_imported(p.read_text()))
+    }
+    assert not importing, importing
