@@ -80,15 +80,37 @@ def form_error(mesh: trimesh.Trimesh, amplitude_mm: float, seed: int) -> trimesh
     return moved
 
 
-def print_tile(color: tuple[float, float, float], seed: int) -> np.ndarray:
+def main_face_texel(mesh: trimesh.Trimesh) -> tuple[int, int, int, int]:
+    """Where the print of ``mesh``'s broadest face lies on the tile (:func:`printed` lays it): ``(u, v)`` texels of
+    the centre of the faces turned along the axis that holds most of the mesh's area, and their extent ``(w, h)``
+    in texels (a fixture's front plate: the face a camera is brought to)."""
+    axis = np.abs(mesh.face_normals).argmax(axis=1)
+    area = np.bincount(axis, weights=mesh.area_faces, minlength=3)
+    main = int(area.argmax())
+    across = [k for k in range(3) if k != main]
+    corners = mesh.vertices[mesh.faces[axis == main]].reshape(-1, 3)[:, across]
+    low, high = corners.min(axis=0), corners.max(axis=0)
+    u, v = ((low + high) / 2.0 / TEXEL_MM) % PRINT_TEXELS
+    w, h = (high - low) / TEXEL_MM
+    return int(u), int(v), int(w), int(h)
+
+
+def print_tile(
+    color: tuple[float, float, float], seed: int, main_face: tuple[int, int, int, int] | None = None
+) -> np.ndarray:
     """A tile of print (``PRINT_TEXELS`` square, RGB uint8) on a part of ``color``: labels with text and a bar
-    code, painted lines and a logo, in dark ink and white, placed by ``seed``."""
+    code, painted lines and a logo, in ink that shows on the part (dark on a light part, light on a dark one) and
+    white, placed by ``seed``; ``main_face`` (:func:`main_face_texel`): a label and a stencilled name on the part's
+    broadest face too, where a camera brought to the part sees it."""
     rng = np.random.default_rng(seed)
     n = PRINT_TEXELS
     base = np.clip(np.asarray(color, float) * 255.0, 0, 255)
     tile = np.empty((n, n, 3), np.uint8)
     tile[:] = base.astype(np.uint8)
-    ink = tuple(int(c * 0.25) for c in base)
+    dark_part = float(base.mean()) < 90.0
+    ink = (205, 205, 196) if dark_part else tuple(int(c * 0.25) for c in base)
+    if main_face is not None:
+        _face_print(tile, main_face, ink, rng)
     # a label: a white card with text and a bar code (about 100 x 50 mm)
     x, y = int(rng.uniform(0, n - 260)), int(rng.uniform(0, n - 130))
     cv2.rectangle(tile, (x, y), (x + 250, y + 125), (235, 235, 228), -1)
@@ -125,6 +147,60 @@ def print_tile(color: tuple[float, float, float], seed: int) -> np.ndarray:
     return tile
 
 
+def _face_print(tile: np.ndarray, face: tuple[int, int, int, int], ink: tuple, rng: np.random.Generator) -> None:
+    """A part's own print on its broadest face (``face``: centre and extent in texels, :func:`main_face_texel`): a
+    small white label with a part number and a bar code at the middle of one side, and a stencilled instruction
+    left of the face's middle, each drawn at its place modulo the tile (the print repeats)."""
+    u, v, w, h = face
+    n = PRINT_TEXELS
+    canvas = np.zeros((3 * n, 3 * n, 3), np.uint8)  # drawn on a 3 x 3 copy about the tile, folded back onto it
+    drawn = np.zeros((3 * n, 3 * n), np.uint8)
+    cu, cv = n + u, n + v
+    lw, lh = int(min(180, 0.3 * w)), int(min(90, 0.2 * h))
+    x, y = int(cu - lw / 2), int(cv - 0.45 * h)  # between the upper corners' features
+    cv2.rectangle(canvas, (x, y), (x + lw, y + lh), (235, 235, 228), -1)
+    cv2.putText(
+        canvas,
+        f"ORU {int(rng.integers(100, 999))}",
+        (x + 10, y + int(0.4 * lh)),
+        cv2.FONT_HERSHEY_SIMPLEX,
+        lh / 90.0,
+        (20, 20, 20),
+        2,
+        cv2.LINE_AA,
+    )
+    for k in range(int((lw - 20) / 6)):
+        if rng.random() < 0.55:
+            bx = x + 10 + 6 * k
+            cv2.rectangle(canvas, (bx, y + int(0.55 * lh)), (bx + 3, y + lh - 8), (15, 15, 15), -1)
+    cv2.rectangle(drawn, (x, y), (x + lw, y + lh), 255, -1)
+    text_scale = 0.3 * w / 180.0  # (the text about a third of the face wide, left of its middle)
+    cv2.putText(
+        canvas,
+        "LIFT HERE",
+        (int(cu - 0.46 * w), int(cv + 0.05 * h)),
+        cv2.FONT_HERSHEY_DUPLEX,
+        text_scale,
+        ink,
+        max(2, int(3 * text_scale)),
+        cv2.LINE_AA,
+    )
+    cv2.putText(
+        drawn,
+        "LIFT HERE",
+        (int(cu - 0.46 * w), int(cv + 0.05 * h)),
+        cv2.FONT_HERSHEY_DUPLEX,
+        text_scale,
+        255,
+        max(2, int(3 * text_scale)),
+        cv2.LINE_AA,
+    )
+    for i in range(3):
+        for j in range(3):
+            block = drawn[j * n : (j + 1) * n, i * n : (i + 1) * n] > 0
+            tile[block] = canvas[j * n : (j + 1) * n, i * n : (i + 1) * n][block]
+
+
 def printed(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, np.ndarray]:
     """``mesh`` with a vertex per face corner and texture coordinates (n, 2): each face takes the print projected
     along the axis nearest its normal, ``TEXEL_MM`` mm a texel, repeating."""
@@ -154,7 +230,13 @@ def real_components(
         # the print carries the colour: a textured surface is drawn white under it, as the renderer multiplies the two
         real.append(
             dataclasses.replace(
-                item, mesh=mesh, color=(1.0, 1.0, 1.0), texture=print_tile(item.color, seed + k), texture_coords=uv
+                item,
+                mesh=mesh,
+                color=(1.0, 1.0, 1.0),
+                texture=print_tile(
+                    item.color, seed + k, main_face_texel(item.mesh) if item.kind == "component" else None
+                ),
+                texture_coords=uv,
             )
         )
     return real

@@ -5,7 +5,15 @@ import numpy as np
 import trimesh
 
 from calib_core.scene import SceneItem
-from videocal_sim.real_look import PRINT_TEXELS, TEXEL_MM, form_error, printed, workshop_studio
+from videocal_sim.real_look import (
+    PRINT_TEXELS,
+    TEXEL_MM,
+    form_error,
+    main_face_texel,
+    print_tile,
+    printed,
+    workshop_studio,
+)
 from videocal_sim.test_bed import TestBed
 from videocal_sim.real_look import make_less_kind
 
@@ -71,3 +79,24 @@ def test_the_lamps_surround_the_components_and_each_lights_them():
         # the cone covers the components (173 mm to a corner) at the lamp's distance
         assert np.degrees(np.arctan2(173.3, np.linalg.norm(to_centre))) < lamp.cone_deg
     assert len({tuple(np.sign(lamp.position_mm[:2])) for lamp in studio.lamps}) == 3  # from three sides
+
+
+def test_a_part_s_broadest_face_carries_its_own_label_and_lettering_in_ink_that_shows():
+    # a fixture's front plate (200 x 150 mm, 10 mm thick) away from the origin: its broadest faces turn along z
+    plate = trimesh.creation.box((200.0, 150.0, 10.0))
+    plate.apply_translation((530.0, -70.0, 40.0))
+    u, v, w, h = main_face_texel(plate)
+    assert (w, h) == (500, 375)  # 200 and 150 mm at 0.4 mm a texel
+    assert (u, v) == (int(530.0 / TEXEL_MM) % PRINT_TEXELS, int(-70.0 / TEXEL_MM) % PRINT_TEXELS)
+    dark = (0.15, 0.17, 0.2)
+    plain = print_tile(dark, seed=1)
+    tile = print_tile(dark, seed=1, main_face=(u, v, w, h))
+    rows = (np.arange(v - h // 2, v + h // 2) % PRINT_TEXELS)[:, None]
+    cols = (np.arange(u - w // 2, u + w // 2) % PRINT_TEXELS)[None, :]
+    face, face_plain = tile[rows, cols].astype(int), plain[rows, cols].astype(int)
+    white = (face.min(axis=2) > 220).mean()
+    assert 0.03 < white < 0.3  # a label, not the whole face
+    assert (face_plain.min(axis=2) > 220).mean() < white
+    # the lettering in a light ink on a dark part (dark ink would not show): light pixels beyond the label's
+    light = (face.mean(axis=2) > 150) & (face.min(axis=2) <= 220)
+    assert light.mean() > 0.002
