@@ -52,7 +52,7 @@ def main(out: Path = OUT) -> None:
     clock = SimulatedClock(1000.0)
     out.parent.mkdir(parents=True, exist_ok=True)
     part = out.with_name(out.stem + ".part.mcap")  # (the sample is replaced only by a whole recording)
-    core.start_recording(part, clock=clock, drop_when_busy=False)
+    core.recording.start(part, clock=clock, drop_when_busy=False)
     start = clock.t_s
     steps = [("pick", name) for name in FEATURES] + [("solve", False), ("solve", True), ("store", None), ("idle", None)]
     next_step = start + DRIVE_S + SETTLE_S
@@ -90,8 +90,8 @@ def main(out: Path = OUT) -> None:
                 except ConfirmationNeeded as why:
                     core.desk.store_correction(confirmation=f"sample recording: {why}")
             next_step += STEP_S
-    rec = core.recorder
-    core.stop_recording()
+    rec = core.recording.recorder
+    core.recording.stop()
     camera.close()
     part.replace(out)
     duration = clock.t_s - start

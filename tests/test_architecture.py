@@ -269,9 +269,7 @@ def _touches_the_core(source: str) -> list[int]:
 
 
 # Widgets that still reach the core through the window or hold it whole; none may join them.
-STILL_TOUCHING_THE_CORE = PANES_STILL_TAKING_THE_CORE | {
-    "file_menu.py",  # the File menu: the workspace, recordings and exports, reached through the window
-}  # fmt: skip
+STILL_TOUCHING_THE_CORE = PANES_STILL_TAKING_THE_CORE
 
 
 def test_no_widget_reaches_the_core_through_the_window():

@@ -5,6 +5,7 @@ autosave. Every action goes through the window's error boundary; one that fails 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtCore import QTimer
@@ -29,10 +30,26 @@ EXPORT_FILTERS = {
 
 
 class FileMenu:
-    """Builds ``menu`` for ``window`` (a :class:`~app.gui.main_window.MainWindow`) and handles it."""
+    """Builds ``menu`` for ``window`` (a :class:`~app.gui.main_window.MainWindow`: the dialogs' parent, its settings,
+    error boundary and replay) and handles it, given the core's parts it works on: the workspace ``files``, the cell
+    ``editor`` (Save cell), the session's ``recording``, the calibration ``session`` (what an unsaved close would
+    lose), ``revision()`` (the core's change count, for the autosave) and ``cell_folder()`` (where dialogs open)."""
 
-    def __init__(self, window, menu: QMenu):
+    def __init__(
+        self,
+        window,
+        menu: QMenu,
+        *,
+        files,
+        editor,
+        recording,
+        session,
+        revision: Callable[[], int],
+        cell_folder: Callable[[], Path],
+    ):
         self.window = window
+        self._files, self._editor, self._recording, self._session = files, editor, recording, session
+        self._revision, self._cell_folder = revision, cell_folder
         self.menu = menu
         self.autosave: Autosave | None = None
         self.restore_action: QAction | None = None
@@ -68,7 +85,7 @@ class FileMenu:
                 "Save ce&ll",
                 w,
                 shortcut=QKeySequence("Ctrl+Shift+S"),
-                triggered=lambda: w.report(w.workbench.editor.save)(),
+                triggered=lambda: w.report(self._editor.save)(),
             )
         )
         menu.addAction(
@@ -117,7 +134,7 @@ class FileMenu:
         path, _ = QFileDialog.getOpenFileName(
             self.window,
             "Open cell",
-            str(self.window.workbench.workcell.path.parent),
+            str(self._cell_folder()),
             "videocal workcell (*.yaml *.yml)",
         )
         if path:
@@ -132,7 +149,7 @@ class FileMenu:
                 f"{path}: that is the recovery folder, which holds autosaves only; save the workspace somewhere else"
             )
             return False
-        if not attempt(self.window.show_error, self.window.workbench.files.save_workspace, path):
+        if not attempt(self.window.show_error, self._files.save_workspace, path):
             return False
         self.recent.remember(path)
         self.autosave.mark_saved()
@@ -143,9 +160,7 @@ class FileMenu:
         """Open a workspace file. ``restored``: an autosave, which is no file of the operator's: it joins
         no recent list and *Save* asks where (it once wrote into the recovery folder, offered again at
         the next start as an unsaved autosave)."""
-        if not attempt(
-            self.window.show_error, lambda: self.window.workbench.files.open_workspace(path, hold=not restored)
-        ):
+        if not attempt(self.window.show_error, lambda: self._files.open_workspace(path, hold=not restored)):
             return False
         if restored:
             self.workspace_path = None
@@ -183,7 +198,7 @@ class FileMenu:
             self.window, "Export corrections", "corrections.script", ";;".join(EXPORT_FILTERS)
         )
         if path:
-            self.window.report(self.window.workbench.files.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
+            self.window.report(self._files.export_corrections)(path, EXPORT_FILTERS.get(chosen, "csv"))
 
     # --- recordings -----------------------------------------------------------------------------------
     def _open_recording_dialog(self) -> None:
@@ -197,7 +212,7 @@ class FileMenu:
 
     def _open_recording(self, path) -> None:
         w = self.window
-        if w.workbench.recorder is not None:
+        if self._recording.recorder is not None:
             raise OperatorError("stop recording before replaying a recording")
         w.replay.open(path)
         w.commands.live.setChecked(False)
@@ -208,22 +223,22 @@ class FileMenu:
         if w.replay.playback is not None:
             w.show_error("close the replay before recording: a recording records the live camera and robot")
             return
-        w.report(w.workbench.start_recording)(path, **options)
-        self.record_action.setChecked(w.workbench.recorder is not None)
-        if w.workbench.recorder is not None:
+        w.report(self._recording.start)(path, **options)
+        self.record_action.setChecked(self._recording.recorder is not None)
+        if self._recording.recorder is not None:
             self.recorder_watch.start()
 
     def stop_recording(self) -> None:
         self.recorder_watch.stop()
-        self.window.workbench.stop_recording()
+        self._recording.stop()
         self.record_action.setChecked(False)
 
     def watch_recorder(self) -> None:
         """A recorder whose disk or encoder failed has stopped: REC goes off, the operator learns why and
         may record on, as JPEG frames (no video encoder) into a new file."""
         w = self.window
-        rec = w.workbench.recorder
-        failure = w.workbench.recording_failure()
+        rec = self._recording.recorder
+        failure = self._recording.failure()
         if failure is None:
             return
         self.recorder_watch.stop()
@@ -251,11 +266,10 @@ class FileMenu:
     def start_autosave(self) -> None:
         """Autosave every minute when the session changed. Sessions that ended without saving left their
         autosave: offer each (File > Restore autosave of ...) rather than load one unasked."""
-        wb = self.window.workbench
         self.autosave = Autosave(
             self.window.settings,
-            lambda: wb.revision,
-            lambda path: wb.files.save_workspace(path, hold=False),
+            self._revision,
+            lambda path: self._files.save_workspace(path, hold=False),
             self._status,
             self.window,
         )
@@ -305,7 +319,7 @@ class FileMenu:
             return True
         if str(w.settings.value("window/ask_unsaved", "true")).lower() in ("false", "0"):
             return True
-        s = w.workbench.session
+        s = self._session
         what = (
             f"{len(s.pairs)} pairs, {sum(len(s.corrections.history(t)) for t in s.corrections.tasks())} stored "
             "corrections"

@@ -135,7 +135,17 @@ class MainWindow(QMainWindow):
         self.resize(1600, 1000)
 
     def _build_menus(self) -> None:
-        self.files = FileMenu(self, self.menuBar().addMenu("&File"))
+        wb = self.workbench
+        self.files = FileMenu(
+            self,
+            self.menuBar().addMenu("&File"),
+            files=wb.files,
+            editor=wb.editor,
+            recording=wb.recording,
+            session=wb.session,
+            revision=lambda: wb.revision,
+            cell_folder=lambda: wb.workcell.path.parent,
+        )
         self.play_action = QAction(
             "Play/pause replay", self, shortcut=QKeySequence("Ctrl+Space"), triggered=self.replay.toggle_play
         )
@@ -175,7 +185,7 @@ class MainWindow(QMainWindow):
             session=wb.session,
             picking=wb.picking,
             link=lambda: wb.link,
-            recorder=lambda: wb.recorder,
+            recording=wb.recording,
             camera_state=self._camera_state,
             parent=self,
         )

@@ -22,9 +22,9 @@ WARN = "<span style='color:#ff9a30'>{}</span>"
 
 class StatusLine:
     """The status bar's fields, given the parts they show: the ``arm`` (its motion, link state and last sample), the
-    ``session`` (its pairs, result and target), ``picking`` (the settle rule and whether a recording is replayed), and
-    callables for what comes and goes: ``link()`` (the controller's link or None), ``recorder()`` (the session
-    recorder or None) and ``camera_state()`` ``(last frame received or None, worker or None, replaying)``."""
+    ``session`` (its pairs, result and target), ``picking`` (the settle rule and whether a recording is replayed),
+    the session's ``recording`` (its recorder, while one writes), ``link()`` (the controller's link, or None) and
+    ``camera_state()`` ``(last frame received or None, worker or None, replaying)``."""
 
     def __init__(
         self,
@@ -34,12 +34,12 @@ class StatusLine:
         session,
         picking,
         link: Callable[[], object],
-        recorder: Callable[[], object],
+        recording,
         camera_state: Callable[[], tuple],
         parent,
     ) -> None:
         self._arm, self._session, self._picking = arm, session, picking
-        self._link, self._recorder = link, recorder
+        self._link, self._recording = link, recording
         self._camera_state = camera_state
         self.record_label = QLabel("")
         self.link_label = QLabel("link: not connected")
@@ -104,7 +104,7 @@ class StatusLine:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)
         self._show_settled()
-        rec = self._recorder()
+        rec = self._recording.recorder
         self.record_label.setText(
             "" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB"
         )

@@ -34,10 +34,12 @@ from calib_core.operator.moves import Moves
 from calib_core.operator.observations import Observations
 from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.picking import Picking
+from calib_core.operator.recording_tap import RecordingTap
 from calib_core.operator.replaying import Replaying
 from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.workspace_files import WorkspaceFiles
+from calib_core.operator.session_recording import SessionRecording
 from calib_core.operator.site import Site
 from calib_core.operator.task_choice import TaskChoice
 from calib_core.operator.tool_measuring import ToolMeasuring
@@ -71,8 +73,6 @@ class OperatorCore:
         self.tasks.changed.connect(self._task_chosen)  # first: the session's target and verdict follow before any view
         if self.task is not None and self.task.component:
             self.session.set_target(self.task.component)
-        self.recorder = None
-        self._tap = None
         self.revision = 0
         """Counts the changes of what a workspace holds (pairs, results, corrections, task locations, the
         target): the autosave writes only when it moved."""
@@ -98,6 +98,8 @@ class OperatorCore:
         self.finder = PointFinding(cell, self.session, self.picking, self.log)
         self.moves = Moves(cell, self.session, self.tasks, self.arm)
         self.robot_calibration = RobotCalibrating(cell, self.session, self.arm, self.log)
+        self.recording = SessionRecording(lambda recorder: RecordingTap(self, recorder), self.log)
+        """The session's recording: start, stop, the recorder writing now."""
         self.tool = ToolMeasuring(
             cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log
         )
@@ -297,51 +299,8 @@ class OperatorCore:
         cam2frame, frame = load_mounting(path)
         self.vision.apply_cam2flange(self.robot.on_flange(cam2frame, frame, str(path)), f"camera mounting from {path}")
 
-    def start_recording(self, path, **options) -> None:
-        """Record the session to ``path`` (MCAP); ``options`` go to the
-        :class:`~calib_core.recording.recorder.SessionRecorder` (``frames="jpeg"``, ``clock``...)."""
-        from calib_core.operator.recording_tap import RecordingTap
-        from calib_core.recording.recorder import SessionRecorder
-
-        self.stop_recording()
-        self.recorder = SessionRecorder(path, **options)
-        self._tap = RecordingTap(self, self.recorder)
-        self.log.say(f"recording to {path}")
-
-    def recording_failure(self) -> str | None:
-        """Poll the recorder (the window does on its status tick): when its disk or encoder failed, the
-        recording is stopped and the reason returned, once. ``None`` while all is well."""
-        rec = self.recorder
-        if rec is None or rec.failure is None:
-            return None
-        failure = rec.failure
-        self.stop_recording()
-        return failure
-
-    def stop_recording(self) -> None:
-        rec = self.recorder
-        if rec is not None:
-            self._tap.detach()
-            rec.close()
-            if rec.failure is not None:
-                self.log.say(
-                    f"recording {rec.path} stopped: {rec.failure}. The file keeps what was written before; `videocal "
-                    "recover` completes it"
-                )
-            elif not rec.finished:
-                self.log.say(f"recording {rec.path}: the file is being finished in the background")
-            else:
-                dropped = f", {rec.frames_dropped} frames dropped" if rec.frames_dropped else ""
-                self.log.say(
-                    f"recording {rec.path} closed ({rec.messages} messages, {rec.frames_written} frames{dropped})"
-                )
-        self.recorder, self._tap = None, None
-
     def close(self) -> None:
-        rec = self.recorder
-        self.stop_recording()
-        if rec is not None:
-            rec.wait_finished(5.0)  # a file finishing in the background is not cut off by the exit
+        self.recording.close(wait_s=5.0)  # a file finishing in the background is not cut off by the exit
         self.arm.close()
         self.files.release()  # the workspace file is free for another window
         if self.site is not None:

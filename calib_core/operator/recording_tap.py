@@ -39,7 +39,6 @@ class RecordingTap:
         self.recorder = recorder
         self.camera_frame = core.robot.roles.get("camera", "camera")
         recorder.camera_frame = self.camera_frame
-        core.recorder = recorder
         recorder.record_setup(
             workcell=str(core.workcell.path),
             cell=core.cell.identity.to_dict(),
@@ -67,7 +66,6 @@ class RecordingTap:
     def detach(self) -> None:
         for signal, slot in self._connections:
             signal.disconnect(slot)
-        self.core.recorder = None
 
     # --- once, at the start ----------------------------------------------------------------------
     def _record_static(self) -> None:

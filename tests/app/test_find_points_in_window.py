@@ -57,7 +57,7 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
     win = window
     wb = win.workbench
     go_to_task(qtbot, win)
-    wb.start_recording(tmp_path / "edges.mcap")
+    wb.recording.start(tmp_path / "edges.mcap")
     qtbot.keyClick(win, Qt.Key.Key_F6)
     qtbot.waitUntil(lambda: win.finder.dialog is not None and win.finder.dialog.isVisible(), timeout=20_000)
     assert win.finder.dialog.edges_button.isEnabled()
@@ -66,7 +66,7 @@ def test_calibrate_on_edges_from_the_list_is_recorded_and_replay_skips_it(qtbot,
     assert result is not None and result.solution.method == "edges" and "OK" in win.results.verdict.text()
     assert "edge samples" in win.results.details.text()
     found = win.finder.dialog.found
-    wb.stop_recording()
+    wb.recording.stop()
     from foxglove_schemas_protobuf.ImageAnnotations_pb2 import ImageAnnotations
 
     from calib_core.recording.reader import read_recording

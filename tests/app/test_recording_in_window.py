@@ -22,13 +22,17 @@ def test_a_full_disk_stops_rec_and_the_operator_records_on_as_jpeg(qtbot, window
     assert "No space left on device" in answered[0] and "session-jpeg.mcap" in answered[0]
     assert "No space left on device" in win.results.status.text()
     again = tmp_path / "session-jpeg.mcap"
-    qtbot.waitUntil(lambda: win.workbench.recorder is not None and win.workbench.recorder.path == again, timeout=5_000)
-    assert win.files.record_action.isChecked() and win.workbench.recorder.frames == "jpeg"
     qtbot.waitUntil(
-        lambda: win.workbench.recorder.messages > 0 and win.workbench.recorder.frames_written > 0, timeout=20_000
+        lambda: win.workbench.recording.recorder is not None and win.workbench.recording.recorder.path == again,
+        timeout=5_000,
+    )
+    assert win.files.record_action.isChecked() and win.workbench.recording.recorder.frames == "jpeg"
+    qtbot.waitUntil(
+        lambda: win.workbench.recording.recorder.messages > 0 and win.workbench.recording.recorder.frames_written > 0,
+        timeout=20_000,
     )
     win.files.stop_recording()
-    assert win.workbench.recorder is None and not win.files.record_action.isChecked()
+    assert win.workbench.recording.recorder is None and not win.files.record_action.isChecked()
     contents = read_recording(again)
     assert contents.complete and contents.topic(FRAME_TOPIC)
 
@@ -40,7 +44,7 @@ def test_declining_leaves_rec_off_and_the_window_working(qtbot, window, tmp_path
     win.files.start_recording(full)
     answered = answer_next_question(qtbot, "Cancel")
     qtbot.waitUntil(lambda: bool(answered), timeout=20_000)
-    assert win.workbench.recorder is None and not win.files.record_action.isChecked()
+    assert win.workbench.recording.recorder is None and not win.files.record_action.isChecked()
     win.status_line.update()
     assert win.status_line.record_label.text() == ""  # no REC lit for a recorder that stopped
 

@@ -159,12 +159,12 @@ def test_a_replayed_session_solves_with_its_recorded_joints(qtbot, window, tmp_p
     win, wb = window, window.workbench
     _go(qtbot, win, win.commands.go_task)
     win.files.start_recording(tmp_path / "s.mcap")
-    qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # joint samples and frames flow in
+    qtbot.waitUntil(lambda: wb.recording.recorder.messages > 20, timeout=10_000)  # joint samples and frames flow in
     _pick_features(qtbot, win)
     qtbot.keyClick(win, Qt.Key.Key_F5)
     live = wb.session.result.estimate.displacement_mm.copy()
-    done = wb.recorder.messages
-    qtbot.waitUntil(lambda: wb.recorder.messages > done + 20, timeout=10_000)
+    done = wb.recording.recorder.messages
+    qtbot.waitUntil(lambda: wb.recording.recorder.messages > done + 20, timeout=10_000)
     win.files.stop_recording()
     win.camera.freeze.setChecked(False)
     wb.moves.move_joints(wb.cell.home_joints, "home", confirmed=True)

@@ -34,7 +34,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
     wb.picking.pick_model_point("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
     wb.picking.pick_image_point((100.0, 120.0))
     qtbot.keyClick(win, Qt.Key.Key_Return, Qt.KeyboardModifier.ControlModifier)  # Accept
-    qtbot.waitUntil(lambda: wb.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
+    qtbot.waitUntil(lambda: wb.recording.recorder.messages > 20, timeout=10_000)  # frames and joints flow in
 
     def recording_shown() -> bool:  # the status line the window's timer refreshes
         win._update_status()
@@ -137,4 +137,4 @@ def test_a_folder_that_cannot_be_written_is_one_line_naming_it(qtbot, window, tm
     qtbot.waitUntil(lambda: asked == ["Record session"] and not win.files.record_action.isChecked())
     shown = win.results.status.text()
     assert str(blocked / "session.mcap") in shown and "internal error" not in shown, shown
-    assert wb.recorder is None and blocked.read_text() == "a file"
+    assert wb.recording.recorder is None and blocked.read_text() == "a file"

@@ -40,7 +40,7 @@ def recorded(tmp_path_factory):
     cell, site = simulated_cell(image_scale=0.5)
     core = OperatorCore(cell, site)
     path = tmp_path_factory.mktemp("tap") / "session.mcap"
-    core.start_recording(path)
+    core.recording.start(path)
     q = task_joints(core)
     # still elsewhere, then a move, then still at q; stamped after the recording's start, as a live session is
     t = still_for(core, 0.4, joints_deg=q - 2.0, start_s=time.monotonic() + 1.0)
@@ -53,7 +53,7 @@ def recorded(tmp_path_factory):
     solution = core.session.result.estimate.solution
     points_obj, _, numbers = core.session.pairs.arrays()
     obj2world = core.workcell.component(core.session.target).item2world
-    core.stop_recording()
+    core.recording.stop()
     return core, read_recording(path), q, solution, apply(invert(obj2world), points_obj), numbers
 
 

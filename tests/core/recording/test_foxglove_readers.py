@@ -63,7 +63,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     cell, site = simulated_cell(image_scale=0.5)
     core = OperatorCore(cell, site)
     path = tmp_path / "fresh.mcap"
-    core.start_recording(path)
+    core.recording.start(path)
     q = task_joints(core)
     still_for(core, 1.0, joints_deg=q)
     for k in range(3):
@@ -72,7 +72,7 @@ def test_a_fresh_recording_through_the_core_opens_indexed_and_decodes(tmp_path):
     assert not core.finder.find_points().result.found  # a flat grey frame: recorded all the same
     core.picking.calibrate()
     core.desk.store_correction(convert="a test: the approach's look stands for the task", confirmation="test")
-    core.stop_recording()
+    core.recording.stop()
     (result,) = _read_indexed(path)
     _agrees_with_ours(result, path)
     assert (
