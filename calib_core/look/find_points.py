@@ -21,7 +21,7 @@ The result never moves anything: the operator accepts, rejects or drags the prop
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 import trimesh
@@ -35,6 +35,7 @@ from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge
 from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
+from calib_core.look.found_points import FoundPoints, Missed, Proposal
 from calib_core.look.coarse_to_fine import coarse_fit, fit_starts
 from calib_core.look.image_evidence import ImageEvidence
 from calib_core.look.in_view import MIN_SHOWN_SAMPLES, hidden_in_view, share_in_view
@@ -60,49 +61,6 @@ _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put 
 _MATCHED_SHARE = (
     0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 )
-
-
-@dataclass(frozen=True)
-class Proposal:
-    """A feature found: ``uv_px`` (2,) px, ``point_mm`` (3,) in the component's frame, ``confidence``
-    in [0, 1] (the detector's, times 1 when the final pose fit keeps it), ``residual_px`` its distance
-    from the final pose's projection."""
-
-    feature: str
-    kind: str
-    uv_px: np.ndarray
-    point_mm: np.ndarray
-    confidence: float
-    residual_px: float
-    why: str = ""
-    """What made the detector unsure, when its confidence is below one half (empty otherwise)."""
-
-
-@dataclass(frozen=True)
-class Missed:
-    feature: str
-    reason: str
-
-
-@dataclass(frozen=True)
-class FoundPoints:
-    """``found``: the target was located and at least four features proposed; ``message`` says what
-    happened in a sentence; ``offset_px`` (2,) the shift between model and image; ``obj2cam`` (4, 4)
-    the robust fit's pose (``None`` when not found); ``seconds`` the time taken."""
-
-    component: str
-    found: bool
-    message: str
-    proposals: tuple[Proposal, ...] = ()
-    missed: tuple[Missed, ...] = ()
-    offset_px: np.ndarray = field(default_factory=lambda: np.zeros(2))
-    obj2cam: np.ndarray | None = None
-    seconds: float = 0.0
-    edges: EdgeFit | None = None
-    """The edge refinement's result (the pose the detections were checked against), when it ran."""
-    edge_seconds: float = 0.0
-    """The time the edges took: the search for where to start, the refinement, its second pass and its
-    check from the features' pose (s)."""
 
 
 def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> np.ndarray:
@@ -192,7 +150,6 @@ def find_points(
     if not names:
         return FoundPoints(item.name, False, f"component {item.name!r} has no features to find")
     evidence = ImageEvidence.of(image)
-    grey = evidence.grey
     points = np.array([item.features[n] for n in names], dtype=float)
     uv_model = project_points(points, obj2cam_model, intrinsics)
     radius_px = search_radius_px(item.mesh.vertices, obj2cam_model, intrinsics, reach_mm, reach_deg)
@@ -206,18 +163,7 @@ def find_points(
     # edges of colour as well as of lightness (an orange top on a tan table has one grey)
     distance = evidence.edge_distance(EDGE_TRUNCATE_PX)
     detectors = TargetDetectors(evidence, item, intrinsics, expected)
-
-    def detect_all(indices, pose, radius):
-        return {i: detectors.detect(kinds.get(names[i], CORNER), points[i], pose, radius) for i in indices}
-
     candidates = [i for i in range(len(names)) if visible[i]]
-    # Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error
-    # moves near and far edges differently: no 2D shift lays them all on the image); from the best few,
-    # in turn until one settles with most of its samples on their edges, the edges pull the pose into
-    # place. The fit with the most samples on their edges runs again from where it got to, with the
-    # model's view and the samples taken afresh there (from a turned start a pin seen end-on can lock
-    # its rims onto each other: 16 mrad of tilt at 0.37 px, which the second pass leaves for the right
-    # pose at 0.13 px).
     t_edges = time.perf_counter()
     samples, _, _, _ = edge_points(
         item.mesh,
@@ -243,86 +189,39 @@ def find_points(
     centre = item.mesh.vertices.mean(axis=0)[None]
     shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     colour = evidence.colour if by_colour else None
-    bins = evidence.colour_bins if colour is not None else None
-
-    def refined(start_pose: np.ndarray) -> EdgeFit:
-        fit = refine_to_edges(
-            grey,
-            intrinsics,
-            item.mesh,
-            start_pose,
-            expected_magnitude=detectors.expected_magnitude(start_pose) if expected is not None else None,
-            magnitude=detectors.magnitude,
-            rms_bound_px=edge_rms_px,
-            colour=colour,
-            prior=prior,
-            colour_bins=bins,
-        )
-        return replace(fit, min_share=_FIT_SHARE)  # settled only on more than half its edges: proposals follow from it
-
-    best = None
-    for start_pose, coarse in fit_starts(obj2cam_model, ranked, prior is not None):
-        fit = refined(coarse_fit(evidence, intrinsics, item.mesh, start_pose, colour, prior) if coarse else start_pose)
-        if best is None or _fit_rank(fit) > _fit_rank(best):
-            best = fit
-        if best.settled and best.inlier_share >= _CLEAR_SHARE:
-            break
-    again = refined(best.obj2cam)  # the second pass, for the best start only
-    edge_fit = again if again.settled or _fit_rank(again) > _fit_rank(best) else best
+    fitting = _Fitting(
+        evidence,
+        intrinsics,
+        item.mesh,
+        detectors,
+        expected is not None,
+        edge_rms_px,
+        colour,
+        prior,
+        evidence.colour_bins if colour is not None else None,
+    )
+    edge_fit = _best_settled_fit(fitting, obj2cam_model, ranked, prior is not None)
     edge_seconds = time.perf_counter() - t_edges
     if not edge_fit.settled:
         # Not there, or the edges did not settle: detections in wide windows would lock onto neighbouring
         # edges, and a wrong proposal costs the operator more than a pick by hand.
-        share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
-        if share < _MATCHED_SHARE:
-            message = (
-                f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet "
-                "an edge of the image): "
-                "pick the points by hand"
-            )
-        else:
-            message = (
-                f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, "
-                f"{100 * edge_fit.inlier_share:.0f} % of "
-                f"{edge_fit.samples} edge samples on their edges): pick the points by hand"
-            )
         return FoundPoints(
             item.name,
             False,
-            message,
+            _unsettled_message(item, edge_fit, distance, intrinsics),
             missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names),
             offset_px=shift,
             seconds=time.perf_counter() - t0,
             edges=edge_fit,
             edge_seconds=edge_seconds,
         )
-    start = edge_fit.obj2cam
-    # The detectors measure against the model's view at the pose they predict from; the second pass's
-    # view serves when its fit moved the target less than _REUSE_PX from there (a render saved: a
-    # quarter of the time close up).
-    shown = detectors.rendered_pose()
-    if (
-        expected is not None
-        and shown is not None
-        and _moved_px(np.vstack([points, detectors.box_corners]), shown, start, intrinsics) < _REUSE_PX
-    ):
-        start = shown
+    start = _detection_start(detectors, expected is not None, points, edge_fit.obj2cam, intrinsics)
     # after the edges, each feature is within a few tenths of a pixel of its prediction: a window of three
     # times the edges' scatter keeps a detector off the neighbouring edge (a boss's base beside its rim)
-    first = detect_all(candidates, start, float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0)))
+    radius = float(np.clip(3.0 * edge_fit.sigma_px, 1.0, 3.0))
+    first = {i: detectors.detect(kinds.get(names[i], CORNER), points[i], start, radius) for i in candidates}
     if edge_fit.converged:
-        # The edges (hundreds of samples) know the pose better than any one detection: a detection far
-        # from where they put its feature found something else (a silhouette in front of a corner).
-        # (within the edges' own scatter too: a photographed box's rounded corners sit 1.5-4.5 px from its edges' lines)
-        uv_edges = project_points(points, edge_fit.obj2cam, intrinsics)
-        agreement = max(_EDGE_AGREEMENT_PX, 2.0 * edge_fit.sigma_px)
-        for i, d in list(first.items()):
-            if isinstance(d, Detection) and np.linalg.norm(d.uv_px - uv_edges[i]) > agreement:
-                first[i] = NotDetected(
-                    f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's "
-                    "edges put it "
-                    "(another edge in front of it?)"
-                )
+        first = _agreeing_with_edges(first, points, edge_fit, intrinsics)
     pose, fit = _robust_fit(first, points, intrinsics, start)
     if pose is not None and _moved_px(points, pose, edge_fit.obj2cam, intrinsics) > _AGREE_PX:
         # The edges can settle where every feature still passes the 1 px gate and yet off the pose the
@@ -331,22 +230,7 @@ def find_points(
         # again from there, and the fit with more samples on their edges is kept. Where the two poses
         # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
-        across = replace(
-            refine_to_edges(
-                grey,
-                intrinsics,
-                item.mesh,
-                pose,
-                expected_magnitude=detectors.expected_magnitude(start) if expected is not None else None,
-                magnitude=detectors.magnitude,
-                search_px=_RECHECK_SEARCH_PX,
-                rms_bound_px=edge_rms_px,
-                colour=colour,
-                prior=prior,
-                colour_bins=bins,
-            ),
-            min_share=_FIT_SHARE,
-        )
+        across = fitting.refine(pose, search_px=_RECHECK_SEARCH_PX, shown_at=start)
         if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
             edge_fit = across
         edge_seconds += time.perf_counter() - t_across
@@ -365,22 +249,7 @@ def find_points(
             edges=edge_fit,
             edge_seconds=edge_seconds,
         )
-    final_pose, second = pose, first
-    proposals = []
-    uv_final = project_points(points, final_pose, intrinsics)
-    for i, d in second.items():
-        if isinstance(d, NotDetected):
-            missed[names[i]] = d.reason
-            continue
-        residual = float(np.linalg.norm(d.uv_px - uv_final[i]))
-        if not fit.get(i, False):
-            missed[names[i]] = f"rejected by the pose fit: {residual:.1f} px from where the other features put it"
-            continue
-        proposals.append(
-            Proposal(
-                names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual, d.why
-            )
-        )
+    proposals = _proposals(first, fit, pose, names, points, kinds, intrinsics, missed)
     found = len(proposals) >= 4
     message = (
         f"{len(proposals)} of {len(names)} features of {item.name} found"
@@ -395,11 +264,148 @@ def find_points(
         tuple(proposals),
         tuple(Missed(n, r) for n, r in missed.items()),
         shift,
-        final_pose if found else None,
+        pose if found else None,
         time.perf_counter() - t0,
         edge_fit,
         edge_seconds,
     )
+
+
+@dataclass(frozen=True)
+class _Fitting:
+    """What every edge fit of one look shares: the image's evidence, the camera, the target's mesh, its detectors
+    (with a model's view, ``has_view``, theirs leaves out edges without contrast), the settle bound, the colours (the
+    outline by colour) and the prior."""
+
+    evidence: ImageEvidence
+    intrinsics: Intrinsics
+    mesh: trimesh.Trimesh
+    detectors: TargetDetectors
+    has_view: bool
+    rms_bound_px: float
+    colour: np.ndarray | None
+    prior: PosePrior | None
+    colour_bins: np.ndarray | None
+
+    def refine(
+        self, start: np.ndarray, *, search_px: float | None = None, shown_at: np.ndarray | None = None
+    ) -> EdgeFit:
+        """The edges refined from ``start`` (4, 4), leaving out those without contrast in the model's view at
+        ``shown_at`` (default ``start``); settled only on more than :data:`_FIT_SHARE` of its samples (proposals
+        follow from it)."""
+        shown = start if shown_at is None else shown_at
+        fit = refine_to_edges(
+            self.evidence.grey,
+            self.intrinsics,
+            self.mesh,
+            start,
+            expected_magnitude=self.detectors.expected_magnitude(shown) if self.has_view else None,
+            magnitude=self.detectors.magnitude,
+            rms_bound_px=self.rms_bound_px,
+            colour=self.colour,
+            prior=self.prior,
+            colour_bins=self.colour_bins,
+            **({} if search_px is None else {"search_px": search_px}),
+        )
+        return replace(fit, min_share=_FIT_SHARE)
+
+
+def _best_settled_fit(fitting: _Fitting, obj2cam_model: np.ndarray, ranked: list, has_prior: bool) -> EdgeFit:
+    """Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error moves near
+    and far edges differently: no 2D shift lays them all on the image); from the best few, in turn until one settles
+    with most of its samples on their edges, the edges pull the pose into place. The fit with the most samples on
+    their edges runs again from where it got to, with the model's view and the samples taken afresh there (from a
+    turned start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px, which the second
+    pass leaves for the right pose at 0.13 px)."""
+    best = None
+    for start_pose, coarse in fit_starts(obj2cam_model, ranked, has_prior):
+        if coarse:
+            start_pose = coarse_fit(
+                fitting.evidence, fitting.intrinsics, fitting.mesh, start_pose, fitting.colour, fitting.prior
+            )
+        fit = fitting.refine(start_pose)
+        if best is None or _fit_rank(fit) > _fit_rank(best):
+            best = fit
+        if best.settled and best.inlier_share >= _CLEAR_SHARE:
+            break
+    again = fitting.refine(best.obj2cam)  # the second pass, for the best start only
+    return again if again.settled or _fit_rank(again) > _fit_rank(best) else best
+
+
+def _unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, intrinsics: Intrinsics) -> str:
+    """Why nothing is proposed: the target is not where the model puts it, or its edges did not settle."""
+    share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
+    if share < _MATCHED_SHARE:
+        return (
+            f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an "
+            "edge of the image): pick the points by hand"
+        )
+    return (
+        f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, "
+        f"{100 * edge_fit.inlier_share:.0f} % of {edge_fit.samples} edge samples on their edges): pick the points by "
+        "hand"
+    )
+
+
+def _detection_start(
+    detectors: TargetDetectors, has_view: bool, points: np.ndarray, fitted: np.ndarray, intrinsics: Intrinsics
+) -> np.ndarray:
+    """The pose the detectors measure from: the edges' ``fitted`` one, or the pose of the model's view they last
+    rendered when it lies within :data:`_REUSE_PX` of it (a render saved: a quarter of the time close up)."""
+    shown = detectors.rendered_pose()
+    if (
+        has_view
+        and shown is not None
+        and _moved_px(np.vstack([points, detectors.box_corners]), shown, fitted, intrinsics) < _REUSE_PX
+    ):
+        return shown
+    return fitted
+
+
+def _agreeing_with_edges(detections: dict, points: np.ndarray, edge_fit: EdgeFit, intrinsics: Intrinsics) -> dict:
+    """``detections`` with those far from where the edges put their feature not detected. The edges (hundreds of
+    samples) know the pose better than any one detection: a detection far from them found something else (a
+    silhouette in front of a corner); within the edges' own scatter too (a photographed box's rounded corners sit
+    1.5-4.5 px from its edges' lines)."""
+    uv_edges = project_points(points, edge_fit.obj2cam, intrinsics)
+    agreement = max(_EDGE_AGREEMENT_PX, 2.0 * edge_fit.sigma_px)
+    out = dict(detections)
+    for i, d in detections.items():
+        if isinstance(d, Detection) and np.linalg.norm(d.uv_px - uv_edges[i]) > agreement:
+            out[i] = NotDetected(
+                f"what was detected lies {np.linalg.norm(d.uv_px - uv_edges[i]):.1f} px from where the target's edges "
+                "put it (another edge in front of it?)"
+            )
+    return out
+
+
+def _proposals(
+    detections: dict,
+    kept: dict[int, bool],
+    pose: np.ndarray,
+    names: list[str],
+    points: np.ndarray,
+    kinds: dict[str, FeatureKind],
+    intrinsics: Intrinsics,
+    missed: dict[str, str],
+) -> list[Proposal]:
+    """The detections the robust fit at ``pose`` kept, as proposals; the others' reasons added to ``missed``."""
+    proposals = []
+    uv_final = project_points(points, pose, intrinsics)
+    for i, d in detections.items():
+        if isinstance(d, NotDetected):
+            missed[names[i]] = d.reason
+            continue
+        residual = float(np.linalg.norm(d.uv_px - uv_final[i]))
+        if not kept.get(i, False):
+            missed[names[i]] = f"rejected by the pose fit: {residual:.1f} px from where the other features put it"
+            continue
+        proposals.append(
+            Proposal(
+                names[i], kinds.get(names[i], CORNER).kind, d.uv_px, points[i].copy(), d.confidence, residual, d.why
+            )
+        )
+    return proposals
 
 
 def _moved_px(points_mm: np.ndarray, a: np.ndarray, b: np.ndarray, intrinsics: Intrinsics) -> float:

@@ -18,7 +18,8 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.scene import SceneItem
 from calib_core.solver import solve_pose
-from calib_core.look.find_points import REACH_DEG, REACH_MM, FoundPoints, find_points
+from calib_core.look.find_points import REACH_DEG, REACH_MM, find_points
+from calib_core.look.found_points import FoundPoints
 from calib_core.look.image_evidence import ImageEvidence
 from calib_core.look.located import Located, LocatedFeature
 from calib_core.look.pose_prior import PosePrior

@@ -26,7 +26,7 @@ from calib_core.operator.operator_log import OperatorLog
 from calib_core.operator.picking import Picking
 
 if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
-    from calib_core.look.find_points import FoundPoints
+    from calib_core.look.found_points import FoundPoints
 
 
 @dataclass(frozen=True)
