@@ -68,6 +68,20 @@ def visible_segments(mesh, obj2cam: np.ndarray, silhouette: np.ndarray | None = 
 _CHAIN_TURN_DEG = 35.0
 
 
+def _same_points(ends: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For integer points (n, 3): each one's number among the distinct points (n,), in lexicographic order, and how
+    many times each distinct point occurs, as ``np.unique(ends, axis=0, return_inverse=True, return_counts=True)``
+    gives them. Within 2 m (in um) each point packs into one integer whose order is the rows' (a unique of rows
+    sorts them as raw bytes, 1.5 ms for a scanned mesh's rim, a sixth of a resampling)."""
+    shifted = ends - ends.min(axis=0)
+    if len(ends) and int(shifted.max()) < 1 << 21:
+        keys = (shifted[:, 0] << 42) | (shifted[:, 1] << 21) | shifted[:, 2]
+        _, point, counts = np.unique(keys, return_inverse=True, return_counts=True)
+    else:
+        _, point, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+    return point.ravel(), counts
+
+
 def edge_chains(seg: np.ndarray) -> np.ndarray:
     """One chain number (E,) per segment (E, 2, 3): segments joined end to end where exactly two meet
     and turn by less than 35 deg (a rim's facets make one chain; a plate's edges meet at corners and
@@ -80,8 +94,7 @@ def edge_chains(seg: np.ndarray) -> np.ndarray:
     if n == 0:
         return np.zeros(0, dtype=int)
     ends = np.round(seg * 1000.0).astype(np.int64).reshape(-1, 3)  # to 1 um; slot i is segment i // 2, end i % 2
-    _, point, counts = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
-    point = point.ravel()
+    point, counts = _same_points(ends)
     shared = np.flatnonzero(counts[point] == 2)  # the ends where exactly two segments meet
     shared = shared[np.argsort(point[shared], kind="stable")]
     first, second = shared[0::2], shared[1::2]

@@ -35,3 +35,16 @@ def test_the_chained_scatter_grows_with_a_shared_error_and_never_falls_below_the
     grown = clustered_scatter(J, shared, chain, independent)
     assert np.trace(grown) > 5 * np.trace(independent)
     assert np.linalg.eigvalsh(grown - independent).min() > -1e-9 * np.trace(grown)
+
+
+def test_a_part_metres_across_chains_as_the_same_part_small():
+    # (points within 2 m are told apart by one packed integer, beyond by their rows: the same chains either way)
+    for scale in (1.0, 100.0):  # a 4 m box and a 10 m cylinder at 100 x
+        box_segments, _ = crease_segments(trimesh.creation.box((40.0 * scale, 30.0 * scale, 10.0 * scale)))
+        assert len(np.unique(edge_chains(box_segments))) == 12
+        cylinder = trimesh.creation.cylinder(radius=5.0 * scale, height=8.0 * scale, sections=32)
+        segments, _ = crease_segments(cylinder)
+        chains = edge_chains(segments)
+        for z in (-4.0 * scale, 4.0 * scale):
+            rim = np.flatnonzero(np.isclose(segments[:, :, 2], z).all(axis=1))
+            assert len(rim) == 32 and len(np.unique(chains[rim])) == 1

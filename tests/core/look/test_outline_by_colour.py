@@ -90,3 +90,25 @@ def test_an_occluder_over_a_third_of_the_outline_does_not_pull_the_fit(scene, co
     located = locate(image, CAMERA, mesh, _prior(1), reach_mm=10.0, reach_deg=3.0, features={})
     assert located.status == "ok", located.message
     assert mspd(located.obj2cam, TRUTH, np.asarray(mesh.vertices), IDENTITY, CAMERA) < 2.0
+
+
+@pytest.mark.parametrize("subdivisions", [2, 5])
+def test_a_sphere_s_silhouette_is_the_disc_its_tangent_cone_cuts(subdivisions):
+    """Known answer: a sphere of radius r at distance d fills a disc of radius f r / sqrt(d^2 - r^2) px, whether its
+    facets are filled one by one (a coarse sphere) or set as their corners' pixels (a fine, scanned-like one: 10k
+    faces under 2 px^2 each)."""
+    import trimesh
+
+    from calib_core.camera.intrinsics import Intrinsics
+
+    camera = Intrinsics(800.0, 800.0, 320.0, 240.0, 640, 480)
+    sphere = trimesh.creation.icosphere(subdivisions=subdivisions, radius=40.0)
+    obj2cam = np.eye(4)
+    obj2cam[:3, 3] = (15.0, -10.0, 600.0)
+    mask, (u0, v0) = silhouette_mask(sphere, obj2cam, camera)
+    radius_px = 800.0 * 40.0 / np.sqrt(600.0**2 + 15.0**2 + 10.0**2 - 40.0**2)
+    area = float((mask > 0).sum())
+    assert area == pytest.approx(np.pi * radius_px**2, rel=0.04)
+    rows, cols = np.nonzero(mask)
+    centre = np.array([cols.mean() + u0, rows.mean() + v0])
+    np.testing.assert_allclose(centre, [320.0 + 800.0 * 15.0 / 600.0, 240.0 - 800.0 * 10.0 / 600.0], atol=1.0)
