@@ -124,10 +124,13 @@ def rank_starts(
     # the unmoved pose wins a tie
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []
+    chosen_seen = np.empty((keep,) + uv.shape[1:])  # where each chosen one puts the samples (keep, m, 2)
     order = np.argsort(cost, axis=None, kind="stable")
     for i, s in zip(*np.unravel_index(order[: 50 * keep], cost.shape)):
         seen = uv[i] + offsets[s]
-        if all(np.nanmean(np.linalg.norm(seen - (uv[j] + offsets[k]), axis=1)) > _DISTINCT_PX for j, k in chosen):
+        apart = np.nanmean(np.linalg.norm(seen - chosen_seen[: len(chosen)], axis=2), axis=1)
+        if (apart > _DISTINCT_PX).all():
+            chosen_seen[len(chosen)] = seen
             chosen.append((int(i), int(s)))
         if len(chosen) == keep:
             break
