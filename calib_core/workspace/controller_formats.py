@@ -1,14 +1,6 @@
-"""Corrected task locations in the conventions of the controllers people have.
-
-Each writer takes poses in the cell's ``base`` frame (4, 4, mm) and prints them as the vendor's
-language declares a Cartesian target:
-
-- Universal Robots URScript: ``p[x, y, z, rx, ry, rz]``, metres and a rotation vector in radians;
-- ABB RAPID: ``robtarget`` ``[[x, y, z], [q1, q2, q3, q4], conf, extax]``, mm and a unit quaternion,
-  scalar first;
-- KUKA KRL: ``FRAME {X, Y, Z, A, B, C}``, mm and degrees, ``R = Rz(A) Ry(B) Rx(C)``;
-- FANUC TP: a position ``(X, Y, Z, W, P, R)``, mm and degrees, ``R = Rz(R) Ry(P) Rx(W)``;
-- COMAU PDL2: ``POS(x, y, z, e1, e2, e3, '')``, mm and Euler ZYZ degrees.
+"""Corrected task locations as listings for the controllers people have: a URScript, a RAPID module, a KRL data
+list, a FANUC TP program, a PDL2 program, each target written as the vendor's language declares a Cartesian pose
+(:mod:`calib_core.workspace.vendor_poses`).
 
 A pose alone does not fix the arm's configuration. Given the cell's robot, each target carries the one the arm takes
 there (:mod:`calib_core.workspace.arm_configuration`: IK from the joints the look was made at): ABB ``confdata``,
@@ -24,12 +16,10 @@ from __future__ import annotations
 
 import re
 import time
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from calib_core.calibration.corrections import CorrectionTable
 from calib_core.workspace.arm_configuration import (
@@ -42,6 +32,14 @@ from calib_core.workspace.arm_configuration import (
 from calib_core.errors import VideocalError
 from calib_core.names import InvalidNameError, check_name
 from calib_core.workcell.model import TaskLocation
+from calib_core.workspace.vendor_poses import (
+    fanuc_position,
+    krl_frame,
+    pdl2_pos,
+    rapid_robtarget,
+    rapid_tooldata,
+    urscript_pose,
+)
 
 
 def unique_identifiers(names: list[str], max_len: int, suffix: str = "_c") -> dict[str, str]:
@@ -70,60 +68,6 @@ def _remark(name: str) -> str:
     """A checked name as it may stand in any listing's comment: characters that end a comment or a
     line in some language (``;`` in FANUC TP, quotes) become ``_``."""
     return "".join(c if (c.isalnum() and c.isascii()) or c in " _-." else "_" for c in name)
-
-
-def urscript_pose(T: np.ndarray) -> str:
-    x, y, z = T[:3, 3] / 1000.0
-    rx, ry, rz = Rotation.from_matrix(T[:3, :3]).as_rotvec()
-    return f"p[{x:.6f}, {y:.6f}, {z:.6f}, {rx:.6f}, {ry:.6f}, {rz:.6f}]"
-
-
-def rapid_pose(T: np.ndarray) -> str:
-    """RAPID's ``pose``: ``[[x, y, z], [q1, q2, q3, q4]]``, mm and a unit quaternion, scalar first."""
-    x, y, z = T[:3, 3]
-    qx, qy, qz, qw = Rotation.from_matrix(T[:3, :3]).as_quat()
-    if qw < 0:  # the same rotation; RAPID's examples keep q1 >= 0
-        qw, qx, qy, qz = -qw, -qx, -qy, -qz
-    return f"[[{x:.3f},{y:.3f},{z:.3f}],[{qw:.8f},{qx:.8f},{qy:.8f},{qz:.8f}]]"
-
-
-def rapid_robtarget(T: np.ndarray, confdata: tuple[int, int, int, int] = (0, 0, 0, 0)) -> str:
-    return f"[{rapid_pose(T)[1:-1]},[{','.join(str(int(v)) for v in confdata)}],[9E9,9E9,9E9,9E9,9E9,9E9]]"
-
-
-def rapid_tooldata(tcp2flange: np.ndarray) -> str:
-    """RAPID's ``tooldata`` held by the robot (``robhold`` TRUE): the TCP frame on the flange, and tool0's own load
-    (0.001 kg at [0, 0, 0.001]): the tool's mass is not something a camera measures."""
-    return f"[TRUE,{rapid_pose(tcp2flange)},[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]"
-
-
-def krl_frame(T: np.ndarray, status_turn: tuple[int, int] | None = None) -> str:
-    """KRL's ``FRAME`` ``{X, Y, Z, A, B, C}``; with ``status_turn`` a ``POS`` (``..., S s, T t}``)."""
-    x, y, z = T[:3, 3]
-    with warnings.catch_warnings():
-        # B = +-90 deg (a tool turned square): A and C are not unique; scipy's choice gives the same rotation
-        warnings.simplefilter("ignore", UserWarning)
-        a, b, c = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
-    st = "" if status_turn is None else f",S {status_turn[0]},T {status_turn[1]}"
-    return f"{{X {x:.3f},Y {y:.3f},Z {z:.3f},A {a:.4f},B {b:.4f},C {c:.4f}{st}}}"
-
-
-def fanuc_position(T: np.ndarray) -> tuple[float, ...]:
-    """(X, Y, Z, W, P, R): mm and degrees."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)  # P = +-90 deg: W and R not unique, the rotation is
-        w, p, r = Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)
-    x, y, z = T[:3, 3]
-    return float(x), float(y), float(z), float(w), float(p), float(r)
-
-
-def pdl2_pos(T: np.ndarray) -> str:
-    x, y, z = T[:3, 3]
-    with warnings.catch_warnings():
-        # e2 = 0 or 180 deg: e1 and e3 are not unique; scipy's choice gives the same rotation
-        warnings.simplefilter("ignore", UserWarning)
-        e = Rotation.from_matrix(T[:3, :3]).as_euler("ZYZ", degrees=True)
-    return f"POS({x:.3f}, {y:.3f}, {z:.3f}, {e[0]:.4f}, {e[1]:.4f}, {e[2]:.4f}, '')"
 
 
 @dataclass(frozen=True)

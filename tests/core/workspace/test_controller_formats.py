@@ -14,14 +14,8 @@ from scipy.spatial.transform import Rotation
 from calib_core.calibration.corrections import Correction, CorrectionTable
 from calib_core.frames import make_transform, transform_from_xyz_rpy
 from calib_core.workcell.model import TaskLocation
-from calib_core.workspace.controller_formats import (
-    controller_listing,
-    fanuc_position,
-    krl_frame,
-    rapid_robtarget,
-    unique_identifiers,
-    urscript_pose,
-)
+from calib_core.workspace.controller_formats import controller_listing, unique_identifiers
+from calib_core.workspace.vendor_poses import fanuc_position, krl_frame, rapid_robtarget, urscript_pose
 from calib_core.workspace.exports import CSV_COLUMNS, corrections_csv, corrections_json
 
 RNG = np.random.default_rng(3)
