@@ -19,7 +19,7 @@ def _look_rows(seed: int) -> list[str]:
     """One look at the paper's task location on the calibrated model, as ``videocal demo --cold`` makes
     it (the tool measured at the other fixtures), from the task location itself and from its approach."""
     from calib_core.calibration.look_fusion import tcp_covariance_from_camera
-    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
     from videocal_sim.cold_cell import cold_test_bed
     from calib_core.workcell import load_workcell
 
@@ -28,7 +28,7 @@ def _look_rows(seed: int) -> list[str]:
     bed, _ = cold_test_bed(seed=seed)
 
     def model_covariance(q):
-        return tcp_covariance_from_camera(pose_covariance(run.result, q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
+        return tcp_covariance_from_camera(run.result.pose_covariance(q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
 
     rows = []
     for where in ("task", "approach"):

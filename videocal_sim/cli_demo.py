@@ -161,10 +161,10 @@ def _cold(args: argparse.Namespace) -> int:
 
     bed, _ = cold_test_bed(seed=0)
     from calib_core.calibration.look_fusion import tcp_covariance_from_camera
-    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+    from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 
     def model_covariance(q):
-        return tcp_covariance_from_camera(pose_covariance(run.result, q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
+        return tcp_covariance_from_camera(run.result.pose_covariance(q), run.robot.fk(q, "camera"), run.tool.tcp2cam)
 
     look = look_at_task(
         bed,

@@ -13,7 +13,8 @@ from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics_io import load_intrinsics
 from calib_core.frames import concat, invert, pose_difference
-from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, RobotCalibration, pose_covariance
+from calib_core.robot_calibration.calibrated_robot import RobotCalibration
+from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 from calib_core.robot_calibration.identify_robot import identify_robot
 from calib_core.robot_calibration.pose_planner import PosePlan, plan_poses
 from calib_core.robot_calibration.camera_to_tool import CameraToTool, Grasp, camera_to_tool, with_tool
@@ -124,7 +125,7 @@ def calibrate_cold_cell(
             result.robot,
             done,
             placement_sigma_mm=SURVEY_SIGMA_MM,
-            camera_covariance=lambda q: pose_covariance(result, q),
+            camera_covariance=lambda q: result.pose_covariance(q),
         )
         robot = with_tool(result.robot, tool.tcp2cam)
         say(
@@ -193,14 +194,12 @@ def _within_3_sigma(result: RobotCalibration, bed, held_out: list[np.ndarray]) -
     ellipsoid of its propagated covariance (chi-square with 6 degrees of freedom at 99.73 %)."""
     from scipy.stats import chi2
 
-    from calib_core.robot_calibration.identification import pose_covariance
-
     limit = chi2.ppf(0.9973, 6)
     inside = 0
     for q in held_out:
         est, tru = result.robot.fk(q, "camera"), bed.true_robot.fk(q, "camera")
         d = np.r_[tru[:3, 3] - est[:3, 3], 1000.0 * Rotation.from_matrix(tru[:3, :3] @ est[:3, :3].T).as_rotvec()]
-        cov = pose_covariance(result, q)
+        cov = result.pose_covariance(q)
         inside += float(d @ np.linalg.pinv(cov) @ d) <= limit
     return round(inside / max(len(held_out), 1), 3)
 

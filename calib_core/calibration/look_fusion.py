@@ -1,7 +1,7 @@
 """A look at a task location weighed against the calibrated model it corrects.
 
 After a robot calibration the model itself places the TCP to a tenth of a millimetre, with a
-covariance (:func:`~calib_core.robot_calibration.identification.pose_covariance`). A look measures
+covariance (:meth:`~calib_core.robot_calibration.calibrated_robot.RobotCalibration.pose_covariance`). A look measures
 the TCP's displacement from that model with its own covariance. Applying the look whole throws the
 model's knowledge away: a look noisier than the model makes the TCP worse (0.00026 -> 0.048 deg on
 the cold cell). The two are fused as two measurements of one displacement: the model says zero with

@@ -164,12 +164,12 @@ class RobotCalibrating:
         if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
             return None
         from calib_core.calibration.look_fusion import fuse_look, tcp_covariance_from_camera
-        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 
         q = context.joints_deg
         cam2base = self.cell.robot.fk(q, "camera")
         model = tcp_covariance_from_camera(
-            pose_covariance(result, q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base))
+            result.pose_covariance(q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base))
         )
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
         tool = self.measured_tool

@@ -127,14 +127,14 @@ class ToolMeasuring:
             raise OperatorError(
                 "record a grasp first: close the gripper on a task location's pin in compliance, then Record grasp"
             )
-        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM, pose_covariance
+        from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 
         calibration = self.robot_calibration.applied_robot_calibration
         tool = camera_to_tool(
             self.cell.robot,
             self.grasps,
             placement_sigma_mm=SURVEY_SIGMA_MM,
-            camera_covariance=(lambda q: pose_covariance(calibration, q)) if calibration is not None else None,
+            camera_covariance=(lambda q: calibration.pose_covariance(q)) if calibration is not None else None,
         )
         self.robot_calibration.use_tool(tool)
         self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)

@@ -13,7 +13,7 @@ residuals taken as one measurement where they share an error (:mod:`calib_core.s
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import cv2
 import numpy as np
@@ -27,8 +27,9 @@ from calib_core.frames import apply, concat, invert, make_transform
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.left_out_views import OVERFIT_RATIO, left_out_ratio
 from calib_core.robot_calibration.mounting_start import mounting_start
-from calib_core.robot_calibration.observability import Observability, analyse
+from calib_core.robot_calibration.observability import analyse
 from calib_core.robot_calibration.observations import BOARD, CELL, OBJECT, PoseView
+from calib_core.robot_calibration.calibrated_robot import FD_STEP, RobotCalibration
 from calib_core.robot_calibration.parameters import CorrectedRobot, delta_transform
 from calib_core.solver.clustered_covariance import clustered_scatter
 from calib_core.vision.pnp_sensitivity import pose_derivatives
@@ -45,56 +46,11 @@ better choice after: on cold cells 0-4 the TCP at held-out poses is 0.036-0.068 
 0.042-0.093 mm with 0.2 mrad."""
 SURVEY_SIGMA_MM = 0.05
 """A theodolite survey's 1-sigma per axis (its points good to about 0.1 mm)."""
-FD_STEP = 1e-4
-"""Forward-difference step, in parameter units (mm, mrad, px, thousandths)."""
 MIN_VIEWS = 6
 
 
 class RobotCalibrationError(VideocalError, ValueError):
     """Views that cannot calibrate the robot (too few, no board pose, nothing identifiable)."""
-
-
-@dataclass(frozen=True)
-class RobotCalibration:
-    """``names`` of the parameters, ``values`` (p,) and 1-sigma ``sigmas`` (p,) in their units
-    (NaN sigma: not identified, left at 0); ``observability``; ``board2base`` (4, 4) mm or ``None``;
-    ``rms_px`` over all points and ``per_view_rms_px``; ``noise_px`` the residuals' sigma per
-    coordinate; ``robot`` the calibrated model and ``intrinsics`` the camera (calibrated when asked)."""
-
-    names: list[str]
-    values: np.ndarray
-    sigmas: np.ndarray
-    observability: Observability
-    board2base: np.ndarray | None
-    rms_px: float
-    per_view_rms_px: dict[str, float]
-    noise_px: float
-    robot: RobotModel
-    intrinsics: Intrinsics
-    seconds: float
-    start_rms_px: float
-    warnings: list[str] = field(default_factory=list)
-    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    """(k, k) of the identified parameters, in the order of ``observability.identified``."""
-    nominal: RobotModel | None = None
-    """A copy of the robot the identification started from (applying the result changes the robot)."""
-    camera_frame: str = "camera"
-    residual_weights: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    """The weight of every residual in the final fit (1 / its group's sigma)."""
-    noise_by_target_px: dict[str, float] = field(default_factory=dict)
-    """The residuals' sigma (px per coordinate) of the board views and of the surveyed-feature views,
-    each group weighted by its own."""
-    left_out: dict[str, str] = field(default_factory=dict)
-    """Views given no weight in the final fit (view name -> why): a component's pose that disagrees
-    with the rest (an edge fit settled on the wrong edges)."""
-
-    def parameter(self, name: str) -> tuple[float, float]:
-        k = self.names.index(name)
-        return float(self.values[k]), float(self.sigmas[k])
-
-    @property
-    def identified_names(self) -> list[str]:
-        return [self.names[k] for k in self.observability.identified]
 
 
 def residual_count(view) -> int:
@@ -427,23 +383,3 @@ def _disagreeing_objects(views: list, bounds: np.ndarray, residuals: np.ndarray,
             f"its pose is {rms[worst]:.1f} of its sigmas from the fit, the other components' views {median:.1f} "
             "(median)"
         )
-
-
-def pose_covariance(result: RobotCalibration, q_deg, frame: str = "camera") -> np.ndarray:
-    """The covariance (6, 6) of ``frame``'s pose at joints ``q_deg`` from the identified parameters'
-    covariance: translation (mm) then rotation vector (mrad), both in the base frame."""
-    corrected = CorrectedRobot(
-        result.nominal, result.camera_frame, len(result.values) > 6 * (result.nominal.n_joints + 1)
-    )
-    corrected.set(result.values)
-    T0 = corrected.robot.fk(q_deg, frame)
-    ids = result.observability.identified
-    J = np.empty((6, len(ids)))
-    for c, k in enumerate(ids):
-        p = result.values.copy()
-        p[k] += FD_STEP
-        corrected.set(p)
-        T = corrected.robot.fk(q_deg, frame)
-        J[:3, c] = (T[:3, 3] - T0[:3, 3]) / FD_STEP
-        J[3:, c] = 1000.0 * Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec() / FD_STEP
-    return J @ result.covariance @ J.T

@@ -18,7 +18,8 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.robot.model import RobotModel
 from calib_core.robot_calibration.cell_views import cell_view
-from calib_core.robot_calibration.identification import RobotCalibration, identify
+from calib_core.robot_calibration.calibrated_robot import RobotCalibration
+from calib_core.robot_calibration.identification import identify
 from calib_core.robot_calibration.observations import PoseView
 
 Progress = Callable[[int, int, str], None]

@@ -18,7 +18,7 @@ import yaml
 from calib_core.atomic_file import atomic_write_text
 from calib_core.frames import concat, invert, transform_from_xyz_rpy, xyz_rpy_from_transform
 from calib_core.robot.model import RobotModel, _to_mm
-from calib_core.robot_calibration.identification import RobotCalibration
+from calib_core.robot_calibration.calibrated_robot import RobotCalibration
 
 
 def _origin_mm(joint: ET.Element) -> np.ndarray:
