@@ -18,7 +18,7 @@ from calib_core.solver.kernels.fast_path import dlt_newton_summary, p3p_newton_s
 from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT
 from calib_core.solver.misfit import FALSE_FLAG_PER_SOLVE, OWN_SCALE_MIN_DOF, fisher_quantile
 from calib_core.solver.problem import PoseProblem
-from calib_core.solver.refine import NewtonResult, residuals_and_jacobian
+from calib_core.solver.refine import NewtonResult
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX, uncertainty_from
 
@@ -35,12 +35,13 @@ class Tie:
     minima: tuple[RefinedPose, ...]
 
 
-def _at_minimum(problem: PoseProblem, obj2cam: np.ndarray, iterations: int, outcome: int) -> RefinedPose:
-    """A minimum the fast path refined (converged), as the full search's refinement gives it: every pair's residual
-    and Jacobian there."""
+def _at_minimum(
+    problem: PoseProblem, obj2cam: np.ndarray, iterations: int, outcome: int, r: np.ndarray, J: np.ndarray
+) -> RefinedPose:
+    """A minimum the fast path refined (converged), as the full search's refinement gives it, with every pair's
+    residual ``r`` (n, 2) and Jacobian ``J`` (n, 2, 6) there (the kernel's, at that minimum)."""
     intr = problem.intrinsics
     R, t = obj2cam[:3, :3].copy(), obj2cam[:3, 3].copy()
-    r, J, _ = residuals_and_jacobian(problem, R, t, intr.fu, intr.fv)
     cost = float(np.sum(r**2))
     newton = NewtonResult(R, t, intr.fu, intr.fv, r, J, iterations, outcome)
     return RefinedPose(obj2cam, intr.fu, intr.fv, cost, float(np.sqrt(cost / problem.n_points)), True, newton)
@@ -92,13 +93,18 @@ def fast_solve(
         )
     if out is None:
         return None
-    obj2cam, r, cov, cov_c, loo, scalars, rivals, rival_fits = out
+    obj2cam, r, cov, cov_c, loo, scalars, rivals, rival_fits, minima_r, minima_J = out
     iterations, outcome, rms, sigma, source, condition, misfit = scalars
     if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
         return None
     if len(rivals):
         fits = ((obj2cam, iterations, outcome), *((pose, *fit) for pose, fit in zip(rivals, rival_fits)))
-        return Tie(tuple(_at_minimum(problem, pose, int(its), int(code)) for pose, its, code in fits))
+        return Tie(
+            tuple(
+                _at_minimum(problem, pose, int(its), int(code), minima_r[k], minima_J[k])
+                for k, (pose, its, code) in enumerate(fits)
+            )
+        )
     if misfit != 0.0:
         return None
     return PoseSolution(

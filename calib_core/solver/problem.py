@@ -19,6 +19,7 @@ from calib_core.solver.kernels.geometry_checks import (
     COLLINEAR,
     NON_FINITE_2D,
     NON_FINITE_3D,
+    OUT_OF_RANGE,
     check_pairs,
     close_pairs,
     close_pairs_swept,
@@ -123,20 +124,20 @@ def make_problem(
     if len(p3) < needed:
         why = " (the focal lengths are estimated too)" if estimate_focal else ""
         raise TooFewPointsError(f"{len(p3)} point pairs given, at least {needed} needed{why}")
-    with np.errstate(invalid="ignore"):  # (NaN and infinity are named below)
-        absurd = np.flatnonzero(
-            (np.isfinite(p3) & (np.abs(p3) > MAX_COORDINATE_MM)).any(axis=1)
-            | (np.isfinite(p2) & (np.abs(p2) > MAX_PIXEL)).any(axis=1)
-        )
-    if len(absurd):
+    code, i, j, coplanar, n_off_image, spread = check_pairs(
+        p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height, MAX_COORDINATE_MM, MAX_PIXEL
+    )
+    if code == OUT_OF_RANGE:
+        with np.errstate(invalid="ignore"):  # (NaN and infinity are named below)
+            absurd = np.flatnonzero(
+                (np.isfinite(p3) & (np.abs(p3) > MAX_COORDINATE_MM)).any(axis=1)
+                | (np.isfinite(p2) & (np.abs(p2) > MAX_PIXEL)).any(axis=1)
+            )
         raise OutOfRangeInputError(
             f"{points_label(absurd)}: a coordinate beyond {MAX_COORDINATE_MM:g} mm or {MAX_PIXEL:g} px (is the unit "
             "right?)",
             absurd,
         )
-    code, i, j, coplanar, n_off_image, spread = check_pairs(
-        p3, p2, _COLLINEAR_RATIO, COPLANAR_RATIO, intrinsics.width, intrinsics.height
-    )
     if code == NON_FINITE_3D or code == NON_FINITE_2D:
         bad = np.flatnonzero(~np.all(np.isfinite(p3), axis=1) | ~np.all(np.isfinite(p2), axis=1))
         raise NonFiniteInputError(f"{points_label(bad)}: coordinates are NaN or infinite", bad)

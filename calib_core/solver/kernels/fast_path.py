@@ -44,7 +44,7 @@ def seed_coordinates(uv, fu, fv, cx, cy, dist):
 @njit(cache=True)
 def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given, default_sigma, misfit_test):
     """Seed by DLT, refine, summarise. Returns ``None`` without a DLT seed, else :func:`_summary`'s tuple and no rival
-    (empty (0, 4, 4) and (0, 2) arrays, as :func:`p3p_newton_summary` returns; all arrays allocated here: one call,
+    (empty rival arrays, as :func:`p3p_newton_summary` returns them; all arrays allocated here: one call,
     few interpreter round trips)."""
     n = P.shape[0]
     R = np.empty((3, 3))
@@ -58,7 +58,18 @@ def dlt_newton_summary(P, uv, fu, fv, cx, cy, dist, max_iterations, sigma_given,
     obj2cam, r, cov, cov_centre, loo, scalars = _summary(
         R, t, r, J, iterations, outcome, sigma_given, default_sigma, misfit_test
     )
-    return obj2cam, r, cov, cov_centre, loo, scalars, np.empty((0, 4, 4)), np.empty((0, 2), dtype=np.int64)
+    return (
+        obj2cam,
+        r,
+        cov,
+        cov_centre,
+        loo,
+        scalars,
+        np.empty((0, 4, 4)),
+        np.empty((0, 2), dtype=np.int64),
+        np.empty((0, n, 2)),
+        np.empty((0, n, 2, 6)),
+    )
 
 
 @njit(cache=True)
@@ -164,7 +175,8 @@ def p3p_newton_summary(
     within ``gate_px`` (RMS) refined, summarised as :func:`dlt_newton_summary`, with the **rivals** (k, 4, 4): every
     other distinct minimum (``same_cos``/``same_rel``: the cosine and relative distance under which two poses are one)
     costing within ``margin_cost`` px^2 of the best (a plane's mirror pose), best first, and their fits (k, 2): each
-    one's Newton iterations and outcome; empty when the best stands alone. ``None`` when no root is near or no
+    one's Newton iterations and outcome; empty when the best stands alone; then the residuals (k + 1, n, 2) and
+    Jacobians (k + 1, n, 2, 6) at the best's minimum and each rival's. ``None`` when no root is near or no
     refinement converges."""
     n = P.shape[0]
     xy = seed_coordinates(uv, fu, fv, cx, cy, dist)
@@ -267,6 +279,12 @@ def p3p_newton_summary(
         return None
     rivals = np.zeros((m, 4, 4))
     rival_fits = np.zeros((m, 2), dtype=np.int64)
+    # the best's and each rival's residuals and Jacobian at their minima, best first (a tie's minima are handed on
+    # as refined: evaluating them again cost a quarter of a tied solve)
+    minima_r = np.empty((m, n, 2))
+    minima_J = np.empty((m, n, 2, 6))
+    minima_r[0] = rs[best]
+    minima_J[0] = Js[best]
     k = 0
     for j in np.argsort(costs):
         if (
@@ -278,6 +296,8 @@ def p3p_newton_summary(
             rivals[k, :3, 3] = ts[j]
             rivals[k, 3, 3] = 1.0
             rival_fits[k, 0], rival_fits[k, 1] = its[j], outcomes[j]
+            minima_r[k + 1] = rs[j]
+            minima_J[k + 1] = Js[j]
             k += 1
     obj2cam, r, cov, cov_centre, loo, scalars = _summary(
         Rs[best],
@@ -290,4 +310,15 @@ def p3p_newton_summary(
         default_sigma,
         misfit_test,
     )
-    return obj2cam, r, cov, cov_centre, loo, scalars, rivals[:k].copy(), rival_fits[:k].copy()
+    return (
+        obj2cam,
+        r,
+        cov,
+        cov_centre,
+        loo,
+        scalars,
+        rivals[:k].copy(),
+        rival_fits[:k].copy(),
+        minima_r[: k + 1].copy(),
+        minima_J[: k + 1].copy(),
+    )

@@ -7,20 +7,29 @@ from numba import njit
 
 from calib_core.solver.kernels.small_linalg import symmetric_eigenvalues
 
-OK, NON_FINITE_3D, NON_FINITE_2D, DUPLICATE_3D, DUPLICATE_2D, COLLINEAR = range(6)
+OK, NON_FINITE_3D, NON_FINITE_2D, DUPLICATE_3D, DUPLICATE_2D, COLLINEAR, OUT_OF_RANGE = range(7)
 
 
 @njit(cache=True)
-def check_pairs(P, uv, collinear_ratio, coplanar_ratio, width, height):
+def check_pairs(P, uv, collinear_ratio, coplanar_ratio, width, height, max_mm, max_px):
     """Return ``(code, i, j, coplanar, off_image, spread)``: ``code`` one of the constants above,
     ``i``/``j`` the point indices at fault (-1 when none); ``coplanar`` whether the points lie
     in one plane; ``off_image`` how many pixels lie outside the ``width`` x ``height`` image;
     ``spread`` the points' largest principal spread (mm). O(n): duplicates are found by the caller.
 
-    ``P`` (n, 3) mm, ``uv`` (n, 2) px. Collinearity and coplanarity compare the square roots
-    of the eigenvalues of the points' scatter matrix (their spread along the principal axes).
+    ``P`` (n, 3) mm, ``uv`` (n, 2) px. A finite coordinate beyond ``max_mm`` or ``max_px`` is
+    :data:`OUT_OF_RANGE` (checked before the others: the first such point is ``i``). Collinearity and
+    coplanarity compare the square roots of the eigenvalues of the points' scatter matrix (their spread
+    along the principal axes).
     """
     n = P.shape[0]
+    for i in range(n):
+        for k in range(3):
+            if np.isfinite(P[i, k]) and abs(P[i, k]) > max_mm:
+                return OUT_OF_RANGE, i, -1, False, 0, 0.0
+        for k in range(2):
+            if np.isfinite(uv[i, k]) and abs(uv[i, k]) > max_px:
+                return OUT_OF_RANGE, i, -1, False, 0, 0.0
     for i in range(n):
         if not (np.isfinite(P[i, 0]) and np.isfinite(P[i, 1]) and np.isfinite(P[i, 2])):
             return NON_FINITE_3D, i, -1, False, 0, 0.0
