@@ -226,13 +226,6 @@ def _widgets_taking_the_core(source: str) -> list[str]:
     return found
 
 
-# The window's panes not yet given only the parts they show; none may join them. The window (main_window.py)
-# alone assembles the panes from the core.
-PANES_STILL_TAKING_THE_CORE = {
-    "workflow_actions.py",  # the window's menu and shortcut actions: every workflow's buttons
-}  # fmt: skip
-
-
 def _widget_modules_where(found) -> set[str]:
     """The window's modules but its assembly (main_window.py) in which ``found(source)`` finds something."""
     return {p.name for p in (ROOT / "app" / "gui").glob("*.py") if p.name != "main_window.py" and found(p.read_text())}
@@ -242,10 +235,9 @@ def test_the_panes_are_given_the_parts_they_show():
     assert _widgets_taking_the_core("class P:\n    def __init__(self, workbench, parent=None):\n        pass\n") == [
         "P"
     ]
+    # the window (main_window.py) alone assembles the panes from the core
     taking = _widget_modules_where(_widgets_taking_the_core)
-    assert taking <= PANES_STILL_TAKING_THE_CORE, (
-        f"given the whole core: {sorted(taking - PANES_STILL_TAKING_THE_CORE)}"
-    )
+    assert not taking, f"given the whole core: {sorted(taking)}"
     # the camera pane shows the frames and the pairs being made, the vision panel the core's camera calibration,
     # the replay bar the core's replay, the pairs table the session, and so on: they exist and take no core
     given_parts = {"camera_pane.py", "virtual_pane.py", "vision_panel.py", "replay_bar.py", "pairs_table.py"}
@@ -268,18 +260,12 @@ def _touches_the_core(source: str) -> list[int]:
     )
 
 
-# Widgets that still reach the core through the window or hold it whole; none may join them.
-STILL_TOUCHING_THE_CORE = PANES_STILL_TAKING_THE_CORE
-
-
 def test_no_widget_reaches_the_core_through_the_window():
     # By what a widget's code touches, not by a parameter's name: Find points once took the window and reached
     # ``self.window.workbench.finder`` eight times; it is now given the finder and two callbacks.
     assert _touches_the_core("class F:\n    def run(self):\n        return self.window.workbench.finder\n") == [3]
     touching = _widget_modules_where(_touches_the_core)
-    assert touching <= STILL_TOUCHING_THE_CORE, (
-        f"reach the core through the window: {sorted(touching - STILL_TOUCHING_THE_CORE)}"
-    )
+    assert not touching, f"reach the core through the window: {sorted(touching)}"
     assert "found_points.py" not in touching
 
 

@@ -72,14 +72,23 @@ class MainWindow(QMainWindow):
             scroll.setWidget(panel)
             self.commands.addTab(scroll, title)
         self.actions = WorkflowActions(
-            workbench,
-            self.commands,
-            self.table,
-            self.results,
-            self.overview,
-            lambda text, ms: self.statusBar().showMessage(text, ms),
-            self.show_error,
-            self,
+            session=workbench.session,
+            picking=workbench.picking,
+            moves=workbench.moves,
+            arm=workbench.arm,
+            desk=workbench.desk,
+            editor=workbench.editor,
+            task_count=lambda: len(workbench.workcell.task_locations),
+            undo=workbench.undo,
+            redo=workbench.redo,
+            choose_candidate=workbench.choose_candidate,
+            commands=self.commands,
+            table=self.table,
+            results=self.results,
+            overview=self.overview,
+            say=lambda text, ms: self.statusBar().showMessage(text, ms),
+            show_error=self.show_error,
+            parent=self,
         )
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0

@@ -18,12 +18,13 @@ def _who() -> str:
     return f"{getpass.getuser()} at {datetime.now(timezone.utc).isoformat(timespec='seconds')}"
 
 
-def store_with_consent(parent: QWidget, core, say) -> None:
-    """Store the last result for ``core``'s task location, asking in ``parent`` what the core needs
-    asked; ``say(text)`` reports what was (not) stored."""
+def store_with_consent(parent: QWidget, desk, say) -> None:
+    """Store the last result for the task location through the correction ``desk``
+    (:class:`~calib_core.operator.correction_desk.CorrectionDesk`), asking in ``parent`` what the desk needs asked;
+    ``say(text)`` reports what was (not) stored."""
     convert = ""
     try:
-        _store(parent, core, convert, say)
+        _store(parent, desk, convert, say)
     except LookNotAtTask as exc:
         task = exc.place.task
         question = "\n".join(
@@ -46,16 +47,16 @@ def store_with_consent(parent: QWidget, core, say) -> None:
             [("measurement", "Store as measurement"), ("convert", f"Convert into {task}'s correction")],
         )
         if chosen == "measurement":
-            core.desk.store_measurement()
+            desk.store_measurement()
         elif chosen == "convert":
-            _store(parent, core, f"converted in the window by {_who()}", say)
+            _store(parent, desk, f"converted in the window by {_who()}", say)
         else:
             say("nothing stored")
 
 
-def _store(parent: QWidget, core, convert: str, say) -> None:
+def _store(parent: QWidget, desk, convert: str, say) -> None:
     try:
-        core.desk.store_correction(convert=convert)
+        desk.store_correction(convert=convert)
     except ConfirmationNeeded as exc:
         question = "\n".join(
             [
@@ -69,6 +70,6 @@ def _store(parent: QWidget, core, convert: str, say) -> None:
         if not ask(parent, "Store an implausible result?", question, "Store anyway"):
             say("nothing stored")
             return
-        core.desk.store_correction(
+        desk.store_correction(
             convert=convert, confirmation=f"confirmed in the window by {_who()}: {'; '.join(exc.reasons)}"
         )

@@ -21,14 +21,28 @@ from calib_core.operator.move_preview import MoveNeedsConfirmation
 
 
 class WorkflowActions(QObject):
-    """``workbench``: the core; ``commands``: the command panel whose buttons trigger these;
-    ``table`` (its selected pair is the one deleted), ``results`` (a chosen candidate, Verify's answer),
-    ``overview`` (a move's preview and its *Move* button, Simulate's path); ``say(text, ms)`` writes the
-    status bar; ``show_error(text)`` shows a refusal; ``parent``: where the store dialogs open."""
+    """Given the core's parts the actions work on: the calibration ``session`` (its undo stack and pairs enable the
+    buttons), ``picking`` (accept, delete, calibrate), ``moves`` and the ``arm`` (the moves, Stop, a move's end),
+    the correction ``desk`` (Store, Verify), the cell ``editor`` (Add location), ``task_count()`` (the cell's task
+    locations, to name a new one) and the core's own commands ``undo()``, ``redo()`` and ``choose_candidate(i)`` (each
+    lets go of the pair being made or records the choice); and the window's: ``commands``, the command panel whose
+    buttons trigger these; ``table`` (its selected pair is the one deleted), ``results`` (a chosen candidate,
+    Verify's answer), ``overview`` (a move's preview and its *Move* button, Simulate's path); ``say(text, ms)`` writes
+    the status bar; ``show_error(text)`` shows a refusal; ``parent``: where the store dialogs open."""
 
     def __init__(
         self,
-        workbench,
+        *,
+        session,
+        picking,
+        moves,
+        arm,
+        desk,
+        editor,
+        task_count: Callable[[], int],
+        undo: Callable[[], str | None],
+        redo: Callable[[], str | None],
+        choose_candidate: Callable[[int], None],
         commands,
         table,
         results,
@@ -38,13 +52,9 @@ class WorkflowActions(QObject):
         parent: QWidget,
     ):
         super().__init__(parent)
-        self.workbench, self.commands, self.table, self.results, self.overview = (
-            workbench,
-            commands,
-            table,
-            results,
-            overview,
-        )
+        self._session, self._picking, self._moves, self._desk, self._editor = session, picking, moves, desk, editor
+        self._task_count, self._undo, self._redo = task_count, undo, redo
+        self.commands, self.table, self.results, self.overview = commands, table, results, overview
         self.say, self.show_error, self.parent_widget = say, show_error, parent
         self.report = guarded(show_error)
         self.undo_action = QAction("&Undo", parent, shortcut=QKeySequence.StandardKey.Undo, triggered=self.undo)
@@ -61,7 +71,7 @@ class WorkflowActions(QObject):
             "&Stop the robot",
             parent,
             shortcut=QKeySequence("Esc"),
-            triggered=lambda: self.report(workbench.moves.stop_robot)(),
+            triggered=lambda: self.report(moves.stop_robot)(),
         )
         self.stop_action.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)  # Esc stops the robot from any pane
         self.approach_action = QAction("Go to &approach", parent, triggered=lambda: self.go(approach=True))
@@ -83,44 +93,42 @@ class WorkflowActions(QObject):
         c.verify.clicked.connect(self.report(self._verify))
         c.animate.clicked.connect(self.report(self._animate))
         c.add_location.clicked.connect(self.report(self.add_location))
-        results.candidate_chosen.connect(self.report(workbench.choose_candidate))
-        workbench.arm.move_finished.connect(self._move_finished)
-        workbench.session.undo.changed.connect(self.update)
-        workbench.session.pairs.changed.connect(
-            self.update
-        )  # pairs also change outside the undo stack (replay, workspace)
+        results.candidate_chosen.connect(self.report(choose_candidate))
+        arm.move_finished.connect(self._move_finished)
+        session.undo.changed.connect(self.update)
+        session.pairs.changed.connect(self.update)  # pairs also change outside the undo stack (replay, workspace)
         self.update()
 
     def update(self, *_) -> None:
         """Undo and Redo name what they would do; Calibrate is enabled with enough usable pairs."""
-        undo = self.workbench.session.undo
+        undo = self._session.undo
         self.undo_action.setEnabled(undo.can_undo)
         self.redo_action.setEnabled(undo.can_redo)
         self.undo_action.setText(f"&Undo {undo.undo_label}" if undo.undo_label else "&Undo")
         self.redo_action.setText(f"&Redo {undo.redo_label}" if undo.redo_label else "&Redo")
         self.commands.undo.setEnabled(undo.can_undo)
         self.commands.redo.setEnabled(undo.can_redo)
-        self.commands.calibrate.setEnabled(self.workbench.session.can_calibrate)
+        self.commands.calibrate.setEnabled(self._session.can_calibrate)
 
     def accept(self) -> None:
-        self.report(lambda: self.say(f"pair {self.workbench.picking.accept_pair()} accepted", 5000))()
+        self.report(lambda: self.say(f"pair {self._picking.accept_pair()} accepted", 5000))()
 
     def delete(self) -> None:
-        self.report(lambda: self.workbench.picking.delete_pair(self.table.selected_number()))()
+        self.report(lambda: self._picking.delete_pair(self.table.selected_number()))()
 
     def undo(self) -> None:
-        label = self.workbench.undo()
+        label = self._undo()
         self.say(f"undone: {label}" if label else "nothing to undo", 5000)
 
     def redo(self) -> None:
-        label = self.workbench.redo()
+        label = self._redo()
         self.say(f"redone: {label}" if label else "nothing to redo", 5000)
 
     def calibrate(self) -> None:
         self.report(self._calibrate)()
 
     def _calibrate(self) -> None:
-        result = self.workbench.picking.calibrate()
+        result = self._picking.calibrate()
         s = result.solution
         self.say(
             f"calibrated: {s.status.value}, RMS {s.rms_px:.2f} px, displacement "
@@ -129,18 +137,14 @@ class WorkflowActions(QObject):
         )
 
     def store(self) -> None:
-        self.report(store_with_consent)(self.parent_widget, self.workbench, lambda text: self.say(text, 5000))
+        self.report(store_with_consent)(self.parent_widget, self._desk, lambda text: self.say(text, 5000))
 
     def _verify(self) -> None:
-        v = self.workbench.desk.verify()
+        v = self._desk.verify()
         self.results.show_message(v.text, ok=v.ok)
 
     def go(self, *, approach: bool, corrected: bool = False) -> None:
-        self.move(
-            lambda confirmed: self.workbench.moves.go_to_task(
-                approach=approach, corrected=corrected, confirmed=confirmed
-            )
-        )
+        self.move(lambda confirmed: self._moves.go_to_task(approach=approach, corrected=corrected, confirmed=confirmed))
 
     def move(self, send: Callable[[object], object]) -> None:
         """Send a move (``send(confirmed)`` calls the core). The core previews it in the overview; one
@@ -162,12 +166,11 @@ class WorkflowActions(QObject):
             self.say(f"arrived at {what}", 8000)
 
     def _animate(self) -> None:
-        path = self.workbench.moves.simulate_approach()
+        path = self._moves.simulate_approach()
         self.commands.sim_status.setText(path.text)
         self.overview.play_path(list(path.joints_deg))
 
     def add_location(self, name: str | None = None) -> None:
-        wb = self.workbench
-        name = name or f"location_{len(wb.workcell.task_locations) + 1}"
-        wb.editor.add_task_location(name)
+        name = name or f"location_{self._task_count() + 1}"
+        self._editor.add_task_location(name)
         self.say(f"task location {name} added at the current pose", 5000)
