@@ -1,8 +1,7 @@
 """The operator's files through the real window: recent workspaces, a recording and a workspace saved while
 calibrating, an unsaved session offered from its autosave."""
 
-from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtWidgets import QApplication, QFileDialog
+from PySide6.QtCore import QSettings, Qt
 
 from app.gui.main_window import MainWindow
 from app.gui.workbench import Workbench
@@ -94,18 +93,7 @@ def test_an_unsaved_session_is_offered_from_its_autosave(qtbot, tmp_path):
         # start offered that file again. A restored session has no file yet: Save asks where.
         assert win.files.workspace_path is None
         chosen = tmp_path / "mine.json"
-        asked = []
-
-        def answer():
-            dialog = QApplication.activeModalWidget()
-            if isinstance(dialog, QFileDialog):
-                asked.append(dialog.windowTitle())
-                dialog.selectFile(str(chosen))
-                dialog.accept()
-            else:
-                QTimer.singleShot(20, answer)
-
-        QTimer.singleShot(0, answer)
+        asked = answer_file_dialog(chosen)
         assert win.files.save_workspace_dialog()
         assert asked == ["Save workspace"] and chosen.is_file()
         assert sorted(p.name for p in (tmp_path / "recovery").iterdir()) == ["recovered-autosave.json"]
