@@ -33,6 +33,10 @@ class Tie:
     fast path refined the roots of the full search's triplets: it would find these same poses."""
 
     minima: tuple[RefinedPose, ...]
+    best: PoseSolution | None = None
+    """The best minimum's solution as the fast path states it (its own summary: uncertainty, leave-one-out, warnings;
+    alone, status ``ok``), for the full search to state it ambiguous when it ranks that minimum first; ``None`` when
+    a pair may be a mis-pick there (the full search then judges it)."""
 
 
 def _at_minimum(
@@ -97,16 +101,33 @@ def fast_solve(
     iterations, outcome, rms, sigma, source, condition, misfit = scalars
     if int(outcome) not in (CONVERGED, EXACT_FIT) or not rms <= limit_px:
         return None
+    solution = None if misfit != 0.0 else _solution(problem, obj2cam, r, cov, cov_c, loo, scalars, noise)
     if len(rivals):
         fits = ((obj2cam, iterations, outcome), *((pose, *fit) for pose, fit in zip(rivals, rival_fits)))
         return Tie(
             tuple(
                 _at_minimum(problem, pose, int(its), int(code), minima_r[k], minima_J[k])
                 for k, (pose, its, code) in enumerate(fits)
-            )
+            ),
+            solution,
         )
-    if misfit != 0.0:
-        return None
+    return solution
+
+
+def _solution(
+    problem: PoseProblem,
+    obj2cam: np.ndarray,
+    r: np.ndarray,
+    cov: np.ndarray,
+    cov_c: np.ndarray,
+    loo: np.ndarray,
+    scalars: np.ndarray,
+    noise: float,
+) -> PoseSolution:
+    """The fast path's fit, summarised by the kernel, as an ``ok`` solution with itself the only candidate."""
+    intr = problem.intrinsics
+    iterations, _, rms, sigma, source, condition, _ = scalars
+    n = problem.n_points
     return PoseSolution(
         status=SolveStatus.OK,
         obj2cam=obj2cam,

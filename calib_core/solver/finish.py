@@ -85,6 +85,18 @@ def _worst(statistics: np.ndarray, loo: np.ndarray, e: np.ndarray) -> int:
     return int(np.nanargmax(np.where(np.isfinite(loo), loo, e)))
 
 
+def _ambiguous_reason(candidates: tuple[PoseCandidate, ...]) -> str:
+    return f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
+
+
+def stated_with_candidates(solution: PoseSolution, candidates: tuple[PoseCandidate, ...]) -> PoseSolution:
+    """An ``ok`` ``solution`` of the first candidate stated with all of ``candidates``: ambiguous where there are two
+    or more (as :func:`finish_solution` states a fit without a flagged pair)."""
+    if len(candidates) < 2:
+        return replace(solution, candidates=candidates)
+    return replace(solution, status=SolveStatus.AMBIGUOUS, reason=_ambiguous_reason(candidates), candidates=candidates)
+
+
 def finish_solution(
     problem: PoseProblem,
     chosen: RefinedPose,
@@ -183,8 +195,7 @@ def finish_solution(
             f"px{others}; check that pick or untick it"
         )
     elif len(candidates) > 1:
-        status = SolveStatus.AMBIGUOUS
-        reason = f"{len(candidates)} poses fit the picks about equally well; choose one or add a point"
+        status, reason = SolveStatus.AMBIGUOUS, _ambiguous_reason(candidates)
     warnings += operator_warnings(problem, uncertainty.condition_number, noise)
     return PoseSolution(
         status=status,

@@ -29,7 +29,7 @@ from calib_core.solver.pick_scale import pick_scale_px
 from calib_core.solver.problem import PoseProblem, check_in_front, first_of_each_pair, make_problem
 from calib_core.solver.errors import RepeatedPairError, named_points_as_given, point_label, points_label
 from calib_core.solver.solution import PoseCandidate, PoseSolution, SolveStatus, pose_matrix
-from calib_core.solver.finish import finish_solution, noise_px
+from calib_core.solver.finish import stated_with_candidates, finish_solution, noise_px
 from calib_core.solver.uncertainty import DEFAULT_SIGMA_PX
 
 # Candidates whose cost exceeds the best by less than this many sigma^2 fit "about equally well"
@@ -205,7 +205,11 @@ def solve_pose(
     )
     ranked = [close[i] for i in rank]
     candidates = tuple(PoseCandidate(p.obj2cam, p.fu, p.fv, p.rms_px, distances[i]) for p, i in zip(ranked, rank))
-    solution = finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
+    if tie is not None and tie.best is not None and ranked[0] is tie.minima[0] and not rivals:
+        # the fast path summarised this minimum already: the same figures finish_solution would take again
+        solution = stated_with_candidates(tie.best, candidates)
+    else:
+        solution = finish_solution(problem, ranked[0], candidates, sigma_px=sigma_px, limit_px=limit, huber_px=huber)
     # name the pairs: the operator re-picks those, not every point (a second minimum of the same pairs names none)
     suspects = sorted({int(i) for r in rivals for i in np.flatnonzero(r.inliers != close[0].inliers)})
     if rivals and solution.status is SolveStatus.AMBIGUOUS and suspects:

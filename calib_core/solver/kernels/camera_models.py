@@ -29,8 +29,8 @@ def pinhole_eval(P, uv, R, t, fu, fv, cx, cy, dist, focal, r, J):
     """Fill ``r`` (n, 2) and ``J`` (n, 2, p) for the pinhole model; return the smallest depth Z, mm."""
     k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
     zmin = np.inf
-    a = np.empty(6)
-    b = np.empty(6)
+    # (the perspective division's derivatives in scalars, not two arrays made per call: a Newton step of four pairs
+    # cost as much in allocations as in arithmetic)
     for i in range(P.shape[0]):
         qx = R[0, 0] * P[i, 0] + R[0, 1] * P[i, 1] + R[0, 2] * P[i, 2]
         qy = R[1, 0] * P[i, 0] + R[1, 1] * P[i, 1] + R[1, 2] * P[i, 2]
@@ -51,13 +51,16 @@ def pinhole_eval(P, uv, R, t, fu, fv, cx, cy, dist, focal, r, J):
         d01 = 2.0 * x * y * drad + 2.0 * p1 * x + 2.0 * p2 * y
         d11 = radial + 2.0 * y * y * drad + 6.0 * p1 * y + 2.0 * p2 * x
         # d(x, y)/d(dt, phi): dp/dt = I, dp/dphi = -[q]x, then the perspective division.
-        a[0], a[1], a[2] = iz, 0.0, -x * iz
-        a[3], a[4], a[5] = -x * qy * iz, (qz + x * qx) * iz, -qy * iz
-        b[0], b[1], b[2] = 0.0, iz, -y * iz
-        b[3], b[4], b[5] = -(qz + y * qy) * iz, y * qx * iz, qx * iz
-        for k in range(6):
-            J[i, 0, k] = fu * (d00 * a[k] + d01 * b[k])
-            J[i, 1, k] = fv * (d01 * a[k] + d11 * b[k])
+        a0, a1, a2 = iz, 0.0, -x * iz
+        a3, a4, a5 = -x * qy * iz, (qz + x * qx) * iz, -qy * iz
+        b0, b1, b2 = 0.0, iz, -y * iz
+        b3, b4, b5 = -(qz + y * qy) * iz, y * qx * iz, qx * iz
+        J[i, 0, 0], J[i, 1, 0] = fu * (d00 * a0 + d01 * b0), fv * (d01 * a0 + d11 * b0)
+        J[i, 0, 1], J[i, 1, 1] = fu * (d00 * a1 + d01 * b1), fv * (d01 * a1 + d11 * b1)
+        J[i, 0, 2], J[i, 1, 2] = fu * (d00 * a2 + d01 * b2), fv * (d01 * a2 + d11 * b2)
+        J[i, 0, 3], J[i, 1, 3] = fu * (d00 * a3 + d01 * b3), fv * (d01 * a3 + d11 * b3)
+        J[i, 0, 4], J[i, 1, 4] = fu * (d00 * a4 + d01 * b4), fv * (d01 * a4 + d11 * b4)
+        J[i, 0, 5], J[i, 1, 5] = fu * (d00 * a5 + d01 * b5), fv * (d01 * a5 + d11 * b5)
         if focal:
             J[i, 0, 6] = xd
             J[i, 0, 7] = 0.0

@@ -14,7 +14,7 @@ from numba import njit
 from calib_core.solver.kernels.camera_models import PINHOLE
 from calib_core.solver.kernels.diagnostics import fit_summary, flags_a_misfit
 from calib_core.solver.kernels.dlt import dlt_pose
-from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, MAX_ITERATIONS, newton
+from calib_core.solver.kernels.newton import CONVERGED, EXACT_FIT, MAX_ITERATIONS, newton, newton_in, newton_work
 from calib_core.solver.kernels.p3p import p3p
 
 # Fixed-point undistortion sweeps for the seed: the Newton iterations absorb what is left.
@@ -237,40 +237,30 @@ def p3p_newton_summary(
     f = np.empty(2)
     best = -1
     basin_cos = np.cos(np.radians(5.0))
+    work = newton_work(rs[0], Js[0], False)
     for j in order:
         # best seeds first; one within a few degrees of a pose already found would only find it again
         # (the true pose's roots from each triplet, apart by the noise)
         if _near_a_minimum(Rs, ts, costs, Rs[j], ts[j], basin_cos):
             continue
         f[0], f[1] = fu, fv
-        first = max_iterations if best < 0 else min(_FIRST_STEPS, max_iterations)
-        its[j], outcomes[j] = newton(
-            PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, first, True, rs[j], Js[j]
-        )
-        if outcomes[j] == MAX_ITERATIONS and first < max_iterations:
-            # on a plane the triplets' roots of one pose lie far apart (its turn is poorly fixed by three points): a few
-            # steps bring each next to the minimum it falls into, and one already found is not sought again
-            if _near_a_minimum(Rs, ts, costs, Rs[j], ts[j], basin_cos):
-                continue
-            more, outcomes[j] = newton(
-                PINHOLE,
-                P,
-                uv,
-                Rs[j],
-                ts[j],
-                f,
-                cx,
-                cy,
-                dist,
-                False,
-                False,
-                0.0,
-                max_iterations - first,
-                True,
-                rs[j],
-                Js[j],
+        # the first seed to its minimum at once; each later one a few steps at a time, leaving it as soon as it comes
+        # within the basin of a minimum found (on a plane the triplets' roots of one pose lie far apart, its turn
+        # poorly fixed by three points, and each takes a dozen steps down the valley to the minimum found already)
+        chunk = max_iterations if best < 0 else min(_FIRST_STEPS, max_iterations)
+        its[j], outcomes[j] = 0, MAX_ITERATIONS
+        joined = False
+        while outcomes[j] == MAX_ITERATIONS and its[j] < max_iterations:
+            if its[j] > 0 and _near_a_minimum(Rs, ts, costs, Rs[j], ts[j], basin_cos):
+                joined = True
+                break
+            steps = min(chunk, max_iterations - its[j])
+            more, outcomes[j] = newton_in(
+                PINHOLE, P, uv, Rs[j], ts[j], f, cx, cy, dist, False, False, 0.0, steps, True, rs[j], Js[j], work
             )
             its[j] += more
+        if joined:
+            continue
         if outcomes[j] == CONVERGED or outcomes[j] == EXACT_FIT:
             costs[j] = np.sum(rs[j] ** 2)
             if best < 0 or costs[j] < costs[best]:

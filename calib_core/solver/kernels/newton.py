@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from calib_core.solver.kernels.camera_models import PINHOLE, evaluate
-from calib_core.solver.kernels.small_linalg import cholesky_solve
+from calib_core.solver.kernels.small_linalg import cholesky_solve_in
 
 # Outcome codes (see ``OUTCOMES``).
 CONVERGED, EXACT_FIT, MAX_ITERATIONS, NO_DESCENT, DIVERGED, START_BEHIND, SINGULAR = range(7)
@@ -55,19 +55,21 @@ def rotate_by(phi, R, out):
     else:
         s, c1 = np.sin(theta) / theta, (1.0 - np.cos(theta)) / (theta * theta)
     x, y, z = phi[0], phi[1], phi[2]
-    M = np.empty((3, 3))
-    M[0, 0] = 1.0 - c1 * (y * y + z * z)
-    M[1, 1] = 1.0 - c1 * (x * x + z * z)
-    M[2, 2] = 1.0 - c1 * (x * x + y * y)
-    M[0, 1] = -s * z + c1 * x * y
-    M[1, 0] = s * z + c1 * x * y
-    M[0, 2] = s * y + c1 * x * z
-    M[2, 0] = -s * y + c1 * x * z
-    M[1, 2] = -s * x + c1 * y * z
-    M[2, 1] = s * x + c1 * y * z
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = M[i, 0] * R[0, j] + M[i, 1] * R[1, j] + M[i, 2] * R[2, j]
+    # (in scalars: an array made per step cost as much as the step's arithmetic for a few pairs)
+    m00 = 1.0 - c1 * (y * y + z * z)
+    m11 = 1.0 - c1 * (x * x + z * z)
+    m22 = 1.0 - c1 * (x * x + y * y)
+    m01 = -s * z + c1 * x * y
+    m10 = s * z + c1 * x * y
+    m02 = s * y + c1 * x * z
+    m20 = -s * y + c1 * x * z
+    m12 = -s * x + c1 * y * z
+    m21 = s * x + c1 * y * z
+    for j in range(3):
+        r0, r1, r2 = R[0, j], R[1, j], R[2, j]
+        out[0, j] = m00 * r0 + m01 * r1 + m02 * r2
+        out[1, j] = m10 * r0 + m11 * r1 + m12 * r2
+        out[2, j] = m20 * r0 + m21 * r1 + m22 * r2
 
 
 @njit(cache=True)
@@ -202,6 +204,27 @@ def _focal_sane(f, f0):
 
 
 @njit(cache=True)
+def newton_work(r, J, focal):
+    """The room :func:`newton_in` works in, for residuals like ``r`` (n, 2) and a Jacobian like ``J`` (n, 2, p):
+    made once by a loop that refines many seeds of one problem (made per call, it cost as much as the steps of four
+    pairs)."""
+    p = 8 if focal else 6
+    return (
+        np.empty_like(r),
+        np.empty_like(J),
+        np.empty((3, 3)),
+        np.empty(3),
+        np.empty(2),
+        np.empty((p, p)),
+        np.empty((p, p)),
+        np.empty((p, p)),
+        np.empty(p),
+        np.empty(p),
+        np.empty(2),
+    )
+
+
+@njit(cache=True)
 def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_iterations, damped, r, J):
     """Minimise the reprojection cost from the state ``(R, t, f)``, updated in place.
 
@@ -209,6 +232,13 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
     ``r`` (n, 2) and ``J`` (n, 2, p) receive the residuals and Jacobian at the final
     state. Returns ``(iterations, outcome code)``.
     """
+    work = newton_work(r, J, focal)
+    return newton_in(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_iterations, damped, r, J, work)
+
+
+@njit(cache=True)
+def newton_in(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_iterations, damped, r, J, work):
+    """:func:`newton` in the room ``work`` (:func:`newton_work`'s)."""
     n = P.shape[0]
     p = 8 if focal else 6
     zmin = evaluate(model, P, uv, R, t, f[0], f[1], cx, cy, dist, focal, as_printed, r, J)
@@ -219,23 +249,16 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
         scale = max(np.sqrt(t[0] ** 2 + t[1] ** 2 + t[2] ** 2), 1.0)
     else:
         scale = max(abs(t[2]), 1.0)
-    r_new = np.empty_like(r)
-    J_new = np.empty_like(J)
-    R_new = np.empty((3, 3))
-    t_new = np.empty(3)
-    f_new = np.empty(2)
-    A = np.empty((p, p))
-    Aa = np.empty((p, p))
-    g = np.empty(p)
-    delta = np.zeros(p)
-    f0 = f.copy()
+    r_new, J_new, R_new, t_new, f_new, A, Aa, L, g, delta, f0 = work
+    delta[:] = 0.0  # (a first factorisation that fails judges the step by it: none taken)
+    f0[:] = f
     lam = _LAMBDA_START
     for iteration in range(1, max_iterations + 1):
         if cost <= 1e-28 * n:
             return iteration - 1, EXACT_FIT
         normal_equations(J, r, huber, p, A, g)
         if not damped:
-            if not cholesky_solve(A, g, delta):
+            if not cholesky_solve_in(A, g, delta, L):
                 return iteration, SINGULAR
             _step(R, t, f, delta, p, R_new, t_new, f_new)
             zmin = evaluate(model, P, uv, R_new, t_new, f_new[0], f_new[1], cx, cy, dist, focal, as_printed, r, J)
@@ -253,7 +276,7 @@ def newton(model, P, uv, R, t, f, cx, cy, dist, focal, as_printed, huber, max_it
                     Aa[a, b] = A[a, b]
                 Aa[a, a] += lam * max(A[a, a], 1e-300)
             cost_new = np.inf
-            if cholesky_solve(Aa, g, delta):
+            if cholesky_solve_in(Aa, g, delta, L):
                 if lam <= _UNDAMPED and _round_off_step(delta, g, p, cost):
                     return iteration - 1, CONVERGED
                 _step(R, t, f, delta, p, R_new, t_new, f_new)

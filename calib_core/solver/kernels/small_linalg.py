@@ -50,7 +50,13 @@ def cholesky_substitute(L, g, x):
 @njit(cache=True)
 def cholesky_solve(A, g, x):
     """Solve ``A x = g`` for symmetric positive definite ``A``; False if not positive definite."""
-    L = np.empty_like(A)
+    return cholesky_solve_in(A, g, x, np.empty_like(A))
+
+
+@njit(cache=True)
+def cholesky_solve_in(A, g, x, L):
+    """:func:`cholesky_solve` with the factor's room ``L`` (p, p) given (a loop that solves many times makes it
+    once)."""
     if not cholesky_factor(A, L):
         return False
     cholesky_substitute(L, g, x)
