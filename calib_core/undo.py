@@ -6,9 +6,21 @@ from psygnal import Signal
 
 
 class Command:
-    """An edit. ``label`` names it in the Edit menu (``"Add pair 3"``)."""
+    """An edit. ``label`` names it in the Edit menu (``"Add pair 3"``). A command checks itself (:meth:`check`)
+    when pushed: the checks of an edit live in its command, once, whoever makes it (a button, the command line, a
+    script)."""
 
     label = "edit"
+
+    def check(self) -> None:
+        """Raise an error saying what is wrong (and what to do instead) when the edit cannot be made now; called by
+        :meth:`UndoStack.push` before :meth:`do`, so a refused edit changes nothing."""
+
+    @property
+    def changes_nothing(self) -> bool:
+        """Whether doing it would leave everything as it is (an option set to the value it has): such a command is
+        not pushed."""
+        return False
 
     def do(self) -> None:
         raise NotImplementedError
@@ -37,18 +49,23 @@ class UndoStack:
     def _changed(self) -> None:
         self.changed.emit()
 
-    def push(self, command: Command) -> None:
-        """Do ``command`` and record it (clears the redo history). A command the last one can
-        :meth:`~Command.merge` (the same spin box turned again) joins it as one undo step."""
+    def push(self, command: Command) -> Command:
+        """Check ``command``, do it and record it (clears the redo history); returns it (a pick's number is on it).
+        A command the last one can :meth:`~Command.merge` (the same spin box turned again) joins it as one undo
+        step; one that :attr:`~Command.changes_nothing` is neither done nor recorded."""
+        command.check()
+        if command.changes_nothing:
+            return command
         command.do()
         self.applied.emit(command)
         if self._done and not self._undone and self._done[-1].merge(command):
             self._changed()
-            return
+            return command
         self._done.append(command)
         del self._done[: -self._limit]
         self._undone.clear()
         self._changed()
+        return command
 
     def undo(self) -> str | None:
         """Undo the last command; its label, or None when there is nothing to undo."""

@@ -70,7 +70,7 @@ def main(out: Path = OUT) -> None:
             n_joint += 1
         elif clock.t_s == t_frame:
             image, _ = camera.render(bed.joints_deg)
-            core.picking.observe_frame(Frame(image, n_frame, clock.t_s))
+            core.frames.observe_frame(Frame(image, n_frame, clock.t_s))
             n_frame += 1
         else:
             kind, arg = steps.pop(0)

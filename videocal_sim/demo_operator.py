@@ -24,6 +24,7 @@ from PySide6.QtCore import QEventLoop, QPointF, QSettings, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
+from calib_core.calibration.commands import DeletePair
 from calib_core.errors import OperatorError, VideocalError
 from calib_core.atomic_file import atomic_write_text
 from calib_core.camera.projection import project
@@ -310,7 +311,7 @@ def run_demo(
                 pending = wb.session.pairs.pending()
                 if pending is None or pending.feature != name:
                     if pending is not None:
-                        wb.session.delete(pending.number)
+                        wb.session.undo.push(DeletePair(wb.session.pairs, pending.number))
                     log.skipped.append(
                         f"{round_name}: {name} ({win.virtual.info.text() or 'hidden in the virtual camera'})"
                     )

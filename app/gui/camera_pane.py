@@ -14,7 +14,7 @@ from app.gui.solved_edges import SolvedEdges
 from calib_core.calibration.session import CalibrationSession
 from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
-from calib_core.operator.observations import Observations
+from calib_core.operator.frame_holding import FrameHolding
 from calib_core.operator.picking import Picking
 from calib_core.operator.point_finding import PointFinding
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
@@ -49,7 +49,7 @@ class CameraPane(QWidget):
     def __init__(
         self,
         cell: Cell,
-        observations: Observations,
+        frames: FrameHolding,
         picking: Picking,
         session: CalibrationSession,
         arm: Arm,
@@ -58,7 +58,7 @@ class CameraPane(QWidget):
     ):
         super().__init__(parent)
         # what it shows: the cell's camera and parts, the frames, the pairs being made, the result's overlay
-        self.cell, self.observations, self.picking, self.session, self.arm = cell, observations, picking, session, arm
+        self.cell, self.frames, self.picking, self.session, self.arm = cell, frames, picking, session, arm
         self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
         self.view.grabber = self._grab
         self.view.dragged.connect(self._dragging)
@@ -109,8 +109,8 @@ class CameraPane(QWidget):
         self.freeze.toggled.connect(self._hold_toggled)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
         self.opacity.valueChanged.connect(lambda _: self.refresh_overlay())
-        observations.frame_observed.connect(self.show_frame)
-        observations.still_changed.connect(self._still_changed)
+        frames.frame_observed.connect(self.show_frame)
+        frames.still_changed.connect(self._still_changed)
         session.pairs.changed.connect(lambda *_: self.refresh_overlay())
         session.result.changed.connect(self._on_solved)
         arm.joints_changed.connect(self._joints_changed)
@@ -120,7 +120,7 @@ class CameraPane(QWidget):
     # --- frames ---------------------------------------------------------------------------------
     @property
     def held(self):
-        return self.observations.still
+        return self.frames.still
 
     def show_frame(self, frame) -> None:
         self.last_frame_received = frame
@@ -133,14 +133,14 @@ class CameraPane(QWidget):
     def _hold_toggled(self, on: bool) -> None:
         if on and self.held is None:
             try:
-                self.picking.hold_frame()
+                self.frames.hold_frame()
             except OperatorError as exc:
                 self.freeze.blockSignals(True)
                 self.freeze.setChecked(False)
                 self.freeze.blockSignals(False)
                 self.pick_rejected.emit(str(exc))
         elif not on and self.held is not None:
-            self.picking.release_frame()
+            self.frames.release_frame()
 
     def _still_changed(self, held) -> None:
         self.freeze.blockSignals(True)

@@ -20,7 +20,9 @@ from PySide6.QtWidgets import (
 
 from app.gui.buttons import button
 from app.gui.error_boundary import attempt
+from calib_core.calibration.commands import ClearPairs
 from calib_core.calibration.session import CalibrationSession
+from calib_core.calibration.solve_options import SetOption
 from calib_core.operator.cell import Cell
 from calib_core.operator.cell_editor import CellEditor
 from calib_core.operator.task_choice import TaskChoice
@@ -176,10 +178,13 @@ class CommandPanel(QTabWidget):
         def run(fn, *args):
             attempt(self.error.emit, fn, *args)
 
-        self.clear.clicked.connect(lambda: run(self.session.clear))
+        self.clear.clicked.connect(lambda: run(self.session.undo.push, ClearPairs(self.session.pairs)))
         self.target.currentTextChanged.connect(lambda name: run(self.session.set_target, name))
-        self.estimate_focal.toggled.connect(lambda on: run(self.session.set_option, "estimate_focal", on))
-        self.robust.toggled.connect(lambda on: run(self.session.set_option, "robust", on))
+        options = self.session.options
+        self.estimate_focal.toggled.connect(
+            lambda on: run(self.session.undo.push, SetOption(options, "estimate_focal", on))
+        )
+        self.robust.toggled.connect(lambda on: run(self.session.undo.push, SetOption(options, "robust", on)))
         self.session.options.changed.connect(self.show_option)  # an undo sets the box back
 
         def task_chosen(name: str) -> None:

@@ -39,7 +39,7 @@ class MainWindow(QMainWindow):
         self.setWindowTitle(f"videocal - {workbench.workcell.name}")
         self.camera = CameraPane(
             workbench.cell,
-            workbench.observations,
+            workbench.frames,
             workbench.picking,
             workbench.session,
             workbench.arm,
@@ -50,7 +50,7 @@ class MainWindow(QMainWindow):
         self.table = PairsTable(workbench.session)
         self.results = ResultsPanel(workbench.session, workbench.arm)
         self.commands = CommandPanel(workbench.cell, workbench.session, workbench.tasks, workbench.editor)
-        self.replay = ReplayBar(workbench.replay, lambda frame: workbench.picking.observe_frame(frame, replayed=True))
+        self.replay = ReplayBar(workbench.replay, lambda frame: workbench.frames.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(
             workbench.vision, workbench.moves, self.show_error, lambda send: self.actions.move(send)
         )
@@ -192,7 +192,7 @@ class MainWindow(QMainWindow):
             self.statusBar(),
             arm=wb.arm,
             session=wb.session,
-            picking=wb.picking,
+            frames=wb.frames,
             link=lambda: wb.link,
             recording=wb.recording,
             camera_state=self._camera_state,
@@ -225,7 +225,7 @@ class MainWindow(QMainWindow):
     # --- camera ----------------------------------------------------------------------------
     def start_camera(self, make_source) -> None:
         self.worker = FrameWorker(make_source, self)
-        self.worker.frame.connect(self.workbench.picking.observe_frame)  # the camera pane shows what the core observed
+        self.worker.frame.connect(self.workbench.frames.observe_frame)  # the camera pane shows what the core observed
         self.worker.failed.connect(self.show_error)
         self.worker.waiting.connect(lambda text: self.statusBar().showMessage(text, 5000))
         self.worker.start()

@@ -7,6 +7,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
+from calib_core.calibration.commands import SetEnabled
 from calib_core.calibration.session import CalibrationSession
 
 COLUMNS = ("#", "feature", "X mm", "Y mm", "Z mm", "u px", "v px", "residual px", "use")
@@ -104,4 +105,4 @@ class PairsTable(QTableWidget):
         number = int(self.item(item.row(), 0).text())
         enabled = item.checkState() == Qt.CheckState.Checked
         if self.session.pairs.get(number).enabled != enabled:
-            self.session.set_enabled(number, enabled)
+            self.session.undo.push(SetEnabled(self.session.pairs, number, enabled))

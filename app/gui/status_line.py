@@ -22,7 +22,7 @@ WARN = "<span style='color:#ff9a30'>{}</span>"
 
 class StatusLine:
     """The status bar's fields, given the parts they show: the ``arm`` (its motion, link state and last sample), the
-    ``session`` (its pairs, result and target), ``picking`` (the settle rule and whether a recording is replayed),
+    ``session`` (its pairs, result and target), ``frames`` (the settle rule and whether a recording is replayed),
     the session's ``recording`` (its recorder, while one writes), ``link()`` (the controller's link, or None) and
     ``camera_state()`` ``(last frame received or None, worker or None, replaying)``."""
 
@@ -32,13 +32,13 @@ class StatusLine:
         *,
         arm,
         session,
-        picking,
+        frames,
         link: Callable[[], object],
         recording,
         camera_state: Callable[[], tuple],
         parent,
     ) -> None:
-        self._arm, self._session, self._picking = arm, session, picking
+        self._arm, self._session, self._frames = arm, session, frames
         self._link, self._recording = link, recording
         self._camera_state = camera_state
         self.record_label = QLabel("")
@@ -128,10 +128,10 @@ class StatusLine:
 
     def _show_settled(self) -> None:
         """Whether the newest frame can be picked on: the settle rule, from the joint samples."""
-        if self._link() is None and not self._picking.replaying:
+        if self._link() is None and not self._frames.replaying:
             self.settled_label.setText("")
             return
-        still = self._picking.robot_settled()
+        still = self._frames.robot_settled()
         self.settled_label.setText(
             "<span style='color:#5fd35f'>settled</span>"
             if still.settled

@@ -1,20 +1,35 @@
-"""The operator's edits as undoable commands on the correspondence set."""
+"""The operator's edits of the pairs as undoable commands, each checking itself when pushed
+(:meth:`~calib_core.undo.Command.check`): the paper's *Point* in its two halves, a moved or ticked point, a deleted
+pair, Clear, and Find points' proposals accepted."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
 from calib_core.calibration.correspondences import Correspondence, CorrespondenceSet, with_pixel
+from calib_core.calibration.errors import CalibrationError
 from calib_core.undo import Command
 
 
 class AddPoint3D(Command):
-    """Start a pair with a 3D point picked on the model (its 2D point comes later)."""
+    """*Point*, first half: start a pair with a 3D point picked on the model, (3,) mm in the world frame (its 2D
+    point comes later). Refused on another object than the ``target`` (when one is chosen) and while a pair still
+    waits for its image point. ``number``: the new pair's."""
 
-    def __init__(self, pairs: CorrespondenceSet, component: str, feature: str | None, point_world_mm):
-        self.pairs = pairs
+    def __init__(
+        self, pairs: CorrespondenceSet, component: str, feature: str | None, point_world_mm, target: str | None = None
+    ):
+        self.pairs, self.target = pairs, target
         self.pair = Correspondence(pairs.new_number(), component, feature, tuple(float(v) for v in point_world_mm))
+        self.number = self.pair.number
         self.label = f"Pick 3D point {self.pair.label}"
+
+    def check(self) -> None:
+        if self.target is not None and self.pair.component != self.target:
+            raise CalibrationError(f"pick on the target object '{self.target}' (the click hit '{self.pair.component}')")
+        pending = self.pairs.pending()
+        if pending is not None:
+            raise CalibrationError(f"pair {pending.number} still needs its 2D point on the camera image")
 
     def do(self) -> None:
         self.pairs._insert(len(self.pairs), self.pair)
@@ -24,15 +39,26 @@ class AddPoint3D(Command):
 
 
 class SetPixel(Command):
-    """Set (or move) the 2D point of a pair, px."""
+    """Set (or move) the 2D point of pair ``number``, (u, v) px, picked on ``view`` (a
+    :class:`~calib_core.calibration.view_stamp.ViewStamp`); ``number`` ``None``: *Point*'s second half, the pair
+    waiting for its image point (refused when none waits)."""
 
-    def __init__(self, pairs: CorrespondenceSet, number: int, pixel, view=None):
+    def __init__(self, pairs: CorrespondenceSet, number: int | None, pixel, view=None):
         self.pairs = pairs
         self.number = number
         self.pixel = (float(pixel[0]), float(pixel[1]))
         self.view = view
         self.old = None
         self.label = f"Pick 2D point of pair {number}"
+
+    def check(self) -> None:
+        if self.number is None:
+            pending = self.pairs.pending()
+            if pending is None:
+                raise CalibrationError("pick the point on the model (virtual camera) first, then on the camera image")
+            self.number = pending.number
+            self.label = f"Pick 2D point of pair {self.number}"
+        self.pairs.get(self.number)  # (names a pair that is not there)
 
     def do(self) -> None:
         self.old = self.pairs._replace(with_pixel(self.pairs.get(self.number), self.pixel, self.view))
@@ -48,6 +74,9 @@ class DeletePair(Command):
         self.index = 0
         self.pair = None
         self.label = f"Delete pair {number}"
+
+    def check(self) -> None:
+        self.pairs.get(self.number)
 
     def do(self) -> None:
         self.index, self.pair = self.pairs._remove(self.number)
@@ -65,6 +94,9 @@ class SetEnabled(Command):
         self.enabled = bool(enabled)
         self.old = None
         self.label = f"{'Enable' if enabled else 'Disable'} pair {number}"
+
+    def check(self) -> None:
+        self.pairs.get(self.number)
 
     def do(self) -> None:
         self.old = self.pairs._replace(replace(self.pairs.get(self.number), enabled=self.enabled))

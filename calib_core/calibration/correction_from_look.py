@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from calib_core.calibration.corrections import Correction
+from calib_core.calibration.corrections import Correction, StoreCorrection
 from calib_core.calibration.end_effector import EndEffectorEstimate
 from calib_core.calibration.errors import ConfirmationNeeded
 from calib_core.calibration.look_result import SolveContext
@@ -81,3 +81,18 @@ def correction_from_look(
         confirmation="" if verdict.ok and (fused is None or fused.agree) else confirmation,
         kind=kind,
     )
+
+
+class StoreLook(StoreCorrection):
+    """*Store correction*: the ``session``'s last look stored for ``task`` (undoable; ``how`` as
+    :func:`correction_from_look`'s). Checks itself when made: a result to store
+    (:meth:`~calib_core.calibration.look_result.LookResult.storable_estimate`: there is one, it belongs to the pairs
+    on screen, it did not fail) and the confirmation a result that is not ``ok`` needs."""
+
+    def __init__(self, session, task: str, source: str = "", **how):
+        result = session.result
+        estimate = result.storable_estimate(session.pairs.usable())
+        verdict = result.verdict or result.judge(estimate)
+        super().__init__(
+            session.corrections, correction_from_look(estimate, result.context, verdict, task, source, **how)
+        )

@@ -16,6 +16,7 @@ from calib_core.calibration.end_effector import EndEffectorEstimate, end_effecto
 from calib_core.calibration.form_error import form_error_covariance
 from calib_core.calibration.verdict import ResultVerdict, judge
 from calib_core.camera.intrinsics import Intrinsics
+from calib_core.solver.solution import SolveStatus
 from calib_core.calibration.errors import CalibrationError
 from calib_core.undo import Command
 from calib_core.workcell.safety import SafetyLimits
@@ -149,6 +150,19 @@ class LookResult:
             shared_covariance=shared_covariance(context, estimate.solution.obj2cam if obj2cam is None else obj2cam),
         )
         self.show(Solved(chosen, context, index))
+
+    def storable_estimate(self, usable_pairs):
+        """The last solve's estimate, when it may be stored as a correction; else :class:`CalibrationError` saying
+        why: there is none, the pairs changed since (``usable_pairs``: the pairs on screen; said before anything else
+        is asked of the look), or it failed."""
+        if self.estimate is None:
+            raise CalibrationError("calibrate first")
+        stale = self.stale_reason(usable_pairs)
+        if stale:
+            raise CalibrationError(f"the result is from an earlier state ({stale}); nothing stored")
+        if self.estimate.solution.status is SolveStatus.FAILED:
+            raise CalibrationError(f"the last solve failed ({self.estimate.solution.reason}); nothing to store")
+        return self.estimate
 
     def stale_reason(self, usable_pairs) -> str | None:
         """Why the result no longer belongs to ``usable_pairs`` (the pairs on screen a solve would use); ``None``:

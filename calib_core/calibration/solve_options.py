@@ -43,6 +43,10 @@ class SetOption(Command):
         self.old = getattr(options, name)
         self.label = f"{'Use' if value else 'Stop using'} the {name.replace('_', ' ')} option"
 
+    @property
+    def changes_nothing(self) -> bool:
+        return self.old == self.value
+
     def do(self) -> None:
         self.options.apply(self.name, self.value)
 

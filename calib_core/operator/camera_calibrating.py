@@ -2,7 +2,7 @@
 the joints then, the camera's intrinsics and its mounting on the flange calibrated from them and checked, and applied
 to the cell or saved; the board put up in the cell and the robot poses that see it.
 
-A part of :class:`~calib_core.operator.core.OperatorCore`, given the cell, the picking (the frame a view is taken
+A part of :class:`~calib_core.operator.core.OperatorCore`, given the cell, the frames (the frame a view is taken
 from), the observations (which source it came from), the arm (where the robot stands) and the log; ``board_put_up``
 tells whoever shows the cell to a camera (the simulated site) what now stands in it. The window's Vision mode is its
 view.
@@ -23,7 +23,7 @@ from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.observations import Observations
 from calib_core.operator.operator_log import OperatorLog
-from calib_core.operator.picking import Picking
+from calib_core.operator.frame_holding import FrameHolding
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
 from calib_core.vision.capture import BoardCapture
 from calib_core.vision.intrinsics_calibration import RejectedView
@@ -59,12 +59,12 @@ class CameraCalibrating:
     def __init__(
         self,
         cell: Cell,
-        picking: Picking,
+        frames: FrameHolding,
         observations: Observations,
         arm: Arm,
         log: OperatorLog,
     ):
-        self.cell, self.picking, self.observations, self.arm, self.log = cell, picking, observations, arm, log
+        self.cell, self.frames, self.observations, self.arm, self.log = cell, frames, observations, arm, log
         self.capture = BoardCapture(parse_board(DEFAULT_SPEC))
         self.intrinsics_result = None
         self.mounting: MountingResult | None = None
@@ -165,7 +165,7 @@ class CameraCalibrating:
     def capture_view(self):
         """Detect the board in the newest frame (taken after the last move, once the robot had settled) and keep it
         with the joints then; a :class:`RejectedView` says why not. Both are said in the log."""
-        frame, stamp = self.picking.frame_to_capture()
+        frame, stamp = self.frames.frame_to_capture()
         joints = None if stamp is None else np.array(stamp.joints_deg)
         view = self.capture.add(
             frame.image,

@@ -18,6 +18,7 @@ from collections.abc import Callable
 import numpy as np
 from psygnal import Signal
 
+from calib_core.calibration.look_result import ChooseCandidate
 from calib_core.calibration.errors import CalibrationError
 from calib_core.calibration.session import CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
@@ -33,6 +34,8 @@ from calib_core.operator.motion import MotionState
 from calib_core.operator.moves import Moves
 from calib_core.operator.observations import Observations
 from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.frame_holding import FrameHolding
+from calib_core.operator.pick_refining import PickRefining
 from calib_core.operator.picking import Picking
 from calib_core.operator.recording_tap import RecordingTap
 from calib_core.operator.replaying import Replaying
@@ -50,6 +53,7 @@ class OperatorCore:
     """The parts, each given what it needs: :attr:`cell` (with its events ``camera_model_changed()``,
     ``scene_changed()``), :attr:`session` (pairs, options, result, corrections, the one undo stack),
     :attr:`tasks` (the task location worked at), :attr:`observations` (frames, the held one),
+    :attr:`frames` (which frame a pick is made on), :attr:`refining` (a click moved onto its feature),
     :attr:`arm` (joints, link, moves, Stop), :attr:`picking` (*Point*, *Accept*, *Calibrate*),
     :attr:`finder` (*Find points*), :attr:`moves` (moves by name), :attr:`robot_calibration` (and the
     measured tool in use), :attr:`tool` (grasps, *Measure tool*), :attr:`desk` (store, *Verify*),
@@ -94,22 +98,24 @@ class OperatorCore:
         """The robot behind the link: its joints, its moves and how the last one stands, Stop."""
         self.arm.message.connect(self.log.say)
         self.arm.event.connect(self.log.event.emit)
-        self.picking = Picking(cell, self.session, self.observations, self.arm, self.log)
-        self.finder = PointFinding(cell, self.session, self.picking, self.log)
+        self.frames = FrameHolding(self.observations, self.arm, self.session.pairs, self.log)
+        self.refining = PickRefining(cell, self.session, self.frames, self.arm)
+        self.picking = Picking(cell, self.session, self.frames, self.refining, self.arm, self.log)
+        self.finder = PointFinding(cell, self.session, self.picking, self.frames, self.refining, self.log)
         self.moves = Moves(cell, self.session, self.tasks, self.arm)
         self.robot_calibration = RobotCalibrating(cell, self.session, self.arm, self.log)
         self.recording = SessionRecording(lambda recorder: RecordingTap(self, recorder), self.log)
         """The session's recording: start, stop, the recorder writing now."""
         self.tool = ToolMeasuring(
-            cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log
+            cell, self.tasks, self.arm, self.frames, self.finder, self.robot_calibration, self.log
         )
         self.desk = CorrectionDesk(
             cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log
         )
-        self.vision = CameraCalibrating(cell, self.picking, self.observations, self.arm, self.log)
+        self.vision = CameraCalibrating(cell, self.frames, self.observations, self.arm, self.log)
         self.vision.board_put_up.connect(self._put_up_on_site)
         """The camera's calibration: board views, intrinsics and mounting, the board in the cell."""
-        self.replay = Replaying(cell, self.session, self.picking, self.arm, self.log)
+        self.replay = Replaying(cell, self.session, self.frames, self.arm, self.log)
         """A recording or bag played back in place of the live camera."""
         self.files = WorkspaceFiles(cell, self.session, self.log)
         self.editor = CellEditor(cell, self.session, self.tasks, self.arm, self.log)
@@ -278,7 +284,7 @@ class OperatorCore:
 
     def choose_candidate(self, index: int) -> None:
         """Take solution ``index`` of an ambiguous solve (undoable)."""
-        self.session.choose_candidate(index)
+        self.session.undo.push(ChooseCandidate(self.session.result, index))
         self.record_event("candidate_chosen", index=index, solution=index + 1)
 
     # --- frames of reference -------------------------------------------------------------------

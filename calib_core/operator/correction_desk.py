@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from psygnal import Signal
 
+from calib_core.calibration.correction_from_look import StoreLook
 from calib_core.calibration.look_place import LookNotAtTask, LookPlace, place_of_look
 from calib_core.calibration.errors import CalibrationError
 from calib_core.calibration.session import CalibrationSession
@@ -78,7 +79,8 @@ class CorrectionDesk:
         stored 1-sigma either way."""
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
-        self.session.storable_estimate()  # said first: a look that changed since is no look at all
+        # said first: a look that changed since is no look at all
+        self.session.result.storable_estimate(self.session.pairs.usable())
         place = self.look_place()
         if place is None:
             raise CalibrationError(
@@ -93,13 +95,15 @@ class CorrectionDesk:
         source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
         if source:
             source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source
-        c = self.session.store_correction(
+        store = StoreLook(
+            self.session,
             self.task.name,
             source,
             confirmation=confirmation,
             fused=self.robot_calibration.look_fused_with_robot(self.session.result.estimate),
             tool_covariance=tool_covariance,
         )
+        c = self.session.undo.push(store).correction
         if not place.counts:
             self.log.record(
                 "look_converted",
@@ -126,7 +130,8 @@ class CorrectionDesk:
             raise CalibrationError("choose the task location the measurement belongs with")
         place = self.look_place()
         where = place.text if place is not None else "a look without a robot pose"
-        c = self.session.store_correction(self.task.name, f"measurement: {where}", kind="measurement")
+        store = StoreLook(self.session, self.task.name, f"measurement: {where}", kind="measurement")
+        c = self.session.undo.push(store).correction
         self.correction_stored.emit(c)
         self.log.say(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
         return c

@@ -1,6 +1,7 @@
 """*Find points*: the target's features located in the held frame and proposed as pairs, accepted
 in one undoable step. A part of :class:`~calib_core.operator.core.OperatorCore` (``core.finder``), given the
-cell, the session, the picking (its held frame and its rule of one robot pose) and the log.
+cell, the session, the picking (the pair being made), the frames (the held one), the refinement of picks (what
+it reads from a frame, shared) and the log.
 
 The frame is held as for a pick (refused while the robot moves), so the proposals carry its
 :class:`~calib_core.calibration.view_stamp.ViewStamp`; the modelled camera pose is the robot model's
@@ -17,12 +18,15 @@ from psygnal import Signal
 
 from calib_core.calibration.commands import AddPairs
 from calib_core.calibration.errors import CalibrationError
+from calib_core.calibration.look_solving import show_solution
 from calib_core.calibration.session import CalibrationSession
 from calib_core.calibration.view_stamp import ViewStamp
 from calib_core.errors import OperatorError
 from calib_core.frames import apply, concat, invert
 from calib_core.operator.cell import Cell
 from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.frame_holding import FrameHolding, refuse_mixed_poses
+from calib_core.operator.pick_refining import PickRefining
 from calib_core.operator.picking import Picking
 
 if TYPE_CHECKING:  # imported when first used: Find points loads the renderer and its detectors
@@ -44,8 +48,17 @@ class PointFinding:
     points_found = Signal(object)
     solved = Signal()
 
-    def __init__(self, cell: Cell, session: CalibrationSession, picking: Picking, log: OperatorLog):
+    def __init__(
+        self,
+        cell: Cell,
+        session: CalibrationSession,
+        picking: Picking,
+        frames: FrameHolding,
+        refining: PickRefining,
+        log: OperatorLog,
+    ):
         self.cell, self.session, self.picking, self.log = cell, session, picking, log
+        self._frames, self._refining = frames, refining
         self.found: FoundOnFrame | None = None
         """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or
         dismissed)."""
@@ -57,15 +70,15 @@ class PointFinding:
         target = self.session.target
         if target is None:
             raise CalibrationError("choose the target object first")
-        was_held = self.picking.observations.still is not None
-        held = self.picking.observations.still or self.picking.hold_frame()
+        was_held = self._frames.still is not None
+        held = self._frames.still or self._frames.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
         item = self.cell.workcell.component(target)
         obj2cam_model = concat(item.item2world, invert(self.cell.robot.fk(q, "camera")))
         from calib_core.look.find_points import find_points
 
         result = find_points(
-            self.picking.evidence(held.frame.image),
+            self._refining.evidence(held.frame.image),
             self.cell.intrinsics,
             item,
             obj2cam_model,
@@ -74,7 +87,7 @@ class PointFinding:
         if not was_held and not result.found and result.edges is None:
             # held for this look, and nothing on it to pick or fit (the target not in view): the next look, after the
             # robot has moved, takes a new frame instead of this one
-            self.picking.release_unused_still()
+            self._frames.release_unused_still()
         self.found = FoundOnFrame(result, held.stamp)
         self.log.record(
             "points_found",
@@ -138,7 +151,8 @@ class PointFinding:
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
         self.picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
-        estimate = self.session.show_result(
+        estimate = show_solution(
+            self.session,
             solution,
             item.item2world,
             cam2world_model,
@@ -178,7 +192,7 @@ class PointFinding:
             raise OperatorError(
                 f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})"
             )
-        self.picking.check_same_state([p for p in session.pairs if p.complete], found.view)
+        refuse_mixed_poses([p for p in session.pairs if p.complete], found.view)
         item = self.cell.workcell.component(found.result.component)
         spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]
         command = AddPairs(session.pairs, spec, found.view)

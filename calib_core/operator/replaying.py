@@ -1,13 +1,13 @@
 """The operator core's replay (``core.replay``): a recording, or a ROS 2 bag, played back in place of the live camera.
 
-At a position on the recording's time axis, the frame recorded then is what picks are made on (through the picking's
+At a position on the recording's time axis, the frame recorded then is what picks are made on (through the frames'
 replay history), the CAD views follow the recorded joints, and the point pairs and the last solve appear as they
 stood. The first edit the operator makes (a pick, a delete, a solve...) branches a new session from that instant: the
 pairs stop following the recording and the operator works on the recorded frames. The file is only ever read. While it
 plays, the cell uses the intrinsics the recording was made with; closing gives the live camera's back, and the live
 session as it was unless it was branched.
 
-A part of :class:`~calib_core.operator.core.OperatorCore`, given the cell, the session, the picking, the arm (which
+A part of :class:`~calib_core.operator.core.OperatorCore`, given the cell, the session, the frames, the arm (which
 shows the recorded joints without moving the robot) and the log. The window's replay bar is its view and its clock.
 """
 
@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from psygnal import Signal
 
+from calib_core.calibration.look_solving import show_solution
 from calib_core.bags.bag_playback import BagPlayback, is_bag
 from calib_core.calibration.session import CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
@@ -27,7 +28,7 @@ from calib_core.link.joint_history import JointHistory
 from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.operator_log import OperatorLog
-from calib_core.operator.picking import Picking
+from calib_core.operator.frame_holding import FrameHolding
 from calib_core.recording.playback import RecordedSolve
 from calib_core.ros2.joint_units import user_per_si
 
@@ -39,8 +40,8 @@ class Replaying:
 
     branched = Signal(float)
 
-    def __init__(self, cell: Cell, session: CalibrationSession, picking: Picking, arm: Arm, log: OperatorLog):
-        self.cell, self.session, self.picking, self.arm, self.log = cell, session, picking, arm, log
+    def __init__(self, cell: Cell, session: CalibrationSession, frames: FrameHolding, arm: Arm, log: OperatorLog):
+        self.cell, self.session, self.frames, self.arm, self.log = cell, session, frames, arm, log
         self.playback = None
         self.path: Path | None = None
         self.position_s = 0.0
@@ -97,7 +98,7 @@ class Replaying:
             self.cell.workcell.safety.settle_rule,
             self.cell.robot.joint_names,
         )
-        self.picking.begin_replay(history, path.name)
+        self.frames.begin_replay(history, path.name)
         self.branched_at_s = None
         self.position_s = 0.0
         self._shown_frame = self._shown_solve = None
@@ -134,7 +135,7 @@ class Replaying:
             self._as_replay(restore)
         self._close_playback()
         self.playback = self.path = self._live_state = None
-        self.picking.end_replay()
+        self.frames.end_replay()
         self.log.say(
             "replay closed: "
             + ("the branched session stays open" if branched else "the live session is back as it was")
@@ -220,7 +221,8 @@ class Replaying:
         obj2world, cam_model, tcp_model = (
             np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model")
         )
-        self.session.show_result(
+        show_solution(
+            self.session,
             solution,
             obj2world,
             cam_model,

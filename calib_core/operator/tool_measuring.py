@@ -11,7 +11,7 @@ through the robot as it is now (calibrated first, or the camera's errors go into
 into the robot's TCP frame, undone by Revert like a robot calibration.
 
 A part of :class:`~calib_core.operator.core.OperatorCore` (``core.tool``), given the cell, the task choice, the
-arm, the picking (the frame held for a grasp), Find points (the modelled view a grasp is checked against), the
+arm, the frames (the one held for a grasp), Find points (the modelled view a grasp is checked against), the
 robot calibration (which puts the tool in) and the log.
 """
 
@@ -24,7 +24,7 @@ from calib_core.operator.arm import Arm
 from calib_core.operator.cell import Cell
 from calib_core.operator.motion import Motion
 from calib_core.operator.operator_log import OperatorLog
-from calib_core.operator.picking import Picking
+from calib_core.operator.frame_holding import FrameHolding
 from calib_core.operator.point_finding import PointFinding
 from calib_core.operator.robot_calibrating import RobotCalibrating
 from calib_core.operator.task_choice import TaskChoice
@@ -38,16 +38,16 @@ class ToolMeasuring:
         cell: Cell,
         tasks: TaskChoice,
         arm: Arm,
-        picking: Picking,
+        frames: FrameHolding,
         finder: PointFinding,
         robot_calibration: RobotCalibrating,
         log: OperatorLog,
     ):
-        self.cell, self.tasks, self.arm, self.picking, self.finder, self.robot_calibration, self.log = (
+        self.cell, self.tasks, self.arm, self.frames, self.finder, self.robot_calibration, self.log = (
             cell,
             tasks,
             arm,
-            picking,
+            frames,
             finder,
             robot_calibration,
             log,
@@ -76,9 +76,9 @@ class ToolMeasuring:
             )
         q = np.array(self.arm.joints_deg, dtype=float)
         seen, how = None, "no camera frame: taken through the robot and the fixture's survey"
-        if self.picking.observations.latest is not None:
+        if self.frames.latest is not None:
             held = (
-                self.picking.hold_frame()
+                self.frames.hold_frame()
             )  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
             q = np.asarray(held.stamp.joints_deg, dtype=float)
             workcell = self.cell.workcell
@@ -96,7 +96,7 @@ class ToolMeasuring:
                 how = f"seen on frame {held.stamp.frame_index} ({seen.edge_samples} edge samples of {seen.component})"
             except GraspNotSeenError as e:
                 how = f"not seen ({e}): taken through the robot and the fixture's survey"
-            self.picking.release_unused_still()
+            self.frames.release_unused_still()
         grasp = Grasp(
             f"{self.task.name} #{sum(g.name.startswith(self.task.name + ' #') for g in self.grasps) + 1}",
             q,

@@ -65,7 +65,7 @@ def test_a_bag_replays_in_the_window_and_a_look_is_solved_on_it(qtbot, window, a
     before = _digest(bag)
     win.files.open_recording(bag)
     bar = win.replay
-    assert bar.isVisible() and wb.picking.replaying, win.results.status.text()
+    assert bar.isVisible() and wb.frames.replaying, win.results.status.text()
     message = win.statusBar().currentMessage()
     assert "ROS 2 bag" in message and "joints from /joint_states" in message and "3 frames" in message
     assert wb.intrinsics.fu == pytest.approx(bed.intrinsics.fu)  # the bag's CameraInfo is the camera in use
@@ -95,7 +95,7 @@ def test_a_bag_replays_in_the_window_and_a_look_is_solved_on_it(qtbot, window, a
     assert np.linalg.norm(result.cam2world_model[:3, 3] - true_cam[:3, 3]) > 1.0  # the model alone was millimetres off
 
     qtbot.mouseClick(bar.close_button, Qt.MouseButton.LeftButton)
-    assert not wb.picking.replaying and bar.playback is None
+    assert not wb.frames.replaying and bar.playback is None
     assert _digest(bag) == before  # the bag is only read
 
 
@@ -107,4 +107,4 @@ def test_a_bag_without_images_is_named_and_changes_nothing(qtbot, window, tmp_pa
     win.files.open_recording(bag)
     text = win.results.status.text()
     assert "joints_only" in text and "no images in this bag" in text and "/joint_states" in text
-    assert not win.replay.isVisible() and not win.workbench.picking.replaying
+    assert not win.replay.isVisible() and not win.workbench.frames.replaying

@@ -1,6 +1,8 @@
 """The whole calibration through the real window: the controller simulator as a child process,
 the simulated camera on its worker thread, and mouse clicks on the panes' widgets."""
 
+from calib_core.calibration.commands import SetPixel
+from calib_core.calibration.commands import AddPoint3D
 from pathlib import Path
 
 import numpy as np
@@ -139,7 +141,9 @@ def test_mistakes_become_messages_not_crashes(qtbot, window):
     # Accept with nothing picked, then with only the 3D point.
     qtbot.mouseClick(win.commands.accept, Qt.MouseButton.LeftButton)
     assert "nothing to accept" in win.results.status.text()
-    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    wb.session.undo.push(
+        AddPoint3D(wb.session.pairs, "oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7), target=wb.session.target)
+    )
     qtbot.mouseClick(win.commands.accept, Qt.MouseButton.LeftButton)
     assert "has no point on the camera image yet" in win.results.status.text()
     # A click outside the image (zoomed out, in the margin): nothing picked, the pair still waits.
@@ -172,8 +176,10 @@ def test_a_camera_that_stops_and_a_link_that_drops_are_reported(qtbot, window, t
     from calib_core.video.folder_source import ImageFolderSource
 
     win, wb = window, window.workbench
-    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
-    wb.session.pick_2d((320.0, 240.0))
+    wb.session.undo.push(
+        AddPoint3D(wb.session.pairs, "oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7), target=wb.session.target)
+    )
+    wb.session.undo.push(SetPixel(wb.session.pairs, None, (320.0, 240.0)))
     # The camera: a folder of two images, not looped, ends; the window says so and keeps the last frame.
     for k in range(2):
         cv2.imwrite(str(tmp_path / f"frame_{k}.png"), np.full((480, 640, 3), 60 + 40 * k, np.uint8))

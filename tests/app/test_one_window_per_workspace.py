@@ -3,6 +3,7 @@ open (or has saved it) holds it; a second window that opens or saves the same fi
 nothing is written; once the first window closes, the file is free."""
 
 from __future__ import annotations
+from calib_core.calibration.commands import AddPoint3D
 
 import json
 
@@ -15,7 +16,15 @@ from videocal_sim.sim_site import simulated_cell
 def test_a_second_window_is_told_and_writes_nothing(qtbot, offline_window, tmp_path):
     first = offline_window
     path = tmp_path / "workspace.json"
-    first.workbench.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    first.workbench.session.undo.push(
+        AddPoint3D(
+            first.workbench.session.pairs,
+            "oru_1_fixture",
+            "pin_tip",
+            (1.0, 2.0, 3.0),
+            target=first.workbench.session.target,
+        )
+    )
     assert first.files.save_workspace(path)
     saved = path.read_text()
 

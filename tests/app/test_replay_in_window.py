@@ -1,6 +1,7 @@
 """Replaying a recording in the real window: the timeline shows the recorded frames, joints, pairs
 and results as they were; the first edit branches a new session; the file is never written."""
 
+from calib_core.calibration.commands import AddPoint3D
 import hashlib
 import shutil
 from pathlib import Path
@@ -36,11 +37,13 @@ def _digest(path: Path) -> str:
 def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
     win, wb = window, window.workbench
     truth = RecordingPlayback(read_recording(recording))
-    live_pair = wb.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    live_pair = wb.session.undo.push(
+        AddPoint3D(wb.session.pairs, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), target=wb.session.target)
+    ).number
     before = _digest(recording)
     win.files.open_recording(recording)
     bar = win.replay
-    assert bar.isVisible() and wb.picking.replaying and not win.commands.live.isChecked()
+    assert bar.isVisible() and wb.frames.replaying and not win.commands.live.isChecked()
     assert "replaying session.mcap" in win.statusBar().currentMessage()
 
     # Scrub to the middle of the pick sequence: that frame, those joints, those pairs, no result yet.
@@ -80,7 +83,7 @@ def test_the_timeline_shows_the_recording_as_it_was(qtbot, window, recording):
 
     # Closing without an edit gives the live session back, pair and all.
     qtbot.mouseClick(bar.close_button, Qt.MouseButton.LeftButton)
-    assert not bar.isVisible() and not wb.picking.replaying and win.commands.live.isChecked()
+    assert not bar.isVisible() and not wb.frames.replaying and win.commands.live.isChecked()
     assert [p.number for p in wb.session.pairs] == [live_pair]
     assert _digest(recording) == before
 
@@ -114,7 +117,7 @@ def test_bad_and_cut_off_recordings(qtbot, window, tmp_path, recording):
     junk.write_bytes(b"not a recording")
     win.files.open_recording(junk)
     assert "not an MCAP recording" in win.results.status.text() and "junk.mcap" in win.results.status.text()
-    assert not win.replay.isVisible() and not wb.picking.replaying
+    assert not win.replay.isVisible() and not wb.frames.replaying
     # A recording cut off by a crash opens with what it holds and offers recovery.
     data = recording.read_bytes()
     cut = tmp_path / "cut.mcap"

@@ -4,6 +4,8 @@ moves picks nothing, overlays of an earlier pose are not drawn over the live ima
 leaves the verdict, a move into an obstacle is refused, a replay solves with the recorded joints, and
 quitting with unsaved work asks."""
 
+from calib_core.calibration.look_solving import calibrate
+from calib_core.calibration.commands import ClearPairs
 import numpy as np
 import trimesh
 from PySide6.QtCore import QPoint, Qt
@@ -64,7 +66,7 @@ def test_a_restored_session_at_home_solves_with_its_own_joints_and_nothing_stale
         c == (0, 220, 255) for *_, c in [(p[0], p[1], p[2], p[3].getRgb()[:3]) for p in overlay.points]
     )  # no reprojected points
     # Quit, start again (a new session on the same cell), the robot at home: the workspace's pairs solve as at the task.
-    wb.session.clear()
+    wb.session.undo.push(ClearPairs(wb.session.pairs))
     assert win.files.open_workspace(tmp_path / "w.json")
     qtbot.keyClick(win, Qt.Key.Key_F5)
     restored = wb.session.result.estimate
@@ -80,7 +82,7 @@ def test_an_implausible_result_is_stored_only_with_a_confirmation(qtbot, window)
     # The pairs solved with the home joints (what the old code did after a restore): 100s of mm off.
     home = wb.cell.home_joints
     obj2world = wb.workcell.component("oru_1_fixture").item2world
-    wb.session.calibrate(wb.intrinsics, obj2world, wb.robot.fk(home, "camera"), wb.robot.fk(home, "tcp"), home)
+    calibrate(wb.session, wb.intrinsics, obj2world, wb.robot.fk(home, "camera"), wb.robot.fk(home, "tcp"), home)
     assert "IMPLAUSIBLE" in win.results.verdict.text() and "model error of 25 mm" in win.results.verdict.text()
     # Solved with the home joints, the look is not one of the task location: it is converted explicitly first.
     convert = f"Convert into {wb.task.name}'s correction"

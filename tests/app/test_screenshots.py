@@ -8,6 +8,7 @@ a wrong colour or a moved pane. ``VIDEOCAL_UPDATE_BASELINES=1`` rewrites the bas
 deliberate change; look at them (and at ``tests/output/*_diff.png``) before committing.
 """
 
+from calib_core.calibration.commands import ClearPairs
 import os
 from pathlib import Path
 
@@ -56,7 +57,7 @@ def calibrated_window(qtbot, tmp_path):
     camera = bed.camera(seed=7)
     image, _ = camera.render(q)
     camera.close()
-    wb.picking.observe_frame(Frame(image, 0, t))
+    wb.frames.observe_frame(Frame(image, 0, t))
     fixture = wb.workcell.component("oru_1_fixture")
     true_cam = bed.true_cam2world(q)
     for name in FEATURES:
@@ -123,7 +124,7 @@ def test_the_comparison_catches_a_missing_overlay(calibrated_window):
     """The tolerance is not so loose that the picks and residuals could vanish unnoticed."""
     win = calibrated_window
     with_marks = _half(_grab(win.camera.view))
-    win.workbench.session.clear()
+    win.workbench.session.undo.push(ClearPairs(win.workbench.session.pairs))
     win.camera.refresh_overlay()
     win.camera.set_edges_image(None)
     without = _half(_grab(win.camera.view))

@@ -1,6 +1,8 @@
 """The operator's files through the real window: recent workspaces, a recording and a workspace saved while
 calibrating, an unsaved session offered from its autosave."""
 
+from calib_core.calibration.commands import ClearPairs
+from calib_core.calibration.commands import AddPoint3D
 from PySide6.QtCore import QSettings, Qt
 
 from app.gui.main_window import MainWindow
@@ -11,9 +13,11 @@ from videocal_sim.sim_site import simulated_cell
 
 def test_recent_files_reopen_a_workspace(qtbot, window, tmp_path):
     win, wb = window, window.workbench
-    wb.session.pick_3d("oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7))
+    wb.session.undo.push(
+        AddPoint3D(wb.session.pairs, "oru_1_fixture", "pin_tip", (1127.5, -421.8, 1367.7), target=wb.session.target)
+    )
     win.files.save_workspace(tmp_path / "w.json")
-    wb.session.clear()
+    wb.session.undo.push(ClearPairs(wb.session.pairs))
     win.files.recent.fill()
     actions = [a for a in win.files.recent.menu.actions() if a.text() == str(tmp_path / "w.json")]
     assert actions
@@ -51,7 +55,7 @@ def test_workspace_and_recording_from_the_window(qtbot, window, tmp_path):
         "pair_accepted",
     ]
     # Clear, then open the saved workspace: the pair comes back.
-    wb.session.clear()
+    wb.session.undo.push(ClearPairs(wb.session.pairs))
     assert len(wb.session.pairs) == 0
     win.files.open_workspace(tmp_path / "w.json")
     assert [p.feature for p in wb.session.pairs] == ["pin_tip"] and win.table.rowCount() == 1

@@ -182,7 +182,7 @@ def test_board_views_captured_from_a_recording_keep_their_recorded_joints(qtbot,
     plan = vision._plan[:4]
     playback = RecordingPlayback(read_recording(tmp_path / "board.mcap"))
     win.files.open_recording(tmp_path / "board.mcap")
-    assert wb.picking.replaying
+    assert wb.frames.replaying
     messages = []
     for q in plan:
         # just before the robot left this pose: frames and joints at rest for 0.3 s and more by then,
@@ -242,7 +242,7 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
     _visit_board_pose(qtbot, win, 0)
     qtbot.mouseClick(vision.capture_button, Qt.MouseButton.LeftButton)
     assert len(vision.capture.views) == 1
-    wb.picking.hold_frame()  # a still held for picking, from before the move: the old code captured it again and again
+    wb.frames.hold_frame()  # a still held for picking, from before the move: the old code captured it again and again
     qtbot.mouseClick(vision.next_pose, Qt.MouseButton.LeftButton)
     confirm_move_if_asked(qtbot, win)
     refusals = []

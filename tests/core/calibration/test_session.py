@@ -1,6 +1,13 @@
 """The calibration workflow without a window, against the simulated test bed: picks, undo and
 redo, the solve, the end-effector displacement against the truth, the stored correction."""
 
+from calib_core.calibration.look_solving import calibrate
+from calib_core.calibration.correction_from_look import StoreLook
+from calib_core.calibration.commands import SetPixel
+from calib_core.calibration.commands import SetEnabled
+from calib_core.calibration.commands import DeletePair
+from calib_core.calibration.commands import ClearPairs
+from calib_core.calibration.commands import AddPoint3D
 import numpy as np
 import pytest
 
@@ -41,9 +48,9 @@ def _pick_all(session, bed, q, names=FEATURES, noise_px=0.2, seed=0):
     cam_true = bed.true_cam2world(q)
     for name in names:
         p_world = apply(fx.item2world, fx.features[name])
-        session.pick_3d("oru_1_fixture", name, p_world)
+        session.undo.push(AddPoint3D(session.pairs, "oru_1_fixture", name, p_world, target=session.target))
         pixel = project(apply(invert(cam_true), p_world[None]), bed.intrinsics)[0] + rng.normal(0, noise_px, 2)
-        session.pick_2d(pixel)
+        session.undo.push(SetPixel(session.pairs, None, pixel))
 
 
 def _look_at_the_approach(bed, noise_px=0.2):
@@ -59,7 +66,7 @@ def _look_at_the_approach(bed, noise_px=0.2):
 
 def _calibrate(session, bed, q):
     fx = bed.workcell.component("oru_1_fixture")
-    return session.calibrate(bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q, "tcp"), q)
+    return calibrate(session, bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q, "tcp"), q)
 
 
 def test_estimated_displacement_matches_the_truth(bed):
@@ -80,7 +87,7 @@ def test_estimated_displacement_matches_the_truth(bed):
 def test_stored_correction_brings_the_real_tool_to_the_target(bed):
     task, s, _ = _look_at_the_approach(bed, noise_px=0.0)
     q_app = s.result.context.joints_deg
-    s.store_correction(task.name)
+    s.undo.push(StoreLook(s, task.name))
     # Uncorrected: the real tool misses the grasp by millimetres; corrected: by far less.
     q_plain = solve_ik(bed.model_robot, task.tcp2base, q_app).q_deg
     miss_plain = np.linalg.norm(pose_difference(bed.true_robot.fk(q_plain), task.tcp2base)[0])
@@ -97,19 +104,19 @@ def test_undo_redo_and_workflow_errors(bed):
     s = CalibrationSession()
     s.set_target("oru_1_fixture")
     with pytest.raises(CalibrationError, match="pick the point on the model"):
-        s.pick_2d((10, 10))
-    n = s.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+        s.undo.push(SetPixel(s.pairs, None, (10, 10)))
+    n = s.undo.push(AddPoint3D(s.pairs, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), target=s.target)).number
     with pytest.raises(CalibrationError, match=f"pair {n} still needs its 2D point"):
-        s.pick_3d("oru_1_fixture", "plate_top_left", (0, 0, 0))
-    s.pick_2d((5.0, 6.0))
+        s.undo.push(AddPoint3D(s.pairs, "oru_1_fixture", "plate_top_left", (0, 0, 0), target=s.target))
+    s.undo.push(SetPixel(s.pairs, None, (5.0, 6.0)))
     with pytest.raises(CalibrationError, match="pick on the target object 'oru_1_fixture'"):
-        s.pick_3d("rack_1", None, (0, 0, 0))
+        s.undo.push(AddPoint3D(s.pairs, "rack_1", None, (0, 0, 0), target=s.target))
     assert s.pairs.get(n).pixel == (5.0, 6.0)
-    s.set_enabled(n, False)
+    s.undo.push(SetEnabled(s.pairs, n, False))
     assert s.pairs.usable() == []
     assert s.undo.undo() == f"Disable pair {n}"
     assert s.pairs.get(n).enabled
-    s.delete(n)
+    s.undo.push(DeletePair(s.pairs, n))
     assert len(s.pairs) == 0
     s.undo.undo()
     assert len(s.pairs) == 1 and s.pairs.get(n).pixel == (5.0, 6.0)
@@ -117,12 +124,12 @@ def test_undo_redo_and_workflow_errors(bed):
     assert s.pairs.get(n).pixel is None
     s.undo.redo()
     assert s.pairs.get(n).pixel == (5.0, 6.0)
-    s.clear()
+    s.undo.push(ClearPairs(s.pairs))
     assert len(s.pairs) == 0
     s.undo.undo()
     assert len(s.pairs) == 1
     with pytest.raises(CalibrationError, match="1 complete pairs; calibrating needs 3"):
-        s.calibrate(bed.intrinsics, np.eye(4), np.eye(4), np.eye(4))
+        calibrate(s, bed.intrinsics, np.eye(4), np.eye(4), np.eye(4))
 
 
 def test_a_solve_is_one_undo_step_that_puts_the_previous_result_back(bed):
@@ -157,8 +164,8 @@ def test_listeners_hear_every_change():
     s = CalibrationSession()
     events = []
     s.pairs.changed.connect(lambda event, number: events.append((event, number)))
-    s.pick_3d("a", None, (0, 0, 1))
-    s.pick_2d((1, 2))
+    s.undo.push(AddPoint3D(s.pairs, "a", None, (0, 0, 1), target=s.target))
+    s.undo.push(SetPixel(s.pairs, None, (1, 2)))
     s.undo.undo()
     s.undo.undo()
     assert events == [("added", 1), ("changed", 1), ("changed", 1), ("removed", 1)]
@@ -175,7 +182,7 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     sigma = np.sqrt(np.diag(look.covariance))
     agreeing = fuse_look(look, np.diag(np.r_[look.displacement_mm, look.rotation_deg] ** 2 + sigma**2))
     assert agreeing.agree
-    c = s.store_correction(task.name, fused=agreeing)
+    c = s.undo.push(StoreLook(s, task.name, fused=agreeing)).correction
     assert np.allclose(c.displacement_mm, agreeing.displacement_mm) and np.allclose(c.delta_base, agreeing.delta_base)
     assert (
         np.all(c.std_displacement_mm < look.std_displacement_mm)
@@ -188,9 +195,9 @@ def test_a_look_weighed_against_a_calibrated_model_stores_the_fused_or_asks(bed)
     )  # a model "certain" the TCP is where it says: millimetres away
     assert not tight.agree
     with pytest.raises(ConfirmationNeeded, match="sigma from the calibrated model"):
-        s.store_correction(task.name, fused=tight)
+        s.undo.push(StoreLook(s, task.name, fused=tight))
     assert s.corrections.latest(task.name) is None  # nothing stored
-    c = s.store_correction(task.name, fused=tight, confirmation="the operator checked the image")
+    c = s.undo.push(StoreLook(s, task.name, fused=tight, confirmation="the operator checked the image")).correction
     assert np.allclose(c.displacement_mm, look.displacement_mm) and "the look alone" in c.source and c.confirmation
 
 
@@ -199,7 +206,7 @@ def test_a_look_stored_alone_carries_the_measured_tool_s_uncertainty(bed):
     axis) is in the stored 1-sigma when no calibrated model is weighed against the look."""
     task, s, look = _look_at_the_approach(bed)
     tool = np.diag([0.05**2] * 3 + [0.01**2] * 3)
-    c = s.store_correction(task.name, tool_covariance=tool)
+    c = s.undo.push(StoreLook(s, task.name, tool_covariance=tool)).correction
     assert np.allclose(c.std_displacement_mm, np.sqrt(look.std_displacement_mm**2 + 0.05**2))
     assert np.allclose(c.std_rotation_deg, np.sqrt(look.std_rotation_deg**2 + 0.01**2))
     assert "measured tool" in c.source and np.allclose(c.displacement_mm, look.displacement_mm)

@@ -35,7 +35,7 @@ def frame_now(core, index: int = 0, image=None, t_s: float | None = None) -> Fra
     if t_s is None:
         t_s = core.observations.history.latest_s or time.monotonic()
     frame = Frame(np.zeros((480, 640, 3), np.uint8) if image is None else image, index, t_s)
-    core.picking.observe_frame(frame)
+    core.frames.observe_frame(frame)
     return frame
 
 

@@ -1,6 +1,10 @@
 """Every image pick bound to its frame and the robot's joints then: the 432 mm correction of a restored
 session, picks while the robot moves, pairs from two poses, a link that drops, and plausibility."""
 
+from calib_core.calibration.look_solving import calibrate
+from calib_core.calibration.commands import SetPixel
+from calib_core.calibration.commands import ClearPairs
+from calib_core.calibration.commands import AddPoint3D
 import numpy as np
 import pytest
 
@@ -69,8 +73,8 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
     core, _ = _picked_at_task(cell, site)
     obj2world = core.workcell.component(core.session.target).item2world
     home = cell.home_joints
-    result = core.session.calibrate(
-        core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home
+    result = calibrate(
+        core.session, core.intrinsics, obj2world, core.robot.fk(home, "camera"), core.robot.fk(home, "tcp"), home
     )
     assert np.linalg.norm(result.displacement_mm) > 100.0
     verdict = core.session.result.verdict
@@ -102,7 +106,7 @@ def test_a_result_whose_pairs_changed_is_stale_and_cannot_be_stored(cell_and_sit
         core.desk.store_correction()
     core.undo()  # the pair is back as it was: the result is current again
     assert core.session.stale_reason is None
-    core.session.clear()
+    core.session.undo.push(ClearPairs(core.session.pairs))
     assert "no longer used" in core.session.stale_reason
     assert core.observations.still is None  # no image point left: the still is let go
 
@@ -135,7 +139,7 @@ def test_a_link_that_drops_leaves_the_pose_unknown_until_a_fresh_sample(cell_and
     still_for(core)
     core.arm._on_link_state("down", "device lost")
     frame_now(core)
-    assert not core.picking.robot_settled().settled and "pose is unknown" in core.picking.robot_settled().reason
+    assert not core.frames.robot_settled().settled and "pose is unknown" in core.frames.robot_settled().reason
     core.picking.pick_model_point(core.task.component, "pin_tip", (0.0, 0.0, 0.0))
     with pytest.raises(NotSettledError, match="link dropped"):
         core.picking.pick_image_point((10.0, 10.0))
@@ -149,8 +153,12 @@ def test_pairs_without_a_robot_pose_are_not_solved(cell_and_site):
     cell, site = cell_and_site
     core = OperatorCore(cell, site)
     for k, name in enumerate(FEATURES[:4]):
-        core.session.pick_3d(core.task.component, name, (float(k), 0.0, 0.0))
-        core.session.pick_2d((10.0 * k, 5.0))  # a script's picks, outside the core's frames
+        core.session.undo.push(
+            AddPoint3D(core.session.pairs, core.task.component, name, (float(k), 0.0, 0.0), target=core.session.target)
+        )
+        core.session.undo.push(
+            SetPixel(core.session.pairs, None, (10.0 * k, 5.0))
+        )  # a script's picks, outside the core's frames
     with pytest.raises(CalibrationError, match="pairs 1, 2, 3, 4 carry no robot pose"):
         core.picking.calibrate()
 

@@ -3,6 +3,7 @@ picks are made on its image, Find points and its edge fit work on it, and the so
 the bundled lens. The lens is the bundled camera's focal length and principal point with OpenCV's fisheye model
 (its corners 175 px from where a pinhole would put them). The truth only scores."""
 
+from calib_core.calibration.commands import ClearPairs
 import numpy as np
 import pytest
 
@@ -53,7 +54,7 @@ def test_the_lens_moves_a_feature_by_pixels_and_the_cell_uses_it(fisheye_look):
 
 def test_hand_picks_on_the_fisheye_image_solve_to_the_true_camera(fisheye_look):
     core, site, q, _ = fisheye_look
-    core.session.clear()
+    core.session.undo.push(ClearPairs(core.session.pairs))
     pick_all(core, site.bed, q)
     estimate = core.picking.calibrate()
     error, model_error = _camera_error(core, site, q, estimate)
@@ -62,7 +63,7 @@ def test_hand_picks_on_the_fisheye_image_solve_to_the_true_camera(fisheye_look):
 
 def test_find_points_and_the_edge_fit_work_through_the_fisheye(fisheye_look):
     core, site, q, _ = fisheye_look
-    core.session.clear()
+    core.session.undo.push(ClearPairs(core.session.pairs))
     found = core.finder.find_points()
     assert found.result.found, found.result.message
     core.finder.accept_found_points()

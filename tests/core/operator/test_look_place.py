@@ -1,6 +1,7 @@
 """A correction is bound to where its look was made: a look from the approach pose or from a
 recording is a measurement at its own pose, never the task's correction unless converted explicitly."""
 
+from calib_core.calibration.commands import ClearPairs
 import numpy as np
 import pytest
 
@@ -87,7 +88,7 @@ def test_looks_at_the_task_and_at_its_corrected_pose_count(cell_and_site):
     first = core.desk.store_correction()
     corrected = core.session.corrections.corrected_target(core.task.name, core.task.tcp2base)
     q_corrected = solve_ik(core.robot, corrected, core.cell.home_joints).q_deg
-    core.session.clear()
+    core.session.undo.push(ClearPairs(core.session.pairs))
     still_for(core, joints_deg=q_corrected)
     frame_now(core, index=1)
     _pick_all(core, site.bed, q_corrected)
@@ -105,14 +106,14 @@ def test_a_look_on_a_recording_is_not_the_live_tasks_correction(cell_and_site, n
     core = OperatorCore(cell, site)
     q = _at_task(core)
     times = np.arange(0.0, 1.0, 0.02)  # a still robot on the recording's time axis, then a frame of it
-    core.picking.begin_replay(
+    core.frames.begin_replay(
         JointHistory.from_arrays(times, np.tile(q, (len(times), 1)), core.workcell.safety.settle_rule),
         name,
     )
-    core.picking.observe_frame(Frame(np.zeros((480, 640, 3), np.uint8), 3, float(times[-1])), replayed=True)
+    core.frames.observe_frame(Frame(np.zeros((480, 640, 3), np.uint8), 3, float(times[-1])), replayed=True)
     _pick_all(core, site.bed, q)
     core.picking.calibrate()
-    core.picking.end_replay()  # "Close replay": the branched session stays open
+    core.frames.end_replay()  # "Close replay": the branched session stays open
     place = core.desk.look_place()
     assert place.at == "recording" and place.source == name
     with pytest.raises(LookNotAtTask, match=f"on the recording {name}"):

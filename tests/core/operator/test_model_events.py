@@ -1,6 +1,7 @@
 """The core's events say what changed and only when it did: joints on a change, not on every
 sample; solve options through the undo stack with their own event."""
 
+from calib_core.calibration.solve_options import SetOption
 import numpy as np
 
 from calib_core.operator.core import OperatorCore
@@ -27,8 +28,8 @@ def test_solve_options_are_undoable_and_announced():
     core = OperatorCore(cell, site)
     changes = []
     core.session.options.changed.connect(lambda name, value: changes.append((name, value)))
-    core.session.set_option("robust", True)
-    core.session.set_option("robust", True)  # no change: no event, no undo entry
+    core.session.undo.push(SetOption(core.session.options, "robust", True))
+    core.session.undo.push(SetOption(core.session.options, "robust", True))  # no change: no event, no undo entry
     assert core.session.options.robust and changes == [("robust", True)]
     assert core.undo() == "Use the robust option"
     assert not core.session.options.robust and changes[-1] == ("robust", False)

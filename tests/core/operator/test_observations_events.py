@@ -22,28 +22,28 @@ def test_one_model_across_a_replay_and_the_still_told_only_on_change():
 
     still_for(core)
     live = frame_now(core, index=1)
-    held = core.picking.hold_frame()
-    core.picking.release_frame()
-    core.picking.release_frame()  # nothing held: nothing to tell
+    held = core.frames.hold_frame()
+    core.frames.release_frame()
+    core.frames.release_frame()  # nothing held: nothing to tell
     assert frames == [live] and stills == [held, None]
 
-    core.picking.hold_frame()
+    core.frames.hold_frame()
     times = np.linspace(0.0, 2.0, 101)
-    core.picking.begin_replay(
+    core.frames.begin_replay(
         JointHistory.from_arrays(times, np.tile(core.joints_deg, (len(times), 1)), core.workcell.safety.settle_rule),
         "take.mcap",
     )
-    assert core.observations is obs and core.picking.replaying and sources == ["take.mcap"]
+    assert core.observations is obs and core.frames.replaying and sources == ["take.mcap"]
     assert stills[-1] is None and obs.still is None  # a replay lets the live still go
     assert obs.latest is None  # the live frames are not the recording's
     frame_now(core, index=2)  # a live frame during a replay is not observed
     replayed = Frame(np.zeros((480, 640, 3), np.uint8), 5, 2.0)
-    core.picking.observe_frame(replayed, replayed=True)
+    core.frames.observe_frame(replayed, replayed=True)
     assert frames[-1] is replayed and len(frames) == 2
     assert obs.stamp(replayed).source == "take.mcap"
 
-    core.picking.end_replay()
-    assert not core.picking.replaying and sources == ["take.mcap", "live"] and obs.latest is None
+    core.frames.end_replay()
+    assert not core.frames.replaying and sources == ["take.mcap", "live"] and obs.latest is None
     still_for(core)
     again = frame_now(core, index=3)
     assert frames[-1] is again and obs.history is obs.live_history

@@ -2,6 +2,8 @@
 solve at a position; the first edit branches; closing gives the live session back; a file that is no recording
 changes nothing."""
 
+from calib_core.calibration.commands import DeletePair
+from calib_core.calibration.commands import AddPoint3D
 import hashlib
 import shutil
 from pathlib import Path
@@ -33,10 +35,12 @@ def recording(tmp_path):
 def test_the_recording_as_it_stood_then_and_the_live_session_back_after(core, recording):
     truth = RecordingPlayback(read_recording(recording))
     before = hashlib.sha256(recording.read_bytes()).digest()
-    live = core.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    live = core.session.undo.push(
+        AddPoint3D(core.session.pairs, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), target=core.session.target)
+    ).number
     core.replay.open(recording)
     first = core.replay.seek(0.0)
-    assert core.picking.replaying and core.replay.state_text() == "0 pairs, 0 solves so far"
+    assert core.frames.replaying and core.replay.state_text() == "0 pairs, 0 solves so far"
     assert first is not None and np.array_equal(first.image, truth.frames.image(truth.frame_index_at(0.0)))
     assert core.replay.seek(0.0) is None  # the same frame is not handed out twice
 
@@ -50,15 +54,19 @@ def test_the_recording_as_it_stood_then_and_the_live_session_back_after(core, re
 
     branched = []
     core.replay.branched.connect(branched.append)
-    core.session.delete(core.session.pairs.pairs()[0].number)  # the operator's first edit
+    core.session.undo.push(
+        DeletePair(core.session.pairs, core.session.pairs.pairs()[0].number)
+    )  # the operator's first edit
     assert branched == [truth.duration_s] and core.replay.state_text() == f"branched at {truth.duration_s:.1f} s"
     assert core.replay.close() is True  # the branched session stays
-    assert not core.picking.replaying and live not in [p.number for p in core.session.pairs]
+    assert not core.frames.replaying and live not in [p.number for p in core.session.pairs]
     assert hashlib.sha256(recording.read_bytes()).digest() == before  # only ever read
 
 
 def test_closing_an_unbranched_replay_gives_the_live_session_back(core, recording):
-    live = core.session.pick_3d("oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0))
+    live = core.session.undo.push(
+        AddPoint3D(core.session.pairs, "oru_1_fixture", "pin_tip", (1.0, 2.0, 3.0), target=core.session.target)
+    ).number
     intrinsics = core.intrinsics
     core.replay.open(recording)
     core.replay.seek(1e9)
@@ -71,7 +79,7 @@ def test_a_file_that_is_no_recording_is_refused_by_name_and_nothing_changes(core
     bad.write_bytes(b"not a recording at all")
     with pytest.raises(FileFormatError, match="notes.mcap"):
         core.replay.open(bad)
-    assert core.replay.playback is None and not core.picking.replaying
+    assert core.replay.playback is None and not core.frames.replaying
 
 
 def test_a_recording_named_live_branched_and_solved_is_no_correction_of_the_live_task(core, tmp_path):
@@ -85,7 +93,7 @@ def test_a_recording_named_live_branched_and_solved_is_no_correction_of_the_live
     truth = RecordingPlayback(read_recording(path))
     core.replay.seek(truth.duration_s)
     assert all(p.view is None or p.view.recorded for p in core.session.pairs)
-    core.session.delete(core.session.pairs.pairs()[0].number)  # branch
+    core.session.undo.push(DeletePair(core.session.pairs, core.session.pairs.pairs()[0].number))  # branch
     core.picking.calibrate()
     assert core.session.result.context.view_sources  # the recording, by name
     place = core.desk.look_place()

@@ -1,5 +1,9 @@
 """The workspace file: round trip, atomic save, every kind of bad file; the correction exports."""
 
+from calib_core.calibration.look_solving import calibrate
+from calib_core.calibration.correction_from_look import StoreLook
+from calib_core.calibration.commands import SetPixel
+from calib_core.calibration.commands import AddPoint3D
 import csv
 import io
 import json
@@ -31,12 +35,20 @@ def workspace():
     fx = cell.component("oru_1_fixture")
     for name in ("plate_top_left", "plate_top_right", "plate_bottom_right", "plate_bottom_left", "pin_tip"):
         p = apply(fx.item2world, fx.features[name])
-        s.pick_3d("oru_1_fixture", name, p)
-        s.pick_2d(project(apply(invert(bed.true_cam2world(q)), p[None]), bed.intrinsics)[0])
-    s.pick_3d("oru_1_fixture", "boss_top_left", apply(fx.item2world, fx.features["boss_top_left"]))  # half a pair
+        s.undo.push(AddPoint3D(s.pairs, "oru_1_fixture", name, p, target=s.target))
+        s.undo.push(SetPixel(s.pairs, None, project(apply(invert(bed.true_cam2world(q)), p[None]), bed.intrinsics)[0]))
+    s.undo.push(
+        AddPoint3D(
+            s.pairs,
+            "oru_1_fixture",
+            "boss_top_left",
+            apply(fx.item2world, fx.features["boss_top_left"]),
+            target=s.target,
+        )
+    )  # half a pair
     for _ in range(2):
-        s.calibrate(bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q), q)
-        s.store_correction(task.name)
+        calibrate(s, bed.intrinsics, fx.item2world, bed.model_cam2world(q), bed.model_robot.fk(q), q)
+        s.undo.push(StoreLook(s, task.name))
     return Workspace(
         str(cell.path), bed.intrinsics, dict(cell.task_locations), s.target, s.pairs.pairs(), s.corrections
     )
