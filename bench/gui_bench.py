@@ -223,7 +223,7 @@ def main() -> str:
     lat = []
     for _ in range(10):
         t_arrive = time.monotonic()
-        wb.observe_sample(
+        wb.arm.observe_sample(
             type(
                 "S",
                 (),

@@ -64,7 +64,7 @@ def main(out: Path = OUT) -> None:
         bed.joints_deg = q_home + (q_task - q_home) * (3 * s * s - 2 * s * s * s)  # smooth start and stop
         if clock.t_s == t_joint:
             q = cell.joint_map.to_controller(bed.joints_deg)
-            core.observe_sample(
+            core.arm.observe_sample(
                 TimedSample(JointSample(n_joint, int(round(20 * n_joint)), tuple(float(v) for v in q)), clock.t_s)
             )
             n_joint += 1

@@ -294,3 +294,102 @@ def test_no_test_module_imports_another():
         if (found := _test_modules_imported(p.read_text()))
     }
     assert not importing, importing
+
+
+_CORE_PARTS = {
+    "log",
+    "cell",
+    "session",
+    "tasks",
+    "observations",
+    "frames",
+    "refining",
+    "arm",
+    "picking",
+    "finder",
+    "moves",
+    "robot_calibration",
+    "recording",
+    "tool",
+    "desk",
+    "vision",
+    "replay",
+    "files",
+    "editor",
+}
+
+
+def _reaches_a_part_through_another(source: str) -> list[str]:
+    """``self.<given>.<part>``: code reaching one of the core's parts through another part it was given (the vision
+    panel once said its messages through ``self.vision.log``)."""
+    return sorted(
+        f"{n.lineno}: self.{n.value.attr}.{n.attr}"
+        for n in ast.walk(ast.parse(source))
+        if isinstance(n, ast.Attribute)
+        and n.attr in _CORE_PARTS
+        and isinstance(n.value, ast.Attribute)
+        and isinstance(n.value.value, ast.Name)
+        and n.value.value.id == "self"
+    )
+
+
+def test_no_widget_reaches_a_part_through_another():
+    assert _reaches_a_part_through_another("class V:\n    def f(self):\n        self.vision.log.say('x')\n") == [
+        "3: self.vision.log"
+    ]
+    reaching = {
+        p.name: found
+        for p in (ROOT / "app" / "gui").glob("*.py")
+        if p.name != "main_window.py" and (found := _reaches_a_part_through_another(p.read_text()))
+    }
+    assert not reaching, f"given a part and reaching another through it: {reaching}"
+
+
+_MANY_MEMBERS = 12
+"""About ten: a class of the core with more public members says why in its docstring ("public members")."""
+
+
+def _public_members(cls: ast.ClassDef) -> set[str]:
+    """A class's public methods and properties, its psygnal signals, and the public attributes its ``__init__`` sets."""
+    names = set()
+    for node in cls.body:
+        if isinstance(node, ast.FunctionDef) and not node.name.startswith("_"):
+            names.add(node.name)
+        elif isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
+            if getattr(node.value.func, "id", None) == "Signal":
+                names |= {t.id for t in node.targets if isinstance(t, ast.Name) and not t.id.startswith("_")}
+        elif isinstance(node, ast.FunctionDef) and node.name == "__init__":
+            for assign in ast.walk(node):
+                targets = assign.targets if isinstance(assign, ast.Assign) else [getattr(assign, "target", None)]
+                for target in targets:
+                    for t in target.elts if isinstance(target, ast.Tuple) else [target]:
+                        if (
+                            isinstance(t, ast.Attribute)
+                            and isinstance(t.value, ast.Name)
+                            and t.value.id == "self"
+                            and not t.attr.startswith("_")
+                        ):
+                            names.add(t.attr)
+    return names
+
+
+def _crowded_without_reason(source: str) -> list[str]:
+    return [
+        f"{node.name} ({len(members)})"
+        for node in ast.parse(source).body
+        if isinstance(node, ast.ClassDef)
+        and len(members := _public_members(node)) > _MANY_MEMBERS
+        and "public members" not in (ast.get_docstring(node) or "")
+    ]
+
+
+def test_no_class_of_the_core_holds_many_members_without_saying_why():
+    probe = "class C:\n    def __init__(self):\n" + "".join(f"        self.a{k} = {k}\n" for k in range(13))
+    assert _crowded_without_reason(probe) == ["C (13)"]
+    assert _crowded_without_reason('class C:\n    """Its public members: ..."""\n' + probe.split("\n", 1)[1]) == []
+    crowded = {
+        str(p.relative_to(ROOT)): found
+        for p in (ROOT / "calib_core").rglob("*.py")
+        if (found := _crowded_without_reason(p.read_text()))
+    }
+    assert not crowded, crowded

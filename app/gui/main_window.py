@@ -52,7 +52,11 @@ class MainWindow(QMainWindow):
         self.commands = CommandPanel(workbench.cell, workbench.session, workbench.tasks, workbench.editor)
         self.replay = ReplayBar(workbench.replay, lambda frame: workbench.frames.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(
-            workbench.vision, workbench.moves, self.show_error, lambda send: self.actions.move(send)
+            workbench.vision,
+            workbench.moves,
+            self.show_error,
+            lambda send: self.actions.move(send),
+            say=workbench.log.say,
         )
         self.vision.board_detected.connect(self.camera.set_board_corners)
         self.robot_calibration = RobotPanel(
@@ -213,7 +217,7 @@ class MainWindow(QMainWindow):
         c.live.toggled.connect(self._live_toggled)
         wb.arm.joints_changed.connect(self._on_joints)
         self.replay.closed.connect(self._replay_closed)
-        wb.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
+        wb.log.message.connect(lambda text: self.statusBar().showMessage(text, 8000))
         self.finder = FindPoints(wb.finder, self, self.show_error, self.statusBar().showMessage)
         self.calibration_menu.addAction(self.finder.action)
         self.commands.find_points.clicked.connect(self.finder.run)

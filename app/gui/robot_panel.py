@@ -151,12 +151,12 @@ class RobotPanel(QWidget):
             row.addWidget(b)
         vl.addLayout(row)
 
-        self.tool = ToolGroup(measuring, show_error, self._refresh)
+        self.tool_group = ToolGroup(measuring, show_error, self._refresh)
         layout = QVBoxLayout(self)
         layout.addWidget(plan)
         layout.addWidget(run)
         layout.addWidget(review)
-        layout.addWidget(self.tool)
+        layout.addWidget(self.tool_group)
         layout.addStretch(1)
         self._refresh()
 
@@ -276,13 +276,13 @@ class RobotPanel(QWidget):
 
     def revert(self) -> None:
         self.robot_calibration.revert_robot_calibration()
-        self.tool.tool = None
+        self.tool_group.measured_tool = None
         self._refresh()
 
     def save(self, folder) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.robot_calibration.save_robot_calibration(folder, self.result, self.tool.tool)
+        self.robot_calibration.save_robot_calibration(folder, self.result, self.tool_group.measured_tool)
 
     def _save_dialog(self) -> None:
         folder = QFileDialog.getExistingDirectory(self, "Save the robot calibration into")

@@ -18,7 +18,7 @@ class ToolGroup(QGroupBox):
         super().__init__("Camera to tool", parent)
         self.measuring = measuring  # the core's ToolMeasuring
         self.changed = changed
-        self.tool = None
+        self.measured_tool = None
         guard = guarded(show_error)
         layout = QVBoxLayout(self)
         how = QLabel(
@@ -66,7 +66,7 @@ class ToolGroup(QGroupBox):
         self.refresh()
 
     def measure(self) -> None:
-        t = self.tool = self.measuring.measure_tool()
+        t = self.measured_tool = self.measuring.measure_tool()
         self.text.setText(
             f"TCP from {len(t.per_grasp)} grasps ({t.seen_grasps} seen by the camera), spread {t.spread_mm:.3f} mm, "
             f"{t.spread_deg:.4f} deg: "

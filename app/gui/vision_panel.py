@@ -54,10 +54,12 @@ class VisionPanel(QWidget):
         moves: Moves,
         show_error: Callable[[str], None],
         move: Callable | None = None,
+        say: Callable[[str], None] = lambda text: None,
         parent=None,
     ):
         super().__init__(parent)
         self.vision, self.moves = vision, moves
+        self._say = say  # the operator's log: what the panel declined to do
         self._move = move or (lambda send: send(False))  # the window previews and confirms moves
         guard = guarded(show_error)
         self._intrinsics_text = ""  # both results stay on screen, one under the other
@@ -203,7 +205,6 @@ class VisionPanel(QWidget):
 
     def _show_board_toggled(self, on: bool) -> None:
         self.vision.show_board(None, on)
-        self.vision.log.say("calibration board put up in front of the robot" if on else "calibration board taken down")
 
     def _next_pose(self) -> None:
         q, what = self.vision.next_board_pose()
@@ -340,7 +341,7 @@ class VisionPanel(QWidget):
             [f"The {what} failed its checks:", *[f"- {p}" for p in problems], "", f"Use this {what} anyway?"]
         )
         if not ask(self, f"Apply a {what} that failed its checks?", text, "Apply anyway"):
-            self.vision.log.say(f"{what} not applied")
+            self._say(f"{what} not applied")
             return None
         return list(problems)
 

@@ -74,7 +74,10 @@ class BagFrames:
 class BagPlayback:
     """A bag as a replay: ``frames`` (:class:`BagFrames`), ``joint_times_s`` (m,) and ``joints_deg`` (m, n) model joints
     (deg, mm; empty for a bag without the arm's joint states), ``setup`` (``{"intrinsics": ...}`` from its CameraInfo),
-    ``duration_s``, no ``solves``. Close it (or use it as a context manager) to close the bag."""
+    ``duration_s``, no ``solves``. Close it (or use it as a context manager) to close the bag.
+
+    Its public members are the recording playback protocol the replay reads (the frames, the joints and their times, the
+    set-up, the solves, the pairs at a time) and what the bag was read from."""
 
     def __init__(
         self, path: str | Path, joint_names, per_si, *, topic: str | None = None, joint_topic: str | None = None

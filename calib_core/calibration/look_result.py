@@ -73,6 +73,10 @@ class LookResult:
     """The last solve's result and its verdict. ``estimate`` is ``None`` before a solve.
 
     Event (psygnal): ``changed()`` after every solve shown, candidate chosen, result cleared or verdict judged again.
+
+    Its public members: the result (estimate, context, the chosen candidate, the numbers solved, the solve's inputs),
+    its verdict with the limits and the task's tolerance it is judged by, whether it still belongs to the pairs, and the
+    changes made to it (show, select, clear, judge).
     """
 
     changed = Signal()

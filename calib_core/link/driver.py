@@ -80,7 +80,11 @@ class ControllerLink(ConnectorEvents):
     handshake, move acknowledgements and a ``$STA`` every :data:`PING_EVERY_S` when nothing else was): the
     dead-man time sent to the controller is ``deadman_ms`` plus the round trip's timeout (a heartbeat
     held up on a slow link is no reason to stop the robot), a link is stale only after ``stale_after_s``
-    plus the round trip's spread, and a hello waits at least the round trip's timeout."""
+    plus the round trip's spread, and a hello waits at least the round trip's timeout.
+
+    Its public members are the connector protocol (start, close, latest, delay_s, stats_snapshot, move_joints, stop),
+    the protocol's own requests (state, version, samples), the dead-man and staleness read-outs, the authentication
+    state and the configuration read from its URL."""
 
     def __init__(
         self,

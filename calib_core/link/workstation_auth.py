@@ -45,7 +45,10 @@ class AuthState(str, Enum):
 
 class WorkstationAuth:
     """The workstation's side of the link's handshake. ``settled(state, failure)`` when a handshake
-    ends (on the link's reader thread)."""
+    ends (on the link's reader thread).
+
+    Its public members are the handshake's steps as the link's reader calls them (hello, each reply, a lost session, a
+    timeout), the sealing of each request, and the state it settled in with why."""
 
     settled = Signal(object, object)
 

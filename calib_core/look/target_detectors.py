@@ -58,7 +58,10 @@ def circle_rim(
 
 class TargetDetectors:
     """The detectors of one image and one target: the gradient computed once, the edges that end at
-    each corner found once."""
+    each corner found once.
+
+    Its public members are what its detectors share of one image and one model view (the grey image and its gradient,
+    the rendered expectation and its gradient, the model's segments and normals, the box corners) and ``detect``."""
 
     def __init__(self, evidence: ImageEvidence, item: SceneItem, intrinsics: Intrinsics, expected=None):
         self.grey = evidence.grey

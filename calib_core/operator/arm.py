@@ -36,7 +36,12 @@ class Arm:
     ``move_previewed(preview)`` (a :class:`~calib_core.operator.move_preview.MovePreview`, before every
     move, sent or not), ``move_finished(what, error)`` (``error`` empty when the move arrived),
     ``prompts_withdrawn()`` (a Stop voided every move prompt still waiting), ``message(text)`` (for a
-    status line) and ``event(kind, detail)`` (worth recording)."""
+    status line) and ``event(kind, detail)`` (worth recording).
+
+    Its public members are many for a reason: nine events (one for each thing a view shows of the robot), the robot's
+    state as the views read it (joints, motion, link, controller clock, last sample, last move sent, stops sent, the
+    move waiting for confirmation) and its few actions (connect, close, a sample observed, show joints, preview, move,
+    Stop)."""
 
     joints_changed = Signal(object)
     sample_received = Signal(object, object)

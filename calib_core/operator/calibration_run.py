@@ -48,7 +48,7 @@ class CalibrationRun:
     finished = Signal(str)
 
     def __init__(self, arm: Arm, log: OperatorLog, spec, plan: list[np.ndarray], cell_views=()):
-        self.arm, self.log = arm, log
+        self._arm, self._log = arm, log
         self.capture = BoardCapture(spec)
         self.components = [None] * len(plan) + [c for c, _ in cell_views]
         self.plan = [np.asarray(q, dtype=float) for q in plan] + [np.asarray(q, dtype=float) for _, q in cell_views]
@@ -68,8 +68,8 @@ class CalibrationRun:
     def start(self) -> None:
         if not self.plan:
             raise VideocalError("no poses planned: plan the robot calibration first")
-        self.arm.motion_changed.connect(self._on_motion)
-        self.arm.observations.frame_observed.connect(self._on_frame)
+        self._arm.motion_changed.connect(self._on_motion)
+        self._arm.observations.frame_observed.connect(self._on_frame)
         self._visit()
 
     def stop(self, why: str = "stopped by the operator") -> None:
@@ -83,14 +83,14 @@ class CalibrationRun:
 
     def _end(self, phase: str, text: str) -> None:
         self.phase = phase
-        self.arm.motion_changed.disconnect(self._on_motion)
-        self.arm.observations.frame_observed.disconnect(self._on_frame)
+        self._arm.motion_changed.disconnect(self._on_motion)
+        self._arm.observations.frame_observed.disconnect(self._on_frame)
         self._say(text)
         self.finished.emit(text)
 
     def _say(self, text: str) -> None:
         self.progress.emit(RunProgress(self.index, len(self.plan), self.phase, text))
-        self.log.say(text)
+        self._log.say(text)
 
     def _visit(self) -> None:
         if self.index >= len(self.plan):
@@ -103,7 +103,7 @@ class CalibrationRun:
             return
         self.phase, self._tries = MOVING, 0
         try:
-            self.arm.move_joints(self.plan[self.index], self.what, confirmed=True)
+            self._arm.move_joints(self.plan[self.index], self.what, confirmed=True)
         except VideocalError as exc:
             self.stop(str(exc))
             return
@@ -122,10 +122,10 @@ class CalibrationRun:
             self.stop(state.text)
 
     def _on_frame(self, frame) -> None:
-        if self.phase != SETTLING or not self.arm.observations.stillness(frame).settled:
+        if self.phase != SETTLING or not self._arm.observations.stillness(frame).settled:
             return
         try:
-            joints = np.array(self.arm.observations.stamp(frame).joints_deg)
+            joints = np.array(self._arm.observations.stamp(frame).joints_deg)
         except VideocalError:  # settled, but its joints not known yet (a sample late): the next frame
             return
         if self.components[self.index] is not None:

@@ -51,7 +51,11 @@ class MountingResult:
 class CameraCalibrating:
     """``capture`` (the board's views), ``intrinsics_result`` and ``mounting`` (the last calibrations, or ``None``),
     ``plan`` (robot poses that see the board). ``changed`` after every capture, removal, calibration or new board;
-    ``board_put_up(extras)`` when a board goes up in the cell or comes down (``[]``)."""
+    ``board_put_up(extras)`` when a board goes up in the cell or comes down (``[]``).
+
+    Its public members are the Vision tab's workflow, a step each: the board (set, placed, shown, the poses that see
+    it), the views (capture, read a set, remove), the intrinsics and the mounting (calibrate, check, apply, save) and
+    the state the tab shows."""
 
     changed = Signal()
     board_put_up = Signal(list)
@@ -64,7 +68,7 @@ class CameraCalibrating:
         arm: Arm,
         log: OperatorLog,
     ):
-        self.cell, self.frames, self.observations, self.arm, self.log = cell, frames, observations, arm, log
+        self._cell, self._frames, self._observations, self._arm, self._log = cell, frames, observations, arm, log
         self.capture = BoardCapture(parse_board(DEFAULT_SPEC))
         self.intrinsics_result = None
         self.mounting: MountingResult | None = None
@@ -80,7 +84,7 @@ class CameraCalibrating:
         if str(spec) == str(self.capture.spec):
             return
         if self.capture.views:
-            self.log.say(
+            self._log.say(
                 f"board changed to {spec}: the {len(self.capture.views)} views of the old board were set aside"
             )
         self.capture = BoardCapture(spec)
@@ -94,7 +98,7 @@ class CameraCalibrating:
         within its reach. ``board2base`` (4, 4) mm."""
         from calib_core.vision.board_placement import board_in_cell
 
-        return board_in_cell(spec or self.capture.spec, self.cell.workcell, self.cell.robot)
+        return board_in_cell(spec or self.capture.spec, self._cell.workcell, self._cell.robot)
 
     def show_board(self, spec=None, on: bool = True) -> np.ndarray:
         """Put a board (this part's, or ``spec``: the robot calibration's) up in the cell, or take it down.
@@ -105,7 +109,9 @@ class CameraCalibrating:
         board2base = self.board_placement(spec)
         extras = [board_item(spec, board2base)] if on else []
         self.board_put_up.emit(list(extras))
-        self.cell.put_up(extras)
+        self._cell.put_up(extras)
+        if on != self.board_shown:
+            self._log.say("calibration board put up in front of the robot" if on else "calibration board taken down")
         self.board_shown = on
         return board2base
 
@@ -116,10 +122,10 @@ class CameraCalibrating:
         from calib_core.operator.move_preview import joint_path
         from calib_core.vision.board_placement import board_view_joints
 
-        world = self.cell.collision_world()
+        world = self._cell.collision_world()
         spec = self.capture.spec
-        plan, q = [], np.asarray(self.arm.joints_deg, dtype=float)
-        for goal in board_view_joints(self.cell.robot, self.cell.home_joints, spec, self.board_placement(spec), n):
+        plan, q = [], np.asarray(self._arm.joints_deg, dtype=float)
+        for goal in board_view_joints(self._cell.robot, self._cell.home_joints, spec, self.board_placement(spec), n):
             if not any(world.check(p) for p in joint_path(q, goal)):
                 plan.append(goal)
                 q = goal
@@ -154,7 +160,7 @@ class CameraCalibrating:
             image = posed.read_image(view)
             capture.add(image, view.joints_deg, flange2base=view.flange2base, name=view.image_path.stem)
         self.capture, self.intrinsics_result, self.mounting = capture, None, None
-        self.log.say(
+        self._log.say(
             f"{len(capture.views)} of {len(posed.views)} views of {posed.source.name} read"
             + (f"; {len(capture.rejected)} rejected (see the list)" if capture.rejected else "")
         )
@@ -165,18 +171,18 @@ class CameraCalibrating:
     def capture_view(self):
         """Detect the board in the newest frame (taken after the last move, once the robot had settled) and keep it
         with the joints then; a :class:`RejectedView` says why not. Both are said in the log."""
-        frame, stamp = self.frames.frame_to_capture()
+        frame, stamp = self._frames.frame_to_capture()
         joints = None if stamp is None else np.array(stamp.joints_deg)
         view = self.capture.add(
             frame.image,
             joints,
-            frame_key=(self.observations.live, self.observations.source, frame.index, frame.t_host_s),
+            frame_key=(self._observations.live, self._observations.source, frame.index, frame.t_host_s),
         )
         if isinstance(view, RejectedView):
-            self.log.say(f"{view.name} rejected: {view.reason}")
+            self._log.say(f"{view.name} rejected: {view.reason}")
         else:
             lost = views_with_lost_corners([len(v.ids) for v in self.capture.views]).get(len(self.capture.views) - 1)
-            self.log.say(
+            self._log.say(
                 f"{view.name}: {len(view.ids)} corners"
                 + ("" if joints is not None else " (no robot pose: not usable for hand-eye)")
                 + (
@@ -204,26 +210,26 @@ class CameraCalibrating:
         """What the last intrinsics calibration's checks found (against the intrinsics in use)."""
         if self.intrinsics_result is None:
             return []
-        return intrinsics_problems(self.intrinsics_result, self.cell.intrinsics)
+        return intrinsics_problems(self.intrinsics_result, self._cell.intrinsics)
 
     def calibrate_mounting(self) -> MountingResult:
         """The camera's mounting on the flange from the views with their joints, through the calibrated intrinsics
         if there are any, with its distance from the model's mounting and its checks."""
-        intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self.cell.intrinsics
-        robot = self.cell.robot
+        intrinsics = self.intrinsics_result.intrinsics if self.intrinsics_result is not None else self._cell.intrinsics
+        robot = self._cell.robot
         calibration = self.capture.calibrate_hand_eye(robot, intrinsics)
         modelled = concat(robot.frame_placement("camera"), invert(robot.frame_placement("flange")))
         d, rot = pose_difference(calibration.cam2flange, modelled)
         off = (float(np.linalg.norm(d)), float(np.linalg.norm(rot)))
         noise = self.intrinsics_result.rms_px if self.intrinsics_result is not None else None
-        problems = hand_eye_problems(calibration, off, noise, self.cell.workcell.safety)
+        problems = hand_eye_problems(calibration, off, noise, self._cell.workcell.safety)
         names = [v.name for v in self.capture.views]
         apart = calibration.poses.per_view_mm if calibration.poses is not None else [0.0] * len(names)
         checks = view_checks(names, calibration.per_view_rms_px, apart)
         self.mounting = MountingResult(calibration, off[0], off[1], problems, checks)
         odd = [c for c in checks if not c.agrees]
         if odd:
-            self.log.say(
+            self._log.say(
                 f"{len(odd)} of {len(checks)} views stand out: "
                 + "; ".join(f"{c.name}: {c.why}" for c in odd[:3])
                 + " - look at them, and remove those that are wrong"
@@ -234,21 +240,21 @@ class CameraCalibrating:
     # --- using the results ----------------------------------------------------------------------
     def apply_intrinsics(self, intrinsics: Intrinsics, why: str = "camera intrinsics replaced") -> None:
         """Use ``intrinsics`` for picking, solving and the virtual camera (the image size must match)."""
-        now = self.cell.intrinsics
+        now = self._cell.intrinsics
         if (intrinsics.width, intrinsics.height) != (now.width, now.height):
             raise CalibrationError(
                 f"the calibration is for {intrinsics.width} x {intrinsics.height} px images, the camera gives "
                 f"{now.width} x {now.height} px"
             )
-        self.cell.use_intrinsics(intrinsics)
-        self.log.say(why)
+        self._cell.use_intrinsics(intrinsics)
+        self._log.say(why)
 
     def apply_cam2flange(self, cam2flange: np.ndarray, why: str = "camera mounting replaced") -> None:
         """Use a measured camera mounting (4, 4) mm on the flange in place of the modelled one."""
-        robot = self.cell.robot
+        robot = self._cell.robot
         robot.set_frame_placement("camera", concat(cam2flange, robot.frame_placement("flange")))
-        self.cell.robot_edited()
-        self.log.say(why)
+        self._cell.robot_edited()
+        self._log.say(why)
 
     def apply_calibrated_intrinsics(self, confirmed_problems: list[str] | None = None) -> None:
         """Use the last intrinsics calibration; one that failed its checks only with them confirmed (recorded)."""
@@ -271,16 +277,16 @@ class CameraCalibrating:
             return
         if confirmed is None or list(confirmed) != list(problems):
             raise OperatorError(f"the {what} failed its checks ({'; '.join(problems)}): confirm it to use it anyway")
-        self.log.record("vision_result_confirmed", what=what, problems=list(problems))
+        self._log.record("vision_result_confirmed", what=what, problems=list(problems))
 
     def save_intrinsics(self, path, fmt: str = "opencv") -> None:
         from calib_core.camera.intrinsics_io import save_intrinsics
 
         save_intrinsics(path, self.intrinsics_result.intrinsics, fmt)
-        self.log.say(f"intrinsics saved to {path}")
+        self._log.say(f"intrinsics saved to {path}")
 
     def save_mounting(self, path) -> None:
         from calib_core.vision.hand_eye_io import save_hand_eye
 
         save_hand_eye(path, self.mounting.calibration)
-        self.log.say(f"camera mounting saved to {path}")
+        self._log.say(f"camera mounting saved to {path}")

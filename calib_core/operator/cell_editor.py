@@ -38,25 +38,25 @@ class CellEditor:
     """``dirty``: edits not yet saved to the workcell file."""
 
     def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, arm: Arm, log: OperatorLog):
-        self.cell, self.session, self.tasks, self.arm, self.log = cell, session, tasks, arm, log
+        self._cell, self._session, self._tasks, self._arm, self._log = cell, session, tasks, arm, log
         self.dirty = False
         session.undo.applied.connect(self._applied)
 
     def _applied(self, command) -> None:
         if not isinstance(command, CellEdit):
             return
-        self.cell.refresh_identity()
+        self._cell.refresh_identity()
         self.dirty = True
         if command.kind == "task":
-            self.tasks.edited(command.name)
+            self._tasks.edited(command.name)
         else:
-            self.cell.scene_edited()
+            self._cell.scene_edited()
 
     def set_task_approach(self, name: str, approach_mm: float) -> None:
         """Edit a task location's approach distance (mm): an undoable edit."""
-        if abs(self.cell.workcell.task(name).approach_mm - approach_mm) < 1e-9:
+        if abs(self._cell.workcell.task(name).approach_mm - approach_mm) < 1e-9:
             return
-        self.session.undo.push(SetTaskApproach(self.cell.workcell, name, approach_mm))
+        self._session.undo.push(SetTaskApproach(self._cell.workcell, name, approach_mm))
 
     def add_task_location(
         self, name: str, tcp2base: np.ndarray | None = None, approach_mm: float = 0.0, component: str | None = None
@@ -65,11 +65,11 @@ class CellEditor:
         ``component`` (default: the current target). Undoable."""
         task = TaskLocation(
             str(name).strip(),
-            self.cell.robot.fk(self.arm.joints_deg, "tcp") if tcp2base is None else np.asarray(tcp2base, dtype=float),
+            self._cell.robot.fk(self._arm.joints_deg, "tcp") if tcp2base is None else np.asarray(tcp2base, dtype=float),
             float(approach_mm),
-            component or self.session.target,
+            component or self._session.target,
         )
-        self.session.undo.push(AddTaskLocation(self.cell.workcell, task))
+        self._session.undo.push(AddTaskLocation(self._cell.workcell, task))
         return task
 
     def add_component(
@@ -93,24 +93,24 @@ class CellEditor:
             else np.array([[1, 0, 0, 1000.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
         )
         item = SceneItem(name, mesh, placement, tuple(float(c) for c in color), kind, {})
-        self.session.undo.push(AddComponent(self.cell.workcell, item, mesh_file, units))
+        self._session.undo.push(AddComponent(self._cell.workcell, item, mesh_file, units))
 
     def place_component(self, name: str, xyz_mm, rpy_deg) -> None:
         """Place a component by numbers (its surveyed placement: mm, deg, in base). Successive
         placements of one component are one undo step."""
-        self.session.undo.push(PlaceComponent(self.cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg)))
+        self._session.undo.push(PlaceComponent(self._cell.workcell, name, transform_from_xyz_rpy(xyz_mm, rpy_deg)))
 
     def snap_feature(self, component: str, point_component_mm, radius_mm: float) -> Snap:
         """Where a click on ``component`` defines a feature (circle centre, corner, vertex or the surface point)."""
-        return snap_point(self.cell.workcell.component(component).mesh, point_component_mm, radius_mm)
+        return snap_point(self._cell.workcell.component(component).mesh, point_component_mm, radius_mm)
 
     def add_feature(self, component: str, name: str, point_component_mm) -> None:
         """A named feature ``point_component_mm`` (3,) in the component's frame. Undoable."""
-        self.session.undo.push(AddFeature(self.cell.workcell, component, name, point_component_mm))
+        self._session.undo.push(AddFeature(self._cell.workcell, component, name, point_component_mm))
 
     def save(self, path=None):
         """Write the edited cell back into its workcell YAML (comments and untouched entries kept)."""
-        written = save_workcell(self.cell.workcell, path)
+        written = save_workcell(self._cell.workcell, path)
         self.dirty = False
-        self.log.say(f"cell saved to {written}")
+        self._log.say(f"cell saved to {written}")
         return written

@@ -24,7 +24,6 @@ from calib_core.calibration.session import CalibrationSession
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import concat, invert
 from calib_core.link.joint_history import JointHistory
-from calib_core.connectors.link_types import TimedSample
 from calib_core.operator.arm import Arm
 from calib_core.operator.camera_calibrating import CameraCalibrating
 from calib_core.operator.cell import Cell
@@ -50,20 +49,22 @@ from calib_core.workcell import TaskLocation
 
 
 class OperatorCore:
-    """The parts, each given what it needs: :attr:`cell` (with its events ``camera_model_changed()``,
-    ``scene_changed()``), :attr:`session` (pairs, options, result, corrections, the one undo stack),
-    :attr:`tasks` (the task location worked at), :attr:`observations` (frames, the held one),
+    """The program's assembly: the parts, each given what it needs: :attr:`cell` (with its events
+    ``camera_model_changed()``, ``scene_changed()``), :attr:`session` (pairs, options, result, corrections, the one
+    undo stack), :attr:`tasks` (the task location worked at), :attr:`observations` (frames, the held one),
     :attr:`frames` (which frame a pick is made on), :attr:`refining` (a click moved onto its feature),
     :attr:`arm` (joints, link, moves, Stop), :attr:`picking` (*Point*, *Accept*, *Calibrate*),
     :attr:`finder` (*Find points*), :attr:`moves` (moves by name), :attr:`robot_calibration` (and the
     measured tool in use), :attr:`tool` (grasps, *Measure tool*), :attr:`desk` (store, *Verify*),
-    :attr:`files` (workspace, exports), :attr:`editor` (edits of the cell) and :attr:`log`.
+    :attr:`recording`, :attr:`vision` (the camera's calibration), :attr:`replay`, :attr:`files` (workspace,
+    exports), :attr:`editor` (edits of the cell) and :attr:`log` (``message(text)``, ``event(kind, detail)``).
 
-    Events (psygnal), here for whoever follows the whole program (a status line, the recorder):
-    ``message(text)`` and ``event(kind, detail)`` (:attr:`log`'s), ``solved()`` (after *Calibrate* or
-    *Calibrate on edges*), ``task_changed(name)``, ``camera_model_changed()``, ``scene_changed()``,
-    ``correction_stored(correction)``, ``points_found(found)`` (the parts' own). The arm's events are
-    :attr:`arm`'s; frames and the held one :attr:`observations`'."""
+    Event (psygnal): ``solved()`` after *Calibrate* or *Calibrate on edges*; every other event is its part's own.
+
+    Its public members are many for a reason: twenty are the parts it assembles; eight read the state the
+    workflow asks for most (the task, the cell's workcell, robot and intrinsics, the arm's link, joints, motion and
+    link state); the rest are the few actions that span parts (connect the site's controller, choose a task,
+    undo and redo with the pair being made let go, choose a solution, a mounting from a file, close)."""
 
     solved = Signal()
 
@@ -124,35 +125,6 @@ class OperatorCore:
             signal.connect(self.solved.emit)
         self._judge_by_the_task()
 
-    # The events of the parts, where a listener to the whole program finds them.
-    @property
-    def message(self):
-        return self.log.message
-
-    @property
-    def event(self):
-        return self.log.event
-
-    @property
-    def task_changed(self):
-        return self.tasks.changed
-
-    @property
-    def camera_model_changed(self):
-        return self.cell.camera_model_changed
-
-    @property
-    def scene_changed(self):
-        return self.cell.scene_changed
-
-    @property
-    def correction_stored(self):
-        return self.desk.correction_stored
-
-    @property
-    def points_found(self):
-        return self.finder.points_found
-
     @property
     def task(self) -> TaskLocation | None:
         """The task location worked at (:attr:`tasks`' choice)."""
@@ -182,10 +154,10 @@ class OperatorCore:
             raise CalibrationError("no site: give a controller (--port) or use the simulated cell")
         url = self.site.start_controller()
         if url is not None:
-            self.connect_link(url, options=getattr(self.site, "controller_options", None))
+            self._connect_link(url, options=getattr(self.site, "controller_options", None))
         return url
 
-    def connect_link(self, url: str, rate_hz: float = 50.0, options: dict | None = None) -> None:
+    def _connect_link(self, url: str, rate_hz: float = 50.0, options: dict | None = None) -> None:
         """Open the controller connector registered for ``url``'s scheme and start it."""
         link = self.arm.connect(url, rate_hz, options)
         if self.site is not None:
@@ -195,7 +167,7 @@ class OperatorCore:
         if getattr(
             link, "publishes_transforms", False
         ):  # declared by the connector (ROS 2: the results on /tf_static too)
-            for signal in (self.camera_model_changed, self.correction_stored):
+            for signal in (self.cell.camera_model_changed, self.desk.correction_stored):
                 signal.connect(self._publish_static_transforms, unique=True)
             self._publish_static_transforms()
 
@@ -216,15 +188,7 @@ class OperatorCore:
     def link_up(self) -> bool:
         return self.arm.link_up
 
-    @property
-    def last_move_sent_s(self) -> float | None:
-        return self.arm.last_move_sent_s
-
-    def observe_sample(self, sample: TimedSample) -> None:
-        """A joint sample from the link (or a test standing in for it)."""
-        self.arm.observe_sample(sample)
-
-    def static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
+    def _static_transforms(self) -> list[tuple[str, str, np.ndarray]]:
         """What the cell's ROS side is told: ``(parent, child, child2parent_mm)`` for the camera mounting in use
         (the site's ``camera_frame`` on its ``camera_parent_frame``, :func:`~calib_core.ros2.frame_names.camera_frames`:
         by default ``videocal_camera_optical_frame`` on the flange; z along the optical axis, x right, y down: ROS's
@@ -246,17 +210,13 @@ class OperatorCore:
         if link is None or not getattr(link, "publishes_transforms", False):
             return
         try:
-            link.publish_static_transforms(self.static_transforms())
+            link.publish_static_transforms(self._static_transforms())
         except Exception as exc:  # the ROS side is an output: its failure must not stop the calibration
             self.log.say(f"could not publish /tf_static: {exc}")
 
     def _put_up_on_site(self, extras: list) -> None:
         if self.site is not None:
             self.site.put_up(extras)
-
-    def record_event(self, kind: str, **detail) -> None:
-        """An operator action or a link change worth keeping in a recording."""
-        self.log.record(kind, **detail)
 
     def set_task(self, name: str) -> None:
         """Work at task location ``name``: its component becomes the target."""
@@ -285,14 +245,11 @@ class OperatorCore:
     def choose_candidate(self, index: int) -> None:
         """Take solution ``index`` of an ambiguous solve (undoable)."""
         self.session.undo.push(ChooseCandidate(self.session.result, index))
-        self.record_event("candidate_chosen", index=index, solution=index + 1)
+        self.log.record("candidate_chosen", index=index, solution=index + 1)
 
     # --- frames of reference -------------------------------------------------------------------
     def model_cam2world(self) -> np.ndarray:
         return self.robot.fk(self.joints_deg, "camera")
-
-    def model_tcp2base(self) -> np.ndarray:
-        return self.robot.fk(self.joints_deg, "tcp")
 
     # --- the camera model ------------------------------------------------------------------------
     def apply_hand_eye_file(self, path) -> None:

@@ -43,7 +43,7 @@ class CorrectionDesk:
         robot_calibration: RobotCalibrating,
         log: OperatorLog,
     ):
-        self.cell, self.session, self.tasks, self.arm, self.picking, self.robot_calibration, self.log = (
+        self._cell, self._session, self._tasks, self._arm, self._picking, self._robot_calibration, self._log = (
             cell,
             session,
             tasks,
@@ -55,18 +55,18 @@ class CorrectionDesk:
 
     @property
     def task(self):
-        return self.tasks.task
+        return self._tasks.task
 
     def look_place(self) -> LookPlace | None:
         """Where the last result's look was made against the chosen task location (``None`` before a
         solve, without a task location or for a look that carries no robot pose)."""
-        context = self.session.result.context
+        context = self._session.result.context
         if self.task is None or context is None or context.joints_deg is None:
             return None
         corrected = None
-        if self.session.corrections.latest(self.task.name) is not None:
-            corrected = self.session.corrections.corrected_target(self.task.name, self.task.tcp2base)
-        return place_of_look(self.task, self.cell.robot.fk(context.joints_deg, "tcp"), corrected, context.view_sources)
+        if self._session.corrections.latest(self.task.name) is not None:
+            corrected = self._session.corrections.corrected_target(self.task.name, self.task.tcp2base)
+        return place_of_look(self.task, self._cell.robot.fk(context.joints_deg, "tcp"), corrected, context.view_sources)
 
     def store_correction(self, *, confirmation: str = "", convert: str = ""):
         """Store the last result as the task location's correction. Only a look made live at the task's
@@ -80,7 +80,7 @@ class CorrectionDesk:
         if self.task is None:
             raise CalibrationError("choose the task location the correction is for")
         # said first: a look that changed since is no look at all
-        self.session.result.storable_estimate(self.session.pairs.usable())
+        self._session.result.storable_estimate(self._session.pairs.usable())
         place = self.look_place()
         if place is None:
             raise CalibrationError(
@@ -88,24 +88,24 @@ class CorrectionDesk:
             )
         if not place.counts and not convert.strip():
             raise LookNotAtTask(place, *self._conversion_change())
-        tool, context = self.robot_calibration.measured_tool, self.session.result.context
+        tool, context = self._robot_calibration.measured_tool, self._session.result.context
         tool_covariance = None
         if tool is not None and context.joints_deg is not None:
-            tool_covariance = tool.covariance_in_base(self.cell.robot.fk(context.joints_deg, "camera"))
+            tool_covariance = tool.covariance_in_base(self._cell.robot.fk(context.joints_deg, "camera"))
         source = "" if place.counts else f"converted: {place.text}; {convert.strip()}"
         if source:
             source = (f"pairs {', '.join(map(str, context.numbers))}; " if context.numbers else "edges; ") + source
         store = StoreLook(
-            self.session,
+            self._session,
             self.task.name,
             source,
             confirmation=confirmation,
-            fused=self.robot_calibration.look_fused_with_robot(self.session.result.estimate),
+            fused=self._robot_calibration.look_fused_with_robot(self._session.result.estimate),
             tool_covariance=tool_covariance,
         )
-        c = self.session.undo.push(store).correction
+        c = self._session.undo.push(store).correction
         if not place.counts:
-            self.log.record(
+            self._log.record(
                 "look_converted",
                 task=c.task,
                 at=place.at,
@@ -115,9 +115,9 @@ class CorrectionDesk:
                 conversion=convert.strip(),
             )
         if c.confirmation:
-            self.log.record("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
+            self._log.record("correction_confirmed", task=c.task, verdict=c.verdict, confirmation=c.confirmation)
         self.correction_stored.emit(c)
-        self.log.say(
+        self._log.say(
             f"correction stored for {self.task.name}: {np.linalg.norm(c.displacement_mm):.2f} mm, "
             f"{np.linalg.norm(c.rotation_deg):.3f} deg"
         )
@@ -130,16 +130,16 @@ class CorrectionDesk:
             raise CalibrationError("choose the task location the measurement belongs with")
         place = self.look_place()
         where = place.text if place is not None else "a look without a robot pose"
-        store = StoreLook(self.session, self.task.name, f"measurement: {where}", kind="measurement")
-        c = self.session.undo.push(store).correction
+        store = StoreLook(self._session, self.task.name, f"measurement: {where}", kind="measurement")
+        c = self._session.undo.push(store).correction
         self.correction_stored.emit(c)
-        self.log.say(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
+        self._log.say(f"measurement kept with {self.task.name} ({where}); the task's correction is unchanged")
         return c
 
     def _conversion_change(self) -> tuple[float, float]:
         """How far the target commanded for the task would move (mm, deg) if the last result became its correction."""
-        r, task = self.session.result.estimate, self.task
-        now = self.session.corrections.corrected_target(task.name, task.tcp2base)
+        r, task = self._session.result.estimate, self.task
+        now = self._session.corrections.corrected_target(task.name, task.tcp2base)
         delta = concat(
             invert(r.tcp2base_model), r.tcp2base_measured
         )  # tcp_real = delta @ tcp_model, as a stored correction's
@@ -154,31 +154,31 @@ class CorrectionDesk:
         task = self.task
         if task is None:
             raise CalibrationError("choose the task location to verify")
-        correction = self.session.corrections.latest(task.name)
+        correction = self._session.corrections.latest(task.name)
         if correction is None:
             raise CalibrationError(f"no stored correction for {task.name}: calibrate, store and execute one first")
         executed = f"{task.name} (task, corrected)"
-        motion = self.arm.state
+        motion = self._arm.state
         if motion.motion is not Motion.ARRIVED or motion.what != executed:
             raise CalibrationError(
                 "execute the task with its correction first (Go to task, corrected), then pick the pairs from there "
                 f"and Verify ({motion.text})"
             )
-        use = self.session.pairs.usable()
+        use = self._session.pairs.usable()
         here = [
             p
             for p in use
             if p.view is not None
-            and np.max(np.abs(np.array(p.view.joints_deg) - self.arm.joints_deg)) <= SAME_STATE_DEG
+            and np.max(np.abs(np.array(p.view.joints_deg) - self._arm.joints_deg)) <= SAME_STATE_DEG
         ]
         if len(here) != len(use) or not use:
             raise CalibrationError(
                 "the pairs were not picked from where the robot stands now: Clear, pick them again here, then Verify"
             )
-        look = self.picking.calibrate()
+        look = self._picking.calibrate()
         v = verify(task.name, task.tcp2base, correction, look, task.tolerance_mm)
-        self.session.corrections.add_verification(v)
-        self.log.record(
+        self._session.corrections.add_verification(v)
+        self._log.record(
             "verified",
             task=task.name,
             remaining_mm=v.remaining_mm.tolist(),
@@ -188,5 +188,5 @@ class CorrectionDesk:
             within_tolerance=v.within_tolerance,
             tolerance_mm=v.tolerance_mm,
         )
-        self.log.say(v.text)
+        self._log.say(v.text)
         return v

@@ -49,7 +49,11 @@ class Observations:
 
     Events (psygnal): ``frame_observed(frame)`` (every frame of the current source),
     ``still_changed(held)`` (a :class:`HeldFrame`, or ``None`` when let go; only on a change),
-    ``source_changed(source)`` (``live`` or the recording's name)."""
+    ``source_changed(source)`` (``live`` or the recording's name).
+
+    Its public members: three events, the frames' state (the live and the replayed joint history, the source, the newest
+    and the held frame) and the rule that stamps a frame (stillness, stamp, newest usable), with hold, release, replay
+    and live."""
 
     frame_observed = Signal(object)
     still_changed = Signal(object)

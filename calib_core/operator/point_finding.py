@@ -57,7 +57,7 @@ class PointFinding:
         refining: PickRefining,
         log: OperatorLog,
     ):
-        self.cell, self.session, self.picking, self.log = cell, session, picking, log
+        self._cell, self._session, self._picking, self._log = cell, session, picking, log
         self._frames, self._refining = frames, refining
         self.found: FoundOnFrame | None = None
         """The last Find points' result (kept for *Calibrate on edges* after its proposals were accepted or
@@ -67,19 +67,19 @@ class PointFinding:
     def find_points(self) -> FoundOnFrame:
         """Locate the target's features in the held frame (holding the newest one first). Emits
         ``points_found``; the proposals wait for :meth:`accept_found_points`."""
-        target = self.session.target
+        target = self._session.target
         if target is None:
             raise CalibrationError("choose the target object first")
         was_held = self._frames.still is not None
         held = self._frames.still or self._frames.hold_frame()
         q = np.asarray(held.stamp.joints_deg, dtype=float)
-        item = self.cell.workcell.component(target)
-        obj2cam_model = concat(item.item2world, invert(self.cell.robot.fk(q, "camera")))
+        item = self._cell.workcell.component(target)
+        obj2cam_model = concat(item.item2world, invert(self._cell.robot.fk(q, "camera")))
         from calib_core.look.find_points import find_points
 
         result = find_points(
             self._refining.evidence(held.frame.image),
-            self.cell.intrinsics,
+            self._cell.intrinsics,
             item,
             obj2cam_model,
             expected=self.modelled_view(q, item),
@@ -89,7 +89,7 @@ class PointFinding:
             # robot has moved, takes a new frame instead of this one
             self._frames.release_unused_still()
         self.found = FoundOnFrame(result, held.stamp)
-        self.log.record(
+        self._log.record(
             "points_found",
             component=target,
             found=result.found,
@@ -98,7 +98,7 @@ class PointFinding:
             seconds=round(result.seconds, 3),
         )
         self.points_found.emit(self.found)
-        self.log.say(result.message)
+        self._log.say(result.message)
         return self.found
 
     def dismiss_found_points(self) -> None:
@@ -109,18 +109,18 @@ class PointFinding:
     def modelled_view(self, q_deg, item):
         """What the modelled camera at joints ``q_deg`` sees of ``item`` (the modelled cell, the robot
         and what is put up in it), for Find points' checks against the image."""
-        if self._model_view is None or self._model_view.intrinsics != self.cell.intrinsics:
+        if self._model_view is None or self._model_view.intrinsics != self._cell.intrinsics:
             from calib_core.render.model_view import ModelView  # VTK loads on the first Find points, not at start-up
 
             if self._model_view is not None:
                 self._model_view.close()
-            self._model_view = ModelView(self.cell.intrinsics)
+            self._model_view = ModelView(self._cell.intrinsics)
         return self._model_view.of_cell(
-            self.cell.workcell.components,
-            self.cell.model_visuals(),
+            self._cell.workcell.components,
+            self._cell.model_visuals(),
             q_deg,
             item.item2world,
-            extras=list(self.cell.extras),
+            extras=list(self._cell.extras),
         )
 
     def calibrate_on_edges(self):
@@ -138,29 +138,29 @@ class PointFinding:
         from calib_core.solver.solve_inputs import solve_inputs
         from calib_core.look.edge_solution import edge_solution
 
-        solution = edge_solution(found.result.edges, self.cell.intrinsics)
-        item = self.cell.workcell.component(found.result.component)
+        solution = edge_solution(found.result.edges, self._cell.intrinsics)
+        item = self._cell.workcell.component(found.result.component)
         q = np.asarray(found.view.joints_deg, dtype=float)
-        cam2world_model = self.cell.robot.fk(q, "camera")
+        cam2world_model = self._cell.robot.fk(q, "camera")
         inputs = solve_inputs(
             np.zeros((0, 3)),
             np.zeros((0, 2)),
-            self.cell.intrinsics,
+            self._cell.intrinsics,
             prior=concat(item.item2world, invert(cam2world_model)),
         )
         inputs.update(method="edges", component=item.name, frame_index=int(found.view.frame_index))
-        self.picking.let_go()
+        self._picking.let_go()
         features = np.array(list(item.features.values()), dtype=float).reshape(-1, 3)
         estimate = show_solution(
-            self.session,
+            self._session,
             solution,
             item.item2world,
             cam2world_model,
-            self.cell.robot.fk(q, "tcp"),
+            self._cell.robot.fk(q, "tcp"),
             q,
             [],
             points_obj_mm=features,
-            intrinsics=self.cell.intrinsics,
+            intrinsics=self._cell.intrinsics,
             view_sources=(found.view.source,) if found.view.recorded else (),
             label="Calibrate on edges",
             form_tolerance_mm=item.form_tolerance_mm,
@@ -175,7 +175,7 @@ class PointFinding:
         found = self.found
         if found is None or not found.result.proposals:
             raise OperatorError("nothing found to accept: Find points (F6) first")
-        session = self.session
+        session = self._session
         pending = session.pairs.pending()
         if pending is not None:
             raise OperatorError(
@@ -193,11 +193,11 @@ class PointFinding:
                 f"every proposed feature is already paired ({', '.join(sorted(paired & {p.feature for p in chosen}))})"
             )
         refuse_mixed_poses([p for p in session.pairs if p.complete], found.view)
-        item = self.cell.workcell.component(found.result.component)
+        item = self._cell.workcell.component(found.result.component)
         spec = [(item.name, p.feature, apply(item.item2world, p.point_mm), p.uv_px) for p in fresh]
         command = AddPairs(session.pairs, spec, found.view)
         session.undo.push(command)
         numbers = [pair.number for pair in command.added]
-        self.log.record("found_points_accepted", numbers=numbers, features=[p.feature for p in fresh])
+        self._log.record("found_points_accepted", numbers=numbers, features=[p.feature for p in fresh])
         self.found = None
         return numbers

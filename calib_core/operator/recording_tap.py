@@ -54,11 +54,11 @@ class RecordingTap:
         self._connections = [
             (core.observations.frame_observed, self._frame),
             (core.arm.sample_received, self._sample),
-            (core.event, self._event),
+            (core.log.event, self._event),
             (core.solved, self._solved),
-            (core.correction_stored, self._correction),
+            (core.desk.correction_stored, self._correction),
             (core.session.pairs.changed, self._pairs),
-            (core.points_found, self._found),
+            (core.finder.points_found, self._found),
         ]
         for signal, slot in self._connections:
             signal.connect(slot)

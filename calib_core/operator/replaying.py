@@ -36,12 +36,15 @@ from calib_core.ros2.joint_units import user_per_si
 class Replaying:
     """``playback`` (a :class:`~calib_core.recording.playback.RecordingPlayback` or a bag's, ``None`` when nothing
     is replayed), ``path``, ``position_s`` (s from its start), ``branched_at_s`` (``None`` until the first edit),
-    ``complete`` and ``problem`` (a recording cut off by a crash, and why). ``branched(t_s)`` at the first edit."""
+    ``complete`` and ``problem`` (a recording cut off by a crash, and why). ``branched(t_s)`` at the first edit.
+
+    Its public members: open, seek, recover, close, the event ``branched`` and the state the replay bar shows (the
+    recording, its playback, the position, where it branched, whether it is complete, what is wrong with it)."""
 
     branched = Signal(float)
 
     def __init__(self, cell: Cell, session: CalibrationSession, frames: FrameHolding, arm: Arm, log: OperatorLog):
-        self.cell, self.session, self.frames, self.arm, self.log = cell, session, frames, arm, log
+        self._cell, self._session, self._frames, self._arm, self._log = cell, session, frames, arm, log
         self.playback = None
         self.path: Path | None = None
         self.position_s = 0.0
@@ -63,7 +66,7 @@ class Replaying:
 
         path = Path(path)
         if is_bag(path):  # a ROS 2 bag: its frames, with the arm's joints at each frame's stamp
-            robot = self.cell.robot
+            robot = self._cell.robot
             playback, complete, problem = (
                 BagPlayback(path, robot.joint_names, user_per_si(robot.joint_units)),
                 True,
@@ -86,23 +89,23 @@ class Replaying:
                 raise FileFormatError(path, f"its intrinsics cannot be read ({exc})", "/videocal/setup") from None
         self._close_playback()
         if self.playback is None:
-            s = self.session
-            self._live_state = (s.pairs.pairs(), s.result.solved, self.cell.intrinsics)
+            s = self._session
+            self._live_state = (s.pairs.pairs(), s.result.solved, self._cell.intrinsics)
         # Picks and solves on the recorded frames need the camera they were recorded with.
         if recorded_intrinsics is not None:
-            self.cell.use_intrinsics(recorded_intrinsics)
+            self._cell.use_intrinsics(recorded_intrinsics)
         self.playback, self.path, self.complete, self.problem = playback, path, complete, problem
         history = JointHistory.from_arrays(
             playback.joint_times_s,
             playback.joints_deg,
-            self.cell.workcell.safety.settle_rule,
-            self.cell.robot.joint_names,
+            self._cell.workcell.safety.settle_rule,
+            self._cell.robot.joint_names,
         )
-        self.frames.begin_replay(history, path.name)
+        self._frames.begin_replay(history, path.name)
         self.branched_at_s = None
         self.position_s = 0.0
         self._shown_frame = self._shown_solve = None
-        self._as_replay(self.session.undo.clear)  # clearing the live session's undo history is not an operator edit
+        self._as_replay(self._session.undo.clear)  # clearing the live session's undo history is not an operator edit
         note = "" if complete else f" - cut off: {problem}; Recover... writes a complete copy"
         if isinstance(playback, BagPlayback):
             joints = (
@@ -111,7 +114,7 @@ class Replaying:
                 else "no joint states: a camera alone, nothing robot-bound"
             )
             note = f" (ROS 2 bag, {playback.frames.topic}; {joints})"
-        self.log.say(
+        self._log.say(
             f"replaying {path.name}: {playback.duration_s:.1f} s, {len(playback.frames)} frames, "
             f"{len(playback.solves)} solves{note}"
         )
@@ -123,20 +126,20 @@ class Replaying:
             return False
         branched = self.branched_at_s is not None
         if self._live_state is not None:
-            self.cell.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
+            self._cell.use_intrinsics(self._live_state[2])  # the live camera's, whatever the recording used
         if not branched and self._live_state is not None:
             pairs, result, _ = self._live_state
 
             def restore():
-                self.session.pairs.replace_all(pairs)
-                self.session.result.show(result)
-                self.session.undo.clear()
+                self._session.pairs.replace_all(pairs)
+                self._session.result.show(result)
+                self._session.undo.clear()
 
             self._as_replay(restore)
         self._close_playback()
         self.playback = self.path = self._live_state = None
-        self.frames.end_replay()
-        self.log.say(
+        self._frames.end_replay()
+        self._log.say(
             "replay closed: "
             + ("the branched session stays open" if branched else "the live session is back as it was")
         )
@@ -159,7 +162,7 @@ class Replaying:
             return None
         out = self.path.with_name(self.path.stem + "-recovered.mcap")
         contents = recover(self.path, out)
-        self.log.say(f"recovered {len(contents.messages)} messages into {out}")
+        self._log.say(f"recovered {len(contents.messages)} messages into {out}")
         return out
 
     # --- the position --------------------------------------------------------------------------
@@ -181,7 +184,7 @@ class Replaying:
                 frame = Frame(image, k, float(pb.frames.times_s[k]), float(pb.frames.times_s[k]))
         q = pb.joints_at(t_s)
         if q is not None:
-            self.arm.show_joints(q)
+            self._arm.show_joints(q)
         if self.branched_at_s is None:
             self._as_replay(lambda: self._apply_session(t_s))
         return frame
@@ -193,10 +196,12 @@ class Replaying:
             return ""
         if self.branched_at_s is not None:
             return f"branched at {self.branched_at_s:.1f} s"
-        return f"{len(self.session.pairs)} pairs, {sum(1 for s in pb.solves if s.t_s <= self.position_s)} solves so far"
+        return (
+            f"{len(self._session.pairs)} pairs, {sum(1 for s in pb.solves if s.t_s <= self.position_s)} solves so far"
+        )
 
     def _apply_session(self, t_s: float) -> None:
-        pb, s = self.playback, self.session
+        pb, s = self.playback, self._session
         pairs = pb.pairs_at(t_s)
         if pairs != s.pairs.pairs():
             s.pairs.replace_all(pairs)
@@ -212,17 +217,17 @@ class Replaying:
 
         c = solve.context
         if not c:
-            self.log.say(
+            self._log.say(
                 f"solve {solve.id} was recorded without its robot context: its camera pose only is in the file"
             )
             return
         solution = solve_from_inputs(solve.inputs)  # deterministic: the same answer as recorded
-        numbers = [p.number for p in self.session.pairs.usable()]
+        numbers = [p.number for p in self._session.pairs.usable()]
         obj2world, cam_model, tcp_model = (
             np.asarray(c[k], dtype=float) for k in ("obj2world", "cam2world_model", "tcp2base_model")
         )
         show_solution(
-            self.session,
+            self._session,
             solution,
             obj2world,
             cam_model,
@@ -247,6 +252,6 @@ class Replaying:
             return
         self.branched_at_s = self.position_s
         self.branched.emit(self.position_s)
-        self.log.say(
+        self._log.say(
             f"new session branched from {self.path.name} at {self.position_s:.1f} s; the recording is not changed"
         )

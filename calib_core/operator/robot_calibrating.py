@@ -29,7 +29,7 @@ class RobotCalibrating:
     :class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool` in use, or ``None``)."""
 
     def __init__(self, cell: Cell, session: CalibrationSession, arm: Arm, log: OperatorLog):
-        self.cell, self.session, self.arm, self.log = cell, session, arm, log
+        self._cell, self._session, self._arm, self._log = cell, session, arm, log
         self.applied_robot_calibration = None
         self.measured_tool = None
         self._robot_before_calibration = None
@@ -46,13 +46,13 @@ class RobotCalibrating:
 
         from calib_core.vision.board_placement import board_in_cell
 
-        world = self.cell.collision_world()
-        start = np.asarray(self.arm.joints_deg, dtype=float)
+        world = self._cell.collision_world()
+        start = np.asarray(self._arm.joints_deg, dtype=float)
         plan = plan_poses(
-            self.cell.robot,
-            self.cell.intrinsics,
+            self._cell.robot,
+            self._cell.intrinsics,
             spec,
-            board_in_cell(spec, self.cell.workcell, self.cell.robot),
+            board_in_cell(spec, self._cell.workcell, self._cell.robot),
             n,
             start_deg=start,
             collisions=world,
@@ -66,14 +66,14 @@ class RobotCalibrating:
         rejected = dict(plan.rejected)
         if len(kept) < len(plan.joints_deg):
             rejected["no collision-free path from the pose before"] = len(plan.joints_deg) - len(kept)
-        cell, home = [], np.asarray(self.cell.home_joints, dtype=float)
+        cell, home = [], np.asarray(self._cell.home_joints, dtype=float)
 
         def free(a, b):
             return not any(world.check(p) for p in joint_path(a, b))
 
         for component, goal in (
             cell_view_joints(
-                self.cell.robot, self.cell.workcell, self.cell.intrinsics, cell_views_per_target, collisions=world
+                self._cell.robot, self._cell.workcell, self._cell.intrinsics, cell_views_per_target, collisions=world
             )
             if cell_views_per_target
             else []
@@ -95,7 +95,7 @@ class RobotCalibrating:
         components' ``cell_views`` ((component, joints deg)), not started."""
         from calib_core.operator.calibration_run import CalibrationRun
 
-        return CalibrationRun(self.arm, self.log, spec, plan, cell_views)
+        return CalibrationRun(self._arm, self._log, spec, plan, cell_views)
 
     def calibrate_robot(self, capture, *, cell_frames=(), with_intrinsics: bool = False, progress=None):
         """Identify the robot from a :class:`~calib_core.vision.capture.BoardCapture`'s views with
@@ -113,18 +113,18 @@ class RobotCalibrating:
         corners = capture.spec.corners_mm()
         views = [PoseView(v.name, q, corners[v.ids], v.corners_px) for v, q in posed]
         done = identify_robot(
-            self.cell.robot,
-            self.cell.intrinsics,
-            self.cell.workcell,
+            self._cell.robot,
+            self._cell.intrinsics,
+            self._cell.workcell,
             views,
             cell_frames,
-            visuals=self.cell.model_visuals(),
-            extras=self.cell.extras,
+            visuals=self._cell.model_visuals(),
+            extras=self._cell.extras,
             with_intrinsics=with_intrinsics,
             progress=progress,
         )
         result = done.result
-        self.log.record(
+        self._log.record(
             "robot_calibrated",
             views=done.board_views,
             component_views=done.cell_views,
@@ -139,17 +139,17 @@ class RobotCalibrating:
         follows); :meth:`revert_robot_calibration` takes it back."""
         self.keep_robot_before_calibration()
         self.applied_robot_calibration = result
-        for j in range(1, self.cell.robot.model.njoints):
-            self.cell.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
-        self.cell.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
-        self.cell.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
-        if result.intrinsics != self.cell.intrinsics:  # refined with the robot: the camera as the same fit saw it
+        for j in range(1, self._cell.robot.model.njoints):
+            self._cell.robot.model.jointPlacements[j] = result.robot.model.jointPlacements[j]
+        self._cell.robot.set_frame_placement("camera", result.robot.frame_placement("camera"))
+        self._cell.robot.set_frame_placement("tcp", result.robot.frame_placement("tcp"))
+        if result.intrinsics != self._cell.intrinsics:  # refined with the robot: the camera as the same fit saw it
             if self._intrinsics_before_calibration is None:
-                self._intrinsics_before_calibration = self.cell.intrinsics
-            self.cell.use_intrinsics(result.intrinsics)
-        self.log.record("robot_calibration_applied", rms_px=result.rms_px)
-        self.cell.robot_edited()
-        self.log.say(
+                self._intrinsics_before_calibration = self._cell.intrinsics
+            self._cell.use_intrinsics(result.intrinsics)
+        self._log.record("robot_calibration_applied", rms_px=result.rms_px)
+        self._cell.robot_edited()
+        self._log.say(
             f"calibrated robot in use ({len(result.observability.identified)} parameters, RMS {result.rms_px:.3f} px)"
         )
 
@@ -160,16 +160,16 @@ class RobotCalibrating:
         component placed to the survey's sigma); ``None`` without an applied robot calibration or a
         look without covariance."""
         result = self.applied_robot_calibration
-        context = self.session.result.context
+        context = self._session.result.context
         if result is None or look is None or look.covariance is None or context is None or context.joints_deg is None:
             return None
         from calib_core.calibration.look_fusion import fuse_look, tcp_covariance_from_camera
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 
         q = context.joints_deg
-        cam2base = self.cell.robot.fk(q, "camera")
+        cam2base = self._cell.robot.fk(q, "camera")
         model = tcp_covariance_from_camera(
-            result.pose_covariance(q), cam2base, concat(self.cell.robot.fk(q, "tcp"), invert(cam2base))
+            result.pose_covariance(q), cam2base, concat(self._cell.robot.fk(q, "tcp"), invert(cam2base))
         )
         fused = fuse_look(look, model, placement_sigma_mm=SURVEY_SIGMA_MM)
         tool = self.measured_tool
@@ -183,9 +183,9 @@ class RobotCalibrating:
         """The robot's placements as loaded, kept once for :meth:`revert_robot_calibration`."""
         if self._robot_before_calibration is None:
             self._robot_before_calibration = (
-                [_to_mm(p) for p in self.cell.robot.model.jointPlacements],
-                self.cell.robot.frame_placement("camera"),
-                self.cell.robot.frame_placement("tcp"),
+                [_to_mm(p) for p in self._cell.robot.model.jointPlacements],
+                self._cell.robot.frame_placement("camera"),
+                self._cell.robot.frame_placement("tcp"),
             )
 
     @property
@@ -198,19 +198,19 @@ class RobotCalibrating:
         if before is None:
             raise OperatorError("no robot calibration is applied")
         placements, camera, tcp = before
-        for j in range(1, self.cell.robot.model.njoints):
-            self.cell.robot.model.jointPlacements[j] = _to_se3(placements[j])
-        self.cell.robot.set_frame_placement("camera", camera)
-        self.cell.robot.set_frame_placement("tcp", tcp)
+        for j in range(1, self._cell.robot.model.njoints):
+            self._cell.robot.model.jointPlacements[j] = _to_se3(placements[j])
+        self._cell.robot.set_frame_placement("camera", camera)
+        self._cell.robot.set_frame_placement("tcp", tcp)
         self._robot_before_calibration = None
         self.applied_robot_calibration = None
         self.measured_tool = None
         if self._intrinsics_before_calibration is not None:
-            self.cell.use_intrinsics(self._intrinsics_before_calibration)
+            self._cell.use_intrinsics(self._intrinsics_before_calibration)
             self._intrinsics_before_calibration = None
-        self.log.record("robot_calibration_reverted")
-        self.cell.robot_edited()
-        self.log.say("the robot's model as loaded is in use again")
+        self._log.record("robot_calibration_reverted")
+        self._cell.robot_edited()
+        self._log.say("the robot's model as loaded is in use again")
 
     def use_tool(self, tool) -> None:
         """Put a measured tool (:class:`~calib_core.robot_calibration.camera_to_tool.CameraToTool`) into the
@@ -219,8 +219,8 @@ class RobotCalibrating:
 
         self.keep_robot_before_calibration()
         self.measured_tool = tool
-        self.cell.robot.set_frame_placement("tcp", with_tool(self.cell.robot, tool.tcp2cam).frame_placement("tcp"))
-        self.cell.robot_edited()
+        self._cell.robot.set_frame_placement("tcp", with_tool(self._cell.robot, tool.tcp2cam).frame_placement("tcp"))
+        self._cell.robot_edited()
 
     def save_robot_calibration(self, folder, result, tool=None) -> tuple[Path, Path]:
         """``robot_calibration.yaml`` and the calibrated URDF into ``folder``; with ``tool`` (from
@@ -231,5 +231,5 @@ class RobotCalibrating:
         Path(folder).mkdir(parents=True, exist_ok=True)
         robot = with_tool(result.robot, tool.tcp2cam) if tool is not None else None
         paths = save_robot_calibration(folder, result, result.nominal, robot=robot, tool=tool)
-        self.log.say(f"robot calibration saved to {paths[0]} and {paths[1]}")
+        self._log.say(f"robot calibration saved to {paths[0]} and {paths[1]}")
         return paths

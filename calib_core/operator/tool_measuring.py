@@ -43,7 +43,7 @@ class ToolMeasuring:
         robot_calibration: RobotCalibrating,
         log: OperatorLog,
     ):
-        self.cell, self.tasks, self.arm, self.frames, self.finder, self.robot_calibration, self.log = (
+        self._cell, self._tasks, self._arm, self._frames, self._finder, self._robot_calibration, self._log = (
             cell,
             tasks,
             arm,
@@ -56,7 +56,7 @@ class ToolMeasuring:
 
     @property
     def task(self):
-        return self.tasks.task
+        return self._tasks.task
 
     def record_grasp(self):
         """A :class:`~calib_core.robot_calibration.camera_to_tool.Grasp` at the current task
@@ -67,36 +67,36 @@ class ToolMeasuring:
 
         if self.task is None:
             raise OperatorError("choose a task location: the grasp puts the TCP on its fixture pin")
-        if not self.arm.link_up:
+        if not self._arm.link_up:
             raise OperatorError("the controller link is down: a grasp needs the joints the controller reports")
-        if self.arm.state.motion in (Motion.MOVING, Motion.UNKNOWN):
+        if self._arm.state.motion in (Motion.MOVING, Motion.UNKNOWN):
             raise OperatorError(
-                f"the robot is {self.arm.state.motion.value}: record the grasp once it stands with the gripper closed "
+                f"the robot is {self._arm.state.motion.value}: record the grasp once it stands with the gripper closed "
                 "on the pin"
             )
-        q = np.array(self.arm.joints_deg, dtype=float)
+        q = np.array(self._arm.joints_deg, dtype=float)
         seen, how = None, "no camera frame: taken through the robot and the fixture's survey"
-        if self.frames.latest is not None:
+        if self._frames.latest is not None:
             held = (
-                self.frames.hold_frame()
+                self._frames.hold_frame()
             )  # NotSettledError (nothing recorded) when the newest frame is of the robot moving
             q = np.asarray(held.stamp.joints_deg, dtype=float)
-            workcell = self.cell.workcell
+            workcell = self._cell.workcell
             item = workcell.component(self.task.component) if self.task.component else None
             try:
                 seen = see_grasp(
                     held.frame.image,
-                    self.cell.intrinsics,
-                    self.cell.robot,
+                    self._cell.intrinsics,
+                    self._cell.robot,
                     workcell,
                     self.task,
                     q,
-                    expected=self.finder.modelled_view(q, item) if item is not None else None,
+                    expected=self._finder.modelled_view(q, item) if item is not None else None,
                 )
                 how = f"seen on frame {held.stamp.frame_index} ({seen.edge_samples} edge samples of {seen.component})"
             except GraspNotSeenError as e:
                 how = f"not seen ({e}): taken through the robot and the fixture's survey"
-            self.frames.release_unused_still()
+            self._frames.release_unused_still()
         grasp = Grasp(
             f"{self.task.name} #{sum(g.name.startswith(self.task.name + ' #') for g in self.grasps) + 1}",
             q,
@@ -104,18 +104,18 @@ class ToolMeasuring:
             seen,
         )
         self.grasps.append(grasp)
-        self.log.record(
+        self._log.record(
             "grasp_recorded",
             task=self.task.name,
             joints_deg=[float(v) for v in grasp.joints_deg],
             seen=seen is not None,
         )
-        self.log.say(f"grasp recorded at {self.task.name} ({len(self.grasps)} in all): {how}")
+        self._log.say(f"grasp recorded at {self.task.name} ({len(self.grasps)} in all): {how}")
         return grasp
 
     def clear_grasps(self) -> None:
         self.grasps.clear()
-        self.log.say("grasps cleared")
+        self._log.say("grasps cleared")
 
     def measure_tool(self):
         """The TCP in the camera frame from the recorded grasps
@@ -129,16 +129,16 @@ class ToolMeasuring:
             )
         from calib_core.robot_calibration.identification import SURVEY_SIGMA_MM
 
-        calibration = self.robot_calibration.applied_robot_calibration
+        calibration = self._robot_calibration.applied_robot_calibration
         tool = camera_to_tool(
-            self.cell.robot,
+            self._cell.robot,
             self.grasps,
             placement_sigma_mm=SURVEY_SIGMA_MM,
             camera_covariance=(lambda q: calibration.pose_covariance(q)) if calibration is not None else None,
         )
-        self.robot_calibration.use_tool(tool)
-        self.log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
-        self.log.say(
+        self._robot_calibration.use_tool(tool)
+        self._log.record("tool_measured", grasps=len(self.grasps), spread_mm=tool.spread_mm)
+        self._log.say(
             f"TCP measured from {len(tool.per_grasp)} grasps, {tool.seen_grasps} seen (spread {tool.spread_mm:.3f} mm, "
             f"{tool.spread_deg:.4f} deg)"
         )

@@ -81,7 +81,11 @@ class SessionRecorder:
     Counters: ``messages`` and ``frames_written`` are in chunks handed to the OS (what a crash
     keeps), ``frames_dropped`` frames the encoder could not keep up with (a full queue of
     ``queue_frames``; a recorder made with ``drop_when_busy=False`` waits instead),
-    ``late_messages`` messages whose log time had to be raised to keep the file in order."""
+    ``late_messages`` messages whose log time had to be raised to keep the file in order.
+
+    Its public members: its settings (given once, read back by the status line and the tests), its counters (frames
+    written and dropped, late and lost messages, size, failure), one ``record_*`` for each channel it writes, and flush,
+    close and wait."""
 
     def __init__(
         self,

@@ -61,7 +61,11 @@ def _joint_kind(joint: pin.JointModel) -> str | None:
 class RobotModel:
     """A serial robot. ``model``/``data`` are Pinocchio's (driven joints only: held joints are
     locked out); ``urdf_xml`` the resolved description; ``roles`` maps each frame role to the
-    Pinocchio frame that plays it; ``base2root`` (4, 4) mm places the cell's base in the URDF root."""
+    Pinocchio frame that plays it; ``base2root`` (4, 4) mm places the cell's base in the URDF root.
+
+    Its public members are the robot description's read-outs (joints, units, limits, speeds, frames) and what is
+    computed from it (forward kinematics, Jacobian, configuration, a frame placed on the flange): the reading side of a
+    URDF, as Pinocchio's model has it."""
 
     model: pin.Model
     data: pin.Data

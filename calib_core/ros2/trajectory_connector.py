@@ -91,7 +91,11 @@ TYPE_CHECK_S = 1.0
 
 class Ros2TrajectoryController(ConnectorEvents):
     """See the module. ``context.joint_names`` are the joints looked for in each JointState message.
-    (``auth_changed`` is never emitted: ROS 2 has no session.)"""
+    (``auth_changed`` is never emitted: ROS 2 has no session.)
+
+    Its public members are the connector protocol (start, close, latest, delay_s, stats_snapshot, move_joints, stop;
+    publish_static_transforms) and the configuration read from its URL (topics, action, domain, speeds, tolerances),
+    kept public for the status line and the tests to read what it was told."""
 
     publishes_transforms = True
 

@@ -51,7 +51,11 @@ _PROTECTIVE_STOP_BIT = 1 << 2
 
 
 class URRtdeController(ConnectorEvents):
-    """See the module. ``status_changed(text)``: the controller's own state in words."""
+    """See the module. ``status_changed(text)``: the controller's own state in words.
+
+    Its public members are the connector protocol (start, close, latest, delay_s, stats_snapshot, move_joints, stop),
+    the configuration read from its URL (speeds, tolerances, rate) and the controller's own status (protective stop,
+    speed scaling, remote control) the status line shows."""
 
     status_changed = Signal(str)
 

@@ -87,7 +87,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     # Camera to tool: the gripper closed on each task location's pin in compliance. The simulated
     # physical world plays the compliance (the joints where the true TCP is on the pin); the window
     # only reads the joints the controller then reports.
-    tool = panel.tool
+    tool = panel.tool_group
     assert not tool.measure_button.isEnabled()
     panel.show_board.setChecked(False)  # the board taken down before the gripper works at the fixtures
     pins = {}
@@ -115,11 +115,13 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
         name: np.linalg.norm(pose_difference(wb.robot.fk(q_pin, "tcp"), pin)[0]) for name, (q_pin, pin) in pins.items()
     }
     qtbot.mouseClick(tool.measure_button, Qt.MouseButton.LeftButton)
-    assert tool.tool is not None and "TCP from 2 grasps (2 seen by the camera), spread" in tool.text.text()
+    assert tool.measured_tool is not None and "TCP from 2 grasps (2 seen by the camera), spread" in tool.text.text()
     # each grasp was seen on the camera's frame (the held fixture's edges): the tool knows its own
     # uncertainty from those views, better than the survey's 0.05 mm per axis; a stored look adds it
-    assert tool.tool.seen_grasps == 2, win.statusBar().currentMessage()
-    assert np.all(np.diag(tool.tool.covariance)[:3] < 0.05**2 / 2) and np.all(np.diag(tool.tool.covariance) > 0)
+    assert tool.measured_tool.seen_grasps == 2, win.statusBar().currentMessage()
+    assert np.all(np.diag(tool.measured_tool.covariance)[:3] < 0.05**2 / 2) and np.all(
+        np.diag(tool.measured_tool.covariance) > 0
+    )
     # scored by the truth: the model with the seen tool puts the TCP on each pin to within the
     # calibrated camera's error there (a short calibration at 640 x 480: its principal point 0.26 px
     # off turns the camera frame by 0.5 mrad, and the seen tool with it, 0.09 mm at the TCP's lever
@@ -157,7 +159,7 @@ def test_plan_run_identify_apply_save_revert(qtbot, live_window, tmp_path):
     assert "look and model agree" in stored.source, stored.source
     # the fused correction is known better than the look alone through the same tool (the tool's error,
     # shared by look and model, is in both), and no better than the tool itself
-    tool_cov = tool.tool.covariance_in_base(wb.robot.fk(wb.session.result.context.joints_deg, "camera"))
+    tool_cov = tool.measured_tool.covariance_in_base(wb.robot.fk(wb.session.result.context.joints_deg, "camera"))
     look_with_tool = np.sqrt(np.diag(look.covariance + tool_cov))
     assert np.linalg.norm(stored.std_displacement_mm) < np.linalg.norm(look_with_tool[:3])
     assert np.linalg.norm(stored.std_rotation_deg) < np.linalg.norm(look_with_tool[3:])

@@ -225,7 +225,7 @@ def test_a_hand_eye_that_fails_its_checks_is_applied_only_when_confirmed(qtbot, 
     qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
     assert asked and "failed its checks" in asked[0] and np.array_equal(wb.robot.frame_placement("camera"), before)
     events = []
-    wb.event.connect(lambda kind, detail: events.append(kind))
+    wb.log.event.connect(lambda kind, detail: events.append(kind))
     asked = _answer(qtbot, "Apply anyway")
     qtbot.mouseClick(vision.apply_hand_eye_button, Qt.MouseButton.LeftButton)
     assert (
@@ -256,7 +256,7 @@ def test_captures_while_the_robot_moves_take_nothing(qtbot, window):
     _fresh_still_frame(qtbot, win)
     qtbot.waitUntil(
         lambda: (
-            wb.observations.latest.t_host_s > wb.last_move_sent_s
+            wb.observations.latest.t_host_s > wb.arm.last_move_sent_s
             and wb.observations.stillness(wb.observations.newest_usable()).settled
         ),
         timeout=10_000,

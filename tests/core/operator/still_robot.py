@@ -14,7 +14,7 @@ _seq = iter(range(10**9))
 def sample(core, joints_deg, t_s: float) -> None:
     """One joint sample (model joints) at host time ``t_s``, through the core's own entry point."""
     q = core.cell.joint_map.to_controller(np.asarray(joints_deg, dtype=float))
-    core.observe_sample(TimedSample(JointSample(next(_seq), int(t_s * 1000), tuple(float(v) for v in q)), t_s))
+    core.arm.observe_sample(TimedSample(JointSample(next(_seq), int(t_s * 1000), tuple(float(v) for v in q)), t_s))
 
 
 def still_for(

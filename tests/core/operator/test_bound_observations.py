@@ -86,7 +86,7 @@ def test_the_old_way_gives_an_implausible_result_that_needs_a_confirmation(cell_
         core.desk.store_correction(convert=converted)
     assert refused.value.reasons == verdict.reasons and core.session.corrections.latest(core.task.name) is None
     events = []
-    core.event.connect(lambda kind, detail: events.append((kind, detail)))
+    core.log.event.connect(lambda kind, detail: events.append((kind, detail)))
     stored = core.desk.store_correction(convert=converted, confirmation="confirmed by a test: the cell was moved")
     assert stored.verdict == "implausible" and stored.confirmation == "confirmed by a test: the cell was moved"
     assert (

@@ -21,7 +21,7 @@ def core():
 
 def test_a_board_goes_up_in_the_cell_and_a_new_one_sets_the_old_views_aside(core):
     said = []
-    core.message.connect(said.append)
+    core.log.message.connect(said.append)
     vision = core.vision
     with pytest.raises(ValueError):
         vision.set_board("charuco:nonsense")
@@ -55,7 +55,7 @@ def test_intrinsics_of_another_image_size_are_refused_by_name(core):
 
 def test_a_mounting_that_failed_its_checks_is_used_only_with_those_checks_confirmed(core):
     events = []
-    core.event.connect(lambda kind, detail: events.append(kind))
+    core.log.event.connect(lambda kind, detail: events.append(kind))
     before = core.robot.frame_placement("camera")
     flange = core.robot.frame_placement("flange")
     moved = concat(concat(before, invert(flange)), transform_from_xyz_rpy([2.0, 0.0, 0.0], [0.0, 0.0, 0.0]))

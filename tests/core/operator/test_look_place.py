@@ -67,7 +67,7 @@ def test_converted_explicitly_it_becomes_the_correction_with_what_the_operator_s
     with pytest.raises(LookNotAtTask) as refused:
         core.desk.store_correction()
     events = []
-    core.event.connect(lambda kind, detail: events.append((kind, detail)))
+    core.log.event.connect(lambda kind, detail: events.append((kind, detail)))
     c = core.desk.store_correction(convert="converted by a test")
     assert c.kind == "correction" and core.session.corrections.latest(core.task.name) is c
     assert "converted: the look was made 200" in c.source and "converted by a test" in c.source

@@ -20,7 +20,7 @@ def core():
 
 def test_point_then_accept_and_a_second_click_moves_the_image_point(core):
     events = []
-    core.event.connect(lambda kind, detail: events.append((kind, detail)))
+    core.log.event.connect(lambda kind, detail: events.append((kind, detail)))
     fixture = core.workcell.component("oru_1_fixture")
     with pytest.raises(OperatorError, match="nothing to accept"):
         core.picking.accept_pair()
@@ -46,8 +46,8 @@ def test_point_then_accept_and_a_second_click_moves_the_image_point(core):
 
 def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
     changed = []
-    core.scene_changed.connect(lambda: changed.append("scene"))
-    core.task_changed.connect(lambda name: changed.append(name))
+    core.cell.scene_changed.connect(lambda: changed.append("scene"))
+    core.tasks.changed.connect(lambda name: changed.append(name))
     before = core.cell.identity
     mesh = core.workcell.path.parent / "meshes" / "drawer.stl"
     core.editor.add_component(mesh, "crate")
@@ -70,7 +70,7 @@ def test_cell_edits_are_undoable_and_change_the_identity(core, tmp_path):
 def test_an_approach_edit_tells_the_task_choice_on_do_undo_and_redo(core):
     task = core.workcell.task("oru_1_grasp")
     told = []
-    core.task_changed.connect(told.append)
+    core.tasks.changed.connect(told.append)
     before = task.approach_mm
     core.editor.set_task_approach(task.name, before + 25.0)
     assert core.workcell.task(task.name).approach_mm == before + 25.0 and core.editor.dirty

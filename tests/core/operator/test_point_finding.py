@@ -13,7 +13,7 @@ from tests.core.operator.still_robot import core_looking_at_task
 def found_core():
     core, site, q, camera = core_looking_at_task()
     events = []
-    core.points_found.connect(events.append)
+    core.finder.points_found.connect(events.append)
     found = core.finder.find_points()
     yield core, site, q, found, events
     camera.close()
