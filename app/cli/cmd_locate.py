@@ -232,10 +232,16 @@ class _Locator:
 
     def _open_camera(self, image: np.ndarray) -> None:
         from calib_core.camera.intrinsics_io import load_intrinsics
-        from calib_core.render.model_view import ModelView
+        from calib_core.look.edge_samples import edge_model
         from calib_core.scene import SceneItem
 
         self.intrinsics = load_intrinsics(self.args.intrinsics, image_size=(image.shape[1], image.shape[0]))
+        if edge_model(self.mesh, self.prior, self.intrinsics).from_outline:
+            # a scanned mesh: its samples come from its outline, which the model's view always shows (its facets'
+            # own edges hold none), so the renderer (a third of the command's memory) is not started
+            return
+        from calib_core.render.model_view import ModelView
+
         self._view = ModelView(self.intrinsics)
         # the model's view only says which edges show: the object alone, light on the renderer's black, its faces
         # shaded apart by the light
