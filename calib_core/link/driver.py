@@ -238,7 +238,11 @@ class ControllerLink(ConnectorEvents):
         handle = MoveHandle(f"m{self._session}.{next(self._ids)}", q, time.monotonic() + timeout_s)
         if self._auth.wait_settled(HANDSHAKE_WAIT_S) not in (AuthState.READY, AuthState.OFF):
             handle.sent = False
-            handle._finish(MoveError(f"move {handle.id}: not sent: {self._auth.why_not}"))
+            if self._state is not LinkState.UP:
+                # (a link that dropped starts its next handshake when it is back: the reason is the link, not that)
+                handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
+            else:
+                handle._finish(MoveError(f"move {handle.id}: not sent: {self._auth.why_not}"))
             return handle
         self._moves.add(handle)
         handle.sent_s = time.monotonic()
