@@ -238,7 +238,7 @@ class ControllerLink(ConnectorEvents):
         handle = MoveHandle(f"m{self._session}.{next(self._ids)}", q, time.monotonic() + timeout_s)
         if self._auth.wait_settled(HANDSHAKE_WAIT_S) not in (AuthState.READY, AuthState.OFF):
             handle.sent = False
-            if self._state is not LinkState.UP:
+            if self._auth.state is AuthState.PENDING and self._state is not LinkState.UP:
                 # (a link that dropped starts its next handshake when it is back: the reason is the link, not that)
                 handle._finish(MoveError(f"move {handle.id}: the link is {self._state.value}; nothing was sent"))
             else:
