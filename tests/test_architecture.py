@@ -393,3 +393,83 @@ def test_no_class_of_the_core_holds_many_members_without_saying_why():
         if (found := _crowded_without_reason(p.read_text()))
     }
     assert not crowded, crowded
+
+
+_ASSEMBLY = {"main_window.py", "workbench.py", "cell_launcher.py"}
+"""The window's assembly: it builds the core (workbench, cell_launcher) and composes each pane's model from the
+core's parts (main_window); every other module of the window is a view."""
+
+
+def _core_models_imported(source: str) -> list[str]:
+    """The classes of the core's state a module imports (the operator's parts and the pane models in
+    ``calib_core.operator``, the calibration session): its arrows into the core's models. Exceptions and constants
+    are not models."""
+    import importlib
+
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, ast.ImportFrom) or not node.module:
+            continue
+        if not (node.module.startswith("calib_core.operator") or node.module == "calib_core.calibration.session"):
+            continue
+        module = importlib.import_module(node.module)
+        for alias in node.names:
+            thing = getattr(module, alias.name, None)
+            if isinstance(thing, type) and not issubclass(thing, BaseException):
+                found.append(f"{node.module}.{alias.name}")
+    return sorted(set(found))
+
+
+def test_every_view_has_one_arrow_into_the_core_s_models():
+    # What a view can touch is what it imports: the camera pane once took six parts (the cell, the frames, the
+    # picking, the session, the arm, Find points); it now takes its CameraPaneModel, and a second part imported to
+    # be given it would show here, whatever the parameter is called.
+    probe = (
+        "from calib_core.operator.arm import Arm\n"
+        "from calib_core.operator.move_preview import MoveNeedsConfirmation\n"  # an exception: no model
+        "from calib_core.operator.calibration_run import VIA\n"  # a constant
+        "def f():\n    from calib_core.calibration.session import CalibrationSession\n"
+    )
+    assert _core_models_imported(probe) == [
+        "calib_core.calibration.session.CalibrationSession",
+        "calib_core.operator.arm.Arm",
+    ]
+    crowded = {
+        p.name: found
+        for p in (ROOT / "app" / "gui").glob("*.py")
+        if p.name not in _ASSEMBLY and len(found := _core_models_imported(p.read_text())) > 1
+    }
+    assert not crowded, f"views importing more than one of the core's models: {crowded}"
+
+
+_VIEW_SUFFIXES = ("Pane", "Panel", "Table", "Bar", "Line")
+
+
+def _core_objects_given(call: ast.Call) -> list[str]:
+    """The arguments of ``call`` that hand over an object of the core: a part reached from the workbench
+    (``workbench.session``, ``wb.cell``) or a model composed of parts (``CameraPaneModel(...)``). A bound method
+    (``workbench.log.say``) or a lambda hands over one capability, not a model."""
+    given = []
+    for arg in list(call.args) + [k.value for k in call.keywords]:
+        if isinstance(arg, ast.Call) and getattr(arg.func, "id", "").endswith("Model"):
+            given.append(arg.func.id)
+        elif isinstance(arg, ast.Attribute) and arg.attr in _CORE_PARTS and isinstance(arg.value, ast.Name):
+            given.append(f"{arg.value.id}.{arg.attr}")
+    return given
+
+
+def test_the_window_gives_each_pane_one_model():
+    probe = ast.parse("CameraPane(wb.cell, wb.frames)\nReplayBar(wb.replay, lambda f: wb.frames.observe(f))\n")
+    calls = [n for n in ast.walk(probe) if isinstance(n, ast.Call) and getattr(n.func, "id", "") in ("CameraPane",)]
+    assert _core_objects_given(calls[0]) == ["wb.cell", "wb.frames"]
+    source = (ROOT / "app" / "gui" / "main_window.py").read_text()
+    views = [
+        n
+        for n in ast.walk(ast.parse(source))
+        if isinstance(n, ast.Call) and getattr(n.func, "id", "").endswith(_VIEW_SUFFIXES)
+    ]
+    names = {v.func.id for v in views}
+    assert {"CameraPane", "VirtualPane", "OverviewPane", "PairsTable", "ResultsPanel", "CommandPanel"} <= names
+    assert {"CellPanel", "RobotPanel", "VisionPanel", "ReplayBar", "StatusLine"} <= names
+    given_more = {v.func.id: found for v in views if len(found := _core_objects_given(v)) != 1}
+    assert not given_more, f"panes given other than one of the core's models: {given_more}"

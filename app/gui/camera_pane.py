@@ -11,12 +11,7 @@ from PySide6.QtWidgets import QCheckBox, QHBoxLayout, QLabel, QSlider, QVBoxLayo
 from app.gui.error_boundary import attempt
 from app.gui.image_view import ImageView, Overlay
 from app.gui.solved_edges import SolvedEdges
-from calib_core.calibration.session import CalibrationSession
-from calib_core.operator.arm import Arm
-from calib_core.operator.cell import Cell
-from calib_core.operator.frame_holding import FrameHolding
-from calib_core.operator.picking import Picking
-from calib_core.operator.point_finding import PointFinding
+from calib_core.operator.panes.camera import CameraPaneModel
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.camera.projection import project_points
 from calib_core.errors import OperatorError
@@ -46,19 +41,9 @@ class CameraPane(QWidget):
     pick_rejected = Signal(str)  # a click or a drag that picks nothing, and why
     pair_selected = Signal(int)  # a click on a pair's point
 
-    def __init__(
-        self,
-        cell: Cell,
-        frames: FrameHolding,
-        picking: Picking,
-        session: CalibrationSession,
-        arm: Arm,
-        finder: PointFinding,
-        parent=None,
-    ):
+    def __init__(self, model: CameraPaneModel, parent=None):
         super().__init__(parent)
-        # what it shows: the cell's camera and parts, the frames, the pairs being made, the result's overlay
-        self.cell, self.frames, self.picking, self.session, self.arm = cell, frames, picking, session, arm
+        self.model = model
         self.view = ImageView(placeholder="waiting for the camera...", loupe=True)
         self.view.grabber = self._grab
         self.view.dragged.connect(self._dragging)
@@ -102,25 +87,25 @@ class CameraPane(QWidget):
         self._board_joints: np.ndarray | None = None  # the robot state it was detected at
         self._board_text = ""
         self._edges_image: np.ndarray | None = None
-        self.solved_edges = SolvedEdges(cell.intrinsics)
+        self.solved_edges = SolvedEdges(model.intrinsics)
         self.edges_drawn = 0  # the solves whose CAD edges were drawn (tests and the bench wait on it)
         self._drawn_state: tuple | None = None
         self.view.clicked.connect(self._on_click)
         self.freeze.toggled.connect(self._hold_toggled)
         self.edges.toggled.connect(lambda _: self.refresh_overlay())
         self.opacity.valueChanged.connect(lambda _: self.refresh_overlay())
-        frames.frame_observed.connect(self.show_frame)
-        frames.still_changed.connect(self._still_changed)
-        session.pairs.changed.connect(lambda *_: self.refresh_overlay())
-        session.result.changed.connect(self._on_solved)
-        arm.joints_changed.connect(self._joints_changed)
-        cell.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.cell.intrinsics))
-        finder.points_found.connect(self._points_found)
+        model.frame_observed.connect(self.show_frame)
+        model.still_changed.connect(self._still_changed)
+        model.pairs_changed.connect(lambda *_: self.refresh_overlay())
+        model.result_changed.connect(self._on_solved)
+        model.joints_changed.connect(self._joints_changed)
+        model.camera_model_changed.connect(lambda: self.solved_edges.set_intrinsics(self.model.intrinsics))
+        model.points_found.connect(self._points_found)
 
     # --- frames ---------------------------------------------------------------------------------
     @property
     def held(self):
-        return self.frames.still
+        return self.model.still
 
     def show_frame(self, frame) -> None:
         self.last_frame_received = frame
@@ -133,14 +118,14 @@ class CameraPane(QWidget):
     def _hold_toggled(self, on: bool) -> None:
         if on and self.held is None:
             try:
-                self.frames.hold_frame()
+                self.model.hold_frame()
             except OperatorError as exc:
                 self.freeze.blockSignals(True)
                 self.freeze.setChecked(False)
                 self.freeze.blockSignals(False)
                 self.pick_rejected.emit(str(exc))
         elif not on and self.held is not None:
-            self.frames.release_frame()
+            self.model.release_frame()
 
     def _still_changed(self, held) -> None:
         self.freeze.blockSignals(True)
@@ -171,7 +156,7 @@ class CameraPane(QWidget):
         # The core holds the newest frame at the first pick of a set and refines on it.
         attempt(
             lambda text: self.pick_rejected.emit(f"nothing picked: {text}"),
-            self.picking.pick_image_point,
+            self.model.pick_image_point,
             (u, v),
             refine=self.subpixel.isChecked(),
         )
@@ -180,11 +165,11 @@ class CameraPane(QWidget):
     def _grab(self, u: float, v: float, radius_px: float) -> bool:
         """Take hold of the complete pair whose point lies within ``radius_px`` of (u, v) on the image
         shown (picked at the robot state it shows). Not while a pair waits for its point: the click is its."""
-        if self.session.pairs.pending() is not None:
+        if self.model.pairs.pending() is not None:
             return False
         near = [
             (np.hypot(p.pixel[0] - u, p.pixel[1] - v), p.number)
-            for p in self.session.pairs
+            for p in self.model.pairs
             if p.pixel is not None and (p.view is None or self._same_state(p.view.joints_deg))
         ]
         near = [n for n in near if n[0] <= radius_px]
@@ -203,7 +188,7 @@ class CameraPane(QWidget):
         if moved:
             attempt(
                 self.pick_rejected.emit,
-                self.picking.move_pair_pixel,
+                self.model.move_pair_pixel,
                 number,
                 (u, v),
                 refine=self.subpixel.isChecked(),
@@ -214,7 +199,7 @@ class CameraPane(QWidget):
         """Show a board detection (n, 2) px over the image (``None`` hides it); it belongs to the
         robot state it was detected at and is hidden when the robot moves."""
         self._board_corners = None if corners_px is None else np.asarray(corners_px, dtype=float)
-        self._board_joints = None if corners_px is None else np.array(self.arm.joints_deg, dtype=float)
+        self._board_joints = None if corners_px is None else np.array(self.model.joints_deg, dtype=float)
         self._board_text = text
         self.refresh_overlay()
 
@@ -240,19 +225,17 @@ class CameraPane(QWidget):
     def _on_solved(self) -> None:
         # The reprojected points and residuals are drawn at once; the CAD edges take a render, so they
         # follow on the next turn of the event loop, after that repaint.
-        if self.session.result.estimate is None:
+        if self.model.result.estimate is None:
             self._edges_image = None
         else:
             QTimer.singleShot(0, self._draw_solved_edges)
         self.refresh_overlay()
 
     def _draw_solved_edges(self) -> None:
-        r = self.session.result.estimate
+        r = self.model.result.estimate
         if r is None:
             return
-        self.set_edges_image(
-            self.solved_edges.render(self.cell.workcell.components, r.cam2world_measured, self.session.target)
-        )
+        self.set_edges_image(self.solved_edges.render(self.model.components, r.cam2world_measured, self.model.target))
         self.edges_drawn += 1
 
     def close_renderer(self) -> None:
@@ -262,7 +245,7 @@ class CameraPane(QWidget):
     def shown_joints(self) -> np.ndarray:
         """The joints (deg/mm) of the robot state the image shows: the held frame's, else the robot's now."""
         held = self.held
-        return np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.arm.joints_deg, dtype=float)
+        return np.array(held.stamp.joints_deg) if held is not None else np.asarray(self.model.joints_deg, dtype=float)
 
     def _same_state(self, joints) -> bool:
         if joints is None:
@@ -271,11 +254,9 @@ class CameraPane(QWidget):
         return a.shape == b.shape and float(np.max(np.abs(a - b))) <= SAME_STATE_DEG
 
     def _state_key(self) -> tuple:
-        session = self.session
-        context = session.result.context
-        pairs = tuple(
-            p.view is None or self._same_state(p.view.joints_deg) for p in session.pairs if p.pixel is not None
-        )
+        model = self.model
+        context = model.result.context
+        pairs = tuple(p.view is None or self._same_state(p.view.joints_deg) for p in model.pairs if p.pixel is not None)
         result = context is None or context.joints_deg is None or self._same_state(context.joints_deg)
         board = self._board_joints is None or self._same_state(self._board_joints)
         return pairs, result, board
@@ -286,12 +267,12 @@ class CameraPane(QWidget):
             self.refresh_overlay()
 
     def refresh_overlay(self) -> None:
-        session = self.session
+        model = self.model
         self._drawn_state = (pairs_current, result_current, board_current) = self._state_key()
         overlay = Overlay()
         banner = []
-        pending = session.pairs.pending()
-        picked = [p for p in session.pairs if p.pixel is not None]
+        pending = model.pairs.pending()
+        picked = [p for p in model.pairs if p.pixel is not None]
         for pair, current in zip(picked, pairs_current):
             color = (PICK_COLOR if pair.enabled else QColor(130, 130, 130)) if current else STALE_COLOR
             u, v = self._drag_at if pair.number == self._grabbed and self._drag_at is not None else pair.pixel
@@ -301,17 +282,17 @@ class CameraPane(QWidget):
                 f"picks {', '.join(str(p.number) for p, c in zip(picked, pairs_current) if not c)} were made at "
                 "another robot pose (grey)"
             )
-        result = session.result.estimate
-        stale = session.stale_reason
+        result = model.result.estimate
+        stale = model.stale_reason
         if result is not None and not result_current:
             banner.append("the last result was solved at another robot pose: not drawn")
         elif result is not None:
-            self._draw_result(overlay, session, result)
+            self._draw_result(overlay, model, result)
             if stale:
                 banner.append(f"the result is from an earlier set of pairs ({stale})")
         if pending is not None:
             overlay.text = f"pick point {pending.number} ({pending.feature or 'surface point'}) on the camera image"
-            expected = self.picking.expected_pixel()
+            expected = self.model.expected_pixel()
             if expected is not None:
                 (u, v), basis = expected
                 overlay.points.append((u, v, "expected", EXPECTED_COLOR))
@@ -333,14 +314,14 @@ class CameraPane(QWidget):
         overlay.banner = "; ".join(banner)
         self.view.set_overlay(overlay)
 
-    def _draw_result(self, overlay: Overlay, session, result) -> None:
+    def _draw_result(self, overlay: Overlay, model: CameraPaneModel, result) -> None:
         obj2cam = concat(result.obj2world, invert(result.cam2world_measured))
-        used = set(session.result.solved_numbers)
-        for pair in session.pairs:
+        used = set(model.result.solved_numbers)
+        for pair in model.pairs:
             if pair.pixel is None or pair.number not in used:
                 continue
             p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-            uv = project_points(p_obj, obj2cam, self.cell.intrinsics)[0]
+            uv = project_points(p_obj, obj2cam, self.model.intrinsics)[0]
             if np.all(np.isfinite(uv)):
                 overlay.points.append((uv[0], uv[1], "", REPROJECTED_COLOR))
                 end = np.array(pair.pixel) + RESIDUAL_SCALE * (np.array(pair.pixel) - uv)
@@ -350,11 +331,11 @@ class CameraPane(QWidget):
         if len(candidates) > 1:
             # Ghosts of the other poses that fit as well, so the operator can tell them apart.
             for k, candidate in enumerate(candidates):
-                if k == session.result.chosen_candidate:
+                if k == model.result.chosen_candidate:
                     continue
-                for pair in session.pairs:
+                for pair in model.pairs:
                     p_obj = apply(invert(result.obj2world), np.array(pair.point_world_mm)[None])
-                    uv = project_points(p_obj, candidate.obj2cam, self.cell.intrinsics)[0]
+                    uv = project_points(p_obj, candidate.obj2cam, self.model.intrinsics)[0]
                     if np.all(np.isfinite(uv)):
                         overlay.points.append((uv[0], uv[1], f"s{k + 1}", GHOST_COLOR))
             overlay.text = f"{len(candidates)} poses fit: magenta ghosts show the others; choose one in Results"

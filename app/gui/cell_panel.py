@@ -27,11 +27,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from calib_core.calibration.session import CalibrationSession
-from calib_core.operator.arm import Arm
-from calib_core.operator.cell import Cell
-from calib_core.operator.cell_editor import CellEditor
-from calib_core.operator.operator_log import OperatorLog
+from calib_core.operator.panes.cell_editing import CellPaneModel
 from calib_core.frames import apply, transform_from_xyz_rpy, xyz_rpy_from_transform
 
 SNAP_RADIUS_PX = 12.0
@@ -54,19 +50,9 @@ class CellPanel(QWidget):
 
     feature_mode_changed = Signal(object)
 
-    def __init__(
-        self,
-        cell: Cell,
-        editor: CellEditor,
-        session: CalibrationSession,
-        arm: Arm,
-        log: OperatorLog,
-        attempt,
-        parent=None,
-    ):
+    def __init__(self, model: CellPaneModel, attempt, parent=None):
         super().__init__(parent)
-        # what it shows and edits: the cell's components, features and task locations (through its editor)
-        self.cell, self.editor, self.session, self.arm, self.log = cell, editor, session, arm, log
+        self.model = model
         self._attempt = attempt
         layout = QVBoxLayout(self)
 
@@ -147,8 +133,8 @@ class CellPanel(QWidget):
         self.add_component.clicked.connect(self._add_component_dialog)
         self.take_pose.clicked.connect(self.fill_current_pose)
         self.add_task.clicked.connect(lambda: self._attempt(self.add_task_location))
-        self.save.clicked.connect(lambda: self._attempt(self.editor.save))
-        cell.scene_changed.connect(self._sync)
+        self.save.clicked.connect(lambda: self._attempt(self.model.save))
+        model.scene_changed.connect(self._sync)
         self.pick_features.toggled.connect(self._feature_mode)
         self.component.currentTextChanged.connect(lambda _: self._feature_mode(self.picking_features))
         self._sync()
@@ -156,20 +142,20 @@ class CellPanel(QWidget):
 
     # --- the core's state into the widgets ------------------------------------------------------
     def _sync(self) -> None:
-        names = [c.name for c in self.cell.workcell.components]
+        names = self.model.component_names
         current = self.component.currentText()
         if [self.component.itemText(i) for i in range(self.component.count())] != names:
             self.component.blockSignals(True)
             self.component.clear()
             self.component.addItems(names)
-            self.component.setCurrentText(current if current in names else (self.session.target or names[0]))
+            self.component.setCurrentText(current if current in names else (self.model.target or names[0]))
             self.component.blockSignals(False)
         self._show_component(self.component.currentText())
 
     def _show_component(self, name: str) -> None:
         if not name:
             return
-        xyz, rpy = xyz_rpy_from_transform(self.cell.workcell.component(name).item2world)
+        xyz, rpy = xyz_rpy_from_transform(self.model.component(name).item2world)
         for box, v in zip(self.xyz + self.rpy, list(xyz) + list(rpy)):
             with QSignalBlocker(box):  # showing the core's placement is not an edit of it
                 box.setValue(float(v))
@@ -177,13 +163,13 @@ class CellPanel(QWidget):
     # --- edits ------------------------------------------------------------------------------------
     def _placement_edited(self) -> None:
         name = self.component.currentText()
-        self._attempt(self.editor.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
+        self._attempt(self.model.place_component, name, [b.value() for b in self.xyz], [b.value() for b in self.rpy])
 
     def _add_component_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
             self,
             "Add component",
-            str(self.cell.workcell.path.parent),
+            str(self.model.cell_folder),
             "Meshes (*.stl *.obj *.dae *.glb *.gltf *.ply)",
         )
         if not path:
@@ -194,20 +180,18 @@ class CellPanel(QWidget):
 
     def add_component_file(self, path, name: str) -> None:
         """Add the component and select it, so its placement can be typed at once."""
-        if self._attempt(self.editor.add_component, path, name):
+        if self._attempt(self.model.add_component, path, name):
             self.component.setCurrentText(name.strip())
 
     def fill_current_pose(self) -> None:
-        xyz, rpy = xyz_rpy_from_transform(self.cell.robot.fk(self.arm.joints_deg, "tcp"))
+        xyz, rpy = xyz_rpy_from_transform(self.model.tcp2base)
         for box, v in zip(self.task_xyz + self.task_rpy, list(xyz) + list(rpy)):
             box.setValue(float(v))
 
     def add_task_location(self) -> None:
-        name = self.task_name.text().strip() or f"location_{len(self.cell.workcell.task_locations) + 1}"
         T = transform_from_xyz_rpy([b.value() for b in self.task_xyz], [b.value() for b in self.task_rpy])
-        self.editor.add_task_location(name, T, self.task_approach.value())
+        self.model.add_task_location(self.task_name.text(), T, self.task_approach.value())
         self.task_name.clear()
-        self.log.say(f"task location {name} added")
 
     def _feature_mode(self, on: bool) -> None:
         self.feature_mode_changed.emit(self.component.currentText() if on else None)
@@ -219,10 +203,10 @@ class CellPanel(QWidget):
     def feature_clicked(self, hit, cam2world: np.ndarray, focal_px: float) -> None:
         """A click on the chosen component in the virtual camera: snap it, name it, add it."""
         depth_mm = float(np.linalg.norm(hit.point_world_mm - cam2world[:3, 3]))
-        snap = self.editor.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
-        item = self.cell.workcell.component(hit.component)
+        snap = self.model.snap_feature(hit.component, hit.point_component_mm, SNAP_RADIUS_PX * depth_mm / focal_px)
+        item = self.model.component(hit.component)
         name = self.feature_name.text().strip() or f"feature_{len(item.features) + 1}"
-        self.editor.add_feature(hit.component, name, snap.point_mm)
+        self.model.add_feature(hit.component, name, snap.point_mm)
         self.feature_name.clear()
         world = apply(item.item2world, np.asarray(snap.point_mm)[None])[0]
         self.feature_info.setText(

@@ -20,12 +20,7 @@ from PySide6.QtWidgets import (
 
 from app.gui.buttons import button
 from app.gui.error_boundary import attempt
-from calib_core.calibration.commands import ClearPairs
-from calib_core.calibration.session import CalibrationSession
-from calib_core.calibration.solve_options import SetOption
-from calib_core.operator.cell import Cell
-from calib_core.operator.cell_editor import CellEditor
-from calib_core.operator.task_choice import TaskChoice
+from calib_core.operator.panes.commands import CommandsPaneModel
 
 
 class CommandPanel(QTabWidget):
@@ -36,11 +31,9 @@ class CommandPanel(QTabWidget):
 
     error = Signal(str)
 
-    def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, editor: CellEditor, parent=None):
+    def __init__(self, model: CommandsPaneModel, parent=None):
         super().__init__(parent)
-        # what it shows and sets: the task locations (the choice, their approach through the cell's editor), the
-        # target and the solve options (the session)
-        self.cell, self.session, self.task_choice, self.editor = cell, session, tasks, editor
+        self.model = model
         self.setMinimumWidth(250)
         # Six tabs (the paper's four modes, Vision and Cell) fit the panel without scroll arrows.
         self.setStyleSheet("QTabBar::tab { padding: 4px 5px; }")
@@ -54,7 +47,7 @@ class CommandPanel(QTabWidget):
         pl.addWidget(QLabel("Task locations"))
         self.tasks = QListWidget()
         self.tasks.setObjectName("tasks")
-        for name in cell.workcell.task_locations:
+        for name in model.task_names:
             self.tasks.addItem(name)
         pl.addWidget(self.tasks, 1)
         approach_row = QFormLayout()
@@ -100,11 +93,10 @@ class CommandPanel(QTabWidget):
         form = QFormLayout()
         self.target = QComboBox()
         self.target.setObjectName("target")
-        for c in cell.workcell.components:
-            if c.kind == "component":
-                self.target.addItem(c.name)
-        if session.target:
-            self.target.setCurrentText(session.target)
+        for name in model.target_names:
+            self.target.addItem(name)
+        if model.target:
+            self.target.setCurrentText(model.target)
         form.addRow("Target object", self.target)
         cl.addLayout(form)
         steps = QGroupBox("Point pairs")
@@ -170,41 +162,35 @@ class CommandPanel(QTabWidget):
         el.addStretch(1)
         self.addTab(ex, "Execute")
         self.setCurrentIndex(2)
-        tasks.changed.connect(self._sync_tasks)
-        cell.scene_changed.connect(self._sync_targets)
+        model.task_changed.connect(self._sync_tasks)
+        model.scene_changed.connect(self._sync_targets)
         self._bind()
 
     def _bind(self) -> None:
         def run(fn, *args):
             attempt(self.error.emit, fn, *args)
 
-        self.clear.clicked.connect(lambda: run(self.session.undo.push, ClearPairs(self.session.pairs)))
-        self.target.currentTextChanged.connect(lambda name: run(self.session.set_target, name))
-        options = self.session.options
-        self.estimate_focal.toggled.connect(
-            lambda on: run(self.session.undo.push, SetOption(options, "estimate_focal", on))
-        )
-        self.robust.toggled.connect(lambda on: run(self.session.undo.push, SetOption(options, "robust", on)))
-        self.session.options.changed.connect(self.show_option)  # an undo sets the box back
+        model = self.model
+        self.clear.clicked.connect(lambda: run(model.clear_pairs))
+        self.target.currentTextChanged.connect(lambda name: run(model.set_target, name))
+        self.estimate_focal.toggled.connect(lambda on: run(model.set_option, "estimate_focal", on))
+        self.robust.toggled.connect(lambda on: run(model.set_option, "robust", on))
+        model.options_changed.connect(self.show_option)  # an undo sets the box back
 
         def task_chosen(name: str) -> None:
             if name:
-                run(self.task_choice.choose, name)
-
-        def approach_edited(mm: float) -> None:
-            if self.task_choice.task is not None:
-                run(self.editor.set_task_approach, self.task_choice.task.name, mm)
+                run(model.choose_task, name)
 
         self.tasks.currentTextChanged.connect(task_chosen)
-        self.approach.valueChanged.connect(approach_edited)
-        self.task_choice.changed.connect(self._show_task)
-        if self.task_choice.task is not None:
-            self._show_task(self.task_choice.task.name)
-        self.session.corrections.changed.connect(lambda task: self.show_corrections(self.session.corrections))
+        self.approach.valueChanged.connect(lambda mm: run(model.set_task_approach, mm))
+        model.task_changed.connect(self._show_task)
+        if model.task is not None:
+            self._show_task(model.task.name)
+        model.corrections_changed.connect(lambda task: self.show_corrections(model.corrections))
 
     def _show_task(self, name: str) -> None:
         """The approach box shows the chosen task location's approach distance (without sending it back)."""
-        task = self.task_choice.task
+        task = self.model.task
         if task is None or task.name != name:
             return
         with QSignalBlocker(self.approach):
@@ -247,7 +233,7 @@ class CommandPanel(QTabWidget):
 
     def _sync_tasks(self, name: str = "") -> None:
         """The task list follows the cell (a location added or undone)."""
-        names = list(self.cell.workcell.task_locations)
+        names = self.model.task_names
         if [self.tasks.item(i).text() for i in range(self.tasks.count())] == names:
             return
         current = self.tasks.currentItem().text() if self.tasks.currentItem() else None
@@ -260,12 +246,12 @@ class CommandPanel(QTabWidget):
 
     def _sync_targets(self) -> None:
         """The target choice follows the cell's components (one added or undone)."""
-        names = [c.name for c in self.cell.workcell.components if c.kind == "component"]
+        names = self.model.target_names
         if [self.target.itemText(i) for i in range(self.target.count())] == names:
             return
         self.target.blockSignals(True)
         self.target.clear()
         self.target.addItems(names)
-        if self.session.target in names:
-            self.target.setCurrentText(self.session.target)
+        if self.model.target in names:
+            self.target.setCurrentText(self.model.target)
         self.target.blockSignals(False)

@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtCore import QSettings, QTimer
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QScrollArea, QSplitter, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QMainWindow, QScrollArea
 
 from app.gui.camera_pane import CameraPane
 from app.gui.cell_panel import CellPanel
@@ -22,9 +22,18 @@ from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
 from app.gui.robot_panel import RobotPanel
 from app.gui.vision_panel import VisionPanel
-from app.gui.window_layout import restore_layout, save_layout
+from app.gui.window_layout import arrange_panes, restore_layout, save_layout
 from app.gui.workbench import Workbench
 from app.gui.workflow_actions import WorkflowActions
+from calib_core.operator.panes.camera import CameraPaneModel
+from calib_core.operator.panes.cell_editing import CellPaneModel
+from calib_core.operator.panes.commands import CommandsPaneModel
+from calib_core.operator.panes.overview import OverviewPaneModel
+from calib_core.operator.panes.pairs import PairsTableModel
+from calib_core.operator.panes.results import ResultsPaneModel
+from calib_core.operator.panes.robot import RobotPaneModel
+from calib_core.operator.panes.status import StatusLineModel
+from calib_core.operator.panes.virtual_camera import VirtualPaneModel
 
 
 VIRTUAL_EVERY_TICKS = 2  # the virtual camera follows a moving robot at 10 fps, the overview at 20
@@ -38,36 +47,42 @@ class MainWindow(QMainWindow):
         self.settings = settings or QSettings("videocal", "videocal")
         self.setWindowTitle(f"videocal - {workbench.workcell.name}")
         self.camera = CameraPane(
-            workbench.cell,
-            workbench.frames,
-            workbench.picking,
-            workbench.session,
-            workbench.arm,
-            workbench.finder,
+            CameraPaneModel(
+                workbench.cell,
+                workbench.frames,
+                workbench.picking,
+                workbench.session,
+                workbench.arm,
+                workbench.finder,
+            )
         )
-        self.virtual = VirtualPane(workbench.cell, workbench.session, workbench.arm, workbench.picking)
-        self.overview = OverviewPane(workbench.cell, workbench.session, workbench.arm, workbench.moves)
-        self.table = PairsTable(workbench.session)
-        self.results = ResultsPanel(workbench.session, workbench.arm)
-        self.commands = CommandPanel(workbench.cell, workbench.session, workbench.tasks, workbench.editor)
+        self.virtual = VirtualPane(
+            VirtualPaneModel(workbench.cell, workbench.session, workbench.arm, workbench.picking)
+        )
+        self.overview = OverviewPane(
+            OverviewPaneModel(workbench.cell, workbench.session, workbench.arm, workbench.moves)
+        )
+        self.table = PairsTable(PairsTableModel(workbench.session))
+        self.results = ResultsPanel(ResultsPaneModel(workbench.session, workbench.arm))
+        self.commands = CommandPanel(
+            CommandsPaneModel(workbench.cell, workbench.session, workbench.tasks, workbench.editor)
+        )
         self.replay = ReplayBar(workbench.replay, lambda frame: workbench.frames.observe_frame(frame, replayed=True))
         self.vision = VisionPanel(
             workbench.vision,
-            workbench.moves,
             self.show_error,
-            lambda send: self.actions.move(send),
+            lambda q, what: self.actions.move(
+                lambda confirmed: workbench.moves.move_joints(q, what, confirmed=confirmed)
+            ),
             say=workbench.log.say,
         )
         self.vision.board_detected.connect(self.camera.set_board_corners)
         self.robot_calibration = RobotPanel(
-            workbench.robot_calibration, workbench.vision, workbench.tool, workbench.log, self.show_error
+            RobotPaneModel(workbench.robot_calibration, workbench.vision, workbench.tool, workbench.log),
+            self.show_error,
         )
         self.cell_panel = CellPanel(
-            workbench.cell,
-            workbench.editor,
-            workbench.session,
-            workbench.arm,
-            workbench.log,
+            CellPaneModel(workbench.cell, workbench.editor, workbench.session, workbench.arm, workbench.log),
             lambda fn, *a, **k: attempt(self.show_error, fn, *a, **k),
         )
         for panel, title in ((self.vision, "Vision"), (self.robot_calibration, "Robot"), (self.cell_panel, "Cell")):
@@ -97,7 +112,7 @@ class MainWindow(QMainWindow):
         self._joints_dirty = False  # joints moved since the virtual camera was last checked
         self._ticks = 0
         self.worker: FrameWorker | None = None
-        self._build_layout()
+        arrange_panes(self)
         self._build_menus()
         self._build_status()
         self._connect()
@@ -109,43 +124,6 @@ class MainWindow(QMainWindow):
         self.virtual.refresh()
         self.overview.refresh()
         self.files.start_autosave()
-
-    # --- layout ----------------------------------------------------------------------------
-    def _build_layout(self) -> None:
-        top = QSplitter(Qt.Orientation.Horizontal)
-        top.addWidget(self.camera)
-        top.addWidget(self.virtual)
-        top.setSizes([700, 620])
-        right_bottom = QWidget()
-        rb = QVBoxLayout(right_bottom)
-        rb.setContentsMargins(0, 0, 0, 0)
-        rb.addWidget(QLabel("<b>Point pairs</b>"))
-        rb.addWidget(self.table, 1)
-        rb.addWidget(QLabel("<b>Results</b>"))
-        rb.addWidget(self.results, 1)
-        bottom = QSplitter(Qt.Orientation.Horizontal)
-        bottom.addWidget(self.overview)
-        bottom.addWidget(right_bottom)
-        bottom.setSizes([700, 620])
-        self.top_splitter, self.bottom_splitter = top, bottom
-        self.splitter = QSplitter(Qt.Orientation.Vertical)
-        self.splitter.addWidget(top)
-        self.splitter.addWidget(bottom)
-        self.splitter.setStretchFactor(0, 3)
-        self.splitter.setStretchFactor(1, 2)
-        central = QWidget()
-        column = QVBoxLayout(central)
-        column.setContentsMargins(0, 0, 0, 0)
-        column.setSpacing(0)
-        column.addWidget(self.replay)
-        column.addWidget(self.splitter, 1)
-        self.setCentralWidget(central)
-        dock = QDockWidget("Commands", self)
-        dock.setObjectName("commands_dock")
-        dock.setWidget(self.commands)
-        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable)
-        self.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, dock)
-        self.resize(1600, 1000)
 
     def _build_menus(self) -> None:
         wb = self.workbench
@@ -194,11 +172,7 @@ class MainWindow(QMainWindow):
         wb = self.workbench
         self.status_line = StatusLine(
             self.statusBar(),
-            arm=wb.arm,
-            session=wb.session,
-            frames=wb.frames,
-            link=lambda: wb.link,
-            recording=wb.recording,
+            StatusLineModel(wb.arm, wb.session, wb.frames, wb.recording, lambda: wb.link),
             camera_state=self._camera_state,
             parent=self,
         )

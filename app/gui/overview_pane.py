@@ -11,10 +11,7 @@ from PySide6.QtCore import QPointF, Qt, QTimer
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.gui.image_view import ImageView
-from calib_core.calibration.session import CalibrationSession
-from calib_core.operator.arm import Arm
-from calib_core.operator.cell import Cell
-from calib_core.operator.moves import Moves
+from calib_core.operator.panes.overview import OverviewPaneModel
 from calib_core.scene_framing import cell_framing, eye_at
 from calib_core.render import RenderOptions, SceneRenderer
 from calib_core.render.frustum import frustum_polyline
@@ -63,11 +60,9 @@ class _OrbitView(ImageView):
 
 
 class OverviewPane(QWidget):
-    def __init__(self, cell: Cell, session: CalibrationSession, arm: Arm, moves: Moves, parent=None):
+    def __init__(self, model: OverviewPaneModel, parent=None):
         super().__init__(parent)
-        # what it shows: the cell as modelled at the arm's joints, the model's and the measured camera, the pairs'
-        # points, a move's preview (Stop from it through the moves)
-        self.cell, self.session, self.arm, self.moves = cell, session, arm, moves
+        self.model = model
         self.renderer = SceneRenderer()
         self.view = _OrbitView(self)
         self.view.setCursor(Qt.CursorShape.OpenHandCursor)
@@ -111,14 +106,14 @@ class OverviewPane(QWidget):
         self._shown_joints: np.ndarray | None = None  # the animation's joints now shown, or None: the robot's
         self._path_timer = QTimer(self)
         self._path_timer.timeout.connect(self._path_step)
-        session.result.changed.connect(self.mark_dirty)
-        session.target_changed.connect(self.mark_dirty)
-        cell.scene_changed.connect(self.mark_dirty)
-        cell.camera_model_changed.connect(self.mark_dirty)
-        session.pairs.changed.connect(lambda *_: self.mark_dirty())
-        arm.move_previewed.connect(lambda preview: self.show_preview(preview))
-        arm.motion_changed.connect(self._motion_changed)
-        arm.prompts_withdrawn.connect(self._withdraw_prompt)
+        model.result_changed.connect(self.mark_dirty)
+        model.target_changed.connect(self.mark_dirty)
+        model.scene.scene_changed.connect(self.mark_dirty)
+        model.scene.camera_model_changed.connect(self.mark_dirty)
+        model.pairs_changed.connect(lambda *_: self.mark_dirty())
+        model.move_previewed.connect(lambda preview: self.show_preview(preview))
+        model.motion_changed.connect(self._motion_changed)
+        model.prompts_withdrawn.connect(self._withdraw_prompt)
 
     # --- previewed moves ------------------------------------------------------------------------
     def show_preview(self, preview, send: Callable[[], None] | None = None) -> None:
@@ -146,10 +141,10 @@ class OverviewPane(QWidget):
         if (
             self._send is None
             and self.preview is not None
-            and self.arm.state.motion.value == "moving"
-            and self.arm.state.what == self.preview.what
+            and self.model.robot_state.motion.value == "moving"
+            and self.model.robot_state.what == self.preview.what
         ):
-            self.moves.stop_robot()
+            self.model.stop_robot()
             return
         self.show_preview(None)
 
@@ -181,7 +176,9 @@ class OverviewPane(QWidget):
     def _ghost_items(self) -> list:
         p = self.preview
         moving = (
-            self._send is None and not p.blocked and self.arm.state.motion.value == "moving" if p is not None else False
+            self._send is None and not p.blocked and self.model.robot_state.motion.value == "moving"
+            if p is not None
+            else False
         )
         if p is None or moving:
             # While the robot runs the move the real one heads there: the tool's path line is enough, and a
@@ -190,7 +187,7 @@ class OverviewPane(QWidget):
         color = (1.0, 0.3, 0.3) if p.blocked else ((1.0, 0.7, 0.3) if self._send is not None else (0.45, 0.75, 1.0))
         q = p.path_deg[p.contact_step] if (p.blocked and p.contact_step is not None) else p.goal_deg
         items = []
-        for item in self.cell.model_visuals().scene_items(q):
+        for item in self.model.scene.robot_items(q):
             items.append(
                 SceneItem(
                     name="ghost/" + item.name,
@@ -230,7 +227,7 @@ class OverviewPane(QWidget):
         """Frame the cell: its components and the robot where it stands (a floor or a wall, far wider
         than it is thick, does not count), seen from the current direction."""
         self.target, self.distance_mm = cell_framing(
-            list(self.cell.workcell.components) + self.cell.model_visuals().scene_items(self.arm.joints_deg)
+            list(self.model.scene.components) + self.model.scene.robot_items(self.model.joints_deg)
         )
         self.mark_dirty()
 
@@ -259,29 +256,26 @@ class OverviewPane(QWidget):
         if not self._dirty:
             return
         # extra_items: things put up in the cell for a while (the calibration board), shown where they stand.
-        q = self.arm.joints_deg if self._shown_joints is None else self._shown_joints
-        self.renderer.set_items(
-            self.cell.workcell.components
-            + self.cell.model_visuals().scene_items(q)
-            + list(self.cell.extras)
-            + self._ghost_items()
-        )
+        q = self.model.joints_deg if self._shown_joints is None else self._shown_joints
+        self.renderer.set_items(self.model.scene.items(q) + self._ghost_items())
         lines = [
             (
-                frustum_polyline(self.cell.intrinsics, self.cell.robot.fk(self.arm.joints_deg, "camera"), 300.0),
+                frustum_polyline(
+                    self.model.scene.intrinsics, self.model.scene.model_cam2world(self.model.joints_deg), 300.0
+                ),
                 MODEL_FRUSTUM,
             )
         ]
         if self.preview is not None and self.preview.tcp_path_mm is not None and len(self.preview.tcp_path_mm) > 1:
             lines.append((self.preview.tcp_path_mm, (1.0, 0.7, 0.3)))
-        if self.session.result.estimate is not None:
+        if self.model.estimate is not None:
             lines.append(
                 (
-                    frustum_polyline(self.cell.intrinsics, self.session.result.estimate.cam2world_measured, 300.0),
+                    frustum_polyline(self.model.scene.intrinsics, self.model.estimate.cam2world_measured, 300.0),
                     MEASURED_FRUSTUM,
                 )
             )
-        markers = [(np.array(p.point_world_mm), (1.0, 0.84, 0.04)) for p in self.session.pairs]
+        markers = [(np.array(p.point_world_mm), (1.0, 0.84, 0.04)) for p in self.model.pairs]
         size = self.view.size()
         w, h = max(size.width(), 320), max(size.height(), 240)
         image = self.renderer.render_overview(
@@ -289,7 +283,7 @@ class OverviewPane(QWidget):
             self.target,
             width=w,
             height=h,
-            options=RenderOptions(highlight=self.session.target, lines=lines, markers=markers, feature_size_px=8),
+            options=RenderOptions(highlight=self.model.target, lines=lines, markers=markers, feature_size_px=8),
         )
         self.view.set_image(image)
         self.redraws += 1

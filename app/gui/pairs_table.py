@@ -7,16 +7,15 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableWidget, QTableWidgetItem
 
-from calib_core.calibration.commands import SetEnabled
-from calib_core.calibration.session import CalibrationSession
+from calib_core.operator.panes.pairs import PairsTableModel
 
 COLUMNS = ("#", "feature", "X mm", "Y mm", "Z mm", "u px", "v px", "residual px", "use")
 
 
 class PairsTable(QTableWidget):
-    def __init__(self, session: CalibrationSession, parent=None):
+    def __init__(self, model: PairsTableModel, parent=None):
         super().__init__(0, len(COLUMNS), parent)
-        self.session = session
+        self.pairs_model = model
         self.setHorizontalHeaderLabels(COLUMNS)
         self.verticalHeader().setVisible(False)
         self.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
@@ -26,8 +25,8 @@ class PairsTable(QTableWidget):
         self.horizontalHeader().setStretchLastSection(True)
         self._updating = False
         self.itemChanged.connect(self._on_item_changed)
-        session.pairs.changed.connect(lambda *_: self.refresh())
-        session.result.changed.connect(self.refresh)
+        model.pairs_changed.connect(lambda *_: self.refresh())
+        model.result_changed.connect(self.refresh)
 
     def selected_number(self) -> int | None:
         rows = self.selectionModel().selectedRows()
@@ -45,27 +44,27 @@ class PairsTable(QTableWidget):
                 return
 
     def _residuals(self) -> dict[int, float]:
-        result = self.session.result.estimate
+        result = self.pairs_model.result.estimate
         if result is None:
             return {}
-        numbers = self.session.result.solved_numbers
+        numbers = self.pairs_model.result.solved_numbers
         norms = result.solution.residual_norms_px
         return {n: float(r) for n, r in zip(numbers, norms)}
 
     def _suspects(self) -> set[int]:
         """The pairs the last solve rejected or found not to fit the others (drawn red, with why)."""
-        result = self.session.result.estimate
+        result = self.pairs_model.result.estimate
         if result is None:
             return set()
         s = result.solution
         flags = np.asarray(s.outliers, dtype=bool) | (
             np.asarray(s.misfits, dtype=bool) if s.misfits is not None else False
         )
-        return {n for n, f in zip(self.session.result.solved_numbers, flags) if f}
+        return {n for n, f in zip(self.pairs_model.result.solved_numbers, flags) if f}
 
     def refresh(self) -> None:
         self._updating = True
-        pairs = self.session.pairs.pairs()
+        pairs = self.pairs_model.pairs.pairs()
         residuals = self._residuals()
         suspects = self._suspects()
         self.setRowCount(len(pairs))
@@ -104,5 +103,4 @@ class PairsTable(QTableWidget):
             return
         number = int(self.item(item.row(), 0).text())
         enabled = item.checkState() == Qt.CheckState.Checked
-        if self.session.pairs.get(number).enabled != enabled:
-            self.session.undo.push(SetEnabled(self.session.pairs, number, enabled))
+        self.pairs_model.set_enabled(number, enabled)

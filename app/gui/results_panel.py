@@ -11,8 +11,7 @@ from PySide6.QtCore import QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QPainter
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
-from calib_core.calibration.session import CalibrationSession
-from calib_core.operator.arm import Arm
+from calib_core.operator.panes.results import ResultsPaneModel
 from calib_core.calibration.verdict import Verdict
 from calib_core.calibration.view_stamp import SAME_STATE_DEG
 from calib_core.solver import SolveStatus
@@ -69,9 +68,9 @@ class ResultsPanel(QWidget):
 
     candidate_chosen = Signal(int)
 
-    def __init__(self, session: CalibrationSession, arm: Arm, parent=None):
+    def __init__(self, model: ResultsPaneModel, parent=None):
         super().__init__(parent)
-        self.session, self.arm = session, arm
+        self.model = model
         self.verdict = QLabel("No solve yet.")
         self.verdict.setObjectName("verdict")
         self.verdict.setWordWrap(True)
@@ -93,19 +92,19 @@ class ResultsPanel(QWidget):
         layout.addWidget(self.details)
         layout.addLayout(self.candidates)
         layout.addWidget(self.chart, 1)
-        session.result.changed.connect(self.refresh)
-        session.pairs.changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
+        model.result_changed.connect(self.refresh)
+        model.pairs_changed.connect(lambda *_: self.refresh())  # a result whose pairs changed is marked
         self._elsewhere = False
         self._shown = None  # the estimate shown: a new one clears the message line
-        arm.joints_changed.connect(self._joints_changed)
-        session.corrections.changed.connect(lambda *_: self.clear_message())
+        model.joints_changed.connect(self._joints_changed)
+        model.corrections_changed.connect(lambda *_: self.clear_message())
 
     def _solved_elsewhere(self) -> bool:
         """The last result was solved from another robot pose than the robot's now."""
-        context = self.session.result.context
-        if context is None or context.joints_deg is None or self.session.result.estimate is None:
+        context = self.model.result.context
+        if context is None or context.joints_deg is None or self.model.result.estimate is None:
             return False
-        now = np.asarray(self.arm.joints_deg, float)
+        now = np.asarray(self.model.joints_deg, float)
         return context.joints_deg.shape != now.shape or float(np.max(np.abs(context.joints_deg - now))) > SAME_STATE_DEG
 
     def _joints_changed(self, _q) -> None:
@@ -145,8 +144,8 @@ class ResultsPanel(QWidget):
         self._fit_text()
 
     def refresh(self) -> None:
-        session = self.session
-        r = session.result.estimate
+        model = self.model
+        r = model.result.estimate
         if r is not self._shown:
             self._shown = r
             self.clear_message()
@@ -155,16 +154,14 @@ class ResultsPanel(QWidget):
             if w is not None:
                 w.deleteLater()
         if r is None:
-            self.verdict.setText(
-                "No solve yet. Pick at least %d pairs, then Calibrate." % session.options.required_pairs
-            )
+            self.verdict.setText("No solve yet. Pick at least %d pairs, then Calibrate." % model.required_pairs)
             self._fit_text()
             self.details.setText("")
             self.chart.set_values([])
             return
         sol = r.solution
-        verdict = session.result.verdict
-        stale = session.stale_reason
+        verdict = model.result.verdict
+        stale = model.stale_reason
         if stale:
             text = (
                 f"<span style='color:#9a9a9a'><b>FROM AN EARLIER STATE</b></span> - {html.escape(stale, quote=False)}"
@@ -210,8 +207,8 @@ class ResultsPanel(QWidget):
             "</table>"
         )
         self._fit_text()
-        numbers = session.result.solved_numbers
-        present = {p.number for p in session.pairs.usable()}
+        numbers = model.result.solved_numbers
+        present = {p.number for p in model.pairs.usable()}
         # bars only for pairs that still exist as they were solved; a stale result shows none
         bars = (
             []
@@ -231,6 +228,6 @@ class ResultsPanel(QWidget):
                 )
                 button.setObjectName(f"candidate_{i}")
                 button.setCheckable(True)
-                button.setChecked(i == session.result.chosen_candidate)
+                button.setChecked(i == model.result.chosen_candidate)
                 button.clicked.connect(functools.partial(self._choose, i))
                 self.candidates.addWidget(button)

@@ -28,10 +28,7 @@ from app.gui.busy import busy
 from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from app.gui.tool_group import ToolGroup
-from calib_core.operator.camera_calibrating import CameraCalibrating
-from calib_core.operator.operator_log import OperatorLog
-from calib_core.operator.robot_calibrating import RobotCalibrating
-from calib_core.operator.tool_measuring import ToolMeasuring
+from calib_core.operator.panes.robot import RobotPaneModel
 from calib_core.errors import OperatorError
 from calib_core.operator.calibration_run import VIA
 from calib_core.vision.board import DEFAULT_SPEC, parse_board
@@ -42,18 +39,9 @@ class RobotPanel(QWidget):
     """``show_error`` puts a failed step's reason in the window; progress goes to the core's log (the
     messages (the status bar) and to the panel's own line."""
 
-    def __init__(
-        self,
-        robot_calibration: RobotCalibrating,
-        vision: CameraCalibrating,
-        measuring: ToolMeasuring,
-        log: OperatorLog,
-        show_error: Callable[[str], None],
-        parent=None,
-    ):
+    def __init__(self, model: RobotPaneModel, show_error: Callable[[str], None], parent=None):
         super().__init__(parent)
-        # what it shows: the core's robot calibration, the board in the cell, the tool being measured
-        self.robot_calibration, self.vision, self.log = robot_calibration, vision, log
+        self.model = model
         guard = guarded(show_error)
         self.plan = None
         self.run = None
@@ -71,7 +59,7 @@ class RobotPanel(QWidget):
         self.show_board.setToolTip(
             "Put the board up where the cell's hand_eye_board says (the simulated camera sees it)"
         )
-        self.show_board.toggled.connect(guard(lambda on: self.vision.show_board(self._spec(), on)))
+        self.show_board.toggled.connect(guard(lambda on: self.model.show_board(self._spec(), on)))
         pl.addWidget(self.show_board)
         row = QHBoxLayout()
         row.addWidget(QLabel("Poses"))
@@ -151,7 +139,7 @@ class RobotPanel(QWidget):
             row.addWidget(b)
         vl.addLayout(row)
 
-        self.tool_group = ToolGroup(measuring, show_error, self._refresh)
+        self.tool_group = ToolGroup(model.tool, show_error, self._refresh)
         layout = QVBoxLayout(self)
         layout.addWidget(plan)
         layout.addWidget(run)
@@ -175,12 +163,12 @@ class RobotPanel(QWidget):
         self.identify_button.setEnabled(views >= 6 and not running)
         self.apply_button.setEnabled(self.result is not None)
         self.save_button.setEnabled(self.result is not None)
-        self.revert_button.setEnabled(self.robot_calibration.can_revert)
+        self.revert_button.setEnabled(self.model.can_revert)
 
     # --- plan and run --------------------------------------------------------------------------
     def make_plan(self) -> None:
         with busy(self, "planning the calibration poses ..."):
-            self.plan = self.robot_calibration.plan_robot_calibration(self._spec(), self.poses.value())
+            self.plan = self.model.plan(self._spec(), self.poses.value())
         n = len(self.plan.joints_deg)
         why = "; ".join(f"{k}: {v}" for k, v in self.plan.rejected.items())
         seen = [c for c, _ in self.plan.cell_views if c != VIA]
@@ -192,7 +180,7 @@ class RobotPanel(QWidget):
             "Every pose sees its target with the model, and every move from the one before is free of collisions."
             + (f" Left out: {why}." if why else "")
         )
-        self.log.say(f"robot calibration: {n} poses planned")
+        self.model.say(f"robot calibration: {n} poses planned")
         self._refresh()
 
     def start_run(self) -> None:
@@ -209,9 +197,7 @@ class RobotPanel(QWidget):
             "Run",
         ):
             return
-        self.run = self.robot_calibration.robot_calibration_run(
-            self._spec(), self.plan.joints_deg, self.plan.cell_views
-        )
+        self.run = self.model.run(self._spec(), self.plan.joints_deg, self.plan.cell_views)
         self.progress.setRange(0, n)
         self.progress.setValue(0)
         self.run.progress.connect(self._on_progress)
@@ -239,7 +225,7 @@ class RobotPanel(QWidget):
         self.identify_button.setEnabled(False)
         try:
             with busy(self, "identifying the robot ..."):
-                r = self.result = self.robot_calibration.calibrate_robot(
+                r = self.result = self.model.identify(
                     self.run.capture,
                     cell_frames=self.run.cell_frames,
                     with_intrinsics=self.fit_intrinsics.isChecked(),
@@ -271,18 +257,18 @@ class RobotPanel(QWidget):
     def apply(self) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.robot_calibration.apply_robot_calibration(self.result)
+        self.model.apply(self.result)
         self._refresh()
 
     def revert(self) -> None:
-        self.robot_calibration.revert_robot_calibration()
+        self.model.revert()
         self.tool_group.measured_tool = None
         self._refresh()
 
     def save(self, folder) -> None:
         if self.result is None:
             raise OperatorError("identify first")
-        self.robot_calibration.save_robot_calibration(folder, self.result, self.tool_group.measured_tool)
+        self.model.save(folder, self.result, self.tool_group.measured_tool)
 
     def _save_dialog(self) -> None:
         folder = QFileDialog.getExistingDirectory(self, "Save the robot calibration into")

@@ -15,31 +15,21 @@ from collections.abc import Callable
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QLabel, QStatusBar
 
+from calib_core.operator.panes.status import StatusLineModel
+
 STALE_CAMERA_S = 2.0
 STALE_LINK_S = 1.0
 WARN = "<span style='color:#ff9a30'>{}</span>"
 
 
 class StatusLine:
-    """The status bar's fields, given the parts they show: the ``arm`` (its motion, link state and last sample), the
-    ``session`` (its pairs, result and target), ``frames`` (the settle rule and whether a recording is replayed),
-    the session's ``recording`` (its recorder, while one writes), ``link()`` (the controller's link, or None) and
-    ``camera_state()`` ``(last frame received or None, worker or None, replaying)``."""
+    """The status bar's fields, given what they show (a
+    :class:`~calib_core.operator.panes.status.StatusLineModel`: the robot's motion and link, the settle rule, the
+    pairs, the recording) and the window's ``camera_state()`` ``(last frame received or None, worker or None,
+    replaying)``."""
 
-    def __init__(
-        self,
-        bar: QStatusBar,
-        *,
-        arm,
-        session,
-        frames,
-        link: Callable[[], object],
-        recording,
-        camera_state: Callable[[], tuple],
-        parent,
-    ) -> None:
-        self._arm, self._session, self._frames = arm, session, frames
-        self._link, self._recording = link, recording
+    def __init__(self, bar: QStatusBar, model: StatusLineModel, *, camera_state: Callable[[], tuple], parent) -> None:
+        self._model = model
         self._camera_state = camera_state
         self.record_label = QLabel("")
         self.link_label = QLabel("link: not connected")
@@ -58,10 +48,10 @@ class StatusLine:
             self.pairs_label,
         ):
             bar.addPermanentWidget(w)
-        arm.motion_changed.connect(self.show_motion)
-        arm.link_state.connect(self.show_link_state)
+        model.motion_changed.connect(self.show_motion)
+        model.link_state.connect(self.show_link_state)
         # (pairs change outside the undo stack too)
-        for signal in (session.pairs.changed, session.result.changed, session.target_changed):
+        for signal in (model.pairs_changed, model.result_changed, model.target_changed):
             signal.connect(self.show_pairs)
         self.show_pairs()
         self._samples_then: tuple[tuple[str, float], int] | None = None  # ((which clock, its time s), samples then)
@@ -81,7 +71,7 @@ class StatusLine:
                 self.fps_label.setText(WARN.format(f"camera: no frame for {age:.0f} s"))
             else:
                 self.fps_label.setText(f"camera: {worker.fps_measured:.1f} fps")
-        link = self._link()
+        link = self._model.link()
         if link is not None:
             s = link.stats_snapshot()
             # the rate by the controller's own clock (the samples' stamps): a far link delivers in bursts, and
@@ -97,14 +87,14 @@ class StatusLine:
                 f"link: {link.state.value}, {rate}{s['samples']} samples, {s['bad_checksum'] + s['malformed']} "
                 f"rejected{delay_text}"
             )
-            last = self._arm.last_sample_s
+            last = self._model.last_sample_s
             # a far link delivers its samples in bursts: late only past its own spread of delays
             late_after = STALE_LINK_S + link.stale_after_now_s()
             if link.state.value == "up" and last is not None and now - last > late_after:
                 text = WARN.format(f"link: up but no joint sample for {now - last:.1f} s")
             self.link_label.setText(text)
         self._show_settled()
-        rec = self._recording.recorder
+        rec = self._model.recorder
         self.record_label.setText(
             "" if rec is None else f"<span style='color:#ff4040'>&#9679; REC</span> {rec.size_bytes / 1e6:.1f} MB"
         )
@@ -128,10 +118,10 @@ class StatusLine:
 
     def _show_settled(self) -> None:
         """Whether the newest frame can be picked on: the settle rule, from the joint samples."""
-        if self._link() is None and not self._frames.replaying:
+        if self._model.link() is None and not self._model.replaying:
             self.settled_label.setText("")
             return
-        still = self._frames.robot_settled()
+        still = self._model.robot_settled()
         self.settled_label.setText(
             "<span style='color:#5fd35f'>settled</span>"
             if still.settled
@@ -140,8 +130,7 @@ class StatusLine:
         self.settled_label.setToolTip(still.reason or f"still for {still.still_for_s:.1f} s: frames can be picked on")
 
     def show_pairs(self, *_) -> None:
-        session = self._session
-        self.pairs_label.setText(f"pairs: {len(session.pairs.usable())}/{session.options.required_pairs} needed")
+        self.pairs_label.setText(f"pairs: {self._model.usable_pairs}/{self._model.required_pairs} needed")
 
     def show_link_state(self, text: str) -> None:
         self.link_label.setText(

@@ -9,10 +9,7 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.gui.error_boundary import attempt
 from app.gui.image_view import ImageView, Overlay
-from calib_core.calibration.session import CalibrationSession
-from calib_core.operator.arm import Arm
-from calib_core.operator.cell import Cell
-from calib_core.operator.picking import Picking
+from calib_core.operator.panes.virtual_camera import VirtualPaneModel
 from calib_core.camera.projection import project
 from calib_core.frames import apply, invert
 from calib_core.render import PickResult, RenderOptions, SceneRenderer
@@ -36,10 +33,9 @@ class VirtualPane(QWidget):
     pick_rejected = Signal(str)
     feature_picked = Signal(object, object, float)
 
-    def __init__(self, cell: Cell, session: CalibrationSession, arm: Arm, picking: Picking, parent=None):
+    def __init__(self, model: VirtualPaneModel, parent=None):
         super().__init__(parent)
-        # what it shows: the cell as modelled, seen by the modelled camera at the arm's joints; the pairs being made
-        self.cell, self.session, self.arm, self.picking = cell, session, arm, picking
+        self.model = model
         self.renderer = SceneRenderer()
         self.view = ImageView(placeholder="rendering...")
         self.info = QLabel("")
@@ -53,69 +49,64 @@ class VirtualPane(QWidget):
         layout.setContentsMargins(2, 2, 2, 2)
         layout.addLayout(bar)
         layout.addWidget(self.view, 1)
-        self.intrinsics = cell.intrinsics.without_distortion().scaled(RENDER_SCALE)
+        self.intrinsics = model.scene.intrinsics.without_distortion().scaled(RENDER_SCALE)
         self.view.clicked.connect(self._on_click)
-        session.pairs.changed.connect(lambda *_: self.refresh())
-        session.target_changed.connect(self.refresh)
-        cell.camera_model_changed.connect(self._camera_model_changed)
-        cell.scene_changed.connect(self.refresh)
+        model.pairs_changed.connect(lambda *_: self.refresh())
+        model.target_changed.connect(self.refresh)
+        model.scene.camera_model_changed.connect(self._camera_model_changed)
+        model.scene.scene_changed.connect(self.refresh)
         self._last_joints = None
         self._render_key = None
         self.feature_component: str | None = None  # naming features: picks land on this component, unsnapped
         self.renders = 0
 
     def _camera_model_changed(self) -> None:
-        self.intrinsics = self.cell.intrinsics.without_distortion().scaled(RENDER_SCALE)
+        self.intrinsics = self.model.scene.intrinsics.without_distortion().scaled(RENDER_SCALE)
         self._render_key = None
         self.refresh()
 
     def _model_cam2world(self) -> np.ndarray:
         """The modelled camera (4, 4) mm in the base frame at the arm's joints."""
-        return self.cell.robot.fk(self.arm.joints_deg, "camera")
+        return self.model.scene.model_cam2world(self.model.joints_deg)
 
     def refresh(self) -> None:
         """Re-render when the joints or the target changed; otherwise only redraw the overlays."""
-        key = (tuple(np.round(self.arm.joints_deg, 6)), self.session.target, self.cell.scene_version)
+        key = (tuple(np.round(self.model.joints_deg, 6)), self.model.target, self.model.scene.version)
         if key != self._render_key:
-            items = (
-                self.cell.workcell.components
-                + self.cell.model_visuals().scene_items(self.arm.joints_deg)
-                + list(self.cell.extras)
-            )
-            self.renderer.set_items(items)
+            self.renderer.set_items(self.model.scene.items(self.model.joints_deg))
             # Feature dots and picks are drawn as 2D overlays, not in 3D: they stay crisp, and they do not
             # cover the very surface points the picker tests for visibility.
             image = self.renderer.render_view(
-                self.intrinsics, self._model_cam2world(), RenderOptions(highlight=self.session.target)
+                self.intrinsics, self._model_cam2world(), RenderOptions(highlight=self.model.target)
             )
             self.view.set_image(image)
             self._render_key = key
             self.renders += 1
         overlay = Overlay()
         world2cam = invert(self._model_cam2world())
-        shown = self.feature_component or self.session.target
+        shown = self.feature_component or self.model.target
         if shown is not None:
-            target = self.cell.workcell.component(shown)
+            target = self.model.scene.component(shown)
             if target.features:
                 pts = apply(world2cam, apply(target.item2world, np.array(list(target.features.values()))))
                 for uv in project(pts, self.intrinsics, distort=False):
                     if np.all(np.isfinite(uv)):
                         overlay.points.append((uv[0], uv[1], "", FEATURE_COLOR))
-        for p in self.session.pairs:
+        for p in self.model.pairs:
             uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
             if np.all(np.isfinite(uv)):
                 overlay.points.append((uv[0], uv[1], str(p.number), _qcolor(p.complete)))
-        overlay.text = f"target: {self.session.target or '(choose one)'}" + (
-            "" if self.session.pairs.pending() else " - click a feature to pick its 3D point"
+        overlay.text = f"target: {self.model.target or '(choose one)'}" + (
+            "" if self.model.pairs.pending() else " - click a feature to pick its 3D point"
         )
         self.view.set_overlay(overlay)
-        self._last_joints = self.arm.joints_deg.copy()
+        self._last_joints = self.model.joints_deg.copy()
 
     def is_current(self, tolerance_deg: float = 1e-3) -> bool:
         """Whether the view shows the robot at the current joints (to ``tolerance_deg``)."""
         return (
             self._last_joints is not None
-            and float(np.max(np.abs(self.arm.joints_deg - self._last_joints))) <= tolerance_deg
+            and float(np.max(np.abs(self.model.joints_deg - self._last_joints))) <= tolerance_deg
         )
 
     def refresh_if_moved(self, tolerance_deg: float = 1e-3) -> None:
@@ -126,7 +117,7 @@ class VirtualPane(QWidget):
         """The pair whose 3D point is drawn within :data:`SELECT_RADIUS_PX` of (u, v), nearest first."""
         world2cam = invert(self._model_cam2world())
         near = []
-        for p in self.session.pairs:
+        for p in self.model.pairs:
             uv = project(apply(world2cam, np.array(p.point_world_mm)[None]), self.intrinsics, distort=False)[0]
             if np.all(np.isfinite(uv)):
                 near.append((float(np.hypot(uv[0] - u, uv[1] - v)), p.number))
@@ -136,13 +127,13 @@ class VirtualPane(QWidget):
     def _on_click(self, u: float, v: float) -> None:
         # A click on a pair's mark selects it, as in the camera pane; while a pair waits for its image
         # point a click here picks its 3D point again, and naming features only picks.
-        if self.feature_component is None and self.session.pairs.pending() is None:
+        if self.feature_component is None and self.model.pairs.pending() is None:
             number = self._pair_at(u, v)
             if number is not None:
                 self.info.setText(f"pair {number} selected")
                 self.pair_selected.emit(number)
                 return
-        target = self.feature_component or self.session.target
+        target = self.feature_component or self.model.target
         snap = 0.0 if self.feature_component else 10.0  # naming a feature: the core snaps it to the mesh
         hit: PickResult | None = self.renderer.pick(
             u, v, snap_radius_px=snap, components=None if target is None else {target}
@@ -160,7 +151,7 @@ class VirtualPane(QWidget):
         attempt(self.pick_rejected.emit, self._pick, hit, where)
 
     def _pick(self, hit: PickResult, where: str) -> None:
-        number = self.picking.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
+        number = self.model.pick_model_point(hit.component, hit.feature, hit.point_world_mm)
         self.info.setText(f"pair {number}: {where}")
 
     def set_feature_component(self, component: str | None) -> None:

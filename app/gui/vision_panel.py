@@ -34,33 +34,31 @@ from app.gui.confirm import ask
 from app.gui.error_boundary import guarded
 from calib_core.errors import OperatorError
 from calib_core.operator.camera_calibrating import CameraCalibrating
-from calib_core.operator.moves import Moves
 from calib_core.vision.board import DEFAULT_SPEC
 from calib_core.vision.intrinsics_calibration import RejectedView
 from calib_core.vision.result_checks import views_with_lost_corners
 
 
 class VisionPanel(QWidget):
-    """Shows and drives ``vision`` (the core's camera calibration), stepping the robot through its board poses with
-    ``moves``; ``board_detected(corners (n, 2) px or None,
-    text)`` tells the camera pane what to draw; ``show_error`` puts a failed step's reason in the window; ``move``
-    sends a move through the window's preview and confirmation. Progress goes to the core's log (the status bar)."""
+    """Shows and drives ``vision`` (the core's camera calibration); ``board_detected(corners (n, 2) px or None,
+    text)`` tells the camera pane what to draw; ``show_error`` puts a failed step's reason in the window;
+    ``move_joints(joints_deg, what)`` steps the robot to a board pose through the window's preview and confirmation.
+    Progress goes to the core's log (the status bar)."""
 
     board_detected = Signal(object, str)
 
     def __init__(
         self,
         vision: CameraCalibrating,
-        moves: Moves,
         show_error: Callable[[str], None],
-        move: Callable | None = None,
+        move_joints: Callable[[object, str], None],
         say: Callable[[str], None] = lambda text: None,
         parent=None,
     ):
         super().__init__(parent)
-        self.vision, self.moves = vision, moves
+        self.vision = vision
         self._say = say  # the operator's log: what the panel declined to do
-        self._move = move or (lambda send: send(False))  # the window previews and confirms moves
+        self._move_joints = move_joints  # the window previews and confirms moves
         guard = guarded(show_error)
         self._intrinsics_text = ""  # both results stay on screen, one under the other
         self._hand_eye_text = ""
@@ -208,7 +206,7 @@ class VisionPanel(QWidget):
 
     def _next_pose(self) -> None:
         q, what = self.vision.next_board_pose()
-        self._move(lambda confirmed: self.moves.move_joints(q, what, confirmed=confirmed))
+        self._move_joints(q, what)
 
     # --- capturing -----------------------------------------------------------------------------
     def capture_view(self) -> None:

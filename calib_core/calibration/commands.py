@@ -98,6 +98,10 @@ class SetEnabled(Command):
     def check(self) -> None:
         self.pairs.get(self.number)
 
+    @property
+    def changes_nothing(self) -> bool:
+        return self.pairs.get(self.number).enabled == self.enabled
+
     def do(self) -> None:
         self.old = self.pairs._replace(replace(self.pairs.get(self.number), enabled=self.enabled))
 
