@@ -23,6 +23,16 @@ class PosePrior:
     sigma_mm: float
     sigma_deg: float
 
+    def __post_init__(self) -> None:
+        from calib_core.errors import OperatorError
+
+        for name, value, unit in (("reach", self.sigma_mm, "mm"), ("reach", self.sigma_deg, "deg")):
+            if not (np.isfinite(value) and value > 0.0):
+                raise OperatorError(
+                    f"the look's {name} must be above 0 {unit} (how far the object may lie from the prior), got "
+                    f"{value!r}"
+                )
+
     def normal_equations(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The prior's terms (6, 6) and (6,) to add to a Gauss-Newton step's ``J^T W J`` and ``J^T W r`` at ``pose``
         (4, 4, mm), in the step's six small motions (the rotation vector rad, then the translation mm, both in the

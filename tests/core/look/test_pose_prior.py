@@ -59,3 +59,19 @@ def test_the_points_sigma_of_a_move_across_the_sight_line_is_f_sigma_over_depth(
     off = trimesh.Trimesh(vertices=np.array([[100.0, 0.0, 0.0]]), faces=np.zeros((0, 3), dtype=int), process=False)
     turn = np.diag([0.0, 0.0, 1e-4, 0.0, 0.0, 0.0])
     assert abs(points_sigma_px(off, pose, turn, camera) - 800.0 * 100.0 * 1e-2 / 1000.0) < 1e-3
+
+
+def test_a_look_with_no_reach_is_refused_with_the_reach_named():
+    """A reach of 0 (or NaN) is a caller's mistake: an error that says which, not a division by zero deep in the
+    fit."""
+    import pytest
+
+    from calib_core.errors import OperatorError
+    from calib_core.look.locate import locate
+
+    camera = Intrinsics(60.0, 60.0, 32.0, 24.0, 64, 48)
+    box = trimesh.creation.box(extents=(40.0, 40.0, 40.0))
+    image = np.zeros((48, 64, 3), np.uint8)
+    for reach_mm, reach_deg, unit in ((0.0, 3.0, "mm"), (10.0, float("nan"), "deg")):
+        with pytest.raises(OperatorError, match=f"reach must be above 0 {unit}"):
+            locate(image, camera, box, _pose([0, 0, 0], [0, 0, 500.0]), reach_mm=reach_mm, reach_deg=reach_deg)
