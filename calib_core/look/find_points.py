@@ -29,8 +29,6 @@ import trimesh
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
-from calib_core.solver import solve_pose
-from calib_core.solver.errors import SolverInputError
 from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge_samples_px, matched_share
 from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
 from calib_core.look.edge_samples import edge_points
@@ -429,6 +427,9 @@ def _robust_fit(
     found = [(i, d) for i, d in detections.items() if isinstance(d, Detection)]
     if len(found) < 4:
         return None, {}
+    from calib_core.solver import solve_pose  # (its kernels load only for a look that detected features)
+    from calib_core.solver.errors import SolverInputError
+
     idx = [i for i, _ in found]
     uv = np.array([d.uv_px for _, d in found])
     confidence = np.array([d.confidence for _, d in found])

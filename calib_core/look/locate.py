@@ -17,7 +17,6 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.frames import check_transform, rotation_angle_deg
 from calib_core.scene import SceneItem
-from calib_core.solver import solve_pose
 from calib_core.look.find_points import REACH_DEG, REACH_MM, find_points
 from calib_core.look.found_points import FoundPoints
 from calib_core.look.image_evidence import ImageEvidence
@@ -206,6 +205,8 @@ def _report(
     std = np.sqrt(np.clip(np.diag(edges.covariance), 0.0, None))
     features_pose, apart = None, None
     if len(features) >= 4:
+        from calib_core.solver import solve_pose  # (its kernels load only for a look that found features)
+
         solution = solve_pose(
             np.array([f.point_mm for f in features]),
             np.array([f.uv_px for f in features]),
