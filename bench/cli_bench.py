@@ -189,8 +189,8 @@ def main() -> str:
         "second process keeping a core busy. The first six rows are the floors the commands stand on: a command "
         "that solves runs numba's kernels (its import and the loading "
         "of its first cached kernel, which initialises its compiler's target and imports SciPy's BLAS, are about "
-        "0.6 s of CPU however little it solves), one that locates also needs trimesh (and VTK for a CAD part's "
-        "creases).",
+        "0.6 s of CPU however little it solves); one that locates needs trimesh, VTK for a CAD part's creases and "
+        "numba only when it found features to solve from (a CAD part's corners: not a scanned mesh).",
         "",
         "| run | CPU idle (s) | wall idle (s) | CPU loaded (s) | wall loaded (s) | target |",
         "|---|---|---|---|---|---|",
