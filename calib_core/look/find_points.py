@@ -36,7 +36,7 @@ from calib_core.look.feature_detectors import Detection, NotDetected
 from calib_core.look.found_points import FoundPoints, Missed, Proposal
 from calib_core.look.coarse_to_fine import coarse_fit, fit_starts
 from calib_core.look.image_evidence import ImageEvidence
-from calib_core.look.in_view import MIN_SHOWN_SAMPLES, hidden_in_view, share_in_view
+from calib_core.look.in_view import MIN_SHOWN_SAMPLES, hidden_in_view, seen_unhidden, share_in_view
 from calib_core.look.target_detectors import TargetDetectors
 from calib_core.look.pose_prior import PosePrior
 from calib_core.look.pose_hypotheses import TRUNCATE_PX as HYPOTHESIS_TRUNCATE_PX, rank_starts
@@ -59,32 +59,6 @@ _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put 
 _MATCHED_SHARE = (
     0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
 )
-
-
-def _visible(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> np.ndarray:
-    """Which feature points (n, 3) a camera at ``obj2cam`` sees, not hidden by the mesh itself: no
-    triangle crosses the segment from the camera to the point short of it (Moller-Trumbore over every
-    triangle, vectorised: features are few and target meshes small)."""
-    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
-    tri = mesh.triangles  # (f, 3, 3)
-    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    out = np.ones(len(points), dtype=bool)
-    for k, p in enumerate(points):
-        d = p - centre
-        length = float(np.linalg.norm(d))
-        d /= length
-        h = np.cross(d, e2)
-        a = np.einsum("ij,ij->i", e1, h)
-        ok = np.abs(a) > 1e-12
-        f = np.where(ok, 1.0 / np.where(ok, a, 1.0), 0.0)
-        s = centre - tri[:, 0]
-        u = f * np.einsum("ij,ij->i", s, h)
-        q = np.cross(s, e1)
-        v = f * (q @ d)
-        t = f * np.einsum("ij,ij->i", e2, q)
-        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < length - 1.0)
-        out[k] = not hit.any()
-    return out
 
 
 def _not_in_view(item: SceneItem, names: list[str], t0: float, why: str) -> FoundPoints:
@@ -152,7 +126,9 @@ def find_points(
     uv_model = project_points(points, obj2cam_model, intrinsics)
     radius_px = search_radius_px(item.mesh.vertices, obj2cam_model, intrinsics, reach_mm, reach_deg)
     z = points @ obj2cam_model[2, :3] + obj2cam_model[2, 3]
-    visible = (z > 0) & intrinsics.contains(uv_model, margin_px=-radius_px) & _visible(item.mesh, points, obj2cam_model)
+    visible = (
+        (z > 0) & intrinsics.contains(uv_model, margin_px=-radius_px) & seen_unhidden(item.mesh, points, obj2cam_model)
+    )
     missed = {n: "hidden or outside the image at the modelled pose" for n, v in zip(names, visible) if not v}
     if share_in_view(item.mesh, obj2cam_model, intrinsics, radius_px) == 0.0:
         # no pose within the robot's error shows it: no search can find it, and no pick by hand either

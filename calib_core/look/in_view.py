@@ -1,6 +1,7 @@
 """Whether the target can be in the camera's view at all where the model puts it: in front of the camera and inside
-its image (widened by the search's reach), and not hidden behind other parts of the cell in the model's view. Find
-points asked where it cannot be says so and names the way (Go to task), not "pick the points by hand"."""
+its image (widened by the search's reach), and not hidden behind other parts of the cell in the model's view; which
+of its features it shows, not hidden by itself. Find points asked where it cannot be says so and names the way (Go to
+task), not "pick the points by hand"."""
 
 from __future__ import annotations
 
@@ -39,3 +40,29 @@ def share_in_view(mesh: trimesh.Trimesh, obj2cam: np.ndarray, intrinsics: Intrin
         return 0.0
     inside = intrinsics.contains(project_points(vertices[ahead], obj2cam, intrinsics), margin_px=-margin_px)
     return float(np.count_nonzero(inside)) / len(vertices)
+
+
+def seen_unhidden(mesh: trimesh.Trimesh, points: np.ndarray, obj2cam: np.ndarray) -> np.ndarray:
+    """Which feature points (n, 3) a camera at ``obj2cam`` sees, not hidden by the mesh itself: no
+    triangle crosses the segment from the camera to the point short of it (Moller-Trumbore over every
+    triangle, vectorised: features are few and target meshes small)."""
+    centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+    tri = mesh.triangles  # (f, 3, 3)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    out = np.ones(len(points), dtype=bool)
+    for k, p in enumerate(points):
+        d = p - centre
+        length = float(np.linalg.norm(d))
+        d /= length
+        h = np.cross(d, e2)
+        a = np.einsum("ij,ij->i", e1, h)
+        ok = np.abs(a) > 1e-12
+        f = np.where(ok, 1.0 / np.where(ok, a, 1.0), 0.0)
+        s = centre - tri[:, 0]
+        u = f * np.einsum("ij,ij->i", s, h)
+        q = np.cross(s, e1)
+        v = f * (q @ d)
+        t = f * np.einsum("ij,ij->i", e2, q)
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-6) & (t < length - 1.0)
+        out[k] = not hit.any()
+    return out
