@@ -18,7 +18,7 @@ class CommandsPaneModel:
     window's.
 
     Its public members: four events (``task_changed(name)``, ``scene_changed()``, ``options_changed(name, value)``,
-    ``corrections_changed(task)``), five values shown (``task``, ``task_names``, ``target``, ``target_names``,
+    ``corrections_changed(task)``), six values shown (``task``, ``task_names``, ``target``, ``target_names``,
     ``options``, ``corrections``) and five settings."""
 
     def __init__(self, cell: Cell, session: CalibrationSession, tasks: TaskChoice, editor: CellEditor):
