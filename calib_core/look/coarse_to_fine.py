@@ -4,6 +4,8 @@ blurred away."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
+
 import numpy as np
 
 from calib_core.camera.intrinsics import Intrinsics
@@ -12,14 +14,20 @@ from calib_core.look.image_evidence import ImageEvidence
 from calib_core.look.pose_prior import PosePrior
 
 
-def fit_starts(model: np.ndarray, ranked: list[np.ndarray], believed: bool) -> list[tuple[np.ndarray, bool]]:
-    """The starts of the edge fit in turn, each with whether it goes coarse to fine: the ranked ones; with a prior
-    believed (a look on a photograph), first the modelled pose itself, at full size and then coarse to fine. On real
-    photographs the chamfer ranking puts clutter first (LM-O from 10 mm / 3 deg off: 11 of 24 views within 5 px
-    from the ranked starts, 18 from the prior alone), and from 30 mm / 10 deg off the fine fit's 8 px window misses
-    edges 20-35 px away that the half-size fit reaches."""
-    first = [(model, False), (model, True)] if believed else []
-    return first + [(r, False) for r in ranked]
+def fit_starts(
+    model: np.ndarray, ranked: Callable[[], list[np.ndarray]], believed: bool
+) -> Iterator[tuple[np.ndarray, bool]]:
+    """The starts of the edge fit in turn, each with whether it goes coarse to fine: the ranked ones (``ranked()``,
+    asked for only when the fit gets to them: ranking a reach's thousands of poses is a fifth of a look that settles
+    from the prior); with a prior believed (a look on a photograph), first the modelled pose itself, at full size and
+    then coarse to fine. On real photographs the chamfer ranking puts clutter first (LM-O from 10 mm / 3 deg off: 11
+    of 24 views within 5 px from the ranked starts, 18 from the prior alone), and from 30 mm / 10 deg off the fine
+    fit's 8 px window misses edges 20-35 px away that the half-size fit reaches."""
+    if believed:
+        yield model, False
+        yield model, True
+    for start in ranked():
+        yield start, False
 
 
 def coarse_fit(

@@ -40,13 +40,12 @@ def _crease_segments(mesh: trimesh.Trimesh) -> tuple[np.ndarray, np.ndarray]:
     sharp = mesh.face_adjacency_angles > np.radians(SHARP_DEG)
     seg = mesh.vertices[mesh.face_adjacency_edges[sharp]]
     normals = mesh.face_normals[mesh.face_adjacency[sharp]]
-    # boundary edges: edges used by one face only
-    edges = np.sort(mesh.edges, axis=1)
-    unique, index, counts = np.unique(edges, axis=0, return_index=True, return_counts=True)
-    lonely = counts == 1
-    if lonely.any():
-        faces = mesh.edges_face[index[lonely]]
-        seg = np.concatenate([seg, mesh.vertices[unique[lonely]]])
+    # boundary edges: edges used by one face only (trimesh groups the rows by hashing: a sort of the rows took 0.2 s
+    # for a 45k-face mesh)
+    lonely = trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)
+    if len(lonely):
+        faces = mesh.edges_face[lonely]
+        seg = np.concatenate([seg, mesh.vertices[mesh.edges_sorted[lonely]]])
         normals = np.concatenate([normals, np.repeat(mesh.face_normals[faces][:, None, :], 2, axis=1)])
     return seg, normals
 

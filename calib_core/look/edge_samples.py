@@ -216,6 +216,9 @@ def _crease_points(
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
     ends = project_points(seg.reshape(-1, 3), obj2cam, intrinsics).reshape(-1, 2, 2)
     counts = np.clip(np.floor(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1) / SAMPLE_STEP_PX).astype(int) - 1, 0, 500)
+    if not counts.any():
+        # no edge long enough to hold a sample (a scanned mesh's facets): its chains are not needed
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=int)
     which = np.repeat(np.arange(len(seg)), counts)
     s = np.concatenate([(np.arange(1, c + 1)) / (c + 1) for c in counts]) if counts.sum() else np.zeros(0)
     pts = seg[which, 0] + (seg[which, 1] - seg[which, 0]) * s[:, None]

@@ -21,6 +21,7 @@ The result never moves anything: the operator accepts, rejects or drags the prop
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -151,17 +152,23 @@ def find_points(
         and hidden_in_view(samples, item.mesh, obj2cam_model, intrinsics)
     ):
         return _not_in_view(item, names, t0, f"only {len(samples)} samples of its edges would show")
-    ranked = rank_starts(
-        evidence.edge_distance(HYPOTHESIS_TRUNCATE_PX),
-        intrinsics,
-        samples,
-        obj2cam_model,
-        reach_mm,
-        reach_deg,
-        keep=_STARTS,
-    )
-    centre = item.mesh.vertices.mean(axis=0)[None]
-    shift = project_points(centre, ranked[0], intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
+    ranking: list[np.ndarray] = []
+
+    def ranked() -> list[np.ndarray]:
+        if not ranking:
+            ranking.extend(
+                rank_starts(
+                    evidence.edge_distance(HYPOTHESIS_TRUNCATE_PX),
+                    intrinsics,
+                    samples,
+                    obj2cam_model,
+                    reach_mm,
+                    reach_deg,
+                    keep=_STARTS,
+                )
+            )
+        return ranking
+
     colour = evidence.colour if by_colour else None
     fitting = _Fitting(
         evidence,
@@ -176,6 +183,10 @@ def find_points(
     )
     edge_fit = _best_settled_fit(fitting, obj2cam_model, ranked, prior is not None)
     edge_seconds = time.perf_counter() - t_edges
+    # where the image puts the target's centre against where the model does
+    centre = item.mesh.vertices.mean(axis=0)[None]
+    seen_at = edge_fit.obj2cam if edge_fit.settled else ranked()[0]
+    shift = project_points(centre, seen_at, intrinsics)[0] - project_points(centre, obj2cam_model, intrinsics)[0]
     if not edge_fit.settled:
         # Not there, or the edges did not settle: detections in wide windows would lock onto neighbouring
         # edges, and a wrong proposal costs the operator more than a pick by hand.
@@ -284,7 +295,9 @@ class _Fitting:
         return replace(fit, min_share=_FIT_SHARE)
 
 
-def _best_settled_fit(fitting: _Fitting, obj2cam_model: np.ndarray, ranked: list, has_prior: bool) -> EdgeFit:
+def _best_settled_fit(
+    fitting: _Fitting, obj2cam_model: np.ndarray, ranked: Callable[[], list[np.ndarray]], has_prior: bool
+) -> EdgeFit:
     """Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error moves near
     and far edges differently: no 2D shift lays them all on the image); from the best few, in turn until one settles
     with most of its samples on their edges, the edges pull the pose into place. The fit with the most samples on

@@ -100,11 +100,16 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
     """The mesh's faces turned to the camera, filled: a uint8 mask over the part of the image the object
     covers (255 inside) and its top-left pixel (u0, v0). Faces reaching behind :data:`NEAR_MM` are left out."""
     vertices = np.asarray(mesh.vertices, dtype=float)
+    depth = vertices @ obj2cam[2, :3] + obj2cam[2, 3]
+    near = depth > NEAR_MM
+    uv = project_points(vertices, obj2cam, intrinsics)
+    if near.all():
+        few = _faces_maybe_large(mesh, float(depth.min()), intrinsics)
+        if few is not None:
+            return _splatted(mesh, uv, obj2cam, intrinsics, few)
     faces = np.asarray(mesh.faces)
     normals, offsets = _face_planes(mesh)
     centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
-    near = vertices @ obj2cam[2, :3] + obj2cam[2, 3] > NEAR_MM
-    uv = project_points(vertices, obj2cam, intrinsics)
     fine = near & np.isfinite(uv[:, 0]) & np.isfinite(uv[:, 1])  # (per vertex: a face keeps three)
     keep = (normals @ centre - offsets > 0) & fine[faces[:, 0]] & fine[faces[:, 1]] & fine[faces[:, 2]]
     if not keep.any():
@@ -138,6 +143,63 @@ def silhouette_mask(mesh, obj2cam: np.ndarray, intrinsics: Intrinsics) -> tuple[
         ]
         mask[corners[:, 1], corners[:, 0]] = 255
         mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
+    return mask, (int(lo[0]), int(lo[1]))
+
+
+_FACES_BY_AREA: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+_FEW_LARGE = 0.1
+"""The largest share of a mesh's faces that may be large for :func:`_splatted` to draw its silhouette."""
+
+
+def _faces_maybe_large(mesh, nearest_mm: float, intrinsics: Intrinsics) -> np.ndarray | None:
+    """The faces (k,) that may cover :data:`_SMALL_FACE_PX2` or more in the image with every vertex at least
+    ``nearest_mm`` deep, or None when they are more than a tenth of the mesh's (a CAD part's: filled face by face as
+    before). A face's image is at most its area (mm^2) times ``fu fv / z^2``, and half as much again seen off the
+    optical axis (its image grows with the line of sight's length: 1.2 times at the corner of a 60 deg view)."""
+    key = id(mesh)
+    if key not in _FACES_BY_AREA:
+        areas = np.asarray(mesh.area_faces, dtype=float)
+        order = np.argsort(-areas, kind="stable")
+        _FACES_BY_AREA[key] = (areas[order], order)
+        weakref.finalize(mesh, _FACES_BY_AREA.pop, key, None)
+    areas, order = _FACES_BY_AREA[key]
+    smallest_large_mm2 = _SMALL_FACE_PX2 * nearest_mm**2 / (1.5 * intrinsics.fu * intrinsics.fv)
+    count = int(np.searchsorted(-areas, -smallest_large_mm2, side="right"))
+    return order[:count] if count <= _FEW_LARGE * len(areas) else None
+
+
+def _splatted(
+    mesh, uv: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, large: np.ndarray
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """:func:`silhouette_mask` of a mesh nearly all of whose faces cover under :data:`_SMALL_FACE_PX2` (a scanned
+    object's): every vertex's pixel set, the gaps closed (3 x 3), and the few ``large`` faces (k,) turned to the camera
+    filled. The vertices of the faces turned away lie inside the silhouette too (every point of a closed object does),
+    so all are set and the small faces are never gathered (4 ms a call for a 40k-face mesh, 1 ms this way)."""
+    # (column by column: numpy reduces over an axis of two ten times slower than along one)
+    u, v = uv[:, 0], uv[:, 1]
+    fine = np.isfinite(u) & np.isfinite(v)
+    if not fine.all():
+        if not fine.any():
+            return np.zeros((0, 0), np.uint8), (0, 0)
+        u, v = u[fine], v[fine]
+    lo = np.maximum(
+        np.floor(np.clip([u.min(), v.min()], 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) - 2, 0
+    )
+    hi = np.ceil(np.clip([u.max(), v.max()], 0, [intrinsics.width - 1, intrinsics.height - 1])).astype(int) + 3
+    hi = np.minimum(hi, [intrinsics.width, intrinsics.height])
+    mask = np.zeros((max(hi[1] - lo[1], 1), max(hi[0] - lo[0], 1)), np.uint8)
+    col, row = np.rint(u - lo[0]).astype(np.intp), np.rint(v - lo[1]).astype(np.intp)
+    within = (col >= 0) & (col < mask.shape[1]) & (row >= 0) & (row < mask.shape[0])
+    mask[row[within], col[within]] = 255
+    mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
+    if len(large):
+        faces = np.asarray(mesh.faces)[large]
+        normals, offsets = _face_planes(mesh)
+        centre = -obj2cam[:3, :3].T @ obj2cam[:3, 3]
+        turned = normals[large] @ centre - offsets[large] > 0
+        turned &= fine[faces[:, 0]] & fine[faces[:, 1]] & fine[faces[:, 2]]
+        for f in np.round((uv[faces[turned]] - lo) * 16.0).astype(np.int32):
+            cv2.fillConvexPoly(mask, f, 255, lineType=cv2.LINE_8, shift=4)
     return mask, (int(lo[0]), int(lo[1]))
 
 

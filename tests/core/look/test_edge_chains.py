@@ -20,6 +20,24 @@ def test_a_box_has_twelve_chains_and_a_cylinder_s_rims_one_each():
     assert chains[rims[0][0]] != chains[rims[1][0]]
 
 
+def test_an_open_box_s_rim_is_among_its_creases():
+    """Known answer: a box with its top's two triangles taken away has the top's four edges as its rim, each with its
+    one face left (a side); the top's diagonal, which the two missing triangles shared, belongs to no face and is
+    not an edge at all."""
+    box = trimesh.creation.box((40.0, 30.0, 10.0))
+    top = np.flatnonzero(np.isclose(box.face_normals[:, 2], 1.0))
+    assert len(top) == 2
+    open_box = trimesh.Trimesh(box.vertices, np.delete(box.faces, top, axis=0), process=False)
+    segments, normals = crease_segments(open_box)
+    on_top = np.isclose(segments[:, :, 2], 5.0).all(axis=1)
+    assert on_top.sum() == 4  # the rim, each edge once; no diagonal (it belongs to no face now)
+    lengths = np.sort(np.linalg.norm(segments[on_top, 1] - segments[on_top, 0], axis=1))
+    np.testing.assert_allclose(lengths, [30.0, 30.0, 40.0, 40.0])
+    # a rim edge repeats its one face's normal: a side's, turned out of the box
+    np.testing.assert_allclose(normals[on_top, 0], normals[on_top, 1])
+    assert np.allclose(normals[on_top, :, 2], 0.0)
+
+
 def test_the_chained_scatter_grows_with_a_shared_error_and_never_falls_below_the_independent():
     rng = np.random.default_rng(0)
     m, sigma = 2000, 0.1
