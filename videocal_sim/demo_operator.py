@@ -16,6 +16,7 @@ pairs and the corrections (for ``videocal export``).
 from __future__ import annotations
 
 import json
+import re
 import time
 from pathlib import Path
 
@@ -62,6 +63,16 @@ def _visible_features(component, cam2world: np.ndarray, intrinsics) -> list[str]
 
 class DemoTimeoutError(VideocalError, TimeoutError):
     """The scripted operator waited too long for something: one ``error:`` line naming it, not a traceback."""
+
+
+class DemoStoppedError(VideocalError):
+    """The scripted operator cannot go on (the window refused a move, a look does not count, too few features in
+    view): one ``error:`` line saying what the window said, not a traceback."""
+
+
+def _plain(text: str) -> str:
+    """A status line's words without its markup (the window colours it)."""
+    return re.sub(r"<[^>]+>", "", text).strip()
 
 
 def _wait(app: QApplication, condition, timeout_s: float, what: str, state=None) -> None:
@@ -225,20 +236,21 @@ def run_demo(
                 log.confirmed.append(win.overview.preview.what)
                 _click(win.overview.move_button, 10, 10)
             if wb.motion.motion.value not in ("moving", "arrived"):
-                raise RuntimeError(f"demo: the move was not sent: {win.results.status.text()}")
+                raise DemoStoppedError(f"demo: the move was not sent: {_plain(win.results.status.text())}")
 
         def store() -> None:
             """Store correction, checked: one more entry in the task location's history."""
             stored_before = len(wb.session.corrections.history(task.name))
             place = wb.desk.look_place()
             if place is None or not place.counts:  # the window would ask; the demo's looks are made where they count
-                raise RuntimeError(
+                raise DemoStoppedError(
                     f"demo: the look does not count for {task.name}: {place.text if place else 'no robot pose'}"
                 )
             _click(win.commands.store, 10, 10)
             if len(wb.session.corrections.history(task.name)) != stored_before + 1:
-                raise RuntimeError(
-                    f"demo: Store correction stored nothing ({win.results.verdict.text()}; {win.results.status.text()})"
+                raise DemoStoppedError(
+                    f"demo: Store correction stored nothing ({_plain(win.results.verdict.text())}; "
+                    f"{_plain(win.results.status.text())})"
                 )
             _act()
             win.camera.freeze.setChecked(False)
@@ -329,8 +341,9 @@ def run_demo(
                         (round(t - h.latest_s, 3), np.round(q, 3).tolist()) for t, q in list(zip(h._t, h._q))[-40::4]
                     ]
                     frame = win.camera.last_frame_received
-                    raise RuntimeError(
-                        f"demo: the click on {name} in the camera image picked nothing: {win.results.status.text()}; "
+                    raise DemoStoppedError(
+                        f"demo: the click on {name} in the camera image picked nothing: "
+                        f"{_plain(win.results.status.text())}; "
                         f"{wb.motion.text}; "
                         f"frame {frame.index} at {frame.t_host_s - h.latest_s:.3f} s; samples {tail}; events "
                         f"{moves_seen}"
@@ -347,7 +360,7 @@ def run_demo(
                 win.actions.accept()
                 app.processEvents()
             if len(picked) < _MIN_FEATURES:
-                raise RuntimeError(
+                raise DemoStoppedError(
                     f"demo: the camera sees {len(picked)} features of {fixture.name} from {task.name} "
                     f"({', '.join(picked) or 'none'}); a calibration needs {_MIN_FEATURES}"
                 )

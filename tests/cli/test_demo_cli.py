@@ -73,6 +73,17 @@ def test_demo_on_the_workshop_camera_still_corrects_the_task_location(tmp_path):
     assert report["corrected_tcp_error_mm"] < min(1.0, report["uncorrected_tcp_error_mm"] / 8)
 
 
+def test_a_task_location_the_robot_cannot_reach_stops_the_demo_with_the_window_s_reason(tmp_path):
+    """The bundled cell's second task location lies below rack 1: the straight path there from the start hits it,
+    the window refuses the move, and the demo says so in one line (what the window said, without its markup)."""
+    out = tmp_path / "demo"
+    run = run_videocal(["demo", "--offscreen", "--location", "oru_2_grasp", "--out", str(out), "--scale", "0.5"])
+    assert run.returncode == 2, run.stderr[-2000:]
+    assert "Traceback" not in run.stderr
+    (line,) = [x for x in run.stderr.splitlines() if x.startswith("error:")]
+    assert "the move was not sent: not moving to oru_2_grasp" in line and "collision" in line and "<" not in line
+
+
 def test_demo_with_a_gige_camera_reaches_the_same_accuracy(tmp_path):
     """``demo --site gige``: the camera is Aravis's fake GigE Vision camera on the loopback interface sending the
     simulated images; the window reads it through the ``aravis://`` connector (GVCP/GVSP over UDP)."""
