@@ -104,15 +104,27 @@ offset from the edge (the print a gradient search is misled by lies further insi
 MIN_REGION_SEPARATION = 0.2
 """The least :attr:`~calib_core.look.region_model.RegionModel.separation` at which the outline is found by
 colour: below it the object's colours are too much its surroundings' to tell the two apart."""
-_RESAMPLE = (1.0, 2.0)
-"""(deg, mm): a fit with contour samples takes them again once it has turned or moved this far from where they
-were taken."""
+RESAMPLE_VIEW_DEG = 1.0
+"""A fit with contour samples takes them again once the camera sees the object from this much another direction (in the
+object's frame): a smooth rim's samples taken a turn ``a`` ago lie off the rim by ``r (1 - cos a)``, 0.006 mm for a
+40 mm radius at 1 deg (an uneven one's by more: LM-O's cat from 10 mm / 3 deg off ended 4.7 px from its truth taking its
+samples again every degree, 5.1 px every two). A turn about the line of sight and a move along it change no rim (a fit
+took them again at every degree of any turn and every 2 mm of any move: a third of a look's time); a depth change of
+2 % does (the tangent cone narrows)."""
+RESAMPLE_DEPTH_SHARE = 0.02
 
 
-def _moved_beyond(a: np.ndarray, b: np.ndarray, bound: tuple[float, float]) -> bool:
-    """Whether pose ``b`` (4, 4, mm) has turned ``bound[0]`` deg or moved ``bound[1]`` mm from ``a``."""
-    turn = np.degrees(np.linalg.norm(Rotation.from_matrix(a[:3, :3] @ b[:3, :3].T).as_rotvec()))
-    return bool(turn > bound[0] or np.linalg.norm(a[:3, 3] - b[:3, 3]) > bound[1])
+def _seen_otherwise(a: np.ndarray, b: np.ndarray, centre_mm: np.ndarray) -> bool:
+    """Whether a camera at pose ``b`` (4, 4, obj2cam, mm) sees the object from a direction :data:`RESAMPLE_VIEW_DEG`
+    or more from ``a``'s, or from a distance :data:`RESAMPLE_DEPTH_SHARE` different, as seen from the object's
+    ``centre_mm`` (3,) (its frame)."""
+    seen_a = -a[:3, :3].T @ a[:3, 3] - centre_mm
+    seen_b = -b[:3, :3].T @ b[:3, 3] - centre_mm
+    na, nb = float(np.linalg.norm(seen_a)), float(np.linalg.norm(seen_b))
+    if na <= 0.0 or nb <= 0.0:
+        return True
+    cos = float(np.clip(seen_a @ seen_b / (na * nb), -1.0, 1.0))
+    return bool(np.degrees(np.arccos(cos)) > RESAMPLE_VIEW_DEG or abs(nb / na - 1.0) > RESAMPLE_DEPTH_SHARE)
 
 
 def perturbed(obj2cam: np.ndarray, xi: np.ndarray) -> np.ndarray:
@@ -186,6 +198,7 @@ def refine_to_edges(
             regions = None  # the object's colours are its surroundings' too: the gradients are all there is
     pose = obj2cam.copy()
     sampled_at = pose
+    centre = np.asarray(mesh.vertices, dtype=float).mean(axis=0)
     window = search_px
     sigma, rms, converged = 1.0, np.inf, False
     H = np.eye(6)
@@ -195,7 +208,7 @@ def refine_to_edges(
     creases_join = None
     gap = J_gap = None  # along each sample's normal: the gradient near the colour step, less the step (px)
     for it in range(iterations):
-        if from_outline and _moved_beyond(sampled_at, pose, _RESAMPLE):
+        if from_outline and _seen_otherwise(sampled_at, pose, centre):
             # a smooth surface's rim is where its surface turns away from this pose's camera: taken again
             model = edge_model(mesh, pose, intrinsics, expected_magnitude, whole_outline=by_colour)
             pts, far, clearance, chain, outward, from_outline = (

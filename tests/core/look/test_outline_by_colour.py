@@ -96,7 +96,7 @@ def test_an_occluder_over_a_third_of_the_outline_does_not_pull_the_fit(scene, co
 def test_a_sphere_s_silhouette_is_the_disc_its_tangent_cone_cuts(subdivisions):
     """Known answer: a sphere of radius r at distance d fills a disc of radius f r / sqrt(d^2 - r^2) px, whether its
     facets are filled one by one (a coarse sphere), its small facets set as their corners' pixels (10k faces of 1-3
-    px^2) or every vertex set with no face gathered (a fine, scanned-like one: 80k faces, none that can reach 2 px^2)."""
+    px^2) or every vertex set with no face gathered (a fine, scanned-like one: 80k faces, none reaching 2 px^2)."""
     import trimesh
 
     from calib_core.camera.intrinsics import Intrinsics
