@@ -355,8 +355,10 @@ def main(argv: list[str] | None = None) -> str:
     offsets = annotation_offset(rows)
     if offsets:
         lines += [
-            "Started at the truth itself, where the look settles against the truth: a shift shared by every view is "
-            "the annotation's (a look's own error has no preferred direction over dozens of objects and places).",
+            "Started at the truth itself, where the look settles against the truth. A shift every view shares is a "
+            "bias between the annotation and the photos: the annotation's (LM-O's was made on the depth camera's "
+            "images and registered to the colour camera) or the look's (light from above, shadows under the "
+            "objects); either way the within-5-px figures above are bounded by it.",
             "",
             *offsets,
             "",
