@@ -207,7 +207,8 @@ def main() -> str:
     lines += [
         "",
         "In one process (the window, `locate` given several photos, or called from Python) the floors are paid once: "
-        "a photo's `locate` is then 0.4-0.8 s for a 640 x 480 Kinect view, 1.0-1.8 s for the tutorial's box (real_photos.md), a solve milliseconds (solver.md).",
+        "a photo's `locate` is then 0.4-0.8 s for a 640 x 480 Kinect view, 1.0-1.8 s for the tutorial's box "
+        "(real_photos.md), a solve milliseconds (solver.md).",
         "",
         f"Peak memory of a whole `videocal locate` (target <= 300 MB): the tutorial's box (a CAD mesh: the renderer "
         f"judges which of its creases show) {peaks['CAD']:.0f} MB; LM-O's cat (a scanned mesh: its outline always "
