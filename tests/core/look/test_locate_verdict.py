@@ -76,3 +76,29 @@ def test_a_fit_elsewhere_is_a_rival_while_its_share_on_edges_is_not_clearly_less
     assert not holds_about_as_many(_fit(0.79, 42), _fit(1.0, 51))
     assert holds_about_as_many(_fit(0.99, 60), _fit(1.0, 60))
     assert not holds_about_as_many(_fit(0.97, 6000), _fit(1.0, 6000))  # many samples: 3 % is clearly less
+
+
+def test_a_rival_a_few_pixels_away_is_said_to_be_the_outline_s_looseness_a_far_one_another_edge():
+    """A start settling 5 px from the answer, as well fitted, is the outline fitted loosely; one 30 px away took another
+    edge for it. Both make the answer ``uncertain``, each with its own reason."""
+    import trimesh
+
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.look.located import Located
+    from calib_core.look.locate_verdict import verdict
+
+    camera = Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480)
+    box = trimesh.creation.box((80.0, 60.0, 40.0))
+    answer = np.eye(4)
+    answer[:3, 3] = (0.0, 0.0, 900.0)
+
+    def fit(pose, share):
+        return Located("ok", "located", pose, np.zeros(3), np.zeros(3), 1.0, share, 60)
+
+    for across_mm, reason in ((7.5, "the outline holds the object only to within about that"), (45.0, "another edge")):
+        other = answer.copy()
+        other[0, 3] += across_mm  # 600 px focal at 900 mm: 0.67 px a mm
+        result = verdict([fit(answer, 1.0), fit(other, 0.99)], box, camera, answer)
+        assert result.status == "uncertain"
+        words = "an inner, printed or neighbouring edge" if reason == "another edge" else reason
+        assert words in result.message, result.message
