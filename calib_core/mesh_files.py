@@ -102,7 +102,6 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
             f"the mesh has coordinates that are not finite numbers (vertex {bad}: {vertices[bad].tolist()})",
             field,
         )
-    mesh.process()  # vertices shared by their faces (an STL repeats them per triangle): the edges' neighbours
     if np.abs(vertices).max() > MAX_COORDINATE_MM:
         raise FileFormatError(
             path,
@@ -110,6 +109,8 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
             "are its units right (mesh_units)?",
             field,
         )
+    # (after the bounds: merging vertices rounds their coordinates to integers, which a coordinate of 1e300 overflows)
+    mesh.process()  # vertices shared by their faces (an STL repeats them per triangle): the edges' neighbours
     if not float(mesh.area) * MESH_SCALE[units] ** 2 > 0.0:
         raise FileFormatError(path, "the mesh has no area (every triangle is degenerate)", field)
     if len(mesh.faces) <= _WINDING_FIX_TRIANGLES and not mesh.is_winding_consistent:
