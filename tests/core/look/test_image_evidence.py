@@ -75,3 +75,21 @@ def test_the_half_size_level_puts_a_point_where_the_scaled_camera_does():
 def test_an_image_that_is_none_is_named(image, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(")", r"\)")):
         ImageEvidence(image)
+
+
+def test_the_coarse_fit_s_pyramid_halves_a_large_photo_twice_and_a_small_one_once():
+    """Known answers: a 1920 x 1440 photo's levels are 480 and 960 px wide (smallest first), a 640 x 480 one's 320, a
+    500 px one's 250 (at least one level); each level's camera is the scaled one whose image it is."""
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.look.coarse_to_fine import pyramid
+    from calib_core.look.image_evidence import ImageEvidence
+
+    for size, widths in (((1920, 1440), [480, 960]), ((640, 480), [320]), ((500, 300), [250])):
+        w, h = size
+        camera = Intrinsics(1.2 * w, 1.2 * w, (w - 1) / 2.0, (h - 1) / 2.0, w, h)
+        levels = pyramid(ImageEvidence(np.zeros((h, w, 3), np.uint8)), camera)
+        assert [level.shape[1] for level, _ in levels] == widths
+        for level, scaled in levels:
+            assert (scaled.width, scaled.height) == (level.shape[1], level.shape[0])
+            assert scaled.fu == pytest.approx(1.2 * w * level.shape[1] / w)
+            assert scaled.cx == pytest.approx((level.shape[1] - 1) / 2.0)
