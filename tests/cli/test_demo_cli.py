@@ -185,7 +185,10 @@ def test_demo_over_ros2_1_5_s_away_reaches_the_same_accuracy(tmp_path, domain):
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads((out / "report.json").read_text())
     assert "over ROS 2" in report["site"] and "1500 ms away" in report["site"]
-    assert 1.0 < report["link"]["measured_one_way_s"] < 2.0  # from the joint states' stamps, not configured
+    # measured from the joint states' stamps, not configured: the median arrival less stamp, which holds the network's
+    # 1.5 s (+-30 %) and the window process's own wait to take a sample off DDS (2.004 s once with the suite on both
+    # cores)
+    assert 1.0 < report["link"]["measured_one_way_s"] < 2.5
     assert report["status"] == "ok" and report["pairs"] >= 6
     assert report["corrected_tcp_error_mm"] < report["uncorrected_tcp_error_mm"] / 10
     assert report["estimate_within_3_sigma"]
