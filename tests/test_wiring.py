@@ -8,8 +8,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _parts_taking_the_core(source: str) -> list[str]:
-    """Classes whose ``__init__`` takes a parameter named ``core`` (a part handed the whole program)."""
+def _classes_taking(source: str, names: tuple[str, ...]) -> list[str]:
+    """Classes whose ``__init__`` takes a parameter of one of ``names``."""
     found = []
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.ClassDef):
@@ -17,10 +17,15 @@ def _parts_taking_the_core(source: str) -> list[str]:
                 if (
                     isinstance(item, ast.FunctionDef)
                     and item.name == "__init__"
-                    and any(a.arg == "core" for a in item.args.args)
+                    and any(a.arg in names for a in item.args.args)
                 ):
                     found.append(node.name)
     return found
+
+
+def _parts_taking_the_core(source: str) -> list[str]:
+    """Classes whose ``__init__`` takes a parameter named ``core`` (a part handed the whole program)."""
+    return _classes_taking(source, ("core",))
 
 
 def test_the_operator_parts_are_given_what_they_need():
@@ -45,17 +50,7 @@ def test_the_operator_parts_are_given_what_they_need():
 
 def _widgets_taking_the_core(source: str) -> list[str]:
     """Classes whose ``__init__`` takes the whole core (a parameter named ``workbench`` or ``core``)."""
-    found = []
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.ClassDef):
-            for item in node.body:
-                if (
-                    isinstance(item, ast.FunctionDef)
-                    and item.name == "__init__"
-                    and any(a.arg in ("workbench", "core") for a in item.args.args)
-                ):
-                    found.append(node.name)
-    return found
+    return _classes_taking(source, ("workbench", "core"))
 
 
 def _widget_modules_where(found) -> set[str]:

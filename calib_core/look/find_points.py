@@ -32,6 +32,7 @@ from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge_samples_px, matched_share
 from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
+from calib_core.look.form_tolerance import form_error_px
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
 from calib_core.look.found_points import FoundPoints, Missed, Proposal
@@ -339,19 +340,6 @@ def _unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray,
             f"{edge_fit.rms_bound_px:.2f} px a settled fit is held to"
         )
     return said + ": pick the points by hand"
-
-
-def form_error_px(item: SceneItem, obj2cam: np.ndarray, intrinsics: Intrinsics) -> float:
-    """How far, px, a part made to its stated form tolerance (:attr:`SceneItem.form_tolerance_mm`, 1-sigma an axis) may
-    lie from its CAD in the image at ``obj2cam`` (4, 4, mm): the tolerance at the depth of the mesh's centre; 0 for a
-    part made as drawn. (Raising the settle bound to it was tried: on the workshop camera at full size, parts 0.5 mm
-    off their CAD at 180 mm and 1120 px focal, the fits then settled on wrong poses and the corrections were 4.3-4.7 mm
-    off, outside their 3-sigma. The look says why it is refused instead.)"""
-    if item.form_tolerance_mm <= 0.0:
-        return 0.0
-    centre = np.asarray(item.mesh.vertices, dtype=float).mean(axis=0)
-    depth = float(centre @ obj2cam[2, :3] + obj2cam[2, 3])
-    return item.form_tolerance_mm * max(intrinsics.fu, intrinsics.fv) / depth if depth > 0.0 else 0.0
 
 
 def _detection_start(
