@@ -305,6 +305,17 @@ def _best_settled_fit(
     their edges runs again from where it got to, with the model's view and the samples taken afresh there (from a
     turned start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px, which the second
     pass leaves for the right pose at 0.13 px)."""
+
+    def held(fit: EdgeFit) -> bool:
+        # the starts cover the prior's reach: a fit that walked beyond three times it found something else (on LM-O
+        # from 10 mm / 3 deg off, fits that slid 35-90 mm along the line of sight onto a neighbour's edges won over
+        # starts that settled on the object, and the look said "not found")
+        return fitting.prior is None or fitting.prior.holds(fit.obj2cam)
+
+    def rank(fit: EdgeFit) -> tuple[bool, float]:
+        settled, count = _fit_rank(fit)
+        return settled and held(fit), count
+
     best = None
     for start_pose, coarse in fit_starts(obj2cam_model, ranked, has_prior):
         if coarse:
@@ -312,12 +323,12 @@ def _best_settled_fit(
                 fitting.evidence, fitting.intrinsics, fitting.mesh, start_pose, fitting.colour, fitting.prior
             )
         fit = fitting.refine(start_pose)
-        if best is None or _fit_rank(fit) > _fit_rank(best):
+        if best is None or rank(fit) > rank(best):
             best = fit
-        if best.settled and best.inlier_share >= _CLEAR_SHARE:
+        if best.settled and held(best) and best.inlier_share >= _CLEAR_SHARE:
             break
     again = fitting.refine(best.obj2cam)  # the second pass, for the best start only
-    return again if again.settled or _fit_rank(again) > _fit_rank(best) else best
+    return again if (again.settled and held(again)) or rank(again) > rank(best) else best
 
 
 def _unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, intrinsics: Intrinsics) -> str:

@@ -104,7 +104,7 @@ def locate(
         located.obj2cam, RIVAL_DEPTH_SHARE
     ):
         other = _report(look(start), intrinsics, start, reach_mm, reach_deg)
-        if other.status == "ok" and _within_reach(other.obj2cam, prior, reach_mm, reach_deg):
+        if other.status == "ok" and believed.holds(other.obj2cam):
             fits.append(other)
     return verdict(fits, mesh, intrinsics, prior)
 
@@ -120,11 +120,6 @@ def _depth_starts(obj2cam: np.ndarray, share: float) -> list[np.ndarray]:
         start[:3, 3] = obj2cam[:3, 3] * (1.0 + sign * share)
         out.append(start)
     return out
-
-
-def _within_reach(pose: np.ndarray, prior: np.ndarray, reach_mm: float, reach_deg: float) -> bool:
-    moved = float(np.linalg.norm(pose[:3, 3] - prior[:3, 3]))
-    return moved <= 3.0 * reach_mm and rotation_angle_deg(pose[:3, :3] @ prior[:3, :3].T) <= 3.0 * reach_deg
 
 
 def _starts_round(prior: np.ndarray, mm: float, deg: float) -> list[np.ndarray]:

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from calib_core.frames import rotation_angle_deg
+
 
 @dataclass(frozen=True)
 class PosePrior:
@@ -48,3 +50,11 @@ class PosePrior:
         J[3:, 3:] = np.eye(3)
         W = np.diag([1.0 / np.radians(self.sigma_deg) ** 2] * 3 + [1.0 / self.sigma_mm**2] * 3)
         return J.T @ W @ J, J.T @ W @ -np.concatenate([turn, moved])
+
+    def holds(self, pose: np.ndarray, sigmas: float = 3.0) -> bool:
+        """Whether ``pose`` (4, 4, mm) lies within ``sigmas`` times the prior's 1-sigma both in position (the distance
+        between the two positions, mm) and in turn (the angle between the two orientations, deg): how far a look's
+        search covered round the prior."""
+        moved = float(np.linalg.norm(pose[:3, 3] - self.obj2cam[:3, 3]))
+        turned = rotation_angle_deg(pose[:3, :3] @ self.obj2cam[:3, :3].T)
+        return moved <= sigmas * self.sigma_mm and turned <= sigmas * self.sigma_deg

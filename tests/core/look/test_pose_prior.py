@@ -75,3 +75,24 @@ def test_a_look_with_no_reach_is_refused_with_the_reach_named():
     for reach_mm, reach_deg, unit in ((0.0, 3.0, "mm"), (10.0, float("nan"), "deg")):
         with pytest.raises(OperatorError, match=f"reach must be above 0 {unit}"):
             locate(image, camera, box, _pose([0, 0, 0], [0, 0, 500.0]), reach_mm=reach_mm, reach_deg=reach_deg)
+
+
+def test_a_pose_is_held_by_the_prior_within_three_times_its_reach_in_distance_and_in_turn():
+    """Known answers at the bounds: 29 mm off a 10 mm reach is held, 31 mm is not (along any direction); 8.9 deg off a
+    3 deg reach is held, 9.1 deg is not; either beyond is enough to leave it."""
+    base = _pose([0.1, -0.2, 0.3], [20.0, -10.0, 900.0])
+    prior = PosePrior(base, sigma_mm=10.0, sigma_deg=3.0)
+    direction = np.array([2.0, -1.0, 2.0]) / 3.0
+    for mm, held in ((29.0, True), (31.0, False)):
+        moved = base.copy()
+        moved[:3, 3] += mm * direction
+        assert prior.holds(moved) is held
+    for deg, held in ((8.9, True), (9.1, False)):
+        turned = base.copy()
+        turned[:3, :3] = Rotation.from_rotvec(np.radians(deg) * np.array([0.0, 0.6, 0.8])).as_matrix() @ base[:3, :3]
+        assert prior.holds(turned) is held
+    both = base.copy()
+    both[:3, 3] += 5.0 * direction
+    both[:3, :3] = Rotation.from_rotvec(np.radians(12.0) * np.array([1.0, 0.0, 0.0])).as_matrix() @ base[:3, :3]
+    assert not prior.holds(both)
+    assert prior.holds(both, sigmas=5.0)
