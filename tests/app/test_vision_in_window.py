@@ -47,7 +47,9 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
             f"{win.overview.preview_text.text()}"
         ) from None
     _fresh_still_frame(qtbot, win)
-    assert np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3
+    # the controller's done can be read before its last samples on the way in (0.0013 deg short once, under load):
+    # the samples that follow must reach the target
+    qtbot.waitUntil(lambda: np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3, timeout=5_000)
 
 
 def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path, monkeypatch):
