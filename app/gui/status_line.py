@@ -48,6 +48,16 @@ class StatusLine:
             self.pairs_label,
         ):
             bar.addPermanentWidget(w)
+        # the fields take most of the bar, and a long message (Find points' reason, an error) is cut at what is left:
+        # the whole of it is the bar's tooltip while it shows; each field says what it is, so hovering one does not
+        # show the message instead
+        bar.messageChanged.connect(bar.setToolTip)
+        self.record_label.setToolTip("the session's recording: shown while it records, with how much it holds")
+        self.link_label.setToolTip(
+            "the robot link: its state, joint samples a second, lines rejected, and a far controller's one-way delay"
+        )
+        self.fps_label.setToolTip("the camera: frames a second, orange when none came for a while")
+        self.pairs_label.setToolTip("the point pairs picked, and those the last solve used")
         model.motion_changed.connect(self.show_motion)
         model.link_state.connect(self.show_link_state)
         # (pairs change outside the undo stack too)
