@@ -54,3 +54,11 @@ def test_without_a_prior_the_fit_with_most_samples_on_their_edges_is_kept():
     chosen = _best_settled_fit(fits, _at(0.0), lambda: [_at(0.0), _at(1.0)], False)
     assert chosen.obj2cam[0, 3] == 40.0
     assert fits.asked == [0.0, 40.0]  # it settled with most of its samples: the search ended there
+
+
+def test_a_photos_settle_bound_grows_with_the_square_root_of_its_width_above_640_px():
+    from calib_core.look.locate import PHOTO_EDGE_RMS_PX, photo_rms_bound_px
+
+    assert photo_rms_bound_px(320) == photo_rms_bound_px(640) == PHOTO_EDGE_RMS_PX
+    assert photo_rms_bound_px(2560) == 2.0 * PHOTO_EDGE_RMS_PX
+    assert photo_rms_bound_px(1920) == np.sqrt(3.0) * PHOTO_EDGE_RMS_PX
