@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from bench.real_photos import FROM_TRUTH, Row, annotation_offset
+from bench.real_photos import FROM_TRUTH, Row
+from bench.truth_checks import annotation_offset
 
 
 def _rows(shift_px, scale, n=40, noise_px=1.0, width=640):
