@@ -193,7 +193,7 @@ def _report(
         )
     moved = float(np.linalg.norm(edges.obj2cam[:3, 3] - prior[:3, 3]))
     turned = rotation_angle_deg(edges.obj2cam[:3, :3] @ prior[:3, :3].T)
-    if moved > 3.0 * reach_mm or turned > 3.0 * reach_deg:
+    if not PosePrior(prior, reach_mm, reach_deg).holds(edges.obj2cam):
         # the search covered the reach round the prior; a fit that walked far beyond it found something else
         return Located(
             "not found",
