@@ -5,7 +5,8 @@ colours, at full size and halved, computed once); where the object's outline and
 (:mod:`~calib_core.look.outline`, :mod:`~calib_core.look.edge_samples`); where its colours end
 (:mod:`~calib_core.look.region_model`); the edge fit that pulls the pose onto the image's edges
 (:mod:`~calib_core.look.edge_refinement`, anchored by :mod:`~calib_core.look.pose_prior` on a photograph); the starts
-it is tried from (:mod:`~calib_core.look.pose_hypotheses`); the features' detectors
+it is tried from (:mod:`~calib_core.look.pose_hypotheses`) and which of their fits is kept
+(:mod:`~calib_core.look.fit_choice`); the features' detectors
 (:mod:`~calib_core.look.target_detectors`); Find points, which proposes pairs in the window
 (:mod:`~calib_core.look.find_points`, refusing a part whose :mod:`~calib_core.look.form_tolerance` is more pixels than
 a settled fit may hold); and a look on any photograph with its verdict

@@ -7,7 +7,8 @@
 3. Refine the pose on the image's gradients from the best few (:mod:`calib_core.look.edge_refinement`), in
    turn until one settles with three quarters of its samples on their edges (the image's noise can rank a
    wrong start first: a wrong minimum settles too, with about half); the fit with the most samples on
-   their edges is kept, and nothing is proposed unless it settles with 60 % of them.
+   their edges is kept, and nothing is proposed unless it settles with 60 % of them
+   (:mod:`calib_core.look.fit_choice`).
 4. Detect each feature by its kind (:mod:`calib_core.look.target_detectors`: with the model's view,
    a corner's edges and a circle's rim measured against it) in a window of three times the edges'
    scatter around its projection; drop detections more than 1 px from where the edges put them; a
@@ -21,22 +22,19 @@ The result never moves anything: the operator accepts, rejects or drags the prop
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, replace
 
 import numpy as np
-import trimesh
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge_samples_px, matched_share
-from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit, refine_to_edges
+from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit
 from calib_core.look.form_tolerance import form_error_px
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
 from calib_core.look.found_points import FoundPoints, Missed, Proposal
-from calib_core.look.coarse_to_fine import coarse_fit, fit_starts
+from calib_core.look.fit_choice import EdgeFitting, best_settled_fit, fit_rank
 from calib_core.look.image_evidence import ImageEvidence
 from calib_core.look.in_view import MIN_SHOWN_SAMPLES, hidden_in_view, seen_unhidden, share_in_view
 from calib_core.look.target_detectors import TargetDetectors
@@ -48,10 +46,6 @@ from calib_core.look.search_reach import REACH_DEG, REACH_MM  # noqa: E402 (name
 
 _EDGE_AGREEMENT_PX = 1.0
 _SIGMA_PX = 0.5
-# a fit settles (is proposed from) with this share of its samples on their edges: wrong minima seen held 52-56 %, the
-# least right one 65 % (the bench)
-_FIT_SHARE = 0.6
-_CLEAR_SHARE = 0.75  # a settled fit with this share ends the search (the right pose of the demo's frame 12 held 90 %)
 # starts tried at most: on one frame of the demo the right one ranked fourth, the first three settling 1.6-1.9 mm off at
 # 55 %
 _STARTS = 8
@@ -171,7 +165,7 @@ def find_points(
         return ranking
 
     colour = evidence.colour if by_colour else None
-    fitting = _Fitting(
+    fitting = EdgeFitting(
         evidence,
         intrinsics,
         item.mesh,
@@ -182,7 +176,7 @@ def find_points(
         prior,
         evidence.colour_bins if colour is not None else None,
     )
-    edge_fit = _best_settled_fit(fitting, obj2cam_model, ranked, prior is not None)
+    edge_fit = best_settled_fit(fitting, obj2cam_model, ranked, prior is not None)
     edge_seconds = time.perf_counter() - t_edges
     # where the image puts the target's centre against where the model does
     centre = item.mesh.vertices.mean(axis=0)[None]
@@ -217,7 +211,7 @@ def find_points(
         # put every feature within _AGREE_PX of each other there is nothing to find.
         t_across = time.perf_counter()
         across = fitting.refine(pose, search_px=_RECHECK_SEARCH_PX, shown_at=start)
-        if across.settled and _fit_rank(across) > _fit_rank(edge_fit):
+        if across.settled and fit_rank(across) > fit_rank(edge_fit):
             edge_fit = across
         edge_seconds += time.perf_counter() - t_across
     if pose is None:
@@ -255,80 +249,6 @@ def find_points(
         edge_fit,
         edge_seconds,
     )
-
-
-@dataclass(frozen=True)
-class _Fitting:
-    """What every edge fit of one look shares: the image's evidence, the camera, the target's mesh, its detectors
-    (with a model's view, ``has_view``, theirs leaves out edges without contrast), the settle bound, the colours (the
-    outline by colour) and the prior."""
-
-    evidence: ImageEvidence
-    intrinsics: Intrinsics
-    mesh: trimesh.Trimesh
-    detectors: TargetDetectors
-    has_view: bool
-    rms_bound_px: float
-    colour: np.ndarray | None
-    prior: PosePrior | None
-    colour_bins: np.ndarray | None
-
-    def refine(
-        self, start: np.ndarray, *, search_px: float | None = None, shown_at: np.ndarray | None = None
-    ) -> EdgeFit:
-        """The edges refined from ``start`` (4, 4), leaving out those without contrast in the model's view at
-        ``shown_at`` (default ``start``); settled only on more than :data:`_FIT_SHARE` of its samples (proposals
-        follow from it)."""
-        shown = start if shown_at is None else shown_at
-        fit = refine_to_edges(
-            self.evidence.grey,
-            self.intrinsics,
-            self.mesh,
-            start,
-            expected_magnitude=self.detectors.expected_magnitude(shown) if self.has_view else None,
-            magnitude=self.detectors.magnitude,
-            rms_bound_px=self.rms_bound_px,
-            colour=self.colour,
-            prior=self.prior,
-            colour_bins=self.colour_bins,
-            **({} if search_px is None else {"search_px": search_px}),
-        )
-        return replace(fit, min_share=_FIT_SHARE)
-
-
-def _best_settled_fit(
-    fitting: _Fitting, obj2cam_model: np.ndarray, ranked: Callable[[], list[np.ndarray]], has_prior: bool
-) -> EdgeFit:
-    """Poses within the robot's error, ranked by their edges' chamfer distance (close up a robot's error moves near
-    and far edges differently: no 2D shift lays them all on the image); from the best few, in turn until one settles
-    with most of its samples on their edges, the edges pull the pose into place. The fit with the most samples on
-    their edges runs again from where it got to, with the model's view and the samples taken afresh there (from a
-    turned start a pin seen end-on can lock its rims onto each other: 16 mrad of tilt at 0.37 px, which the second
-    pass leaves for the right pose at 0.13 px)."""
-
-    def held(fit: EdgeFit) -> bool:
-        # the starts cover the prior's reach: a fit that walked beyond three times it found something else (on LM-O
-        # from 10 mm / 3 deg off, fits that slid 35-90 mm along the line of sight onto a neighbour's edges won over
-        # starts that settled on the object, and the look said "not found")
-        return fitting.prior is None or fitting.prior.holds(fit.obj2cam)
-
-    def rank(fit: EdgeFit) -> tuple[bool, float]:
-        settled, count = _fit_rank(fit)
-        return settled and held(fit), count
-
-    best = None
-    for start_pose, coarse in fit_starts(obj2cam_model, ranked, has_prior):
-        if coarse:
-            start_pose = coarse_fit(
-                fitting.evidence, fitting.intrinsics, fitting.mesh, start_pose, fitting.colour, fitting.prior
-            )
-        fit = fitting.refine(start_pose)
-        if best is None or rank(fit) > rank(best):
-            best = fit
-        if best.settled and held(best) and best.inlier_share >= _CLEAR_SHARE:
-            break
-    again = fitting.refine(best.obj2cam)  # the second pass, for the best start only
-    return again if (again.settled and held(again)) or rank(again) > rank(best) else best
 
 
 def _unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, intrinsics: Intrinsics) -> str:
@@ -421,11 +341,6 @@ def _moved_px(points_mm: np.ndarray, a: np.ndarray, b: np.ndarray, intrinsics: I
             np.linalg.norm(project_points(points_mm, a, intrinsics) - project_points(points_mm, b, intrinsics), axis=1)
         )
     )
-
-
-def _fit_rank(fit: EdgeFit) -> tuple[bool, float]:
-    """Settled first, then the most samples on their edges."""
-    return fit.settled, fit.inlier_share * fit.samples
 
 
 def _robust_fit(

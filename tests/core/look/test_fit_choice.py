@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from calib_core.look.edge_refinement import EdgeFit
-from calib_core.look.find_points import _best_settled_fit
+from calib_core.look.fit_choice import best_settled_fit
 from calib_core.look.pose_prior import PosePrior
 
 
@@ -44,14 +44,14 @@ def _fits() -> dict[float, EdgeFit]:
 
 def test_a_fit_beyond_three_times_the_reach_loses_to_one_within_it():
     fits = _RecordedFits(_fits(), PosePrior(_at(0.0), sigma_mm=10.0, sigma_deg=3.0))
-    chosen = _best_settled_fit(fits, _at(0.0), lambda: [_at(0.0), _at(1.0)], False)
+    chosen = best_settled_fit(fits, _at(0.0), lambda: [_at(0.0), _at(1.0)], False)
     assert chosen.obj2cam[0, 3] == 4.0
     assert fits.asked == [0.0, 1.0, 4.0]  # the second start tried, and its fit refined again
 
 
 def test_without_a_prior_the_fit_with_most_samples_on_their_edges_is_kept():
     fits = _RecordedFits(_fits(), None)
-    chosen = _best_settled_fit(fits, _at(0.0), lambda: [_at(0.0), _at(1.0)], False)
+    chosen = best_settled_fit(fits, _at(0.0), lambda: [_at(0.0), _at(1.0)], False)
     assert chosen.obj2cam[0, 3] == 40.0
     assert fits.asked == [0.0, 40.0]  # it settled with most of its samples: the search ended there
 
