@@ -31,6 +31,7 @@ class StatusLine:
     def __init__(self, bar: QStatusBar, model: StatusLineModel, *, camera_state: Callable[[], tuple], parent) -> None:
         self._model = model
         self._camera_state = camera_state
+        self._bar = bar
         self.record_label = QLabel("")
         self.link_label = QLabel("link: not connected")
         self.fps_label = QLabel("camera: -")
@@ -51,7 +52,9 @@ class StatusLine:
         # the fields take most of the bar, and a long message (Find points' reason, an error) is cut at what is left:
         # the whole of it is the bar's tooltip while it shows; each field says what it is, so hovering one does not
         # show the message instead
-        bar.messageChanged.connect(bar.setToolTip)
+        # (through a Python callable: PySide cannot connect a signal to QStatusBar.setToolTip itself and says so on
+        # stderr at every start)
+        bar.messageChanged.connect(self._message_as_tooltip)
         self.record_label.setToolTip("the session's recording: shown while it records, with how much it holds")
         self.link_label.setToolTip(
             "the robot link: its state, joint samples a second, lines rejected, and a far controller's one-way delay"
@@ -69,6 +72,9 @@ class StatusLine:
         self.timer.setInterval(1000)
         self.timer.timeout.connect(self.update)
         self.timer.start()
+
+    def _message_as_tooltip(self, text: str) -> None:
+        self._bar.setToolTip(text)
 
     def update(self) -> None:
         now = time.monotonic()

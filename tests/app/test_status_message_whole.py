@@ -29,3 +29,20 @@ def test_every_field_of_the_bar_says_what_it_is_not_the_message(offline_window):
     line = win.status_line
     for label in (line.record_label, line.link_label, line.fps_label, line.pairs_label):
         assert label.toolTip() and label.toolTip() != "the last message"
+
+
+def test_the_window_opens_without_a_warning_from_pyside(qtbot, qtlog, tmp_path, capfd):
+    # PySide cannot connect a signal straight to a slot of a widget Qt made itself (the main window's status bar) and
+    # warns at every start: through Qt's message handler (pytest-qt's, under capture), else on the process's stderr
+    from app.gui.main_window import MainWindow
+    from app.gui.workbench import Workbench
+    from tests.app.windows import window_settings
+    from videocal_sim.sim_site import simulated_cell
+
+    capfd.readouterr()
+    win = MainWindow(Workbench(*simulated_cell()), settings=window_settings(tmp_path))
+    qtbot.addWidget(win)
+    win.show_error("a message")
+    assert "libpyside" not in capfd.readouterr().err
+    assert not [r.message for r in qtlog.records if "libpyside" in r.message]
+    assert win.statusBar().toolTip() == "a message"
