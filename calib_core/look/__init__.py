@@ -6,10 +6,9 @@ colours, at full size and halved, computed once); where the object's outline and
 (:mod:`~calib_core.look.region_model`); the edge fit that pulls the pose onto the image's edges
 (:mod:`~calib_core.look.edge_refinement`, anchored by :mod:`~calib_core.look.pose_prior` on a photograph); the starts
 it is tried from (:mod:`~calib_core.look.pose_hypotheses`) and which of their fits is kept
-(:mod:`~calib_core.look.fit_choice`); the features' detectors
-(:mod:`~calib_core.look.target_detectors`); Find points, which proposes pairs in the window
-(:mod:`~calib_core.look.find_points`, refusing a part whose :mod:`~calib_core.look.form_tolerance` is more pixels than
-a settled fit may hold); and a look on any photograph with its verdict
-(:mod:`~calib_core.look.locate`, :mod:`~calib_core.look.locate_verdict`). The camera's own calibration (boards,
-intrinsics, hand-eye) is :mod:`calib_core.vision`.
+(:mod:`~calib_core.look.fit_choice`); the features' detectors (:mod:`~calib_core.look.target_detectors`); Find points,
+which proposes pairs in the window (:mod:`~calib_core.look.find_points`; on the image halved for a part whose
+:mod:`~calib_core.look.form_tolerance` is more pixels than the fit averages over, :mod:`~calib_core.look.halved_look`);
+and a look on any photograph with its verdict (:mod:`~calib_core.look.locate`, :mod:`~calib_core.look.locate_verdict`).
+The camera's own calibration (boards, intrinsics, hand-eye) is :mod:`calib_core.vision`.
 """

@@ -83,17 +83,25 @@ class EdgeFit:
     (the demo's frame 12: 52-56 %, 1.6-1.9 mm off, where the right pose holds 90 %; the least right fit of the
     Find points bench held 65 %)."""
 
+    px_scale: float = 1.0
+    """The image's pixels to one of the image the fit ran on (2 for a fit on the image halved, its pixel figures given
+    in the whole image's): what :attr:`settled` scales its 0.5 px by."""
+
     @property
     def settled(self) -> bool:
-        """Converged, and either within 0.5 px RMS with at least ``min_share`` of the samples on their edges, or within
-        its ``rms_bound_px`` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold more of its edges)."""
+        """Converged, and either within 0.5 px RMS (of the image it ran on) with at least ``min_share`` of the samples
+        on their edges, or within its ``rms_bound_px`` with :data:`COARSE_FIT_SHARE` of them (a coarser fit must hold
+        more of its edges)."""
         if not self.converged:
             return False
-        return (self.rms_px <= 0.5 and self.inlier_share >= self.min_share) or (
+        return (self.rms_px <= 0.5 * self.px_scale and self.inlier_share >= self.min_share) or (
             self.rms_px <= self.rms_bound_px and self.inlier_share >= COARSE_FIT_SHARE
         )
 
 
+FINEST_WINDOW_PX = 2.0
+"""The search along each sample's normal narrows, as the fit settles, to this many pixels either side: an edge further
+from the model's than this (a part's bend off its CAD) drops out of the fit."""
 CREASES_JOIN_PX = 2.0
 """With the outline found by colour, the creases join the fit once its search window is this narrow, px."""
 CREASES_AGREE_PX = 0.75
@@ -298,8 +306,10 @@ def refine_to_edges(
         edges, offsets, vectors = found[ok], r[ok], (r[:, None] * normals)[ok]
         share = float(np.mean(wts[counted] > 0)) if counted.any() else 0.0
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
-        at_finest = window <= 2.0
-        window = max(2.0, min(0.7 * window, 3.0 * sigma + 1.0))  # coarse to fine: wrong matches fall away as it shrinks
+        at_finest = window <= FINEST_WINDOW_PX
+        window = max(
+            FINEST_WINDOW_PX, min(0.7 * window, 3.0 * sigma + 1.0)
+        )  # coarse to fine: wrong matches fall away as it shrinks
         # Settled when the samples stop moving; at the finest window a step under a tenth of the
         # noise is samples trading places at the window's rim (a cycle, not a descent).
         if it > 0 and (moved_px < 0.01 or (at_finest and moved_px < 0.1 * sigma)):

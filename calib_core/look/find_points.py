@@ -22,6 +22,7 @@ The result never moves anything: the operator accepts, rejects or drags the prop
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -29,8 +30,9 @@ from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
 from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge_samples_px, matched_share
-from calib_core.look.edge_refinement import SETTLED_RMS_PX, EdgeFit
+from calib_core.look.edge_refinement import FINEST_WINDOW_PX, SETTLED_RMS_PX, EdgeFit
 from calib_core.look.form_tolerance import form_error_px
+from calib_core.look.halved_look import at_full_size, halved_view, halvings
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
 from calib_core.look.found_points import FoundPoints, Missed, Proposal
@@ -118,6 +120,32 @@ def find_points(
     if not names:
         return FoundPoints(item.name, False, f"component {item.name!r} has no features to find")
     evidence = ImageEvidence.of(image)
+    form_px = form_error_px(item, obj2cam_model, intrinsics)
+    count = halvings(form_px, intrinsics.width)
+    if count:
+        camera = intrinsics
+        for _ in range(count):
+            evidence, camera = evidence.half(), camera.scaled(0.5)
+        # (the half leaves an odd last row or column out)
+        camera = replace(camera, width=evidence.shape[1], height=evidence.shape[0])
+        smaller = find_points(
+            evidence,
+            camera,
+            item,
+            obj2cam_model,
+            kinds=kinds,
+            reach_mm=reach_mm,
+            reach_deg=reach_deg,
+            expected=halved_view(expected, count),
+            edge_rms_px=edge_rms_px,
+            by_colour=by_colour,
+            prior=prior,
+        )
+        why = (
+            f"its stated form tolerance, {item.form_tolerance_mm:g} mm, is {form_px:.1f} px in the whole image, more "
+            f"than the {FINEST_WINDOW_PX:g} px the edge fit averages over"
+        )
+        return replace(at_full_size(smaller, count, why), seconds=time.perf_counter() - t0)
     points = np.array([item.features[n] for n in names], dtype=float)
     uv_model = project_points(points, obj2cam_model, intrinsics)
     radius_px = search_radius_px(item.mesh.vertices, obj2cam_model, intrinsics, reach_mm, reach_deg)

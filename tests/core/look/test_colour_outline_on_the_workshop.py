@@ -68,11 +68,16 @@ def test_the_fixture_by_its_colours_from_the_approach_states_a_1_sigma_its_error
     assert error_mm < 3.0 * stated_mm, (error_mm, stated_mm)
 
 
-def test_parts_a_millimetre_off_their_cad_at_full_size_are_refused_saying_their_tolerance_is_the_reason():
+def test_parts_a_millimetre_off_their_cad_at_full_size_are_looked_at_on_the_image_halved():
     """The workshop's parts printed up to 1 mm off their CAD (stated: 0.5 mm, 1-sigma), Find points as the window runs
-    it (edges by gradient), at full size from the task location: the edges cannot settle within 0.5 px of the CAD's, and
-    the message says why (the tolerance in pixels), not only that they did not settle."""
-    from videocal_sim.real_look import WORKSHOP_FORM_TOLERANCE_MM
+    it (edges by gradient), at full size from the task location: the stated tolerance is 3.3 px there, more than the
+    edge fit's finest window, and the fixture's bent outline tilted the fit (refused: RMS 1.2 px against 0.5). On the
+    image halved the bend is within the window: the fixture is found, its centre within half a millimetre of where it
+    truly is (the model puts it 9 mm off), the proposals in the whole image's pixels, and the message says where it
+    looked and why."""
+    from calib_core.look.edge_refinement import FINEST_WINDOW_PX
+    from calib_core.look.form_tolerance import form_error_px
+    from videocal_sim.real_look import WORKSHOP_FORM_ERROR_MM, WORKSHOP_FORM_TOLERANCE_MM
 
     bed = TestBed.create()
     make_less_kind(bed)
@@ -90,6 +95,24 @@ def test_parts_a_millimetre_off_their_cad_at_full_size_are_refused_saying_their_
     finally:
         view.close()
         camera.close()
-    assert not result.found and result.edges is not None and not result.edges.settled
-    assert result.edges.inlier_share > 0.9  # on the part's edges, only not within the CAD's bound
-    assert "its stated form tolerance, 0.5 mm, is" in result.message and "pick the points by hand" in result.message
+    assert form_error_px(item, model, bed.intrinsics) > FINEST_WINDOW_PX
+    assert result.found and result.edges is not None and result.edges.settled, result.message
+    assert result.edges.px_scale == 2.0
+    assert (
+        "(looked at the image at half its size, where the figures above are measured: its stated form tolerance, "
+        in (result.message)
+    )
+    truth = np.linalg.inv(camera.last_truth.cam2world) @ item.item2world
+    centre = item.mesh.vertices.mean(axis=0)
+    assert np.linalg.norm(concat_point(result.obj2cam, centre) - concat_point(truth, centre)) < 0.6
+    assert np.linalg.norm(concat_point(model, centre) - concat_point(truth, centre)) > 5.0
+    # the proposals where the whole camera sees the part: each within the part's own bend (1 mm) of its CAD feature
+    names = list(item.features)
+    true_px = project_points(np.array([item.features[n] for n in names]), truth, bed.intrinsics)
+    form_px = form_error_px(item, truth, bed.intrinsics)
+    errors = [float(np.linalg.norm(p.uv_px - true_px[names.index(p.feature)])) for p in result.proposals]
+    assert len(errors) >= 4 and max(errors) < WORKSHOP_FORM_ERROR_MM * form_px / WORKSHOP_FORM_TOLERANCE_MM, errors
+
+
+def concat_point(obj2cam: np.ndarray, point_mm: np.ndarray) -> np.ndarray:
+    return obj2cam[:3, :3] @ point_mm + obj2cam[:3, 3]
