@@ -97,6 +97,8 @@ def test_the_model_s_view_for_the_halved_image_is_the_whole_view_averaged_as_the
     shown = np.argwhere(view[..., 0] > 0)
     assert shown.min(axis=0).tolist() == [50, 100] and shown.max(axis=0).tolist() == [89, 160]
     assert halved_view(None, 1) is None
+    odd = halved_view(lambda pose, box_px=None, supersample=1: np.full((961, 1281, 3), 80, np.uint8), 1)(_pose())
+    assert odd.shape == (480, 640, 3)  # the last row and column left out, as the photo's half leaves them
     quarter = halved_view(expected, 2)(_pose(), box_px=(50, 25, 80, 45))
     assert asked[-1] == ((200, 100, 320, 180), 1) and quarter.shape == (240, 320, 3)
     np.testing.assert_array_equal(
