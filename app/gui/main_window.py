@@ -18,6 +18,7 @@ from app.gui.replay_bar import ReplayBar
 from app.gui.results_panel import ResultsPanel
 from app.gui.file_menu import FileMenu
 from app.gui.found_points import FindPoints
+from app.gui.message_status_bar import MessageStatusBar
 from app.gui.status_line import StatusLine
 from app.gui.virtual_pane import VirtualPane
 from app.gui.robot_panel import RobotPanel
@@ -46,6 +47,7 @@ class MainWindow(QMainWindow):
         self.launcher = launcher  # opens another cell in a new window (File > Open cell); None: this window's cell only
         self.settings = settings or QSettings("videocal", "videocal")
         self.setWindowTitle(f"videocal - {workbench.workcell.name}")
+        self.setStatusBar(MessageStatusBar(self))  # (before anything says a word: a long message ends in an ellipsis)
         self.camera = CameraPane(
             CameraPaneModel(
                 workbench.cell,

@@ -46,3 +46,19 @@ def test_the_window_opens_without_a_warning_from_pyside(qtbot, qtlog, tmp_path, 
     assert "libpyside" not in capfd.readouterr().err
     assert not [r.message for r in qtlog.records if "libpyside" in r.message]
     assert win.statusBar().toolTip() == "a message"
+
+
+def test_a_long_message_ends_in_an_ellipsis_before_the_fields_and_a_short_one_is_whole(offline_window):
+    win = offline_window
+    bar = win.statusBar()
+    first_field = min(w.x() for w in (win.status_line.motion_label, win.status_line.link_label) if w.isVisible())
+    long = "fixture: its edges did not settle on the image " * 6
+    win.show_error(long)
+    shown = bar.shown_message()
+    assert shown.endswith("…") and long.startswith(shown[:-1])  # cut, and says so
+    assert QFontMetrics(bar.font()).horizontalAdvance(shown) <= bar.message_room_px() < first_field
+    assert bar.currentMessage() == long  # the message itself is whole (and the tooltip)
+    win.show_error("stored")
+    assert bar.shown_message() == "stored"
+    image = bar.grab().toImage()  # it paints (a message drawn: dark text pixels left of the fields)
+    assert any(image.pixelColor(x, image.height() // 2).lightness() < 100 for x in range(6, first_field))
