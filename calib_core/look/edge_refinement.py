@@ -307,9 +307,8 @@ def refine_to_edges(
         share = float(np.mean(wts[counted] > 0)) if counted.any() else 0.0
         moved_px = float(np.max(np.abs(J @ xi))) if len(J) else 0.0
         at_finest = window <= FINEST_WINDOW_PX
-        window = max(
-            FINEST_WINDOW_PX, min(0.7 * window, 3.0 * sigma + 1.0)
-        )  # coarse to fine: wrong matches fall away as it shrinks
+        # coarse to fine: wrong matches fall away as it shrinks
+        window = max(FINEST_WINDOW_PX, min(0.7 * window, 3.0 * sigma + 1.0))
         # Settled when the samples stop moving; at the finest window a step under a tenth of the
         # noise is samples trading places at the window's rim (a cycle, not a descent).
         if it > 0 and (moved_px < 0.01 or (at_finest and moved_px < 0.1 * sigma)):
