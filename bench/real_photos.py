@@ -253,6 +253,7 @@ def table(rows: list[Row]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> str:
     from bench.box_photo import box_photo_rows
+    from bench.photo_targets import target_rows
     from bench.truth_checks import annotation_offset, colour_evidence, stated_sigma
 
     argv = sys.argv[1:] if argv is None else argv
@@ -285,6 +286,13 @@ def main(argv: list[str] | None = None) -> str:
             ["Data sets run: " + "; ".join(sets) + ".", ""]
             + table(rows)
             + ["", f"Peak memory of the process: {peak_mb:.0f} MB."]
+            + ["", "## The targets", ""]
+            + target_rows(rows)
+            + [
+                "",
+                "The whole `videocal locate` command on one photo (target 1.5 s) is measured with the command line's "
+                "start-up in [cli.md](cli.md).",
+            ]
         )
     else:
         lines += [

@@ -1,0 +1,37 @@
+"""The real-photo page's targets: known answers on made-up rows."""
+
+from __future__ import annotations
+
+from bench.photo_targets import target_rows
+from bench.real_photos import FROM_TRUTH, Row
+
+
+def _row(dataset, prior, mspd_px, visible=1.0, status="ok", seconds=0.5, width=640):
+    return Row(dataset, prior, "k", status, visible, mspd_px, 1.0, 1.0, 1.0, 100.0, seconds, width)
+
+
+def _cells(lines: list[str], target: str) -> list[str]:
+    (line,) = [x for x in lines if x.startswith(f"| {target}")]
+    return [c.strip() for c in line.strip("|").split("|")][1:]
+
+
+def test_each_target_beside_what_each_set_measured_and_whether_it_is_met_everywhere():
+    rows = [_row("lmo_dev", (10.0, 3.0), m) for m in (1.0, 2.0, 3.0, 4.0, 6.0)]  # 4 of 5 within 5 px: 80 %
+    rows += [_row("lmo_dev", (10.0, 3.0), 2.0, visible=0.6)]  # 50-70 % in sight: 1 of 1
+    rows += [_row("lmo_dev", (30.0, 10.0), 12.0, status="uncertain")]  # not counted as wrong: not `ok`
+    rows += [_row("lmo_dev", FROM_TRUTH, 30.0, seconds=9.0)]  # the truth itself: no target counts it
+    # HANDAL-like: 1920 px wide, 12 px there is 4 px at 640; a wrong `ok` of 40 px (13 at 640)
+    rows += [_row("handal_dev", (10.0, 3.0), 12.0, width=1920, seconds=3.0)]
+    rows += [_row("handal_dev", (30.0, 10.0), 40.0, width=1920, seconds=3.0)]
+    lines = target_rows(rows)
+    assert lines[0] == "| target | handal_dev | lmo_dev | met |"
+    assert _cells(lines, "within MSPD 5 px from 10 mm / 3 deg, 70 %") == ["100 % (1 of 1)", "80 % (4 of 5)", "no"]
+    assert _cells(lines, "within MSPD 5 px from 10 mm / 3 deg, 50-70 %") == ["-", "100 % (1 of 1)", "yes"]
+    assert _cells(lines, "within MSPD 5 px from 30 mm / 10 deg") == ["0 % (0 of 1)", "0 % (0 of 1)", "no"]
+    assert _cells(lines, "wrong `ok`") == ["1", "0", "no"]
+    # the median over lmo_dev's 640 px views from the priors (0.5 s), the truth's 9 s left out; HANDAL has none
+    assert _cells(lines, "a 640 x 480 view") == ["- (no 640 x 480 views)", "0.50 s", "yes"]
+
+
+def test_no_rows_no_table():
+    assert target_rows([]) == []
