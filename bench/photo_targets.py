@@ -14,14 +14,14 @@ VIEW_SECONDS = 1.0
 def _within_5(rows) -> str:
     if not rows:
         return "-"
-    within = sum(r.mspd_px * 640.0 / r.width < 5.0 for r in rows)
+    within = sum(r.mspd_640_px < 5.0 for r in rows)
     return f"{100 * within / len(rows):.0f} % ({within} of {len(rows)})"
 
 
 def _share_met(rows, least: float) -> bool | None:
     if not rows:
         return None
-    return sum(r.mspd_px * 640.0 / r.width < 5.0 for r in rows) >= least * len(rows)
+    return sum(r.mspd_640_px < 5.0 for r in rows) >= least * len(rows)
 
 
 def target_rows(rows) -> list[str]:
@@ -47,7 +47,7 @@ def target_rows(rows) -> list[str]:
     wrong = []
     for name in sets:
         counted = [r for r in rows if r.dataset == name and r.prior in PRIORS]
-        wrong.append(sum(r.status == "ok" and r.mspd_px * 640.0 / r.width > WRONG_OK_PX for r in counted))
+        wrong.append(sum(r.status == "ok" and r.mspd_640_px > WRONG_OK_PX for r in counted))
     checks.append(("wrong `ok` (over 10 px) from every prior: 0", [f"{w}" for w in wrong], [w == 0 for w in wrong]))
     seconds, met_time = [], []
     for name in sets:

@@ -67,6 +67,11 @@ class Row:
     apart_sigma_px: float | None = None
     """The two answers' stated 1-sigmas combined (the root of their squares' sum), px."""
 
+    @property
+    def mspd_640_px(self) -> float:
+        """The answer's MSPD at 640 px width (BOP's scale: a 1920 px photo's pixels count a third)."""
+        return self.mspd_px * 640.0 / self.width
+
 
 def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
     import cv2
@@ -232,7 +237,7 @@ def table(rows: list[Row]) -> list[str]:
                 rs = [r for r in rows if r.dataset == name and r.prior == prior and lo <= r.visible < hi]
                 if not rs:
                     continue
-                mspd_all = np.array([r.mspd_px * 640.0 / r.width for r in rs])
+                mspd_all = np.array([r.mspd_640_px for r in rs])
                 mssd_all = np.array([r.mssd_mm / r.diameter_mm for r in rs])
                 ok = np.array([r.status == "ok" for r in rs])
                 secs = np.array([r.seconds for r in rs])

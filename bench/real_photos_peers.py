@@ -167,7 +167,7 @@ def real_peer_rows(ours: list, root: Path, views_per_set: int, priors=((10.0, 3.
                     results.setdefault((prior, method), []).append((error, seconds))
         for prior in priors:
             mine = [r for r in ours if r.dataset == dataset.name and r.prior == prior]
-            measured = [("videocal locate", [(r.mspd_px * 640.0 / r.width, r.seconds) for r in mine])]
+            measured = [("videocal locate", [(r.mspd_640_px, r.seconds) for r in mine])]
             measured += [(m, rs) for (p, m), rs in results.items() if p == prior]
             for method, rs in measured:
                 if not rs:

@@ -44,9 +44,7 @@ def stated_sigma(rows: list[Row]) -> list[str]:
             if len(rs) < 5:
                 continue
             own = np.array([r.apart_px / max(r.apart_sigma_px, 1e-9) for r in rs])
-            annotation = np.array(
-                [r.mspd_px * 640.0 / r.width / max(r.points_sigma_px * 640.0 / r.width, 1e-9) for r in rs]
-            )
+            annotation = np.array([r.mspd_px / max(r.points_sigma_px, 1e-9) for r in rs])  # (both the image's px)
             out.append(
                 f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {len(rs)} | {np.median(own):.2f}, "
                 f"{np.percentile(own, 90):.2f} | {int((own > 3).sum())} | {np.median(annotation):.2f}, "

@@ -45,7 +45,7 @@ def pyramid(evidence: ImageEvidence, intrinsics: Intrinsics) -> list[tuple[Image
     levels = []
     level, camera = evidence, intrinsics
     while level.shape[1] // 2 >= COARSEST_WIDTH_PX or not levels:
-        level, camera = level.half(), camera.scaled(0.5)
+        level, camera = level.half_with(camera)
         levels.append((level, camera))
     return levels[::-1]
 

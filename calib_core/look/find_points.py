@@ -125,9 +125,7 @@ def find_points(
     if count:
         camera = intrinsics
         for _ in range(count):
-            evidence, camera = evidence.half(), camera.scaled(0.5)
-        # (the half leaves an odd last row or column out)
-        camera = replace(camera, width=evidence.shape[1], height=evidence.shape[0])
+            evidence, camera = evidence.half_with(camera)
         smaller = find_points(
             evidence,
             camera,

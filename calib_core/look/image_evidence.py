@@ -9,11 +9,13 @@ is made once per image and computes each on first use; every start, Find points 
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cached_property
 
 import cv2
 import numpy as np
 
+from calib_core.camera.intrinsics import Intrinsics
 from calib_core.look import colour_contrast
 
 COLOUR_LEVELS = 32
@@ -100,3 +102,10 @@ class ImageEvidence:
             even = self.image[: h - h % 2, : w - w % 2]
             self.__dict__["_half"] = ImageEvidence(cv2.resize(even, (w // 2, h // 2), interpolation=cv2.INTER_AREA))
         return self.__dict__["_half"]
+
+    def half_with(self, intrinsics: Intrinsics) -> tuple[ImageEvidence, Intrinsics]:
+        """:meth:`half` and its camera: ``intrinsics`` (this image's) scaled by a half, its width and height the
+        half's own (an odd last row or column is left out, where scaling the size would round it in)."""
+        half = self.half()
+        camera = intrinsics.scaled(0.5)
+        return half, replace(camera, width=half.shape[1], height=half.shape[0])

@@ -93,3 +93,12 @@ def test_the_coarse_fit_s_pyramid_halves_a_large_photo_twice_and_a_small_one_onc
             assert (scaled.width, scaled.height) == (level.shape[1], level.shape[0])
             assert scaled.fu == pytest.approx(1.2 * w * level.shape[1] / w)
             assert scaled.cx == pytest.approx((level.shape[1] - 1) / 2.0)
+
+
+def test_the_half_of_an_odd_sized_image_comes_with_a_camera_of_its_own_size():
+    camera = Intrinsics(fu=1000.0, fv=1000.0, cx=640.0, cy=480.0, width=1283, height=963)
+    half, half_camera = ImageEvidence(np.zeros((963, 1283, 3), np.uint8)).half_with(camera)
+    assert half.shape[:2] == (481, 641)
+    assert (camera.scaled(0.5).width, camera.scaled(0.5).height) == (642, 482)  # scaling the size rounds 641.5 up
+    assert (half_camera.width, half_camera.height) == (641, 481)
+    assert half_camera.fu == 500.0 and half_camera.cx == camera.scaled(0.5).cx
