@@ -26,8 +26,12 @@ class ImageEvidence:
     """One camera image (h, w) grey or (h, w, 3) RGB, uint8, and what is computed from it, each on first use.
 
     Pixels are the image's own (u right, v down, px); :meth:`half` is the image at half size, whose pixel (u, v) is
-    this image's (2u + 0.5, 2v + 0.5): use ``intrinsics.scaled(0.5)`` with it.
-    The image is not copied and must not change while the evidence is in use."""
+    this image's (2u + 0.5, 2v + 0.5): :meth:`half_with` gives it with its camera.
+    The image is not copied and must not change while the evidence is in use.
+
+    Its public members are the image (``source``, ``image``, ``shape``, ``colour``) and what a look reads from it, each
+    computed once (grey, the two gradients, the edges and their distance maps, the colour bins, the half with its
+    camera): one image's evidence, which every start of a look shares."""
 
     def __init__(self, image: np.ndarray):
         image = np.asarray(image)
