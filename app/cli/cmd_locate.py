@@ -2,10 +2,11 @@
 
 Runs Find points and the edge fit (:mod:`calib_core.look.locate`) on one photo of one object and prints the
 object's pose in the camera's frame with its 1-sigma as JSON (``R_obj2cam``, ``t_obj2cam_mm``, ``std``,
-``status``, the features found). ``--overlay OUT.png`` draws the located outline (green) and the prior's (red) on
-the photo. The prior is JSON: ``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as this command prints them, or
-``obj2cam`` (4 x 4, mm). ``--features`` is YAML: ``name: [x, y, z]`` in the mesh's units, corners of the object
-(default: the vertices of a mesh of at most 64, a box's eight).
+``status``, the features found; for an ``uncertain`` answer the ``rival`` pose that made it so). ``--overlay OUT.png``
+draws the located outline (green), the prior's (red) and the rival's (amber) on the photo. The prior is JSON:
+``R_obj2cam`` (3 x 3) and ``t_obj2cam_mm`` (3), as this command prints them, or ``obj2cam`` (4 x 4, mm).
+``--features`` is YAML: ``name: [x, y, z]`` in the mesh's units, corners of the object (default: the vertices of a
+mesh of at most 64, a box's eight).
 
 Several photos (frames of a recording, one look's photos) are located in one process, from the same prior: the
 libraries are loaded once (about 2 s), then each photo takes its own time. The output is then JSON Lines, one object
@@ -79,8 +80,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--overlay",
         type=Path,
-        help="write the photo with the located outline (green) and the prior's (red) to this PNG (several photos: a "
-        "folder of them)",
+        help="write the photo with the located outline (green), the prior's (red) and an uncertain answer's rival "
+        "(amber) to this PNG (several photos: a folder of them)",
     )
     parser.add_argument("--indent", type=int, default=2, help="JSON indentation (0 for one line)")
 
@@ -156,7 +157,7 @@ def run(args: argparse.Namespace) -> int:
         if not several:
             image, result = locator.locate(args.photo[0])
             if args.overlay:
-                _write_overlay(args.overlay, image, locator.intrinsics, locator.mesh, locator.prior, result)
+                locator.draw(args.overlay, image, result)
             json.dump(result.to_dict(), sys.stdout, indent=args.indent or None)
             sys.stdout.write("\n")
             return 0 if result.status == "ok" else EXIT_NOT_LOCATED
@@ -171,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
                 continue
             if args.overlay:
                 overlay = args.overlay / f"{photo.stem}.png"
-                _write_overlay(overlay, image, locator.intrinsics, locator.mesh, locator.prior, result)
+                locator.draw(overlay, image, result)
             _write_line({"photo": str(photo), **result.to_dict()})
             if result.status != "ok" and worst == 0:
                 worst = EXIT_NOT_LOCATED
@@ -248,6 +249,11 @@ class _Locator:
         item = SceneItem(self.args.mesh.stem, self.mesh, np.eye(4), color=(0.75, 0.75, 0.75))
         self._expected = self._view.of([item], np.eye(4))
 
+    def draw(self, path: Path, image: np.ndarray, result) -> None:
+        """The overlay of ``result`` on ``image`` written to ``path`` (:func:`_write_overlay`), a CAD part's creases
+        drawn (the part whose model's view was rendered), a scanned mesh's not."""
+        _write_overlay(path, image, self.intrinsics, self.mesh, self.prior, result, creases=self._expected is not None)
+
     def close(self) -> None:
         if self._view is not None:
             self._view.close()
@@ -272,19 +278,32 @@ def _write_line(document: dict) -> None:
     sys.stdout.flush()  # a line as each photo is done: progress for whoever reads the stream
 
 
-def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.ndarray, result) -> None:
+def _write_overlay(
+    path: Path, image: np.ndarray, intrinsics, mesh, prior: np.ndarray, result, *, creases: bool = True
+) -> None:
+    """The photo with the object's outline drawn at the prior (red), at the answer (green) and, for an ``uncertain``
+    answer, at the rival that made it so (amber), each with its creases when ``creases`` (a CAD part's: a scanned mesh's
+    facets meet at every angle, and its creases would be noise), and the features found (blue crosses)."""
     import cv2
 
     from calib_core.atomic_file import atomic_write_bytes
     from calib_core.camera.projection import project_points
+    from calib_core.look.outline import silhouette_mask
 
     out = cv2.cvtColor(image, cv2.COLOR_RGB2BGR) if image.ndim == 3 else cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
-    creases = mesh.face_adjacency_edges[mesh.face_adjacency_angles > np.radians(20)]
+    edges = mesh.face_adjacency_edges[mesh.face_adjacency_angles > np.radians(20)] if creases else np.zeros((0, 2), int)
     vertices = np.asarray(mesh.vertices, dtype=float)
-    for pose, colour in ((prior, (0, 0, 255)), (result.obj2cam, (0, 200, 0))):
-        if pose is None or len(creases) == 0:
+    drawn = [("prior", prior, (0, 0, 255)), ("answer", result.obj2cam, (0, 200, 0))]
+    if result.rival_obj2cam is not None:
+        drawn.append(("rival", result.rival_obj2cam, (0, 170, 255)))
+    for _, pose, colour in drawn:
+        if pose is None:
             continue
-        for a, b in project_points(vertices[creases.reshape(-1)], pose, intrinsics).reshape(-1, 2, 2):
+        mask, corner = silhouette_mask(mesh, pose, intrinsics)
+        if mask.size:
+            outline, _ = cv2.findContours(mask, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_SIMPLE, offset=corner)
+            cv2.polylines(out, outline, True, colour, 1, cv2.LINE_AA)
+        for a, b in project_points(vertices[edges.reshape(-1)], pose, intrinsics).reshape(-1, 2, 2):
             cv2.line(
                 out,
                 (int(round(a[0] * 4)), int(round(a[1] * 4))),
@@ -294,6 +313,11 @@ def _write_overlay(path: Path, image: np.ndarray, intrinsics, mesh, prior: np.nd
                 cv2.LINE_AA,
                 shift=2,
             )
+    # which colour is which, in the corner (white under black, readable on any photo)
+    for row, (name, pose, colour) in enumerate(d for d in drawn if d[1] is not None):
+        at = (8, 18 + 18 * row)
+        cv2.putText(out, name, at, cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
+        cv2.putText(out, name, at, cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, 1, cv2.LINE_AA)
     for f in result.features:
         cv2.drawMarker(out, (int(round(f.uv_px[0])), int(round(f.uv_px[1]))), (255, 200, 0), cv2.MARKER_CROSS, 9, 1)
     if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):

@@ -141,6 +141,7 @@ def verdict(fits: list[Located], mesh, intrinsics: Intrinsics, prior: np.ndarray
     return with_fields(
         located,
         status="uncertain",
+        rival_obj2cam=rival.obj2cam,
         message=f"uncertain: another start settled with the object {d:.1f} px away in the image (more than {bound:.1f} "
         "px), "
         f"{100 * (rival.edge_share or 0.0):.0f} % of its samples on their edges against this answer's "

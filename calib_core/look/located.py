@@ -52,6 +52,10 @@ class Located:
     points_sigma_px: float | None = None
     """How far the object's points may lie from where ``obj2cam`` puts them in the image, 1-sigma px (the largest over
     its vertices): what a pose error scored as BOP scores it (MSPD) would be."""
+    rival_obj2cam: np.ndarray | None = field(default=None, repr=False)
+    """(4, 4) mm: where the rival that made the answer ``uncertain`` puts the object (the furthest in the image of the
+    settled fits that hold about as many of their edges), else ``None``: the other explanation the photo holds, for
+    an operator to look at beside the answer."""
 
     def to_dict(self) -> dict:
         """The JSON form (mm, degrees): ``R_obj2cam``, ``t_obj2cam_mm``, ``std`` and the rest."""
@@ -93,6 +97,13 @@ class Located:
             "moved_from_prior": None
             if self.prior_moved_mm is None
             else {"mm": self.prior_moved_mm, "deg": self.prior_turned_deg},
+            "rival": None
+            if self.rival_obj2cam is None
+            else {
+                "R_obj2cam": matrix(self.rival_obj2cam[:3, :3]),
+                "t_obj2cam_mm": matrix(self.rival_obj2cam[:3, 3]),
+                "apart_px": self.extra.get("rival_apart_px"),
+            },
             "starts_apart_mm": self.extra.get("starts_apart_mm"),
             "starts_apart_px": self.extra.get("starts_apart_px"),
             "points_sigma_px": _finite(self.points_sigma_px),

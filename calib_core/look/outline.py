@@ -3,10 +3,9 @@
 A CAD part's outline runs along long crease edges, each of which holds many samples; a scanned object (a
 smooth mesh of 10-25 thousand facets, as BOP's and YCB's models are) has no crease, and its outline is made of
 facet edges a fraction of a pixel long, none long enough to hold a sample. Here the outline is taken from the
-object's own silhouette: the mesh's faces are filled into a mask at the pose, the mask's boundaries (its outer one
-and that of every hole through it: a can's handle, a turner's slots) are walked every few pixels, and each boundary
-sample takes the 3D point of the nearest rim edge (an edge between a face turned to the camera and one turned
-away). The image point is that 3D point's projection, so the sample
+object's own silhouette: the mesh's faces are filled into a mask at the pose, the mask's outer boundary is
+walked every few pixels, and each boundary sample takes the 3D point of the nearest rim edge (an edge between a
+face turned to the camera and one turned away). The image point is that 3D point's projection, so the sample
 sits on the geometric rim, not on the mask's pixel grid. A rim moves over a smooth surface as the pose changes:
 the samples are for the pose they were taken at, and a fit takes them again as it moves.
 """
@@ -29,9 +28,6 @@ _RIM_STEP_PX = 1.0
 _SMALL_FACE_PX2 = 2.0
 _MATCH_PX = 2.5
 _BORDER_PX = 3.0
-HOLE_MIN_PX2 = 25.0
-"""A hole through the silhouette (a can's handle, a turner's slots) is outline too from this area, px^2: a smaller one
-holds a handful of samples on a rim the photo barely resolves."""
 CHAIN_SAMPLES = 12
 """Consecutive outline samples taken as one edge chain (what the image does to a stretch of outline, its
 background and its shading, is shared by its neighbours): about 50 px of outline at the default step."""
@@ -237,11 +233,10 @@ def outline_samples(
     silhouette=None,
     rims: np.ndarray | None = None,
 ) -> Outline:
-    """Samples every ``step_px`` along the boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
-    mesh's frame to the camera's, mm), a hole's of :data:`HOLE_MIN_PX2` or more included, each on the rim edge
-    nearest its boundary pixel (within 2.5 px); none where the image's border cuts the silhouette (the border is not
-    the object's edge). ``silhouette``: the :func:`silhouette_mask` at that pose, and ``rims`` its rim edges
-    (E, 2, 3), when the caller has them."""
+    """Samples every ``step_px`` along the outer boundary of the mesh's silhouette at ``obj2cam`` (4, 4: the
+    mesh's frame to the camera's, mm), each on the rim edge nearest its boundary pixel (within 2.5 px); none
+    where the image's border cuts the silhouette (the border is not the object's edge). ``silhouette``: the
+    :func:`silhouette_mask` at that pose, and ``rims`` its rim edges (E, 2, 3), when the caller has them."""
     mask, (u0, v0) = silhouette_mask(mesh, obj2cam, intrinsics) if silhouette is None else silhouette
     if mask.size == 0 or not mask.any():
         return Outline.empty()
@@ -249,12 +244,12 @@ def outline_samples(
     if not len(rim):
         return Outline.empty()
     tree = cKDTree(rim_px)
-    contours, hierarchy = cv2.findContours(mask, cv2.RETR_CCOMP, cv2.CHAIN_APPROX_NONE)
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
     points, along, chain = [], [], []
     next_chain = 0
-    for contour, (_, _, _, parent) in zip(contours, hierarchy[0]):
+    for contour in contours:
         c = contour[:, 0, :].astype(float) + [u0, v0]
-        if len(c) < 8 or (parent >= 0 and cv2.contourArea(contour) < HOLE_MIN_PX2):
+        if len(c) < 8:
             continue
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
         picks = np.searchsorted(arc, np.arange(0.0, arc[-1], step_px))

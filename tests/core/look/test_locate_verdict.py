@@ -102,3 +102,10 @@ def test_a_rival_a_few_pixels_away_is_said_to_be_the_outline_s_looseness_a_far_o
         assert result.status == "uncertain"
         words = "an inner, printed or neighbouring edge" if reason == "another edge" else reason
         assert words in result.message, result.message
+        # the rival is given with the answer, in the JSON too, with how far apart it lies in the image
+        np.testing.assert_array_equal(result.rival_obj2cam, other)
+        said = result.to_dict()["rival"]
+        np.testing.assert_allclose(said["t_obj2cam_mm"], other[:3, 3])
+        assert said["apart_px"] > across_mm * 600.0 / 900.0 * 0.9
+    alone = verdict([fit(answer, 1.0), fit(answer.copy(), 0.99)], box, camera, answer)
+    assert alone.rival_obj2cam is None and alone.to_dict()["rival"] is None
