@@ -12,12 +12,12 @@ from bench.real_photos import FROM_TRUTH, PRIORS, WRONG_OK_PX, Row
 
 def with_start_agreement(view_rows: list[Row], answers: dict, points, symmetries, view) -> list[Row]:
     """One view's rows, each ``ok`` answer from a prior other than the truth with how far it lies from the ``ok``
-    answer started at the truth (``answers``: prior -> obj2cam) and the two stated 1-sigmas combined."""
+    answer started at the truth (``answers``: :attr:`Row.run` -> obj2cam) and the two stated 1-sigmas combined."""
     from dataclasses import replace
 
     from calib_core.datasets.pose_errors import mspd
 
-    (at_truth,) = [r for r in view_rows if r.prior == FROM_TRUTH]
+    (at_truth,) = [r for r in view_rows if r.at_truth]
     if at_truth.status != "ok" or at_truth.points_sigma_px is None:
         return view_rows
     out = []
@@ -25,7 +25,7 @@ def with_start_agreement(view_rows: list[Row], answers: dict, points, symmetries
         if r.prior != FROM_TRUTH and r.status == "ok" and r.points_sigma_px is not None:
             r = replace(
                 r,
-                apart_px=mspd(answers[r.prior], answers[FROM_TRUTH], points, symmetries, view.intrinsics),
+                apart_px=mspd(answers[r.run], answers[at_truth.run], points, symmetries, view.intrinsics),
                 apart_sigma_px=float(np.hypot(r.points_sigma_px, at_truth.points_sigma_px)),
             )
         out.append(r)
@@ -68,7 +68,7 @@ def annotation_offset(rows: list[Row]) -> list[str]:
     look's scatter."""
     out = []
     for name in sorted({r.dataset for r in rows}):
-        rs = [r for r in rows if r.dataset == name and r.prior == FROM_TRUTH and r.status == "ok" and r.centre_moved_px]
+        rs = [r for r in rows if r.dataset == name and r.at_truth and r.status == "ok" and r.centre_moved_px]
         if len(rs) < 8:
             continue
         moved = np.array([r.centre_moved_px for r in rs])

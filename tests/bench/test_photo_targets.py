@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from bench.photo_targets import target_rows
-from bench.real_photos import FROM_TRUTH, Row
+from bench.real_photos import FROM_TRUTH, ROBOTS_REACH, Row
 
 
-def _row(dataset, prior, mspd_px, visible=1.0, status="ok", seconds=0.5, width=640):
-    return Row(dataset, prior, "k", status, visible, mspd_px, 1.0, 1.0, 1.0, 100.0, seconds, width)
+def _row(dataset, prior, mspd_px, visible=1.0, status="ok", seconds=0.5, width=640, reach=None):
+    return Row(dataset, prior, "k", status, visible, mspd_px, 1.0, 1.0, 1.0, 100.0, seconds, width, reach=reach)
 
 
 def _cells(lines: list[str], target: str) -> list[str]:
@@ -31,6 +31,21 @@ def test_each_target_beside_what_each_set_measured_and_whether_it_is_met_everywh
     assert _cells(lines, "wrong `ok`") == ["1", "0", "no"]
     # the median over lmo_dev's 640 px views from the priors (0.5 s), the truth's 9 s left out; HANDAL has none
     assert _cells(lines, "a 640 x 480 view") == ["- (no 640 x 480 views)", "0.50 s", "yes"]
+    assert not any("a bound" in line for line in lines)  # no run from the truth with a robot's reach: no bound said
+
+
+def test_the_first_target_s_bound_is_said_from_the_truth_searched_as_far_as_a_robot_s_error():
+    """The look started at the truth itself and searching 10 mm / 3 deg: its share within 5 px (70 % or more in sight)
+    beside the target's, counted in no target (its 9 s and its 30 px answer neither)."""
+    rows = [_row("lmo_dev", (10.0, 3.0), m) for m in (1.0, 2.0, 6.0, 7.0)]
+    rows += [_row("lmo_dev", FROM_TRUTH, m, reach=ROBOTS_REACH, seconds=9.0) for m in (1.0, 2.0, 3.0, 30.0)]
+    rows += [_row("lmo_dev", FROM_TRUTH, 1.0, reach=ROBOTS_REACH, visible=0.6)]  # under 70 % in sight: left out
+    rows += [_row("lmo_dev", FROM_TRUTH, 30.0)]  # from the truth with the checks' reach: not the bound
+    lines = target_rows(rows)
+    assert _cells(lines, "within MSPD 5 px from 10 mm / 3 deg, 70 %") == ["50 % (2 of 4)", "no"]
+    assert _cells(lines, "(a bound, not a target)") == ["75 % (3 of 4)", "-"]
+    assert _cells(lines, "wrong `ok`") == ["0", "yes"]
+    assert _cells(lines, "a 640 x 480 view") == ["0.50 s", "yes"]
 
 
 def test_no_rows_no_table():

@@ -7,12 +7,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from bench.real_photos import FROM_TRUTH, RUNS, Row
+from bench.real_photos import FROM_TRUTH, RUNS, TRUTH_REACH, Row
 from bench.truth_checks import stated_sigma, with_start_agreement
 from calib_core.camera.intrinsics import Intrinsics
 
 
-def _row(prior, status="ok", mspd_px=4.0, sigma=2.0, apart=None, apart_sigma=None, width=640):
+def _row(prior, status="ok", mspd_px=4.0, sigma=2.0, apart=None, apart_sigma=None, width=640, reach=None):
     return Row(
         "lmo_dev",
         prior,
@@ -29,6 +29,7 @@ def _row(prior, status="ok", mspd_px=4.0, sigma=2.0, apart=None, apart_sigma=Non
         points_sigma_px=sigma,
         apart_px=apart,
         apart_sigma_px=apart_sigma,
+        reach=reach,
     )
 
 
@@ -53,20 +54,24 @@ def test_a_photo_twice_as_wide_gives_the_same_ratios():
 
 
 def test_each_answer_is_measured_from_the_answer_started_at_the_truth():
+    """Known answers: each run's answer 1 mm further right at 600 mm (1 px a mm); every ``ok`` answer from a prior off
+    the truth is measured from the one started at the truth searching :data:`TRUTH_REACH`, not from the one searching a
+    robot's reach, and neither of those from itself."""
     camera = Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480)
     points = np.array([[0.0, 0.0, 0.0], [30.0, 0.0, 0.0], [0.0, 30.0, 0.0]])
     at = {}
-    for prior, x in zip(RUNS, (0.0, 1.0, 2.0, 3.0)):  # each answer 1 mm further right at 600 mm: 1 px a mm
+    for (prior, reach), x in zip(RUNS, (0.0, 1.0, 2.0, 3.0, 4.0)):
         pose = np.eye(4)
         pose[:3, 3] = [x, 0.0, 600.0]
-        at[prior] = pose
-    rows = [_row(prior, sigma=1.5 if prior == FROM_TRUTH else 2.0) for prior in RUNS]
-    rows[1] = _row(RUNS[1], status="uncertain")
+        at[(prior, reach)] = pose
+    assert RUNS[3] == (FROM_TRUTH, TRUTH_REACH)
+    rows = [_row(prior, sigma=1.5 if prior == FROM_TRUTH else 2.0, reach=reach) for prior, reach in RUNS]
+    rows[1] = _row(RUNS[1][0], status="uncertain")
     view = SimpleNamespace(intrinsics=camera)
     out = with_start_agreement(rows, at, points, np.eye(4)[None], view)
     assert out[0].apart_px == pytest.approx(3.0) and out[0].apart_sigma_px == pytest.approx(2.5)
     assert out[1].apart_px is None  # not ok
     assert out[2].apart_px == pytest.approx(1.0)
-    assert out[3].apart_px is None  # the answer started at the truth itself
-    rows[3] = _row(FROM_TRUTH, status="not found")
+    assert out[3].apart_px is None and out[4].apart_px is None  # the answers started at the truth itself
+    rows[3] = _row(FROM_TRUTH, status="not found", reach=TRUTH_REACH)
     assert all(r.apart_px is None for r in with_start_agreement(rows, at, points, np.eye(4)[None], view))
