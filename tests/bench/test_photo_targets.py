@@ -43,7 +43,11 @@ def test_the_first_target_s_bound_is_said_from_the_truth_searched_as_far_as_a_ro
     rows += [_row("lmo_dev", FROM_TRUTH, 30.0)]  # from the truth with the checks' reach: not the bound
     lines = target_rows(rows)
     assert _cells(lines, "within MSPD 5 px from 10 mm / 3 deg, 70 %") == ["50 % (2 of 4)", "no"]
-    assert _cells(lines, "(a bound, not a target)") == ["75 % (3 of 4)", "-"]
+    assert _cells(lines, "(a bound, not a target) within MSPD 5 px started at the truth itself, searching 10 mm") == [
+        "75 % (3 of 4)",
+        "-",
+    ]
+    assert not any("searching 30 mm" in line for line in lines)  # not run: not said
     assert _cells(lines, "wrong `ok`") == ["0", "yes"]
     assert _cells(lines, "a 640 x 480 view") == ["0.50 s", "yes"]
 
