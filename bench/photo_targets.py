@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.real_photos import BOUND_REACHES, FROM_TRUTH, PRIORS, WRONG_OK_PX
+from bench.photo_runs import BOUND_REACHES, FROM_TRUTH, PRIORS, WRONG_OK_PX
 
 VIEW_SECONDS = 1.0
 """The most a 640 x 480 view may take (median, one process)."""
@@ -25,7 +25,7 @@ def _share_met(rows, least: float) -> bool | None:
 
 
 def target_rows(rows) -> list[str]:
-    """A table of the targets (``rows``: the bench's :class:`~bench.real_photos.Row`; the runs from the truth itself
+    """A table of the targets (``rows``: the bench's :class:`~bench.photo_runs.Row`; the runs from the truth itself
     count for none), one column a data set, and whether each is met everywhere it was measured."""
     sets = sorted({r.dataset for r in rows})
     if not sets:

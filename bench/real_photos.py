@@ -19,86 +19,15 @@ import platform
 import resource
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from bench.photo_runs import FROM_TRUTH, RUNS, VISIBLE_BINS, WRONG_OK_PX, Row
 from bench.real_views import chosen_views, datasets_root, found_datasets, view_prior
 
 PROJECT = Path(__file__).resolve().parent.parent
 OUT = PROJECT / "docs" / "benchmarks" / "real_photos.md"
-PRIORS = ((5.0, 1.0), (10.0, 3.0), (30.0, 10.0))
-FROM_TRUTH = (0.0, 0.0)
-"""The annotation itself as the prior: where the look ends when it starts at the truth says how far the image's edges,
-the scanned mesh and the annotation agree, a bound on every row above."""
-TRUTH_REACH = (5.0, 1.0)
-"""How far the look searches round the truth (mm, deg) for the checks of what the truth is worth
-(:mod:`bench.truth_checks`): a prior held that tightly pulls the fit towards the annotation."""
-ROBOTS_REACH = (10.0, 3.0)
-"""A robot's error (mm, deg)."""
-BOUND_REACHES = (ROBOTS_REACH, (30.0, 10.0))
-"""The truth also searched as far as these priors are off (mm, deg), its prior held as loosely as theirs, so that where
-it ends is what the photo says round the annotation, beside where the look ends from that far off: the same share
-within 5 px from both says the search is not what a miss lacks."""
-RUNS = (
-    tuple((prior, prior) for prior in PRIORS)
-    + ((FROM_TRUTH, TRUTH_REACH),)
-    + tuple((FROM_TRUTH, reach) for reach in BOUND_REACHES)
-)
-"""(prior's offset from the truth, reach searched), each (mm, deg)."""
-VISIBLE_BINS = ((0.5, 0.7), (0.7, 0.9), (0.9, 1.01))
-WRONG_OK_PX = 10.0
-"""An answer called ``ok`` further than this from the truth (MSPD at 640 px width) is a wrong ``ok``."""
-
-
-@dataclass
-class Row:
-    dataset: str
-    prior: tuple[float, float]
-    key: str
-    status: str
-    visible: float
-    mspd_px: float
-    mssd_mm: float
-    t_mm: float
-    r_deg: float
-    diameter_mm: float
-    seconds: float
-    width: int
-    centre_px: tuple[float, float] | None = None
-    """Where the truth puts the object's centre in the image (px)."""
-    centre_moved_px: tuple[float, float] | None = None
-    """The answer's image of the object's centre less the truth's (px), when there is an answer."""
-    colours_at: tuple[float | None, float | None] | None = None
-    """How well the mesh's own colours agree with the photo at the answer and at the truth
-    (:func:`bench.colour_agreement.colour_agreement`), when there is an answer."""
-    points_sigma_px: float | None = None
-    """The answer's stated 1-sigma of the object's points in the image (px, the image's own)."""
-    apart_px: float | None = None
-    """MSPD (px, the image's own) between this answer and the one the look gave started at the truth itself, both
-    ``ok``: two of the look's own answers, no annotation in between."""
-    apart_sigma_px: float | None = None
-    """The two answers' stated 1-sigmas combined (the root of their squares' sum), px."""
-    reach: tuple[float, float] | None = None
-    """How far the look searched (mm, deg); ``None``: as far as the prior is off (the truth: :data:`TRUTH_REACH`)."""
-
-    @property
-    def run(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        """(prior, reach), as in :data:`RUNS`."""
-        if self.reach is not None:
-            return self.prior, self.reach
-        return self.prior, TRUTH_REACH if self.prior == FROM_TRUTH else self.prior
-
-    @property
-    def at_truth(self) -> bool:
-        """Started at the truth, searching :data:`TRUTH_REACH` round it (what the truth checks compare with)."""
-        return self.run == (FROM_TRUTH, TRUTH_REACH)
-
-    @property
-    def mspd_640_px(self) -> float:
-        """The answer's MSPD at 640 px width (BOP's scale: a 1920 px photo's pixels count a third)."""
-        return self.mspd_px * 640.0 / self.width
 
 
 def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
@@ -191,63 +120,6 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[str]]:
                 flush=True,
             )
     return rows, sets
-
-
-OVERLAID = ("lmo_dev/test/000002/000178/2", "lmo_dev/test/000002/000365/0")
-"""Views whose truth and answer are drawn on the photo for the page (an ok answer scored 9 and 16 px off)."""
-
-
-def truth_overlays(root: Path) -> list[str]:
-    """The outline at the truth (green) and at ``locate``'s answer from 10 mm / 3 deg off (red) on the photo, cropped
-    and enlarged four times, for each of :data:`OVERLAID` found; the page's lines that show them."""
-    import cv2
-
-    from calib_core.camera.projection import project_points
-    from calib_core.datasets.bop import BopDataset
-    from calib_core.mesh_files import load_mesh
-    from calib_core.look.locate import locate
-    from calib_core.look.outline import outline_samples
-
-    folder = root / "lmo_dev"
-    if not (folder / "test").is_dir():
-        return ["(lmo_dev not found: no overlay drawn)"]
-    dataset = BopDataset(folder, "test")
-    out = [
-        "LM-O's truth comes from the Kinect's depth images, registered to its colour camera: in the colour photo it "
-        "can lie several pixels off the object as seen. Green: the object's outline at the truth; red: at the answer "
-        "`locate` called `ok` from 10 mm / 3 deg off. Where the red follows the object and the green does not, an "
-        "answer scored 5-16 px off is the annotation's error as much as the look's: the within-5-px figures above are "
-        "bounded by it.",
-        "",
-    ]
-    wanted = {key: None for key in OVERLAID}
-    for view in dataset.views(min_visible=0.5):
-        if view.key in wanted:
-            wanted[view.key] = view
-    for key, view in wanted.items():
-        if view is None:
-            continue
-        mesh = load_mesh(dataset.models()[view.obj_id].path)
-        image = cv2.imread(str(view.image_path))
-        prior = view_prior(view, 10.0, 3.0)
-        located = locate(
-            np.ascontiguousarray(image[:, :, ::-1]), view.intrinsics, mesh, prior, reach_mm=10, reach_deg=3, features={}
-        )
-        drawn = image.copy()
-        for pose, colour in ((view.obj2cam, (0, 200, 0)), (located.obj2cam, (0, 0, 255))):
-            if pose is None:
-                continue
-            outline = outline_samples(mesh, pose, view.intrinsics, 1.0)
-            for u, v in project_points(outline.points_mm, pose, view.intrinsics):
-                cv2.circle(drawn, (int(round(u)), int(round(v))), 0, colour, -1)
-        uv = project_points(np.asarray(mesh.vertices), view.obj2cam, view.intrinsics)
-        lo = np.maximum(uv.min(axis=0).astype(int) - 15, 0)
-        hi = uv.max(axis=0).astype(int) + 15
-        crop = cv2.resize(drawn[lo[1] : hi[1], lo[0] : hi[0]], None, fx=4, fy=4, interpolation=cv2.INTER_NEAREST)
-        name = "real_photo_truth_" + key.replace("/", "_") + ".png"
-        cv2.imwrite(str(OUT.parent / "images" / name), crop)
-        out += [f"![{key}, `{located.status}`](images/{name})", ""]
-    return out
 
 
 def table(rows: list[Row]) -> list[str]:
@@ -395,7 +267,9 @@ def main(argv: list[str] | None = None) -> str:
             *colours,
             "",
         ]
-    lines += truth_overlays(root)
+    from bench.truth_overlays import truth_overlays
+
+    lines += truth_overlays(root, OUT.parent / "images")
     lines += [
         "",
         "## Where the data comes from",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.real_photos import FROM_TRUTH, PRIORS, WRONG_OK_PX, Row
+from bench.photo_runs import FROM_TRUTH, PRIORS, WRONG_OK_PX, Row
 
 
 def with_start_agreement(view_rows: list[Row], answers: dict, points, symmetries, view) -> list[Row]:

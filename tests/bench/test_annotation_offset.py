@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bench.real_photos import FROM_TRUTH, Row
+from bench.photo_runs import FROM_TRUTH, Row
 from bench.truth_checks import annotation_offset
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from bench.colour_agreement import colour_agreement, seen_inside, vertex_grey
-from bench.real_photos import Row
+from bench.photo_runs import Row
 from bench.truth_checks import colour_evidence
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.mesh_files import load_mesh

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from bench.photo_targets import target_rows
-from bench.real_photos import FROM_TRUTH, ROBOTS_REACH, Row
+from bench.photo_runs import FROM_TRUTH, ROBOTS_REACH, Row
 
 
 def _row(dataset, prior, mspd_px, visible=1.0, status="ok", seconds=0.5, width=640, reach=None):

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from bench.real_photos import FROM_TRUTH, RUNS, TRUTH_REACH, Row
+from bench.photo_runs import FROM_TRUTH, RUNS, TRUTH_REACH, Row
 from bench.truth_checks import stated_sigma, with_start_agreement
 from calib_core.camera.intrinsics import Intrinsics
 
