@@ -51,6 +51,9 @@ _SIGMA_PX = 0.5
 # starts tried at most: on one frame of the demo the right one ranked fourth, the first three settling 1.6-1.9 mm off at
 # 55 %
 _STARTS = 8
+OBJECT_TURN_SHARE = 0.5
+"""With a prior (a look on a photo), the ranked starts also turn the object this share of the reach's angle each way
+across the line of sight (HANDAL's tools from 30 mm / 10 deg off, three seeds of priors: within 5 px 7 -> 13 of 30)."""
 _REUSE_PX = 0.25  # the second pass's view serves the detectors when its fit moved the target less than this
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put a feature further apart
@@ -186,6 +189,10 @@ def find_points(
                     reach_mm,
                     reach_deg,
                     keep=_STARTS,
+                    # a photo's prior is an error of the object itself, moved and turned about its own origin
+                    # (PosePrior): close up or long, a turn of the object changes its outline's shape, which no move
+                    # or turn of the camera in the grid makes (decision 158)
+                    object_turn_deg=0.0 if prior is None else OBJECT_TURN_SHARE * reach_deg,
                 )
             )
         return ranking

@@ -59,6 +59,26 @@ def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndar
     return concat(obj2cam, moved)
 
 
+def object_turned(
+    poses: np.ndarray, grid: np.ndarray, centre_mm: np.ndarray, turn_deg: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each of ``poses`` (H, 4, 4, obj2cam) with the object turned by -``turn_deg``, 0 and +``turn_deg`` about the
+    camera's x and y axes through ``centre_mm`` (3,, the object's frame), which stays where it was: (9 H, 4, 4), and
+    ``grid`` (H, k) with the two turns (deg) as two more columns (9 H, k + 2), the unturned ones first."""
+    centre = np.einsum("hij,j->hi", poses[:, :3, :3], centre_mm) + poses[:, :3, 3]  # (in the camera's frame)
+    steps = (0.0, -turn_deg, turn_deg)
+    out_poses, out_grid = [], []
+    for a in steps:
+        for b in steps:
+            turn = Rotation.from_rotvec(np.radians([a, b, 0.0])).as_matrix()
+            turned = poses.copy()
+            turned[:, :3, :3] = np.matmul(turn, poses[:, :3, :3])
+            turned[:, :3, 3] = centre - np.einsum("hij,j->hi", turned[:, :3, :3], centre_mm)
+            out_poses.append(turned)
+            out_grid.append(np.column_stack([grid, np.full(len(grid), a), np.full(len(grid), b)]))
+    return np.concatenate(out_poses), np.concatenate(out_grid)
+
+
 def _scores(padded_flat: np.ndarray, base: np.ndarray, offsets_flat: np.ndarray) -> np.ndarray:
     """Mean truncated distance (H, S) of the samples at the flat indices ``base`` (H, m) of the padded
     distance map, each moved by every flat offset ``offsets_flat`` (S,) (a move of (du, dv) whole
@@ -74,6 +94,7 @@ def rank_starts(
     reach_mm: float,
     reach_deg: float,
     keep: int = 3,
+    object_turn_deg: float = 0.0,
 ) -> list[np.ndarray]:
     """The ``keep`` best poses (4, 4) to start an edge refinement from, best first, near ``obj2cam``.
 
@@ -81,7 +102,10 @@ def rank_starts(
     :data:`TRUNCATE_PX` (:func:`calib_core.look.edge_alignment.edge_distance_map`);
     ``samples_mm`` (m, 3): points on the target's edges that the camera sees (object frame);
     ``reach_mm``, ``reach_deg``: how far the camera's centre and its line of sight may be from
-    ``obj2cam``'s. Candidates whose edges lie within a few pixels of a better one's are left out.
+    ``obj2cam``'s. ``object_turn_deg``: every candidate also with the object turned this far each way about the two
+    axes across the line of sight through its samples' centre (nine times the candidates), for a prior that is an
+    error of the object itself (:func:`object_turned`). Candidates whose edges lie within a few pixels of a better
+    one's are left out.
     """
     if len(samples_mm) < 10:
         return [obj2cam]
@@ -92,23 +116,29 @@ def rank_starts(
     rolls = np.linspace(-ROLL_DEG, ROLL_DEG, _ROLL_STEPS)
     grid = np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
     poses = moved_cameras(obj2cam, grid[:, :3], grid[:, 3])
-    # (a batched matmul: einsum's generic loop took 30 ms for a thousand poses of 400 samples)
-    pts = np.matmul(samples_mm, poses[:, :3, :3].transpose(0, 2, 1)) + poses[:, None, :3, 3]
-    uv = project(pts.reshape(-1, 3), intrinsics).reshape(len(grid), -1, 2)
+    if object_turn_deg > 0.0:
+        poses, grid = object_turned(poses, grid, samples_mm.mean(axis=0), object_turn_deg)
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
     offsets = np.rint(
         np.stack(np.meshgrid(t, t, indexing="xy"), axis=-1).reshape(-1, 2)
     )  # whole pixels: a chamfer ranking needs no finer
-    # whole pixels; anything outside the image (or behind the camera: NaN) clipped to just outside it,
-    # where the padding (wider than any offset) holds the cap
     h, w = distance.shape
     pad = int(np.abs(offsets).max()) + 2
     padded = np.pad(np.asarray(distance, dtype=np.float32), pad, constant_values=TRUNCATE_PX)
-    uv_px = np.rint(np.nan_to_num(uv, nan=-1e6).clip(-1e6, 1e6)).astype(np.int64)
-    u = np.clip(uv_px[..., 0], -1, w) + pad
-    v = np.clip(uv_px[..., 1], -1, h) + pad
-    base = v * padded.shape[1] + u  # (H, m)
+    # Where each candidate puts the samples (H, m, 2) and their flat indices in the padded map (H, m): whole pixels,
+    # anything outside the image (or behind the camera: NaN) clipped to just outside it, where the padding (wider
+    # than any offset) holds the cap. A few thousand candidates at a time (with the object's turns, nine times as
+    # many: their points and pixels whole took some 220 MB); a batched matmul (einsum's generic loop took
+    # 30 ms for a thousand poses of 400 samples).
+    uv = np.empty((len(poses), len(samples_mm), 2))
+    base = np.empty((len(poses), len(samples_mm)), np.int64)
+    for chunk in np.array_split(np.arange(len(poses)), max(1, len(poses) // 2048)):
+        pts = np.matmul(samples_mm, poses[chunk, :3, :3].transpose(0, 2, 1)) + poses[chunk, None, :3, 3]
+        seen = project(pts.reshape(-1, 3), intrinsics).reshape(len(chunk), -1, 2)
+        uv[chunk] = seen
+        px = np.rint(np.nan_to_num(seen, nan=-1e6).clip(-1e6, 1e6)).astype(np.int64)
+        base[chunk] = (np.clip(px[..., 1], -1, h) + pad) * padded.shape[1] + np.clip(px[..., 0], -1, w) + pad
     offsets_flat = (offsets[:, 1] * padded.shape[1] + offsets[:, 0]).astype(np.int64)
     flat = padded.ravel()
     # every candidate on a third of the samples, the best few hundred again on all of them (the coarse

@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.look.edge_alignment import edge_distance_map
-from calib_core.look.pose_hypotheses import TRUNCATE_PX, moved_cameras, rank_starts, turned_camera
+from calib_core.look.pose_hypotheses import TRUNCATE_PX, moved_cameras, object_turned, rank_starts, turned_camera
 
 INTRINSICS = Intrinsics(fu=1120.0, fv=1116.0, cx=640.0, cy=480.0, width=1280, height=960)
 
@@ -96,3 +96,47 @@ def test_the_best_start_is_near_the_true_pose_where_a_two_d_shift_is_not():
             )
             > 5.0
         )
+
+
+def test_an_object_turned_keeps_its_centre_and_turns_about_the_camera_s_axes_across_the_line_of_sight():
+    poses = np.stack([_pose([10, -20, 5], [15, -8, 300]), _pose([0, 30, 0], [-40, 5, 650])])
+    grid = np.array([[1.0, 2.0, 3.0, 0.5], [0.0, 0.0, 0.0, 0.0]])
+    centre = np.array([12.0, -4.0, 30.0])
+    turned, turned_grid = object_turned(poses, grid, centre, 4.0)
+    assert turned.shape == (18, 4, 4) and turned_grid.shape == (18, 6)
+    assert np.array_equal(turned[:2], poses) and np.array_equal(turned_grid[:2, :4], grid)  # the unturned first
+    for k, (T, row) in enumerate(zip(turned, turned_grid)):
+        P = poses[k % 2]
+        # the centre stays where the camera saw it
+        assert np.allclose(T[:3, :3] @ centre + T[:3, 3], P[:3, :3] @ centre + P[:3, 3], atol=1e-9)
+        # the turn, in the camera's frame, is the grid's two angles about its x and y axes
+        turn = Rotation.from_matrix(T[:3, :3] @ P[:3, :3].T).as_rotvec()
+        assert np.allclose(np.degrees(turn), [row[4], row[5], 0.0], atol=1e-9)
+        assert np.array_equal(row[:4], grid[k % 2])
+    assert sorted({(a, b) for a, b in turned_grid[:, 4:]}) == [(a, b) for a in (-4, 0, 4) for b in (-4, 0, 4)]
+
+
+def test_with_the_object_s_turn_searched_a_long_part_turned_from_its_prior_gets_a_start_near_it():
+    """A tool-like bar 240 mm long, pointing 55 deg away from the camera 350 mm off, its prior turned 6 deg about an
+    axis across the line of sight through its centre (an error of the object itself, as a photo's prior is): its
+    edges lie some 26 px off, and no start of the camera's grid (its centre moved up to 10 mm, its line of sight
+    turned up to 10 deg) lays them on the image: a turn of the object changes its outline's shape. Searched, the
+    object's own turn does."""
+    mesh = trimesh.creation.box(extents=[240.0, 24.0, 16.0])
+    truth = _pose([0, 55, 10], [10, 0, 350.0])
+    model = truth.copy()
+    model[:3, :3] = Rotation.from_rotvec(np.radians([0.0, 6.0, 0.0])).as_matrix() @ truth[:3, :3]  # about its centre
+    distance = edge_distance_map(_edge_image(mesh, truth), TRUNCATE_PX)
+    samples = np.concatenate(
+        [a + (b - a) * np.linspace(0.05, 0.95, 12)[:, None] for a, b in mesh.vertices[mesh.edges_unique]]
+    )
+
+    def miss_px(pose):
+        seen = project_points(samples, pose, INTRINSICS) - project_points(samples, truth, INTRINSICS)
+        return float(np.mean(np.linalg.norm(seen, axis=1)))
+
+    assert miss_px(model) > 20.0
+    camera_only = rank_starts(distance, INTRINSICS, samples, model, reach_mm=10.0, reach_deg=10.0)
+    with_turns = rank_starts(distance, INTRINSICS, samples, model, reach_mm=10.0, reach_deg=10.0, object_turn_deg=5.0)
+    assert min(miss_px(s) for s in camera_only) > 15.0
+    assert miss_px(with_turns[0]) < 4.0, [miss_px(s) for s in with_turns]
