@@ -59,6 +59,16 @@ def moved_cameras(obj2cam: np.ndarray, shifts_mm: np.ndarray, rolls_deg: np.ndar
     return concat(obj2cam, moved)
 
 
+def turn_moves_px(samples_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Intrinsics, turn_deg: float) -> float:
+    """How far (px) the farthest-moved of ``samples_mm`` (m, 3, the object's frame) moves in the image at ``obj2cam``
+    when the object turns ``turn_deg`` each way about the camera's x and y axes through the samples' centre (as
+    :func:`object_turned` turns it): a part seen face on and far off hardly moves, a long one pointing away swings."""
+    turned, _ = object_turned(obj2cam[None], np.zeros((1, 0)), samples_mm.mean(axis=0), turn_deg)
+    seen = np.array([project(samples_mm @ T[:3, :3].T + T[:3, 3], intrinsics) for T in turned])  # (9, m, 2)
+    moved = np.linalg.norm(seen[1:] - seen[0], axis=2)
+    return float(np.nanmax(moved)) if np.isfinite(moved).any() else 0.0
+
+
 def object_turned(
     poses: np.ndarray, grid: np.ndarray, centre_mm: np.ndarray, turn_deg: float
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -104,8 +114,9 @@ def rank_starts(
     ``reach_mm``, ``reach_deg``: how far the camera's centre and its line of sight may be from
     ``obj2cam``'s. ``object_turn_deg``: every candidate also with the object turned this far each way about the two
     axes across the line of sight through its samples' centre (nine times the candidates), for a prior that is an
-    error of the object itself (:func:`object_turned`). Candidates whose edges lie within a few pixels of a better
-    one's are left out.
+    error of the object itself (:func:`object_turned`), where such a turn moves its samples further in the image
+    than candidates are told apart by (:func:`turn_moves_px`). Candidates whose edges lie within a few pixels of a
+    better one's are left out.
     """
     if len(samples_mm) < 10:
         return [obj2cam]
@@ -116,8 +127,10 @@ def rank_starts(
     rolls = np.linspace(-ROLL_DEG, ROLL_DEG, _ROLL_STEPS)
     grid = np.array([(x, y, z, r) for x in lateral for y in lateral for z in depth for r in rolls])
     poses = moved_cameras(obj2cam, grid[:, :3], grid[:, 3])
-    if object_turn_deg > 0.0:
-        poses, grid = object_turned(poses, grid, samples_mm.mean(axis=0), object_turn_deg)
+    centre = samples_mm.mean(axis=0)
+    if object_turn_deg > 0.0 and turn_moves_px(samples_mm, obj2cam, intrinsics, object_turn_deg) > _DISTINCT_PX:
+        # (a turn that moves no sample further than candidates are told apart by adds none: a small part far off)
+        poses, grid = object_turned(poses, grid, centre, object_turn_deg)
     turn_px = max(intrinsics.fu, intrinsics.fv) * np.radians(reach_deg)
     t = np.linspace(-turn_px, turn_px, _TURN_STEPS)
     offsets = np.rint(

@@ -5,13 +5,21 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.look.edge_alignment import edge_distance_map
-from calib_core.look.pose_hypotheses import TRUNCATE_PX, moved_cameras, object_turned, rank_starts, turned_camera
+from calib_core.look.pose_hypotheses import (
+    TRUNCATE_PX,
+    moved_cameras,
+    object_turned,
+    rank_starts,
+    turn_moves_px,
+    turned_camera,
+)
 
 INTRINSICS = Intrinsics(fu=1120.0, fv=1116.0, cx=640.0, cy=480.0, width=1280, height=960)
 
@@ -140,3 +148,33 @@ def test_with_the_object_s_turn_searched_a_long_part_turned_from_its_prior_gets_
     with_turns = rank_starts(distance, INTRINSICS, samples, model, reach_mm=10.0, reach_deg=10.0, object_turn_deg=5.0)
     assert min(miss_px(s) for s in camera_only) > 15.0
     assert miss_px(with_turns[0]) < 4.0, [miss_px(s) for s in with_turns]
+
+
+def test_a_turn_moves_a_point_seen_face_on_little_and_one_pointing_away_by_its_arc():
+    obj2cam = _pose([0, 0, 0], [0, 0, 500.0])
+    face_on = np.array([[100.0, 0.0, 0.0], [-100.0, 0.0, 0.0], [0.0, 50.0, 0.0], [0.0, -50.0, 0.0]])
+    pointing_away = np.array([[0.0, 0.0, 100.0], [0.0, 0.0, -100.0]])
+    arc = np.radians(5.0) * 100.0 * 1120.0 / 500.0  # 19.5 px, to first order
+    # face on, a turn across the line of sight moves the ends along it: foreshortening, a quarter of the arc
+    assert 0.1 * arc < turn_moves_px(face_on, obj2cam, INTRINSICS, 5.0) < 0.3 * arc
+    # pointing away, the near end swings across the image: turned about both axes at once (7.1 deg) and 100 mm
+    # nearer the camera, sqrt(2) x 500 / 400 times the arc
+    assert turn_moves_px(pointing_away, obj2cam, INTRINSICS, 5.0) == pytest.approx(
+        1120.0 * 100.0 * np.sin(np.radians(5.0) * np.sqrt(2.0)) / 400.0, rel=0.03
+    )
+
+
+def test_a_small_part_far_off_is_ranked_as_without_the_object_s_turn():
+    """A 30 mm cube a metre off, turned 1 deg: its samples move under a pixel, no candidate more than the camera's
+    grid gives; the ranking is the camera's alone."""
+    mesh = trimesh.creation.box(extents=[30.0, 30.0, 30.0])
+    truth = _pose([20, 30, 0], [40, -20, 1000.0])
+    model = moved_cameras(truth, np.array([[4.0, -3.0, 5.0]]), np.array([0.5]))[0]
+    distance = edge_distance_map(_edge_image(mesh, truth), TRUNCATE_PX)
+    samples = np.concatenate(
+        [a + (b - a) * np.linspace(0.05, 0.95, 12)[:, None] for a, b in mesh.vertices[mesh.edges_unique]]
+    )
+    assert turn_moves_px(samples, model, INTRINSICS, 1.0) < 1.0
+    plain = rank_starts(distance, INTRINSICS, samples, model, reach_mm=10.0, reach_deg=1.0)
+    turned = rank_starts(distance, INTRINSICS, samples, model, reach_mm=10.0, reach_deg=1.0, object_turn_deg=1.0)
+    assert len(plain) == len(turned) and all(np.array_equal(a, b) for a, b in zip(plain, turned))
