@@ -23,6 +23,12 @@ from calib_core.camera.distortion_map import distortion_map
 from calib_core.connectors.frame import Frame, FrameSource
 
 
+AT_REST_DEG = 0.01
+"""Joints that moved no more than this during a render (deg) count as at rest for the live video's integrated
+frame: a controller's last samples on the way in differ by a thousandth of a degree (0.0013 deg seen under load),
+and a frame point-sampled there could be measured on (the robot counts as settled) while aliasing a board's squares."""
+
+
 @dataclass(frozen=True)
 class CameraLook:
     """Image formation beyond geometry: ``noise_sigma`` (grey levels), ``blur_sigma_px`` (0: none),
@@ -140,12 +146,15 @@ class SimulatedCamera(FrameSource):
         items = self._scene_at(q)
         cam2world = self._cam2world_at(q)
         ideal = self._ideal_render(items, cam2world)
-        if self._last_ideal[2] < samples_per_pixel(self.look, self._map.ideal.width) and np.array_equal(
-            np.asarray(self._joints(), dtype=float), q
+        moved_during_render = float(np.max(np.abs(np.asarray(self._joints(), dtype=float) - q), initial=0.0))
+        if (
+            self._last_ideal[2] < samples_per_pixel(self.look, self._map.ideal.width)
+            and moved_during_render <= AT_REST_DEG
         ):
             # Point-sampled because the scene changed, yet the robot did not move during that render:
             # it may have come to rest, and the first frame at rest must be integrated too (a slow
             # machine can deliver it after the robot has been still long enough to be measured on).
+            # (Its last samples on the way in may still differ by a thousandth of a degree: at rest too.)
             ideal = self._ideal_render(items, cam2world, integrate=True)
         image = self._map.apply(ideal).astype(np.float32) * self._vignette
         if self.look.blur_sigma_px > 0:
