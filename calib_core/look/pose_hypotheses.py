@@ -64,9 +64,17 @@ def turn_moves_px(samples_mm: np.ndarray, obj2cam: np.ndarray, intrinsics: Intri
     when the object turns ``turn_deg`` each way about the camera's x and y axes through the samples' centre (as
     :func:`object_turned` turns it): a part seen face on and far off hardly moves, a long one pointing away swings."""
     turned, _ = object_turned(obj2cam[None], np.zeros((1, 0)), samples_mm.mean(axis=0), turn_deg)
-    seen = np.array([project(samples_mm @ T[:3, :3].T + T[:3, 3], intrinsics) for T in turned])  # (9, m, 2)
+    seen = projected(samples_mm, turned, intrinsics)  # (9, m, 2)
     moved = np.linalg.norm(seen[1:] - seen[0], axis=2)
     return float(np.nanmax(moved)) if np.isfinite(moved).any() else 0.0
+
+
+def projected(samples_mm: np.ndarray, poses: np.ndarray, intrinsics: Intrinsics) -> np.ndarray:
+    """Where each of ``poses`` (H, 4, 4, obj2cam) puts ``samples_mm`` (m, 3, the object's frame) in the image: (H, m, 2)
+    px, NaN behind the camera. A batched matmul (einsum's generic loop took 30 ms for a thousand poses of 400
+    samples)."""
+    pts = np.matmul(samples_mm, poses[:, :3, :3].transpose(0, 2, 1)) + poses[:, None, :3, 3]
+    return project(pts.reshape(-1, 3), intrinsics).reshape(len(poses), -1, 2)
 
 
 def object_turned(
@@ -139,18 +147,15 @@ def rank_starts(
     h, w = distance.shape
     pad = int(np.abs(offsets).max()) + 2
     padded = np.pad(np.asarray(distance, dtype=np.float32), pad, constant_values=TRUNCATE_PX)
-    # Where each candidate puts the samples (H, m, 2) and their flat indices in the padded map (H, m): whole pixels,
-    # anything outside the image (or behind the camera: NaN) clipped to just outside it, where the padding (wider
-    # than any offset) holds the cap. A few thousand candidates at a time (with the object's turns, nine times as
-    # many: their points and pixels whole took some 220 MB); a batched matmul (einsum's generic loop took
-    # 30 ms for a thousand poses of 400 samples).
-    uv = np.empty((len(poses), len(samples_mm), 2))
+    # Each candidate's samples as flat indices in the padded map (H, m): whole pixels, anything outside the image (or
+    # behind the camera: NaN) clipped to just outside it, where the padding (wider than any offset) holds the cap. A
+    # few thousand candidates at a time (with the object's turns, nine times as many: their points and pixels whole
+    # took some 220 MB); only the indices kept, where the pixels were the candidates' largest array and the
+    # distinctness check below reads a few hundred of them.
     base = np.empty((len(poses), len(samples_mm)), np.int64)
     for chunk in np.array_split(np.arange(len(poses)), max(1, len(poses) // 2048)):
-        pts = np.matmul(samples_mm, poses[chunk, :3, :3].transpose(0, 2, 1)) + poses[chunk, None, :3, 3]
-        seen = project(pts.reshape(-1, 3), intrinsics).reshape(len(chunk), -1, 2)
-        uv[chunk] = seen
-        px = np.rint(np.nan_to_num(seen, nan=-1e6).clip(-1e6, 1e6)).astype(np.int64)
+        px = np.rint(np.nan_to_num(projected(samples_mm, poses[chunk], intrinsics), nan=-1e6).clip(-1e6, 1e6))
+        px = px.astype(np.int64)
         base[chunk] = (np.clip(px[..., 1], -1, h) + pad) * padded.shape[1] + np.clip(px[..., 0], -1, w) + pad
     offsets_flat = (offsets[:, 1] * padded.shape[1] + offsets[:, 0]).astype(np.int64)
     flat = padded.ravel()
@@ -167,10 +172,10 @@ def rank_starts(
     # the unmoved pose wins a tie
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []
-    chosen_seen = np.empty((keep,) + uv.shape[1:])  # where each chosen one puts the samples (keep, m, 2)
+    chosen_seen = np.empty((keep, len(samples_mm), 2))  # where each chosen one puts the samples (keep, m, 2)
     order = np.argsort(cost, axis=None, kind="stable")
     for i, s in zip(*np.unravel_index(order[: 50 * keep], cost.shape)):
-        seen = uv[i] + offsets[s]
+        seen = projected(samples_mm, poses[i : i + 1], intrinsics)[0] + offsets[s]
         apart = np.nanmean(np.linalg.norm(seen - chosen_seen[: len(chosen)], axis=2), axis=1)
         if (apart > _DISTINCT_PX).all():
             chosen_seen[len(chosen)] = seen
