@@ -59,6 +59,10 @@ class Row:
     """The two answers' stated 1-sigmas combined (the root of their squares' sum), px."""
     reach: tuple[float, float] | None = None
     """How far the look searched (mm, deg); ``None``: as far as the prior is off (the truth: :data:`TRUTH_REACH`)."""
+    seed: str = ""
+    """The seed word the prior was drawn with beside the view and distance (empty: the bench's own priors)."""
+    obj_id: int | None = None
+    """The data set's object id."""
 
     @property
     def run(self) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -24,9 +24,10 @@ def _share_met(rows, least: float) -> bool | None:
     return sum(r.mspd_640_px < 5.0 for r in rows) >= least * len(rows)
 
 
-def target_rows(rows) -> list[str]:
+def target_rows(rows, seeded=()) -> list[str]:
     """A table of the targets (``rows``: the bench's :class:`~bench.photo_runs.Row`; the runs from the truth itself
-    count for none), one column a data set, and whether each is met everywhere it was measured."""
+    count for none; ``seeded``: the rows from other draws of the priors, :mod:`bench.photo_seeds`, for the wrong
+    ``ok``), one column a data set, and whether each is met everywhere it was measured."""
     sets = sorted({r.dataset for r in rows})
     if not sets:
         return []
@@ -49,6 +50,17 @@ def target_rows(rows) -> list[str]:
         counted = [r for r in rows if r.dataset == name and r.prior in PRIORS]
         wrong.append(sum(r.status == "ok" and r.mspd_640_px > WRONG_OK_PX for r in counted))
     checks.append(("wrong `ok` (over 10 px) from every prior: 0", [f"{w}" for w in wrong], [w == 0 for w in wrong]))
+    if seeded:
+        others = [
+            sum(r.status == "ok" and r.mspd_640_px > WRONG_OK_PX for r in seeded if r.dataset == name) for name in sets
+        ]
+        checks.append(
+            (
+                "wrong `ok` (over 10 px) from the other draws of the priors: 0",
+                [f"{w}" for w in others],
+                [w == 0 for w in others],
+            )
+        )
     seconds, met_time = [], []
     for name in sets:
         small = [r.seconds for r in rows if r.dataset == name and r.width <= 640 and r.prior in PRIORS]

@@ -57,7 +57,9 @@ def chosen_views(dataset, views_per_set: int) -> list:
     return chosen
 
 
-def view_prior(view, mm: float, deg: float) -> np.ndarray:
+def view_prior(view, mm: float, deg: float, seed: str = "") -> np.ndarray:
     """The prior (4, 4) of ``view``: its truth moved ``mm`` in a random direction and turned ``deg`` about a random
-    axis, seeded by the view and the distance."""
-    return moved_prior(view.obj2cam, mm, deg, np.random.default_rng(zlib.crc32(f"{view.key}/{mm:g}".encode())))
+    axis, seeded by the view, the distance and ``seed`` (empty: the bench's own priors; another word, another draw
+    of them, as :mod:`bench.photo_seeds` takes)."""
+    salt = f"{view.key}/{mm:g}" + (f"/{seed}" if seed else "")
+    return moved_prior(view.obj2cam, mm, deg, np.random.default_rng(zlib.crc32(salt.encode())))

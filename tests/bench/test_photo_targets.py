@@ -54,3 +54,20 @@ def test_the_first_target_s_bound_is_said_from_the_truth_searched_as_far_as_a_ro
 
 def test_no_rows_no_table():
     assert target_rows([]) == []
+
+
+def test_wrong_ok_from_other_draws_of_the_priors_is_a_target_of_its_own():
+    """Rows from other draws of the priors count in their own line only: the bench's own draw keeps its count."""
+    rows = [_row("lmo_dev", (10.0, 3.0), 2.0)]
+    seeded = [_seeded("lmo_dev", (10.0, 3.0), 11.0, "a"), _seeded("lmo_dev", (30.0, 10.0), 30.0, "b", "uncertain")]
+    seeded += [_seeded("handal_dev", (30.0, 10.0), 36.0, "a", width=1920)]  # 12 px at 640: wrong
+    lines = target_rows(rows + [_row("handal_dev", (10.0, 3.0), 3.0, width=1920)], seeded)
+    assert _cells(lines, "wrong `ok` (over 10 px) from every prior") == ["0", "0", "yes"]
+    assert _cells(lines, "wrong `ok` (over 10 px) from the other draws") == ["1", "1", "no"]
+    assert not any("other draws" in line for line in target_rows(rows))  # none run: not said
+
+
+def _seeded(dataset, prior, mspd_px, seed, status="ok", width=640):
+    from dataclasses import replace
+
+    return replace(_row(dataset, prior, mspd_px, status=status, width=width), seed=seed)
