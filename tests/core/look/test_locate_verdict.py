@@ -109,3 +109,40 @@ def test_a_rival_a_few_pixels_away_is_said_to_be_the_outline_s_looseness_a_far_o
         assert said["apart_px"] > across_mm * 600.0 / 900.0 * 0.9
     alone = verdict([fit(answer, 1.0), fit(answer.copy(), 0.99)], box, camera, answer)
     assert alone.rival_obj2cam is None and alone.to_dict()["rival"] is None
+
+
+def test_more_starts_settling_together_elsewhere_than_at_the_answer_make_it_uncertain():
+    """A HANDAL spoon's answer held 94 % of its samples on edges, alone, where three starts settled together 24 px away
+    holding 76-80 %: clearly fewer each, so no rival, yet no strays either. Two fits together elsewhere against the
+    answer alone make it ``uncertain``, the crowd's best given as the rival; two fits elsewhere apart from each other
+    are strays (the answer stays ``ok``), and so is one fit elsewhere beside two at the answer."""
+    import trimesh
+
+    from calib_core.camera.intrinsics import Intrinsics
+    from calib_core.look.located import Located
+    from calib_core.look.locate_verdict import verdict
+
+    camera = Intrinsics(600.0, 600.0, 320.0, 240.0, 640, 480)
+    box = trimesh.creation.box((80.0, 60.0, 40.0))
+    answer = np.eye(4)
+    answer[:3, 3] = (0.0, 0.0, 900.0)
+
+    def fit(across_mm, up_mm, share):
+        pose = answer.copy()
+        pose[:3, 3] += (across_mm, up_mm, 0.0)  # 0.67 px a mm
+        return Located("ok", "located", pose, np.full(3, 0.5), np.full(3, 0.05), 1.0, share, 160)
+
+    together = [fit(0.0, 0.0, 0.94), fit(36.0, 0.0, 0.77), fit(36.5, 0.5, 0.80), fit(36.0, 0.5, 0.76)]
+    result = verdict(together, box, camera, answer)
+    assert result.status == "uncertain", result.message
+    assert (
+        result.message.startswith("uncertain: 3 of 4 settled fits put the object together 2")
+        and "1 here" in result.message
+    )
+    np.testing.assert_allclose(result.rival_obj2cam[:3, 3], (36.5, 0.5, 900.0))  # the crowd's best: 80 %
+    np.testing.assert_allclose(result.obj2cam, answer)  # the answer is still the one with most samples on edges
+
+    strays = [fit(0.0, 0.0, 0.94), fit(36.0, 0.0, 0.77), fit(-36.0, 0.0, 0.78)]
+    assert verdict(strays, box, camera, answer).status == "ok"
+    outnumbered = [fit(0.0, 0.0, 0.94), fit(0.5, 0.0, 0.93), fit(36.0, 0.0, 0.77), fit(36.5, 0.0, 0.78)]
+    assert verdict(outnumbered, box, camera, answer).status == "ok"  # two here, two there: not more elsewhere
