@@ -5,7 +5,9 @@ truth is moved as a robot's model error would move it (seeded: 5 mm / 1 deg, 10 
 move of that length in a random direction and a turn of that angle about a random axis) and ``locate`` starts from
 there, searching as far as the error (its reach). Scored against the truth: MSPD and MSSD over the object's
 symmetries, BOP's average recalls, the share within MSPD 5 px, and every answer called ``ok`` that is more than
-10 px off (a wrong ``ok``), by the share of the object in sight. Time and the process's peak memory.
+10 px off (a wrong ``ok``), by the share of the object in sight. Time and the process's peak memory. Then the same
+views from priors drawn again with other seeds (:mod:`bench.photo_seeds`): the verdict's wrong ``ok`` there, each
+named.
 
 Data sets are read from ``--datasets FOLDER``, else ``$VIDEOCAL_DATASETS``, else the workplace's shared folder next
 to the project (``../shared/datasets``), else ``~/.cache/videocal/datasets``: one BOP data set a folder. Writes

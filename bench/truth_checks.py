@@ -93,15 +93,19 @@ OFF_BY_PX = ((0.0, 5.0), (5.0, WRONG_OK_PX), (WRONG_OK_PX, np.inf))
 def colour_evidence(rows: list[Row]) -> list[str]:
     """For the answers (every prior, any status) in each band of MSPD from the annotation, per data set: at how many
     the scanned mesh's own colours, which the look does not read, agree better with the photo at the answer than at
-    the annotation, at how many the other way, at how many neither (within :data:`COLOURS_APART`). Where the
-    answer is far off the annotation should win: that row says what the measure is worth."""
+    the annotation, at how many the other way, at how many neither (within :data:`COLOURS_APART`); the bands in px at
+    640 px width, as a wrong ``ok`` is counted. Where the answer is far off the annotation should win: that row says
+    what the measure is worth."""
     out = []
     for name in sorted({r.dataset for r in rows}):
         for lo, hi in OFF_BY_PX:
             pairs = [
                 r.colours_at
                 for r in rows
-                if r.dataset == name and lo <= r.mspd_px < hi and r.colours_at is not None and None not in r.colours_at
+                if r.dataset == name
+                and lo <= r.mspd_640_px < hi
+                and r.colours_at is not None
+                and None not in r.colours_at
             ]
             if not pairs:
                 continue

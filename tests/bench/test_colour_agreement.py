@@ -65,9 +65,21 @@ def test_a_mesh_without_vertex_colours_or_out_of_sight_has_no_agreement(cat):
     assert colour_agreement(photo, mesh, behind, CAMERA) is None
 
 
-def _row(mspd_px: float, at_answer: float, at_truth: float, dataset: str = "lmo_dev") -> Row:
+def _row(mspd_px: float, at_answer: float, at_truth: float, dataset: str = "lmo_dev", width: int = 640) -> Row:
     return Row(
-        dataset, (10.0, 3.0), "k", "ok", 1.0, mspd_px, 1.0, 1.0, 1.0, 100.0, 0.5, 640, colours_at=(at_answer, at_truth)
+        dataset,
+        (10.0, 3.0),
+        "k",
+        "ok",
+        1.0,
+        mspd_px,
+        1.0,
+        1.0,
+        1.0,
+        100.0,
+        0.5,
+        width,
+        colours_at=(at_answer, at_truth),
     )
 
 
@@ -82,3 +94,9 @@ def test_the_page_counts_which_pose_the_colours_agree_with_by_how_far_the_answer
         "| lmo_dev | more than 10 px | 1 | 0 | 1 | 0 |",
     ]
     assert colour_evidence([]) == []
+
+
+def test_a_wide_photo_s_answer_is_banded_at_640_px_width():
+    """18 px off on a 1920 px photo is 6 px at 640 px width, where a wrong ``ok`` is counted too."""
+    table = colour_evidence([_row(18.0, 0.6, 0.3, dataset="handal_dev", width=1920)])
+    assert table[2:] == ["| handal_dev | 5-10 px | 1 | 1 | 0 | 0 |"]
