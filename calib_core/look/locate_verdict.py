@@ -123,7 +123,9 @@ def verdict(fits: list[Located], mesh, intrinsics: Intrinsics, prior: np.ndarray
         },
     )
     sigma_bound = POINTS_SIGMA_PX * intrinsics.width / 640.0
-    crowd = [] if rivals else crowd_elsewhere(fits, apart, bound, mesh, intrinsics)
+    # (no group elsewhere can outnumber the answer's while the fits elsewhere do not: the distances left unmeasured)
+    outnumbered = len(fits) - len(agreeing) > len(agreeing)
+    crowd = crowd_elsewhere(fits, apart, bound, mesh, intrinsics) if outnumbered and not rivals else []
     if len(crowd) > len(agreeing):
         other = max(crowd, key=fit_quality)
         d = image_distance_px(best.obj2cam, other.obj2cam, mesh, intrinsics)
