@@ -173,9 +173,11 @@ def rank_starts(
     cost[np.flatnonzero((np.abs(grid) < 1e-12).all(axis=1)), len(offsets) // 2] -= 1e-6
     chosen: list[tuple[int, int]] = []
     chosen_seen = np.empty((keep, len(samples_mm), 2))  # where each chosen one puts the samples (keep, m, 2)
-    order = np.argsort(cost, axis=None, kind="stable")
-    for i, s in zip(*np.unravel_index(order[: 50 * keep], cost.shape)):
-        seen = projected(samples_mm, poses[i : i + 1], intrinsics)[0] + offsets[s]
+    # the rescored ones, least cost first (ties by index, as a stable sort of the whole table: only they are finite)
+    order = best[np.lexsort((best, cost.ravel()[best]))][: 50 * keep]
+    top_rows, top_cols = np.unravel_index(order, cost.shape)
+    top_seen = projected(samples_mm, poses[top_rows], intrinsics) + offsets[top_cols][:, None, :]
+    for i, s, seen in zip(top_rows, top_cols, top_seen):
         apart = np.nanmean(np.linalg.norm(seen - chosen_seen[: len(chosen)], axis=2), axis=1)
         if (apart > _DISTINCT_PX).all():
             chosen_seen[len(chosen)] = seen
