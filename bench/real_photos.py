@@ -107,22 +107,22 @@ class _ViewLook:
         self.pose = pose = located.obj2cam
         visible = 1.0 if view.visib_fract is None else view.visib_fract
         if pose is None:
-            return Row(
-                self.dataset,
-                offset,
-                view.key,
-                located.status,
-                visible,
-                np.inf,
-                np.inf,
-                np.inf,
-                np.inf,
-                info.diameter_mm,
-                seconds,
-                view.intrinsics.width,
-                reach=reach,
-                seed=seed,
-                obj_id=view.obj_id,
+            scores, seen = (np.inf, np.inf, np.inf, np.inf), {}
+        else:
+            scores = (
+                mspd(pose, view.obj2cam, self.points, info.symmetries, view.intrinsics),
+                mssd(pose, view.obj2cam, self.points, info.symmetries),
+                translation_error_mm(pose, view.obj2cam),
+                rotation_error_deg(pose, view.obj2cam),
+            )
+            seen = dict(
+                centre_px=tuple(self.truth_centre),
+                centre_moved_px=tuple(project_points(self.centre, pose, view.intrinsics)[0] - self.truth_centre),
+                colours_at=(
+                    colour_agreement(self.image, self.mesh, pose, view.intrinsics),
+                    colour_agreement(self.image, self.mesh, view.obj2cam, view.intrinsics),
+                ),
+                points_sigma_px=located.points_sigma_px,
             )
         return Row(
             self.dataset,
@@ -130,23 +130,14 @@ class _ViewLook:
             view.key,
             located.status,
             visible,
-            mspd(pose, view.obj2cam, self.points, info.symmetries, view.intrinsics),
-            mssd(pose, view.obj2cam, self.points, info.symmetries),
-            translation_error_mm(pose, view.obj2cam),
-            rotation_error_deg(pose, view.obj2cam),
+            *scores,
             info.diameter_mm,
             seconds,
             view.intrinsics.width,
-            tuple(self.truth_centre),
-            tuple(project_points(self.centre, pose, view.intrinsics)[0] - self.truth_centre),
-            (
-                colour_agreement(self.image, self.mesh, pose, view.intrinsics),
-                colour_agreement(self.image, self.mesh, view.obj2cam, view.intrinsics),
-            ),
-            located.points_sigma_px,
             reach=reach,
             seed=seed,
             obj_id=view.obj_id,
+            **seen,
         )
 
 
