@@ -63,6 +63,9 @@ class Row:
     """The seed word the prior was drawn with beside the view and distance (empty: the bench's own priors)."""
     obj_id: int | None = None
     """The data set's object id."""
+    model_view: bool = False
+    """Given the model's view as ``videocal locate`` renders it for a mesh whose samples are its creases (a CAD-like
+    mesh), which the bench's own rows are not: :mod:`bench.command_path`."""
 
     @property
     def run(self) -> tuple[tuple[float, float], tuple[float, float]]:

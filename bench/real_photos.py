@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.photo_runs import FROM_TRUTH, RUNS, VISIBLE_BINS, WRONG_OK_PX, Row
+from bench.photo_runs import FROM_TRUTH, PRIORS, RUNS, VISIBLE_BINS, WRONG_OK_PX, Row
 from bench.real_views import chosen_views, datasets_root, found_datasets, view_prior
 
 PROJECT = Path(__file__).resolve().parent.parent
@@ -34,16 +34,18 @@ OUT = PROJECT / "docs" / "benchmarks" / "real_photos.md"
 
 def run(views_per_set: int, root: Path) -> tuple[list[Row], list[Row], list[str]]:
     """Every view of every set found under ``root`` from each of :data:`RUNS`, then from the priors of
-    :mod:`bench.photo_seeds` (rows kept apart: the tables above read the bench's own priors): the rows of each, and a
-    line per set."""
+    :mod:`bench.photo_seeds` and, for a mesh the command renders a model's view of, from the bench's priors with that
+    view (:mod:`bench.command_path`): the rows of the first, the others' (kept apart: the tables above read the
+    bench's own priors, without a view), and a line per set."""
     import cv2
 
+    from bench.command_path import model_view_of
     from bench.photo_seeds import SEEDED_RUNS
     from bench.truth_checks import with_start_agreement
 
     from calib_core.mesh_files import load_mesh
 
-    rows, seeded, sets = [], [], []
+    rows, seeded, commanded, sets = [], [], [], []
     for dataset in found_datasets(root):
         models = dataset.models()
         meshes = {}
@@ -72,11 +74,17 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[Row], list[str]
             )
             for seed, (mm, deg) in SEEDED_RUNS:
                 seeded.append(look.scored(view_prior(view, mm, deg, seed), (mm, deg), (mm, deg), seed=seed))
+            with model_view_of(meshes[view.obj_id], view) as expected:
+                if expected is not None:
+                    commanded += [
+                        look.scored(view_prior(view, mm, deg), (mm, deg), (mm, deg), expected=expected)
+                        for mm, deg in PRIORS
+                    ]
             print(
                 f"   {view.key}: " + ", ".join(f"{r.status} {r.mspd_px:.1f}px" for r in rows[-len(RUNS) :]),
                 flush=True,
             )
-    return rows, seeded, sets
+    return rows, seeded + commanded, sets
 
 
 class _ViewLook:
@@ -92,7 +100,9 @@ class _ViewLook:
         self.truth_centre = project_points(self.centre, view.obj2cam, view.intrinsics)[0]
         self.pose = None
 
-    def scored(self, prior: np.ndarray, offset: tuple[float, float], reach: tuple[float, float], seed: str = "") -> Row:
+    def scored(
+        self, prior: np.ndarray, offset: tuple[float, float], reach: tuple[float, float], seed: str = "", expected=None
+    ) -> Row:
         from bench.colour_agreement import colour_agreement
         from calib_core.camera.projection import project_points
         from calib_core.datasets.pose_errors import mspd, mssd, rotation_error_deg, translation_error_mm
@@ -101,7 +111,14 @@ class _ViewLook:
         view, info = self.view, self.info
         t0 = time.perf_counter()
         located = locate(
-            self.image, view.intrinsics, self.mesh, prior, reach_mm=reach[0], reach_deg=reach[1], features={}
+            self.image,
+            view.intrinsics,
+            self.mesh,
+            prior,
+            reach_mm=reach[0],
+            reach_deg=reach[1],
+            features={},
+            expected=expected,
         )
         seconds = time.perf_counter() - t0
         self.pose = pose = located.obj2cam
@@ -137,6 +154,7 @@ class _ViewLook:
             reach=reach,
             seed=seed,
             obj_id=view.obj_id,
+            model_view=expected is not None,
             **seen,
         )
 
@@ -182,6 +200,7 @@ def table(rows: list[Row]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> str:
     from bench.box_photo import box_photo_rows
+    from bench.command_path import command_section
     from bench.photo_seeds import seeded_section
     from bench.photo_targets import target_rows
     from bench.truth_checks import annotation_offset, colour_evidence, stated_sigma
@@ -221,7 +240,7 @@ def main(argv: list[str] | None = None) -> str:
             + table(rows)
             + ["", f"Peak memory of the process: {peak_mb:.0f} MB."]
             + ["", "## The targets", ""]
-            + target_rows(rows, seeded)
+            + target_rows(rows, [r for r in seeded if not r.model_view])
             + [
                 "",
                 "## Other draws of the priors",
@@ -232,7 +251,9 @@ def main(argv: list[str] | None = None) -> str:
                 "camera): which pose the scanned mesh's own colours agree with better is said for each.",
                 "",
             ]
-            + seeded_section(seeded)
+            + seeded_section([r for r in seeded if not r.model_view])
+            + ["", "## As the command calls it", ""]
+            + command_section(rows, [r for r in seeded if r.model_view])
             + [
                 "",
                 "The whole `videocal locate` command on one photo (targets: 1.5 s, and 300 MB for a 640 x 480 view) is "
