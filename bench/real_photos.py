@@ -159,6 +159,16 @@ class _ViewLook:
         )
 
 
+def _with_renderer(rows: list[Row]) -> str:
+    """What the process's peak holds beyond the looks: the renderer, when rows were run the command's way."""
+    if not any(r.model_view for r in rows):
+        return ""
+    return (
+        ", the renderer's included (the rows as the command calls the look started VTK's offscreen renderer, as "
+        "`videocal locate` does for a CAD-like mesh; the command's own peak: cli.md)"
+    )
+
+
 def table(rows: list[Row]) -> list[str]:
     """One row per data set, prior and share in sight: how many views, found within MSPD 5 px, called ``ok``,
     uncertain, not found, wrong ``ok``; BOP's recalls; the time a view."""
@@ -238,7 +248,7 @@ def main(argv: list[str] | None = None) -> str:
         lines += (
             ["Data sets run: " + "; ".join(sets) + ".", ""]
             + table(rows)
-            + ["", f"Peak memory of the process: {peak_mb:.0f} MB."]
+            + ["", f"Peak memory of the process: {peak_mb:.0f} MB{_with_renderer(seeded)}."]
             + ["", "## The targets", ""]
             + target_rows(rows, [r for r in seeded if not r.model_view])
             + [
