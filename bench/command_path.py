@@ -9,7 +9,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from bench.photo_runs import PRIORS, WRONG_OK_PX, Row
+from bench.photo_runs import PRIORS, Row, Tally
 
 
 @contextmanager
@@ -54,11 +54,9 @@ def command_section(rows: list[Row], commanded: list[Row]) -> list[str]:
             for way, rs in (("without the model's view (above)", theirs), ("as the command: with it", ours)):
                 if not rs:
                     continue
+                t = Tally.of(rs)
                 out.append(
-                    f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {way} | {len(rs)} | "
-                    f"{sum(r.mspd_640_px < 5.0 for r in rs)} | {sum(r.status == 'ok' for r in rs)} | "
-                    f"{sum(r.status == 'ok' and r.mspd_640_px > WRONG_OK_PX for r in rs)} | "
-                    f"{sum(r.status == 'uncertain' for r in rs)} | {sum(r.status == 'not found' for r in rs)} | "
-                    f"{np.median([r.seconds for r in rs]):.1f} |"
+                    f"| {name} | {prior[0]:g} mm / {prior[1]:g} deg | {way} | {t.views} | {t.within_5} | {t.ok} | "
+                    f"{t.wrong_ok} | {t.uncertain} | {t.not_found} | {np.median([r.seconds for r in rs]):.1f} |"
                 )
     return out

@@ -83,3 +83,31 @@ class Row:
     def mspd_640_px(self) -> float:
         """The answer's MSPD at 640 px width (BOP's scale: a 1920 px photo's pixels count a third)."""
         return self.mspd_px * 640.0 / self.width
+
+
+@dataclass(frozen=True)
+class Tally:
+    """What a list of rows came to: ``views``; ``within_5`` within MSPD 5 px (at 640 px width) whatever the status;
+    ``ok``; ``ok_5_10`` called ``ok`` 5-10 px off; ``wrong_ok`` called ``ok`` over :data:`WRONG_OK_PX` off;
+    ``uncertain``; ``not_found``."""
+
+    views: int
+    within_5: int
+    ok: int
+    ok_5_10: int
+    wrong_ok: int
+    uncertain: int
+    not_found: int
+
+    @staticmethod
+    def of(rows: list[Row]) -> Tally:
+        ok = [r.mspd_640_px for r in rows if r.status == "ok"]
+        return Tally(
+            views=len(rows),
+            within_5=sum(r.mspd_640_px < 5.0 for r in rows),
+            ok=len(ok),
+            ok_5_10=sum(5.0 <= e <= WRONG_OK_PX for e in ok),
+            wrong_ok=sum(e > WRONG_OK_PX for e in ok),
+            uncertain=sum(r.status == "uncertain" for r in rows),
+            not_found=sum(r.status == "not found" for r in rows),
+        )

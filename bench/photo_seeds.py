@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.photo_runs import WRONG_OK_PX, Row
+from bench.photo_runs import WRONG_OK_PX, Row, Tally
 from bench.truth_checks import COLOURS_APART
 
 OTHER_SEEDS = ("a", "b")
@@ -33,10 +33,10 @@ def seeded_section(rows: list[Row]) -> list[str]:
                 continue
             bad = [r for r in rs if r.status == "ok" and r.mspd_640_px > WRONG_OK_PX]
             wrong += bad
+            t = Tally.of(rs)
             out.append(
-                f"| {name} | {mm:g} mm / {deg:g} deg | {seed} | {len(rs)} | "
-                f"{sum(r.mspd_640_px < 5.0 for r in rs)} | {sum(r.status == 'ok' for r in rs)} | {len(bad)} | "
-                f"{sum(r.status == 'uncertain' for r in rs)} | {sum(r.status == 'not found' for r in rs)} |"
+                f"| {name} | {mm:g} mm / {deg:g} deg | {seed} | {t.views} | {t.within_5} | {t.ok} | {t.wrong_ok} | "
+                f"{t.uncertain} | {t.not_found} |"
             )
     answers = sum(r.status == "ok" for r in rows)
     out += ["", f"Wrong `ok` over these draws: {len(wrong)} of {answers} answers called `ok`."]

@@ -21,22 +21,34 @@ import platform
 import resource
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from bench.photo_runs import FROM_TRUTH, PRIORS, RUNS, VISIBLE_BINS, WRONG_OK_PX, Row
+from bench.photo_runs import FROM_TRUTH, PRIORS, RUNS, VISIBLE_BINS, Row, Tally
 from bench.real_views import chosen_views, datasets_root, found_datasets, view_prior
 
 PROJECT = Path(__file__).resolve().parent.parent
 OUT = PROJECT / "docs" / "benchmarks" / "real_photos.md"
 
 
-def run(views_per_set: int, root: Path) -> tuple[list[Row], list[Row], list[str]]:
-    """Every view of every set found under ``root`` from each of :data:`RUNS`, then from the priors of
-    :mod:`bench.photo_seeds` and, for a mesh the command renders a model's view of, from the bench's priors with that
-    view (:mod:`bench.command_path`): the rows of the first, the others' (kept apart: the tables above read the
-    bench's own priors, without a view), and a line per set."""
+@dataclass(frozen=True)
+class PhotoRuns:
+    """The rows of one bench run, each kind apart: ``rows`` from each of :data:`RUNS` (the bench's own priors, the
+    look without a model's view: what the tables read); ``seeded`` from the other draws of :mod:`bench.photo_seeds`;
+    ``commanded`` from the bench's priors with the model's view, for a mesh the command renders one of
+    (:mod:`bench.command_path`); ``sets`` a line per data set run."""
+
+    rows: list[Row]
+    seeded: list[Row]
+    commanded: list[Row]
+    sets: list[str]
+
+
+def run(views_per_set: int, root: Path) -> PhotoRuns:
+    """Every view of every set found under ``root`` from each of :data:`RUNS`, from the other draws' priors and, where
+    the command renders a model's view, from the bench's priors with it."""
     import cv2
 
     from bench.command_path import model_view_of
@@ -84,7 +96,7 @@ def run(views_per_set: int, root: Path) -> tuple[list[Row], list[Row], list[str]
                 f"   {view.key}: " + ", ".join(f"{r.status} {r.mspd_px:.1f}px" for r in rows[-len(RUNS) :]),
                 flush=True,
             )
-    return rows, seeded + commanded, sets
+    return PhotoRuns(rows, seeded, commanded, sets)
 
 
 class _ViewLook:
@@ -159,9 +171,9 @@ class _ViewLook:
         )
 
 
-def _with_renderer(rows: list[Row]) -> str:
+def _with_renderer(commanded: list[Row]) -> str:
     """What the process's peak holds beyond the looks: the renderer, when rows were run the command's way."""
-    if not any(r.model_view for r in rows):
+    if not commanded:
         return ""
     return (
         ", the renderer's included (the rows as the command calls the look started VTK's offscreen renderer, as "
@@ -187,9 +199,8 @@ def table(rows: list[Row]) -> list[str]:
                     continue
                 mspd_all = np.array([r.mspd_640_px for r in rs])
                 mssd_all = np.array([r.mssd_mm / r.diameter_mm for r in rs])
-                ok = np.array([r.status == "ok" for r in rs])
                 secs = np.array([r.seconds for r in rs])
-                within = int(np.sum(mspd_all < 5.0))
+                t = Tally.of(rs)
                 label = (
                     f"the truth itself, searching {reach[0]:g} mm / {reach[1]:g} deg"
                     if prior == FROM_TRUTH
@@ -197,10 +208,8 @@ def table(rows: list[Row]) -> list[str]:
                 )
                 out.append(
                     f"| {name} | {label} | {lo:.1f}-{min(hi, 1.0):.1f} | {len(rs)} | "
-                    f"{within} ({100 * within / len(rs):.0f} %) | {int(ok.sum())} | "
-                    f"{int(np.sum(ok & (mspd_all >= 5.0) & (mspd_all <= WRONG_OK_PX)))} | "
-                    f"{int(np.sum(ok & (mspd_all > WRONG_OK_PX)))} | "
-                    f"{sum(r.status == 'uncertain' for r in rs)} | {sum(r.status == 'not found' for r in rs)} | "
+                    f"{t.within_5} ({100 * t.within_5 / t.views:.0f} %) | {t.ok} | {t.ok_5_10} | {t.wrong_ok} | "
+                    f"{t.uncertain} | {t.not_found} | "
                     f"{average_recall(mspd_all, MSPD_THRESHOLDS_PX):.2f} | "
                     f"{average_recall(mssd_all, MSSD_THRESHOLDS):.2f} | "
                     f"{np.median(secs):.1f}, {np.percentile(secs, 95):.1f} |"
@@ -218,7 +227,8 @@ def main(argv: list[str] | None = None) -> str:
     argv = sys.argv[1:] if argv is None else argv
     views = int(argv[argv.index("--views") + 1]) if "--views" in argv else 60
     root = datasets_root(argv[argv.index("--datasets") + 1] if "--datasets" in argv else None)
-    rows, seeded, sets = run(views, root)
+    runs = run(views, root)
+    rows, seeded, commanded, sets = runs.rows, runs.seeded, runs.commanded, runs.sets
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     lines = [
         "# Real photographs with ground truth",
@@ -248,9 +258,9 @@ def main(argv: list[str] | None = None) -> str:
         lines += (
             ["Data sets run: " + "; ".join(sets) + ".", ""]
             + table(rows)
-            + ["", f"Peak memory of the process: {peak_mb:.0f} MB{_with_renderer(seeded)}."]
+            + ["", f"Peak memory of the process: {peak_mb:.0f} MB{_with_renderer(commanded)}."]
             + ["", "## The targets", ""]
-            + target_rows(rows, [r for r in seeded if not r.model_view])
+            + target_rows(rows, seeded)
             + [
                 "",
                 "## Other draws of the priors",
@@ -261,9 +271,9 @@ def main(argv: list[str] | None = None) -> str:
                 "camera): which pose the scanned mesh's own colours agree with better is said for each.",
                 "",
             ]
-            + seeded_section([r for r in seeded if not r.model_view])
+            + seeded_section(seeded)
             + ["", "## As the command calls it", ""]
-            + command_section(rows, [r for r in seeded if r.model_view])
+            + command_section(rows, commanded)
             + [
                 "",
                 "The whole `videocal locate` command on one photo (targets: 1.5 s, and 300 MB for a 640 x 480 view) is "
