@@ -14,6 +14,7 @@ import numpy as np
 import trimesh
 
 from calib_core.errors import FileFormatError
+from calib_core.mesh_ply_ascii import read_ascii_ply
 
 MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply")
 from calib_core.mesh_units import MESH_SCALE  # noqa: E402,F401 (the readers' units, named where --help can read them)
@@ -74,7 +75,9 @@ def load_mesh(path: str | Path, units: str = "mm", field: str | None = None) -> 
                 "ignore"
             )  # trimesh's own warnings on a broken file: the checks below say what is wrong
             # unprocessed first: trimesh's processing drops faces with non-finite vertices without a word
-            mesh = trimesh.load(path, force="mesh", process=False)
+            mesh = read_ascii_ply(path) if path.suffix.lower() == ".ply" else None
+            if mesh is None:
+                mesh = trimesh.load(path, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds on a broken file; all mean the same to the user
         raise FileFormatError(path, f"cannot read the mesh: {exc}", field) from None
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
