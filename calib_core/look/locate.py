@@ -178,9 +178,15 @@ def _report(
     missed = tuple((m.feature, m.reason) for m in found.missed if m.feature != "centre")
     if edges is None or not edges.settled:
         why = found.message.replace(": pick the points by hand", "")
+        lines_up = edges is not None and edges.converged and edges.rms_px <= edges.rms_bound_px
         return Located(
             "not found",
-            f"{why}; give a prior nearer the object, or a larger reach",
+            f"{why}; "
+            + (
+                "pick its points by hand in the window, or give a prior nearer it"
+                if lines_up
+                else "give a prior nearer the object, or a larger reach"
+            ),
             None,
             None,
             None,
