@@ -37,8 +37,8 @@ _HEADER_BYTES = 64 * 1024
 
 def read_ascii_ply(path: str | Path):
     """The triangle mesh in the ASCII PLY at ``path`` as trimesh would read it unprocessed (vertices, faces and RGBA
-    colours as the file gives them; its normals, as trimesh's loader leaves them, taken from the faces), or ``None`` when the file is not such a PLY (trimesh reads it
-    then, and names what is wrong with a broken one)."""
+    colours as the file gives them; its normals, as trimesh's loader leaves them, taken from the faces), or ``None``
+    when the file is not such a PLY (trimesh reads it then, and names what is wrong with a broken one)."""
     import trimesh
 
     with open(path, "rb") as f:
