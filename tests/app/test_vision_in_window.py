@@ -2,6 +2,7 @@
 through viewing poses over the controller link, views captured from the live camera, the intrinsics
 and the camera's mounting calibrated against the test bed's truth, applied and saved."""
 
+import time
 from pathlib import Path
 
 import numpy as np
@@ -25,13 +26,18 @@ def window(live_window):
     return live_window(RobotErrors(hand_eye_xyz_mm=typical.hand_eye_xyz_mm, hand_eye_rpy_deg=typical.hand_eye_rpy_deg))
 
 
-def _fresh_still_frame(qtbot, win):
-    """Wait until the camera shows a frame the core accepts: taken after the robot had settled."""
+def _fresh_still_frame(qtbot, win, after_s: float | None = None):
+    """Wait until the camera shows a frame the core accepts: taken after the robot had settled (and after
+    ``after_s``, the monotonic clock's seconds the frames are stamped in, when given)."""
     wb = win.workbench
-    qtbot.waitUntil(
-        lambda: win.camera.last_frame is not None and wb.observations.stillness(win.camera.last_frame).settled,
-        timeout=10_000,
-    )
+
+    def fresh() -> bool:
+        frame = win.camera.last_frame
+        if frame is None or (after_s is not None and frame.t_host_s <= after_s):
+            return False
+        return wb.observations.stillness(frame).settled
+
+    qtbot.waitUntil(fresh, timeout=10_000)
 
 
 def _visit_board_pose(qtbot, win, k: int) -> None:
@@ -46,10 +52,12 @@ def _visit_board_pose(qtbot, win, k: int) -> None:
             f"board pose {k + 1}: {win.workbench.motion.text}; {win.results.status.text()}; "
             f"{win.overview.preview_text.text()}"
         ) from None
-    _fresh_still_frame(qtbot, win)
     # the controller's done can be read before its last samples on the way in (0.0013 deg short once, under load):
     # the samples that follow must reach the target
     qtbot.waitUntil(lambda: np.max(np.abs(win.workbench.joints_deg - target)) < 1e-3, timeout=5_000)
+    # and a frame taken since: under load the last frame shown can still be one from before the move, taken with the
+    # robot at rest at its start (settled, and without the board: "no board found" once)
+    _fresh_still_frame(qtbot, win, after_s=time.monotonic())
 
 
 def test_board_views_to_intrinsics_and_mounting(qtbot, window, tmp_path, monkeypatch):
