@@ -10,7 +10,7 @@ import numpy as np
 from bench.photo_runs import WRONG_OK_PX, Row, Tally
 from bench.truth_checks import COLOURS_APART
 
-OTHER_SEEDS = ("a", "b")
+OTHER_SEEDS = ("a", "b", "c", "d", "e")
 """The seed words of the other draws (:func:`bench.real_views.view_prior`)."""
 SEEDED_PRIORS = ((10.0, 3.0), (30.0, 10.0))
 """The priors (mm, deg) drawn again: a robot's error and a coarser one, each searched as far as it is off."""
