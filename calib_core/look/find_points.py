@@ -29,9 +29,10 @@ import numpy as np
 from calib_core.camera.intrinsics import Intrinsics
 from calib_core.camera.projection import project_points
 from calib_core.scene import SceneItem
-from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX, edge_samples_px, matched_share
-from calib_core.look.edge_refinement import COARSE_FIT_SHARE, FINEST_WINDOW_PX, SETTLED_RMS_PX, EdgeFit
+from calib_core.look.edge_alignment import TRUNCATE_PX as EDGE_TRUNCATE_PX
+from calib_core.look.edge_refinement import FINEST_WINDOW_PX, SETTLED_RMS_PX, EdgeFit
 from calib_core.look.form_tolerance import form_error_px
+from calib_core.look.unsettled_message import unsettled_message
 from calib_core.look.halved_look import at_full_size, halved_view, halvings
 from calib_core.look.edge_samples import edge_points
 from calib_core.look.feature_detectors import Detection, NotDetected
@@ -57,9 +58,6 @@ across the line of sight (HANDAL's tools from 30 mm / 10 deg off, three seeds of
 _REUSE_PX = 0.25  # the second pass's view serves the detectors when its fit moved the target less than this
 _RECHECK_SEARCH_PX = 3.0  # the features' pose is within a pixel or so of the edges'
 _AGREE_PX = 0.2  # the edges' run from the features' pose only when the two put a feature further apart
-_MATCHED_SHARE = (
-    0.12  # fewer of the target's edge samples on an image edge: it is not there (the edge fit decides the rest)
-)
 
 
 def _not_in_view(item: SceneItem, names: list[str], t0: float, why: str) -> FoundPoints:
@@ -221,7 +219,7 @@ def find_points(
         return FoundPoints(
             item.name,
             False,
-            _unsettled_message(item, edge_fit, distance, intrinsics),
+            unsettled_message(item, edge_fit, distance, intrinsics),
             missed=tuple(Missed(n, missed.get(n, "the target's pose was not found")) for n in names),
             offset_px=shift,
             seconds=time.perf_counter() - t0,
@@ -282,36 +280,6 @@ def find_points(
         edge_fit,
         edge_seconds,
     )
-
-
-def _unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, intrinsics: Intrinsics) -> str:
-    """Why nothing is proposed: the target is not where the model puts it, or its edges did not settle."""
-    share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
-    if share < _MATCHED_SHARE:
-        return (
-            f"{item.name} was not found near where the model puts it (only {100 * share:.0f} % of its edges meet an "
-            "edge of the image): pick the points by hand"
-        )
-    said = (
-        f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, "
-        f"{100 * edge_fit.inlier_share:.0f} % of {edge_fit.samples} edge samples on their edges)"
-    )
-    if edge_fit.converged and edge_fit.rms_px <= edge_fit.rms_bound_px:
-        # it lines up: too few of its samples found an edge (a partly hidden object from a robot's error fits so,
-        # 2.6-8 px off its truth on LM-O, as does a fit on clutter: which one, the share cannot tell, decision 160)
-        least = edge_fit.min_share if edge_fit.rms_px <= 0.5 * edge_fit.px_scale else COARSE_FIT_SHARE
-        return said + (
-            f": it lines up, but a fit must hold {100 * least:.0f} % of its samples on edges (is part of {item.name} "
-            "hidden, in shadow or against a background of its own colour?): pick the points by hand"
-        )
-    form_px = form_error_px(item, edge_fit.obj2cam, intrinsics)
-    if form_px > edge_fit.rms_bound_px and edge_fit.rms_px > edge_fit.rms_bound_px:
-        # the part itself keeps its edges off its CAD's by more than a settled fit may be: no look can settle here
-        said += (
-            f"; its stated form tolerance, {item.form_tolerance_mm:g} mm, is {form_px:.1f} px in this image, above the "
-            f"{edge_fit.rms_bound_px:.2f} px a settled fit is held to"
-        )
-    return said + ": pick the points by hand"
 
 
 def _detection_start(
