@@ -22,6 +22,7 @@ from calib_core.look.found_points import FoundPoints
 from calib_core.look.image_evidence import ImageEvidence
 from calib_core.look.located import Located, LocatedFeature
 from calib_core.look.pose_prior import PosePrior
+from calib_core.look.unsettled_message import lines_up
 from calib_core.look.locate_verdict import verdict
 
 PHOTO_EDGE_RMS_PX = 1.5
@@ -178,13 +179,12 @@ def _report(
     missed = tuple((m.feature, m.reason) for m in found.missed if m.feature != "centre")
     if edges is None or not edges.settled:
         why = found.message.replace(": pick the points by hand", "")
-        lines_up = edges is not None and edges.converged and edges.rms_px <= edges.rms_bound_px
         return Located(
             "not found",
             f"{why}; "
             + (
                 "pick its points by hand in the window, or give a prior nearer it"
-                if lines_up
+                if edges is not None and lines_up(edges)
                 else "give a prior nearer the object, or a larger reach"
             ),
             None,

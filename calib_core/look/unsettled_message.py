@@ -18,6 +18,11 @@ _MATCHED_SHARE = (
 )
 
 
+def lines_up(edge_fit: EdgeFit) -> bool:
+    """Whether an unsettled fit converged within its RMS bound: too few of its samples found an edge, not too far."""
+    return edge_fit.converged and edge_fit.rms_px <= edge_fit.rms_bound_px
+
+
 def unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, intrinsics: Intrinsics) -> str:
     """Why nothing is proposed: the target is not where the model puts it, or its edges did not settle."""
     share = matched_share(edge_samples_px(item.mesh, edge_fit.obj2cam, intrinsics), distance)
@@ -30,7 +35,7 @@ def unsettled_message(item: SceneItem, edge_fit: EdgeFit, distance: np.ndarray, 
         f"{item.name}: its edges did not settle on the image (RMS {edge_fit.rms_px:.2f} px, "
         f"{100 * edge_fit.inlier_share:.0f} % of {edge_fit.samples} edge samples on their edges)"
     )
-    if edge_fit.converged and edge_fit.rms_px <= edge_fit.rms_bound_px:
+    if lines_up(edge_fit):
         # it lines up: too few of its samples found an edge (a partly hidden object from a robot's error fits so,
         # 2.6-8 px off its truth on LM-O, as does a fit on clutter: which one, the share cannot tell, decision 160)
         least = edge_fit.min_share if edge_fit.rms_px <= 0.5 * edge_fit.px_scale else COARSE_FIT_SHARE
