@@ -116,13 +116,12 @@ def locate(
     # with printed or inner edges (the tutorial box's printed frame lies 10-15 px inside its outline) a fit that
     # took an inner edge for the outline, or the outline for an inner edge, finds the other one from there.
     fits = [located]
-    for start in _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(
-        located.obj2cam, RIVAL_DEPTH_SHARE
-    ):
+    others = _starts_round(prior, reach_mm / 2.0, reach_deg / 2.0) + _depth_starts(located.obj2cam, RIVAL_DEPTH_SHARE)
+    for start in others:
         other = _report(look(start), intrinsics, start, reach_mm, reach_deg)
         if other.status == "ok" and believed.holds(other.obj2cam):
             fits.append(other)
-    return verdict(fits, mesh, intrinsics, prior)
+    return verdict(fits, mesh, intrinsics, prior, starts=1 + len(others))
 
 
 RIVAL_DEPTH_SHARE = 0.04
